@@ -1,0 +1,340 @@
+#include "cosim/master.h"
+
+#include <tbb/parallel_for.h>
+
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+namespace linesim::cosim {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+bool SameBits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
+
+}  // namespace
+
+Master::Master(System& system, MasterOptions options)
+    : system_(system), options_(options) {
+  if (!system_.built()) system_.Build();
+  std::vector<Problem> problems;
+  const TimeNs h = options_.base_step;
+  if (h <= 0) problems.push_back({"master step must be positive", std::nullopt});
+  if (options_.stop < options_.start) {
+    problems.push_back({"stop time " + FormatSeconds(options_.stop) + " s is before start time " +
+                            FormatSeconds(options_.start) + " s",
+                        std::nullopt});
+  }
+  if (options_.threads < 1) problems.push_back({"threads must be at least 1", std::nullopt});
+  const TimeNs duration = options_.stop - options_.start;
+  if (h > 0 && duration % h != 0) {
+    problems.push_back({"duration " + FormatSeconds(duration) +
+                            " s is not a whole number of master steps of " + FormatSeconds(h) +
+                            " s",
+                        std::nullopt});
+  }
+  const std::size_t n = system_.unit_count();
+  decimation_.assign(n, 1);
+  for (std::size_t u = 0; u < n && h > 0; ++u) {
+    const TimeNs step = system_.unit_step(u) == 0 ? h : system_.unit_step(u);
+    const std::string& name = system_.unit(u).name();
+    if (step % h != 0) {
+      problems.push_back({"unit '" + name + "' step " + FormatSeconds(step) +
+                              " s is not an integer multiple of the master step " +
+                              FormatSeconds(h) + " s",
+                          std::nullopt});
+    } else if (duration % step != 0) {
+      problems.push_back({"unit '" + name + "' step " + FormatSeconds(step) +
+                              " s does not divide the duration " + FormatSeconds(duration) +
+                              " s",
+                          std::nullopt});
+    }
+    decimation_[u] = std::max<TimeNs>(1, step / h);
+  }
+  if (!problems.empty()) throw ConfigError(std::move(problems));
+
+  links_into_.assign(n, {});
+  const auto& links = system_.links();
+  for (std::size_t l = 0; l < links.size(); ++l) links_into_[links[l].to_unit].push_back(l);
+  real_outputs_.assign(n, {});
+  for (std::size_t u = 0; u < n; ++u) {
+    for (const auto& info : system_.unit(u).variables().infos()) {
+      if (info.causality == Causality::kOutput &&
+          (info.type == VarType::kReal || info.type == VarType::kRealArray)) {
+        real_outputs_[u].push_back(info.ref);
+      }
+    }
+  }
+  unit_wall_seconds_.assign(n, 0.0);
+  time_ = options_.start;
+}
+
+bool Master::Transfer(const Link& link) {
+  const VariableTable& from = system_.unit(link.from_unit).variables();
+  VariableTable& to = system_.unit(link.to_unit).variables();
+  switch (link.type) {
+    case VarType::kReal: {
+      const double v = link.from_index < 0 ? from.GetReal(link.from_ref)
+                                           : from.GetRealElement(link.from_ref, link.from_index);
+      const double old = link.to_index < 0 ? to.GetReal(link.to_ref)
+                                           : to.GetRealElement(link.to_ref, link.to_index);
+      if (link.to_index < 0) {
+        to.SetReal(link.to_ref, v);
+      } else {
+        to.SetRealElement(link.to_ref, link.to_index, v);
+      }
+      return !SameBits(v, old);
+    }
+    case VarType::kRealArray: {
+      const auto src = from.GetRealArray(link.from_ref);
+      const auto dst = to.GetRealArray(link.to_ref);
+      const bool changed = std::memcmp(src.data(), dst.data(), src.size_bytes()) != 0;
+      if (changed) to.SetRealArray(link.to_ref, src);
+      return changed;
+    }
+    case VarType::kInteger: {
+      const auto v = from.GetInteger(link.from_ref);
+      const bool changed = v != to.GetInteger(link.to_ref);
+      to.SetInteger(link.to_ref, v);
+      return changed;
+    }
+    case VarType::kBoolean: {
+      const bool v = from.GetBoolean(link.from_ref);
+      const bool changed = v != to.GetBoolean(link.to_ref);
+      to.SetBoolean(link.to_ref, v);
+      return changed;
+    }
+    case VarType::kString: {
+      const std::string& v = from.GetString(link.from_ref);
+      const bool changed = v != to.GetString(link.to_ref);
+      if (changed) to.SetString(link.to_ref, v);
+      return changed;
+    }
+  }
+  return false;
+}
+
+void Master::RecordError(std::size_t u, TimeNs t, const std::string& cause) {
+  const Unit& unit = system_.unit(u);
+  errors_.push_back("unit '" + unit.name() + "' (" + unit.type_name() + ") at t = " +
+                    FormatSeconds(t) + " s: " + cause);
+  failed_ = true;
+}
+
+bool Master::CheckOutputs(std::size_t u, TimeNs t) {
+  const VariableTable& table = system_.unit(u).variables();
+  for (ValueRef ref : real_outputs_[u]) {
+    const VariableInfo& info = table.info(ref);
+    if (info.type == VarType::kReal) {
+      const double v = table.GetReal(ref);
+      if (!std::isfinite(v)) {
+        RecordError(u, t, "output '" + info.name + "' is " + FormatValue(v));
+        return false;
+      }
+    } else {
+      const auto values = table.GetRealArray(ref);
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        if (!std::isfinite(values[i])) {
+          RecordError(u, t, "output '" + info.name + "[" + std::to_string(i) + "]' is " +
+                                FormatValue(values[i]));
+          return false;
+        }
+      }
+    }
+  }
+  return true;
+}
+
+// Steps one unit; returns false with the cause in the unit's error slot.
+// Safe to call for different units concurrently.
+bool Master::StepUnit(std::size_t u, TimeNs t, TimeNs dt) {
+  Unit& unit = system_.unit(u);
+  const auto t0 = options_.profile ? Clock::now() : Clock::time_point{};
+  StepResult result;
+  std::string cause;
+  try {
+    result = unit.DoStep(t, dt);
+    if (result == StepResult::kDiscard) {
+      cause = "discarded the step (" + unit.last_error() +
+              "); a fixed-step master cannot retry it";
+    } else if (result == StepResult::kError) {
+      cause = unit.last_error().empty() ? "step failed" : unit.last_error();
+    }
+  } catch (const std::exception& e) {
+    result = StepResult::kError;
+    cause = e.what();
+  }
+  if (options_.profile) unit_wall_seconds_[u] += SecondsSince(t0);
+  if (result != StepResult::kOk) {
+    pending_errors_[u] = std::move(cause);
+    return false;
+  }
+  return true;
+}
+
+void Master::PropagateInitialValues() {
+  // Outputs with direct feedthrough depend on inputs, which come from other
+  // units' outputs: repeat transfer + Initialize until nothing changes. With
+  // no algebraic loop this settles within (longest feedthrough chain + 1)
+  // passes.
+  const std::size_t n = system_.unit_count();
+  for (std::size_t pass = 0; pass <= n + 1; ++pass) {
+    bool changed = false;
+    for (const Link& link : system_.links()) changed |= Transfer(link);
+    if (!changed && pass > 0) return;
+    for (std::size_t u = 0; u < n; ++u) {
+      const auto t0 = Clock::now();
+      system_.unit(u).Initialize();
+      unit_wall_seconds_[u] += SecondsSince(t0);
+    }
+  }
+  throw UnitError("initial values did not settle after " + std::to_string(n + 2) + " passes");
+}
+
+void Master::Notify(TimeNs t) {
+  for (Observer* o : observers_) o->OnSample(t, system_);
+}
+
+void Master::Start() {
+  const auto wall0 = Clock::now();
+  const std::size_t n = system_.unit_count();
+  pending_errors_.assign(n, {});
+  errors_.clear();
+  failed_ = false;
+  time_ = options_.start;
+  step_index_ = 0;
+  for (std::size_t u = 0; u < n; ++u) {
+    try {
+      const auto t0 = Clock::now();
+      system_.unit(u).Setup(options_.start, options_.stop);
+      unit_wall_seconds_[u] += SecondsSince(t0);
+    } catch (const std::exception& e) {
+      RecordError(u, time_, std::string("setup failed: ") + e.what());
+    }
+  }
+  if (!failed_) {
+    try {
+      for (std::size_t u = 0; u < n; ++u) {
+        try {
+          system_.unit(u).Initialize();
+        } catch (const std::exception& e) {
+          RecordError(u, time_, std::string("initialize failed: ") + e.what());
+        }
+      }
+      if (!failed_) PropagateInitialValues();
+    } catch (const std::exception& e) {
+      errors_.push_back(std::string("initialization at t = ") + FormatSeconds(time_) +
+                        " s: " + e.what());
+      failed_ = true;
+    }
+  }
+  for (std::size_t u = 0; u < n && !failed_; ++u) CheckOutputs(u, time_);
+  started_ = true;
+  for (Observer* o : observers_) o->OnStart(*this);
+  if (!failed_) Notify(time_);
+  total_wall_seconds_ += SecondsSince(wall0);
+}
+
+bool Master::Step() {
+  if (!started_ || failed_ || time_ >= options_.stop) return false;
+  const auto wall0 = Clock::now();
+  const TimeNs t = time_;
+  const TimeNs h = options_.base_step;
+  const auto& links = system_.links();
+  const auto at_point = [&](std::size_t u) { return step_index_ % decimation_[u] == 0; };
+  // A link transfers when its destination steps now and its source is at a
+  // communication point too, so a slow unit's future output never leaks
+  // into a fast unit between the slow unit's points.
+  const auto transfer_into = [&](std::size_t u) {
+    for (std::size_t l : links_into_[u]) {
+      if (at_point(links[l].from_unit)) Transfer(links[l]);
+    }
+  };
+
+  due_.clear();
+  for (std::size_t u : system_.dependency_order()) {
+    if (at_point(u)) due_.push_back(u);
+  }
+
+  bool ok = true;
+  if (options_.algorithm == Algorithm::kJacobi) {
+    for (std::size_t u : due_) transfer_into(u);
+    if (options_.threads > 1 && due_.size() > 1) {
+      tbb::parallel_for(std::size_t{0}, due_.size(), [&](std::size_t i) {
+        const std::size_t u = due_[i];
+        StepUnit(u, t, h * decimation_[u]);
+      });
+      for (std::size_t u : due_) ok &= pending_errors_[u].empty();
+    } else {
+      for (std::size_t u : due_) ok &= StepUnit(u, t, h * decimation_[u]);
+    }
+  } else {
+    for (std::size_t u : due_) {
+      transfer_into(u);
+      if (!StepUnit(u, t, h * decimation_[u])) {
+        ok = false;
+        break;
+      }
+    }
+  }
+
+  if (!ok) {
+    for (std::size_t u : due_) {
+      if (!pending_errors_[u].empty()) {
+        RecordError(u, t, pending_errors_[u]);
+        pending_errors_[u].clear();
+      }
+    }
+    total_wall_seconds_ += SecondsSince(wall0);
+    return false;
+  }
+  for (std::size_t u : due_) {
+    if (!CheckOutputs(u, t + h * decimation_[u])) ok = false;
+  }
+  if (!ok) {
+    total_wall_seconds_ += SecondsSince(wall0);
+    return false;
+  }
+  ++step_index_;
+  time_ = options_.start + step_index_ * h;
+  Notify(time_);
+  total_wall_seconds_ += SecondsSince(wall0);
+  return time_ < options_.stop;
+}
+
+RunResult Master::Finish() {
+  const auto wall0 = Clock::now();
+  for (std::size_t u = 0; u < system_.unit_count(); ++u) {
+    try {
+      system_.unit(u).Terminate();
+    } catch (const std::exception& e) {
+      RecordError(u, time_, std::string("terminate failed: ") + e.what());
+    }
+  }
+  for (Observer* o : observers_) o->OnEnd(time_, !failed_);
+  total_wall_seconds_ += SecondsSince(wall0);
+  RunResult r;
+  r.ok = !failed_;
+  r.end_time = time_;
+  r.base_steps = step_index_;
+  r.errors = errors_;
+  return r;
+}
+
+RunResult Master::Run() {
+  Start();
+  while (Step()) {
+  }
+  return Finish();
+}
+
+}  // namespace linesim::cosim

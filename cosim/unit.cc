@@ -1,0 +1,23 @@
+#include "cosim/unit.h"
+
+namespace linesim::cosim {
+
+UnitState Unit::SaveState() const {
+  UnitState state;
+  state.variables.reserve(variables_.size());
+  for (const auto& info : variables_.infos()) state.variables.push_back(variables_.GetValue(info.ref));
+  SaveInternal(state);
+  return state;
+}
+
+void Unit::RestoreState(const UnitState& state) {
+  if (state.variables.size() != variables_.size()) {
+    throw std::invalid_argument("state of " + std::to_string(state.variables.size()) +
+                                " variables restored into unit '" + name_ + "' with " +
+                                std::to_string(variables_.size()));
+  }
+  for (ValueRef r = 0; r < variables_.size(); ++r) variables_.SetValue(r, state.variables[r]);
+  RestoreInternal(state);
+}
+
+}  // namespace linesim::cosim

@@ -1,0 +1,89 @@
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "cosim/time.h"
+#include "cosim/variable_table.h"
+
+namespace linesim::cosim {
+
+enum class StepResult { kOk, kDiscard, kError };
+
+/// A snapshot of one unit: every declared variable plus whatever internal
+/// state the unit adds (integrator states, random generator, counters).
+struct UnitState {
+  std::vector<Value> variables;
+  std::vector<double> reals;
+  std::vector<std::int64_t> integers;
+  std::vector<std::string> strings;
+};
+
+/// Thrown by a unit for a failure it cannot recover from; the master adds the
+/// unit name and time.
+class UnitError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The FMI-style co-simulation unit. Lifecycle, in order:
+///   Setup(start, stop) -> parameters and start values set through the table
+///   -> Initialize() (may be called several times while the master
+///   propagates initial values) -> repeated {set inputs, DoStep, get outputs}
+///   -> Terminate().
+/// Outputs are valid after Initialize() and after each DoStep(t, dt), for the
+/// time t + dt.
+class Unit {
+ public:
+  Unit(std::string type_name, std::string instance_name)
+      : type_name_(std::move(type_name)), name_(std::move(instance_name)) {}
+  virtual ~Unit() = default;
+  Unit(const Unit&) = delete;
+  Unit& operator=(const Unit&) = delete;
+
+  const std::string& type_name() const { return type_name_; }
+  const std::string& name() const { return name_; }
+  VariableTable& variables() { return variables_; }
+  const VariableTable& variables() const { return variables_; }
+
+  virtual void Setup(TimeNs start, TimeNs stop) {
+    (void)start;
+    (void)stop;
+  }
+  /// Computes outputs at the start time from parameters, start values and
+  /// the current inputs. Must be idempotent.
+  virtual void Initialize() {}
+  /// Advances from t to t + dt with the inputs held as set.
+  virtual StepResult DoStep(TimeNs t, TimeNs dt) = 0;
+  virtual void Terminate() {}
+
+  /// Why the last DoStep did not return kOk (empty when it did).
+  const std::string& last_error() const { return last_error_; }
+
+  /// Every declared variable plus the unit's internal state. A restored unit
+  /// continues bit for bit like the one that was saved.
+  UnitState SaveState() const;
+  void RestoreState(const UnitState& state);
+
+ protected:
+  /// Internal state beyond the variable table; the default has none.
+  virtual void SaveInternal(UnitState& state) const { (void)state; }
+  virtual void RestoreInternal(const UnitState& state) { (void)state; }
+
+  /// For DoStep: record why the step failed and return kError.
+  StepResult Fail(std::string message) {
+    last_error_ = std::move(message);
+    return StepResult::kError;
+  }
+  void ClearError() { last_error_.clear(); }
+
+ private:
+  std::string type_name_;
+  std::string name_;
+  VariableTable variables_;
+  std::string last_error_;
+};
+
+}  // namespace linesim::cosim
