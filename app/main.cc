@@ -1,1 +1,40 @@
-int main() { return 0; }
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+
+#include "app/commands.h"
+
+int main(int argc, char** argv) {
+  using namespace linesim::app;
+  CLI::App cli{"linesim: co-simulation of mobile robots on moving-floor assembly lines"};
+  cli.require_subcommand(1);
+
+  std::string run_file, out_dir;
+  std::vector<std::string> run_sets;
+  CLI::App* run = cli.add_subcommand("run", "run a scenario and write summary.json and signals.csv");
+  run->add_option("file", run_file, "scenario YAML file")->required();
+  run->add_option("--out,-o", out_dir, "output folder (created if missing)")->required();
+  run->add_option("--set", run_sets, "override a value: dotted.path=value (repeatable)")
+      ->take_all();
+
+  std::string what;
+  std::vector<std::string> inspect_sets;
+  CLI::App* inspect =
+      cli.add_subcommand("inspect", "print the variables of a unit type or of a scenario's units");
+  inspect->add_option("what", what, "unit type name, or a scenario YAML file")->required();
+  inspect->add_option("--set", inspect_sets, "override a value: dotted.path=value (repeatable)")
+      ->take_all();
+
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return cli.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return cli.exit(e);
+  } catch (const CLI::ParseError& e) {
+    cli.exit(e);
+    return kExitBadInput;
+  }
+  if (run->parsed()) return RunCommand(run_file, out_dir, run_sets);
+  return InspectCommand(what, inspect_sets);
+}

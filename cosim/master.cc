@@ -125,8 +125,12 @@ bool Master::Transfer(const Link& link) {
 
 void Master::RecordError(std::size_t u, TimeNs t, const std::string& cause) {
   const Unit& unit = system_.unit(u);
-  errors_.push_back("unit '" + unit.name() + "' (" + unit.type_name() + ") at t = " +
-                    FormatSeconds(t) + " s: " + cause);
+  const std::string who = "unit '" + unit.name() + "' (" + unit.type_name() + ")";
+  // A unit's own error may already name it (solver helpers do).
+  const auto colon = cause.find(": ");
+  const bool named = cause.rfind("unit '" + unit.name() + "'", 0) == 0 && colon != std::string::npos;
+  errors_.push_back(who + " at t = " + FormatSeconds(t) + " s: " +
+                    (named ? cause.substr(colon + 2) : cause));
   failed_ = true;
 }
 

@@ -1,6 +1,7 @@
 #include "cosim/system.h"
 
 #include <algorithm>
+#include <charconv>
 #include <functional>
 #include <map>
 #include <set>
@@ -47,7 +48,12 @@ Endpoint Endpoint::Parse(std::string_view text) {
                      [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
       return fail();
     }
-    e.index = std::stoul(std::string(digits));
+    // from_chars, not stoul: an index too large for size_t is a malformed
+    // endpoint (std::invalid_argument), not std::out_of_range.
+    std::size_t index = 0;
+    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), index);
+    if (ec != std::errc() || end != digits.data() + digits.size()) return fail();
+    e.index = index;
     rest = rest.substr(0, open);
   }
   e.variable = std::string(rest);

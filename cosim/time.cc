@@ -1,6 +1,7 @@
 #include "cosim/time.h"
 
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <stdexcept>
 
@@ -17,12 +18,15 @@ TimeNs SecondsToNs(double seconds) {
 
 std::string FormatSeconds(TimeNs t) {
   std::string out;
+  // The magnitude as unsigned: -t overflows for the most negative time.
+  std::uint64_t magnitude = static_cast<std::uint64_t>(t);
   if (t < 0) {
     out = "-";
-    t = -t;
+    magnitude = 0 - magnitude;
   }
-  out += std::to_string(t / kNsPerSecond);
-  TimeNs frac = t % kNsPerSecond;
+  const auto ns_per_s = static_cast<std::uint64_t>(kNsPerSecond);
+  out += std::to_string(magnitude / ns_per_s);
+  const std::uint64_t frac = magnitude % ns_per_s;
   if (frac != 0) {
     std::string digits = std::to_string(frac);
     digits.insert(0, 9 - digits.size(), '0');

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -19,6 +20,13 @@ struct UnitState {
   std::vector<double> reals;
   std::vector<std::int64_t> integers;
   std::vector<std::string> strings;
+};
+
+/// A parameter value a unit refuses, found before time zero.
+struct ParameterProblem {
+  std::string variable;
+  std::optional<std::size_t> index;  // element of an array parameter
+  std::string message;               // what was expected
 };
 
 /// Thrown by a unit for a failure it cannot recover from; the master adds the
@@ -47,6 +55,10 @@ class Unit {
   const std::string& name() const { return name_; }
   VariableTable& variables() { return variables_; }
   const VariableTable& variables() const { return variables_; }
+
+  /// Checks parameter values after they are set and before Setup, so that a
+  /// scenario is refused before time zero. The default accepts everything.
+  virtual std::vector<ParameterProblem> CheckParameters() const { return {}; }
 
   virtual void Setup(TimeNs start, TimeNs stop) {
     (void)start;

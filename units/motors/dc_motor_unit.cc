@@ -1,1 +1,445 @@
-namespace linesim::motors {}
+#include "units/motors/dc_motor_unit.h"
+
+#include <cvode/cvode.h>
+#include <cvode/cvode_ls.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <utility>
+
+namespace linesim::motors {
+
+namespace {
+
+std::string FormatNumber(double x) { return cosim::FormatValue(cosim::Value{x}); }
+
+// Bitwise, so that -0.0 vs 0.0 or a NaN payload also count as a change.
+bool SameBits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+}  // namespace
+
+struct DcMotorUnit::Sundials {
+  SUNContext ctx = nullptr;
+  N_Vector y = nullptr;
+  N_Vector abstol = nullptr;
+  SUNMatrix matrix = nullptr;
+  SUNLinearSolver solver = nullptr;
+  void* cvode = nullptr;
+  // Last error message from CVODE's error handler (CVODE would print it
+  // otherwise; we put it into the exception instead).
+  std::string message;
+
+  Sundials() = default;
+  Sundials(const Sundials&) = delete;
+  Sundials& operator=(const Sundials&) = delete;
+  ~Sundials() {
+    if (cvode) CVodeFree(&cvode);
+    if (solver) SUNLinSolFree(solver);
+    if (matrix) SUNMatDestroy(matrix);
+    if (abstol) N_VDestroy(abstol);
+    if (y) N_VDestroy(y);
+    if (ctx) SUNContext_Free(&ctx);
+  }
+
+  static int Rhs(realtype, N_Vector y, N_Vector ydot, void* user_data) {
+    static_cast<const DcMotorUnit*>(user_data)->EvalRhs(N_VGetArrayPointer(y),
+                                                        N_VGetArrayPointer(ydot));
+    return 0;
+  }
+
+  static int Jacobian(realtype, N_Vector, N_Vector, SUNMatrix jac, void* user_data, N_Vector,
+                      N_Vector, N_Vector) {
+    static_cast<const DcMotorUnit*>(user_data)->FillJacobian(SUNDenseMatrix_Data(jac));
+    return 0;
+  }
+
+  static void ErrorHandler(int error_code, const char* module, const char* function, char* msg,
+                           void* user_data) {
+    if (error_code >= 0) return;  // warnings are not failures
+    static_cast<Sundials*>(user_data)->message = std::string(module) + "/" + function + ": " + msg;
+  }
+};
+
+DcMotorUnit::DcMotorUnit(std::string name, int count, MotorMode mode,
+                         const models::DcMotorParams& defaults)
+    : cosim::Unit(kTypeName, std::move(name)),
+      count_(count),
+      mode_(mode),
+      states_per_motor_(mode == MotorMode::kFull ? 2 : 1) {
+  if (count < 1) {
+    throw cosim::UnitError(Where() + ": count must be at least 1, got " + std::to_string(count));
+  }
+  const auto n = static_cast<std::size_t>(count);
+  const bool full = mode_ == MotorMode::kFull;
+  resistance_.assign(n, defaults.resistance_ohm);
+  inductance_.assign(n, defaults.inductance_h);
+  torque_constant_.assign(n, defaults.torque_constant_nm_per_a);
+  rotor_inertia_.assign(n, defaults.rotor_inertia_kgm2);
+  viscous_friction_.assign(n, defaults.viscous_friction_nms_per_rad);
+  gear_ratio_.assign(n, defaults.gear_ratio);
+  gear_efficiency_.assign(n, defaults.gear_efficiency);
+  initial_current_.assign(n, 0.0);
+  voltage_.assign(n, 0.0);
+  current_.assign(n, 0.0);
+  torque_.assign(n, 0.0);
+  if (full) {
+    load_inertia_.assign(n, defaults.load_inertia_kgm2);
+    initial_speed_.assign(n, 0.0);
+    load_torque_.assign(n, 0.0);
+    speed_.assign(n, 0.0);
+  } else {
+    shaft_speed_.assign(n, 0.0);
+  }
+
+  auto& v = variables();
+  v.Parameter("resistance", "Ohm", &resistance_, "armature (terminal) resistance");
+  v.Parameter("inductance", "H", &inductance_, "armature (terminal) inductance");
+  v.Parameter("torque_constant", "N.m/A", &torque_constant_,
+              "torque constant k_t, equal to the back-EMF constant in V.s/rad");
+  v.Parameter("rotor_inertia", "kg.m2", &rotor_inertia_, "rotor inertia");
+  v.Parameter("viscous_friction", "N.m.s/rad", &viscous_friction_,
+              "viscous friction on the rotor, b (friction torque b * rotor speed)");
+  v.Parameter("gear_ratio", "1", &gear_ratio_,
+              "N: rotor revolutions per output revolution (1 = no gearbox)");
+  v.Parameter("gear_efficiency", "1", &gear_efficiency_,
+              "eta in (0, 1]: fraction of the motor torque reaching the output");
+  v.Parameter("initial_current", "A", &initial_current_, "armature current at the start");
+  if (full) {
+    v.Parameter("load_inertia", "kg.m2", &load_inertia_,
+                "inertia at the gearbox output, reflected to the rotor as J / (eta N^2)");
+    v.Parameter("initial_speed", "rad/s", &initial_speed_, "output shaft speed at the start");
+  }
+  v.Parameter("rel_tol", "1", &rel_tol_, "CVODE relative tolerance");
+  v.Parameter("abs_tol", "1", &abs_tol_,
+              "CVODE absolute tolerance, relative to the stall current per volt 1 V/R "
+              "and the no-load rotor speed per volt 1 V/k_t of each motor");
+
+  v.Input("voltage", "V", &voltage_, "terminal voltage, held over a communication step");
+  if (full) {
+    v.Input("load_torque", "N.m", &load_torque_,
+            "torque applied BY the load ON the output shaft: positive accelerates the shaft "
+            "in the positive direction (a braking load has the opposite sign of speed)");
+  } else {
+    v.Input("shaft_speed", "rad/s", &shaft_speed_,
+            "output shaft speed from the physics; rotor speed = gear_ratio * shaft_speed");
+  }
+
+  v.Output("current", "A", &current_, "armature current", {});
+  if (full) {
+    v.Output("speed", "rad/s", &speed_, "output shaft speed", {});
+    v.Output("torque", "N.m", &torque_,
+             "torque delivered by the gearbox, eta N (k_t i - b w_rotor); rotor "
+             "inertia not included",
+             {});
+  } else {
+    v.Output("torque", "N.m", &torque_,
+             "torque delivered by the gearbox, eta N (k_t i - b N shaft_speed); rotor "
+             "inertia not included",
+             {"shaft_speed"});
+  }
+
+  const auto size = static_cast<sunindextype>(count_ * states_per_motor_);
+  y_.assign(static_cast<std::size_t>(size), 0.0);
+  sun_ = std::make_unique<Sundials>();
+  if (SUNContext_Create(nullptr, &sun_->ctx) != 0) {
+    throw cosim::UnitError(Where() + ": SUNContext_Create failed");
+  }
+  sun_->y = N_VNew_Serial(size, sun_->ctx);
+  sun_->abstol = N_VNew_Serial(size, sun_->ctx);
+  sun_->matrix = SUNDenseMatrix(size, size, sun_->ctx);
+  if (!sun_->y || !sun_->abstol || !sun_->matrix) {
+    throw cosim::UnitError(Where() + ": SUNDIALS could not allocate vectors or matrix");
+  }
+  sun_->solver = SUNLinSol_Dense(sun_->y, sun_->matrix, sun_->ctx);
+  sun_->cvode = CVodeCreate(CV_BDF, sun_->ctx);
+  if (!sun_->solver || !sun_->cvode) {
+    throw cosim::UnitError(Where() + ": SUNDIALS could not create the solver");
+  }
+  N_VConst(0.0, sun_->y);
+  Check(CVodeSetErrHandlerFn(sun_->cvode, &Sundials::ErrorHandler, sun_.get()),
+        "CVodeSetErrHandlerFn", 0);
+  Check(CVodeInit(sun_->cvode, &Sundials::Rhs, 0.0, sun_->y), "CVodeInit", 0);
+  Check(CVodeSetUserData(sun_->cvode, this), "CVodeSetUserData", 0);
+  Check(CVodeSetLinearSolver(sun_->cvode, sun_->solver, sun_->matrix), "CVodeSetLinearSolver", 0);
+  Check(CVodeSetJacFn(sun_->cvode, &Sundials::Jacobian), "CVodeSetJacFn", 0);
+  // The default of 500 steps per call is too few for long communication
+  // steps right after a restart at tight tolerances.
+  Check(CVodeSetMaxNumSteps(sun_->cvode, 100000), "CVodeSetMaxNumSteps", 0);
+}
+
+DcMotorUnit::~DcMotorUnit() = default;
+
+std::string DcMotorUnit::Where() const { return "unit '" + name() + "' (" + kTypeName + ")"; }
+
+void DcMotorUnit::Check(int flag, const char* function, cosim::TimeNs t) const {
+  if (flag >= 0) return;
+  // The CVLS functions have their own flag names. Both return a malloc'ed
+  // string.
+  const bool linear = std::strcmp(function, "CVodeSetLinearSolver") == 0 ||
+                      std::strcmp(function, "CVodeSetJacFn") == 0;
+  char* flag_name = linear ? CVodeGetLinReturnFlagName(flag) : CVodeGetReturnFlagName(flag);
+  std::string text = Where() + ": " + function + " failed at t = " + cosim::FormatSeconds(t) +
+                     " s with " + (flag_name ? flag_name : std::to_string(flag));
+  std::free(flag_name);
+  if (sun_ && !sun_->message.empty()) {
+    text += " (" + sun_->message + ")";
+    sun_->message.clear();
+  }
+  throw cosim::UnitError(text);
+}
+
+std::vector<cosim::ParameterProblem> DcMotorUnit::CheckParameters() const {
+  std::vector<cosim::ParameterProblem> problems;
+  const auto rule = [&](const char* var, const std::vector<double>& p, auto ok,
+                        const char* expected) {
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      if (!ok(p[k]))
+        problems.push_back({var, k, std::string(expected) + ", got " + FormatNumber(p[k])});
+    }
+  };
+  const auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
+  const auto non_negative = [](double x) { return x >= 0.0 && std::isfinite(x); };
+  const auto finite = [](double x) { return std::isfinite(x); };
+  const auto efficiency = [](double x) { return x > 0.0 && x <= 1.0; };
+  rule("resistance", resistance_, positive, "must be positive and finite");
+  rule("inductance", inductance_, positive, "must be positive and finite");
+  rule("torque_constant", torque_constant_, positive, "must be positive and finite");
+  rule("rotor_inertia", rotor_inertia_, positive, "must be positive and finite");
+  rule("viscous_friction", viscous_friction_, non_negative, "must be zero or positive and finite");
+  rule("gear_ratio", gear_ratio_, positive, "must be positive and finite");
+  rule("gear_efficiency", gear_efficiency_, efficiency, "must be in (0, 1]");
+  rule("initial_current", initial_current_, finite, "must be finite");
+  if (mode_ == MotorMode::kFull) {
+    rule("load_inertia", load_inertia_, non_negative, "must be zero or positive and finite");
+    rule("initial_speed", initial_speed_, finite, "must be finite");
+  }
+  for (const auto& [var, value] : {std::pair{"rel_tol", rel_tol_}, {"abs_tol", abs_tol_}}) {
+    if (!positive(value)) {
+      problems.push_back(
+          {var, std::nullopt, "must be positive and finite, got " + FormatNumber(value)});
+    }
+  }
+  return problems;
+}
+
+void DcMotorUnit::Validate() const {
+  const auto problems = CheckParameters();
+  if (problems.empty()) return;
+  // Every bad value at once, each as 'name[index]': what was expected.
+  std::string text = Where() + ": ";
+  for (std::size_t p = 0; p < problems.size(); ++p) {
+    const auto& problem = problems[p];
+    if (p > 0) text += "; ";
+    text += "parameter '" + problem.variable +
+            (problem.index ? "[" + std::to_string(*problem.index) + "]" : "") + "' " +
+            problem.message;
+  }
+  throw cosim::UnitError(text);
+}
+
+void DcMotorUnit::ComputeCoefficients() {
+  const auto n = static_cast<std::size_t>(count_);
+  di_di_.resize(n);
+  di_dw_.resize(n);
+  di_dv_.resize(n);
+  dw_di_.assign(n, 0.0);
+  dw_dw_.assign(n, 0.0);
+  dw_dload_.assign(n, 0.0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double inv_l = 1.0 / inductance_[k];
+    di_di_[k] = -resistance_[k] * inv_l;
+    di_dw_[k] = -torque_constant_[k] * inv_l;
+    di_dv_[k] = inv_l;
+    if (mode_ == MotorMode::kFull) {
+      const double n_eta = gear_ratio_[k] * gear_efficiency_[k];
+      const double j_eff = rotor_inertia_[k] + load_inertia_[k] / (n_eta * gear_ratio_[k]);
+      dw_di_[k] = torque_constant_[k] / j_eff;
+      dw_dw_[k] = -viscous_friction_[k] / j_eff;
+      dw_dload_[k] = 1.0 / (n_eta * j_eff);
+    }
+  }
+}
+
+void DcMotorUnit::SetTolerances() {
+  // abs_tol is scaled per state by what 1 V produces (stall current 1 V/R,
+  // no-load rotor speed 1 V/k_t), so one number suits motors of any size.
+  double* a = N_VGetArrayPointer(sun_->abstol);
+  for (int k = 0; k < count_; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    a[k * states_per_motor_] = abs_tol_ / resistance_[kk];
+    if (mode_ == MotorMode::kFull) a[k * states_per_motor_ + 1] = abs_tol_ / torque_constant_[kk];
+  }
+  Check(CVodeSVtolerances(sun_->cvode, rel_tol_, sun_->abstol), "CVodeSVtolerances", end_time_);
+}
+
+void DcMotorUnit::EvalRhs(const double* y, double* ydot) const {
+  if (mode_ == MotorMode::kFull) {
+    for (int k = 0; k < count_; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      const double i = y[2 * k];
+      const double w = y[2 * k + 1];
+      ydot[2 * k] = di_di_[kk] * i + di_dw_[kk] * w + di_dv_[kk] * held_voltage_[kk];
+      ydot[2 * k + 1] = dw_di_[kk] * i + dw_dw_[kk] * w + dw_dload_[kk] * held_load_torque_[kk];
+    }
+  } else {
+    for (int k = 0; k < count_; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      const double w = gear_ratio_[kk] * held_shaft_speed_[kk];
+      ydot[k] = di_di_[kk] * y[k] + di_dw_[kk] * w + di_dv_[kk] * held_voltage_[kk];
+    }
+  }
+}
+
+void DcMotorUnit::FillJacobian(double* data) const {
+  const int n = count_ * states_per_motor_;
+  std::fill(data, data + static_cast<std::ptrdiff_t>(n) * n, 0.0);
+  const auto at = [&](int row, int col) -> double& {
+    return data[static_cast<std::ptrdiff_t>(col) * n + row];
+  };
+  for (int k = 0; k < count_; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    if (mode_ == MotorMode::kFull) {
+      at(2 * k, 2 * k) = di_di_[kk];
+      at(2 * k, 2 * k + 1) = di_dw_[kk];
+      at(2 * k + 1, 2 * k) = dw_di_[kk];
+      at(2 * k + 1, 2 * k + 1) = dw_dw_[kk];
+    } else {
+      at(k, k) = di_di_[kk];
+    }
+  }
+}
+
+void DcMotorUnit::ComputeOutputs() {
+  for (int k = 0; k < count_; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    const double i = y_[static_cast<std::size_t>(k * states_per_motor_)];
+    double w_rotor;
+    if (mode_ == MotorMode::kFull) {
+      w_rotor = y_[static_cast<std::size_t>(2 * k + 1)];
+      speed_[kk] = w_rotor / gear_ratio_[kk];
+    } else {
+      // Feedthrough: the torque uses the shaft speed input as it is now.
+      w_rotor = gear_ratio_[kk] * shaft_speed_[kk];
+    }
+    current_[kk] = i;
+    torque_[kk] = gear_efficiency_[kk] * gear_ratio_[kk] *
+                  (torque_constant_[kk] * i - viscous_friction_[kk] * w_rotor);
+  }
+}
+
+void DcMotorUnit::Initialize() {
+  Validate();
+  ComputeCoefficients();
+  SetTolerances();
+  for (int k = 0; k < count_; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    y_[static_cast<std::size_t>(k * states_per_motor_)] = initial_current_[kk];
+    if (mode_ == MotorMode::kFull) {
+      y_[static_cast<std::size_t>(2 * k + 1)] = gear_ratio_[kk] * initial_speed_[kk];
+    }
+  }
+  ComputeOutputs();
+  initialized_ = true;
+  restart_pending_ = true;
+}
+
+bool DcMotorUnit::InputsChanged() const {
+  if (!SameBits(voltage_, held_voltage_)) return true;
+  return mode_ == MotorMode::kFull ? !SameBits(load_torque_, held_load_torque_)
+                                   : !SameBits(shaft_speed_, held_shaft_speed_);
+}
+
+void DcMotorUnit::HoldInputs() {
+  held_voltage_ = voltage_;
+  held_load_torque_ = load_torque_;
+  held_shaft_speed_ = shaft_speed_;
+}
+
+cosim::StepResult DcMotorUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
+  ClearError();
+  if (!initialized_) return Fail(Where() + ": DoStep called before Initialize");
+  if (dt <= 0) {
+    return Fail(Where() + ": step size must be positive, got " + cosim::FormatSeconds(dt) +
+                " s at t = " + cosim::FormatSeconds(t) + " s");
+  }
+  const auto check_finite = [&](const char* var, const std::vector<double>& in) {
+    for (std::size_t k = 0; k < in.size(); ++k) {
+      if (!std::isfinite(in[k])) {
+        Fail(Where() + ": input '" + var + "[" + std::to_string(k) + "]' is " +
+             FormatNumber(in[k]) + " at t = " + cosim::FormatSeconds(t) + " s");
+        return false;
+      }
+    }
+    return true;
+  };
+  if (!check_finite("voltage", voltage_) || !check_finite("load_torque", load_torque_) ||
+      !check_finite("shaft_speed", shaft_speed_)) {
+    return cosim::StepResult::kError;
+  }
+
+  // Time in CVODE is double seconds converted from the integer ns each step,
+  // never accumulated.
+  const double t0_s = cosim::NsToSeconds(t);
+  const double t1_s = cosim::NsToSeconds(t + dt);
+  const bool restart = restart_pending_ || t != end_time_ || InputsChanged();
+  // Until this step succeeds, CVODE's history no longer matches y_.
+  restart_pending_ = true;
+  if (restart) {
+    HoldInputs();
+    std::copy(y_.begin(), y_.end(), N_VGetArrayPointer(sun_->y));
+    Check(CVodeReInit(sun_->cvode, t0_s, sun_->y), "CVodeReInit", t);
+    ++restarts_;
+    steps_since_restart_ = 0;
+  }
+  Check(CVodeSetStopTime(sun_->cvode, t1_s), "CVodeSetStopTime", t);
+  double t_reached = t0_s;
+  Check(CVode(sun_->cvode, t1_s, sun_->y, &t_reached, CV_NORMAL), "CVode", t);
+  long nst = 0;
+  Check(CVodeGetNumSteps(sun_->cvode, &nst), "CVodeGetNumSteps", t);
+  steps_ += nst - steps_since_restart_;
+  steps_since_restart_ = nst;
+
+  const double* y = N_VGetArrayPointer(sun_->y);
+  std::copy(y, y + y_.size(), y_.begin());
+  end_time_ = t + dt;
+  ComputeOutputs();
+  restart_pending_ = false;
+  return cosim::StepResult::kOk;
+}
+
+// CVODE's history (Nordsieck array, order, step size) cannot be saved, so a
+// save point is made a restart point: the state vector is saved, and the
+// next DoStep of this unit restarts CVODE from it, exactly as a unit restored
+// from this state will. Both then continue bit for bit alike.
+void DcMotorUnit::SaveInternal(cosim::UnitState& state) const {
+  state.reals = y_;
+  state.integers = {end_time_, initialized_ ? 1 : 0};
+  restart_pending_ = true;
+}
+
+void DcMotorUnit::RestoreInternal(const cosim::UnitState& state) {
+  if (state.reals.size() != y_.size() || state.integers.size() != 2) {
+    throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
+                           " reals and " + std::to_string(state.integers.size()) +
+                           " integers, expected " + std::to_string(y_.size()) + " and 2");
+  }
+  y_ = state.reals;
+  end_time_ = state.integers[0];
+  initialized_ = state.integers[1] != 0;
+  // Parameters came back with the variables: derive from them again.
+  if (initialized_) {
+    Validate();
+    ComputeCoefficients();
+    SetTolerances();
+  }
+  restart_pending_ = true;
+}
+
+}  // namespace linesim::motors

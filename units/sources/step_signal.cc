@@ -1,1 +1,56 @@
-namespace linesim::sources {}
+#include "units/sources/step_signal.h"
+
+#include <stdexcept>
+
+namespace linesim::sources {
+
+StepSignalUnit::StepSignalUnit(std::string name, int count, std::string unit,
+                               std::vector<Step> steps)
+    : cosim::Unit(kTypeName, std::move(name)),
+      steps_(std::move(steps)),
+      initial_(static_cast<std::size_t>(count), 0.0),
+      value_(static_cast<std::size_t>(count), 0.0) {
+  if (count < 1) throw std::invalid_argument("step_signal needs at least one channel");
+  for (std::size_t i = 0; i < steps_.size(); ++i) {
+    if (steps_[i].value.size() != value_.size()) {
+      throw std::invalid_argument("step " + std::to_string(i) + " has " +
+                                  std::to_string(steps_[i].value.size()) + " values, expected " +
+                                  std::to_string(value_.size()));
+    }
+  }
+  auto& v = variables();
+  v.Parameter("initial", unit, &initial_, "value before the first step");
+  v.Output("value", unit, &value_, "the signal, one element per channel", {});
+}
+
+std::vector<cosim::ParameterProblem> StepSignalUnit::CheckParameters() const {
+  std::vector<cosim::ParameterProblem> problems;
+  for (std::size_t i = 1; i < steps_.size(); ++i) {
+    if (steps_[i].time <= steps_[i - 1].time) {
+      problems.push_back({"steps", i, "step times must increase, got " +
+                                          cosim::FormatSeconds(steps_[i].time) + " s after " +
+                                          cosim::FormatSeconds(steps_[i - 1].time) + " s"});
+    }
+  }
+  return problems;
+}
+
+void StepSignalUnit::Evaluate(cosim::TimeNs t) {
+  const std::vector<double>* current = &initial_;
+  for (const Step& s : steps_) {
+    if (s.time > t) break;
+    current = &s.value;
+  }
+  value_ = *current;
+}
+
+void StepSignalUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }
+
+void StepSignalUnit::Initialize() { Evaluate(start_); }
+
+cosim::StepResult StepSignalUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
+  Evaluate(t + dt);
+  return cosim::StepResult::kOk;
+}
+
+}  // namespace linesim::sources

@@ -1,0 +1,245 @@
+#include "app/commands.h"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "cosim/observers.h"
+#include "loader/scenario.h"
+#include "loader/unit_types.h"
+
+namespace linesim::app {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+namespace {
+
+void PrintIssues(const loader::ScenarioError& e) {
+  std::cerr << "linesim: the scenario is refused (" << e.issues().size()
+            << (e.issues().size() == 1 ? " problem" : " problems") << "):\n";
+  for (const auto& i : e.issues()) std::cerr << "  " << i.ToString() << "\n";
+}
+
+Json Number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+std::string TypeLabel(const cosim::VariableInfo& v) {
+  if (v.type == cosim::VarType::kRealArray) return "Real[" + std::to_string(v.size) + "]";
+  return std::string(cosim::ToString(v.type));
+}
+
+// The variable table as aligned columns.
+void PrintTable(const cosim::Unit& unit, std::ostream& out) {
+  struct Row {
+    std::string cells[6];
+  };
+  std::vector<Row> rows{{{"name", "causality", "type", "unit", "start", "description"}}};
+  const auto& table = unit.variables();
+  for (const auto& v : table.infos()) {
+    std::string description = v.description;
+    if (!v.depends_on.empty()) {
+      description += " [depends directly on:";
+      for (auto ref : v.depends_on) description += " " + table.info(ref).name;
+      description += "]";
+    }
+    rows.push_back({{v.name, std::string(cosim::ToString(v.causality)), TypeLabel(v),
+                     v.unit.empty() ? "-" : v.unit, cosim::FormatValue(v.start), description}});
+  }
+  std::size_t width[5] = {};
+  for (const auto& r : rows) {
+    for (int c = 0; c < 5; ++c) width[c] = std::max(width[c], std::min<std::size_t>(r.cells[c].size(), 40));
+  }
+  for (const auto& r : rows) {
+    out << "  ";
+    for (int c = 0; c < 5; ++c) out << std::left << std::setw(static_cast<int>(width[c]) + 2) << r.cells[c];
+    out << r.cells[5] << "\n";
+  }
+}
+
+// Writes through a temporary file and a rename, so a reader never sees half
+// a file.
+void WriteAtomically(const fs::path& path, const std::string& text) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    f << text;
+    if (!f) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, path);
+}
+
+}  // namespace
+
+int RunCommand(const std::string& file, const std::string& out_dir,
+               const std::vector<std::string>& set_args) {
+  loader::Scenario s;
+  try {
+    s = loader::LoadScenario(file, set_args);
+  } catch (const loader::ScenarioError& e) {
+    PrintIssues(e);
+    return kExitBadInput;
+  }
+
+  // Everything is checked: only now is anything written.
+  const fs::path dir(out_dir);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) {
+    std::cerr << "linesim: cannot create the output folder " << out_dir << ": "
+              << (ec ? ec.message() : "a file of that name exists") << "\n";
+    return kExitBadInput;
+  }
+  const fs::path csv_path = dir / "signals.csv";
+  std::ofstream csv(csv_path, std::ios::binary | std::ios::trunc);
+  if (!csv) {
+    std::cerr << "linesim: cannot write " << csv_path.string() << "\n";
+    return kExitBadInput;
+  }
+
+  cosim::CsvRecorder recorder(csv, s.recorded, s.record_interval);
+  cosim::MetricsObserver metrics(s.metrics);
+  s.master->AddObserver(&recorder);
+  s.master->AddObserver(&metrics);
+
+  const auto wall0 = std::chrono::steady_clock::now();
+  const cosim::RunResult result = s.master->Run();
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  csv.close();
+
+  const cosim::MasterOptions& options = s.master->options();
+  const double simulated_s = cosim::NsToSeconds(result.end_time - options.start);
+  Json summary;
+  summary["scenario"] = s.name;
+  summary["file"] = file;
+  summary["status"] = result.ok ? "ok" : "failed";
+  summary["errors"] = result.errors;
+  Json settings;
+  settings["duration_s"] = s.duration_s;
+  settings["seed"] = s.seed;
+  settings["master"] = {
+      {"algorithm", options.algorithm == cosim::Algorithm::kJacobi ? "jacobi" : "gauss_seidel"},
+      {"step_s", cosim::NsToSeconds(options.base_step)},
+      {"threads", options.threads}};
+  Json overrides = Json::array();
+  for (const auto& o : s.overrides) overrides.push_back(o.path + "=" + o.value);
+  settings["overrides"] = overrides;
+  Json units = Json::object();
+  const cosim::System& system = *s.system;
+  for (std::size_t u = 0; u < system.unit_count(); ++u) {
+    units[system.unit(u).name()] = {
+        {"type", system.unit(u).type_name()},
+        {"step_s", cosim::NsToSeconds(options.base_step * s.master->decimation(u))}};
+  }
+  settings["units"] = units;
+  summary["settings"] = settings;
+
+  Json metric_values = Json::object();
+  for (const auto& [name, value] : metrics.Results()) metric_values[name] = Number(value);
+  summary["metrics"] = metric_values;
+
+  Json timing;
+  timing["simulated_s"] = simulated_s;
+  timing["wall_s"] = wall_s;
+  timing["real_time_factor"] = Number(simulated_s / wall_s);
+  double unit_total = 0;
+  Json shares = Json::object();
+  for (std::size_t u = 0; u < system.unit_count(); ++u) {
+    const double w = s.master->unit_wall_seconds()[u];
+    unit_total += w;
+    shares[system.unit(u).name()] = {{"wall_s", w}, {"share", Number(w / wall_s)}};
+  }
+  timing["units"] = shares;
+  timing["master_and_observers_share"] = Number((wall_s - unit_total) / wall_s);
+  summary["timing"] = timing;
+  Json columns = Json::array();
+  for (const auto& p : s.recorded) columns.push_back(p.label);
+  summary["recording"] = {{"file", "signals.csv"},
+                          {"rows", recorder.rows()},
+                          {"interval_s", cosim::NsToSeconds(s.record_interval)},
+                          {"columns", columns}};
+  try {
+    WriteAtomically(dir / "summary.json", summary.dump(2) + "\n");
+  } catch (const std::exception& e) {
+    std::cerr << "linesim: " << e.what() << "\n";
+    return kExitRunFailed;
+  }
+
+  std::cout << s.name << ": " << (result.ok ? "ok" : "FAILED") << ", "
+            << cosim::FormatSeconds(result.end_time - options.start) << " s simulated in "
+            << std::setprecision(3) << wall_s << " s wall (" << std::setprecision(4)
+            << simulated_s / wall_s << "x real time)\n";
+  std::size_t name_width = 0;
+  for (const auto& [name, value] : metrics.Results()) name_width = std::max(name_width, name.size());
+  for (const auto& [name, value] : metrics.Results()) {
+    std::cout << "  " << std::left << std::setw(static_cast<int>(name_width)) << name << " = "
+              << std::setprecision(6) << value << "\n";
+  }
+  std::cout << "  wrote " << (dir / "summary.json").string() << ", " << csv_path.string() << " ("
+            << recorder.rows() << " rows)\n";
+  for (const auto& e : result.errors) std::cerr << "linesim: " << e << "\n";
+  return result.ok ? kExitOk : kExitRunFailed;
+}
+
+int InspectCommand(const std::string& what, const std::vector<std::string>& set_args) {
+  const bool is_file = fs::exists(what) || what.ends_with(".yaml") || what.ends_with(".yml");
+  if (!is_file) {
+    if (!set_args.empty()) {
+      std::cerr << "linesim: --set applies to a scenario file, not to a unit type\n";
+      return kExitBadInput;
+    }
+    std::unique_ptr<cosim::Unit> unit;
+    try {
+      unit = loader::CreateDefaultUnit(what);
+    } catch (const loader::ScenarioError& e) {
+      std::cerr << "linesim: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+    const loader::UnitType& type = *loader::FindUnitType(what);
+    std::cout << "unit type '" << type.name << "': " << type.description << "\n";
+    std::cout << "keys under parameters: that shape the unit:\n";
+    for (const auto& k : type.structural_keys) {
+      std::cout << "  " << std::left << std::setw(8) << k.name << "  " << k.description << "\n";
+    }
+    std::cout << "variables (with the default keys above):\n";
+    PrintTable(*unit, std::cout);
+    return kExitOk;
+  }
+
+  loader::Scenario s;
+  try {
+    s = loader::LoadScenario(what, set_args);
+  } catch (const loader::ScenarioError& e) {
+    PrintIssues(e);
+    return kExitBadInput;
+  }
+  const auto& o = s.master->options();
+  std::cout << "scenario '" << s.name << "' (" << what << ")";
+  if (!s.description.empty()) std::cout << ": " << s.description;
+  std::cout << "\n  duration " << cosim::FormatSeconds(o.stop - o.start) << " s, seed " << s.seed
+            << ", master "
+            << (o.algorithm == cosim::Algorithm::kJacobi ? "jacobi" : "gauss_seidel")
+            << " step " << cosim::FormatSeconds(o.base_step) << " s\n";
+  const cosim::System& system = *s.system;
+  for (std::size_t u = 0; u < system.unit_count(); ++u) {
+    std::cout << "\nunit '" << system.unit(u).name() << "' (" << system.unit(u).type_name()
+              << ", step " << cosim::FormatSeconds(o.base_step * s.master->decimation(u))
+              << " s)\n";
+    PrintTable(system.unit(u), std::cout);
+  }
+  std::cout << "\nconnections:\n";
+  for (const auto& c : system.connections()) {
+    std::cout << "  " << c.from.ToString() << " -> " << c.to.ToString() << "\n";
+  }
+  std::cout << "\nstep order (Gauss-Seidel):";
+  for (std::size_t u : system.dependency_order()) std::cout << " " << system.unit(u).name();
+  std::cout << "\n";
+  return kExitOk;
+}
+
+}  // namespace linesim::app

@@ -1,0 +1,111 @@
+#include "loader/overrides.h"
+
+#include <algorithm>
+#include <cctype>
+
+#include "cosim/closest_names.h"
+#include "loader/yaml_reader.h"
+
+namespace linesim::loader {
+
+namespace {
+
+std::vector<std::string> Split(const std::string& path) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  while (true) {
+    const auto dot = path.find('.', start);
+    parts.push_back(path.substr(start, dot - start));
+    if (dot == std::string::npos) break;
+    start = dot + 1;
+  }
+  return parts;
+}
+
+bool IsIndex(const std::string& s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
+    return std::isdigit(static_cast<unsigned char>(c));
+  });
+}
+
+}  // namespace
+
+Override ParseOverride(const std::string& text) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw ScenarioError({{"", 0, "--set " + text,
+                          "expected dotted.path=value (for example master.step_s=0.002)"}});
+  }
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+void ApplyOverrides(YAML::Node& root, const std::vector<Override>& overrides,
+                    const std::string& file, std::vector<Issue>& issues) {
+  for (const Override& o : overrides) {
+    const auto report = [&](const std::string& message) {
+      issues.push_back({file, 0, o.path, message + " (in --set " + o.path + "=" + o.value + ")",
+                        true});
+    };
+    const std::vector<std::string> parts = Split(o.path);
+    if (std::any_of(parts.begin(), parts.end(), [](const std::string& p) { return p.empty(); })) {
+      report("empty key in the path");
+      continue;
+    }
+    YAML::Node value;
+    try {
+      value = o.value.empty() ? YAML::Node(YAML::NodeType::Null) : YAML::Load(o.value);
+    } catch (const YAML::Exception&) {
+      value = YAML::Node(o.value);
+    }
+
+    // Walk with copies of node handles (yaml-cpp nodes are references).
+    YAML::Node node = root;
+    std::string walked;
+    bool ok = true;
+    for (std::size_t i = 0; i < parts.size() && ok; ++i) {
+      const std::string& key = parts[i];
+      const bool last = i + 1 == parts.size();
+      if (node.IsSequence()) {
+        if (!IsIndex(key) || std::stoul(key) >= node.size()) {
+          report("'" + JoinPath(walked, key) + "' is not an item of the list at '" + walked +
+                 "', which has " + std::to_string(node.size()) + " items (0 to " +
+                 std::to_string(node.size() == 0 ? 0 : node.size() - 1) + ")");
+          ok = false;
+          break;
+        }
+        const std::size_t index = std::stoul(key);
+        if (last) {
+          node[index] = value;
+        } else {
+          node.reset(node[index]);
+        }
+      } else if (node.IsMap() || (node.IsNull() && last)) {
+        const YAML::Node& cnode = node;
+        const bool exists = cnode.IsMap() && cnode[key].IsDefined();
+        if (last) {
+          node[key] = value;
+        } else if (!exists) {
+          std::vector<std::string> keys;
+          for (const auto& kv : cnode) keys.push_back(kv.first.Scalar());
+          std::string hint;
+          for (const auto& c : cosim::ClosestNames(key, keys)) {
+            hint += (hint.empty() ? "" : ", ") + JoinPath(walked, c);
+          }
+          report("no key '" + key + "' at '" + (walked.empty() ? "(top)" : walked) + "'" +
+                 (hint.empty() ? "" : "; closest: " + hint));
+          ok = false;
+          break;
+        } else {
+          node.reset(node[key]);
+        }
+      } else {
+        report("'" + walked + "' holds a value, not a map or list, so it has no key '" + key +
+               "'");
+        ok = false;
+      }
+      walked = JoinPath(walked, key);
+    }
+  }
+}
+
+}  // namespace linesim::loader

@@ -1,0 +1,29 @@
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <string>
+#include <vector>
+
+#include "loader/scenario_error.h"
+
+namespace linesim::loader {
+
+/// A command-line override `dotted.path=value`: map keys by name, list items
+/// by index ("units.motors.parameters.gear_ratio.2=5").
+struct Override {
+  std::string path;
+  std::string value;
+};
+
+/// Splits "a.b=value"; throws ScenarioError when there is no '=' or path.
+Override ParseOverride(const std::string& text);
+
+/// Writes each override into the tree. Every key on the way must exist (an
+/// unknown one is reported with the closest existing paths); the last key of
+/// a map may be new, and is then checked like any key of the file. The value
+/// is read as YAML, so "true", "3" and "[1, 2]" keep their types.
+void ApplyOverrides(YAML::Node& root, const std::vector<Override>& overrides,
+                    const std::string& file, std::vector<Issue>& issues);
+
+}  // namespace linesim::loader

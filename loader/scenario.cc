@@ -1,0 +1,450 @@
+#include "loader/scenario.h"
+
+#include <filesystem>
+#include <map>
+
+#include "cosim/closest_names.h"
+#include "cosim/seed.h"
+#include "loader/unit_types.h"
+#include "loader/yaml_reader.h"
+#include "models/models_dir.h"
+
+namespace linesim::loader {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Where a parameter's value came from, to point at it if the unit refuses it.
+struct ParameterOrigin {
+  YamlReader* reader;
+  YAML::Node node;
+  std::string path;
+};
+
+// Converts a YAML value to the declared type of a unit variable and sets it.
+void ApplyParameter(cosim::Unit& unit, const cosim::VariableInfo& info, const YAML::Node& node,
+                    const std::string& path, YamlReader& r) {
+  cosim::Value value;
+  bool ok = false;
+  std::string expected;
+  switch (info.type) {
+    case cosim::VarType::kReal: {
+      double v;
+      ok = node.IsScalar() && YAML::convert<double>::decode(node, v);
+      value = v;
+      expected = "a number";
+      break;
+    }
+    case cosim::VarType::kInteger: {
+      std::int64_t v;
+      ok = node.IsScalar() && YAML::convert<std::int64_t>::decode(node, v);
+      value = v;
+      expected = "an integer";
+      break;
+    }
+    case cosim::VarType::kBoolean: {
+      bool v;
+      ok = node.IsScalar() && YAML::convert<bool>::decode(node, v);
+      value = v;
+      expected = "true or false";
+      break;
+    }
+    case cosim::VarType::kString:
+      ok = node.IsScalar();
+      if (ok) value = node.Scalar();
+      expected = "a text value";
+      break;
+    case cosim::VarType::kRealArray: {
+      expected = "a number (for every element) or a list of " + std::to_string(info.size) +
+                 " numbers";
+      double v;
+      if (node.IsScalar() && YAML::convert<double>::decode(node, v)) {
+        value = v;
+        ok = true;
+      } else if (node.IsSequence() && node.size() == info.size) {
+        std::vector<double> list(info.size);
+        ok = true;
+        for (std::size_t i = 0; i < info.size && ok; ++i) {
+          ok = node[i].IsScalar() && YAML::convert<double>::decode(node[i], list[i]);
+        }
+        value = std::move(list);
+      } else if (node.IsSequence()) {
+        r.Error(node, path,
+                "expected " + expected + ", got a list of " + std::to_string(node.size()));
+        return;
+      }
+      break;
+    }
+  }
+  if (!ok) {
+    r.Error(node, path, "expected " + expected + " (" + info.unit + "), got " + Describe(node));
+    return;
+  }
+  try {
+    unit.variables().SetValue(info.ref, value);
+  } catch (const std::exception& e) {
+    r.Error(node, path, e.what());
+  }
+}
+
+// Applies every key of `map` to the unit's parameters, skipping `skip`.
+void ApplyParameters(cosim::Unit& unit, const YAML::Node& map, const std::string& path,
+                     const std::vector<std::string>& skip, YamlReader& r,
+                     std::map<std::string, ParameterOrigin>& origins) {
+  std::vector<std::string> parameter_names;
+  for (const auto& info : unit.variables().infos()) {
+    if (info.causality == cosim::Causality::kParameter) parameter_names.push_back(info.name);
+  }
+  std::vector<std::string> allowed = parameter_names;
+  allowed.insert(allowed.end(), skip.begin(), skip.end());
+  for (const auto& kv : map) {
+    const std::string key = kv.first.Scalar();
+    if (std::find(skip.begin(), skip.end(), key) != skip.end()) continue;
+    const std::string key_path = JoinPath(path, key);
+    const auto ref = unit.variables().Find(key);
+    if (!ref || unit.variables().info(*ref).causality != cosim::Causality::kParameter) {
+      std::string hint;
+      for (const auto& c : cosim::ClosestNames(key, allowed)) {
+        hint += (hint.empty() ? "" : ", ") + JoinPath(path, c);
+      }
+      r.Error(kv.first, key_path,
+              "unknown parameter of a " + unit.type_name() + " unit" +
+                  (hint.empty() ? "" : "; closest: " + hint) +
+                  " (linesim inspect " + unit.type_name() + " lists them)");
+      continue;
+    }
+    ApplyParameter(unit, unit.variables().info(*ref), kv.second, key_path, r);
+    origins[key] = {&r, kv.second, key_path};
+  }
+}
+
+fs::path ModelFile(const std::string& value, const std::string& folder,
+                   const std::string& scenario_file) {
+  const bool is_path = value.find('/') != std::string::npos ||
+                       value.ends_with(".yaml") || value.ends_with(".yml");
+  if (is_path) return fs::path(scenario_file).parent_path() / value;
+  return fs::path(models::ModelsDir()) / folder / (value + ".yaml");
+}
+
+std::vector<std::string> ModelNames(const std::string& folder) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(fs::path(models::ModelsDir()) / folder, ec)) {
+    if (e.path().extension() == ".yaml") names.push_back(e.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+class Builder {
+ public:
+  Builder(Scenario& s, YamlReader& r) : s_(s), r_(r) {}
+
+  void Build(const YAML::Node& root) {
+    if (!r_.ExpectMap(root, "(top)")) return;
+    r_.CheckKeys(root, "", {"name", "description", "duration_s", "seed", "master", "units",
+                            "connections", "recording", "metrics"});
+    s_.name = r_.String(root, "", "name", fs::path(s_.file).stem().string());
+    s_.description = r_.String(root, "", "description", "");
+    s_.duration_s = r_.Real(root, "", "duration_s", std::nullopt, {0.0, 1e7, true});
+    s_.seed = static_cast<std::uint64_t>(
+        r_.Integer(root, "", "seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
+
+    cosim::MasterOptions options;
+    const YAML::Node master = Child(root, "master");
+    if (master.IsDefined() && !master.IsNull() && r_.ExpectMap(master, "master")) {
+      r_.CheckKeys(master, "master", {"algorithm", "step_s", "threads"});
+    }
+    const YAML::Node master_map = master.IsMap() ? master : YAML::Node(YAML::NodeType::Map);
+    const std::string algorithm =
+        r_.String(master_map, "master", "algorithm", "gauss_seidel", {"jacobi", "gauss_seidel"});
+    options.algorithm = algorithm == "jacobi" ? cosim::Algorithm::kJacobi
+                                              : cosim::Algorithm::kGaussSeidel;
+    const double step_s = r_.Real(master_map, "master", "step_s", 0.001, {0.0, 10.0, true});
+    options.base_step = cosim::SecondsToNs(step_s);
+    if (options.base_step <= 0) {
+      r_.Error(Child(master_map, "step_s"), "master.step_s",
+               "step is below one nanosecond: expected at least 1e-9");
+    }
+    options.threads = static_cast<int>(r_.Integer(master_map, "master", "threads", 1, 1, 256));
+    options.start = 0;
+    options.stop = cosim::SecondsToNs(s_.duration_s);
+
+    s_.system = std::make_unique<cosim::System>();
+    const std::size_t issues_before_units = r_.issues().size();
+    BuildUnits(Child(root, "units"));
+    const bool units_ok = r_.issues().size() == issues_before_units;
+    const auto connection_nodes = BuildConnections(Child(root, "connections"));
+    // With a unit missing, every connection to it would be reported again.
+    if (!units_ok) return;
+
+    try {
+      s_.system->Build();
+      const bool options_ok = r_.ok();
+      s_.master = std::make_unique<cosim::Master>(*s_.system, options);
+      if (!options_ok) return;
+    } catch (const cosim::ConfigError& e) {
+      for (const auto& p : e.problems()) {
+        if (p.connection && *p.connection < connection_nodes.size()) {
+          const auto& [index, node] = connection_nodes[*p.connection];
+          r_.Error(node, "connections." + std::to_string(index), p.message);
+        } else {
+          r_.Error(root, "", p.message);
+        }
+      }
+      return;
+    }
+    BuildRecording(Child(root, "recording"), options);
+    BuildMetrics(Child(root, "metrics"));
+  }
+
+ private:
+  void BuildUnits(const YAML::Node& units) {
+    if (!units.IsDefined() || units.IsNull()) {
+      r_.Error(YAML::Node(), "units", "missing required key: a map of unit name -> {type, ...}");
+      return;
+    }
+    if (!r_.ExpectMap(units, "units")) return;
+    if (units.size() == 0) r_.Error(units, "units", "expected at least one unit");
+    for (const auto& kv : units) BuildUnit(kv.first.Scalar(), kv.first, kv.second);
+  }
+
+  void BuildUnit(const std::string& name, const YAML::Node& key, const YAML::Node& spec) {
+    const std::string path = JoinPath("units", name);
+    if (!r_.ExpectMap(spec, path)) return;
+    r_.CheckKeys(spec, path, {"type", "step_s", "parameters"});
+    const std::string type_name = r_.String(spec, path, "type", std::nullopt);
+    if (type_name.empty()) return;
+    const UnitType* type = FindUnitType(type_name);
+    if (!type) {
+      r_.Error(Child(spec, "type"), JoinPath(path, "type"),
+               "unknown unit type '" + type_name + "'" +
+                   cosim::ClosestHint(type_name, UnitTypeNames()) +
+                   "; known types: " + [] {
+                     std::string all;
+                     for (const auto& n : UnitTypeNames()) all += (all.empty() ? "" : ", ") + n;
+                     return all;
+                   }());
+      return;
+    }
+    cosim::TimeNs step = 0;
+    if (Child(spec, "step_s").IsDefined()) {
+      step = cosim::SecondsToNs(r_.Real(spec, path, "step_s", 0.0, {0.0, 1e6, true}));
+    }
+    const YAML::Node params = Child(spec, "parameters");
+    const std::string params_path = JoinPath(path, "parameters");
+    if (params.IsDefined() && !params.IsNull() && !r_.ExpectMap(params, params_path)) return;
+
+    const std::size_t issues_before = r_.issues().size();
+    std::unique_ptr<cosim::Unit> unit;
+    try {
+      unit = type->create({name, cosim::DeriveSeed(s_.seed, name), r_, params, params_path});
+    } catch (const std::exception& e) {
+      r_.Error(spec, path, std::string("cannot create the unit: ") + e.what());
+      return;
+    }
+    if (!unit || r_.issues().size() != issues_before) return;
+    (void)key;
+
+    std::vector<std::string> structural;
+    for (const auto& k : type->structural_keys) structural.push_back(k.name);
+    std::map<std::string, ParameterOrigin> origins;
+
+    // Model file first, then the scenario's own values on top.
+    std::vector<std::unique_ptr<YamlReader>>& model_readers = model_readers_;
+    if (params.IsMap() && Child(params, "model").IsDefined() && !type->model_folder.empty()) {
+      const std::string model_path = JoinPath(params_path, "model");
+      if (const auto value = r_.AsString(Child(params, "model"), model_path)) {
+        const fs::path file = ModelFile(*value, type->model_folder, s_.file);
+        YAML::Node model;
+        try {
+          model = YAML::LoadFile(file.string());
+        } catch (const YAML::BadFile&) {
+          r_.Error(Child(params, "model"), model_path,
+                   "no model file " + file.string() +
+                       cosim::ClosestHint(*value, ModelNames(type->model_folder)));
+        } catch (const YAML::Exception& e) {
+          r_.Error(Child(params, "model"), model_path,
+                   "model file " + file.string() + " is not valid YAML: " + e.what());
+        }
+        if (model.IsDefined()) {
+          model_readers.push_back(std::make_unique<YamlReader>(file.string()));
+          YamlReader& mr = *model_readers.back();
+          if (mr.ExpectMap(model, "")) {
+            ApplyParameters(*unit, model, "", {"source", "description"}, mr, origins);
+          }
+          for (auto& issue : mr.mutable_issues()) r_.mutable_issues().push_back(issue);
+          mr.mutable_issues().clear();
+        }
+      }
+    }
+    if (params.IsMap()) ApplyParameters(*unit, params, params_path, structural, r_, origins);
+
+    for (const auto& p : unit->CheckParameters()) {
+      const std::string suffix = p.index ? "." + std::to_string(*p.index) : "";
+      if (auto it = origins.find(p.variable); it != origins.end()) {
+        YamlReader& where = *it->second.reader;
+        const std::size_t n = where.issues().size();
+        where.Error(it->second.node, it->second.path + suffix, p.message);
+        if (&where != &r_) {
+          r_.mutable_issues().push_back(where.issues()[n]);
+          where.mutable_issues().clear();
+        }
+      } else {
+        r_.Error(params.IsDefined() ? params : spec, JoinPath(params_path, p.variable) + suffix,
+                 p.message);
+      }
+    }
+    if (r_.issues().size() == issues_before) s_.system->Add(std::move(unit), step);
+  }
+
+  // The YAML index and node of each connection added to the system.
+  std::vector<std::pair<std::size_t, YAML::Node>> BuildConnections(const YAML::Node& list) {
+    std::vector<std::pair<std::size_t, YAML::Node>> nodes;
+    if (!list.IsDefined() || list.IsNull()) return nodes;
+    if (!r_.ExpectSequence(list, "connections")) return nodes;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string path = "connections." + std::to_string(i);
+      const YAML::Node item = list[i];
+      if (!r_.ExpectMap(item, path)) continue;
+      r_.CheckKeys(item, path, {"from", "to"});
+      const std::string from = r_.String(item, path, "from", std::nullopt);
+      const std::string to = r_.String(item, path, "to", std::nullopt);
+      if (from.empty() || to.empty()) continue;
+      try {
+        s_.system->Connect(cosim::Endpoint::Parse(from), cosim::Endpoint::Parse(to));
+        nodes.emplace_back(i, item);
+      } catch (const std::invalid_argument& e) {
+        r_.Error(item, path, e.what());
+      }
+    }
+    return nodes;
+  }
+
+  void BuildRecording(const YAML::Node& rec, const cosim::MasterOptions& options) {
+    std::vector<std::string> names;
+    s_.record_interval = options.base_step;
+    if (!rec.IsDefined() || rec.IsNull()) {
+      for (const auto& n : s_.system->UnitNames()) names.push_back(n + ".*");
+    } else if (r_.ExpectMap(rec, "recording")) {
+      r_.CheckKeys(rec, "recording", {"variables", "interval_s"});
+      if (Child(rec, "interval_s").IsDefined()) {
+        s_.record_interval = cosim::SecondsToNs(
+            r_.Real(rec, "recording", "interval_s", 0.0, {0.0, 1e7, true}));
+        if (s_.record_interval % options.base_step != 0) {
+          r_.Error(Child(rec, "interval_s"), "recording.interval_s",
+                   "expected a whole multiple of master.step_s (" +
+                       cosim::FormatSeconds(options.base_step) + " s)");
+        }
+      }
+      const YAML::Node vars = Child(rec, "variables");
+      if (vars.IsDefined() && r_.ExpectSequence(vars, "recording.variables")) {
+        for (std::size_t i = 0; i < vars.size(); ++i) {
+          if (auto v = r_.AsString(vars[i], "recording.variables." + std::to_string(i))) {
+            names.push_back(*v);
+            try {
+              cosim::ResolveProbes(*s_.system, {*v});
+            } catch (const cosim::ConfigError& e) {
+              r_.Error(vars[i], "recording.variables." + std::to_string(i), e.what());
+            }
+          }
+        }
+      }
+    }
+    if (r_.ok()) s_.recorded = cosim::ResolveProbes(*s_.system, names);
+  }
+
+  void BuildMetrics(const YAML::Node& list) {
+    if (!list.IsDefined() || list.IsNull()) return;
+    if (!r_.ExpectSequence(list, "metrics")) return;
+    std::vector<std::string> seen;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string path = "metrics." + std::to_string(i);
+      const YAML::Node item = list[i];
+      if (!r_.ExpectMap(item, path)) continue;
+      r_.CheckKeys(item, path, {"name", "of", "reduce"});
+      cosim::MetricSpec spec;
+      spec.name = r_.String(item, path, "name", std::nullopt);
+      const std::string of = r_.String(item, path, "of", std::nullopt);
+      const std::string reduce =
+          r_.String(item, path, "reduce", "final", cosim::ReductionNames());
+      cosim::ParseReduction(reduce, &spec.reduction);
+      if (std::find(seen.begin(), seen.end(), spec.name) != seen.end()) {
+        r_.Error(Child(item, "name"), JoinPath(path, "name"), "metric '" + spec.name + "' defined twice");
+      }
+      seen.push_back(spec.name);
+      if (of.empty()) continue;
+      try {
+        const auto probes = cosim::ResolveProbes(*s_.system, {of});
+        if (probes.size() != 1) {
+          r_.Error(Child(item, "of"), JoinPath(path, "of"),
+                   "'" + of + "' is " + std::to_string(probes.size()) +
+                       " values: expected one, e.g. " + probes.front().label);
+          continue;
+        }
+        spec.probe = probes.front();
+        s_.metrics.push_back(spec);
+      } catch (const cosim::ConfigError& e) {
+        r_.Error(Child(item, "of"), JoinPath(path, "of"), e.what());
+      }
+    }
+  }
+
+  Scenario& s_;
+  YamlReader& r_;
+  std::vector<std::unique_ptr<YamlReader>> model_readers_;
+};
+
+}  // namespace
+
+Scenario LoadScenario(const std::string& file, const std::vector<std::string>& set_args) {
+  Scenario s;
+  s.file = file;
+  std::vector<Issue> issues;
+  for (const auto& arg : set_args) {
+    try {
+      s.overrides.push_back(ParseOverride(arg));
+    } catch (const ScenarioError& e) {
+      for (auto i : e.issues()) {
+        i.file = file;
+        issues.push_back(i);
+      }
+    }
+  }
+  try {
+    s.tree = YAML::LoadFile(file);
+  } catch (const YAML::BadFile&) {
+    throw ScenarioError({{file, 0, "", "cannot read the file (missing or not readable)"}});
+  } catch (const YAML::ParserException& e) {
+    throw ScenarioError({{file, e.mark.is_null() ? 0 : e.mark.line + 1, "",
+                          "not valid YAML: " + e.msg}});
+  }
+  ApplyOverrides(s.tree, s.overrides, file, issues);
+  std::set<std::string> overridden;
+  for (const auto& o : s.overrides) overridden.insert(o.path);
+  YamlReader reader(file, overridden);
+  for (auto& i : issues) reader.mutable_issues().push_back(i);
+  Builder(s, reader).Build(s.tree);
+  if (!reader.ok()) throw ScenarioError(reader.issues());
+  return s;
+}
+
+std::unique_ptr<cosim::Unit> CreateDefaultUnit(const std::string& type_name) {
+  const UnitType* type = FindUnitType(type_name);
+  if (!type) {
+    std::string all;
+    for (const auto& n : UnitTypeNames()) all += (all.empty() ? "" : ", ") + n;
+    throw ScenarioError({{"", 0, "", "unknown unit type '" + type_name + "'" +
+                                         cosim::ClosestHint(type_name, UnitTypeNames()) +
+                                         "; known types: " + all}});
+  }
+  YamlReader reader("(defaults)");
+  const YAML::Node none;
+  const std::string path = "parameters";
+  auto unit = type->create({type_name, 1, reader, none, path});
+  if (!reader.ok() || !unit) throw ScenarioError(reader.issues());
+  return unit;
+}
+
+}  // namespace linesim::loader

@@ -1,0 +1,48 @@
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cosim/master.h"
+#include "cosim/observers.h"
+#include "cosim/system.h"
+#include "loader/overrides.h"
+#include "loader/scenario_error.h"
+
+namespace linesim::loader {
+
+/// A scenario file read, checked and built into a system and a master,
+/// ready to run. Everything that can be wrong with the file has been found
+/// by the time this exists.
+struct Scenario {
+  std::string file;
+  std::string name;
+  std::string description;
+  std::uint64_t seed = 1;
+  double duration_s = 0;
+  std::vector<Override> overrides;
+  YAML::Node tree;  // the file after --set overrides
+
+  std::unique_ptr<cosim::System> system;  // declared before master: outlives it
+  std::unique_ptr<cosim::Master> master;
+
+  std::vector<cosim::Probe> recorded;
+  cosim::TimeNs record_interval = 0;
+  std::vector<cosim::MetricSpec> metrics;
+};
+
+/// Reads `file`, applies the `--set` overrides ("dotted.path=value"), checks
+/// everything and builds the system. Throws ScenarioError listing every
+/// problem (file, line, key path, bad value, what was expected).
+Scenario LoadScenario(const std::string& file, const std::vector<std::string>& set_args = {});
+
+/// A unit of a registered type with default structural parameters, named
+/// after its type (for `linesim inspect TYPE`); throws ScenarioError with the
+/// closest type names when the type is unknown.
+std::unique_ptr<cosim::Unit> CreateDefaultUnit(const std::string& type);
+
+}  // namespace linesim::loader

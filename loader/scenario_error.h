@@ -1,0 +1,31 @@
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace linesim::loader {
+
+/// One thing wrong with a scenario: where (file, line, key path) and what
+/// (the bad value and what was expected).
+struct Issue {
+  std::string file;
+  int line = 0;          // 1-based; 0 when unknown
+  std::string key_path;  // "units.motors.parameters.resistance"
+  std::string message;
+  bool from_command_line = false;  // the value came from --set
+
+  std::string ToString() const;
+};
+
+/// Every issue of a scenario at once; what() lists them one per line.
+class ScenarioError : public std::runtime_error {
+ public:
+  explicit ScenarioError(std::vector<Issue> issues);
+  const std::vector<Issue>& issues() const { return issues_; }
+
+ private:
+  std::vector<Issue> issues_;
+};
+
+}  // namespace linesim::loader

@@ -1,0 +1,185 @@
+#include "loader/yaml_reader.h"
+
+#include <cmath>
+
+#include "cosim/closest_names.h"
+
+namespace linesim::loader {
+
+std::string JoinPath(const std::string& path, const std::string& key) {
+  return path.empty() ? key : path + "." + key;
+}
+
+YAML::Node Child(const YAML::Node& map, const std::string& key) {
+  if (map.IsDefined() && map.IsMap()) {
+    for (const auto& kv : map) {
+      if (kv.first.Scalar() == key) return kv.second;
+    }
+  }
+  return YAML::Node(YAML::NodeType::Undefined);
+}
+
+std::string Describe(const YAML::Node& node) {
+  if (!node.IsDefined() || node.IsNull()) return "nothing";
+  if (node.IsMap()) return "a map";
+  if (node.IsSequence()) return "a list";
+  return "'" + node.Scalar() + "'";
+}
+
+YamlReader::YamlReader(std::string file, std::set<std::string> overridden)
+    : file_(std::move(file)), overridden_(std::move(overridden)) {}
+
+int YamlReader::LineOf(const YAML::Node& node) {
+  if (!node.IsDefined() || node.Mark().is_null()) return 0;
+  return node.Mark().line + 1;
+}
+
+bool YamlReader::FromCommandLine(const std::string& path) const {
+  for (const auto& o : overridden_) {
+    if (path == o || path.rfind(o + ".", 0) == 0) return true;
+  }
+  return false;
+}
+
+void YamlReader::Error(const YAML::Node& at, const std::string& path, std::string message) {
+  Issue issue;
+  issue.file = file_;
+  issue.key_path = path;
+  issue.message = std::move(message);
+  issue.from_command_line = FromCommandLine(path);
+  issue.line = issue.from_command_line ? 0 : LineOf(at);
+  issues_.push_back(std::move(issue));
+}
+
+bool YamlReader::ExpectMap(const YAML::Node& node, const std::string& path) {
+  if (node.IsMap()) return true;
+  Error(node, path, "expected a map of keys, got " + Describe(node));
+  return false;
+}
+
+bool YamlReader::ExpectSequence(const YAML::Node& node, const std::string& path) {
+  if (node.IsSequence()) return true;
+  Error(node, path, "expected a list, got " + Describe(node));
+  return false;
+}
+
+void YamlReader::CheckKeys(const YAML::Node& map, const std::string& path,
+                           const std::vector<std::string>& allowed) {
+  if (!map.IsMap()) return;
+  for (const auto& kv : map) {
+    const std::string key = kv.first.Scalar();
+    bool known = false;
+    for (const auto& a : allowed) known |= (a == key);
+    if (known) continue;
+    std::vector<std::string> close = cosim::ClosestNames(key, allowed);
+    std::string hint;
+    for (const auto& c : close) hint += (hint.empty() ? "" : ", ") + JoinPath(path, c);
+    std::string expected;
+    for (const auto& a : allowed) expected += (expected.empty() ? "" : ", ") + a;
+    Error(kv.first, JoinPath(path, key),
+          "unknown key" + (hint.empty() ? "" : "; closest: " + hint) +
+              "; expected one of: " + expected);
+  }
+}
+
+const YAML::Node YamlReader::Lookup(const YAML::Node& map, const std::string& path,
+                                    const std::string& key, bool required) {
+  const YAML::Node node = Child(map, key);
+  if ((!node.IsDefined() || node.IsNull()) && required) {
+    Error(map, JoinPath(path, key), "missing required key");
+  }
+  return node;
+}
+
+std::optional<double> YamlReader::AsReal(const YAML::Node& node, const std::string& path,
+                                         Range range) {
+  double v = 0;
+  if (!node.IsScalar() || !YAML::convert<double>::decode(node, v) || std::isnan(v)) {
+    Error(node, path, "expected a number, got " + Describe(node));
+    return std::nullopt;
+  }
+  const bool below = range.min_exclusive ? v <= range.min : v < range.min;
+  if (below || v > range.max) {
+    std::string want;
+    if (std::isfinite(range.min)) {
+      want = (range.min_exclusive ? "> " : ">= ") + YAML::Node(range.min).Scalar();
+    }
+    if (std::isfinite(range.max)) {
+      want += (want.empty() ? "<= " : " and <= ") + YAML::Node(range.max).Scalar();
+    }
+    Error(node, path, "value " + node.Scalar() + " is out of range: expected a number " + want);
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::optional<std::string> YamlReader::AsString(const YAML::Node& node, const std::string& path) {
+  if (!node.IsScalar()) {
+    Error(node, path, "expected a text value, got " + Describe(node));
+    return std::nullopt;
+  }
+  return node.Scalar();
+}
+
+double YamlReader::Real(const YAML::Node& map, const std::string& path, const std::string& key,
+                        std::optional<double> fallback, Range range) {
+  const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
+  if (!node.IsDefined() || node.IsNull()) return fallback.value_or(0.0);
+  return AsReal(node, JoinPath(path, key), range).value_or(fallback.value_or(0.0));
+}
+
+std::int64_t YamlReader::Integer(const YAML::Node& map, const std::string& path,
+                                 const std::string& key, std::optional<std::int64_t> fallback,
+                                 std::int64_t min, std::int64_t max) {
+  const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
+  if (!node.IsDefined() || node.IsNull()) return fallback.value_or(0);
+  std::int64_t v = 0;
+  const std::string p = JoinPath(path, key);
+  if (!node.IsScalar() || !YAML::convert<std::int64_t>::decode(node, v)) {
+    Error(node, p, "expected an integer, got " + Describe(node));
+    return fallback.value_or(0);
+  }
+  if (v < min || v > max) {
+    Error(node, p,
+          "value " + std::to_string(v) + " is out of range: expected an integer from " +
+              std::to_string(min) + " to " + std::to_string(max));
+    return fallback.value_or(0);
+  }
+  return v;
+}
+
+bool YamlReader::Boolean(const YAML::Node& map, const std::string& path, const std::string& key,
+                         std::optional<bool> fallback) {
+  const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
+  if (!node.IsDefined() || node.IsNull()) return fallback.value_or(false);
+  bool v = false;
+  if (!node.IsScalar() || !YAML::convert<bool>::decode(node, v)) {
+    Error(node, JoinPath(path, key), "expected true or false, got " + Describe(node));
+    return fallback.value_or(false);
+  }
+  return v;
+}
+
+std::string YamlReader::String(const YAML::Node& map, const std::string& path,
+                               const std::string& key, std::optional<std::string> fallback,
+                               const std::vector<std::string>& allowed) {
+  const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
+  if (!node.IsDefined() || node.IsNull()) return fallback.value_or("");
+  const std::string p = JoinPath(path, key);
+  const auto s = AsString(node, p);
+  if (!s) return fallback.value_or("");
+  if (!allowed.empty()) {
+    bool found = false;
+    for (const auto& a : allowed) found |= (a == *s);
+    if (!found) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      Error(node, p, "'" + *s + "' is not allowed: expected one of " + list +
+                         cosim::ClosestHint(*s, allowed));
+      return fallback.value_or(allowed.front());
+    }
+  }
+  return *s;
+}
+
+}  // namespace linesim::loader

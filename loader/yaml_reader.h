@@ -1,0 +1,82 @@
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "loader/scenario_error.h"
+
+namespace linesim::loader {
+
+/// "a.b" + "c" -> "a.b.c".
+std::string JoinPath(const std::string& path, const std::string& key);
+
+/// Accepted interval of a number.
+struct Range {
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  bool min_exclusive = false;
+};
+
+/// Reads a YAML tree and collects issues with file, line and key path
+/// instead of stopping at the first one.
+class YamlReader {
+ public:
+  /// `overridden` holds the key paths set with --set, so that issues under
+  /// them say so instead of pointing at a line.
+  YamlReader(std::string file, std::set<std::string> overridden = {});
+
+  void Error(const YAML::Node& at, const std::string& path, std::string message);
+  bool ok() const { return issues_.empty(); }
+  const std::vector<Issue>& issues() const { return issues_; }
+  std::vector<Issue>& mutable_issues() { return issues_; }
+  const std::string& file() const { return file_; }
+  static int LineOf(const YAML::Node& node);
+
+  bool ExpectMap(const YAML::Node& node, const std::string& path);
+  bool ExpectSequence(const YAML::Node& node, const std::string& path);
+  /// Reports every key of `map` not in `allowed`, with the closest allowed
+  /// keys as full paths.
+  void CheckKeys(const YAML::Node& map, const std::string& path,
+                 const std::vector<std::string>& allowed);
+
+  /// A key of `map`; when absent, `fallback` (or an issue if none is given).
+  double Real(const YAML::Node& map, const std::string& path, const std::string& key,
+              std::optional<double> fallback, Range range = {});
+  std::int64_t Integer(const YAML::Node& map, const std::string& path, const std::string& key,
+                       std::optional<std::int64_t> fallback, std::int64_t min,
+                       std::int64_t max);
+  bool Boolean(const YAML::Node& map, const std::string& path, const std::string& key,
+               std::optional<bool> fallback);
+  /// With a non-empty `allowed`, the value must be one of them.
+  std::string String(const YAML::Node& map, const std::string& path, const std::string& key,
+                     std::optional<std::string> fallback,
+                     const std::vector<std::string>& allowed = {});
+
+  /// Scalar readers for a node already looked up.
+  std::optional<double> AsReal(const YAML::Node& node, const std::string& path, Range range = {});
+  std::optional<std::string> AsString(const YAML::Node& node, const std::string& path);
+
+ private:
+  bool FromCommandLine(const std::string& path) const;
+  const YAML::Node Lookup(const YAML::Node& map, const std::string& path, const std::string& key,
+                          bool required);
+
+  std::string file_;
+  std::set<std::string> overridden_;
+  std::vector<Issue> issues_;
+};
+
+/// The value of `key` in `map`, or an undefined node (never an invalid one,
+/// which yaml-cpp would throw on) when `map` is not a map or lacks the key.
+YAML::Node Child(const YAML::Node& map, const std::string& key);
+
+/// A short rendering of a node for messages: the scalar, or "a map"/"a list".
+std::string Describe(const YAML::Node& node);
+
+}  // namespace linesim::loader

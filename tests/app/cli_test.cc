@@ -1,0 +1,170 @@
+// End-to-end tests of the `linesim` command: the real binary, real files.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int status;
+  std::string out;
+  std::string err;
+};
+
+std::string ReadFile(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// Runs `linesim ARGS` and captures its exit status, stdout and stderr.
+Result Linesim(const std::string& args) {
+  static int counter = 0;
+  const std::string base = ::testing::TempDir() + "cli_" + std::to_string(++counter);
+  const std::string cmd = std::string(LINESIM_CLI) + " " + args + " >" + base + ".out 2>" +
+                          base + ".err </dev/null";
+  const int raw = std::system(cmd.c_str());
+  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, ReadFile(base + ".out"),
+          ReadFile(base + ".err")};
+}
+
+std::string Fresh(const std::string& name) {
+  const fs::path p = fs::path(::testing::TempDir()) / name;
+  fs::remove_all(p);
+  return p.string();
+}
+
+std::string WriteScenario(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+const std::string kMotorStep = LINESIM_SOURCE_DIR "/scenarios/motor_step.yaml";
+
+// Guards the documented main job: it runs, prints its headline numbers and
+// writes both outputs with the documented columns.
+TEST(Cli, RunMotorStepWritesSummaryAndSignals) {
+  const std::string out = Fresh("run_ok");
+  const Result r = Linesim("run " + kMotorStep + " --out " + out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("final_speed_rad_s_motor0"), std::string::npos) << r.out;
+  const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
+  EXPECT_EQ(summary["status"], "ok");
+  EXPECT_EQ(summary["settings"]["master"]["step_s"], 0.001);
+  EXPECT_TRUE(summary["metrics"].contains("peak_current_a_motor1"));
+  EXPECT_TRUE(summary["timing"]["units"].contains("motors"));
+  const std::string csv = ReadFile(fs::path(out) / "signals.csv");
+  EXPECT_EQ(csv.rfind("time,supply.value[0],supply.value[1],load.value[0]", 0), 0u) << csv.substr(0, 200);
+  // 1.5 s at 1 ms: rows at 0, 0.001, ..., 1.5 plus the header.
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 1501);
+  EXPECT_NE(csv.find("\n1.5,"), std::string::npos);
+}
+
+// Guards determinism (same scenario and seed -> same bytes), also with the
+// other master algorithm and Jacobi threads.
+TEST(Cli, SameFileAndSeedGiveIdenticalSignals) {
+  for (const std::string extra : {"", " --set master.algorithm=jacobi --set master.threads=2"}) {
+    const std::string a = Fresh("det_a"), b = Fresh("det_b");
+    ASSERT_EQ(Linesim("run " + kMotorStep + " --out " + a + extra).status, 0);
+    ASSERT_EQ(Linesim("run " + kMotorStep + " --out " + b + extra).status, 0);
+    const std::string ca = ReadFile(fs::path(a) / "signals.csv");
+    EXPECT_GT(ca.size(), 1000u);
+    EXPECT_EQ(ca, ReadFile(fs::path(b) / "signals.csv")) << extra;
+  }
+}
+
+// Guards the bad-input contract: exit status 2, the key named, nothing
+// written (the output folder is not even created).
+TEST(Cli, BadInputExitsTwoAndWritesNothing) {
+  struct Case {
+    std::string name, text, expected;
+  };
+  const Case cases[] = {
+      {"malformed", "duration_s: 1\nunits: {a: [1, 2\n", "not valid YAML"},
+      {"unknown_type", "duration_s: 1\nunits:\n  m: {type: dc_motr}\n",
+       "units.m.type: unknown unit type 'dc_motr' (closest: dc_motor)"},
+      {"missing_param", "units:\n  m: {type: dc_motor}\n", "duration_s: missing required key"},
+      {"wrong_type", "duration_s: 1\nunits:\n  m: {type: dc_motor, parameters: {resistance: low}}\n",
+       "units.m.parameters.resistance: expected a number"},
+  };
+  for (const Case& c : cases) {
+    const std::string file = WriteScenario(c.name + ".yaml", c.text);
+    const std::string out = Fresh("bad_" + c.name);
+    const Result r = Linesim("run " + file + " --out " + out);
+    EXPECT_EQ(r.status, 2) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(file), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.name;
+  }
+}
+
+// Guards the --set path check from the command line.
+TEST(Cli, UnknownSetPathNamesClosest) {
+  const std::string out = Fresh("bad_set");
+  const Result r = Linesim("run " + kMotorStep + " --out " + out + " --set master.step=0.002");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("closest: master.step_s"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// Guards a numerical failure: the run stops naming unit, variable and time,
+// exits 1, and keeps the rows recorded before the failure.
+TEST(Cli, NumericalFailureKeepsRecordedRows) {
+  const std::string file = WriteScenario("blowup.yaml", R"(duration_s: 0.1
+master: {algorithm: jacobi}
+units:
+  supply:
+    type: step_signal
+    parameters: {unit: V, steps: [{time_s: 0.01, value: 1.0e308}]}
+  motor:
+    type: dc_motor
+connections:
+  - {from: supply.value, to: motor.voltage}
+)");
+  const std::string out = Fresh("blowup");
+  const Result r = Linesim("run " + file + " --out " + out);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("unit 'motor' (dc_motor) at t = 0.01 s"), std::string::npos) << r.err;
+  const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
+  EXPECT_EQ(summary["status"], "failed");
+  const std::string csv = ReadFile(fs::path(out) / "signals.csv");
+  // Jacobi: the motor sees the absurd voltage from the step starting at
+  // 0.01 s, so rows 0 .. 0.01 s (11 rows at 1 ms) were recorded before.
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 11) << csv;
+}
+
+// Guards `inspect` on a type and on a file, and an unknown type.
+TEST(Cli, InspectTypeAndFile) {
+  const Result type = Linesim("inspect dc_motor");
+  ASSERT_EQ(type.status, 0) << type.err;
+  for (const char* part : {"resistance", "parameter", "Ohm", "voltage", "input", "torque",
+                           "output", "N.m"}) {
+    EXPECT_NE(type.out.find(part), std::string::npos) << part;
+  }
+  const Result file = Linesim("inspect " + kMotorStep + " --set units.motors.parameters.count=2");
+  ASSERT_EQ(file.status, 0) << file.err;
+  EXPECT_NE(file.out.find("unit 'supply' (step_signal"), std::string::npos) << file.out;
+  EXPECT_NE(file.out.find("supply.value -> motors.voltage"), std::string::npos) << file.out;
+  const Result unknown = Linesim("inspect dc_motr");
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_NE(unknown.err.find("closest: dc_motor"), std::string::npos) << unknown.err;
+}
+
+// Guards command-line usage errors: they are bad input too.
+TEST(Cli, UsageErrorsExitTwo) {
+  EXPECT_EQ(Linesim("").status, 2);
+  EXPECT_EQ(Linesim("run " + kMotorStep).status, 2);  // --out missing
+  EXPECT_EQ(Linesim("frobnicate").status, 2);
+}
+
+}  // namespace

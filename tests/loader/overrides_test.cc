@@ -1,0 +1,38 @@
+#include "loader/overrides.h"
+
+#include <gtest/gtest.h>
+
+namespace linesim::loader {
+namespace {
+
+// Guards value typing: YAML scalars keep their types and lists stay lists.
+TEST(ApplyOverrides, WritesTypedValuesIntoTheTree) {
+  YAML::Node root = YAML::Load("a: {b: 1, c: [1, 2, 3]}\nflag: false\n");
+  std::vector<Issue> issues;
+  ApplyOverrides(root,
+                 {ParseOverride("a.b=2.5"), ParseOverride("a.c.2=7"), ParseOverride("flag=true"),
+                  ParseOverride("a.d=[4, 5]")},
+                 "f.yaml", issues);
+  EXPECT_TRUE(issues.empty());
+  EXPECT_EQ(root["a"]["b"].as<double>(), 2.5);
+  EXPECT_EQ(root["a"]["c"][2].as<int>(), 7);
+  EXPECT_TRUE(root["flag"].as<bool>());
+  EXPECT_EQ(root["a"]["d"].size(), 2u);
+}
+
+// Guards against creating whole subtrees from a typo: only the last key may
+// be new, and an unknown intermediate key names the closest one.
+TEST(ApplyOverrides, UnknownIntermediateKeyIsAnIssue) {
+  YAML::Node root = YAML::Load("master: {step_s: 0.001}\n");
+  std::vector<Issue> issues;
+  ApplyOverrides(root, {ParseOverride("mastr.step_s=1"), ParseOverride("master.step_s.x=1")},
+                 "f.yaml", issues);
+  ASSERT_EQ(issues.size(), 2u);
+  EXPECT_NE(issues[0].message.find("closest: master"), std::string::npos) << issues[0].message;
+  EXPECT_TRUE(issues[0].from_command_line);
+  EXPECT_NE(issues[1].message.find("holds a value"), std::string::npos) << issues[1].message;
+  EXPECT_FALSE(root["mastr"].IsDefined());
+}
+
+}  // namespace
+}  // namespace linesim::loader

@@ -1,0 +1,219 @@
+#include "loader/scenario.h"
+
+#include <gtest/gtest.h>
+
+#include "loader/unit_types.h"
+#include "scenario_test.h"
+
+namespace linesim::loader {
+namespace {
+
+using testing::kValidScenario;
+using testing::WriteScenario;
+
+// Every issue of an error, one per line, for matching in assertions.
+std::string Issues(const std::string& file, const std::vector<std::string>& sets = {}) {
+  try {
+    LoadScenario(file, sets);
+  } catch (const ScenarioError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+bool Has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// Guards the shipped example: it must load, with its units, connections and
+// master settings as written in the file.
+TEST(LoadScenario, ShippedMotorStepLoads) {
+  const Scenario s = LoadScenario(LINESIM_SOURCE_DIR "/scenarios/motor_step.yaml");
+  EXPECT_EQ(s.name, "motor_step");
+  ASSERT_EQ(s.system->unit_count(), 3u);
+  EXPECT_EQ(s.system->connections().size(), 2u);
+  EXPECT_EQ(s.master->options().base_step, 1'000'000);
+  EXPECT_EQ(s.master->options().stop, 1'500'000'000);
+  EXPECT_EQ(s.metrics.size(), 6u);
+  // The model file sets the datasheet resistance (maxon RE 40: 0.299 Ohm);
+  // the scenario's own gear ratios override the model's.
+  const auto& motors = s.system->unit(*s.system->FindUnit("motors")).variables();
+  EXPECT_EQ(motors.GetRealElement(*motors.Find("resistance"), 1), 0.299);
+  EXPECT_EQ(motors.GetRealElement(*motors.Find("gear_ratio"), 1), 21.0);
+}
+
+// Guards the --set contract: values, list items and new leaf keys.
+TEST(LoadScenario, OverridesChangeValues) {
+  const std::string f = WriteScenario("ov.yaml", kValidScenario);
+  const Scenario s = LoadScenario(
+      f, {"master.step_s=0.002", "master.algorithm=gauss_seidel",
+          "units.motor.parameters.resistance=0.5", "units.supply.parameters.steps.0.value=6"});
+  EXPECT_EQ(s.master->options().base_step, 2'000'000);
+  EXPECT_EQ(s.master->options().algorithm, cosim::Algorithm::kGaussSeidel);
+  const auto& m = s.system->unit(*s.system->FindUnit("motor")).variables();
+  EXPECT_EQ(m.GetRealElement(*m.Find("resistance"), 0), 0.5);
+}
+
+// Guards against a typo in --set going unnoticed: it names the closest path.
+TEST(LoadScenario, UnknownOverridePathNamesClosest) {
+  const std::string f = WriteScenario("ov2.yaml", kValidScenario);
+  const std::string a = Issues(f, {"master.stepp_s=0.1"});
+  EXPECT_TRUE(Has(a, "master.stepp_s")) << a;
+  EXPECT_TRUE(Has(a, "closest: master.step_s")) << a;
+  EXPECT_TRUE(Has(a, "set on the command line")) << a;
+  const std::string b = Issues(f, {"units.motorz.parameters.resistance=1"});
+  EXPECT_TRUE(Has(b, "closest: units.motor")) << b;
+  const std::string c = Issues(f, {"units.motor.parameters.resistanse=1"});
+  EXPECT_TRUE(Has(c, "units.motor.parameters.resistance")) << c;
+  const std::string d = Issues(f, {"connections.5.from=x.y"});
+  EXPECT_TRUE(Has(d, "has 1 items")) << d;
+  const std::string e = Issues(f, {"no_equals_sign"});
+  EXPECT_TRUE(Has(e, "dotted.path=value")) << e;
+}
+
+// Guards the "every problem at once, with line and key path" contract.
+TEST(LoadScenario, ReportsEveryProblemWithLineAndPath) {
+  const std::string f = WriteScenario("many.yaml", R"(name: bad
+duration_s: -1
+colour: blue
+master: {algorithm: simplex, step_s: 0.001}
+units:
+  supply:
+    type: step_signal
+    parameters: {count: 1, unit: V}
+  motor:
+    type: dc_motr
+connections:
+  - {from: supply.value, to: motor.voltage}
+)");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, f + ":2: duration_s: value -1 is out of range")) << all;
+  EXPECT_TRUE(Has(all, f + ":3: colour: unknown key")) << all;
+  EXPECT_TRUE(Has(all, "master.algorithm: 'simplex' is not allowed: expected one of jacobi, "
+                       "gauss_seidel"))
+      << all;
+  EXPECT_TRUE(Has(all, f + ":10: units.motor.type: unknown unit type 'dc_motr' (closest: "
+                       "dc_motor)"))
+      << all;
+}
+
+// Guards: a missing required key and a wrong type each name their key path.
+TEST(LoadScenario, MissingKeyAndWrongTypeNameTheKey) {
+  const std::string f = WriteScenario("missing.yaml", R"(units:
+  motor:
+    type: dc_motor
+    parameters: {count: two, resistance: [1, 2, 3]}
+)");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, "duration_s: missing required key")) << all;
+  EXPECT_TRUE(Has(all, "units.motor.parameters.count: expected an integer, got 'two'")) << all;
+}
+
+// Guards the parameter path: a value of the wrong shape or an unknown name
+// is refused with what was expected.
+TEST(LoadScenario, ParameterValuesAreChecked) {
+  const std::string f = WriteScenario("params.yaml", R"(duration_s: 0.01
+units:
+  motor:
+    type: dc_motor
+    parameters: {count: 2, resistance: [1, 2, 3], inductanse: 1, gear_ratio: fast}
+)");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, "units.motor.parameters.resistance: expected a number (for every "
+                       "element) or a list of 2 numbers, got a list of 3"))
+      << all;
+  EXPECT_TRUE(Has(all, "units.motor.parameters.inductanse: unknown parameter of a dc_motor unit; "
+                       "closest: units.motor.parameters.inductance"))
+      << all;
+  EXPECT_TRUE(Has(all, "units.motor.parameters.gear_ratio: expected a number (for every element)"))
+      << all;
+}
+
+// Guards the range check before time zero: the unit's own parameter check
+// (a resistance must be positive) reaches the user with the key path.
+TEST(LoadScenario, OutOfRangeParameterIsRefusedBeforeTimeZero) {
+  const std::string f = WriteScenario("range.yaml", R"(duration_s: 0.01
+units:
+  motor:
+    type: dc_motor
+    parameters: {count: 2, resistance: [0.3, -1]}
+)");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, f + ":5: units.motor.parameters.resistance.1:")) << all;
+}
+
+// Guards the connection checks through the loader: the system's problems
+// point at the line of the connection.
+TEST(LoadScenario, ConnectionProblemsPointAtTheirLine) {
+  const std::string f = WriteScenario("conn.yaml", R"(duration_s: 0.01
+units:
+  supply:
+    type: step_signal
+    parameters: {count: 3, unit: A}
+  motor:
+    type: dc_motor
+connections:
+  - {from: supply.value, to: motor.voltage}
+  - {from: supply.valu, to: motor.load_torque}
+  - {from: supply, to: motor.voltage}
+)");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, f + ":9: connections.0: connection supply.value -> motor.voltage: "
+                       "array size mismatch"))
+      << all;
+  EXPECT_TRUE(Has(all, "units of measure differ")) << all;
+  EXPECT_TRUE(Has(all, f + ":10: connections.1:")) << all;
+  EXPECT_TRUE(Has(all, "has no variable 'valu' (closest: value)")) << all;
+  EXPECT_TRUE(Has(all, f + ":11: connections.2: 'supply' is not an endpoint")) << all;
+}
+
+// Guards model files: an unknown name lists the closest shipped model.
+TEST(LoadScenario, UnknownModelFileNamesClosest) {
+  const std::string f = WriteScenario("model.yaml", R"(duration_s: 0.01
+units:
+  motor:
+    type: dc_motor
+    parameters: {model: raw3_driv}
+)");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, "units.motor.parameters.model: no model file")) << all;
+  EXPECT_TRUE(Has(all, "closest: raw3_drive")) << all;
+}
+
+// Guards file-level failures: a missing file and malformed YAML.
+TEST(LoadScenario, UnreadableAndMalformedFiles) {
+  EXPECT_TRUE(Has(Issues("/nonexistent/x.yaml"), "cannot read the file"));
+  const std::string f = WriteScenario("broken.yaml", "units: {motor: [1, 2\nduration_s: 1\n");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, "not valid YAML")) << all;
+  EXPECT_TRUE(Has(all, f + ":")) << all;
+}
+
+// Guards recording and metrics validation.
+TEST(LoadScenario, RecordingAndMetricsAreChecked) {
+  const std::string f = WriteScenario("rec.yaml", std::string(kValidScenario) + R"(recording:
+  interval_s: 0.0015
+  variables: [motor.current, motor.currnt]
+metrics:
+  - {name: m, of: motor.current, reduce: median}
+)");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, "recording.interval_s: expected a whole multiple of master.step_s")) << all;
+  EXPECT_TRUE(Has(all, "recording.variables.1:")) << all;
+  EXPECT_TRUE(Has(all, "(closest: current)")) << all;
+  EXPECT_TRUE(Has(all, "metrics.0.reduce: 'median' is not allowed")) << all;
+}
+
+// Guards `inspect TYPE`: every registered type builds with its defaults.
+TEST(UnitTypes, EveryTypeBuildsWithDefaults) {
+  for (const auto& name : UnitTypeNames()) {
+    const auto unit = CreateDefaultUnit(name);
+    ASSERT_TRUE(unit) << name;
+    EXPECT_EQ(unit->type_name(), name);
+    EXPECT_GT(unit->variables().size(), 0u);
+  }
+  EXPECT_THROW(CreateDefaultUnit("dc_motorr"), ScenarioError);
+}
+
+}  // namespace
+}  // namespace linesim::loader

@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Installs what is missing (tools/setup.sh), then configures and builds
+# linesim in ./build (Release). Safe to run again: it only rebuilds what
+# changed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash tools/setup.sh
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake --build build --parallel "$(nproc)"
