@@ -180,6 +180,22 @@ units:
   EXPECT_TRUE(Has(all, "closest: raw3_drive")) << all;
 }
 
+// Guards the shipped motor model files: each loads in both motor modes (a
+// model file describes motor and gearbox, never the load, so it has no
+// full-mode-only keys).
+TEST(LoadScenario, ModelFilesLoadInBothModes) {
+  for (const char* model : {"maxon_re40_148877", "raw3_drive", "raw3_steer"}) {
+    for (const char* mode : {"full", "current_only"}) {
+      const std::string f = WriteScenario("models.yaml", std::string(R"(duration_s: 0.01
+units:
+  motor:
+    type: dc_motor
+    parameters: {model: )") + model + ", mode: " + mode + "}\n");
+      EXPECT_NO_THROW(LoadScenario(f)) << model << " " << mode << ": " << Issues(f);
+    }
+  }
+}
+
 // Guards file-level failures: a missing file and malformed YAML.
 TEST(LoadScenario, UnreadableAndMalformedFiles) {
   EXPECT_TRUE(Has(Issues("/nonexistent/x.yaml"), "cannot read the file"));
