@@ -197,7 +197,13 @@ void Master::PropagateInitialValues() {
     if (!changed && pass > 0) return;
     for (std::size_t u = 0; u < n; ++u) {
       const auto t0 = Clock::now();
-      system_.unit(u).Initialize();
+      // Name the unit, as the first Initialize pass in Start() does.
+      try {
+        system_.unit(u).Initialize();
+      } catch (const std::exception& e) {
+        RecordError(u, time_, std::string("initialize failed: ") + e.what());
+        return;
+      }
       unit_wall_seconds_[u] += SecondsSince(t0);
     }
   }

@@ -216,6 +216,25 @@ TEST(MasterInitialValues, PropagateThroughAChainOfFeedthroughUnits) {
   }
 }
 
+// Guards against: a unit that refuses an initial input value being
+// reported without its name. The input only arrives during initial value
+// propagation (source value 2 > limit 1), after the first Initialize pass.
+TEST(MasterInitialValues, UnitThrowingDuringPropagationIsNamed) {
+  System system;
+  system.Add(std::make_unique<RampSource>("source", 0.0, 2.0, "1"));
+  system.Add(std::make_unique<test_units::PickyUnit>("picky", 1.0));
+  system.Connect("source.value", "picky.u");
+  MasterOptions o;
+  o.stop = 10 * kMs;
+  Master master(system, o);
+  const RunResult r = master.Run();
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.base_steps, 0);
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_THAT(r.errors[0], HasSubstr("unit 'picky' (Picky) at t = 0 s"));
+  EXPECT_THAT(r.errors[0], HasSubstr("above its limit"));
+}
+
 struct FaultyRun {
   RunResult result;
   std::string csv;

@@ -127,8 +127,9 @@ TEST(CsvRecorder, RecordsEveryTypeAsNumbers) {
 }
 
 // Guards against: the decimation interval being ignored or counted from 0
-// instead of the start time. Start 0.5 s, stop 0.52 s, base 1 ms, interval
-// 4 ms: rows at 0.5, 0.504, ..., 0.52 (6 rows).
+// instead of the start time. Start 0.501 s (not a multiple of the
+// interval), stop 0.521 s, base 1 ms, interval 4 ms: rows at 0.501, 0.505,
+// ..., 0.521 (6 rows).
 TEST(CsvRecorder, DecimationInterval) {
   System system;
   system.Add(std::make_unique<RampSource>("ramp"));
@@ -136,14 +137,14 @@ TEST(CsvRecorder, DecimationInterval) {
   CsvRecorder recorder(csv, ResolveProbes(system, {"ramp.value"}), 4 * kMs);
   MasterOptions o;
   o.base_step = kMs;
-  o.start = 500 * kMs;
-  o.stop = 520 * kMs;
+  o.start = 501 * kMs;
+  o.stop = 521 * kMs;
   Master master(system, o);
   master.AddObserver(&recorder);
   ASSERT_TRUE(master.Run().ok);
   EXPECT_EQ(csv.str(),
-            "time,ramp.value\n0.5,0.5\n0.504,0.504\n0.508,0.508\n0.512,0.512\n0.516,0.516\n"
-            "0.52,0.52\n");
+            "time,ramp.value\n0.501,0.501\n0.505,0.505\n0.509,0.509\n0.513,0.513\n"
+            "0.517,0.517\n0.521,0.521\n");
 }
 
 std::vector<MetricSpec> RampMetrics(const System& system) {

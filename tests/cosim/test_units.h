@@ -3,13 +3,15 @@
 // Units used only by the cosim tests. Each is as small as the test that uses
 // it allows; none includes robot code.
 
-#include <Eigen/Dense>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <Eigen/Dense>
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "cosim/unit.h"
@@ -227,6 +229,29 @@ class PassThrough : public Unit {
 
  private:
   bool feedthrough_;
+  double u_ = 0.0;
+  double y_ = 0.0;
+};
+
+/// y = u with feedthrough; Initialize refuses an input above `limit`, as a
+/// unit checking a value it receives from another unit would.
+class PickyUnit : public Unit {
+ public:
+  PickyUnit(std::string name, double limit) : Unit("Picky", std::move(name)), limit_(limit) {
+    variables().Input("u", "1", &u_, "checked input");
+    variables().Output("y", "1", &y_, "copy of u", {"u"});
+  }
+  void Initialize() override {
+    if (u_ > limit_) throw UnitError("input u = " + std::to_string(u_) + " above its limit");
+    y_ = u_;
+  }
+  StepResult DoStep(TimeNs, TimeNs) override {
+    y_ = u_;
+    return StepResult::kOk;
+  }
+
+ private:
+  double limit_;
   double u_ = 0.0;
   double y_ = 0.0;
 };
