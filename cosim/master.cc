@@ -1,6 +1,7 @@
 #include "cosim/master.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <bit>
 #include <chrono>
@@ -22,6 +23,14 @@ bool SameBits(double a, double b) {
 }
 
 }  // namespace
+
+// Keeps TBB out of the public header; limits Jacobi to `threads` threads.
+struct Master::Arena {
+  explicit Arena(int threads) : arena(threads) {}
+  tbb::task_arena arena;
+};
+
+Master::~Master() = default;
 
 Master::Master(System& system, MasterOptions options)
     : system_(system), options_(options) {
@@ -63,8 +72,19 @@ Master::Master(System& system, MasterOptions options)
   if (!problems.empty()) throw ConfigError(std::move(problems));
 
   links_into_.assign(n, {});
+  links_from_.assign(n, {});
   const auto& links = system_.links();
-  for (std::size_t l = 0; l < links.size(); ++l) links_into_[links[l].to_unit].push_back(l);
+  for (std::size_t l = 0; l < links.size(); ++l) {
+    links_into_[links[l].to_unit].push_back(l);
+    links_from_[links[l].from_unit].push_back(l);
+  }
+  has_feedthrough_.assign(n, false);
+  for (std::size_t u = 0; u < n; ++u) {
+    for (const auto& info : system_.unit(u).variables().infos()) {
+      if (!info.depends_on.empty()) has_feedthrough_[u] = true;
+    }
+  }
+  if (options_.threads > 1) arena_ = std::make_unique<Arena>(options_.threads);
   real_outputs_.assign(n, {});
   for (std::size_t u = 0; u < n; ++u) {
     for (const auto& info : system_.unit(u).variables().infos()) {
@@ -185,6 +205,18 @@ bool Master::StepUnit(std::size_t u, TimeNs t, TimeNs dt) {
   return true;
 }
 
+bool Master::UpdateUnitOutputs(std::size_t u, TimeNs t) {
+  const auto t0 = options_.profile ? Clock::now() : Clock::time_point{};
+  try {
+    system_.unit(u).UpdateOutputs();
+  } catch (const std::exception& e) {
+    RecordError(u, t, std::string("updating outputs from new inputs failed: ") + e.what());
+    return false;
+  }
+  if (options_.profile) unit_wall_seconds_[u] += SecondsSince(t0);
+  return CheckOutputs(u, t);
+}
+
 void Master::PropagateInitialValues() {
   // Outputs with direct feedthrough depend on inputs, which come from other
   // units' outputs: repeat transfer + Initialize until nothing changes. With
@@ -218,6 +250,8 @@ void Master::Start() {
   const auto wall0 = Clock::now();
   const std::size_t n = system_.unit_count();
   pending_errors_.assign(n, {});
+  unit_wall_seconds_.assign(n, 0.0);
+  total_wall_seconds_ = 0;
   errors_.clear();
   failed_ = false;
   time_ = options_.start;
@@ -275,13 +309,30 @@ bool Master::Step() {
     if (at_point(u)) due_.push_back(u);
   }
 
+  // Outputs with direct feedthrough follow the inputs of this communication
+  // point (FMI: outputs read after inputs are set reflect them). Dependency
+  // order puts a feedthrough unit after the units feeding it, so one pass
+  // resolves chains; each update is passed on to the due units it feeds.
+  for (std::size_t u : due_) transfer_into(u);
+  for (std::size_t u : due_) {
+    if (!has_feedthrough_[u]) continue;
+    if (!UpdateUnitOutputs(u, t)) {
+      total_wall_seconds_ += SecondsSince(wall0);
+      return false;
+    }
+    for (std::size_t l : links_from_[u]) {
+      if (at_point(links[l].to_unit)) Transfer(links[l]);
+    }
+  }
+
   bool ok = true;
   if (options_.algorithm == Algorithm::kJacobi) {
-    for (std::size_t u : due_) transfer_into(u);
     if (options_.threads > 1 && due_.size() > 1) {
-      tbb::parallel_for(std::size_t{0}, due_.size(), [&](std::size_t i) {
-        const std::size_t u = due_[i];
-        StepUnit(u, t, h * decimation_[u]);
+      arena_->arena.execute([&] {
+        tbb::parallel_for(std::size_t{0}, due_.size(), [&](std::size_t i) {
+          const std::size_t u = due_[i];
+          StepUnit(u, t, h * decimation_[u]);
+        });
       });
       for (std::size_t u : due_) ok &= pending_errors_[u].empty();
     } else {

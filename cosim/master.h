@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,7 @@ class Master {
   /// Builds the system if needed and checks the steps; throws ConfigError
   /// listing every problem.
   Master(System& system, MasterOptions options);
+  ~Master();
 
   void AddObserver(Observer* observer) { observers_.push_back(observer); }
 
@@ -84,6 +86,7 @@ class Master {
   bool Transfer(const Link& link);
   bool StepUnit(std::size_t u, TimeNs t, TimeNs dt);
   bool CheckOutputs(std::size_t u, TimeNs t);
+  bool UpdateUnitOutputs(std::size_t u, TimeNs t);
   void RecordError(std::size_t u, TimeNs t, const std::string& cause);
   void Notify(TimeNs t);
 
@@ -92,6 +95,10 @@ class Master {
   std::vector<Observer*> observers_;
   std::vector<std::int64_t> decimation_;
   std::vector<std::vector<std::size_t>> links_into_;  // per destination unit
+  std::vector<std::vector<std::size_t>> links_from_;  // per source unit
+  std::vector<bool> has_feedthrough_;                 // some output depends on an input
+  struct Arena;                                       // TBB arena of `threads` threads
+  std::unique_ptr<Arena> arena_;
   std::vector<std::vector<ValueRef>> real_outputs_;   // per unit, for the NaN guard
   std::vector<std::size_t> due_;
   std::vector<double> unit_wall_seconds_;

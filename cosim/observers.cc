@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "cosim/closest_names.h"
 
@@ -71,6 +72,12 @@ CsvRecorder::CsvRecorder(std::ostream& out, std::vector<Probe> probes, TimeNs in
 void CsvRecorder::OnStart(const Master& master) {
   start_ = master.options().start;
   if (interval_ <= 0) interval_ = master.options().base_step;
+  // Rows exist only at master steps: any other interval would record nothing.
+  if (interval_ % master.options().base_step != 0) {
+    throw std::invalid_argument("recording interval " + FormatSeconds(interval_) +
+                                " s is not a multiple of the master step " +
+                                FormatSeconds(master.options().base_step) + " s");
+  }
   out_ << "time";
   for (const Probe& p : probes_) out_ << ',' << p.label;
   out_ << '\n';

@@ -1,6 +1,7 @@
 #include "cosim/system.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <functional>
 #include <map>

@@ -4,6 +4,7 @@ namespace linesim::cosim {
 
 UnitState Unit::SaveState() const {
   UnitState state;
+  state.type_name = type_name_;
   state.variables.reserve(variables_.size());
   for (const auto& info : variables_.infos()) state.variables.push_back(variables_.GetValue(info.ref));
   SaveInternal(state);
@@ -11,6 +12,10 @@ UnitState Unit::SaveState() const {
 }
 
 void Unit::RestoreState(const UnitState& state) {
+  if (state.type_name != type_name_) {
+    throw std::invalid_argument("state of a '" + state.type_name + "' unit restored into unit '" +
+                                name_ + "' of type '" + type_name_ + "'");
+  }
   if (state.variables.size() != variables_.size()) {
     throw std::invalid_argument("state of " + std::to_string(state.variables.size()) +
                                 " variables restored into unit '" + name_ + "' with " +

@@ -16,6 +16,7 @@ enum class StepResult { kOk, kDiscard, kError };
 /// A snapshot of one unit: every declared variable plus whatever internal
 /// state the unit adds (integrator states, random generator, counters).
 struct UnitState {
+  std::string type_name;  // a state restores only into a unit of its type
   std::vector<Value> variables;
   std::vector<double> reals;
   std::vector<std::int64_t> integers;
@@ -67,6 +68,11 @@ class Unit {
   /// Computes outputs at the start time from parameters, start values and
   /// the current inputs. Must be idempotent.
   virtual void Initialize() {}
+  /// At a communication point, after new inputs are set: recomputes the
+  /// outputs that depend directly on inputs (declared with depends_on) from
+  /// the current state and those inputs, without advancing. The master calls
+  /// it only for units that declare such outputs; the default does nothing.
+  virtual void UpdateOutputs() {}
   /// Advances from t to t + dt with the inputs held as set.
   virtual StepResult DoStep(TimeNs t, TimeNs dt) = 0;
   virtual void Terminate() {}

@@ -1,6 +1,7 @@
 // End-to-end tests of the `linesim` command: the real binary, real files.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -29,7 +30,9 @@ std::string ReadFile(const fs::path& p) {
 // Runs `linesim ARGS` and captures its exit status, stdout and stderr.
 Result Linesim(const std::string& args) {
   static int counter = 0;
-  const std::string base = ::testing::TempDir() + "cli_" + std::to_string(++counter);
+  // ctest runs tests as parallel processes: the pid keeps their files apart.
+  const std::string base = ::testing::TempDir() + "cli_" + std::to_string(getpid()) + "_" +
+                           std::to_string(++counter);
   const std::string cmd = std::string(LINESIM_CLI) + " " + args + " >" + base + ".out 2>" +
                           base + ".err </dev/null";
   const int raw = std::system(cmd.c_str());
@@ -38,13 +41,13 @@ Result Linesim(const std::string& args) {
 }
 
 std::string Fresh(const std::string& name) {
-  const fs::path p = fs::path(::testing::TempDir()) / name;
+  const fs::path p = fs::path(::testing::TempDir()) / (name + "_" + std::to_string(getpid()));
   fs::remove_all(p);
   return p.string();
 }
 
 std::string WriteScenario(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + name;
+  const std::string path = ::testing::TempDir() + std::to_string(getpid()) + "_" + name;
   std::ofstream(path) << text;
   return path;
 }

@@ -385,3 +385,41 @@ TEST(MasterStepwise, NonZeroStartTime) {
 
 }  // namespace
 }  // namespace linesim::cosim
+
+namespace linesim::cosim {
+namespace {
+
+// Guards the FMI feedthrough contract at communication points: with Jacobi,
+// a chain source -> a -> b -> sink of direct-feedthrough pass-throughs must
+// deliver the source's value of the same communication point (the chain is
+// algebraic: y = u), not one stale step per unit. Expected from the rule:
+// the sink sees ramp(t) = t at each of its steps t. Gauss-Seidel steps the
+// source first, so the sink sees ramp(t + h).
+TEST(MasterFeedthrough, OutputsFollowInputsSetAtTheSameCommunicationPoint) {
+  for (Algorithm alg : {Algorithm::kJacobi, Algorithm::kGaussSeidel}) {
+    System system;
+    auto* sink = static_cast<test_units::RecordingSink*>(
+        &system.Add(std::make_unique<test_units::RecordingSink>("sink", "s")));
+    system.Add(std::make_unique<test_units::PassThrough>("b", true, "s"));
+    system.Add(std::make_unique<test_units::PassThrough>("a", true, "s"));
+    system.Add(std::make_unique<test_units::RampSource>("source"));
+    system.Connect("source.value", "a.u");
+    system.Connect("a.y", "b.u");
+    system.Connect("b.y", "sink.value");
+    MasterOptions o;
+    o.algorithm = alg;
+    o.base_step = kMs;
+    o.stop = 5 * kMs;
+    Master master(system, o);
+    ASSERT_TRUE(master.Run().ok);
+    ASSERT_EQ(sink->seen.size(), 5u);
+    for (std::size_t k = 0; k < 5; ++k) {
+      const double t = static_cast<double>(k) * 1e-3;
+      const double expected = alg == Algorithm::kJacobi ? t : t + 1e-3;
+      EXPECT_DOUBLE_EQ(sink->seen[k], expected) << "step " << k;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace linesim::cosim

@@ -147,6 +147,21 @@ TEST(CsvRecorder, DecimationInterval) {
             "0.517,0.517\n0.521,0.521\n");
 }
 
+// Guards against a recording that silently writes no rows: an interval that
+// is not a multiple of the master step is refused when the run starts.
+TEST(CsvRecorder, RefusesAnIntervalOffTheMasterSteps) {
+  System system;
+  system.Add(std::make_unique<RampSource>("ramp"));
+  std::ostringstream csv;
+  CsvRecorder recorder(csv, ResolveProbes(system, {"ramp.value"}), 3 * kMs / 2);
+  MasterOptions o;
+  o.base_step = kMs;
+  o.stop = 6 * kMs;
+  Master master(system, o);
+  master.AddObserver(&recorder);
+  EXPECT_THROW(master.Run(), std::invalid_argument);
+}
+
 std::vector<MetricSpec> RampMetrics(const System& system) {
   const Probe probe = ResolveProbes(system, {"ramp.value"}).front();
   std::vector<MetricSpec> specs;

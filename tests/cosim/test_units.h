@@ -222,6 +222,9 @@ class PassThrough : public Unit {
   void Initialize() override {
     if (feedthrough_) y_ = u_;
   }
+  void UpdateOutputs() override {
+    if (feedthrough_) y_ = u_;
+  }
   StepResult DoStep(TimeNs, TimeNs) override {
     y_ = u_;
     return StepResult::kOk;

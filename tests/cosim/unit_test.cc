@@ -131,6 +131,15 @@ TEST(UnitState, RestoringAStateOfTheWrongSizeThrows) {
   }
   UnitState empty;
   EXPECT_THROW(coupling.RestoreState(empty), std::invalid_argument);
+  // Same variable count (8), other type: refused before anything is written.
+  const UnitState before = mass1.SaveState();
+  try {
+    mass1.RestoreState(coupling.SaveState());
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("restored into unit 'mass1'"));
+  }
+  EXPECT_EQ(mass1.SaveState().variables, before.variables);
 }
 
 // Guards against: a unit's internal part accepting a truncated snapshot

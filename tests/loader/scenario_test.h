@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <fstream>
 #include <string>
 
@@ -9,7 +11,8 @@ namespace linesim::loader::testing {
 
 /// Writes `text` to a fresh file in the test's temporary folder.
 inline std::string WriteScenario(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + name;
+  // ctest runs tests as parallel processes: the pid keeps their files apart.
+  const std::string path = ::testing::TempDir() + std::to_string(getpid()) + "_" + name;
   std::ofstream(path) << text;
   return path;
 }

@@ -56,6 +56,8 @@ class DcMotorUnit : public cosim::Unit {
   /// value; Initialize throws them all as one cosim::UnitError.
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
+  /// Current-only mode: the torque follows a new shaft speed at once.
+  void UpdateOutputs() override { ComputeOutputs(); }
 
   int count() const { return count_; }
   MotorMode mode() const { return mode_; }

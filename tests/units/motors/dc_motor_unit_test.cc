@@ -298,6 +298,26 @@ TEST(DcMotorUnit, CurrentOnlyConvergesExponentially) {
   EXPECT_NEAR(Get(u, "current")[0], i_ss, 1e-6 * std::abs(i_ss));
 }
 
+// Guards the FMI feedthrough contract in current-only mode: after a new
+// shaft speed is set at a communication point, UpdateOutputs makes the
+// torque follow it at once (torque = eta N (k_t i - b N w), the model's own
+// output equation), without advancing the current.
+TEST(DcMotorUnit, CurrentOnlyTorqueFollowsNewShaftSpeedOnUpdate) {
+  const Motor m;
+  const double n = 21.0, eta = 0.75;
+  DcMotorUnit u("m", 1, MotorMode::kCurrentOnly);
+  SetAll(u, "gear_ratio", n);
+  SetAll(u, "gear_efficiency", eta);
+  SetAll(u, "voltage", 24.0);
+  u.Initialize();
+  ASSERT_EQ(u.DoStep(0, kMs), cosim::StepResult::kOk);
+  const double i = Get(u, "current")[0];
+  SetAll(u, "shaft_speed", 30.0);
+  u.UpdateOutputs();
+  EXPECT_EQ(Get(u, "current")[0], i);
+  EXPECT_NEAR(Get(u, "torque")[0], eta * n * (m.kt * i - m.b * n * 30.0), 1e-12);
+}
+
 // ---------------------------------------------------------------------------
 // (d) Guards against motors of one instance leaking into each other (state
 // or parameter indexing, Jacobian blocks). Each must match its own
