@@ -25,13 +25,17 @@ using linesim::cosim::System;
 using linesim::cosim::TimeNs;
 using linesim::cosim::Unit;
 
+// y = u, declared with or without direct feedthrough (with it, the master
+// also updates the output at each communication point: the worst case).
 class CopyUnit : public Unit {
  public:
-  explicit CopyUnit(std::string name) : Unit("Copy", std::move(name)) {
+  CopyUnit(std::string name, bool feedthrough) : Unit("Copy", std::move(name)) {
     variables().Input("u", "1", &u_, "input");
-    variables().Output("y", "1", &y_, "copy of u", {"u"});
+    variables().Output("y", "1", &y_, "copy of u",
+                       feedthrough ? std::vector<std::string>{"u"} : std::vector<std::string>{});
   }
   void Initialize() override { y_ = u_; }
+  void UpdateOutputs() override { y_ = u_; }
   StepResult DoStep(TimeNs, TimeNs) override {
     y_ = u_;
     return StepResult::kOk;
@@ -45,7 +49,7 @@ class CopyUnit : public Unit {
 void BM_MasterStep(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   System system;
-  for (int i = 0; i < n; ++i) system.Add(std::make_unique<CopyUnit>("u" + std::to_string(i)));
+  for (int i = 0; i < n; ++i) system.Add(std::make_unique<CopyUnit>("u" + std::to_string(i), state.range(3) != 0));
   for (int i = 1; i < n; ++i) {
     system.Connect("u" + std::to_string(i - 1) + ".y", "u" + std::to_string(i) + ".u");
   }
@@ -70,12 +74,13 @@ void BM_MasterStep(benchmark::State& state) {
   state.counters["ns_per_step"] = ns / steps;
   state.counters["ns_per_unit_step"] = ns / (steps * n);
   state.SetLabel(std::string(o.algorithm == Algorithm::kJacobi ? "jacobi" : "gauss_seidel") +
-                 (o.profile ? " profile" : " no_profile"));
+                 (o.profile ? " profile" : " no_profile") +
+                 (state.range(3) ? " feedthrough" : ""));
   master.Finish();
 }
 
 BENCHMARK(BM_MasterStep)
-    ->ArgNames({"units", "gs", "profile"})
-    ->ArgsProduct({{1, 10, 100}, {0, 1}, {0, 1}});
+    ->ArgNames({"units", "gs", "profile", "feedthrough"})
+    ->ArgsProduct({{1, 10, 100}, {0, 1}, {0, 1}, {0, 1}});
 
 }  // namespace

@@ -313,9 +313,15 @@ bool Master::Step() {
   // point (FMI: outputs read after inputs are set reflect them). Dependency
   // order puts a feedthrough unit after the units feeding it, so one pass
   // resolves chains; each update is passed on to the due units it feeds.
-  for (std::size_t u : due_) transfer_into(u);
+  // Gauss-Seidel transfers into every unit right before it steps anyway, so
+  // here only the feedthrough units need their inputs.
+  const bool jacobi = options_.algorithm == Algorithm::kJacobi;
+  if (jacobi) {
+    for (std::size_t u : due_) transfer_into(u);
+  }
   for (std::size_t u : due_) {
     if (!has_feedthrough_[u]) continue;
+    if (!jacobi) transfer_into(u);
     if (!UpdateUnitOutputs(u, t)) {
       total_wall_seconds_ += SecondsSince(wall0);
       return false;
@@ -326,7 +332,7 @@ bool Master::Step() {
   }
 
   bool ok = true;
-  if (options_.algorithm == Algorithm::kJacobi) {
+  if (jacobi) {
     if (options_.threads > 1 && due_.size() > 1) {
       arena_->arena.execute([&] {
         tbb::parallel_for(std::size_t{0}, due_.size(), [&](std::size_t i) {
