@@ -33,7 +33,8 @@ std::string TypeLabel(const cosim::VariableInfo& v) {
   return std::string(cosim::ToString(v.type));
 }
 
-// The variable table as aligned columns.
+// The variable table as aligned columns; "start" is the value the unit
+// starts with: its declared start value, or what the scenario set.
 void PrintTable(const cosim::Unit& unit, std::ostream& out) {
   struct Row {
     std::string cells[6];
@@ -48,11 +49,12 @@ void PrintTable(const cosim::Unit& unit, std::ostream& out) {
       description += "]";
     }
     rows.push_back({{v.name, std::string(cosim::ToString(v.causality)), TypeLabel(v),
-                     v.unit.empty() ? "-" : v.unit, cosim::FormatValue(v.start), description}});
+                     v.unit.empty() ? "-" : v.unit, cosim::FormatValue(table.GetValue(v.ref)),
+                     description}});
   }
   std::size_t width[5] = {};
   for (const auto& r : rows) {
-    for (int c = 0; c < 5; ++c) width[c] = std::max(width[c], std::min<std::size_t>(r.cells[c].size(), 40));
+    for (int c = 0; c < 5; ++c) width[c] = std::max(width[c], r.cells[c].size());
   }
   for (const auto& r : rows) {
     out << "  ";
