@@ -345,11 +345,17 @@ bool Master::Step() {
       for (std::size_t u : due_) ok &= StepUnit(u, t, h * decimation_[u]);
     }
   } else {
+    // Check each unit before the next one consumes its outputs, so that a
+    // NaN is blamed on the unit that made it.
     for (std::size_t u : due_) {
       transfer_into(u);
       if (!StepUnit(u, t, h * decimation_[u])) {
         ok = false;
         break;
+      }
+      if (!CheckOutputs(u, t + h * decimation_[u])) {
+        total_wall_seconds_ += SecondsSince(wall0);
+        return false;
       }
     }
   }
@@ -364,12 +370,12 @@ bool Master::Step() {
     total_wall_seconds_ += SecondsSince(wall0);
     return false;
   }
-  for (std::size_t u : due_) {
-    if (!CheckOutputs(u, t + h * decimation_[u])) ok = false;
-  }
-  if (!ok) {
-    total_wall_seconds_ += SecondsSince(wall0);
-    return false;
+  if (jacobi) {
+    for (std::size_t u : due_) ok &= CheckOutputs(u, t + h * decimation_[u]);
+    if (!ok) {
+      total_wall_seconds_ += SecondsSince(wall0);
+      return false;
+    }
   }
   ++step_index_;
   time_ = options_.start + step_index_ * h;

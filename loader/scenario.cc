@@ -1,5 +1,7 @@
 #include "loader/scenario.h"
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <map>
 
@@ -212,6 +214,14 @@ class Builder {
 
   void BuildUnit(const std::string& name, const YAML::Node& key, const YAML::Node& spec) {
     const std::string path = JoinPath("units", name);
+    const bool identifier =
+        !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+          return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+        });
+    if (!identifier) {
+      r_.Error(key, path, "unit name '" + name + "' is not valid: expected letters, digits and _");
+      return;
+    }
     if (!r_.ExpectMap(spec, path)) return;
     r_.CheckKeys(spec, path, {"type", "step_s", "parameters"});
     const std::string type_name = r_.String(spec, path, "type", std::nullopt);
@@ -245,7 +255,6 @@ class Builder {
       return;
     }
     if (!unit || r_.issues().size() != issues_before) return;
-    (void)key;
 
     std::vector<std::string> structural;
     for (const auto& k : type->structural_keys) structural.push_back(k.name);

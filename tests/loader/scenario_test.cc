@@ -129,6 +129,18 @@ units:
       << all;
 }
 
+// Guards unit names: they are the first part of every connection path, so
+// a dot or a dash in one is refused at its line.
+TEST(LoadScenario, InvalidUnitNameIsRefused) {
+  const std::string f = WriteScenario("name.yaml", R"(duration_s: 0.01
+units:
+  left-motor:
+    type: dc_motor
+)");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, f + ":3: units.left-motor: unit name 'left-motor' is not valid")) << all;
+}
+
 // Guards the range check before time zero: the unit's own parameter check
 // (a resistance must be positive) reaches the user with the key path.
 TEST(LoadScenario, OutOfRangeParameterIsRefusedBeforeTimeZero) {
