@@ -60,12 +60,12 @@ Master::Master(System& system, MasterOptions options)
       problems.push_back({"unit '" + name + "' step " + FormatSeconds(step) +
                               " s is not an integer multiple of the master step " +
                               FormatSeconds(h) + " s",
-                          std::nullopt});
+                          std::nullopt, u});
     } else if (duration % step != 0) {
       problems.push_back({"unit '" + name + "' step " + FormatSeconds(step) +
                               " s does not divide the duration " + FormatSeconds(duration) +
                               " s",
-                          std::nullopt});
+                          std::nullopt, u});
     }
     decimation_[u] = std::max<TimeNs>(1, step / h);
   }

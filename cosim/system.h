@@ -31,12 +31,16 @@ struct Connection {
   Endpoint to;
 };
 
-/// One problem found while building a system or a master; `connection` is
-/// the index of the connection it concerns, when it concerns one (so that a
-/// loader can point at the line of that connection in its file).
+/// One problem found while building a system or a master; `connection` and
+/// `unit` are the indices of the connection or unit it concerns, when it
+/// concerns one (so that a loader can point at its line in the file).
 struct Problem {
+  Problem(std::string message_text, std::optional<std::size_t> connection_index = std::nullopt,
+          std::optional<std::size_t> unit_index = std::nullopt)
+      : message(std::move(message_text)), connection(connection_index), unit(unit_index) {}
   std::string message;
   std::optional<std::size_t> connection;
+  std::optional<std::size_t> unit;
 };
 
 /// Every problem found at once, never just the first.

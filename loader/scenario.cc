@@ -154,6 +154,7 @@ class Builder {
         r_.Integer(root, "", "seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
 
     cosim::MasterOptions options;
+    const std::size_t issues_before_master = r_.issues().size();
     const YAML::Node master = Child(root, "master");
     if (master.IsDefined() && !master.IsNull() && r_.ExpectMap(master, "master")) {
       r_.CheckKeys(master, "master", {"algorithm", "step_s", "threads"});
@@ -172,6 +173,7 @@ class Builder {
     options.threads = static_cast<int>(r_.Integer(master_map, "master", "threads", 1, 1, 256));
     options.start = 0;
     options.stop = cosim::SecondsToNs(s_.duration_s);
+    const bool master_ok = r_.issues().size() == issues_before_master;
 
     s_.system = std::make_unique<cosim::System>();
     const std::size_t issues_before_units = r_.issues().size();
@@ -183,14 +185,22 @@ class Builder {
 
     try {
       s_.system->Build();
-      const bool options_ok = r_.ok();
+      // Bad master settings were reported above; the master would only
+      // report them again.
+      if (!master_ok) return;
       s_.master = std::make_unique<cosim::Master>(*s_.system, options);
-      if (!options_ok) return;
+      if (!r_.ok()) return;
     } catch (const cosim::ConfigError& e) {
       for (const auto& p : e.problems()) {
         if (p.connection && *p.connection < connection_nodes.size()) {
           const auto& [index, node] = connection_nodes[*p.connection];
           r_.Error(node, "connections." + std::to_string(index), p.message);
+        } else if (p.unit && *p.unit < unit_nodes_.size()) {
+          const auto& [name, node] = unit_nodes_[*p.unit];
+          const YAML::Node step = Child(node, "step_s");
+          r_.Error(step.IsDefined() ? step : node,
+                   JoinPath(JoinPath("units", name), step.IsDefined() ? "step_s" : ""),
+                   p.message);
         } else {
           r_.Error(root, "", p.message);
         }
@@ -305,7 +315,10 @@ class Builder {
                  p.message);
       }
     }
-    if (r_.issues().size() == issues_before) s_.system->Add(std::move(unit), step);
+    if (r_.issues().size() == issues_before) {
+      s_.system->Add(std::move(unit), step);
+      unit_nodes_.emplace_back(name, spec);
+    }
   }
 
   // The YAML index and node of each connection added to the system.
@@ -403,6 +416,8 @@ class Builder {
   Scenario& s_;
   YamlReader& r_;
   std::vector<std::unique_ptr<YamlReader>> model_readers_;
+  // Name and YAML node of each unit added to the system, in system order.
+  std::vector<std::pair<std::string, YAML::Node>> unit_nodes_;
 };
 
 }  // namespace

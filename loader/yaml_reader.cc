@@ -23,7 +23,9 @@ std::string Describe(const YAML::Node& node) {
   if (!node.IsDefined() || node.IsNull()) return "nothing";
   if (node.IsMap()) return "a map";
   if (node.IsSequence()) return "a list";
-  return "'" + node.Scalar() + "'";
+  // Long values (a whole file read as one scalar) are cut for messages.
+  const std::string& v = node.Scalar();
+  return "'" + (v.size() > 60 ? v.substr(0, 57) + "..." : v) + "'";
 }
 
 YamlReader::YamlReader(std::string file, std::set<std::string> overridden)

@@ -141,6 +141,21 @@ units:
   EXPECT_TRUE(Has(all, f + ":3: units.left-motor: unit name 'left-motor' is not valid")) << all;
 }
 
+// Guards master checks through the loader: a unit step that is not a
+// multiple of the master step points at that unit's step_s line.
+TEST(LoadScenario, UnitStepProblemPointsAtItsLine) {
+  const std::string f = WriteScenario("step.yaml", R"(duration_s: 0.01
+units:
+  motor:
+    type: dc_motor
+    step_s: 0.0015
+)");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, f + ":5: units.motor.step_s: unit 'motor' step 0.0015 s is not an integer "
+                       "multiple of the master step 0.001 s"))
+      << all;
+}
+
 // Guards the range check before time zero: the unit's own parameter check
 // (a resistance must be positive) reaches the user with the key path.
 TEST(LoadScenario, OutOfRangeParameterIsRefusedBeforeTimeZero) {
