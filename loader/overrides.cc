@@ -91,8 +91,13 @@ void ApplyOverrides(YAML::Node& root, const std::vector<Override>& overrides,
           for (const auto& c : cosim::ClosestNames(key, keys)) {
             hint += (hint.empty() ? "" : ", ") + JoinPath(walked, c);
           }
+          const bool item_next = i + 2 == parts.size() && IsIndex(parts[i + 1]);
           report("no key '" + key + "' at '" + (walked.empty() ? "(top)" : walked) + "'" +
-                 (hint.empty() ? "" : "; closest: " + hint));
+                 (hint.empty() ? "" : "; closest: " + hint) +
+                 (item_next ? "; one item can be set only where the file writes the list: "
+                              "set the whole value instead, e.g. " +
+                                  JoinPath(walked, key) + "=[...]"
+                            : ""));
           ok = false;
           break;
         } else {

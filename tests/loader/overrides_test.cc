@@ -34,5 +34,18 @@ TEST(ApplyOverrides, UnknownIntermediateKeyIsAnIssue) {
   EXPECT_FALSE(root["mastr"].IsDefined());
 }
 
+// Guards the message for a list item of a value the file does not write
+// (e.g. a parameter left to its model file): it says how to set it.
+TEST(ApplyOverrides, ItemOfAnAbsentListSaysToSetTheWholeValue) {
+  YAML::Node root = YAML::Load("units: {m: {parameters: {count: 2}}}\n");
+  std::vector<Issue> issues;
+  ApplyOverrides(root, {ParseOverride("units.m.parameters.resistance.1=0.5")}, "f.yaml", issues);
+  ASSERT_EQ(issues.size(), 1u);
+  EXPECT_NE(issues[0].message.find("set the whole value instead, e.g. "
+                                   "units.m.parameters.resistance=[...]"),
+            std::string::npos)
+      << issues[0].message;
+}
+
 }  // namespace
 }  // namespace linesim::loader
