@@ -48,9 +48,9 @@ void PrintTable(const cosim::Unit& unit, std::ostream& out) {
       for (auto ref : v.depends_on) description += " " + table.info(ref).name;
       description += "]";
     }
-    rows.push_back({{v.name, std::string(cosim::ToString(v.causality)), TypeLabel(v),
-                     v.unit.empty() ? "-" : v.unit, cosim::FormatValue(table.GetValue(v.ref)),
-                     description}});
+    rows.push_back(
+        {{v.name, std::string(cosim::ToString(v.causality)), TypeLabel(v),
+          v.unit.empty() ? "-" : v.unit, cosim::FormatValue(table.GetValue(v.ref)), description}});
   }
   std::size_t width[5] = {};
   for (const auto& r : rows) {
@@ -58,7 +58,8 @@ void PrintTable(const cosim::Unit& unit, std::ostream& out) {
   }
   for (const auto& r : rows) {
     out << "  ";
-    for (int c = 0; c < 5; ++c) out << std::left << std::setw(static_cast<int>(width[c]) + 2) << r.cells[c];
+    for (int c = 0; c < 5; ++c)
+      out << std::left << std::setw(static_cast<int>(width[c]) + 2) << r.cells[c];
     out << r.cells[5] << "\n";
   }
 }
@@ -177,7 +178,8 @@ int RunCommand(const std::string& file, const std::string& out_dir,
             << std::setprecision(3) << wall_s << " s wall (" << std::setprecision(4)
             << simulated_s / wall_s << "x real time)\n";
   std::size_t name_width = 0;
-  for (const auto& [name, value] : metrics.Results()) name_width = std::max(name_width, name.size());
+  for (const auto& [name, value] : metrics.Results())
+    name_width = std::max(name_width, name.size());
   for (const auto& [name, value] : metrics.Results()) {
     std::cout << "  " << std::left << std::setw(static_cast<int>(name_width)) << name << " = "
               << std::setprecision(6) << value << "\n";
@@ -224,8 +226,7 @@ int InspectCommand(const std::string& what, const std::vector<std::string>& set_
   std::cout << "scenario '" << s.name << "' (" << what << ")";
   if (!s.description.empty()) std::cout << ": " << s.description;
   std::cout << "\n  duration " << cosim::FormatSeconds(o.stop - o.start) << " s, seed " << s.seed
-            << ", master "
-            << (o.algorithm == cosim::Algorithm::kJacobi ? "jacobi" : "gauss_seidel")
+            << ", master " << (o.algorithm == cosim::Algorithm::kJacobi ? "jacobi" : "gauss_seidel")
             << " step " << cosim::FormatSeconds(o.base_step) << " s\n";
   const cosim::System& system = *s.system;
   for (std::size_t u = 0; u < system.unit_count(); ++u) {

@@ -1,5 +1,4 @@
 #include <CLI/CLI.hpp>
-
 #include <iostream>
 
 #include "app/commands.h"
@@ -11,7 +10,8 @@ int main(int argc, char** argv) {
 
   std::string run_file, out_dir;
   std::vector<std::string> run_sets;
-  CLI::App* run = cli.add_subcommand("run", "run a scenario and write summary.json and signals.csv");
+  CLI::App* run =
+      cli.add_subcommand("run", "run a scenario and write summary.json and signals.csv");
   run->add_option("file", run_file, "scenario YAML file")->required();
   run->add_option("--out,-o", out_dir, "output folder (created if missing)")->required();
   run->add_option("--set", run_sets, "override a value: dotted.path=value (repeatable)")

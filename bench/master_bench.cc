@@ -49,7 +49,8 @@ class CopyUnit : public Unit {
 void BM_MasterStep(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   System system;
-  for (int i = 0; i < n; ++i) system.Add(std::make_unique<CopyUnit>("u" + std::to_string(i), state.range(3) != 0));
+  for (int i = 0; i < n; ++i)
+    system.Add(std::make_unique<CopyUnit>("u" + std::to_string(i), state.range(3) != 0));
   for (int i = 1; i < n; ++i) {
     system.Connect("u" + std::to_string(i - 1) + ".y", "u" + std::to_string(i) + ".u");
   }
@@ -74,8 +75,7 @@ void BM_MasterStep(benchmark::State& state) {
   state.counters["ns_per_step"] = ns / steps;
   state.counters["ns_per_unit_step"] = ns / (steps * n);
   state.SetLabel(std::string(o.algorithm == Algorithm::kJacobi ? "jacobi" : "gauss_seidel") +
-                 (o.profile ? " profile" : " no_profile") +
-                 (state.range(3) ? " feedthrough" : ""));
+                 (o.profile ? " profile" : " no_profile") + (state.range(3) ? " feedthrough" : ""));
   master.Finish();
 }
 

@@ -33,7 +33,8 @@ void BM_Scenario(benchmark::State& state, const std::string& file) {
   state.counters["top_unit_share"] = unit_share_max;
 }
 
-BENCHMARK_CAPTURE(BM_Scenario, motor_step, std::string(LINESIM_SOURCE_DIR "/scenarios/motor_step.yaml"))
+BENCHMARK_CAPTURE(BM_Scenario, motor_step,
+                  std::string(LINESIM_SOURCE_DIR "/scenarios/motor_step.yaml"))
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

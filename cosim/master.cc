@@ -32,8 +32,7 @@ struct Master::Arena {
 
 Master::~Master() = default;
 
-Master::Master(System& system, MasterOptions options)
-    : system_(system), options_(options) {
+Master::Master(System& system, MasterOptions options) : system_(system), options_(options) {
   if (!system_.built()) system_.Build();
   std::vector<Problem> problems;
   const TimeNs h = options_.base_step;
@@ -63,8 +62,7 @@ Master::Master(System& system, MasterOptions options)
                           std::nullopt, u});
     } else if (duration % step != 0) {
       problems.push_back({"unit '" + name + "' step " + FormatSeconds(step) +
-                              " s does not divide the duration " + FormatSeconds(duration) +
-                              " s",
+                              " s does not divide the duration " + FormatSeconds(duration) + " s",
                           std::nullopt, u});
     }
     decimation_[u] = std::max<TimeNs>(1, step / h);
@@ -148,9 +146,10 @@ void Master::RecordError(std::size_t u, TimeNs t, const std::string& cause) {
   const std::string who = "unit '" + unit.name() + "' (" + unit.type_name() + ")";
   // A unit's own error may already name it (solver helpers do).
   const auto colon = cause.find(": ");
-  const bool named = cause.rfind("unit '" + unit.name() + "'", 0) == 0 && colon != std::string::npos;
-  errors_.push_back(who + " at t = " + FormatSeconds(t) + " s: " +
-                    (named ? cause.substr(colon + 2) : cause));
+  const bool named =
+      cause.rfind("unit '" + unit.name() + "'", 0) == 0 && colon != std::string::npos;
+  errors_.push_back(who + " at t = " + FormatSeconds(t) +
+                    " s: " + (named ? cause.substr(colon + 2) : cause));
   failed_ = true;
 }
 
@@ -168,8 +167,9 @@ bool Master::CheckOutputs(std::size_t u, TimeNs t) {
       const auto values = table.GetRealArray(ref);
       for (std::size_t i = 0; i < values.size(); ++i) {
         if (!std::isfinite(values[i])) {
-          RecordError(u, t, "output '" + info.name + "[" + std::to_string(i) + "]' is " +
-                                FormatValue(values[i]));
+          RecordError(
+              u, t,
+              "output '" + info.name + "[" + std::to_string(i) + "]' is " + FormatValue(values[i]));
           return false;
         }
       }
@@ -188,8 +188,7 @@ bool Master::StepUnit(std::size_t u, TimeNs t, TimeNs dt) {
   try {
     result = unit.DoStep(t, dt);
     if (result == StepResult::kDiscard) {
-      cause = "discarded the step (" + unit.last_error() +
-              "); a fixed-step master cannot retry it";
+      cause = "discarded the step (" + unit.last_error() + "); a fixed-step master cannot retry it";
     } else if (result == StepResult::kError) {
       cause = unit.last_error().empty() ? "step failed" : unit.last_error();
     }

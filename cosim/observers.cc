@@ -60,9 +60,12 @@ double ReadProbe(const System& system, const Probe& p) {
   const VariableTable& t = system.unit(p.where.unit).variables();
   if (p.where.index >= 0) return t.GetRealElement(p.where.ref, p.where.index);
   switch (p.type) {
-    case VarType::kInteger: return static_cast<double>(t.GetInteger(p.where.ref));
-    case VarType::kBoolean: return t.GetBoolean(p.where.ref) ? 1.0 : 0.0;
-    default: return t.GetReal(p.where.ref);
+    case VarType::kInteger:
+      return static_cast<double>(t.GetInteger(p.where.ref));
+    case VarType::kBoolean:
+      return t.GetBoolean(p.where.ref) ? 1.0 : 0.0;
+    default:
+      return t.GetReal(p.where.ref);
   }
 }
 
@@ -105,7 +108,7 @@ void CsvRecorder::OnEnd(TimeNs, bool) { out_.flush(); }
 
 bool ParseReduction(const std::string& text, Reduction* out) {
   static const std::pair<const char*, Reduction> kNames[] = {
-      {"final", Reduction::kFinal}, {"min", Reduction::kMin},   {"max", Reduction::kMax},
+      {"final", Reduction::kFinal},    {"min", Reduction::kMin},   {"max", Reduction::kMax},
       {"max_abs", Reduction::kMaxAbs}, {"mean", Reduction::kMean}, {"rms", Reduction::kRms}};
   for (const auto& [name, r] : kNames) {
     if (text == name) {
@@ -149,12 +152,24 @@ std::vector<std::pair<std::string, double>> MetricsObserver::Results() const {
     double v = std::numeric_limits<double>::quiet_NaN();
     if (samples_ > 0) {
       switch (specs_[i].reduction) {
-        case Reduction::kFinal: v = a.last; break;
-        case Reduction::kMin: v = a.min; break;
-        case Reduction::kMax: v = a.max; break;
-        case Reduction::kMaxAbs: v = a.max_abs; break;
-        case Reduction::kMean: v = a.sum / n; break;
-        case Reduction::kRms: v = std::sqrt(a.sum_sq / n); break;
+        case Reduction::kFinal:
+          v = a.last;
+          break;
+        case Reduction::kMin:
+          v = a.min;
+          break;
+        case Reduction::kMax:
+          v = a.max;
+          break;
+        case Reduction::kMaxAbs:
+          v = a.max_abs;
+          break;
+        case Reduction::kMean:
+          v = a.sum / n;
+          break;
+        case Reduction::kRms:
+          v = std::sqrt(a.sum_sq / n);
+          break;
       }
     }
     out.emplace_back(specs_[i].name, v);

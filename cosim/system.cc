@@ -105,10 +105,9 @@ System::Resolved System::Resolve(std::string_view text) const {
   }
   const auto u = FindUnit(e.unit);
   if (!u) {
-    throw ConfigError(
-        {{"unknown unit '" + e.unit + "' in '" + std::string(text) + "'" +
-              ClosestHint(e.unit, UnitNames()),
-          std::nullopt}});
+    throw ConfigError({{"unknown unit '" + e.unit + "' in '" + std::string(text) + "'" +
+                            ClosestHint(e.unit, UnitNames()),
+                        std::nullopt}});
   }
   const VariableTable& table = unit(*u).variables();
   const auto ref = table.Find(e.variable);
@@ -119,12 +118,12 @@ System::Resolved System::Resolve(std::string_view text) const {
   }
   const VariableInfo& info = table.info(*ref);
   if (e.index && (info.type != VarType::kRealArray || *e.index >= info.size)) {
-    throw ConfigError({{"'" + std::string(text) + "': " +
-                            (info.type == VarType::kRealArray
-                                 ? "index out of range, " + e.variable + " has " +
-                                       std::to_string(info.size) + " elements"
-                                 : e.variable + " is not an array"),
-                        std::nullopt}});
+    throw ConfigError(
+        {{"'" + std::string(text) + "': " +
+              (info.type == VarType::kRealArray ? "index out of range, " + e.variable + " has " +
+                                                      std::to_string(info.size) + " elements"
+                                                : e.variable + " is not an array"),
+          std::nullopt}});
   }
   return {*u, *ref, e.index ? static_cast<std::ptrdiff_t>(*e.index) : -1};
 }
@@ -153,8 +152,8 @@ std::optional<Link> System::CheckConnection(std::size_t c, std::vector<Problem>&
       for (const auto& i : table.infos()) {
         if (i.causality == wanted) same_causality.push_back(i.name);
       }
-      report("unit '" + e.unit + "' (" + unit(*u).type_name() + ") has no variable '" +
-             e.variable + "'" + ClosestHint(e.variable, same_causality));
+      report("unit '" + e.unit + "' (" + unit(*u).type_name() + ") has no variable '" + e.variable +
+             "'" + ClosestHint(e.variable, same_causality));
       return std::nullopt;
     }
     const VariableInfo& info = table.info(*ref);
@@ -190,9 +189,8 @@ std::optional<Link> System::CheckConnection(std::size_t c, std::vector<Problem>&
   const VarType to_type = effective(*to, conn.to);
   bool ok = true;
   if (from_type != to_type) {
-    report("type mismatch: " + conn.from.ToString() + " is " +
-           std::string(ToString(from_type)) + ", " + conn.to.ToString() + " is " +
-           std::string(ToString(to_type)));
+    report("type mismatch: " + conn.from.ToString() + " is " + std::string(ToString(from_type)) +
+           ", " + conn.to.ToString() + " is " + std::string(ToString(to_type)));
     ok = false;
   } else if (from_type == VarType::kRealArray && from->info->size != to->info->size) {
     report("array size mismatch: " + conn.from.ToString() + " has " +
@@ -211,9 +209,8 @@ std::optional<Link> System::CheckConnection(std::size_t c, std::vector<Problem>&
   link.to_unit = to->unit;
   link.from_ref = from->info->ref;
   link.to_ref = to->info->ref;
-  link.type = from_type == VarType::kReal && (conn.from.index || conn.to.index)
-                  ? VarType::kReal
-                  : from->info->type;
+  link.type = from_type == VarType::kReal && (conn.from.index || conn.to.index) ? VarType::kReal
+                                                                                : from->info->type;
   link.from_index = conn.from.index ? static_cast<std::ptrdiff_t>(*conn.from.index) : -1;
   link.to_index = conn.to.index ? static_cast<std::ptrdiff_t>(*conn.to.index) : -1;
   return link;
@@ -251,8 +248,7 @@ void System::CheckAlgebraicLoops(std::vector<Problem>& problems) const {
           for (auto p = begin; p != stack.end(); ++p) cycle += name(*p) + " -> ";
           cycle += name(next);
           if (reported.insert(cycle).second) {
-            problems.push_back({"algebraic loop (every step of it is direct feedthrough): " +
-                                    cycle,
+            problems.push_back({"algebraic loop (every step of it is direct feedthrough): " + cycle,
                                 std::nullopt});
           }
         } else if (color[next] == 0) {
@@ -351,9 +347,9 @@ void System::Build() {
   std::set<std::string> seen;
   for (const auto& e : units_) {
     if (!IsIdentifier(e.unit->name())) {
-      problems.push_back({"unit name '" + e.unit->name() +
-                              "' is not valid: use letters, digits and '_'",
-                          std::nullopt});
+      problems.push_back(
+          {"unit name '" + e.unit->name() + "' is not valid: use letters, digits and '_'",
+           std::nullopt});
     }
     if (!seen.insert(e.unit->name()).second) {
       problems.push_back({"two units are named '" + e.unit->name() + "'", std::nullopt});
@@ -381,9 +377,8 @@ void System::Build() {
         const Link& lb = *checked[conns[b]];
         if (la.to_index < 0 || lb.to_index < 0 || la.to_index == lb.to_index) {
           problems.push_back({"input " + connections_[conns[b]].to.ToString() +
-                                  " has two sources: " +
-                                  connections_[conns[a]].from.ToString() + " and " +
-                                  connections_[conns[b]].from.ToString(),
+                                  " has two sources: " + connections_[conns[a]].from.ToString() +
+                                  " and " + connections_[conns[b]].from.ToString(),
                               conns[b]});
         }
       }

@@ -6,7 +6,8 @@ UnitState Unit::SaveState() const {
   UnitState state;
   state.type_name = type_name_;
   state.variables.reserve(variables_.size());
-  for (const auto& info : variables_.infos()) state.variables.push_back(variables_.GetValue(info.ref));
+  for (const auto& info : variables_.infos())
+    state.variables.push_back(variables_.GetValue(info.ref));
   SaveInternal(state);
   return state;
 }

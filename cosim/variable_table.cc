@@ -7,32 +7,46 @@ namespace linesim::cosim {
 
 std::string_view ToString(VarType t) {
   switch (t) {
-    case VarType::kReal: return "Real";
-    case VarType::kInteger: return "Integer";
-    case VarType::kBoolean: return "Boolean";
-    case VarType::kString: return "String";
-    case VarType::kRealArray: return "Real[]";
+    case VarType::kReal:
+      return "Real";
+    case VarType::kInteger:
+      return "Integer";
+    case VarType::kBoolean:
+      return "Boolean";
+    case VarType::kString:
+      return "String";
+    case VarType::kRealArray:
+      return "Real[]";
   }
   return "?";
 }
 
 std::string_view ToString(Causality c) {
   switch (c) {
-    case Causality::kParameter: return "parameter";
-    case Causality::kInput: return "input";
-    case Causality::kOutput: return "output";
-    case Causality::kLocal: return "local";
+    case Causality::kParameter:
+      return "parameter";
+    case Causality::kInput:
+      return "input";
+    case Causality::kOutput:
+      return "output";
+    case Causality::kLocal:
+      return "local";
   }
   return "?";
 }
 
 std::string_view ToString(Variability v) {
   switch (v) {
-    case Variability::kConstant: return "constant";
-    case Variability::kFixed: return "fixed";
-    case Variability::kTunable: return "tunable";
-    case Variability::kDiscrete: return "discrete";
-    case Variability::kContinuous: return "continuous";
+    case Variability::kConstant:
+      return "constant";
+    case Variability::kFixed:
+      return "fixed";
+    case Variability::kTunable:
+      return "tunable";
+    case Variability::kDiscrete:
+      return "discrete";
+    case Variability::kContinuous:
+      return "continuous";
   }
   return "?";
 }
@@ -65,8 +79,7 @@ std::string FormatValue(const Value& v) {
   return std::visit(Visitor{}, v);
 }
 
-ValueRef VariableTable::Declare(VariableInfo info, void* storage, std::size_t size,
-                                Value start) {
+ValueRef VariableTable::Declare(VariableInfo info, void* storage, std::size_t size, Value start) {
   info.size = size;
   info.start = std::move(start);
   return Add(std::move(info), storage);
@@ -86,8 +99,8 @@ ValueRef VariableTable::Add(VariableInfo info, void* storage) {
 
 namespace {
 
-VariableInfo MakeInfo(std::string name, VarType type, Causality c, Variability v,
-                      std::string unit, std::string description) {
+VariableInfo MakeInfo(std::string name, VarType type, Causality c, Variability v, std::string unit,
+                      std::string description) {
   VariableInfo info;
   info.name = std::move(name);
   info.type = type;
@@ -107,10 +120,10 @@ Variability SignalVariability(VarType t) {
 
 }  // namespace
 
-ValueRef VariableTable::Parameter(std::string name, std::string unit, double* s,
-                                  std::string d, Variability v) {
-  auto info = MakeInfo(std::move(name), VarType::kReal, Causality::kParameter, v,
-                       std::move(unit), std::move(d));
+ValueRef VariableTable::Parameter(std::string name, std::string unit, double* s, std::string d,
+                                  Variability v) {
+  auto info = MakeInfo(std::move(name), VarType::kReal, Causality::kParameter, v, std::move(unit),
+                       std::move(d));
   return Declare(std::move(info), s, 1, *s);
 }
 ValueRef VariableTable::Parameter(std::string name, std::string unit, std::vector<double>* s,
@@ -119,21 +132,19 @@ ValueRef VariableTable::Parameter(std::string name, std::string unit, std::vecto
                        std::move(unit), std::move(d));
   return Declare(std::move(info), s, s->size(), *s);
 }
-ValueRef VariableTable::Parameter(std::string name, std::int64_t* s, std::string d,
-                                  Variability v) {
-  auto info = MakeInfo(std::move(name), VarType::kInteger, Causality::kParameter, v, "1",
-                       std::move(d));
+ValueRef VariableTable::Parameter(std::string name, std::int64_t* s, std::string d, Variability v) {
+  auto info =
+      MakeInfo(std::move(name), VarType::kInteger, Causality::kParameter, v, "1", std::move(d));
   return Declare(std::move(info), s, 1, *s);
 }
 ValueRef VariableTable::Parameter(std::string name, bool* s, std::string d, Variability v) {
-  auto info = MakeInfo(std::move(name), VarType::kBoolean, Causality::kParameter, v, "1",
-                       std::move(d));
+  auto info =
+      MakeInfo(std::move(name), VarType::kBoolean, Causality::kParameter, v, "1", std::move(d));
   return Declare(std::move(info), s, 1, *s);
 }
-ValueRef VariableTable::Parameter(std::string name, std::string* s, std::string d,
-                                  Variability v) {
-  auto info = MakeInfo(std::move(name), VarType::kString, Causality::kParameter, v, "",
-                       std::move(d));
+ValueRef VariableTable::Parameter(std::string name, std::string* s, std::string d, Variability v) {
+  auto info =
+      MakeInfo(std::move(name), VarType::kString, Causality::kParameter, v, "", std::move(d));
   return Declare(std::move(info), s, 1, *s);
 }
 
@@ -159,8 +170,8 @@ ValueRef VariableTable::Input(std::string name, bool* s, std::string d) {
   return Declare(std::move(info), s, 1, *s);
 }
 ValueRef VariableTable::Input(std::string name, std::string* s, std::string d) {
-  auto info = MakeInfo(std::move(name), VarType::kString, Causality::kInput,
-                       Variability::kDiscrete, "", std::move(d));
+  auto info = MakeInfo(std::move(name), VarType::kString, Causality::kInput, Variability::kDiscrete,
+                       "", std::move(d));
   return Declare(std::move(info), s, 1, *s);
 }
 
@@ -194,8 +205,8 @@ ValueRef VariableTable::Output(std::string name, bool* s, std::string d,
 }
 
 ValueRef VariableTable::Local(std::string name, std::string unit, double* s, std::string d) {
-  auto info = MakeInfo(std::move(name), VarType::kReal, Causality::kLocal,
-                       Variability::kContinuous, std::move(unit), std::move(d));
+  auto info = MakeInfo(std::move(name), VarType::kReal, Causality::kLocal, Variability::kContinuous,
+                       std::move(unit), std::move(d));
   return Declare(std::move(info), s, 1, *s);
 }
 ValueRef VariableTable::Local(std::string name, std::string unit, std::vector<double>* s,
@@ -249,9 +260,8 @@ std::span<const double> VariableTable::GetRealArray(ValueRef ref) const {
 void VariableTable::SetRealArray(ValueRef ref, std::span<const double> v) {
   auto* dst = Slot<std::vector<double>>(ref, VarType::kRealArray);
   if (v.size() != dst->size()) {
-    throw std::invalid_argument("'" + infos_[ref].name + "' holds " +
-                                std::to_string(dst->size()) + " elements, got " +
-                                std::to_string(v.size()));
+    throw std::invalid_argument("'" + infos_[ref].name + "' holds " + std::to_string(dst->size()) +
+                                " elements, got " + std::to_string(v.size()));
   }
   std::copy(v.begin(), v.end(), dst->begin());
 }
@@ -266,10 +276,14 @@ void VariableTable::SetRealElement(ValueRef ref, std::size_t index, double v) {
 
 Value VariableTable::GetValue(ValueRef ref) const {
   switch (info(ref).type) {
-    case VarType::kReal: return GetReal(ref);
-    case VarType::kInteger: return GetInteger(ref);
-    case VarType::kBoolean: return GetBoolean(ref);
-    case VarType::kString: return GetString(ref);
+    case VarType::kReal:
+      return GetReal(ref);
+    case VarType::kInteger:
+      return GetInteger(ref);
+    case VarType::kBoolean:
+      return GetBoolean(ref);
+    case VarType::kString:
+      return GetString(ref);
     case VarType::kRealArray: {
       auto s = GetRealArray(ref);
       return std::vector<double>(s.begin(), s.end());
@@ -285,10 +299,14 @@ void VariableTable::SetValue(ValueRef ref, const Value& v) {
       return "a number or a list of " + std::to_string(i.size) + " numbers";
     }
     switch (i.type) {
-      case VarType::kReal: return "a number";
-      case VarType::kInteger: return "an integer";
-      case VarType::kBoolean: return "true or false";
-      default: return "a string";
+      case VarType::kReal:
+        return "a number";
+      case VarType::kInteger:
+        return "an integer";
+      case VarType::kBoolean:
+        return "true or false";
+      default:
+        return "a string";
     }
   };
   switch (i.type) {

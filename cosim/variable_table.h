@@ -58,8 +58,8 @@ class VariableTable {
   VariableTable(const VariableTable&) = delete;
   VariableTable& operator=(const VariableTable&) = delete;
 
-  ValueRef Parameter(std::string name, std::string unit, double* storage,
-                     std::string description, Variability v = Variability::kFixed);
+  ValueRef Parameter(std::string name, std::string unit, double* storage, std::string description,
+                     Variability v = Variability::kFixed);
   ValueRef Parameter(std::string name, std::string unit, std::vector<double>* storage,
                      std::string description, Variability v = Variability::kFixed);
   ValueRef Parameter(std::string name, std::int64_t* storage, std::string description,
@@ -107,9 +107,7 @@ class VariableTable {
   std::int64_t GetInteger(ValueRef ref) const {
     return *Slot<std::int64_t>(ref, VarType::kInteger);
   }
-  void SetInteger(ValueRef ref, std::int64_t v) {
-    *Slot<std::int64_t>(ref, VarType::kInteger) = v;
-  }
+  void SetInteger(ValueRef ref, std::int64_t v) { *Slot<std::int64_t>(ref, VarType::kInteger) = v; }
   bool GetBoolean(ValueRef ref) const { return *Slot<bool>(ref, VarType::kBoolean); }
   void SetBoolean(ValueRef ref, bool v) { *Slot<bool>(ref, VarType::kBoolean) = v; }
   const std::string& GetString(ValueRef ref) const {

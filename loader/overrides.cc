@@ -33,8 +33,8 @@ bool IsIndex(const std::string& s) {
 Override ParseOverride(const std::string& text) {
   const auto eq = text.find('=');
   if (eq == std::string::npos || eq == 0) {
-    throw ScenarioError({{"", 0, "--set " + text,
-                          "expected dotted.path=value (for example master.step_s=0.002)"}});
+    throw ScenarioError(
+        {{"", 0, "--set " + text, "expected dotted.path=value (for example master.step_s=0.002)"}});
   }
   return {text.substr(0, eq), text.substr(eq + 1)};
 }
@@ -43,8 +43,8 @@ void ApplyOverrides(YAML::Node& root, const std::vector<Override>& overrides,
                     const std::string& file, std::vector<Issue>& issues) {
   for (const Override& o : overrides) {
     const auto report = [&](const std::string& message) {
-      issues.push_back({file, 0, o.path, message + " (in --set " + o.path + "=" + o.value + ")",
-                        true});
+      issues.push_back(
+          {file, 0, o.path, message + " (in --set " + o.path + "=" + o.value + ")", true});
     };
     const std::vector<std::string> parts = Split(o.path);
     if (std::any_of(parts.begin(), parts.end(), [](const std::string& p) { return p.empty(); })) {
@@ -104,8 +104,7 @@ void ApplyOverrides(YAML::Node& root, const std::vector<Override>& overrides,
           node.reset(node[key]);
         }
       } else {
-        report("'" + walked + "' holds a value, not a map or list, so it has no key '" + key +
-               "'");
+        report("'" + walked + "' holds a value, not a map or list, so it has no key '" + key + "'");
         ok = false;
       }
       walked = JoinPath(walked, key);

@@ -58,8 +58,8 @@ void ApplyParameter(cosim::Unit& unit, const cosim::VariableInfo& info, const YA
       expected = "a text value";
       break;
     case cosim::VarType::kRealArray: {
-      expected = "a number (for every element) or a list of " + std::to_string(info.size) +
-                 " numbers";
+      expected =
+          "a number (for every element) or a list of " + std::to_string(info.size) + " numbers";
       double v;
       if (node.IsScalar() && YAML::convert<double>::decode(node, v)) {
         value = v;
@@ -112,8 +112,8 @@ void ApplyParameters(cosim::Unit& unit, const YAML::Node& map, const std::string
       }
       r.Error(kv.first, key_path,
               "unknown parameter of a " + unit.type_name() + " unit" +
-                  (hint.empty() ? "" : "; closest: " + hint) +
-                  " (linesim inspect " + unit.type_name() + " lists them)");
+                  (hint.empty() ? "" : "; closest: " + hint) + " (linesim inspect " +
+                  unit.type_name() + " lists them)");
       continue;
     }
     ApplyParameter(unit, unit.variables().info(*ref), kv.second, key_path, r);
@@ -123,8 +123,8 @@ void ApplyParameters(cosim::Unit& unit, const YAML::Node& map, const std::string
 
 fs::path ModelFile(const std::string& value, const std::string& folder,
                    const std::string& scenario_file) {
-  const bool is_path = value.find('/') != std::string::npos ||
-                       value.ends_with(".yaml") || value.ends_with(".yml");
+  const bool is_path =
+      value.find('/') != std::string::npos || value.ends_with(".yaml") || value.ends_with(".yml");
   if (is_path) return fs::path(scenario_file).parent_path() / value;
   return fs::path(models::ModelsDir()) / folder / (value + ".yaml");
 }
@@ -145,8 +145,9 @@ class Builder {
 
   void Build(const YAML::Node& root) {
     if (!r_.ExpectMap(root, "(top)")) return;
-    r_.CheckKeys(root, "", {"name", "description", "duration_s", "seed", "master", "units",
-                            "connections", "recording", "metrics"});
+    r_.CheckKeys(root, "",
+                 {"name", "description", "duration_s", "seed", "master", "units", "connections",
+                  "recording", "metrics"});
     s_.name = r_.String(root, "", "name", fs::path(s_.file).stem().string());
     s_.description = r_.String(root, "", "description", "");
     s_.duration_s = r_.Real(root, "", "duration_s", std::nullopt, {0.0, 1e7, true});
@@ -162,8 +163,8 @@ class Builder {
     const YAML::Node master_map = master.IsMap() ? master : YAML::Node(YAML::NodeType::Map);
     const std::string algorithm =
         r_.String(master_map, "master", "algorithm", "gauss_seidel", {"jacobi", "gauss_seidel"});
-    options.algorithm = algorithm == "jacobi" ? cosim::Algorithm::kJacobi
-                                              : cosim::Algorithm::kGaussSeidel;
+    options.algorithm =
+        algorithm == "jacobi" ? cosim::Algorithm::kJacobi : cosim::Algorithm::kGaussSeidel;
     const double step_s = r_.Real(master_map, "master", "step_s", 0.001, {0.0, 10.0, true});
     options.base_step = cosim::SecondsToNs(step_s);
     if (options.base_step <= 0) {
@@ -199,8 +200,7 @@ class Builder {
           const auto& [name, node] = unit_nodes_[*p.unit];
           const YAML::Node step = Child(node, "step_s");
           r_.Error(step.IsDefined() ? step : node,
-                   JoinPath(JoinPath("units", name), step.IsDefined() ? "step_s" : ""),
-                   p.message);
+                   JoinPath(JoinPath("units", name), step.IsDefined() ? "step_s" : ""), p.message);
         } else {
           r_.Error(root, "", p.message);
         }
@@ -224,10 +224,9 @@ class Builder {
 
   void BuildUnit(const std::string& name, const YAML::Node& key, const YAML::Node& spec) {
     const std::string path = JoinPath("units", name);
-    const bool identifier =
-        !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
-          return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
-        });
+    const bool identifier = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+    });
     if (!identifier) {
       r_.Error(key, path, "unit name '" + name + "' is not valid: expected letters, digits and _");
       return;
@@ -238,14 +237,14 @@ class Builder {
     if (type_name.empty()) return;
     const UnitType* type = FindUnitType(type_name);
     if (!type) {
-      r_.Error(Child(spec, "type"), JoinPath(path, "type"),
-               "unknown unit type '" + type_name + "'" +
-                   cosim::ClosestHint(type_name, UnitTypeNames()) +
-                   "; known types: " + [] {
-                     std::string all;
-                     for (const auto& n : UnitTypeNames()) all += (all.empty() ? "" : ", ") + n;
-                     return all;
-                   }());
+      r_.Error(
+          Child(spec, "type"), JoinPath(path, "type"),
+          "unknown unit type '" + type_name + "'" + cosim::ClosestHint(type_name, UnitTypeNames()) +
+              "; known types: " + [] {
+                std::string all;
+                for (const auto& n : UnitTypeNames()) all += (all.empty() ? "" : ", ") + n;
+                return all;
+              }());
       return;
     }
     cosim::TimeNs step = 0;
@@ -352,8 +351,8 @@ class Builder {
     } else if (r_.ExpectMap(rec, "recording")) {
       r_.CheckKeys(rec, "recording", {"variables", "interval_s"});
       if (Child(rec, "interval_s").IsDefined()) {
-        s_.record_interval = cosim::SecondsToNs(
-            r_.Real(rec, "recording", "interval_s", 0.0, {0.0, 1e7, true}));
+        s_.record_interval =
+            cosim::SecondsToNs(r_.Real(rec, "recording", "interval_s", 0.0, {0.0, 1e7, true}));
         if (s_.record_interval % options.base_step != 0) {
           r_.Error(Child(rec, "interval_s"), "recording.interval_s",
                    "expected a whole multiple of master.step_s (" +
@@ -389,11 +388,11 @@ class Builder {
       cosim::MetricSpec spec;
       spec.name = r_.String(item, path, "name", std::nullopt);
       const std::string of = r_.String(item, path, "of", std::nullopt);
-      const std::string reduce =
-          r_.String(item, path, "reduce", "final", cosim::ReductionNames());
+      const std::string reduce = r_.String(item, path, "reduce", "final", cosim::ReductionNames());
       cosim::ParseReduction(reduce, &spec.reduction);
       if (std::find(seen.begin(), seen.end(), spec.name) != seen.end()) {
-        r_.Error(Child(item, "name"), JoinPath(path, "name"), "metric '" + spec.name + "' defined twice");
+        r_.Error(Child(item, "name"), JoinPath(path, "name"),
+                 "metric '" + spec.name + "' defined twice");
       }
       seen.push_back(spec.name);
       if (of.empty()) continue;
@@ -441,8 +440,8 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
   } catch (const YAML::BadFile&) {
     throw ScenarioError({{file, 0, "", "cannot read the file (missing or not readable)"}});
   } catch (const YAML::ParserException& e) {
-    throw ScenarioError({{file, e.mark.is_null() ? 0 : e.mark.line + 1, "",
-                          "not valid YAML: " + e.msg}});
+    throw ScenarioError(
+        {{file, e.mark.is_null() ? 0 : e.mark.line + 1, "", "not valid YAML: " + e.msg}});
   }
   ApplyOverrides(s.tree, s.overrides, file, issues);
   std::set<std::string> overridden;
@@ -459,9 +458,10 @@ std::unique_ptr<cosim::Unit> CreateDefaultUnit(const std::string& type_name) {
   if (!type) {
     std::string all;
     for (const auto& n : UnitTypeNames()) all += (all.empty() ? "" : ", ") + n;
-    throw ScenarioError({{"", 0, "", "unknown unit type '" + type_name + "'" +
-                                         cosim::ClosestHint(type_name, UnitTypeNames()) +
-                                         "; known types: " + all}});
+    throw ScenarioError(
+        {{"", 0, "",
+          "unknown unit type '" + type_name + "'" + cosim::ClosestHint(type_name, UnitTypeNames()) +
+              "; known types: " + all}});
   }
   YamlReader reader("(defaults)");
   const YAML::Node none;

@@ -76,7 +76,8 @@ const std::vector<UnitType>& UnitTypes() {
        "",
        {{"count", "number of channels (default 1)"},
         {"unit", "unit of measure of the output, e.g. V or N.m (default 1)"},
-        {"steps", "list of {time_s, value}: value (one number, or one per channel) from time_s on"}},
+        {"steps",
+         "list of {time_s, value}: value (one number, or one per channel) from time_s on"}},
        MakeStepSignal},
   };
   return types;

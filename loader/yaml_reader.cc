@@ -176,8 +176,9 @@ std::string YamlReader::String(const YAML::Node& map, const std::string& path,
     if (!found) {
       std::string list;
       for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      Error(node, p, "'" + *s + "' is not allowed: expected one of " + list +
-                         cosim::ClosestHint(*s, allowed));
+      Error(
+          node, p,
+          "'" + *s + "' is not allowed: expected one of " + list + cosim::ClosestHint(*s, allowed));
       return fallback.value_or(allowed.front());
     }
   }

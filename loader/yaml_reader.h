@@ -49,8 +49,7 @@ class YamlReader {
   double Real(const YAML::Node& map, const std::string& path, const std::string& key,
               std::optional<double> fallback, Range range = {});
   std::int64_t Integer(const YAML::Node& map, const std::string& path, const std::string& key,
-                       std::optional<std::int64_t> fallback, std::int64_t min,
-                       std::int64_t max);
+                       std::optional<std::int64_t> fallback, std::int64_t min, std::int64_t max);
   bool Boolean(const YAML::Node& map, const std::string& path, const std::string& key,
                std::optional<bool> fallback);
   /// With a non-empty `allowed`, the value must be one of them.

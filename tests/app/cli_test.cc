@@ -31,13 +31,12 @@ std::string ReadFile(const fs::path& p) {
 Result Linesim(const std::string& args) {
   static int counter = 0;
   // ctest runs tests as parallel processes: the pid keeps their files apart.
-  const std::string base = ::testing::TempDir() + "cli_" + std::to_string(getpid()) + "_" +
-                           std::to_string(++counter);
-  const std::string cmd = std::string(LINESIM_CLI) + " " + args + " >" + base + ".out 2>" +
-                          base + ".err </dev/null";
+  const std::string base =
+      ::testing::TempDir() + "cli_" + std::to_string(getpid()) + "_" + std::to_string(++counter);
+  const std::string cmd =
+      std::string(LINESIM_CLI) + " " + args + " >" + base + ".out 2>" + base + ".err </dev/null";
   const int raw = std::system(cmd.c_str());
-  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, ReadFile(base + ".out"),
-          ReadFile(base + ".err")};
+  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, ReadFile(base + ".out"), ReadFile(base + ".err")};
 }
 
 std::string Fresh(const std::string& name) {
@@ -67,7 +66,8 @@ TEST(Cli, RunMotorStepWritesSummaryAndSignals) {
   EXPECT_TRUE(summary["metrics"].contains("peak_current_a_motor1"));
   EXPECT_TRUE(summary["timing"]["units"].contains("motors"));
   const std::string csv = ReadFile(fs::path(out) / "signals.csv");
-  EXPECT_EQ(csv.rfind("time,supply.value[0],supply.value[1],load.value[0]", 0), 0u) << csv.substr(0, 200);
+  EXPECT_EQ(csv.rfind("time,supply.value[0],supply.value[1],load.value[0]", 0), 0u)
+      << csv.substr(0, 200);
   // 1.5 s at 1 ms: rows at 0, 0.001, ..., 1.5 plus the header.
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 1501);
   EXPECT_NE(csv.find("\n1.5,"), std::string::npos);
@@ -97,7 +97,8 @@ TEST(Cli, BadInputExitsTwoAndWritesNothing) {
       {"unknown_type", "duration_s: 1\nunits:\n  m: {type: dc_motr}\n",
        "units.m.type: unknown unit type 'dc_motr' (closest: dc_motor)"},
       {"missing_param", "units:\n  m: {type: dc_motor}\n", "duration_s: missing required key"},
-      {"wrong_type", "duration_s: 1\nunits:\n  m: {type: dc_motor, parameters: {resistance: low}}\n",
+      {"wrong_type",
+       "duration_s: 1\nunits:\n  m: {type: dc_motor, parameters: {resistance: low}}\n",
        "units.m.parameters.resistance: expected a number"},
   };
   for (const Case& c : cases) {
@@ -150,8 +151,8 @@ connections:
 TEST(Cli, InspectTypeAndFile) {
   const Result type = Linesim("inspect dc_motor");
   ASSERT_EQ(type.status, 0) << type.err;
-  for (const char* part : {"resistance", "parameter", "Ohm", "voltage", "input", "torque",
-                           "output", "N.m"}) {
+  for (const char* part :
+       {"resistance", "parameter", "Ohm", "voltage", "input", "torque", "output", "N.m"}) {
     EXPECT_NE(type.out.find(part), std::string::npos) << part;
   }
   const Result file = Linesim("inspect " + kMotorStep + " --set units.motors.parameters.count=2");

@@ -37,10 +37,10 @@ struct Multirate {
 // first so that Gauss-Seidel must order by dependency, not declaration.
 std::unique_ptr<Multirate> MakeMultirate() {
   auto m = std::make_unique<Multirate>();
-  m->sink = static_cast<RecordingSink*>(
-      &m->system.Add(std::make_unique<RecordingSink>("sink"), 3 * kMs));
-  m->source = static_cast<RampSource*>(
-      &m->system.Add(std::make_unique<RampSource>("source"), 2 * kMs));
+  m->sink =
+      static_cast<RecordingSink*>(&m->system.Add(std::make_unique<RecordingSink>("sink"), 3 * kMs));
+  m->source =
+      static_cast<RampSource*>(&m->system.Add(std::make_unique<RampSource>("source"), 2 * kMs));
   m->system.Connect("source.value", "sink.value");
   return m;
 }
@@ -91,8 +91,7 @@ TEST(MasterMultirate, JacobiTransfersOnlyAtCommonCommunicationPoints) {
   auto m = MakeMultirate();
   Master master(m->system, MultirateOptions(Algorithm::kJacobi));
   ASSERT_TRUE(master.Run().ok);
-  const std::vector<double> expected = {0.0,   0.0,   0.006, 0.006,
-                                        0.012, 0.012, 0.018, 0.018};
+  const std::vector<double> expected = {0.0, 0.0, 0.006, 0.006, 0.012, 0.012, 0.018, 0.018};
   EXPECT_EQ(m->sink->seen, expected);
 }
 
@@ -106,8 +105,7 @@ TEST(MasterMultirate, GaussSeidelTransfersTheSourcesNewOutputAtCommonPoints) {
   Master master(m->system, MultirateOptions(Algorithm::kGaussSeidel));
   ASSERT_TRUE(master.Run().ok);
   EXPECT_EQ(m->system.dependency_order(), (std::vector<std::size_t>{1, 0}));
-  const std::vector<double> expected = {0.002, 0.002, 0.008, 0.008,
-                                        0.014, 0.014, 0.020, 0.020};
+  const std::vector<double> expected = {0.002, 0.002, 0.008, 0.008, 0.014, 0.014, 0.020, 0.020};
   EXPECT_EQ(m->sink->seen, expected);
 }
 

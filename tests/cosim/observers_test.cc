@@ -194,7 +194,7 @@ TEST(MetricsObserver, ReductionsOfARamp) {
   const auto results = metrics.Results();
   ASSERT_EQ(results.size(), 6u);
   const std::vector<std::pair<std::string, double>> expected = {
-      {"final", 0.25},    {"min", -0.75}, {"max", 0.25},
+      {"final", 0.25},   {"min", -0.75},  {"max", 0.25},
       {"max_abs", 0.75}, {"mean", -0.25}, {"rms", std::sqrt(0.146)}};
   for (std::size_t i = 0; i < expected.size(); ++i) {
     EXPECT_EQ(results[i].first, expected[i].first);

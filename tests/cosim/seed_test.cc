@@ -10,9 +10,7 @@ namespace {
 
 // Guards reproducibility: a unit's seed is a pure function of the scenario
 // seed and the unit name (no global counter, no thread or order dependence).
-TEST(DeriveSeed, SameInputsSameSeed) {
-  EXPECT_EQ(DeriveSeed(7, "belt"), DeriveSeed(7, "belt"));
-}
+TEST(DeriveSeed, SameInputsSameSeed) { EXPECT_EQ(DeriveSeed(7, "belt"), DeriveSeed(7, "belt")); }
 
 // Guards against two noise sources sharing a stream: over 1000 unit names
 // and 10 scenario seeds no two derived seeds collide (a 64-bit mix makes a

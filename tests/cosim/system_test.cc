@@ -44,14 +44,13 @@ TEST(Endpoint, ParsesUnitVariableAndIndex) {
 // std::out_of_range).
 TEST(Endpoint, RefusesMalformedText) {
   for (const char* bad :
-       {"", "nodot", ".v", "u.", "u.v[", "u.v[]", "u.v[x]", "u.v[-1]", "u.v[1]x", "u.v]",
-        "a.b.c", "u v.x", "u.v[1][2]", "u.v[99999999999999999999999999]"}) {
+       {"", "nodot", ".v", "u.", "u.v[", "u.v[]", "u.v[x]", "u.v[-1]", "u.v[1]x", "u.v]", "a.b.c",
+        "u v.x", "u.v[1][2]", "u.v[99999999999999999999999999]"}) {
     try {
       Endpoint::Parse(bad);
       ADD_FAILURE() << "accepted '" << bad << "'";
     } catch (const std::invalid_argument& e) {
-      EXPECT_THAT(e.what(), HasSubstr("expected unit.variable or unit.variable[index]"))
-          << bad;
+      EXPECT_THAT(e.what(), HasSubstr("expected unit.variable or unit.variable[index]")) << bad;
     } catch (const std::exception& e) {
       ADD_FAILURE() << "'" << bad << "' threw a non-invalid_argument: " << e.what();
     }
@@ -143,8 +142,7 @@ TEST(SystemBuild, WrongCausality) {
               HasSubstr("a.pos is input, a connection must go from an output to an input"));
   EXPECT_THAT(OnlyMessage(BuildProblems({{"a.pos_out", "b.pos_out"}})),
               HasSubstr("b.pos_out is output, a connection must go from an output to an input"));
-  EXPECT_THAT(OnlyMessage(BuildProblems({{"a.gain", "b.pos"}})),
-              HasSubstr("a.gain is parameter"));
+  EXPECT_THAT(OnlyMessage(BuildProblems({{"a.gain", "b.pos"}})), HasSubstr("a.gain is parameter"));
 }
 
 // Guards against: a speed in m/s fed into a position input in m.
@@ -162,12 +160,13 @@ TEST(SystemBuild, InputWithTwoSources) {
   EXPECT_EQ(whole[0].message, "input c.pos has two sources: a.pos_out and b.pos_out");
   EXPECT_EQ(whole[0].connection, 1u);
 
-  EXPECT_THAT(OnlyMessage(BuildProblems({{"a.scan_out[0]", "c.scan[1]"},
-                                         {"b.scan_out[2]", "c.scan[1]"}})),
-              HasSubstr("input c.scan[1] has two sources: a.scan_out[0] and b.scan_out[2]"));
+  EXPECT_THAT(
+      OnlyMessage(BuildProblems({{"a.scan_out[0]", "c.scan[1]"}, {"b.scan_out[2]", "c.scan[1]"}})),
+      HasSubstr("input c.scan[1] has two sources: a.scan_out[0] and b.scan_out[2]"));
   EXPECT_THAT(OnlyMessage(BuildProblems({{"a.scan_out", "c.scan"}, {"b.pos_out", "c.scan[2]"}})),
               HasSubstr("input c.scan[2] has two sources: a.scan_out and b.pos_out"));
-  EXPECT_TRUE(BuildProblems({{"a.scan_out[0]", "c.scan[0]"}, {"b.scan_out[0]", "c.scan[1]"},
+  EXPECT_TRUE(BuildProblems({{"a.scan_out[0]", "c.scan[0]"},
+                             {"b.scan_out[0]", "c.scan[1]"},
                              {"a.pos_out", "c.scan[2]"}})
                   .empty());
 }
@@ -215,8 +214,8 @@ TEST(SystemBuild, AlgebraicLoopNamesTheCycle) {
     ASSERT_EQ(e.problems().size(), 1u) << e.what();
     const std::string& m = e.problems()[0].message;
     EXPECT_THAT(m, HasSubstr("algebraic loop"));
-    for (const char* hop : {"a.u -> a.y", "a.y -> b.u", "b.u -> b.y", "b.y -> c.u",
-                            "c.u -> c.y", "c.y -> a.u"}) {
+    for (const char* hop :
+         {"a.u -> a.y", "a.y -> b.u", "b.u -> b.y", "b.y -> c.u", "c.u -> c.y", "c.y -> a.u"}) {
       EXPECT_THAT(m, HasSubstr(hop));
     }
   }
@@ -282,10 +281,11 @@ TEST(SystemBuild, ReportsConnectionProblemsAndAlgebraicLoopTogether) {
 // element.
 TEST(SystemBuild, LinksResolveUnitsRefsAndElements) {
   System system;
-  ASSERT_TRUE(BuildProblems({{"a.scan_out[2]", "b.pos"}, {"b.pos_out", "c.scan[1]"},
-                             {"a.scan_out", "b.scan"}},
-                            &system)
-                  .empty());
+  ASSERT_TRUE(
+      BuildProblems(
+          {{"a.scan_out[2]", "b.pos"}, {"b.pos_out", "c.scan[1]"}, {"a.scan_out", "b.scan"}},
+          &system)
+          .empty());
   const auto& l = system.links();
   ASSERT_EQ(l.size(), 3u);
   const auto& ta = system.unit(0).variables();

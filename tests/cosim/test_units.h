@@ -3,16 +3,15 @@
 // Units used only by the cosim tests. Each is as small as the test that uses
 // it allows; none includes robot code.
 
+#include <Eigen/Dense>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <unsupported/Eigen/MatrixFunctions>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Dense>
-#include <unsupported/Eigen/MatrixFunctions>
 
 #include "cosim/unit.h"
 
@@ -143,8 +142,8 @@ class CouplingUnit : public Unit {
     Eigen::Matrix2d a;
     a << 0.0, 1.0, -k, -d;
     const Eigen::Vector2d b(0.0, k * x1_m_ + d * v1_mps_);
-    const Eigen::Vector2d x = ExactZohStep<2>(a, b, Eigen::Vector2d(x2_m_, v2_mps_),
-                                              NsToSeconds(dt));
+    const Eigen::Vector2d x =
+        ExactZohStep<2>(a, b, Eigen::Vector2d(x2_m_, v2_mps_), NsToSeconds(dt));
     x2_m_ = x[0];
     v2_mps_ = x[1];
     Publish();
@@ -199,8 +198,7 @@ class RampSource : public Unit {
 /// Records, at each DoStep, the time, the step and the input it sees.
 class RecordingSink : public Unit {
  public:
-  explicit RecordingSink(std::string name, std::string unit = "s")
-      : Unit("Sink", std::move(name)) {
+  explicit RecordingSink(std::string name, std::string unit = "s") : Unit("Sink", std::move(name)) {
     variables().Input("value", std::move(unit), &value_, "recorded input");
   }
   StepResult DoStep(TimeNs t, TimeNs dt) override {
@@ -223,8 +221,7 @@ class PassThrough : public Unit {
       : Unit("PassThrough", std::move(name)), feedthrough_(feedthrough) {
     variables().Input("u", unit, &u_, "input");
     variables().Output("y", unit, &y_, "copy of u",
-                       feedthrough ? std::vector<std::string>{"u"}
-                                   : std::vector<std::string>{});
+                       feedthrough ? std::vector<std::string>{"u"} : std::vector<std::string>{});
   }
   void Initialize() override {
     if (feedthrough_) y_ = u_;

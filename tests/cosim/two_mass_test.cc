@@ -85,8 +85,8 @@ Trajectory RunTwoMass(Algorithm algorithm, TimeNs h, int threads = 1,
     out.x1.push_back(mass1.GetReal(x));
     out.v1.push_back(mass1.GetReal(v));
     out.force.push_back(coupling.GetReal(f));
-    out.max_error_m = std::max(out.max_error_m,
-                               std::abs(out.x1.back() - ReferenceX1(p, master.time())));
+    out.max_error_m =
+        std::max(out.max_error_m, std::abs(out.x1.back() - ReferenceX1(p, master.time())));
   } while (master.Step());
   const RunResult r = master.Finish();
   EXPECT_TRUE(r.ok);
@@ -109,13 +109,12 @@ TEST(TwoMass, BothAlgorithmsConvergeAtFirstOrderAndGaussSeidelIsMoreAccurate) {
     jacobi[i] = RunTwoMass(Algorithm::kJacobi, steps[i]).max_error_m;
     gauss[i] = RunTwoMass(Algorithm::kGaussSeidel, steps[i]).max_error_m;
   }
-  std::printf("%10s %14s %14s %8s %8s\n", "h [s]", "Jacobi err [m]", "GS err [m]",
-              "p_J", "p_GS");
+  std::printf("%10s %14s %14s %8s %8s\n", "h [s]", "Jacobi err [m]", "GS err [m]", "p_J", "p_GS");
   for (int i = 0; i < 4; ++i) {
     const double pj = i ? std::log2(jacobi[i - 1] / jacobi[i]) : NAN;
     const double pg = i ? std::log2(gauss[i - 1] / gauss[i]) : NAN;
-    std::printf("%10.6f %14.6e %14.6e %8.3f %8.3f\n", NsToSeconds(steps[i]), jacobi[i],
-                gauss[i], pj, pg);
+    std::printf("%10.6f %14.6e %14.6e %8.3f %8.3f\n", NsToSeconds(steps[i]), jacobi[i], gauss[i],
+                pj, pg);
   }
   for (int i = 0; i < 4; ++i) {
     EXPECT_LT(gauss[i], jacobi[i]) << "h = " << FormatSeconds(steps[i]);

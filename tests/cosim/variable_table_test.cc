@@ -43,8 +43,8 @@ struct Holder {
   bool on = false;
   double force = 0.0;
   double state = 7.0;
-  ValueRef gain_ref, offsets_ref, mode_ref, enabled_ref, frame_ref, speed_ref, scan_ref,
-      count_ref, on_ref, force_ref, state_ref;
+  ValueRef gain_ref, offsets_ref, mode_ref, enabled_ref, frame_ref, speed_ref, scan_ref, count_ref,
+      on_ref, force_ref, state_ref;
 };
 
 // Guards against: start values not taken from the bound members at
@@ -72,8 +72,7 @@ TEST(VariableTable, DeclarationRecordsStartValuesAndMetadata) {
   EXPECT_EQ(h.t.info(h.count_ref).unit, "1");
   EXPECT_EQ(h.t.info(h.gain_ref).variability, Variability::kFixed);
   EXPECT_EQ(h.t.info(h.state_ref).causality, Causality::kLocal);
-  EXPECT_EQ(h.t.info(h.force_ref).depends_on,
-            (std::vector<ValueRef>{h.speed_ref, h.on_ref}));
+  EXPECT_EQ(h.t.info(h.force_ref).depends_on, (std::vector<ValueRef>{h.speed_ref, h.on_ref}));
   EXPECT_TRUE(h.t.info(h.speed_ref).depends_on.empty());
 
   EXPECT_EQ(h.t.Find("count"), h.count_ref);

@@ -89,11 +89,12 @@ connections:
   const std::string all = Issues(f);
   EXPECT_TRUE(Has(all, f + ":2: duration_s: value -1 is out of range")) << all;
   EXPECT_TRUE(Has(all, f + ":3: colour: unknown key")) << all;
-  EXPECT_TRUE(Has(all, "master.algorithm: 'simplex' is not allowed: expected one of jacobi, "
-                       "gauss_seidel"))
+  EXPECT_TRUE(Has(all,
+                  "master.algorithm: 'simplex' is not allowed: expected one of jacobi, "
+                  "gauss_seidel"))
       << all;
   EXPECT_TRUE(Has(all, f + ":10: units.motor.type: unknown unit type 'dc_motr' (closest: "
-                       "dc_motor)"))
+                           "dc_motor)"))
       << all;
 }
 
@@ -119,11 +120,13 @@ units:
     parameters: {count: 2, resistance: [1, 2, 3], inductanse: 1, gear_ratio: fast}
 )");
   const std::string all = Issues(f);
-  EXPECT_TRUE(Has(all, "units.motor.parameters.resistance: expected a number (for every "
-                       "element) or a list of 2 numbers, got a list of 3"))
+  EXPECT_TRUE(Has(all,
+                  "units.motor.parameters.resistance: expected a number (for every "
+                  "element) or a list of 2 numbers, got a list of 3"))
       << all;
-  EXPECT_TRUE(Has(all, "units.motor.parameters.inductanse: unknown parameter of a dc_motor unit; "
-                       "closest: units.motor.parameters.inductance"))
+  EXPECT_TRUE(Has(all,
+                  "units.motor.parameters.inductanse: unknown parameter of a dc_motor unit; "
+                  "closest: units.motor.parameters.inductance"))
       << all;
   EXPECT_TRUE(Has(all, "units.motor.parameters.gear_ratio: expected a number (for every element)"))
       << all;
@@ -152,7 +155,7 @@ units:
 )");
   const std::string all = Issues(f);
   EXPECT_TRUE(Has(all, f + ":5: units.motor.step_s: unit 'motor' step 0.0015 s is not an integer "
-                       "multiple of the master step 0.001 s"))
+                           "multiple of the master step 0.001 s"))
       << all;
 }
 
@@ -186,7 +189,7 @@ connections:
 )");
   const std::string all = Issues(f);
   EXPECT_TRUE(Has(all, f + ":9: connections.0: connection supply.value -> motor.voltage: "
-                       "array size mismatch"))
+                           "array size mismatch"))
       << all;
   EXPECT_TRUE(Has(all, "units of measure differ")) << all;
   EXPECT_TRUE(Has(all, f + ":10: connections.1:")) << all;

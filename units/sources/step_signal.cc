@@ -27,9 +27,9 @@ std::vector<cosim::ParameterProblem> StepSignalUnit::CheckParameters() const {
   std::vector<cosim::ParameterProblem> problems;
   for (std::size_t i = 1; i < steps_.size(); ++i) {
     if (steps_[i].time <= steps_[i - 1].time) {
-      problems.push_back({"steps", i, "step times must increase, got " +
-                                          cosim::FormatSeconds(steps_[i].time) + " s after " +
-                                          cosim::FormatSeconds(steps_[i - 1].time) + " s"});
+      problems.push_back({"steps", i,
+                          "step times must increase, got " + cosim::FormatSeconds(steps_[i].time) +
+                              " s after " + cosim::FormatSeconds(steps_[i - 1].time) + " s"});
     }
   }
   return problems;
