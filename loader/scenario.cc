@@ -174,6 +174,12 @@ class Builder {
     options.threads = static_cast<int>(r_.Integer(master_map, "master", "threads", 1, 1, 256));
     options.start = 0;
     options.stop = cosim::SecondsToNs(s_.duration_s);
+    if (options.base_step > 0 && options.stop > 0 && options.stop % options.base_step != 0) {
+      r_.Error(Child(root, "duration_s"), "duration_s",
+               "duration " + cosim::FormatSeconds(options.stop) +
+                   " s is not a whole number of master steps (master.step_s = " +
+                   cosim::FormatSeconds(options.base_step) + " s)");
+    }
     const bool master_ok = r_.issues().size() == issues_before_master;
 
     s_.system = std::make_unique<cosim::System>();
@@ -199,8 +205,9 @@ class Builder {
         } else if (p.unit && *p.unit < unit_nodes_.size()) {
           const auto& [name, node] = unit_nodes_[*p.unit];
           const YAML::Node step = Child(node, "step_s");
+          const std::string unit_path = JoinPath("units", name);
           r_.Error(step.IsDefined() ? step : node,
-                   JoinPath(JoinPath("units", name), step.IsDefined() ? "step_s" : ""), p.message);
+                   step.IsDefined() ? JoinPath(unit_path, "step_s") : unit_path, p.message);
         } else {
           r_.Error(root, "", p.message);
         }

@@ -159,6 +159,20 @@ units:
       << all;
 }
 
+// Guards: a duration that is not a whole number of master steps is refused
+// at duration_s (the run could not end exactly at the requested time).
+TEST(LoadScenario, DurationOffTheMasterStepsIsRefused) {
+  const std::string f = WriteScenario("dur.yaml", R"(duration_s: 0.0105
+units:
+  motor:
+    type: dc_motor
+)");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, f + ":1: duration_s: duration 0.0105 s is not a whole number of master "
+                       "steps (master.step_s = 0.001 s)"))
+      << all;
+}
+
 // Guards the range check before time zero: the unit's own parameter check
 // (a resistance must be positive) reaches the user with the key path.
 TEST(LoadScenario, OutOfRangeParameterIsRefusedBeforeTimeZero) {
