@@ -139,6 +139,8 @@ connections:
   const Result r = Linesim("run " + file + " --out " + out);
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_NE(r.err.find("unit 'motor' (dc_motor) at t = 0.01 s"), std::string::npos) << r.err;
+  // The variable: 1e308 V over 0.0823 mH makes di/dt overflow.
+  EXPECT_NE(r.err.find("the derivative of current[0] is inf"), std::string::npos) << r.err;
   const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
   EXPECT_EQ(summary["status"], "failed");
   const std::string csv = ReadFile(fs::path(out) / "signals.csv");

@@ -195,6 +195,47 @@ void DcMotorUnit::Check(int flag, const char* function, cosim::TimeNs t) const {
   throw cosim::UnitError(text);
 }
 
+// After a failed CVode call, the state to blame: one whose derivative is
+// not finite at the last state (an absurd input or parameter), else the one
+// with the largest weighted local error estimate.
+std::string DcMotorUnit::WorstState() const {
+  const auto state_name = [&](std::size_t j) {
+    const std::size_t motor = j / static_cast<std::size_t>(states_per_motor_);
+    const bool is_current = j % static_cast<std::size_t>(states_per_motor_) == 0;
+    return std::string(is_current ? "current" : "rotor speed (output 'speed')") + "[" +
+           std::to_string(motor) + "]";
+  };
+  std::vector<double> ydot(y_.size());
+  EvalRhs(y_.data(), ydot.data());
+  for (std::size_t j = 0; j < y_.size(); ++j) {
+    if (!std::isfinite(ydot[j])) {
+      return "the derivative of " + state_name(j) + " is " + FormatNumber(ydot[j]) +
+             " (check the inputs)";
+    }
+  }
+  N_Vector weights = N_VClone(sun_->y);
+  N_Vector errors = N_VClone(sun_->y);
+  std::string text;
+  if (weights && errors && CVodeGetErrWeights(sun_->cvode, weights) == CV_SUCCESS &&
+      CVodeGetEstLocalErrors(sun_->cvode, errors) == CV_SUCCESS) {
+    const double* w = N_VGetArrayPointer(weights);
+    const double* e = N_VGetArrayPointer(errors);
+    std::size_t worst = 0;
+    double worst_value = -1.0;
+    for (std::size_t j = 0; j < y_.size(); ++j) {
+      const double v = std::abs(e[j] * w[j]);
+      if (!(v <= worst_value)) {  // also picks a NaN
+        worst = j;
+        worst_value = v;
+      }
+    }
+    text = "largest local error in " + state_name(worst);
+  }
+  if (weights) N_VDestroy(weights);
+  if (errors) N_VDestroy(errors);
+  return text;
+}
+
 std::vector<cosim::ParameterProblem> DcMotorUnit::CheckParameters() const {
   std::vector<cosim::ParameterProblem> problems;
   const auto rule = [&](const char* var, const std::vector<double>& p, auto ok,
@@ -400,7 +441,11 @@ cosim::StepResult DcMotorUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   }
   Check(CVodeSetStopTime(sun_->cvode, t1_s), "CVodeSetStopTime", t);
   double t_reached = t0_s;
-  Check(CVode(sun_->cvode, t1_s, sun_->y, &t_reached, CV_NORMAL), "CVode", t);
+  const int flag = CVode(sun_->cvode, t1_s, sun_->y, &t_reached, CV_NORMAL);
+  if (flag < 0) {
+    sun_->message += (sun_->message.empty() ? "" : "; ") + WorstState();
+    Check(flag, "CVode", t);
+  }
   long nst = 0;
   Check(CVodeGetNumSteps(sun_->cvode, &nst), "CVodeGetNumSteps", t);
   steps_ += nst - steps_since_restart_;

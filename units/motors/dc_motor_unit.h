@@ -88,6 +88,7 @@ class DcMotorUnit : public cosim::Unit {
   /// Throws cosim::UnitError naming the unit, the SUNDIALS function, the time
   /// and the flag when `flag` is negative.
   void Check(int flag, const char* function, cosim::TimeNs t) const;
+  std::string WorstState() const;
   void SetTolerances();
   std::string Where() const;
 
