@@ -526,6 +526,23 @@ TEST(DcMotorUnit, SundialsFailureNamesUnitFunctionTimeAndFlag) {
   }
 }
 
+// Guards the "name the variable" contract of a numerical failure: with a
+// finite but absurd voltage on motor 1 (1e308 V over 0.0823 mH, so di/dt
+// overflows to inf), the error names current[1], not motor 0.
+TEST(DcMotorUnit, IntegratorFailureNamesTheStateToBlame) {
+  DcMotorUnit u("m", 2, MotorMode::kFull);
+  u.Initialize();
+  SetArray(u, "voltage", {1.0, 1e308});
+  try {
+    u.DoStep(0, kMs);
+    FAIL() << "no error";
+  } catch (const cosim::UnitError& e) {
+    EXPECT_NE(std::string(e.what()).find("the derivative of current[1] is inf"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // Guards against a NaN input silently poisoning the integrator.
 TEST(DcMotorUnit, NonFiniteInputFailsTheStep) {
   DcMotorUnit u("m", 2, MotorMode::kFull);
