@@ -11,14 +11,14 @@
 
 namespace linesim::cosim {
 
-namespace {
-
 bool IsIdentifier(std::string_view s) {
   if (s.empty()) return false;
   return std::all_of(s.begin(), s.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
   });
 }
+
+namespace {
 
 std::string JoinProblems(const std::vector<Problem>& problems) {
   std::string out;

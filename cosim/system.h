@@ -13,6 +13,9 @@
 
 namespace linesim::cosim {
 
+/// True for a valid unit or variable name: letters, digits and '_'.
+bool IsIdentifier(std::string_view s);
+
 /// One end of a connection: `unit.variable` or `unit.variable[index]` for
 /// one element of a real array.
 struct Endpoint {

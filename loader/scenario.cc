@@ -1,7 +1,6 @@
 #include "loader/scenario.h"
 
 #include <algorithm>
-#include <cctype>
 #include <filesystem>
 #include <map>
 
@@ -231,10 +230,7 @@ class Builder {
 
   void BuildUnit(const std::string& name, const YAML::Node& key, const YAML::Node& spec) {
     const std::string path = JoinPath("units", name);
-    const bool identifier = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
-      return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
-    });
-    if (!identifier) {
+    if (!cosim::IsIdentifier(name)) {
       r_.Error(key, path, "unit name '" + name + "' is not valid: expected letters, digits and _");
       return;
     }
@@ -244,14 +240,7 @@ class Builder {
     if (type_name.empty()) return;
     const UnitType* type = FindUnitType(type_name);
     if (!type) {
-      r_.Error(
-          Child(spec, "type"), JoinPath(path, "type"),
-          "unknown unit type '" + type_name + "'" + cosim::ClosestHint(type_name, UnitTypeNames()) +
-              "; known types: " + [] {
-                std::string all;
-                for (const auto& n : UnitTypeNames()) all += (all.empty() ? "" : ", ") + n;
-                return all;
-              }());
+      r_.Error(Child(spec, "type"), JoinPath(path, "type"), UnknownTypeMessage(type_name));
       return;
     }
     cosim::TimeNs step = 0;
@@ -462,14 +451,7 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
 
 std::unique_ptr<cosim::Unit> CreateDefaultUnit(const std::string& type_name) {
   const UnitType* type = FindUnitType(type_name);
-  if (!type) {
-    std::string all;
-    for (const auto& n : UnitTypeNames()) all += (all.empty() ? "" : ", ") + n;
-    throw ScenarioError(
-        {{"", 0, "",
-          "unknown unit type '" + type_name + "'" + cosim::ClosestHint(type_name, UnitTypeNames()) +
-              "; known types: " + all}});
-  }
+  if (!type) throw ScenarioError({{"", 0, "", UnknownTypeMessage(type_name)}});
   YamlReader reader("(defaults)");
   const YAML::Node none;
   const std::string path = "parameters";

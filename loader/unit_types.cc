@@ -96,4 +96,11 @@ std::vector<std::string> UnitTypeNames() {
   return names;
 }
 
+std::string UnknownTypeMessage(const std::string& name) {
+  std::string all;
+  for (const auto& n : UnitTypeNames()) all += (all.empty() ? "" : ", ") + n;
+  return "unknown unit type '" + name + "'" + cosim::ClosestHint(name, UnitTypeNames()) +
+         "; known types: " + all;
+}
+
 }  // namespace linesim::loader

@@ -45,5 +45,7 @@ struct UnitType {
 const std::vector<UnitType>& UnitTypes();
 const UnitType* FindUnitType(std::string_view name);
 std::vector<std::string> UnitTypeNames();
+/// "unknown unit type 'x' (closest: ...); known types: a, b".
+std::string UnknownTypeMessage(const std::string& name);
 
 }  // namespace linesim::loader
