@@ -14,9 +14,23 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double SecondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+// Adds the wall time of its scope to `total`, only when profiling, so that
+// every exit of a function is counted and an unprofiled run reads no clock.
+class ScopedTimer {
+ public:
+  ScopedTimer(bool on, double& total) : total_(on ? &total : nullptr) {
+    if (total_) start_ = Clock::now();
+  }
+  ~ScopedTimer() {
+    if (total_) *total_ += std::chrono::duration<double>(Clock::now() - start_).count();
+  }
+  ScopedTimer(const ScopedTimer&) = delete;
+  ScopedTimer& operator=(const ScopedTimer&) = delete;
+
+ private:
+  double* total_;
+  Clock::time_point start_;
+};
 
 bool SameBits(double a, double b) {
   return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
@@ -182,10 +196,10 @@ bool Master::CheckOutputs(std::size_t u, TimeNs t) {
 // Safe to call for different units concurrently.
 bool Master::StepUnit(std::size_t u, TimeNs t, TimeNs dt) {
   Unit& unit = system_.unit(u);
-  const auto t0 = options_.profile ? Clock::now() : Clock::time_point{};
   StepResult result;
   std::string cause;
   try {
+    const ScopedTimer timer(options_.profile, unit_wall_seconds_[u]);
     result = unit.DoStep(t, dt);
     if (result == StepResult::kDiscard) {
       cause = "discarded the step (" + unit.last_error() + "); a fixed-step master cannot retry it";
@@ -196,7 +210,6 @@ bool Master::StepUnit(std::size_t u, TimeNs t, TimeNs dt) {
     result = StepResult::kError;
     cause = e.what();
   }
-  if (options_.profile) unit_wall_seconds_[u] += SecondsSince(t0);
   if (result != StepResult::kOk) {
     pending_errors_[u] = std::move(cause);
     return false;
@@ -205,14 +218,13 @@ bool Master::StepUnit(std::size_t u, TimeNs t, TimeNs dt) {
 }
 
 bool Master::UpdateUnitOutputs(std::size_t u, TimeNs t) {
-  const auto t0 = options_.profile ? Clock::now() : Clock::time_point{};
   try {
+    const ScopedTimer timer(options_.profile, unit_wall_seconds_[u]);
     system_.unit(u).UpdateOutputs();
   } catch (const std::exception& e) {
     RecordError(u, t, std::string("updating outputs from new inputs failed: ") + e.what());
     return false;
   }
-  if (options_.profile) unit_wall_seconds_[u] += SecondsSince(t0);
   return CheckOutputs(u, t);
 }
 
@@ -227,15 +239,14 @@ void Master::PropagateInitialValues() {
     for (const Link& link : system_.links()) changed |= Transfer(link);
     if (!changed && pass > 0) return;
     for (std::size_t u = 0; u < n; ++u) {
-      const auto t0 = Clock::now();
       // Name the unit, as the first Initialize pass in Start() does.
       try {
+        const ScopedTimer timer(options_.profile, unit_wall_seconds_[u]);
         system_.unit(u).Initialize();
       } catch (const std::exception& e) {
         RecordError(u, time_, std::string("initialize failed: ") + e.what());
         return;
       }
-      unit_wall_seconds_[u] += SecondsSince(t0);
     }
   }
   throw UnitError("initial values did not settle after " + std::to_string(n + 2) + " passes");
@@ -246,20 +257,19 @@ void Master::Notify(TimeNs t) {
 }
 
 void Master::Start() {
-  const auto wall0 = Clock::now();
   const std::size_t n = system_.unit_count();
   pending_errors_.assign(n, {});
   unit_wall_seconds_.assign(n, 0.0);
   total_wall_seconds_ = 0;
+  const ScopedTimer timer(options_.profile, total_wall_seconds_);
   errors_.clear();
   failed_ = false;
   time_ = options_.start;
   step_index_ = 0;
   for (std::size_t u = 0; u < n; ++u) {
     try {
-      const auto t0 = Clock::now();
+      const ScopedTimer unit_timer(options_.profile, unit_wall_seconds_[u]);
       system_.unit(u).Setup(options_.start, options_.stop);
-      unit_wall_seconds_[u] += SecondsSince(t0);
     } catch (const std::exception& e) {
       RecordError(u, time_, std::string("setup failed: ") + e.what());
     }
@@ -284,12 +294,11 @@ void Master::Start() {
   started_ = true;
   for (Observer* o : observers_) o->OnStart(*this);
   if (!failed_) Notify(time_);
-  total_wall_seconds_ += SecondsSince(wall0);
 }
 
 bool Master::Step() {
   if (!started_ || failed_ || time_ >= options_.stop) return false;
-  const auto wall0 = Clock::now();
+  const ScopedTimer timer(options_.profile, total_wall_seconds_);
   const TimeNs t = time_;
   const TimeNs h = options_.base_step;
   const auto& links = system_.links();
@@ -322,7 +331,6 @@ bool Master::Step() {
     if (!has_feedthrough_[u]) continue;
     if (!jacobi) transfer_into(u);
     if (!UpdateUnitOutputs(u, t)) {
-      total_wall_seconds_ += SecondsSince(wall0);
       return false;
     }
     for (std::size_t l : links_from_[u]) {
@@ -353,7 +361,6 @@ bool Master::Step() {
         break;
       }
       if (!CheckOutputs(u, t + h * decimation_[u])) {
-        total_wall_seconds_ += SecondsSince(wall0);
         return false;
       }
     }
@@ -366,25 +373,22 @@ bool Master::Step() {
         pending_errors_[u].clear();
       }
     }
-    total_wall_seconds_ += SecondsSince(wall0);
     return false;
   }
   if (jacobi) {
     for (std::size_t u : due_) ok &= CheckOutputs(u, t + h * decimation_[u]);
     if (!ok) {
-      total_wall_seconds_ += SecondsSince(wall0);
       return false;
     }
   }
   ++step_index_;
   time_ = options_.start + step_index_ * h;
   Notify(time_);
-  total_wall_seconds_ += SecondsSince(wall0);
   return time_ < options_.stop;
 }
 
 RunResult Master::Finish() {
-  const auto wall0 = Clock::now();
+  const ScopedTimer timer(options_.profile, total_wall_seconds_);
   for (std::size_t u = 0; u < system_.unit_count(); ++u) {
     try {
       system_.unit(u).Terminate();
@@ -393,7 +397,6 @@ RunResult Master::Finish() {
     }
   }
   for (Observer* o : observers_) o->OnEnd(time_, !failed_);
-  total_wall_seconds_ += SecondsSince(wall0);
   RunResult r;
   r.ok = !failed_;
   r.end_time = time_;

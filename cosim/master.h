@@ -76,9 +76,11 @@ class Master {
   TimeNs time() const { return time_; }
   /// Communication step of unit i as a multiple of the base step.
   std::int64_t decimation(std::size_t unit) const { return decimation_[unit]; }
-  /// Wall time spent in each unit (Setup, Initialize, DoStep), in seconds.
+  /// Wall time spent in each unit (Setup, Initialize, DoStep, UpdateOutputs),
+  /// in seconds; zero without `profile`.
   const std::vector<double>& unit_wall_seconds() const { return unit_wall_seconds_; }
-  /// Wall time spent in the master itself (transfers, checks, observers).
+  /// Wall time of Start, every Step and Finish together (units included);
+  /// zero without `profile`.
   double total_wall_seconds() const { return total_wall_seconds_; }
 
  private:
