@@ -32,7 +32,9 @@ std::unique_ptr<cosim::Unit> MakeStepSignal(const UnitBuildContext& c) {
       if (!r.ExpectMap(item, item_path)) continue;
       r.CheckKeys(item, item_path, {"time_s", "value"});
       sources::StepSignalUnit::Step step;
-      step.time = cosim::SecondsToNs(r.Real(item, item_path, "time_s", std::nullopt, {0.0}));
+      // Bounded like duration_s, so that the time fits in int64 nanoseconds.
+      step.time =
+          cosim::SecondsToNs(r.Real(item, item_path, "time_s", std::nullopt, {0.0, 1e7}));
       const YAML::Node value = Child(item, "value");
       const std::string value_path = JoinPath(item_path, "value");
       if (!value.IsDefined()) {

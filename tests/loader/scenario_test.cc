@@ -110,6 +110,20 @@ TEST(LoadScenario, MissingKeyAndWrongTypeNameTheKey) {
   EXPECT_TRUE(Has(all, "units.motor.parameters.count: expected an integer, got 'two'")) << all;
 }
 
+// Guards against a time that cannot be held in int64 nanoseconds escaping
+// as an exception instead of an issue at its key.
+TEST(LoadScenario, StepTimeBeyondRangeIsAnIssueAtItsKey) {
+  const std::string f = WriteScenario("far.yaml", R"(duration_s: 0.01
+units:
+  supply:
+    type: step_signal
+    parameters: {steps: [{time_s: 1.0e300, value: 1}]}
+)");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, "units.supply.parameters.steps.0.time_s: value 1.0e300 is out of range"))
+      << all;
+}
+
 // Guards the parameter path: a value of the wrong shape or an unknown name
 // is refused with what was expected.
 TEST(LoadScenario, ParameterValuesAreChecked) {
