@@ -79,13 +79,48 @@ std::string FormatValue(const Value& v) {
   return std::visit(Visitor{}, v);
 }
 
-ValueRef VariableTable::Declare(VariableInfo info, void* storage, std::size_t size, Value start) {
-  info.size = size;
-  info.start = std::move(start);
-  return Add(std::move(info), storage);
+namespace {
+
+template <typename T>
+constexpr VarType kTypeOf = VarType::kReal;
+template <>
+constexpr VarType kTypeOf<std::vector<double>> = VarType::kRealArray;
+template <>
+constexpr VarType kTypeOf<std::int64_t> = VarType::kInteger;
+template <>
+constexpr VarType kTypeOf<bool> = VarType::kBoolean;
+template <>
+constexpr VarType kTypeOf<std::string> = VarType::kString;
+
+template <typename T>
+std::size_t ElementCount(const T&) {
+  return 1;
+}
+std::size_t ElementCount(const std::vector<double>& v) { return v.size(); }
+
+// Inputs and outputs exchanged as signals are continuous for reals and
+// discrete for the other types.
+Variability SignalVariability(VarType t) {
+  return (t == VarType::kReal || t == VarType::kRealArray) ? Variability::kContinuous
+                                                           : Variability::kDiscrete;
 }
 
-ValueRef VariableTable::Add(VariableInfo info, void* storage) {
+}  // namespace
+
+template <typename T>
+ValueRef VariableTable::Bind(std::string name, Causality causality, Variability variability,
+                             std::string unit, T* storage, std::string description,
+                             const std::vector<std::string>& depends_on) {
+  VariableInfo info;
+  info.name = std::move(name);
+  info.type = kTypeOf<T>;
+  info.size = ElementCount(*storage);
+  info.causality = causality;
+  info.variability = variability;
+  info.unit = std::move(unit);
+  info.description = std::move(description);
+  info.start = *storage;
+  info.depends_on = ResolveDependencies(info.name, depends_on);
   if (info.name.empty()) throw std::logic_error("variable with an empty name");
   if (by_name_.count(info.name)) {
     throw std::logic_error("variable '" + info.name + "' declared twice");
@@ -97,123 +132,72 @@ ValueRef VariableTable::Add(VariableInfo info, void* storage) {
   return infos_.back().ref;
 }
 
-namespace {
-
-VariableInfo MakeInfo(std::string name, VarType type, Causality c, Variability v, std::string unit,
-                      std::string description) {
-  VariableInfo info;
-  info.name = std::move(name);
-  info.type = type;
-  info.causality = c;
-  info.variability = v;
-  info.unit = std::move(unit);
-  info.description = std::move(description);
-  return info;
-}
-
-// Inputs and outputs exchanged as signals are continuous for reals and
-// discrete for the other types.
-Variability SignalVariability(VarType t) {
-  return (t == VarType::kReal || t == VarType::kRealArray) ? Variability::kContinuous
-                                                           : Variability::kDiscrete;
-}
-
-}  // namespace
-
 ValueRef VariableTable::Parameter(std::string name, std::string unit, double* s, std::string d,
                                   Variability v) {
-  auto info = MakeInfo(std::move(name), VarType::kReal, Causality::kParameter, v, std::move(unit),
-                       std::move(d));
-  return Declare(std::move(info), s, 1, *s);
+  return Bind(std::move(name), Causality::kParameter, v, std::move(unit), s, std::move(d));
 }
 ValueRef VariableTable::Parameter(std::string name, std::string unit, std::vector<double>* s,
                                   std::string d, Variability v) {
-  auto info = MakeInfo(std::move(name), VarType::kRealArray, Causality::kParameter, v,
-                       std::move(unit), std::move(d));
-  return Declare(std::move(info), s, s->size(), *s);
+  return Bind(std::move(name), Causality::kParameter, v, std::move(unit), s, std::move(d));
 }
 ValueRef VariableTable::Parameter(std::string name, std::int64_t* s, std::string d, Variability v) {
-  auto info =
-      MakeInfo(std::move(name), VarType::kInteger, Causality::kParameter, v, "1", std::move(d));
-  return Declare(std::move(info), s, 1, *s);
+  return Bind(std::move(name), Causality::kParameter, v, "1", s, std::move(d));
 }
 ValueRef VariableTable::Parameter(std::string name, bool* s, std::string d, Variability v) {
-  auto info =
-      MakeInfo(std::move(name), VarType::kBoolean, Causality::kParameter, v, "1", std::move(d));
-  return Declare(std::move(info), s, 1, *s);
+  return Bind(std::move(name), Causality::kParameter, v, "1", s, std::move(d));
 }
 ValueRef VariableTable::Parameter(std::string name, std::string* s, std::string d, Variability v) {
-  auto info =
-      MakeInfo(std::move(name), VarType::kString, Causality::kParameter, v, "", std::move(d));
-  return Declare(std::move(info), s, 1, *s);
+  return Bind(std::move(name), Causality::kParameter, v, "", s, std::move(d));
 }
 
 ValueRef VariableTable::Input(std::string name, std::string unit, double* s, std::string d) {
-  auto info = MakeInfo(std::move(name), VarType::kReal, Causality::kInput,
-                       SignalVariability(VarType::kReal), std::move(unit), std::move(d));
-  return Declare(std::move(info), s, 1, *s);
+  return Bind(std::move(name), Causality::kInput, SignalVariability(VarType::kReal),
+              std::move(unit), s, std::move(d));
 }
 ValueRef VariableTable::Input(std::string name, std::string unit, std::vector<double>* s,
                               std::string d) {
-  auto info = MakeInfo(std::move(name), VarType::kRealArray, Causality::kInput,
-                       SignalVariability(VarType::kRealArray), std::move(unit), std::move(d));
-  return Declare(std::move(info), s, s->size(), *s);
+  return Bind(std::move(name), Causality::kInput, SignalVariability(VarType::kRealArray),
+              std::move(unit), s, std::move(d));
 }
 ValueRef VariableTable::Input(std::string name, std::int64_t* s, std::string d) {
-  auto info = MakeInfo(std::move(name), VarType::kInteger, Causality::kInput,
-                       Variability::kDiscrete, "1", std::move(d));
-  return Declare(std::move(info), s, 1, *s);
+  return Bind(std::move(name), Causality::kInput, Variability::kDiscrete, "1", s, std::move(d));
 }
 ValueRef VariableTable::Input(std::string name, bool* s, std::string d) {
-  auto info = MakeInfo(std::move(name), VarType::kBoolean, Causality::kInput,
-                       Variability::kDiscrete, "1", std::move(d));
-  return Declare(std::move(info), s, 1, *s);
+  return Bind(std::move(name), Causality::kInput, Variability::kDiscrete, "1", s, std::move(d));
 }
 ValueRef VariableTable::Input(std::string name, std::string* s, std::string d) {
-  auto info = MakeInfo(std::move(name), VarType::kString, Causality::kInput, Variability::kDiscrete,
-                       "", std::move(d));
-  return Declare(std::move(info), s, 1, *s);
+  return Bind(std::move(name), Causality::kInput, Variability::kDiscrete, "", s, std::move(d));
 }
 
 ValueRef VariableTable::Output(std::string name, std::string unit, double* s, std::string d,
                                const std::vector<std::string>& deps) {
-  auto info = MakeInfo(std::move(name), VarType::kReal, Causality::kOutput,
-                       SignalVariability(VarType::kReal), std::move(unit), std::move(d));
-  info.depends_on = ResolveDependencies(info.name, deps);
-  return Declare(std::move(info), s, 1, *s);
+  return Bind(std::move(name), Causality::kOutput, SignalVariability(VarType::kReal),
+              std::move(unit), s, std::move(d), deps);
 }
 ValueRef VariableTable::Output(std::string name, std::string unit, std::vector<double>* s,
                                std::string d, const std::vector<std::string>& deps) {
-  auto info = MakeInfo(std::move(name), VarType::kRealArray, Causality::kOutput,
-                       SignalVariability(VarType::kRealArray), std::move(unit), std::move(d));
-  info.depends_on = ResolveDependencies(info.name, deps);
-  return Declare(std::move(info), s, s->size(), *s);
+  return Bind(std::move(name), Causality::kOutput, SignalVariability(VarType::kRealArray),
+              std::move(unit), s, std::move(d), deps);
 }
 ValueRef VariableTable::Output(std::string name, std::int64_t* s, std::string d,
                                const std::vector<std::string>& deps) {
-  auto info = MakeInfo(std::move(name), VarType::kInteger, Causality::kOutput,
-                       Variability::kDiscrete, "1", std::move(d));
-  info.depends_on = ResolveDependencies(info.name, deps);
-  return Declare(std::move(info), s, 1, *s);
+  return Bind(std::move(name), Causality::kOutput, Variability::kDiscrete, "1", s, std::move(d),
+              deps);
 }
 ValueRef VariableTable::Output(std::string name, bool* s, std::string d,
                                const std::vector<std::string>& deps) {
-  auto info = MakeInfo(std::move(name), VarType::kBoolean, Causality::kOutput,
-                       Variability::kDiscrete, "1", std::move(d));
-  info.depends_on = ResolveDependencies(info.name, deps);
-  return Declare(std::move(info), s, 1, *s);
+  return Bind(std::move(name), Causality::kOutput, Variability::kDiscrete, "1", s, std::move(d),
+              deps);
 }
 
 ValueRef VariableTable::Local(std::string name, std::string unit, double* s, std::string d) {
-  auto info = MakeInfo(std::move(name), VarType::kReal, Causality::kLocal, Variability::kContinuous,
-                       std::move(unit), std::move(d));
-  return Declare(std::move(info), s, 1, *s);
+  return Bind(std::move(name), Causality::kLocal, Variability::kContinuous, std::move(unit), s,
+              std::move(d));
 }
 ValueRef VariableTable::Local(std::string name, std::string unit, std::vector<double>* s,
                               std::string d) {
-  auto info = MakeInfo(std::move(name), VarType::kRealArray, Causality::kLocal,
-                       Variability::kContinuous, std::move(unit), std::move(d));
-  return Declare(std::move(info), s, s->size(), *s);
+  return Bind(std::move(name), Causality::kLocal, Variability::kContinuous, std::move(unit), s,
+              std::move(d));
 }
 
 std::vector<ValueRef> VariableTable::ResolveDependencies(

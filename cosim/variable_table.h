@@ -124,8 +124,13 @@ class VariableTable {
   void SetValue(ValueRef ref, const Value& v);
 
  private:
-  ValueRef Declare(VariableInfo info, void* storage, std::size_t size, Value start);
-  ValueRef Add(VariableInfo info, void* storage);
+  /// Declares a variable bound to `storage`; its type, element count and
+  /// start value come from the storage. Defined in the .cc for the five
+  /// storage types only.
+  template <typename T>
+  ValueRef Bind(std::string name, Causality causality, Variability variability, std::string unit,
+                T* storage, std::string description,
+                const std::vector<std::string>& depends_on = {});
   std::vector<ValueRef> ResolveDependencies(const std::string& output,
                                             const std::vector<std::string>& names) const;
 
