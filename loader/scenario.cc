@@ -266,7 +266,6 @@ class Builder {
     std::map<std::string, ParameterOrigin> origins;
 
     // Model file first, then the scenario's own values on top.
-    std::vector<std::unique_ptr<YamlReader>>& model_readers = model_readers_;
     if (params.IsMap() && Child(params, "model").IsDefined() && !type->model_folder.empty()) {
       const std::string model_path = JoinPath(params_path, "model");
       if (const auto value = r_.AsString(Child(params, "model"), model_path)) {
@@ -283,8 +282,9 @@ class Builder {
                    "model file " + file.string() + " is not valid YAML: " + e.what());
         }
         if (model.IsDefined()) {
-          model_readers.push_back(std::make_unique<YamlReader>(file.string()));
-          YamlReader& mr = *model_readers.back();
+          // Kept alive: parameter origins point into it for later checks.
+          model_readers_.push_back(std::make_unique<YamlReader>(file.string()));
+          YamlReader& mr = *model_readers_.back();
           if (mr.ExpectMap(model, "")) {
             ApplyParameters(*unit, model, "", {"source", "description"}, mr, origins);
           }
@@ -431,20 +431,21 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
       }
     }
   }
+  YAML::Node tree;
   try {
-    s.tree = YAML::LoadFile(file);
+    tree = YAML::LoadFile(file);
   } catch (const YAML::BadFile&) {
     throw ScenarioError({{file, 0, "", "cannot read the file (missing or not readable)"}});
   } catch (const YAML::ParserException& e) {
     throw ScenarioError(
         {{file, e.mark.is_null() ? 0 : e.mark.line + 1, "", "not valid YAML: " + e.msg}});
   }
-  ApplyOverrides(s.tree, s.overrides, file, issues);
+  ApplyOverrides(tree, s.overrides, file, issues);
   std::set<std::string> overridden;
   for (const auto& o : s.overrides) overridden.insert(o.path);
   YamlReader reader(file, overridden);
   for (auto& i : issues) reader.mutable_issues().push_back(i);
-  Builder(s, reader).Build(s.tree);
+  Builder(s, reader).Build(tree);
   if (!reader.ok()) throw ScenarioError(reader.issues());
   return s;
 }

@@ -25,7 +25,6 @@ struct Scenario {
   std::uint64_t seed = 1;
   double duration_s = 0;
   std::vector<Override> overrides;
-  YAML::Node tree;  // the file after --set overrides
 
   std::unique_ptr<cosim::System> system;  // declared before master: outlives it
   std::unique_ptr<cosim::Master> master;
