@@ -280,6 +280,9 @@ class Builder {
         } catch (const YAML::Exception& e) {
           r_.Error(Child(params, "model"), model_path,
                    "model file " + file.string() + " is not valid YAML: " + e.what());
+        } catch (const std::exception& e) {  // a folder, an unreadable file
+          r_.Error(Child(params, "model"), model_path,
+                   "cannot read model file " + file.string() + ": " + e.what());
         }
         if (model.IsDefined()) {
           // Kept alive: parameter origins point into it for later checks.
@@ -431,6 +434,12 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
       }
     }
   }
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) {
+    throw ScenarioError({{file, 0, "",
+                          fs::exists(file, ec) ? "is not a file (a folder?): expected a YAML file"
+                                               : "cannot read the file (missing or not readable)"}});
+  }
   YAML::Node tree;
   try {
     tree = YAML::LoadFile(file);
@@ -439,6 +448,8 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
   } catch (const YAML::ParserException& e) {
     throw ScenarioError(
         {{file, e.mark.is_null() ? 0 : e.mark.line + 1, "", "not valid YAML: " + e.msg}});
+  } catch (const std::exception& e) {
+    throw ScenarioError({{file, 0, "", std::string("cannot read the file: ") + e.what()}});
   }
   ApplyOverrides(tree, s.overrides, file, issues);
   std::set<std::string> overridden;

@@ -236,6 +236,14 @@ units:
   const std::string all = Issues(f);
   EXPECT_TRUE(Has(all, "units.motor.parameters.model: no model file")) << all;
   EXPECT_TRUE(Has(all, "closest: raw3_drive")) << all;
+  // A path that is a folder is an issue at the key, not a crash.
+  const std::string g = WriteScenario("model_dir.yaml", R"(duration_s: 0.01
+units:
+  motor:
+    type: dc_motor
+    parameters: {model: ./}
+)");
+  EXPECT_TRUE(Has(Issues(g), "units.motor.parameters.model: cannot read model file")) << Issues(g);
 }
 
 // Guards the shipped motor model files: each loads in both motor modes (a
@@ -257,6 +265,7 @@ units:
 // Guards file-level failures: a missing file and malformed YAML.
 TEST(LoadScenario, UnreadableAndMalformedFiles) {
   EXPECT_TRUE(Has(Issues("/nonexistent/x.yaml"), "cannot read the file"));
+  EXPECT_TRUE(Has(Issues(::testing::TempDir()), "is not a file (a folder?)"));
   const std::string f = WriteScenario("broken.yaml", "units: {motor: [1, 2\nduration_s: 1\n");
   const std::string all = Issues(f);
   EXPECT_TRUE(Has(all, "not valid YAML")) << all;
