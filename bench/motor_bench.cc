@@ -31,12 +31,20 @@ enum class Inputs {
   kConstant,       // voltage set once: CVODE never restarts
   kEvery20ms,      // new voltage every 20 ms (the controller cycle)
   kEveryStep,      // new voltage every communication step
-  kSpeedEveryStep  // current-only: shaft speed changes every step
+  kSpeedEveryStep,  // current-only: shaft speed changes every step
+  kRobot            // current-only: shaft speed every step, voltage every 20 ms
 };
 
-std::unique_ptr<DcMotorUnit> MakeUnit(MotorMode mode) {
+struct Options {
+  std::string hold = "zero_order";  // current-only: shaft_speed_hold
+  double rel_tol = 1e-8;            // the unit's default
+};
+
+std::unique_ptr<DcMotorUnit> MakeUnit(MotorMode mode, const Options& options) {
   auto u = std::make_unique<DcMotorUnit>("motors", kMotors, mode);
   auto& v = u->variables();
+  v.SetReal(*v.Find("rel_tol"), options.rel_tol);
+  if (mode == MotorMode::kCurrentOnly) v.SetString(*v.Find("shaft_speed_hold"), options.hold);
   // Motors 0-3 drive (gear 21, eta 0.75), 4-7 steer (belt 4, eta 0.9), as in
   // models/motors/raw3_*.yaml; the loads are rough wheel / module inertias.
   std::vector<double> ratio, eta, j_load;
@@ -59,8 +67,9 @@ double Command(std::int64_t k, int motor) {
   return 12.0 + 6.0 * std::sin(0.37 * static_cast<double>(k) + motor);
 }
 
-void RunMotors(benchmark::State& state, MotorMode mode, TimeNs dt, Inputs inputs) {
-  auto unit = MakeUnit(mode);
+void RunMotors(benchmark::State& state, MotorMode mode, TimeNs dt, Inputs inputs,
+               const Options& options) {
+  auto unit = MakeUnit(mode, options);
   auto& v = unit->variables();
   const auto voltage = *v.Find("voltage");
   const auto second = *v.Find(mode == MotorMode::kFull ? "load_torque" : "shaft_speed");
@@ -79,7 +88,12 @@ void RunMotors(benchmark::State& state, MotorMode mode, TimeNs dt, Inputs inputs
     if (inputs == Inputs::kEveryStep || (inputs == Inputs::kEvery20ms && t % period == 0)) {
       for (int m = 0; m < kMotors; ++m) volts[static_cast<std::size_t>(m)] = Command(k, m);
       v.SetRealArray(voltage, volts);
-    } else if (inputs == Inputs::kSpeedEveryStep) {
+    }
+    if (inputs == Inputs::kRobot && t % period == 0) {
+      for (int m = 0; m < kMotors; ++m) volts[static_cast<std::size_t>(m)] = Command(k, m);
+      v.SetRealArray(voltage, volts);
+    }
+    if (inputs == Inputs::kSpeedEveryStep || inputs == Inputs::kRobot) {
       // Output shaft speeds as the chassis would report them, about 10 rad/s.
       for (int m = 0; m < kMotors; ++m) {
         other[static_cast<std::size_t>(m)] =
@@ -113,6 +127,7 @@ void Register() {
     MotorMode mode;
     TimeNs dt;
     Inputs inputs;
+    Options options = {};
   };
   static const Case kCases[] = {
       {"BM_Motor8Full/1ms_const", MotorMode::kFull, kMs, Inputs::kConstant},
@@ -124,10 +139,22 @@ void Register() {
        Inputs::kSpeedEveryStep},
       {"BM_Motor8CurrentOnly/10ms_speed_change", MotorMode::kCurrentOnly, 10 * kMs,
        Inputs::kSpeedEveryStep},
+      // The robot's case: voltage from the 20 ms controller, shaft speed from
+      // the 1 ms physics, held to first order without restarts.
+      {"BM_Motor8CurrentOnly/1ms_speed_change_first_order", MotorMode::kCurrentOnly, kMs,
+       Inputs::kSpeedEveryStep, {"first_order", 1e-8}},
+      {"BM_Motor8CurrentOnly/1ms_robot_zoh_rtol1e-6", MotorMode::kCurrentOnly, kMs,
+       Inputs::kRobot, {"zero_order", 1e-6}},
+      {"BM_Motor8CurrentOnly/1ms_robot_first_order_rtol1e-8", MotorMode::kCurrentOnly, kMs,
+       Inputs::kRobot, {"first_order", 1e-8}},
+      {"BM_Motor8CurrentOnly/1ms_robot_first_order_rtol1e-6", MotorMode::kCurrentOnly, kMs,
+       Inputs::kRobot, {"first_order", 1e-6}},
+      {"BM_Motor8CurrentOnly/1ms_robot_first_order_rtol1e-4", MotorMode::kCurrentOnly, kMs,
+       Inputs::kRobot, {"first_order", 1e-4}},
   };
   for (const Case& c : kCases) {
     benchmark::RegisterBenchmark(c.name, [c](benchmark::State& s) {
-      RunMotors(s, c.mode, c.dt, c.inputs);
+      RunMotors(s, c.mode, c.dt, c.inputs, c.options);
     })->Unit(benchmark::kMicrosecond);
   }
 }

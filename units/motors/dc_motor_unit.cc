@@ -48,8 +48,8 @@ struct DcMotorUnit::Sundials {
     if (ctx) SUNContext_Free(&ctx);
   }
 
-  static int Rhs(realtype, N_Vector y, N_Vector ydot, void* user_data) {
-    static_cast<const DcMotorUnit*>(user_data)->EvalRhs(N_VGetArrayPointer(y),
+  static int Rhs(realtype t, N_Vector y, N_Vector ydot, void* user_data) {
+    static_cast<const DcMotorUnit*>(user_data)->EvalRhs(t, N_VGetArrayPointer(y),
                                                         N_VGetArrayPointer(ydot));
     return 0;
   }
@@ -96,6 +96,8 @@ DcMotorUnit::DcMotorUnit(std::string name, int count, MotorMode mode,
     speed_.assign(n, 0.0);
   } else {
     shaft_speed_.assign(n, 0.0);
+    shaft_slope_.assign(n, 0.0);
+    previous_shaft_speed_.assign(n, 0.0);
   }
 
   auto& v = variables();
@@ -115,6 +117,13 @@ DcMotorUnit::DcMotorUnit(std::string name, int count, MotorMode mode,
     v.Parameter("load_inertia", "kg.m2", &load_inertia_,
                 "inertia at the gearbox output, reflected to the rotor as J / (eta N^2)");
     v.Parameter("initial_speed", "rad/s", &initial_speed_, "output shaft speed at the start");
+  }
+  if (!full) {
+    v.Parameter("shaft_speed_hold", &shaft_speed_hold_,
+                "zero_order: the shaft speed is held constant over a step and a new value "
+                "restarts CVODE (exact for a piecewise-constant input); first_order: it is "
+                "extrapolated along the slope of its last two samples and a new value does not "
+                "restart CVODE (only a new voltage does), for a speed that varies continuously");
   }
   v.Parameter("rel_tol", "1", &rel_tol_, "CVODE relative tolerance");
   v.Parameter("abs_tol", "1", &abs_tol_,
@@ -206,7 +215,7 @@ std::string DcMotorUnit::WorstState() const {
            std::to_string(motor) + "]";
   };
   std::vector<double> ydot(y_.size());
-  EvalRhs(y_.data(), ydot.data());
+  EvalRhs(cosim::NsToSeconds(end_time_), y_.data(), ydot.data());
   for (std::size_t j = 0; j < y_.size(); ++j) {
     if (!std::isfinite(ydot[j])) {
       return "the derivative of " + state_name(j) + " is " + FormatNumber(ydot[j]) +
@@ -260,6 +269,10 @@ std::vector<cosim::ParameterProblem> DcMotorUnit::CheckParameters() const {
   if (mode_ == MotorMode::kFull) {
     rule("load_inertia", load_inertia_, non_negative, "must be zero or positive and finite");
     rule("initial_speed", initial_speed_, finite, "must be finite");
+  }
+  if (shaft_speed_hold_ != "zero_order" && shaft_speed_hold_ != "first_order") {
+    problems.push_back({"shaft_speed_hold", std::nullopt,
+                        "must be zero_order or first_order, got '" + shaft_speed_hold_ + "'"});
   }
   for (const auto& [var, value] : {std::pair{"rel_tol", rel_tol_}, {"abs_tol", abs_tol_}}) {
     if (!positive(value)) {
@@ -320,7 +333,7 @@ void DcMotorUnit::SetTolerances() {
   Check(CVodeSVtolerances(sun_->cvode, rel_tol_, sun_->abstol), "CVodeSVtolerances", end_time_);
 }
 
-void DcMotorUnit::EvalRhs(const double* y, double* ydot) const {
+void DcMotorUnit::EvalRhs(double t_s, const double* y, double* ydot) const {
   if (mode_ == MotorMode::kFull) {
     for (int k = 0; k < count_; ++k) {
       const auto kk = static_cast<std::size_t>(k);
@@ -332,7 +345,10 @@ void DcMotorUnit::EvalRhs(const double* y, double* ydot) const {
   } else {
     for (int k = 0; k < count_; ++k) {
       const auto kk = static_cast<std::size_t>(k);
-      const double w = gear_ratio_[kk] * held_shaft_speed_[kk];
+      const double shaft = first_order_
+                               ? held_shaft_speed_[kk] + shaft_slope_[kk] * (t_s - held_since_s_)
+                               : held_shaft_speed_[kk];
+      const double w = gear_ratio_[kk] * shaft;
       ydot[k] = di_di_[kk] * y[k] + di_dw_[kk] * w + di_dv_[kk] * held_voltage_[kk];
     }
   }
@@ -379,6 +395,8 @@ void DcMotorUnit::Initialize() {
   Validate();
   ComputeCoefficients();
   SetTolerances();
+  first_order_ = mode_ == MotorMode::kCurrentOnly && shaft_speed_hold_ == "first_order";
+  previous_sample_time_ = -1;
   for (int k = 0; k < count_; ++k) {
     const auto kk = static_cast<std::size_t>(k);
     y_[static_cast<std::size_t>(k * states_per_motor_)] = initial_current_[kk];
@@ -393,14 +411,46 @@ void DcMotorUnit::Initialize() {
 
 bool DcMotorUnit::InputsChanged() const {
   if (!SameBits(voltage_, held_voltage_)) return true;
-  return mode_ == MotorMode::kFull ? !SameBits(load_torque_, held_load_torque_)
-                                   : !SameBits(shaft_speed_, held_shaft_speed_);
+  if (mode_ == MotorMode::kFull) return !SameBits(load_torque_, held_load_torque_);
+  // Under a first-order hold the shaft speed is continuous: CVODE's error
+  // control absorbs the small mismatch between the extrapolated and the new
+  // sample, so a new speed is no discontinuity.
+  return !first_order_ && !SameBits(shaft_speed_, held_shaft_speed_);
 }
 
-void DcMotorUnit::HoldInputs() {
+void DcMotorUnit::HoldInputs(cosim::TimeNs t) {
   held_voltage_ = voltage_;
   held_load_torque_ = load_torque_;
+  if (first_order_) {
+    // Slope from the previous sample, if it was taken one step ago (after a
+    // restore or a time jump there is none yet: hold to zero order once).
+    const bool have_previous = previous_sample_time_ >= 0 && previous_sample_time_ < t &&
+                               held_shaft_speed_.size() == shaft_speed_.size();
+    const double span_s = cosim::NsToSeconds(t - previous_sample_time_);
+    for (std::size_t k = 0; k < shaft_speed_.size(); ++k) {
+      shaft_slope_[k] = have_previous ? (shaft_speed_[k] - previous_shaft_speed_[k]) / span_s : 0.0;
+    }
+    previous_shaft_speed_ = shaft_speed_;
+    previous_sample_time_ = t;
+    held_since_s_ = cosim::NsToSeconds(t);
+  }
   held_shaft_speed_ = shaft_speed_;
+}
+
+int DcMotorUnit::Integrate(cosim::TimeNs t, double t0_s, double t1_s, bool restart) {
+  if (restart) {
+    // Count the steps since the last restart first (a failed attempt's too).
+    long nst = 0;
+    Check(CVodeGetNumSteps(sun_->cvode, &nst), "CVodeGetNumSteps", t);
+    steps_ += nst - steps_since_restart_;
+    std::copy(y_.begin(), y_.end(), N_VGetArrayPointer(sun_->y));
+    Check(CVodeReInit(sun_->cvode, t0_s, sun_->y), "CVodeReInit", t);
+    ++restarts_;
+    steps_since_restart_ = 0;
+  }
+  Check(CVodeSetStopTime(sun_->cvode, t1_s), "CVodeSetStopTime", t);
+  double t_reached = t0_s;
+  return CVode(sun_->cvode, t1_s, sun_->y, &t_reached, CV_NORMAL);
 }
 
 cosim::StepResult DcMotorUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
@@ -432,16 +482,15 @@ cosim::StepResult DcMotorUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   const bool restart = restart_pending_ || t != end_time_ || InputsChanged();
   // Until this step succeeds, CVODE's history no longer matches y_.
   restart_pending_ = true;
-  if (restart) {
-    HoldInputs();
-    std::copy(y_.begin(), y_.end(), N_VGetArrayPointer(sun_->y));
-    Check(CVodeReInit(sun_->cvode, t0_s, sun_->y), "CVodeReInit", t);
-    ++restarts_;
-    steps_since_restart_ = 0;
+  if (restart || first_order_) HoldInputs(t);
+  int flag = Integrate(t, t0_s, t1_s, restart);
+  if (flag < 0 && !restart) {
+    // A first-order hold met a jump in shaft speed (a wheel touching down,
+    // a collision) too large for CVODE's error control: redo the step from
+    // its start as a restart, as a zero-order hold would.
+    sun_->message.clear();
+    flag = Integrate(t, t0_s, t1_s, true);
   }
-  Check(CVodeSetStopTime(sun_->cvode, t1_s), "CVodeSetStopTime", t);
-  double t_reached = t0_s;
-  const int flag = CVode(sun_->cvode, t1_s, sun_->y, &t_reached, CV_NORMAL);
   if (flag < 0) {
     sun_->message += (sun_->message.empty() ? "" : "; ") + WorstState();
     Check(flag, "CVode", t);
@@ -464,25 +513,34 @@ cosim::StepResult DcMotorUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
 // next DoStep of this unit restarts CVODE from it, exactly as a unit restored
 // from this state will. Both then continue bit for bit alike.
 void DcMotorUnit::SaveInternal(cosim::UnitState& state) const {
+  // The first-order hold's previous sample decides the next slope, so it is
+  // state too.
   state.reals = y_;
-  state.integers = {end_time_, initialized_ ? 1 : 0};
+  state.reals.insert(state.reals.end(), previous_shaft_speed_.begin(),
+                     previous_shaft_speed_.end());
+  state.integers = {end_time_, initialized_ ? 1 : 0, previous_sample_time_};
   restart_pending_ = true;
 }
 
 void DcMotorUnit::RestoreInternal(const cosim::UnitState& state) {
-  if (state.reals.size() != y_.size() || state.integers.size() != 2) {
+  const std::size_t reals = y_.size() + previous_shaft_speed_.size();
+  if (state.reals.size() != reals || state.integers.size() != 3) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
-                           " integers, expected " + std::to_string(y_.size()) + " and 2");
+                           " integers, expected " + std::to_string(reals) + " and 3");
   }
-  y_ = state.reals;
+  const auto split = state.reals.begin() + static_cast<std::ptrdiff_t>(y_.size());
+  y_.assign(state.reals.begin(), split);
+  previous_shaft_speed_.assign(split, state.reals.end());
   end_time_ = state.integers[0];
   initialized_ = state.integers[1] != 0;
+  previous_sample_time_ = state.integers[2];
   // Parameters came back with the variables: derive from them again.
   if (initialized_) {
     Validate();
     ComputeCoefficients();
     SetTolerances();
+    first_order_ = mode_ == MotorMode::kCurrentOnly && shaft_speed_hold_ == "first_order";
   }
   restart_pending_ = true;
 }

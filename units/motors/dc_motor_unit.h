@@ -75,7 +75,7 @@ class DcMotorUnit : public cosim::Unit {
   // the callbacks; defined in the .cc so that SUNDIALS stays private.
   struct Sundials;
 
-  void EvalRhs(const double* y, double* ydot) const;
+  void EvalRhs(double t_s, const double* y, double* ydot) const;
   /// Column-major dense n x n Jacobian; only the 2x2 (or 1x1) diagonal
   /// blocks are non-zero.
   void FillJacobian(double* data) const;
@@ -84,7 +84,10 @@ class DcMotorUnit : public cosim::Unit {
   void ComputeCoefficients();
   void ComputeOutputs();
   bool InputsChanged() const;
-  void HoldInputs();
+  void HoldInputs(cosim::TimeNs t);
+  /// Advances CVODE from t0_s to t1_s (the step starting at t), restarting it
+  /// from y_ first if asked; returns CVode's flag.
+  int Integrate(cosim::TimeNs t, double t0_s, double t1_s, bool restart);
   /// Throws cosim::UnitError naming the unit, the SUNDIALS function, the time
   /// and the flag when `flag` is negative.
   void Check(int flag, const char* function, cosim::TimeNs t) const;
@@ -106,6 +109,10 @@ class DcMotorUnit : public cosim::Unit {
   // zero crossings.
   double rel_tol_ = 1e-8;
   double abs_tol_ = 1e-10;
+  // Current-only mode: how the shaft speed is held over a step ("zero_order"
+  // or "first_order"); see the parameter's description.
+  std::string shaft_speed_hold_ = "zero_order";
+  bool first_order_ = false;
 
   // Inputs.
   std::vector<double> voltage_, load_torque_, shaft_speed_;
@@ -116,6 +123,12 @@ class DcMotorUnit : public cosim::Unit {
   std::vector<double> di_di_, di_dw_, di_dv_, dw_di_, dw_dw_, dw_dload_;
   // Inputs as held over the current step (the right-hand side reads these).
   std::vector<double> held_voltage_, held_load_torque_, held_shaft_speed_;
+  // First-order hold: slope of the shaft speed over the current step (from
+  // the last two samples), the sample before the current one, and the step
+  // start in seconds (the right-hand side needs the time since the sample).
+  std::vector<double> shaft_slope_, previous_shaft_speed_;
+  double held_since_s_ = 0.0;
+  cosim::TimeNs previous_sample_time_ = -1;
   // State at the end of the last step (current, rotor speed per motor).
   std::vector<double> y_;
   cosim::TimeNs end_time_ = 0;

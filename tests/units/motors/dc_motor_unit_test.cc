@@ -407,10 +407,13 @@ std::vector<Snapshot> Drive(DcMotorUnit& u, int from, int to, TimeNs dt) {
   return out;
 }
 
-void CheckSaveRestoreBitForBit(MotorMode mode) {
+void CheckSaveRestoreBitForBit(MotorMode mode, const std::string& hold = "zero_order") {
   const TimeNs dt = kMs;
   DcMotorUnit u("m", 2, mode);
   SetArray(u, "gear_ratio", {1.0, 21.0});
+  if (mode == MotorMode::kCurrentOnly) {
+    u.variables().SetString(*u.variables().Find("shaft_speed_hold"), hold);
+  }
   u.Initialize();
   Drive(u, 0, 6, dt);
   const cosim::UnitState saved = u.SaveState();
@@ -423,7 +426,7 @@ void CheckSaveRestoreBitForBit(MotorMode mode) {
   }
   // A fresh unit restored from the same state continues identically too.
   DcMotorUnit fresh("m", 2, mode);
-  fresh.RestoreState(saved);
+  fresh.RestoreState(saved);  // parameters, the hold among them, come back too
   const auto third = Drive(fresh, 6, 21, dt);
   for (std::size_t k = 0; k < first.size(); ++k) {
     EXPECT_TRUE(first[k] == third[k]) << "step " << 6 + k;
@@ -441,6 +444,71 @@ TEST(DcMotorUnit, SaveStepRestoreStepIsBitForBitFullMode) {
 
 TEST(DcMotorUnit, SaveStepRestoreStepIsBitForBitCurrentOnly) {
   CheckSaveRestoreBitForBit(MotorMode::kCurrentOnly);
+}
+
+// Guards against the first-order hold's previous sample (which sets the next
+// slope) being left out of the saved state.
+TEST(DcMotorUnit, SaveStepRestoreStepIsBitForBitCurrentOnlyFirstOrderHold) {
+  CheckSaveRestoreBitForBit(MotorMode::kCurrentOnly, "first_order");
+}
+
+// Current-only motor driven by a continuously varying shaft speed
+// w(t) = A sin(W t) sampled every 1 ms, against the exact solution of the
+// continuous problem L i' = V - R i - k N w(t), i(0) = 0:
+//   i(t) = V/R + i_p(t) - (V/R + i_p(0)) exp(-t R/L),
+//   i_p(t) = -(k N A / (R^2 + L^2 W^2)) (R sin Wt - L W cos Wt).
+// Guards the first-order hold: it must be far closer to the continuous
+// solution than the zero-order hold (whose lag is half a step), restart
+// CVODE only for the voltage, and stay so at the loose tolerance the robot
+// scenarios use.
+TEST(DcMotorUnit, FirstOrderHoldTracksAContinuouslyVaryingShaftSpeed) {
+  const models::DcMotorParams p;
+  const double n = 21.0, amplitude = 10.0, omega = 2.0 * std::numbers::pi, volts = 12.0;
+  const double r = p.resistance_ohm, l = p.inductance_h, k = p.torque_constant_nm_per_a;
+  const auto exact = [&](double t) {
+    const double z2 = r * r + l * l * omega * omega;
+    const auto ip = [&](double s) {
+      return -(k * n * amplitude / z2) * (r * std::sin(omega * s) - l * omega * std::cos(omega * s));
+    };
+    return volts / r + ip(t) - (volts / r + ip(0.0)) * std::exp(-t * r / l);
+  };
+  struct Result {
+    double max_error;
+    std::int64_t restarts;
+  };
+  const auto run = [&](const std::string& hold, double rel_tol) {
+    DcMotorUnit u("m", 1, MotorMode::kCurrentOnly);
+    SetAll(u, "gear_ratio", n);
+    SetAll(u, "gear_efficiency", 1.0);
+    SetAll(u, "viscous_friction", 0.0);
+    SetAll(u, "rel_tol", rel_tol);
+    u.variables().SetString(*u.variables().Find("shaft_speed_hold"), hold);
+    SetAll(u, "voltage", volts);
+    u.Initialize();
+    double worst = 0.0;
+    // Skip the first 5 ms (the electrical start transient, where both holds
+    // see the same first sample).
+    for (int step = 0; step < 1000; ++step) {
+      const double t = step * 1e-3;
+      SetAll(u, "shaft_speed", amplitude * std::sin(omega * t));
+      EXPECT_EQ(u.DoStep(step * kMs, kMs), cosim::StepResult::kOk) << u.last_error();
+      if (step >= 5) worst = std::max(worst, std::abs(Get(u, "current")[0] - exact(t + 1e-3)));
+    }
+    return Result{worst, u.cvode_restarts()};
+  };
+  const Result zoh = run("zero_order", 1e-8);
+  const Result foh = run("first_order", 1e-8);
+  const Result foh_loose = run("first_order", 1e-4);
+  std::cout << "max |current error| over 1 s: zero-order " << zoh.max_error << " A ("
+            << zoh.restarts << " restarts), first-order " << foh.max_error << " A ("
+            << foh.restarts << "), first-order rel_tol 1e-4 " << foh_loose.max_error << " A ("
+            << foh_loose.restarts << ")\n";
+  // Zero-order lag of half a step: about k N A W (h/2) / R = 0.067 A.
+  EXPECT_GT(zoh.max_error, 0.03);
+  EXPECT_LT(foh.max_error, 0.1 * zoh.max_error);
+  EXPECT_LT(foh_loose.max_error, 0.1 * zoh.max_error);
+  EXPECT_EQ(foh.restarts, 1);  // the voltage never changes after the start
+  EXPECT_EQ(zoh.restarts, 1000);
 }
 
 // Guards against a state from a different unit layout being accepted.
@@ -635,8 +703,12 @@ void CheckTable(const DcMotorUnit& u, const std::vector<Expected>& expected) {
     EXPECT_EQ(info.causality, e.causality) << e.name;
     EXPECT_EQ(info.unit, e.unit) << e.name;
     const bool scalar = e.name == "rel_tol" || e.name == "abs_tol";
-    EXPECT_EQ(info.type, scalar ? cosim::VarType::kReal : cosim::VarType::kRealArray) << e.name;
-    if (!scalar) {
+    const bool text = e.name == "shaft_speed_hold";
+    EXPECT_EQ(info.type, text     ? cosim::VarType::kString
+                         : scalar ? cosim::VarType::kReal
+                                  : cosim::VarType::kRealArray)
+        << e.name;
+    if (!scalar && !text) {
       EXPECT_EQ(info.size, static_cast<std::size_t>(u.count())) << e.name;
     }
     if (info.causality == cosim::Causality::kParameter) {
@@ -682,6 +754,7 @@ TEST(DcMotorUnit, VariableTableCurrentOnlyMode) {
                  {"gear_ratio", C::kParameter, "1", {}},
                  {"gear_efficiency", C::kParameter, "1", {}},
                  {"initial_current", C::kParameter, "A", {}},
+                 {"shaft_speed_hold", C::kParameter, "", {}},
                  {"rel_tol", C::kParameter, "1", {}},
                  {"abs_tol", C::kParameter, "1", {}},
                  {"voltage", C::kInput, "V", {}},
