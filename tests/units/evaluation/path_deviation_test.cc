@@ -1,0 +1,59 @@
+#include "units/evaluation/path_deviation.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace linesim::evaluation {
+namespace {
+
+// Guards the geometry of the crossing metric: perpendicular distance inside
+// a segment, distance to the end point beyond it (Pythagoras), progress as
+// arc length.
+TEST(DistanceToPath, SegmentInteriorAndEnds) {
+  const std::vector<std::array<double, 2>> path = {{0, -2}, {0, 2}};
+  const auto inside = DistanceToPath(path, 0.03, 0.5);
+  EXPECT_DOUBLE_EQ(inside.distance_m, 0.03);
+  EXPECT_DOUBLE_EQ(inside.progress_m, 2.5);
+  const auto beyond = DistanceToPath(path, 3.0, 6.0);  // 3-4-5 from the end (0, 2)
+  EXPECT_DOUBLE_EQ(beyond.distance_m, 5.0);
+  EXPECT_DOUBLE_EQ(beyond.progress_m, 4.0);
+}
+
+// Guards the corner of a polyline: the nearest of its segments wins.
+TEST(DistanceToPath, PolylineTakesTheNearestSegment) {
+  const std::vector<std::array<double, 2>> path = {{0, 0}, {1, 0}, {1, 1}};
+  const auto d = DistanceToPath(path, 1.2, 0.5);
+  EXPECT_NEAR(d.distance_m, 0.2, 1e-15);
+  EXPECT_NEAR(d.progress_m, 1.5, 1e-15);
+}
+
+// Guards the hold metric: a one-point path is the distance to that point.
+TEST(DistanceToPath, SinglePointIsAHoldTarget) {
+  EXPECT_DOUBLE_EQ(DistanceToPath({{1, 1}}, 4, 5).distance_m, 5.0);
+}
+
+// Guards the unit wiring: the deviation follows the pose input at once
+// (feedthrough) and after a step.
+TEST(PathDeviationUnit, OutputsFollowThePose) {
+  PathDeviationUnit u("monitor", {{0, -2}, {0, 2}});
+  ASSERT_TRUE(u.CheckParameters().empty());
+  auto& v = u.variables();
+  v.SetRealArray(*v.Find("pose"), std::vector<double>{0.1, 0.0, 0.3});
+  u.Initialize();
+  EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("deviation")), 0.1);
+  v.SetRealArray(*v.Find("pose"), std::vector<double>{-0.04, 1.0, 0.0});
+  u.UpdateOutputs();
+  EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("deviation")), 0.04);
+  EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("progress")), 3.0);
+  EXPECT_EQ(u.DoStep(0, 1'000'000), cosim::StepResult::kOk);
+}
+
+// Guards against an empty path being accepted (every distance would be NaN).
+TEST(PathDeviationUnit, RefusesAnEmptyPath) {
+  PathDeviationUnit u("monitor", {});
+  EXPECT_EQ(u.CheckParameters().size(), 1u);
+}
+
+}  // namespace
+}  // namespace linesim::evaluation

@@ -1,0 +1,46 @@
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "cosim/unit.h"
+
+namespace linesim::evaluation {
+
+/// Distance from a point to a polyline in the plane (to the point itself
+/// when the polyline has one vertex), and the arc length of the nearest
+/// point along it.
+struct PathDistance {
+  double distance_m;
+  double progress_m;
+};
+PathDistance DistanceToPath(const std::vector<std::array<double, 2>>& path, double x_m,
+                            double y_m);
+
+/// Ground-truth evaluation of a robot task: how far the robot's centre is
+/// from the desired path (a crossing) or from the held point (a position
+/// hold). It reads the true pose, never an estimate, so that the scenario's
+/// metrics judge the controller and the estimators together.
+class PathDeviationUnit : public cosim::Unit {
+ public:
+  static constexpr const char* kTypeName = "path_deviation";
+
+  /// `path`: one point (a hold target) or a polyline of at least two.
+  PathDeviationUnit(std::string name, std::vector<std::array<double, 2>> path);
+
+  std::vector<cosim::ParameterProblem> CheckParameters() const override;
+  void Initialize() override { Evaluate(); }
+  void UpdateOutputs() override { Evaluate(); }
+  cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
+
+ private:
+  void Evaluate();
+
+  std::vector<std::array<double, 2>> path_;
+  std::vector<double> pose_ = std::vector<double>(3, 0.0);
+  double deviation_ = 0.0;
+  double progress_ = 0.0;
+};
+
+}  // namespace linesim::evaluation
