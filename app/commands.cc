@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <yaml-cpp/yaml.h>
 #include <sstream>
 
 #include "cosim/observers.h"
@@ -228,6 +229,13 @@ int InspectCommand(const std::string& what, const std::vector<std::string>& set_
   std::cout << "\n  duration " << cosim::FormatSeconds(o.stop - o.start) << " s, seed " << s.seed
             << ", master " << (o.algorithm == cosim::Algorithm::kJacobi ? "jacobi" : "gauss_seidel")
             << " step " << cosim::FormatSeconds(o.base_step) << " s\n";
+  if (s.robot) {
+    // The robot-level file and what it stands for, in the system-level
+    // format (a file of its own could be run as is).
+    YAML::Emitter yaml;
+    yaml << s.expanded;
+    std::cout << "\nexpands into this system:\n" << yaml.c_str() << "\n";
+  }
   const cosim::System& system = *s.system;
   for (std::size_t u = 0; u < system.unit_count(); ++u) {
     std::cout << "\nunit '" << system.unit(u).name() << "' (" << system.unit(u).type_name()

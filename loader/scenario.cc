@@ -456,6 +456,14 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
   for (const auto& o : s.overrides) overridden.insert(o.path);
   YamlReader reader(file, overridden);
   for (auto& i : issues) reader.mutable_issues().push_back(i);
+  if (IsRobotScenario(tree)) {
+    RobotInfo info;
+    s.expanded = ExpandRobotScenario(tree, reader, info);
+    // A robot-level problem would only echo as problems of the expansion.
+    if (!reader.ok()) throw ScenarioError(reader.issues());
+    s.robot = std::move(info);
+    tree = s.expanded;
+  }
   Builder(s, reader).Build(tree);
   if (!reader.ok()) throw ScenarioError(reader.issues());
   return s;

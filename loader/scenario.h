@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "cosim/observers.h"
 #include "cosim/system.h"
 #include "loader/overrides.h"
+#include "loader/robot_scenario.h"
 #include "loader/scenario_error.h"
 
 namespace linesim::loader {
@@ -32,6 +34,11 @@ struct Scenario {
   std::vector<cosim::Probe> recorded;
   cosim::TimeNs record_interval = 0;
   std::vector<cosim::MetricSpec> metrics;
+
+  /// Robot scenarios only: the system-level tree they expanded into (what
+  /// `linesim inspect` prints) and the geometry for the plots.
+  std::optional<RobotInfo> robot;
+  YAML::Node expanded;
 };
 
 /// Reads `file`, applies the `--set` overrides ("dotted.path=value"), checks

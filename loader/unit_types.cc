@@ -2,6 +2,7 @@
 
 #include "cosim/closest_names.h"
 #include "units/motors/dc_motor_unit.h"
+#include "units/evaluation/path_deviation.h"
 #include "units/sources/step_signal.h"
 
 namespace linesim::loader {
@@ -60,6 +61,40 @@ std::unique_ptr<cosim::Unit> MakeStepSignal(const UnitBuildContext& c) {
                                                    std::move(steps));
 }
 
+// A list of points [x, y] at `key` (at least `min_points` of them).
+std::vector<std::array<double, 2>> ReadPoints(const UnitBuildContext& c, const std::string& key,
+                                              std::size_t min_points) {
+  std::vector<std::array<double, 2>> points;
+  const YAML::Node list = Child(c.parameters, key);
+  const std::string path = JoinPath(c.path, key);
+  if (!list.IsDefined() && !c.parameters.IsDefined()) {
+    return {{0.0, 0.0}};  // `linesim inspect TYPE`: no parameters at all
+  }
+  if (!list.IsDefined()) {
+    c.reader.Error(c.parameters, path, "missing required key: a list of points [x, y] (m)");
+    return points;
+  }
+  if (!c.reader.ExpectSequence(list, path)) return points;
+  if (list.size() < min_points) {
+    c.reader.Error(list, path, "expected at least " + std::to_string(min_points) + " points");
+  }
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string item_path = JoinPath(path, std::to_string(i));
+    if (!list[i].IsSequence() || list[i].size() != 2) {
+      c.reader.Error(list[i], item_path, "expected a point [x, y], got " + Describe(list[i]));
+      continue;
+    }
+    const auto x = c.reader.AsReal(list[i][0], JoinPath(item_path, "0"));
+    const auto y = c.reader.AsReal(list[i][1], JoinPath(item_path, "1"));
+    if (x && y) points.push_back({*x, *y});
+  }
+  return points;
+}
+
+std::unique_ptr<cosim::Unit> MakePathDeviation(const UnitBuildContext& c) {
+  return std::make_unique<evaluation::PathDeviationUnit>(c.name, ReadPoints(c, "path", 1));
+}
+
 }  // namespace
 
 const std::vector<UnitType>& UnitTypes() {
@@ -81,6 +116,11 @@ const std::vector<UnitType>& UnitTypes() {
         {"steps",
          "list of {time_s, value}: value (one number, or one per channel) from time_s on"}},
        MakeStepSignal},
+      {evaluation::PathDeviationUnit::kTypeName,
+       "ground-truth distance of the robot centre from its desired path or held point",
+       "",
+       {{"path", "list of points [x, y] (m): a polyline, or one point for a hold"}},
+       MakePathDeviation},
   };
   return types;
 }

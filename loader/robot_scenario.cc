@@ -1,0 +1,425 @@
+#include "loader/robot_scenario.h"
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+
+#include "cosim/closest_names.h"
+#include "models/models_dir.h"
+
+namespace linesim::loader {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+
+// Names of the units a robot scenario expands into. Connections, recording,
+// metrics and the plots refer to these.
+constexpr const char* kBelt = "belt";
+constexpr const char* kChassis = "chassis";
+constexpr const char* kSteerMotors = "steer_motors";
+constexpr const char* kDriveMotors = "drive_motors";
+constexpr const char* kWheelController = "wheel_controller";
+constexpr const char* kPathFollower = "path_follower";
+constexpr const char* kDeviation = "deviation";
+
+YAML::Node Point(double x, double y) {
+  YAML::Node p(YAML::NodeType::Sequence);
+  p.push_back(x);
+  p.push_back(y);
+  return p;
+}
+
+YAML::Node List(const std::vector<double>& values) {
+  YAML::Node list(YAML::NodeType::Sequence);
+  for (double v : values) list.push_back(v);
+  return list;
+}
+
+// Reads an [x, y] pair at `path`.
+std::optional<std::array<double, 2>> ReadPoint(const YAML::Node& node, const std::string& path,
+                                               YamlReader& r) {
+  if (!node.IsSequence() || node.size() != 2) {
+    r.Error(node, path, "expected a point [x, y] in metres, got " + Describe(node));
+    return std::nullopt;
+  }
+  const auto x = r.AsReal(node[0], JoinPath(path, "0"), {-1e6, 1e6});
+  const auto y = r.AsReal(node[1], JoinPath(path, "1"), {-1e6, 1e6});
+  if (!x || !y) return std::nullopt;
+  return std::array<double, 2>{*x, *y};
+}
+
+// Copies every key of `from` into `to` (both maps), the later one winning.
+void MergeInto(YAML::Node to, const YAML::Node& from) {
+  if (!from.IsMap()) return;
+  for (const auto& kv : from) to[kv.first.Scalar()] = kv.second;
+}
+
+class Expander {
+ public:
+  Expander(const YAML::Node& root, YamlReader& r, RobotInfo& info)
+      : root_(root), r_(r), info_(info) {}
+
+  YAML::Node Expand() {
+    r_.CheckKeys(root_, "",
+                 {"name", "description", "duration_s", "seed", "master", "robot", "line",
+                  "control", "task", "sensing", "localization", "units", "connections",
+                  "recording", "metrics"});
+    for (const char* key : {"name", "description", "duration_s", "seed", "master"}) {
+      if (Child(root_, key).IsDefined()) out_[key] = Child(root_, key);
+    }
+    Robot();
+    Line();
+    Control();
+    Sensing();
+    Task();
+    Passthrough();
+    Recording();
+    Metrics();
+    return out_;
+  }
+
+ private:
+  YAML::Node Unit(const char* name) { return out_["units"][name]; }
+  YAML::Node Params(const char* name) { return out_["units"][name]["parameters"]; }
+  void Connect(const std::string& from, const std::string& to) {
+    YAML::Node c;
+    c["from"] = from;
+    c["to"] = to;
+    out_["connections"].push_back(c);
+  }
+
+  // A section that must be a map if present; an empty map if absent.
+  YAML::Node Section(const YAML::Node& parent, const std::string& path, const std::string& key,
+                     const std::vector<std::string>& keys) {
+    const YAML::Node node = Child(parent, key);
+    const std::string full = JoinPath(path, key);
+    if (!node.IsDefined() || node.IsNull()) return YAML::Node(YAML::NodeType::Map);
+    if (!r_.ExpectMap(node, full)) return YAML::Node(YAML::NodeType::Map);
+    r_.CheckKeys(node, full, keys);
+    return node;
+  }
+
+  void Robot() {
+    const YAML::Node robot = Section(root_, "", "robot", {"model", "pose"});
+    if (!Child(root_, "robot").IsMap()) {
+      r_.Error(Child(root_, "robot"), "robot", "expected a map with model and pose");
+    }
+    const std::string model = r_.String(robot, "robot", "model", "raw3");
+    const YAML::Node pose = Section(robot, "robot", "pose", {"x_m", "y_m", "yaw_deg"});
+    x_m_ = r_.Real(pose, "robot.pose", "x_m", 0.0, {-1e6, 1e6});
+    y_m_ = r_.Real(pose, "robot.pose", "y_m", 0.0, {-1e6, 1e6});
+    yaw_rad_ = r_.Real(pose, "robot.pose", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad;
+
+    // The robot model file names the models of each unit and their settings.
+    const fs::path file = fs::path(models::ModelsDir()) / "robots" / (model + ".yaml");
+    YAML::Node robot_model;
+    try {
+      robot_model = YAML::LoadFile(file.string());
+    } catch (const std::exception& e) {
+      std::vector<std::string> names;
+      std::error_code ec;
+      for (const auto& entry :
+           fs::directory_iterator(fs::path(models::ModelsDir()) / "robots", ec)) {
+        if (entry.path().extension() == ".yaml") names.push_back(entry.path().stem().string());
+      }
+      r_.Error(Child(robot, "model"), "robot.model",
+               "cannot read robot model " + file.string() + cosim::ClosestHint(model, names));
+      return;
+    }
+    const YAML::Node units = Child(robot_model, "units");
+    info_.body_length_m = Child(Child(robot_model, "plot"), "body_length_m").as<double>(1.03);
+    info_.body_width_m = Child(Child(robot_model, "plot"), "body_width_m").as<double>(0.57);
+    info_.wheel_count = 4;
+
+    Unit(kChassis)["type"] = "chassis";
+    MergeInto(Params(kChassis), Child(units, kChassis));
+    Params(kChassis)["initial_x"] = x_m_;
+    Params(kChassis)["initial_y"] = y_m_;
+    Params(kChassis)["initial_yaw"] = yaw_rad_;
+    for (const char* motors : {kSteerMotors, kDriveMotors}) {
+      Unit(motors)["type"] = "dc_motor";
+      Params(motors)["count"] = info_.wheel_count;
+      // The chassis owns the mechanics; the motors get its joint rates.
+      Params(motors)["mode"] = "current_only";
+      MergeInto(Params(motors), Child(units, motors));
+    }
+    Connect("steer_motors.torque", "chassis.steer_torque");
+    Connect("drive_motors.torque", "chassis.drive_torque");
+    Connect("chassis.steer_rate", "steer_motors.shaft_speed");
+    Connect("chassis.drive_rate", "drive_motors.shaft_speed");
+    controller_defaults_ = Child(units, kWheelController);
+    follower_defaults_ = Child(units, kPathFollower);
+  }
+
+  void Line() {
+    const YAML::Node line = Section(root_, "", "line", {"belts"});
+    const YAML::Node belts = Child(line, "belts");
+    std::vector<double> cx, cy, length, width, direction, speed, variation, period, accel, on0;
+    YAML::Node schedules(YAML::NodeType::Sequence);
+    if (belts.IsDefined() && !belts.IsNull() && r_.ExpectSequence(belts, "line.belts")) {
+      for (std::size_t i = 0; i < belts.size(); ++i) {
+        const std::string path = JoinPath("line.belts", std::to_string(i));
+        const YAML::Node b = belts[i];
+        if (!r_.ExpectMap(b, path)) continue;
+        r_.CheckKeys(b, path,
+                     {"center_x_m", "center_y_m", "length_m", "width_m", "direction_deg",
+                      "speed_mps", "speed_variation", "variation_period_s", "acceleration_mps2",
+                      "schedule"});
+        RobotInfo::Belt belt{};
+        belt.center_x_m = r_.Real(b, path, "center_x_m", std::nullopt, {-1e6, 1e6});
+        belt.center_y_m = r_.Real(b, path, "center_y_m", std::nullopt, {-1e6, 1e6});
+        belt.length_m = r_.Real(b, path, "length_m", std::nullopt, {0.0, 1e4, true});
+        belt.width_m = r_.Real(b, path, "width_m", std::nullopt, {0.0, 1e3, true});
+        belt.direction_rad = r_.Real(b, path, "direction_deg", 0.0, {-360, 360}) * kDegToRad;
+        info_.belts.push_back(belt);
+        cx.push_back(belt.center_x_m);
+        cy.push_back(belt.center_y_m);
+        length.push_back(belt.length_m);
+        width.push_back(belt.width_m);
+        direction.push_back(belt.direction_rad);
+        // Paper 1: lines run below 0.2 m/s; 2 m/s leaves room for studies.
+        speed.push_back(r_.Real(b, path, "speed_mps", std::nullopt, {0.0, 2.0, true}));
+        // Paper 1: "almost constant velocity (+-10 % variation)".
+        variation.push_back(r_.Real(b, path, "speed_variation", 0.1, {0.0, 0.5}));
+        period.push_back(r_.Real(b, path, "variation_period_s", 20.0, {0.0, 1e6, true}));
+        accel.push_back(r_.Real(b, path, "acceleration_mps2", 0.5, {0.0, 100.0, true}));
+        // The schedule: [{time_s, on}], in increasing time; on at t = 0
+        // unless the first entry (at 0) says otherwise.
+        YAML::Node switches(YAML::NodeType::Sequence);
+        bool initially_on = true;
+        const YAML::Node schedule = Child(b, "schedule");
+        const std::string schedule_path = JoinPath(path, "schedule");
+        if (schedule.IsDefined() && !schedule.IsNull() &&
+            r_.ExpectSequence(schedule, schedule_path)) {
+          double last_s = -1.0;
+          for (std::size_t k = 0; k < schedule.size(); ++k) {
+            const std::string item_path = JoinPath(schedule_path, std::to_string(k));
+            if (!r_.ExpectMap(schedule[k], item_path)) continue;
+            r_.CheckKeys(schedule[k], item_path, {"time_s", "on"});
+            const double t = r_.Real(schedule[k], item_path, "time_s", std::nullopt, {0.0, 1e7});
+            const bool on = r_.Boolean(schedule[k], item_path, "on", std::nullopt);
+            if (t <= last_s) {
+              r_.Error(Child(schedule[k], "time_s"), JoinPath(item_path, "time_s"),
+                       "switching times must increase");
+            }
+            last_s = t;
+            if (t == 0.0) {
+              initially_on = on;
+              continue;
+            }
+            YAML::Node s;
+            s["time_s"] = t;
+            s["on"] = on;
+            switches.push_back(s);
+          }
+        }
+        on0.push_back(initially_on ? 1.0 : 0.0);
+        schedules.push_back(switches);
+      }
+    }
+    const auto count = static_cast<int>(info_.belts.size());
+    Params(kChassis)["belt_count"] = count;
+    if (count == 0) return;
+    Unit(kBelt)["type"] = "belt";
+    YAML::Node p = Params(kBelt);
+    p["count"] = count;
+    p["schedules"] = schedules;
+    p["center_x"] = List(cx);
+    p["center_y"] = List(cy);
+    p["length"] = List(length);
+    p["width"] = List(width);
+    p["direction"] = List(direction);
+    p["speed"] = List(speed);
+    p["speed_variation"] = List(variation);
+    p["variation_period"] = List(period);
+    p["acceleration"] = List(accel);
+    p["initially_on"] = List(on0);
+    YAML::Node c = Params(kChassis);
+    c["belt_center_x"] = List(cx);
+    c["belt_center_y"] = List(cy);
+    c["belt_length"] = List(length);
+    c["belt_width"] = List(width);
+    c["belt_direction"] = List(direction);
+    Connect("belt.velocity", "chassis.belt_velocity");
+  }
+
+  void Control() {
+    const YAML::Node control = Section(root_, "", "control", {"compensation", "period_s"});
+    const bool compensation = r_.Boolean(control, "control", "compensation", true);
+    // FACTS.md: the Rob@Work 3 control cycle is 20 ms.
+    period_s_ = r_.Real(control, "control", "period_s", 0.02, {0.0, 10.0, true});
+    for (const char* name : {kWheelController, kPathFollower}) Unit(name)["step_s"] = period_s_;
+    Unit(kWheelController)["type"] = "wheel_controller";
+    MergeInto(Params(kWheelController), controller_defaults_);
+    Params(kWheelController)["compensation"] = compensation;
+    Connect("wheel_controller.steer_voltage", "steer_motors.voltage");
+    Connect("wheel_controller.drive_voltage", "drive_motors.voltage");
+    Connect("chassis.steer_angle", "wheel_controller.steer_angle");
+    Connect("chassis.steer_rate", "wheel_controller.steer_rate");
+    Connect("chassis.drive_rate", "wheel_controller.drive_rate");
+    Connect("path_follower.twist_command", "wheel_controller.twist_command");
+  }
+
+  void Sensing() {
+    // Later capabilities add sensors and estimators here; the names are
+    // reserved now so that sweeps can vary them without changes.
+    const YAML::Node sensing = Section(root_, "", "sensing", {"surface_velocity"});
+    const std::string surface =
+        r_.String(sensing, "sensing", "surface_velocity", "ground_truth", {"ground_truth"});
+    if (surface == "ground_truth") {
+      Connect("chassis.wheel_surface_velocity", "wheel_controller.surface_velocity");
+    }
+    const YAML::Node localization = Section(root_, "", "localization", {"source"});
+    const std::string source =
+        r_.String(localization, "localization", "source", "ground_truth", {"ground_truth"});
+    if (source == "ground_truth") Connect("chassis.pose", "path_follower.pose");
+  }
+
+  void Task() {
+    const YAML::Node task = Section(root_, "", "task",
+                                    {"type", "waypoints", "point", "speed_mps",
+                                     "acceleration_mps2", "yaw_deg"});
+    info_.task = r_.String(task, "task", "type", std::nullopt, {"path", "hold"});
+    Unit(kPathFollower)["type"] = "path_follower";
+    YAML::Node p = Params(kPathFollower);
+    MergeInto(p, follower_defaults_);
+    if (info_.task == "path") {
+      const YAML::Node waypoints = Child(task, "waypoints");
+      if (!waypoints.IsDefined()) {
+        r_.Error(task, "task.waypoints", "missing required key: a list of points [x, y] (m)");
+      } else if (r_.ExpectSequence(waypoints, "task.waypoints")) {
+        if (waypoints.size() < 2) {
+          r_.Error(waypoints, "task.waypoints", "expected at least two points [x, y]");
+        }
+        for (std::size_t i = 0; i < waypoints.size(); ++i) {
+          if (auto pt = ReadPoint(waypoints[i], JoinPath("task.waypoints", std::to_string(i)),
+                                  r_)) {
+            info_.path.push_back(*pt);
+          }
+        }
+      }
+      p["mode"] = "path";
+      p["speed"] = r_.Real(task, "task", "speed_mps", 0.3, {0.0, 1.2, true});  // Table I max
+    } else if (info_.task == "hold") {
+      std::array<double, 2> point{x_m_, y_m_};
+      if (Child(task, "point").IsDefined()) {
+        if (auto pt = ReadPoint(Child(task, "point"), "task.point", r_)) point = *pt;
+      }
+      info_.path.push_back(point);
+      p["mode"] = "hold";
+    }
+    if (Child(task, "acceleration_mps2").IsDefined()) {
+      p["acceleration"] = r_.Real(task, "task", "acceleration_mps2", 0.3, {0.0, 10.0, true});
+    }
+    // The robot is omnidirectional: it keeps this heading while it moves.
+    p["yaw"] = Child(task, "yaw_deg").IsDefined()
+                   ? r_.Real(task, "task", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad
+                   : yaw_rad_;
+    YAML::Node waypoints(YAML::NodeType::Sequence);
+    for (const auto& pt : info_.path) waypoints.push_back(Point(pt[0], pt[1]));
+    p["waypoints"] = waypoints;
+
+    Unit(kDeviation)["type"] = "path_deviation";
+    Params(kDeviation)["path"] = YAML::Clone(waypoints);
+    Connect("chassis.pose", "deviation.pose");
+  }
+
+  // `units:` in a robot scenario adds to or overrides the expanded units,
+  // in the system-level shape: units.NAME.{type, step_s, parameters}.
+  void Passthrough() {
+    const YAML::Node units = Child(root_, "units");
+    if (units.IsDefined() && !units.IsNull() && r_.ExpectMap(units, "units")) {
+      for (const auto& kv : units) {
+        const std::string name = kv.first.Scalar();
+        const std::string path = JoinPath("units", name);
+        YAML::Node target = out_["units"][name];
+        if (!kv.second.IsMap()) {
+          r_.ExpectMap(kv.second, path);
+          continue;
+        }
+        for (const auto& item : kv.second) {
+          const std::string key = item.first.Scalar();
+          if (key == "parameters" && item.second.IsMap()) {
+            MergeInto(target["parameters"], item.second);
+          } else {
+            target[key] = item.second;
+          }
+        }
+      }
+    }
+    const YAML::Node connections = Child(root_, "connections");
+    if (connections.IsDefined() && !connections.IsNull() &&
+        r_.ExpectSequence(connections, "connections")) {
+      for (const auto& c : connections) out_["connections"].push_back(c);
+    }
+  }
+
+  void Recording() {
+    if (Child(root_, "recording").IsDefined()) {
+      out_["recording"] = Child(root_, "recording");
+      return;
+    }
+    YAML::Node vars(YAML::NodeType::Sequence);
+    for (const char* v :
+         {"chassis.pose", "chassis.velocity", "chassis.steer_angle", "chassis.drive_rate",
+          "chassis.wheel_surface", "chassis.wheel_contact", "path_follower.twist_command",
+          "wheel_controller.steer_voltage", "wheel_controller.drive_voltage",
+          "drive_motors.current", "deviation.deviation"}) {
+      vars.push_back(v);
+    }
+    if (!info_.belts.empty()) {
+      vars.push_back("belt.speed");
+      vars.push_back("belt.on");
+    }
+    out_["recording"]["variables"] = vars;
+    // 100 Hz is enough for the plots and keeps signals.csv small.
+    out_["recording"]["interval_s"] = 0.01;
+  }
+
+  void Metrics() {
+    YAML::Node metrics(YAML::NodeType::Sequence);
+    const auto add = [&](const char* name, const char* of, const char* reduce) {
+      YAML::Node m;
+      m["name"] = name;
+      m["of"] = of;
+      m["reduce"] = reduce;
+      metrics.push_back(m);
+    };
+    if (info_.task == "path") {
+      add("max_path_deviation_m", "deviation.deviation", "max");
+      add("final_path_deviation_m", "deviation.deviation", "final");
+      add("final_progress_m", "deviation.progress", "final");
+    } else {
+      add("max_position_drift_m", "deviation.deviation", "max");
+      add("final_position_drift_m", "deviation.deviation", "final");
+    }
+    add("final_yaw_rad", "chassis.pose[2]", "final");
+    const YAML::Node extra = Child(root_, "metrics");
+    if (extra.IsDefined() && !extra.IsNull() && r_.ExpectSequence(extra, "metrics")) {
+      for (const auto& m : extra) metrics.push_back(m);
+    }
+    out_["metrics"] = metrics;
+  }
+
+  const YAML::Node& root_;
+  YamlReader& r_;
+  RobotInfo& info_;
+  YAML::Node out_{YAML::NodeType::Map};
+  YAML::Node controller_defaults_, follower_defaults_;
+  double x_m_ = 0, y_m_ = 0, yaw_rad_ = 0, period_s_ = 0.02;
+};
+
+}  // namespace
+
+bool IsRobotScenario(const YAML::Node& root) {
+  return root.IsMap() && Child(root, "robot").IsDefined();
+}
+
+YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& reader, RobotInfo& info) {
+  return Expander(root, reader, info).Expand();
+}
+
+}  // namespace linesim::loader
