@@ -67,7 +67,7 @@ std::vector<std::array<double, 2>> ReadPoints(const UnitBuildContext& c, const s
   std::vector<std::array<double, 2>> points;
   const YAML::Node list = Child(c.parameters, key);
   const std::string path = JoinPath(c.path, key);
-  if (!list.IsDefined() && !c.parameters.IsDefined()) {
+  if (!list.IsDefined() && (!c.parameters.IsDefined() || c.parameters.IsNull())) {
     return {{0.0, 0.0}};  // `linesim inspect TYPE`: no parameters at all
   }
   if (!list.IsDefined()) {
