@@ -186,8 +186,9 @@ void BeltUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }
 
 void BeltUnit::Initialize() {
   Validate();
-  for (std::size_t b = 0; b < nominal_speed_.size(); ++b)
+  for (std::size_t b = 0; b < nominal_speed_.size(); ++b) {
     belt_speed_[b] = TargetSpeed(b, ScheduledOn(static_cast<int>(b), start_), start_);
+  }
   ComputeOutputs(start_);
   initialized_ = true;
 }
