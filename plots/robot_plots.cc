@@ -1,0 +1,455 @@
+#include "plots/robot_plots.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <stdexcept>
+
+#include "cosim/closest_names.h"
+
+extern char** environ;
+
+namespace linesim::plots {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kSignals = "signals.csv";
+constexpr const char* kScript = "plots.gp";
+
+// Shortest text that reads back to the same double: deterministic and
+// independent of the locale.
+std::string Num(double x) {
+  char buf[32];
+  const auto res = std::to_chars(buf, buf + sizeof buf, x);
+  return std::string(buf, res.ptr);
+}
+
+// A gnuplot single-quoted string: no escapes inside except '' for a quote.
+std::string Quote(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) {
+    if (c == '\'') {
+      out += "''";
+    } else if (c == '\n' || c == '\r') {
+      out += ' ';
+    } else {
+      out += c;
+    }
+  }
+  return out + "'";
+}
+
+std::vector<std::string> SplitCsv(std::string_view line) {
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  std::vector<std::string> fields;
+  std::size_t begin = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', begin);
+    fields.emplace_back(line.substr(begin, comma - begin));
+    if (comma == std::string_view::npos) break;
+    begin = comma + 1;
+  }
+  return fields;
+}
+
+std::optional<double> ParseNumber(const std::string& field) {
+  double x = 0.0;
+  const char* end = field.data() + field.size();
+  const auto res = std::from_chars(field.data(), end, x);
+  if (res.ec != std::errc() || res.ptr != end) return std::nullopt;
+  return x;
+}
+
+/// signals.csv: the column names and the data lines (unparsed; only a few
+/// are read as numbers).
+struct Signals {
+  std::vector<std::string> header;
+  std::vector<std::string> lines;
+};
+
+Signals ReadSignals(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    throw std::runtime_error("cannot read " + file.string() + ": " + std::strerror(errno));
+  }
+  Signals s;
+  std::string line;
+  if (!std::getline(in, line)) throw std::runtime_error(file.string() + " is empty");
+  s.header = SplitCsv(line);
+  while (std::getline(in, line)) {
+    if (!line.empty() && line != "\r") s.lines.push_back(std::move(line));
+  }
+  if (s.lines.empty()) throw std::runtime_error(file.string() + " has no data rows");
+  return s;
+}
+
+/// 1-based column numbers (as gnuplot's `using` counts) by name; every
+/// unknown name is collected so that one error lists them all.
+class ColumnFinder {
+ public:
+  ColumnFinder(const std::vector<std::string>& header, fs::path file)
+      : header_(header), file_(std::move(file)) {}
+
+  int operator()(const std::string& name, const char* role) {
+    const auto it = std::find(header_.begin(), header_.end(), name);
+    if (it != header_.end()) return static_cast<int>(it - header_.begin()) + 1;
+    unknown_.push_back("no column '" + name + "' (" + role + ")" +
+                       cosim::ClosestHint(name, header_));
+    return 0;
+  }
+
+  void ThrowIfUnknown() const {
+    if (unknown_.empty()) return;
+    std::string text = file_.string() + ": ";
+    for (std::size_t i = 0; i < unknown_.size(); ++i) text += (i ? "; " : "") + unknown_[i];
+    throw std::runtime_error(text);
+  }
+
+ private:
+  const std::vector<std::string>& header_;
+  fs::path file_;
+  std::vector<std::string> unknown_;
+};
+
+struct Point {
+  double x, y;
+};
+
+// Extent of what the top view shows, ignoring non-finite points.
+struct Bounds {
+  double x_min = INFINITY, x_max = -INFINITY, y_min = INFINITY, y_max = -INFINITY;
+  void Add(double x, double y) {
+    if (!std::isfinite(x) || !std::isfinite(y)) return;
+    x_min = std::min(x_min, x);
+    x_max = std::max(x_max, x);
+    y_min = std::min(y_min, y);
+    y_max = std::max(y_max, y);
+  }
+  bool empty() const { return x_min > x_max; }
+};
+
+// Canvas and top-view plot area (screen fractions): the ranges are widened
+// to the area's aspect ratio, so that an equal-scale view fills it.
+constexpr int kCanvasWidthPx = 1000, kCanvasHeightPx = 800;
+constexpr double kLeft = 0.09, kRight = 0.97, kBottom = 0.16, kTop = 0.93;
+
+// Corners of a rectangle centred at (x, y), `length` along heading `yaw`.
+std::array<Point, 4> Rectangle(double x, double y, double yaw, double length, double width) {
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  const double hl = 0.5 * length, hw = 0.5 * width;
+  std::array<Point, 4> corners;
+  const double sx[4] = {hl, -hl, -hl, hl}, sy[4] = {hw, hw, -hw, -hw};
+  for (int k = 0; k < 4; ++k) {
+    corners[k] = {x + c * sx[k] - s * sy[k], y + s * sx[k] + c * sy[k]};
+  }
+  return corners;
+}
+
+void AppendPolygon(std::string& block, const std::array<Point, 4>& corners) {
+  for (int k = 0; k <= 4; ++k) {
+    const Point& p = corners[k % 4];
+    block += Num(p.x) + "," + Num(p.y) + "\n";
+  }
+  block += "\n";
+}
+
+void AppendBlock(std::string& script, const std::string& name, const std::string& data) {
+  script += "$" + name + " << EOD\n" + data + "EOD\n";
+}
+
+// Row indices of `count` instants evenly spaced from the first row to the
+// last (rounded to the nearest row).
+std::vector<std::size_t> EvenlySpaced(std::size_t rows, int count) {
+  std::vector<std::size_t> picks;
+  if (count <= 0) return picks;
+  if (count == 1) return {0};
+  for (int i = 0; i < count; ++i) {
+    const double at = static_cast<double>(i) * static_cast<double>(rows - 1) / (count - 1);
+    const auto row = static_cast<std::size_t>(std::lround(at));
+    if (picks.empty() || picks.back() != row) picks.push_back(row);
+  }
+  return picks;
+}
+
+std::string Script(const RobotPlotSpec& spec, const Signals& signals, const fs::path& csv,
+                   std::vector<std::string>* outputs) {
+  if (spec.x_column.empty() || spec.y_column.empty()) {
+    throw std::runtime_error("robot plots need the x and y columns of the robot position");
+  }
+  ColumnFinder column(signals.header, csv);
+  const int ix = column(spec.x_column, "robot x");
+  const int iy = column(spec.y_column, "robot y");
+  const int iyaw = spec.yaw_column.empty() ? 0 : column(spec.yaw_column, "robot yaw");
+  std::vector<std::pair<int, int>> wheels;
+  for (const auto& [wx, wy] : spec.wheel_columns) {
+    wheels.emplace_back(column(wx, "wheel x"), column(wy, "wheel y"));
+  }
+  const int ierr = spec.error_column.empty() ? 0 : column(spec.error_column, "error");
+  std::vector<int> speeds, ons;
+  for (const auto& name : spec.belt_speed_columns) speeds.push_back(column(name, "belt speed"));
+  for (const auto& name : spec.belt_on_columns) ons.push_back(column(name, "belt on"));
+  column.ThrowIfUnknown();
+
+  std::string s =
+      "# Written by linesim (plots/robot_plots.cc). Run `gnuplot plots.gp` in this folder\n"
+      "# to redraw; data come from signals.csv (columns by number, header skipped).\n"
+      "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {\n"
+      "  set terminal pngcairo size " +
+      std::to_string(kCanvasWidthPx) + "," + std::to_string(kCanvasHeightPx) +
+      " noenhanced font ',10'\n"
+      "} else {\n"
+      "  set terminal png size " +
+      std::to_string(kCanvasWidthPx) + "," + std::to_string(kCanvasHeightPx) +
+      " noenhanced\n"
+      "}\n"
+      "set datafile separator comma\n"
+      "set grid\n";
+
+  // Belt rectangles, and arrows about every metre along each centre line showing
+  // the direction of motion (only those in view are drawn).
+  std::string belts, arrows;
+  for (const BeltRect& b : spec.belts) {
+    AppendPolygon(belts,
+                  Rectangle(b.center_x_m, b.center_y_m, b.direction_rad, b.length_m, b.width_m));
+    const double c = std::cos(b.direction_rad), sn = std::sin(b.direction_rad);
+    const int n = std::clamp(static_cast<int>(b.length_m), 1, 200);
+    for (int k = 0; k < n; ++k) {
+      const double along_m = (k + 0.5) * b.length_m / n - 0.5 * b.length_m - 0.15;
+      arrows += Num(b.center_x_m + c * along_m) + "," + Num(b.center_y_m + sn * along_m) + "," +
+                Num(0.3 * c) + "," + Num(0.3 * sn) + "\n";
+    }
+  }
+  std::string path;
+  for (const auto& p : spec.path_m) path += Num(p[0]) + "," + Num(p[1]) + "\n";
+
+  // Outlines (with a heading tick from the centre to the front), wheel
+  // contact points and time labels at the chosen instants.
+  std::string outlines, contacts, labels;
+  Bounds view;
+  for (const auto& p : spec.path_m) view.Add(p[0], p[1]);
+  for (const std::string& line : signals.lines) {
+    const auto fields = SplitCsv(line);
+    if (static_cast<std::size_t>(std::max(ix, iy)) > fields.size()) continue;
+    const auto x = ParseNumber(fields[static_cast<std::size_t>(ix - 1)]);
+    const auto y = ParseNumber(fields[static_cast<std::size_t>(iy - 1)]);
+    if (x && y) view.Add(*x, *y);
+  }
+  if (iyaw > 0) {
+    for (std::size_t row : EvenlySpaced(signals.lines.size(), spec.footprint_count)) {
+      const auto fields = SplitCsv(signals.lines[row]);
+      const auto get = [&](int col) -> std::optional<double> {
+        if (col < 1 || static_cast<std::size_t>(col) > fields.size()) return std::nullopt;
+        return ParseNumber(fields[static_cast<std::size_t>(col - 1)]);
+      };
+      const auto t = get(1), x = get(ix), y = get(iy), yaw = get(iyaw);
+      if (!x || !y || !yaw || !std::isfinite(*x + *y + *yaw)) continue;
+      const auto corners = Rectangle(*x, *y, *yaw, spec.body_length_m, spec.body_width_m);
+      for (const Point& c : corners) view.Add(c.x, c.y);
+      AppendPolygon(outlines, corners);
+      outlines += Num(*x) + "," + Num(*y) + "\n" +
+                  Num(*x + 0.5 * spec.body_length_m * std::cos(*yaw)) + "," +
+                  Num(*y + 0.5 * spec.body_length_m * std::sin(*yaw)) + "\n\n";
+      if (t) labels += Num(*x) + "," + Num(*y) + ",t = " + Num(*t) + " s\n";
+      for (const auto& [wx, wy] : wheels) {
+        const auto px = get(wx), py = get(wy);
+        if (px && py) {
+          contacts += Num(*px) + "," + Num(*py) + "\n";
+          view.Add(*px, *py);
+        }
+      }
+    }
+  }
+  if (!belts.empty()) AppendBlock(s, "belts", belts);
+  if (!arrows.empty()) AppendBlock(s, "belt_direction", arrows);
+  if (!path.empty()) AppendBlock(s, "path", path);
+  if (!outlines.empty()) AppendBlock(s, "outlines", outlines);
+  if (!contacts.empty()) AppendBlock(s, "contacts", contacts);
+  if (!labels.empty()) AppendBlock(s, "labels", labels);
+
+  const std::string title_prefix = spec.title.empty() ? "" : spec.title + ": ";
+  const std::string signals_file = Quote(kSignals);
+
+  // Top view of the robot's neighbourhood (path, track, outlines), not of
+  // the whole line: belts are clipped to it.
+  outputs->push_back("top_view.png");
+  s += "\nset output 'top_view.png'\n"
+       "set title " +
+       Quote(title_prefix + "top view (map frame)") +
+       "\n"
+       "set xlabel 'x (m)'\nset ylabel 'y (m)'\n"
+       "set lmargin at screen " +
+       Num(kLeft) + "\nset rmargin at screen " + Num(kRight) + "\nset bmargin at screen " +
+       Num(kBottom) + "\nset tmargin at screen " + Num(kTop) +
+       "\nset key at screen 0.5, 0.04 center bottom horizontal maxrows 2\n"
+       "set style textbox opaque noborder\n"
+       "set size ratio -1\n";
+  if (!view.empty()) {
+    const double area_aspect =
+        (kRight - kLeft) * kCanvasWidthPx / ((kTop - kBottom) * kCanvasHeightPx);
+    const double margin_m = 0.3 + 0.05 * std::max(view.x_max - view.x_min, view.y_max - view.y_min);
+    double half_x = 0.5 * (view.x_max - view.x_min) + margin_m;
+    double half_y = 0.5 * (view.y_max - view.y_min) + margin_m;
+    half_x = std::max(half_x, half_y * area_aspect);
+    half_y = std::max(half_y, half_x / area_aspect);
+    const double cx = 0.5 * (view.x_min + view.x_max), cy = 0.5 * (view.y_min + view.y_max);
+    s += "set xrange [" + Num(cx - half_x) + ":" + Num(cx + half_x) + "]\nset yrange [" +
+         Num(cy - half_y) + ":" + Num(cy + half_y) + "]\n";
+  }
+  s += "plot ";
+  std::vector<std::string> items;
+  if (!belts.empty()) {
+    items.push_back(
+        "$belts using 1:2 with filledcurves closed fillcolor rgb '#dbe6f4' fillstyle solid 1.0 "
+        "border lc rgb '#8fa9cc' noautoscale title 'belt'");
+  }
+  if (!arrows.empty()) {
+    items.push_back(
+        "$belt_direction using 1:2:3:4 with vectors lc rgb '#8fa9cc' noautoscale "
+        "title 'belt motion'");
+  }
+  if (spec.path_m.size() == 1) {
+    items.push_back(
+        "$path using 1:2 with points pt 3 ps 3 lw 2 lc rgb 'black' title 'hold target'");
+  } else if (!path.empty()) {
+    items.push_back("$path using 1:2 with lines dt 2 lw 1.5 lc rgb 'black' title 'desired path'");
+  }
+  items.push_back(signals_file + " skip 1 using " + std::to_string(ix) + ":" + std::to_string(iy) +
+                  " with lines lw 2 lc rgb '#d62728' title 'actual path'");
+  if (!outlines.empty()) {
+    items.push_back("$outlines using 1:2 with lines lw 1 lc rgb '#1f77b4' title 'robot outline'");
+  }
+  if (!contacts.empty()) {
+    items.push_back(
+        "$contacts using 1:2 with points pt 7 ps 0.8 lc rgb '#2ca02c' title 'wheel contacts'");
+  }
+  if (!labels.empty()) {
+    items.push_back("$labels using 1:2:3 with labels boxed offset 0,1 font ',8' notitle");
+  }
+  for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
+  s += "\n\n# Back to defaults for the time plots.\n"
+       "set size noratio\nset autoscale\nset key default\n"
+       "set lmargin -1\nset rmargin -1\nset bmargin -1\nset tmargin -1\n";
+
+  if (ierr > 0) {
+    outputs->push_back("error.png");
+    s += "\nset output 'error.png'\nset title " + Quote(title_prefix + spec.error_label) +
+         "\nset xlabel 'time (s)'\nset ylabel " + Quote(spec.error_label) + "\nplot " +
+         signals_file + " skip 1 using 1:" + std::to_string(ierr) + " with lines lw 1.5 title " +
+         Quote(spec.error_column) + "\n";
+  }
+
+  if (!speeds.empty() || !ons.empty()) {
+    outputs->push_back("belt.png");
+    s += "\nset output 'belt.png'\nset title " + Quote(title_prefix + "belts") +
+         "\nset xlabel 'time (s)'\nset ylabel 'belt speed (m/s)'\n"
+         "set y2label 'scheduled on (1) / off (0)'\n"
+         "set yrange [0:*]\nset offsets 0, 0, graph 0.08, 0\n"
+         "set y2range [-0.05:1.05]\nset y2tics 0, 1, 1\nset ytics nomirror\nplot ";
+    items.clear();
+    for (std::size_t i = 0; i < speeds.size(); ++i) {
+      items.push_back(signals_file + " skip 1 using 1:" + std::to_string(speeds[i]) +
+                      " with lines lw 2 title " + Quote(spec.belt_speed_columns[i]));
+    }
+    for (std::size_t i = 0; i < ons.size(); ++i) {
+      items.push_back(signals_file + " skip 1 using 1:" + std::to_string(ons[i]) +
+                      " axes x1y2 with steps dt 2 lw 1.5 title " + Quote(spec.belt_on_columns[i]));
+    }
+    for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
+    s += "\n";
+  }
+  s += "unset output\n";
+  return s;
+}
+
+/// Runs `gnuplot plots.gp` in `dir` without a shell (paths with spaces or
+/// quotes need no escaping); returns gnuplot's exit status and stderr text.
+std::pair<int, std::string> RunGnuplot(const fs::path& dir) {
+  int err_pipe[2];
+  if (pipe(err_pipe) != 0) {
+    throw std::runtime_error(std::string("cannot create a pipe for gnuplot: ") +
+                             std::strerror(errno));
+  }
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_adddup2(&actions, err_pipe[1], 2);
+  posix_spawn_file_actions_addclose(&actions, err_pipe[0]);
+  posix_spawn_file_actions_addclose(&actions, err_pipe[1]);
+  const std::string dir_text = dir.string();
+  posix_spawn_file_actions_addchdir_np(&actions, dir_text.c_str());
+  char arg0[] = "gnuplot";
+  char arg1[] = "plots.gp";
+  char* argv[] = {arg0, arg1, nullptr};
+  pid_t pid = 0;
+  const int spawn_error = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&actions);
+  close(err_pipe[1]);
+  if (spawn_error != 0) {
+    close(err_pipe[0]);
+    throw std::runtime_error("cannot run gnuplot (is it installed and on PATH?): " +
+                             std::string(std::strerror(spawn_error)));
+  }
+  std::string text;
+  char buf[4096];
+  while (true) {
+    const ssize_t n = read(err_pipe[0], buf, sizeof buf);
+    if (n > 0) {
+      text.append(buf, static_cast<std::size_t>(n));
+    } else if (n == 0 || errno != EINTR) {
+      break;
+    }
+  }
+  close(err_pipe[0]);
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) throw std::runtime_error("waiting for gnuplot failed");
+  }
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return {code, text};
+}
+
+}  // namespace
+
+std::vector<std::string> WriteRobotPlots(const std::string& dir, const RobotPlotSpec& spec) {
+  const fs::path folder(dir);
+  const fs::path csv = folder / kSignals;
+  const Signals signals = ReadSignals(csv);
+  std::vector<std::string> names;
+  const std::string script = Script(spec, signals, csv, &names);
+  {
+    std::ofstream out(folder / kScript, std::ios::binary | std::ios::trunc);
+    out << script;
+    if (!out.flush()) throw std::runtime_error("cannot write " + (folder / kScript).string());
+  }
+  // Stale plots from an earlier run must not pass for new ones.
+  for (const auto& name : names) fs::remove(folder / name);
+  const auto [code, errors] = RunGnuplot(folder);
+  std::vector<std::string> written;
+  for (const auto& name : names) {
+    const fs::path png = folder / name;
+    if (code == 0 && !fs::exists(png)) {
+      throw std::runtime_error("gnuplot did not write " + png.string() + ": " + errors);
+    }
+    written.push_back(png.string());
+  }
+  if (code != 0) {
+    throw std::runtime_error("gnuplot failed on " + (folder / kScript).string() + " (exit status " +
+                             std::to_string(code) + "): " + errors);
+  }
+  return written;
+}
+
+}  // namespace linesim::plots

@@ -1,0 +1,58 @@
+#pragma once
+
+#include <array>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace linesim::plots {
+
+/// A belt as a rectangle in the map frame.
+struct BeltRect {
+  double center_x_m = 0.0;
+  double center_y_m = 0.0;
+  double length_m = 1.0;  // along the direction of motion
+  double width_m = 1.0;   // across it
+  double direction_rad = 0.0;
+};
+
+/// What to draw for one robot run. Column names are header names of
+/// signals.csv as the recorder writes them ("chassis.pose[0]"); an empty name
+/// leaves out what it would draw.
+struct RobotPlotSpec {
+  std::string title;
+  std::vector<BeltRect> belts;
+  /// Desired path polyline in the map frame; a single point is a hold target.
+  std::vector<std::array<double, 2>> path_m;
+  /// Robot position (m) and yaw (rad) in the map frame. x and y are
+  /// required; without yaw no outlines are drawn.
+  std::string x_column, y_column, yaw_column;
+  /// x and y columns (map frame, m) of each wheel's contact point, drawn as
+  /// footprints with the outlines.
+  std::vector<std::pair<std::string, std::string>> wheel_columns;
+  /// Deviation from the path or drift from the hold target against time
+  /// (error.png); none when empty. The label names it on the y axis.
+  std::string error_column;
+  std::string error_label = "error (m)";
+  /// Belt speed (m/s) and on state (0/1) columns for belt.png; none when
+  /// both are empty.
+  std::vector<std::string> belt_speed_columns, belt_on_columns;
+  /// Robot outlines and wheel footprints drawn at this many instants,
+  /// evenly spaced over the recorded rows from first to last.
+  int footprint_count = 5;
+  /// Body rectangle centred on the robot position, length along its x axis
+  /// (Rob@Work 3: 1.03 x 0.57 m, paper 1 Table I).
+  double body_length_m = 1.03;
+  double body_width_m = 0.57;
+};
+
+/// Writes top_view.png, and error.png and belt.png when the spec asks for
+/// them, into `dir`, from `dir`/signals.csv. The gnuplot script is left in
+/// `dir`/plots.gp with paths relative to `dir`, so `gnuplot plots.gp` run in
+/// `dir` redraws the plots. Returns the paths of the PNG files written.
+/// Throws std::runtime_error when signals.csv cannot be read, a column is
+/// unknown (naming every unknown column and the closest known ones), or
+/// gnuplot is missing or fails (with gnuplot's error text).
+std::vector<std::string> WriteRobotPlots(const std::string& dir, const RobotPlotSpec& spec);
+
+}  // namespace linesim::plots

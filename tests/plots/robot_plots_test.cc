@@ -1,0 +1,212 @@
+#include "plots/robot_plots.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace linesim::plots {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A fresh folder per test, with a space and a quote in its name so that any
+// quoting mistake in running gnuplot shows; removed afterwards.
+class RobotPlotsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("linesim plots 'test' " + std::to_string(getpid()) + " " + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // A synthetic run in the recorder's format: a Rob@Work-3-sized robot
+  // crossing a belt along +y over 30 s, recorded every 10 ms (3001 rows, the
+  // size the brief asks to plot quickly), wheels at the raw3-1 steering axes
+  // (FACTS.md), a belt that runs from 0 to 10 s and ramps up at 0.5 m/s^2.
+  void WriteSignals() const {
+    std::ofstream out(dir_ / "signals.csv");
+    out << "time,chassis.pose[0],chassis.pose[1],chassis.pose[2]";
+    for (int w = 0; w < 4; ++w)
+      out << ",chassis.contact_x[" << w << "],chassis.contact_y[" << w << "]";
+    out << ",metrics.deviation,belt.speed[0],belt.on[0]\n";
+    const double wheel_x[4] = {0.368, -0.368, -0.368, 0.368};
+    const double wheel_y[4] = {0.186, 0.134, -0.186, -0.134};
+    for (int k = 0; k <= 3000; ++k) {
+      const double t = 0.01 * k;
+      const double x = 0.02 * std::sin(t), y = -1.5 + 0.1 * t, yaw = 0.5 * std::numbers::pi;
+      out << t << "," << x << "," << y << "," << yaw;
+      for (int w = 0; w < 4; ++w) {
+        out << "," << x + std::cos(yaw) * wheel_x[w] - std::sin(yaw) * wheel_y[w] << ","
+            << y + std::sin(yaw) * wheel_x[w] + std::cos(yaw) * wheel_y[w];
+      }
+      const bool on = t < 10.0;
+      const double speed = on ? std::min(0.1, 0.5 * t) : std::max(0.0, 0.1 - 0.5 * (t - 10.0));
+      out << "," << std::abs(x) << "," << speed << "," << (on ? 1 : 0) << "\n";
+    }
+  }
+
+  static RobotPlotSpec Spec() {
+    RobotPlotSpec spec;
+    spec.title = "crossing 'test'";
+    spec.belts = {{0.0, 0.0, 10.0, 1.0, 0.0}};
+    spec.path_m = {{0.0, -1.5}, {0.0, 1.5}};
+    spec.x_column = "chassis.pose[0]";
+    spec.y_column = "chassis.pose[1]";
+    spec.yaw_column = "chassis.pose[2]";
+    for (int w = 0; w < 4; ++w) {
+      spec.wheel_columns.emplace_back("chassis.contact_x[" + std::to_string(w) + "]",
+                                      "chassis.contact_y[" + std::to_string(w) + "]");
+    }
+    spec.error_column = "metrics.deviation";
+    spec.error_label = "deviation from path (m)";
+    spec.belt_speed_columns = {"belt.speed[0]"};
+    spec.belt_on_columns = {"belt.on[0]"};
+    return spec;
+  }
+
+  static std::string ReadAll(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+
+  // The 8-byte signature every PNG file starts with (PNG specification,
+  // section 5.2).
+  static bool IsPng(const fs::path& file) {
+    const std::string bytes = ReadAll(file);
+    return bytes.size() > 8 && bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0;
+  }
+
+  fs::path dir_;
+};
+
+// Guards against a run that silently produces no plots, broken files, or a
+// script the user cannot re-run: all three PNGs are real PNG files, and
+// plots.gp refers to signals.csv by a relative name.
+TEST_F(RobotPlotsTest, WritesTheThreePngsAndTheScript) {
+  WriteSignals();
+  const auto files = WriteRobotPlots(dir_.string(), Spec());
+  ASSERT_EQ(files.size(), 3u);
+  EXPECT_EQ(fs::path(files[0]).filename(), "top_view.png");
+  EXPECT_EQ(fs::path(files[1]).filename(), "error.png");
+  EXPECT_EQ(fs::path(files[2]).filename(), "belt.png");
+  for (const auto& f : files) EXPECT_TRUE(IsPng(f)) << f;
+  const std::string script = ReadAll(dir_ / "plots.gp");
+  EXPECT_NE(script.find("'signals.csv'"), std::string::npos);
+  EXPECT_NE(script.find("set size ratio -1"), std::string::npos);
+  // 5 outlines of the robot by default, each a closed 5-point polygon plus a
+  // 2-point heading tick; 4 wheel contacts at each of those instants.
+  EXPECT_NE(script.find("$outlines << EOD"), std::string::npos);
+  const std::string head = "$contacts << EOD\n";
+  const auto begin = script.find(head);
+  ASSERT_NE(begin, std::string::npos);
+  const auto end = script.find("EOD\n", begin + head.size());
+  int lines = 0;
+  for (auto i = begin + head.size(); i < end; ++i) lines += script[i] == '\n';
+  EXPECT_EQ(lines, 20);
+}
+
+// Guards against output that changes from run to run (timestamps, map
+// order): the same input gives the same script and the same PNG bytes.
+TEST_F(RobotPlotsTest, IsDeterministic) {
+  WriteSignals();
+  WriteRobotPlots(dir_.string(), Spec());
+  const std::string script = ReadAll(dir_ / "plots.gp");
+  const std::string png = ReadAll(dir_ / "top_view.png");
+  WriteRobotPlots(dir_.string(), Spec());
+  EXPECT_EQ(ReadAll(dir_ / "plots.gp"), script);
+  EXPECT_EQ(ReadAll(dir_ / "top_view.png"), png);
+}
+
+// Guards against an unknown column being plotted as garbage or reported
+// vaguely: every unknown name is in the message with the closest real one.
+TEST_F(RobotPlotsTest, UnknownColumnIsNamed) {
+  WriteSignals();
+  RobotPlotSpec spec = Spec();
+  spec.yaw_column = "chassis.pose[7]";
+  spec.belt_on_columns = {"belt.of[0]"};
+  try {
+    WriteRobotPlots(dir_.string(), spec);
+    FAIL() << "an unknown column was accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("no column 'chassis.pose[7]' (robot yaw)"), std::string::npos) << what;
+    EXPECT_NE(what.find("no column 'belt.of[0]' (belt on)"), std::string::npos) << what;
+    EXPECT_NE(what.find("belt.on[0]"), std::string::npos) << what;  // the closest name
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "top_view.png"));
+}
+
+// Guards against plots that are always drawn: without an error column or
+// belt columns only the top view is written; a single path point (a hold
+// target) and no yaw (no outlines) still give a valid plot.
+TEST_F(RobotPlotsTest, WritesOnlyWhatTheSpecAsksFor) {
+  WriteSignals();
+  RobotPlotSpec spec = Spec();
+  spec.error_column.clear();
+  spec.belt_speed_columns.clear();
+  spec.belt_on_columns.clear();
+  spec.yaw_column.clear();
+  spec.path_m = {{0.0, 0.0}};
+  const auto files = WriteRobotPlots(dir_.string(), spec);
+  ASSERT_EQ(files.size(), 1u);
+  EXPECT_TRUE(IsPng(files[0]));
+  EXPECT_FALSE(fs::exists(dir_ / "error.png"));
+  const std::string script = ReadAll(dir_ / "plots.gp");
+  EXPECT_NE(script.find("hold target"), std::string::npos);
+  EXPECT_EQ(script.find("$outlines"), std::string::npos);
+}
+
+// Guards against a missing signals.csv or gnuplot being reported as
+// something else: both errors say what is missing.
+TEST_F(RobotPlotsTest, MissingInputOrGnuplotIsAClearError) {
+  try {
+    WriteRobotPlots(dir_.string(), Spec());
+    FAIL() << "no signals.csv was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("signals.csv"), std::string::npos) << e.what();
+  }
+  WriteSignals();
+  const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  setenv("PATH", (dir_ / "nowhere").c_str(), 1);
+  try {
+    WriteRobotPlots(dir_.string(), Spec());
+    ADD_FAILURE() << "gnuplot ran without a PATH to it";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot run gnuplot"), std::string::npos) << e.what();
+  }
+  setenv("PATH", path.c_str(), 1);
+}
+
+// Guards against gnuplot's own errors being swallowed: a file that is not
+// numbers where gnuplot expects a column fails the run with gnuplot's text.
+TEST_F(RobotPlotsTest, GnuplotFailureCarriesItsErrorText) {
+  // Only a header and a row with too few fields: the position columns do not
+  // exist in the data, so gnuplot finds no valid points to autoscale on.
+  std::ofstream(dir_ / "signals.csv") << "time,a,b\n0\n";
+  RobotPlotSpec spec;
+  spec.x_column = "a";
+  spec.y_column = "b";
+  try {
+    WriteRobotPlots(dir_.string(), spec);
+    FAIL() << "gnuplot's failure was not reported";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("gnuplot failed"), std::string::npos) << what;
+    EXPECT_NE(what.find("plots.gp"), std::string::npos) << what;
+  }
+}
+
+}  // namespace
+}  // namespace linesim::plots
