@@ -13,6 +13,7 @@
 #include "cosim/observers.h"
 #include "loader/scenario.h"
 #include "loader/unit_types.h"
+#include "plots/robot_plots.h"
 
 namespace linesim::app {
 
@@ -75,6 +76,35 @@ void WriteAtomically(const fs::path& path, const std::string& text) {
     if (!f) throw std::runtime_error("cannot write " + tmp.string());
   }
   fs::rename(tmp, path);
+}
+
+// What the plots of a robot run draw, by the column names the recorder
+// gives the expanded units' variables.
+plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
+  const loader::RobotInfo& robot = *s.robot;
+  plots::RobotPlotSpec spec;
+  spec.title = s.name;
+  for (const auto& b : robot.belts) {
+    spec.belts.push_back({b.center_x_m, b.center_y_m, b.length_m, b.width_m, b.direction_rad});
+  }
+  spec.path_m = robot.path;
+  spec.x_column = "chassis.pose[0]";
+  spec.y_column = "chassis.pose[1]";
+  spec.yaw_column = "chassis.pose[2]";
+  for (int w = 0; w < robot.wheel_count; ++w) {
+    spec.wheel_columns.emplace_back("chassis.wheel_contact[" + std::to_string(2 * w) + "]",
+                                    "chassis.wheel_contact[" + std::to_string(2 * w + 1) + "]");
+  }
+  spec.error_column = "deviation.deviation";
+  spec.error_label = robot.task == "path" ? "deviation from the path (m)"
+                                          : "drift from the held position (m)";
+  for (std::size_t b = 0; b < robot.belts.size(); ++b) {
+    spec.belt_speed_columns.push_back("belt.speed[" + std::to_string(b) + "]");
+    spec.belt_on_columns.push_back("belt.on[" + std::to_string(b) + "]");
+  }
+  spec.body_length_m = robot.body_length_m;
+  spec.body_width_m = robot.body_width_m;
+  return spec;
 }
 
 }  // namespace
@@ -167,6 +197,20 @@ int RunCommand(const std::string& file, const std::string& out_dir,
                           {"rows", recorder.rows()},
                           {"interval_s", cosim::NsToSeconds(s.record_interval)},
                           {"columns", columns}};
+  // Robot runs are drawn (also a failed one: the plots show how it failed).
+  std::vector<std::string> pictures;
+  if (s.robot && recorder.rows() > 0) {
+    try {
+      for (const auto& p : plots::WriteRobotPlots(dir.string(), PlotSpec(s))) {
+        pictures.push_back(fs::path(p).filename().string());
+      }
+      summary["plots"] = {{"files", pictures}};
+    } catch (const std::exception& e) {
+      // The run itself is fine: say why there are no pictures, do not fail.
+      summary["plots"] = {{"error", e.what()}};
+      std::cerr << "linesim: no plots: " << e.what() << "\n";
+    }
+  }
   try {
     WriteAtomically(dir / "summary.json", summary.dump(2) + "\n");
   } catch (const std::exception& e) {
@@ -186,7 +230,9 @@ int RunCommand(const std::string& file, const std::string& out_dir,
               << std::setprecision(6) << value << "\n";
   }
   std::cout << "  wrote " << (dir / "summary.json").string() << ", " << csv_path.string() << " ("
-            << recorder.rows() << " rows)\n";
+            << recorder.rows() << " rows)";
+  for (const auto& p : pictures) std::cout << ", " << p;
+  std::cout << "\n";
   for (const auto& e : result.errors) std::cerr << "linesim: " << e << "\n";
   return result.ok ? kExitOk : kExitRunFailed;
 }
@@ -208,8 +254,11 @@ int InspectCommand(const std::string& what, const std::vector<std::string>& set_
     const loader::UnitType& type = *loader::FindUnitType(what);
     std::cout << "unit type '" << type.name << "': " << type.description << "\n";
     std::cout << "keys under parameters: that shape the unit:\n";
+    std::size_t key_width = 0;
+    for (const auto& k : type.structural_keys) key_width = std::max(key_width, k.name.size());
     for (const auto& k : type.structural_keys) {
-      std::cout << "  " << std::left << std::setw(8) << k.name << "  " << k.description << "\n";
+      std::cout << "  " << std::left << std::setw(static_cast<int>(key_width)) << k.name << "  "
+                << k.description << "\n";
     }
     std::cout << "variables (with the default keys above):\n";
     PrintTable(*unit, std::cout);

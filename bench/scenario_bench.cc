@@ -1,20 +1,28 @@
 // Real-time factor of whole shipped scenarios: load, build and run through
 // the master as `linesim run` does, without writing files.
+//
+// Counters: rtf = simulated seconds per wall second on this (single) thread;
+// share_<unit> = that unit's share of the wall time (the master's per-unit
+// profile, two clock reads per unit step); the rest is the master itself.
 #include <benchmark/benchmark.h>
 
+#include <map>
 #include <string>
+#include <vector>
 
 #include "cosim/observers.h"
 #include "loader/scenario.h"
 
 namespace {
 
-void BM_Scenario(benchmark::State& state, const std::string& file) {
+void BM_Scenario(benchmark::State& state, const std::string& file,
+                 const std::vector<std::string>& sets) {
   double simulated_s = 0;
-  double unit_share_max = 0;
+  double total_wall_s = 0;
+  std::map<std::string, double> unit_wall_s;
   for (auto _ : state) {
     state.PauseTiming();
-    linesim::loader::Scenario s = linesim::loader::LoadScenario(file);
+    linesim::loader::Scenario s = linesim::loader::LoadScenario(file, sets);
     linesim::cosim::MetricsObserver metrics(s.metrics);
     s.master->AddObserver(&metrics);
     state.ResumeTiming();
@@ -24,17 +32,28 @@ void BM_Scenario(benchmark::State& state, const std::string& file) {
       break;
     }
     simulated_s += linesim::cosim::NsToSeconds(result.end_time);
-    for (double w : s.master->unit_wall_seconds()) {
-      unit_share_max = std::max(unit_share_max, w / s.master->total_wall_seconds());
+    total_wall_s += s.master->total_wall_seconds();
+    for (std::size_t u = 0; u < s.system->unit_count(); ++u) {
+      unit_wall_s[s.system->unit(u).name()] += s.master->unit_wall_seconds()[u];
     }
   }
-  // Simulated seconds per wall second (a rate over the timed loop).
   state.counters["rtf"] = benchmark::Counter(simulated_s, benchmark::Counter::kIsRate);
-  state.counters["top_unit_share"] = unit_share_max;
+  for (const auto& [name, wall_s] : unit_wall_s) {
+    state.counters["share_" + name] = total_wall_s > 0 ? wall_s / total_wall_s : 0.0;
+  }
 }
 
-BENCHMARK_CAPTURE(BM_Scenario, motor_step,
-                  std::string(LINESIM_SOURCE_DIR "/scenarios/motor_step.yaml"))
-    ->Unit(benchmark::kMillisecond);
+#define LINESIM_SCENARIO(name, file, ...)                                                    \
+  BENCHMARK_CAPTURE(BM_Scenario, name, std::string(LINESIM_SOURCE_DIR "/scenarios/" file), \
+                    std::vector<std::string>{__VA_ARGS__})                                 \
+      ->Unit(benchmark::kMillisecond)                                                      \
+      ->MeasureProcessCPUTime()                                                            \
+      ->UseRealTime()
+
+LINESIM_SCENARIO(motor_step, "motor_step.yaml");
+LINESIM_SCENARIO(cross_line, "cross_line.yaml");
+LINESIM_SCENARIO(cross_line_nominal, "cross_line.yaml", "control.compensation=false");
+LINESIM_SCENARIO(hold_on_belt, "hold_on_belt.yaml");
+LINESIM_SCENARIO(hold_straddle, "hold_straddle.yaml");
 
 }  // namespace

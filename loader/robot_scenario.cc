@@ -232,7 +232,7 @@ class Expander {
     p["length"] = List(length);
     p["width"] = List(width);
     p["direction"] = List(direction);
-    p["speed"] = List(speed);
+    p["nominal_speed"] = List(speed);
     p["speed_variation"] = List(variation);
     p["variation_period"] = List(period);
     p["acceleration"] = List(accel);

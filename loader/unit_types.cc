@@ -2,6 +2,7 @@
 
 #include "cosim/closest_names.h"
 #include "units/motors/dc_motor_unit.h"
+#include "units/belt/belt_unit.h"
 #include "units/evaluation/path_deviation.h"
 #include "units/sources/step_signal.h"
 
@@ -95,6 +96,39 @@ std::unique_ptr<cosim::Unit> MakePathDeviation(const UnitBuildContext& c) {
   return std::make_unique<evaluation::PathDeviationUnit>(c.name, ReadPoints(c, "path", 1));
 }
 
+std::unique_ptr<cosim::Unit> MakeBelt(const UnitBuildContext& c) {
+  YamlReader& r = c.reader;
+  const auto count = r.Integer(c.parameters, c.path, "count", 1, 1, 64);
+  std::vector<std::vector<belt::BeltUnit::Switch>> schedules;
+  const YAML::Node list = Child(c.parameters, "schedules");
+  const std::string list_path = JoinPath(c.path, "schedules");
+  if (list.IsDefined() && !list.IsNull() && r.ExpectSequence(list, list_path)) {
+    if (list.size() != static_cast<std::size_t>(count)) {
+      r.Error(list, list_path,
+              "expected one schedule per belt (" + std::to_string(count) + "), got " +
+                  std::to_string(list.size()));
+      return nullptr;
+    }
+    for (std::size_t b = 0; b < list.size(); ++b) {
+      const std::string belt_path = JoinPath(list_path, std::to_string(b));
+      schedules.emplace_back();
+      if (list[b].IsNull() || !r.ExpectSequence(list[b], belt_path)) continue;
+      for (std::size_t i = 0; i < list[b].size(); ++i) {
+        const YAML::Node item = list[b][i];
+        const std::string item_path = JoinPath(belt_path, std::to_string(i));
+        if (!r.ExpectMap(item, item_path)) continue;
+        r.CheckKeys(item, item_path, {"time_s", "on"});
+        // Bounded like duration_s, so that the time fits in int64 nanoseconds.
+        const double t = r.Real(item, item_path, "time_s", std::nullopt, {0.0, 1e7});
+        schedules.back().push_back({cosim::SecondsToNs(t), r.Boolean(item, item_path, "on",
+                                                                     std::nullopt)});
+      }
+    }
+  }
+  return std::make_unique<belt::BeltUnit>(c.name, static_cast<int>(count), std::move(schedules),
+                                          c.seed);
+}
+
 }  // namespace
 
 const std::vector<UnitType>& UnitTypes() {
@@ -116,6 +150,13 @@ const std::vector<UnitType>& UnitTypes() {
         {"steps",
          "list of {time_s, value}: value (one number, or one per channel) from time_s on"}},
        MakeStepSignal},
+      {belt::BeltUnit::kTypeName,
+       "assembly-line belts: on/off schedule, finite acceleration, seeded +-variation of speed",
+       "",
+       {{"count", "number of belts (default 1)"},
+        {"schedules",
+         "one list per belt of {time_s, on}: switching times of the line (default: none)"}},
+       MakeBelt},
       {evaluation::PathDeviationUnit::kTypeName,
        "ground-truth distance of the robot centre from its desired path or held point",
        "",
