@@ -320,7 +320,9 @@ struct Trace {
 // inertia), drive load a quarter of 120 kg at r = 0.08 m, 0.192 kg.m^2
 // (FACTS.md); gear 21 (eta 0.75) and belt 4 (eta 0.9) as
 // models/motors/raw3_{drive,steer}.yaml.
-Trace RunClosedLoop(const std::vector<double>& twist, TimeNs duration) {
+Trace RunClosedLoop(const std::vector<double>& twist, TimeNs duration,
+                    double drive_load_kgm2 = 30.0 * kRadiusM * kRadiusM,
+                    double steer_load_kgm2 = 0.01) {
   cosim::System system;
   auto ctl = std::make_unique<WheelControllerUnit>("ctl");
   Set(*ctl, "twist_command", twist);
@@ -328,12 +330,12 @@ Trace RunClosedLoop(const std::vector<double>& twist, TimeNs duration) {
   auto steer = std::make_unique<motors::DcMotorUnit>("steer", 4, motors::MotorMode::kFull);
   SetAll(*steer, "gear_ratio", 4.0);
   SetAll(*steer, "gear_efficiency", 0.9);
-  SetAll(*steer, "load_inertia", 0.01);
+  SetAll(*steer, "load_inertia", steer_load_kgm2);
   system.Add(std::move(steer));
   auto drive = std::make_unique<motors::DcMotorUnit>("drive", 4, motors::MotorMode::kFull);
   SetAll(*drive, "gear_ratio", 21.0);
   SetAll(*drive, "gear_efficiency", 0.75);
-  SetAll(*drive, "load_inertia", 30.0 * kRadiusM * kRadiusM);
+  SetAll(*drive, "load_inertia", drive_load_kgm2);
   system.Add(std::move(drive));
   system.Add(std::make_unique<AngleIntegrator>(4));
   system.Connect("ctl.steer_voltage", "steer.voltage");
@@ -406,6 +408,33 @@ TEST(WheelControllerUnit, ClosedLoopSteeringReachesFortyFiveDegrees) {
   EXPECT_LE(settle_s, 0.5);
   EXPECT_LE(peak, goal + Deg(2));
   EXPECT_NEAR(tr.steer_angle.back(), goal, Deg(0.2));
+}
+
+// Guards against default gains that only work for the nominal loads: a
+// drive wheel off the ground (a 2 kg wheel alone, 0.5 * 2 * 0.08^2 =
+// 0.0064 kg.m^2, 30 times less than on the floor: its mechanical time
+// constant is shorter than the period) and a light steering module
+// (0.002 kg.m^2) must still converge without sustained oscillation. The
+// acceleration feedforward is then too large, so some overshoot is allowed.
+TEST(WheelControllerUnit, ClosedLoopStaysStableWithLightLoads) {
+  const double goal = 0.5 / kRadiusM;
+  const Trace drive = RunClosedLoop({0.5, 0.0, 0.0}, 1500 * kMs, 0.5 * 2.0 * kRadiusM * kRadiusM);
+  double peak = 0;
+  for (double w : drive.drive_rate) peak = std::max(peak, w);
+  std::cout << "airborne drive wheel: overshoot " << 100 * (peak / goal - 1) << " %\n";
+  EXPECT_LE(peak, 1.2 * goal);
+  for (std::size_t k = drive.time_s.size() - 300; k < drive.time_s.size(); ++k) {
+    EXPECT_NEAR(drive.drive_rate[k], goal, 0.01 * goal) << drive.time_s[k];
+  }
+  const Trace steer = RunClosedLoop({0.1, 0.1, 0.0}, 800 * kMs, 30.0 * kRadiusM * kRadiusM, 0.002);
+  double steer_peak = 0;
+  for (double a : steer.steer_angle) steer_peak = std::max(steer_peak, a);
+  std::cout << "light steering module: overshoot " << (steer_peak - Deg(45)) * 180 / kPi
+            << " deg\n";
+  EXPECT_LE(steer_peak, Deg(45) + Deg(2));
+  for (std::size_t k = steer.time_s.size() - 200; k < steer.time_s.size(); ++k) {
+    EXPECT_NEAR(steer.steer_angle[k], Deg(45), Deg(0.2)) << steer.time_s[k];
+  }
 }
 
 // ---------------------------------------------------------------------------
