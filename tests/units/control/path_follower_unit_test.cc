@@ -1,0 +1,281 @@
+#include "units/control/path_follower_unit.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "cosim/time.h"
+
+namespace linesim::control {
+namespace {
+
+using cosim::TimeNs;
+using Mode = PathFollowerUnit::Mode;
+
+constexpr TimeNs kPeriod = 20'000'000;
+constexpr double kPeriodS = 0.02;
+constexpr double kPi = std::numbers::pi;
+
+void SetPose(PathFollowerUnit& u, double x, double y, double yaw) {
+  u.variables().SetRealArray(*u.variables().Find("pose"), std::vector<double>{x, y, yaw});
+}
+void SetParam(PathFollowerUnit& u, const std::string& name, double v) {
+  u.variables().SetReal(*u.variables().Find(name), v);
+}
+std::vector<double> Twist(const PathFollowerUnit& u) {
+  const auto s = u.variables().GetRealArray(*u.variables().Find("twist_command"));
+  return {s.begin(), s.end()};
+}
+double Real(const PathFollowerUnit& u, const std::string& name) {
+  return u.variables().GetReal(*u.variables().Find(name));
+}
+bool Done(const PathFollowerUnit& u) {
+  return u.variables().GetBoolean(*u.variables().Find("done"));
+}
+
+// An ideal omnidirectional robot: the base_link twist, held over a period,
+// moves the pose exactly (the heading is integrated first; with the yaw
+// rate zero in these tests, the translation is exact).
+struct Robot {
+  double x = 0, y = 0, yaw = 0;
+  void Move(const std::vector<double>& twist, double dt_s) {
+    const double c = std::cos(yaw), s = std::sin(yaw);
+    x += (c * twist[0] - s * twist[1]) * dt_s;
+    y += (s * twist[0] + c * twist[1]) * dt_s;
+    yaw += twist[2] * dt_s;
+  }
+};
+
+// One sample as the master runs it: pose in, outputs read, then DoStep.
+std::vector<double> Sample(PathFollowerUnit& u, const Robot& r, int k) {
+  SetPose(u, r.x, r.y, r.yaw);
+  u.UpdateOutputs();
+  const std::vector<double> twist = Twist(u);
+  EXPECT_EQ(u.DoStep(k * kPeriod, kPeriod), cosim::StepResult::kOk) << u.last_error();
+  return twist;
+}
+
+// Guards against the interface drifting (names, units, feedthrough on pose).
+TEST(PathFollowerUnit, VariableTable) {
+  PathFollowerUnit u("follow", Mode::kPath, {{0, 0}, {1, 0}});
+  EXPECT_EQ(u.type_name(), "path_follower");
+  const auto& v = u.variables();
+  for (const char* p : {"speed", "acceleration", "yaw", "k_cross", "k_position", "k_yaw",
+                        "max_speed", "max_yaw_rate", "goal_tolerance"}) {
+    ASSERT_TRUE(v.Find(p)) << p;
+    EXPECT_EQ(v.info(*v.Find(p)).causality, cosim::Causality::kParameter) << p;
+  }
+  EXPECT_EQ(v.info(*v.Find("pose")).size, 3u);
+  EXPECT_EQ(v.info(*v.Find("pose")).causality, cosim::Causality::kInput);
+  for (const char* o : {"twist_command", "cross_track_error", "progress", "done"}) {
+    const auto& info = v.info(*v.Find(o));
+    EXPECT_EQ(info.causality, cosim::Causality::kOutput) << o;
+    ASSERT_EQ(info.depends_on.size(), 1u) << o;
+    EXPECT_EQ(v.info(info.depends_on[0]).name, "pose") << o;
+  }
+  EXPECT_EQ(v.info(*v.Find("twist_command")).size, 3u);
+  EXPECT_EQ(v.info(*v.Find("twist_command")).unit, "m/s");
+  EXPECT_EQ(v.info(*v.Find("cross_track_error")).unit, "m");
+}
+
+// Guards against a wrong sign or frame of the cross-track correction. On a
+// path along +x, a robot 0.1 m to the left (+y) must be sent right at
+// k_cross * 0.1 m/s in map; with the robot turned to +90 deg that map
+// velocity (0, -0.1) is (-0.1, 0) in base_link (rotation by -yaw). The
+// speed ramp starts at 0, so the along-track part is 0 at the first sample.
+TEST(PathFollowerUnit, CrossTrackCommandIsMinusGainTimesOffsetInBaseLink) {
+  for (const double yaw : {0.0, kPi / 2}) {
+    PathFollowerUnit u("follow", Mode::kPath, {{0, 0}, {10, 0}});
+    SetParam(u, "k_cross", 1.5);
+    SetParam(u, "yaw", yaw);
+    SetPose(u, 2.0, 0.1, yaw);
+    u.Initialize();
+    EXPECT_NEAR(Real(u, "cross_track_error"), 0.1, 1e-15);
+    EXPECT_NEAR(Real(u, "progress"), 2.0, 1e-15);
+    const auto t = Twist(u);
+    const double vx_map = 0.0, vy_map = -1.5 * 0.1;
+    EXPECT_NEAR(t[0], std::cos(yaw) * vx_map + std::sin(yaw) * vy_map, 1e-15);
+    EXPECT_NEAR(t[1], -std::sin(yaw) * vx_map + std::cos(yaw) * vy_map, 1e-15);
+    EXPECT_EQ(t[2], 0.0);
+  }
+  // Right of the path: negative error, sent left.
+  PathFollowerUnit u("follow", Mode::kPath, {{0, 0}, {10, 0}});
+  SetPose(u, 2.0, -0.2, 0.0);
+  u.Initialize();
+  EXPECT_NEAR(Real(u, "cross_track_error"), -0.2, 1e-15);
+  EXPECT_NEAR(Twist(u)[1], 0.2, 1e-15);  // k_cross 1
+}
+
+// Guards against a yaw command of the wrong sign or one that goes the long
+// way round across +-pi: k_yaw * wrap(yaw_ref - yaw), clamped.
+TEST(PathFollowerUnit, YawRateSignAndWrap) {
+  PathFollowerUnit u("hold", Mode::kHold, {{0, 0}});
+  SetParam(u, "k_yaw", 2.0);
+  SetParam(u, "max_yaw_rate", 10.0);
+  SetParam(u, "yaw", 0.3);
+  SetPose(u, 0, 0, 0.1);
+  u.Initialize();
+  EXPECT_NEAR(Twist(u)[2], 2.0 * 0.2, 1e-15);  // counter-clockwise
+  SetParam(u, "yaw", -3.0);
+  SetPose(u, 0, 0, 3.0);  // 2 pi - 6 = 0.283 rad counter-clockwise
+  u.UpdateOutputs();
+  EXPECT_NEAR(Twist(u)[2], 2.0 * (2 * kPi - 6.0), 1e-12);
+  SetParam(u, "max_yaw_rate", 0.5);
+  SetPose(u, 0, 0, 0.0);
+  SetParam(u, "yaw", -1.0);
+  u.UpdateOutputs();
+  EXPECT_EQ(Twist(u)[2], -0.5);
+}
+
+// Guards against a follower that does not stop at the goal, overshoots it,
+// or exceeds its speed and acceleration. Ideal robot, 2 m straight path
+// along a diagonal, 0.3 m/s cruise, 0.3 m/s^2: the along-track speed grows
+// by at most 0.3 * 0.02 m/s per sample, never exceeds 0.3 m/s, and the
+// robot stops within goal_tolerance with done set and the command zero.
+TEST(PathFollowerUnit, FollowsPathAndStopsAtTheGoal) {
+  const double c = std::cos(0.5), s = std::sin(0.5);
+  PathFollowerUnit u("follow", Mode::kPath, {{1, 1}, {1 + 2 * c, 1 + 2 * s}});
+  EXPECT_NEAR(u.length_m(), 2.0, 1e-15);
+  Robot r{1.0, 1.05, 0.0};
+  SetPose(u, r.x, r.y, r.yaw);
+  u.Initialize();
+  double last_speed = 0, max_progress = -1;
+  int k = 0;
+  for (; k < 1000 && !Done(u); ++k) {
+    const auto twist = Sample(u, r, k);
+    const double speed = std::hypot(twist[0], twist[1]);
+    EXPECT_LE(speed, 0.5 + 1e-12);  // max_speed
+    // Along-track part, from the map direction of the path.
+    const double along = twist[0] * c + twist[1] * s;
+    EXPECT_LE(along, 0.3 + 1e-12);
+    EXPECT_LE(along - last_speed, 0.3 * kPeriodS + 1e-12) << k;
+    last_speed = along;
+    max_progress = std::max(max_progress, Real(u, "progress"));
+    r.Move(twist, kPeriodS);
+  }
+  ASSERT_TRUE(Done(u)) << "not done after " << k << " samples";
+  EXPECT_LE(std::hypot(r.x - (1 + 2 * c), r.y - (1 + 2 * s)), 0.02);
+  EXPECT_LE(max_progress, 2.0 + 1e-9);  // never past the goal
+  // Minimum time: ramp 1 s (0.15 m) each way and 1.7 m at 0.3 m/s = 7.7 s;
+  // the k_position tail adds some. A follower that crawls fails this.
+  EXPECT_LT(k * kPeriodS, 10.0);
+  // Once done, the command is zero and stays zero.
+  for (int j = 0; j < 5; ++j) {
+    const auto twist = Sample(u, r, k + j);
+    EXPECT_EQ(twist, (std::vector<double>{0, 0, 0}));
+    EXPECT_TRUE(Done(u));
+  }
+}
+
+// Guards against wrong corner handling: on an L path the progress is the
+// arc length of the nearest point (1 m leg, then along the second leg).
+TEST(PathFollowerUnit, ProgressAlongAPolyline) {
+  PathFollowerUnit u("follow", Mode::kPath, {{0, 0}, {1, 0}, {1, 2}});
+  SetPose(u, 1.1, 0.5, 0.0);
+  u.Initialize();
+  EXPECT_NEAR(Real(u, "progress"), 1.5, 1e-15);
+  EXPECT_NEAR(Real(u, "cross_track_error"), -0.1, 1e-15);  // right of +y
+  EXPECT_NEAR(u.length_m(), 3.0, 1e-15);
+}
+
+// Guards against a hold controller of the wrong sign or gain. With an ideal
+// robot and the command held over each period, the offset decays exactly
+// geometrically: e_{n+1} = (1 - k T) e_n (analytic, while below max_speed).
+TEST(PathFollowerUnit, HoldReturnsToThePointGeometrically) {
+  PathFollowerUnit u("hold", Mode::kHold, {{2.0, -1.0}});
+  SetParam(u, "k_position", 2.0);
+  Robot r{2.1, -1.05, 0.7};
+  SetParam(u, "yaw", 0.7);
+  SetPose(u, r.x, r.y, r.yaw);
+  u.Initialize();
+  const double e0 = std::hypot(0.1, 0.05);
+  EXPECT_NEAR(Real(u, "cross_track_error"), e0, 1e-15);
+  EXPECT_FALSE(Done(u));
+  for (int k = 0; k < 50; ++k) {
+    Sample(u, r, k);
+    r.Move(Twist(u), kPeriodS);
+  }
+  const double expected = e0 * std::pow(1.0 - 2.0 * kPeriodS, 50);
+  EXPECT_NEAR(std::hypot(r.x - 2.0, r.y + 1.0), expected, 1e-12);
+  SetPose(u, r.x, r.y, r.yaw);
+  u.UpdateOutputs();
+  EXPECT_TRUE(Done(u));  // 0.112 * 0.96^50 = 0.015 m < 0.02 m
+}
+
+// Guards against a restored unit drifting from the original (ramp or done
+// missing from the save).
+TEST(PathFollowerUnit, SaveStepRestoreStepIsBitForBit) {
+  const auto run = [](PathFollowerUnit& u, Robot r, int from, int to) {
+    std::vector<double> out;
+    for (int k = from; k < to; ++k) {
+      const auto twist = Sample(u, r, k);
+      out.insert(out.end(), twist.begin(), twist.end());
+      out.push_back(Real(u, "progress"));
+      r.Move(twist, kPeriodS);
+    }
+    return out;
+  };
+  PathFollowerUnit u("follow", Mode::kPath, {{0, 0}, {0.5, 0}, {0.5, 0.5}});
+  Robot r{0, 0.02, 0.1};
+  SetPose(u, r.x, r.y, r.yaw);
+  u.Initialize();
+  for (int k = 0; k < 20; ++k) r.Move(Sample(u, r, k), kPeriodS);
+  const cosim::UnitState saved = u.SaveState();
+  const auto first = run(u, r, 20, 200);
+  u.RestoreState(saved);
+  const auto second = run(u, r, 20, 200);
+  PathFollowerUnit fresh("follow", Mode::kPath, {{0, 0}, {0.5, 0}, {0.5, 0.5}});
+  fresh.RestoreState(saved);
+  const auto third = run(fresh, r, 20, 200);
+  ASSERT_EQ(first.size(), second.size());
+  EXPECT_EQ(std::memcmp(first.data(), second.data(), first.size() * sizeof(double)), 0);
+  EXPECT_EQ(std::memcmp(first.data(), third.data(), first.size() * sizeof(double)), 0);
+}
+
+// Guards against paths that cannot be followed and gains that would
+// divide by zero or run away being accepted before time zero.
+TEST(PathFollowerUnit, CheckParametersRejectsBadValues) {
+  PathFollowerUnit ok("ok", Mode::kPath, {{0, 0}, {1, 0}});
+  EXPECT_TRUE(ok.CheckParameters().empty());
+  PathFollowerUnit one("one", Mode::kPath, {{0, 0}});
+  ASSERT_EQ(one.CheckParameters().size(), 1u);
+  EXPECT_EQ(one.CheckParameters()[0].variable, "waypoints");
+  EXPECT_THROW(one.Initialize(), cosim::UnitError);
+  PathFollowerUnit repeat("repeat", Mode::kPath, {{0, 0}, {1, 0}, {1, 0}});
+  ASSERT_EQ(repeat.CheckParameters().size(), 1u);
+  EXPECT_EQ(repeat.CheckParameters()[0].index, 2u);
+  PathFollowerUnit none("none", Mode::kHold, {});
+  EXPECT_EQ(none.CheckParameters().size(), 1u);
+  PathFollowerUnit bad("bad", Mode::kHold, {{0, 0}});
+  SetParam(bad, "speed", 0.0);
+  SetParam(bad, "k_cross", -1.0);
+  SetParam(bad, "goal_tolerance", NAN);
+  const auto problems = bad.CheckParameters();
+  ASSERT_EQ(problems.size(), 3u);
+  EXPECT_EQ(problems[0].variable, "speed");
+  EXPECT_EQ(problems[1].variable, "k_cross");
+  EXPECT_EQ(problems[2].variable, "goal_tolerance");
+  try {
+    bad.Initialize();
+    FAIL() << "bad parameters accepted";
+  } catch (const cosim::UnitError& e) {
+    EXPECT_NE(std::string(e.what()).find("unit 'bad'"), std::string::npos) << e.what();
+  }
+}
+
+// Guards against a NaN pose (a lost estimator) turning into a command.
+TEST(PathFollowerUnit, NonFinitePoseFailsTheStep) {
+  PathFollowerUnit u("hold", Mode::kHold, {{0, 0}});
+  u.Initialize();
+  SetPose(u, 0, NAN, 0);
+  EXPECT_EQ(u.DoStep(0, kPeriod), cosim::StepResult::kError);
+  EXPECT_NE(u.last_error().find("pose[1]"), std::string::npos) << u.last_error();
+}
+
+}  // namespace
+}  // namespace linesim::control

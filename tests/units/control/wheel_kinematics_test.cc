@@ -1,0 +1,180 @@
+#include "units/control/wheel_kinematics.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+namespace linesim::control {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kRadiusM = 0.08;  // Rob@Work 3 wheel (FACTS.md)
+
+double Deg(double d) { return d * kPi / 180.0; }
+
+// Rob@Work 3 steering axes W1..W4 (FACTS.md, raw3-1 Platform.ini).
+const std::array<Eigen::Vector2d, 4> kWheels = {
+    Eigen::Vector2d(0.368, 0.186), Eigen::Vector2d(-0.368, 0.134), Eigen::Vector2d(-0.368, -0.186),
+    Eigen::Vector2d(0.368, -0.134)};
+
+// Guards against a wrap that leaves -pi (two names for one heading) or
+// drifts multiples of 2 pi. Definition: result in (-pi, pi], same angle.
+TEST(WrapAngle, MapsIntoHalfOpenInterval) {
+  EXPECT_EQ(WrapAngle(kPi), kPi);
+  EXPECT_EQ(WrapAngle(-kPi), kPi);
+  EXPECT_NEAR(WrapAngle(3 * kPi), kPi, 1e-15);
+  EXPECT_NEAR(WrapAngle(Deg(190)), Deg(-170), 1e-15);
+  EXPECT_NEAR(WrapAngle(Deg(-190)), Deg(170), 1e-15);
+  EXPECT_NEAR(WrapAngle(Deg(725)), Deg(5), 1e-14);
+  EXPECT_EQ(WrapAngle(0.25), 0.25);
+}
+
+// Guards against wrong signs in Eq. 1 (paper 1): a pure translation moves
+// every contact alike.
+TEST(WheelVelocity, PureTranslationIsTheSameForAllWheels) {
+  const Eigen::Vector3d twist(0.3, -0.2, 0.0);
+  for (const auto& p : kWheels) {
+    const Eigen::Vector2d v = WheelVelocity(twist, p);
+    EXPECT_EQ(v[0], 0.3);
+    EXPECT_EQ(v[1], -0.2);
+  }
+}
+
+// Guards against wrong signs in Eq. 1: a pure rotation (counter-clockwise,
+// phidot > 0) moves each contact at phidot * |p| perpendicular to p, turned
+// +90 deg from p (rigid body: v = omega z x p).
+TEST(WheelVelocity, PureRotationIsTangentialWithSpeedProportionalToDistance) {
+  const double phidot = 0.7;
+  for (const auto& p : kWheels) {
+    const Eigen::Vector2d v = WheelVelocity({0.0, 0.0, phidot}, p);
+    EXPECT_NEAR(v.norm(), phidot * p.norm(), 1e-15);
+    EXPECT_NEAR(v.dot(p), 0.0, 1e-15);
+    EXPECT_NEAR(v[0], -phidot * p[1], 1e-15);
+    EXPECT_NEAR(v[1], phidot * p[0], 1e-15);
+  }
+}
+
+// Guards against a wrong sign or frame in Algorithm 1: the wheel must move
+// relative to its floor, so a floor moving at +0.2 m/s under a robot that
+// stands still needs -0.2 m/s from the wheel.
+TEST(CompensateSurface, SubtractsTheSurfaceVelocity) {
+  const Eigen::Vector2d v = CompensateSurface({0.1, 0.05}, {0.2, -0.1});
+  EXPECT_NEAR(v[0], -0.1, 1e-16);
+  EXPECT_NEAR(v[1], 0.15, 1e-16);
+}
+
+// Guards against the flip rule turning a wheel 180 deg for a command behind
+// it instead of reversing the drive (FACTS.md, IPA controller).
+TEST(ToWheelSetpoint, CommandBehindTheWheelReversesTheDrive) {
+  const WheelSetpoint s = ToWheelSetpoint({-0.4, 0.0}, kRadiusM, 0.0, 0.0, 1e-3);
+  EXPECT_NEAR(s.steer_angle_rad, 0.0, 1e-15);
+  EXPECT_NEAR(s.drive_rate_rad_s, -0.4 / kRadiusM, 1e-12);
+  // Ahead: forward at |v| / R on the heading atan2(v_y, v_x).
+  const WheelSetpoint f = ToWheelSetpoint({0.3, 0.3}, kRadiusM, 0.0, 0.0, 1e-3);
+  EXPECT_NEAR(f.steer_angle_rad, Deg(45), 1e-15);
+  EXPECT_NEAR(f.drive_rate_rad_s, std::sqrt(0.18) / kRadiusM, 1e-12);
+}
+
+// Guards the invariant of the flip rule: a wheel that sits at its last
+// target never gets a new heading more than 90 deg away, and the set point
+// always reproduces the commanded contact velocity. Random commands and
+// headings; the numbers are the rule's definition.
+TEST(ToWheelSetpoint, NeverMoreThanNinetyDegreesAndReproducesTheVelocity) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> angle(-kPi, kPi), speed(-1.0, 1.0);
+  for (int k = 0; k < 2000; ++k) {
+    const double now = angle(rng);
+    const Eigen::Vector2d v(speed(rng), speed(rng));
+    if (v.norm() < 1e-3) continue;
+    const WheelSetpoint s = ToWheelSetpoint(v, kRadiusM, now, now, 1e-3);
+    EXPECT_LE(std::abs(WrapAngle(s.steer_angle_rad - now)), kPi / 2 + 1e-12);
+    EXPECT_GT(s.steer_angle_rad, -kPi);
+    EXPECT_LE(s.steer_angle_rad, kPi);
+    const double rim = s.drive_rate_rad_s * kRadiusM;
+    EXPECT_NEAR(rim * std::cos(s.steer_angle_rad), v[0], 1e-12);
+    EXPECT_NEAR(rim * std::sin(s.steer_angle_rad), v[1], 1e-12);
+  }
+}
+
+// Guards against a wheel pointing somewhere random when the command is
+// (nearly) zero and atan2 is meaningless: it keeps its last target, stops.
+TEST(ToWheelSetpoint, ZeroCommandHoldsTheLastTargetAngle) {
+  const double last = Deg(30);
+  for (const Eigen::Vector2d& v : {Eigen::Vector2d(0, 0), Eigen::Vector2d(-5e-4, 5e-4)}) {
+    const WheelSetpoint s = ToWheelSetpoint(v, kRadiusM, Deg(28), last, 1e-3);
+    EXPECT_EQ(s.steer_angle_rad, last);
+    EXPECT_EQ(s.drive_rate_rad_s, 0.0);
+  }
+  // Just above the threshold the heading follows the command again.
+  const WheelSetpoint s = ToWheelSetpoint({0.0, 2e-3}, kRadiusM, 0.0, 0.0, 1e-3);
+  EXPECT_NEAR(s.steer_angle_rad, Deg(90), 1e-15);
+}
+
+// Guards against flip-flop near 90 deg. Cost 0.6 |a - now| + 0.4 |a - last|:
+// - a wheel at 0 (now = last = 0) commanded to 91 deg: forward costs
+//   91 deg, reverse (-89 deg) costs 89: it reverses;
+// - a wheel that chose 89 deg forward and lags at 80 deg, commanded to
+//   91 deg: forward costs 0.6*11 + 0.4*2 = 7.4 deg, reverse (-89) costs
+//   0.6*169 + 0.4*178 = 172.6 deg: it keeps going forward, no flip.
+TEST(ToWheelSetpoint, HysteresisNearNinetyDegrees) {
+  const Eigen::Vector2d at91(std::cos(Deg(91)), std::sin(Deg(91)));
+  const WheelSetpoint fresh = ToWheelSetpoint(0.2 * at91, kRadiusM, 0.0, 0.0, 1e-3);
+  EXPECT_NEAR(fresh.steer_angle_rad, Deg(-89), 1e-12);
+  EXPECT_LT(fresh.drive_rate_rad_s, 0.0);
+  const WheelSetpoint lagging = ToWheelSetpoint(0.2 * at91, kRadiusM, Deg(80), Deg(89), 1e-3);
+  EXPECT_NEAR(lagging.steer_angle_rad, Deg(91), 1e-12);
+  EXPECT_GT(lagging.drive_rate_rad_s, 0.0);
+  // The mirror case, across the +-180 deg seam: last target -179 deg
+  // (forward), command at 179 deg: 2 deg away forward, no reversal.
+  const Eigen::Vector2d at179(std::cos(Deg(179)), std::sin(Deg(179)));
+  const WheelSetpoint seam = ToWheelSetpoint(0.2 * at179, kRadiusM, Deg(-179), Deg(-179), 1e-3);
+  EXPECT_NEAR(seam.steer_angle_rad, Deg(179), 1e-12);
+  EXPECT_GT(seam.drive_rate_rad_s, 0.0);
+}
+
+// Guards against Algorithm 1 acting on the wrong wheels or with the wrong
+// sign (brief): standstill command, floor at (0.2, 0) m/s under W1 and W2
+// only: those wheels roll at -0.2 m/s relative to it (heading kept at 0,
+// drive reversed), the others stay at zero.
+TEST(ToWheelSetpoint, AlgorithmOneOnlyMovesTheWheelsOnTheBelt) {
+  const std::array<Eigen::Vector2d, 4> surface = {Eigen::Vector2d(0.2, 0), Eigen::Vector2d(0.2, 0),
+                                                  Eigen::Vector2d(0, 0), Eigen::Vector2d(0, 0)};
+  for (std::size_t i = 0; i < 4; ++i) {
+    const Eigen::Vector2d v = CompensateSurface(WheelVelocity({0, 0, 0}, kWheels[i]), surface[i]);
+    const WheelSetpoint s = ToWheelSetpoint(v, kRadiusM, 0.0, 0.0, 1e-3);
+    EXPECT_NEAR(s.steer_angle_rad, 0.0, 1e-15);
+    EXPECT_NEAR(s.drive_rate_rad_s * kRadiusM, i < 2 ? -0.2 : 0.0, 1e-15) << "wheel " << i;
+  }
+}
+
+// Guards against Eq. 1 and its least-squares inverse disagreeing (odometry
+// would drift): random twists through Eq. 1 and the flip rule (from random
+// headings, so that some wheels reverse) come back to 1e-12.
+TEST(BodyTwist, RoundTripThroughEquationOneAndFlipRule) {
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> lin(-1.0, 1.0), yaw(-2.0, 2.0), angle(-kPi, kPi);
+  for (int k = 0; k < 200; ++k) {
+    const Eigen::Vector3d twist(lin(rng), lin(rng), yaw(rng));
+    std::vector<WheelSetpoint> wheels;
+    for (const auto& p : kWheels) {
+      const double now = angle(rng);
+      wheels.push_back(ToWheelSetpoint(WheelVelocity(twist, p), kRadiusM, now, now, 0.0));
+    }
+    const Eigen::Vector3d back = BodyTwist(kWheels, wheels, kRadiusM);
+    EXPECT_LT((back - twist).norm(), 1e-12) << twist.transpose() << " vs " << back.transpose();
+  }
+}
+
+// Guards against an unusable call being accepted silently.
+TEST(BodyTwist, RejectsMismatchedSizes) {
+  const std::vector<WheelSetpoint> one(1);
+  EXPECT_THROW(BodyTwist(kWheels, one, kRadiusM), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace linesim::control

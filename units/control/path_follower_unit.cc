@@ -1,0 +1,226 @@
+#include "units/control/path_follower_unit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "units/control/wheel_kinematics.h"
+
+namespace linesim::control {
+
+namespace {
+
+std::string FormatNumber(double x) { return cosim::FormatValue(cosim::Value{x}); }
+
+}  // namespace
+
+PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
+                                   std::vector<std::array<double, 2>> waypoints_m)
+    : cosim::Unit(kTypeName, std::move(name)),
+      mode_(mode),
+      waypoints_m_(std::move(waypoints_m)),
+      pose_(3, 0.0),
+      twist_command_(3, 0.0) {
+  if (mode_ == Mode::kPath) {
+    cumulative_m_.push_back(0.0);
+    for (std::size_t k = 1; k < waypoints_m_.size(); ++k) {
+      const double dx = waypoints_m_[k][0] - waypoints_m_[k - 1][0];
+      const double dy = waypoints_m_[k][1] - waypoints_m_[k - 1][1];
+      cumulative_m_.push_back(cumulative_m_.back() + std::hypot(dx, dy));
+    }
+  }
+  auto& v = variables();
+  v.Parameter("speed", "m/s", &speed_, "cruise speed along the path");
+  v.Parameter("acceleration", "m/s2", &acceleration_,
+              "along-path ramp up from the start and down before the goal");
+  v.Parameter("yaw", "rad", &yaw_, "heading to hold in map while translating");
+  v.Parameter("k_cross", "1/s", &k_cross_, "cross-track gain");
+  v.Parameter("k_position", "1/s", &k_position_,
+              "position gain: along-track near the goal, and in hold mode");
+  v.Parameter("k_yaw", "1/s", &k_yaw_, "heading gain");
+  v.Parameter("max_speed", "m/s", &max_speed_, "limit on the commanded translation speed");
+  v.Parameter("max_yaw_rate", "rad/s", &max_yaw_rate_, "limit on the commanded yaw rate");
+  v.Parameter("goal_tolerance", "m", &goal_tolerance_,
+              "distance from the goal (hold: the point) counted as arrived");
+  v.Input("pose", "m", &pose_, "robot pose in map: x (m), y (m), yaw (rad)");
+  v.Output("twist_command", "m/s", &twist_command_,
+           "body twist command in base_link: vx (m/s), vy (m/s), yaw rate (rad/s)", {"pose"});
+  v.Output("cross_track_error", "m", &cross_track_error_,
+           "signed distance from the path, + left of it; hold: distance from the point", {"pose"});
+  v.Output("progress", "m", &progress_, "arc length of the nearest path point (hold: 0)", {"pose"});
+  v.Output("done", &done_, "path: the goal was reached (latched); hold: within tolerance",
+           {"pose"});
+}
+
+std::string PathFollowerUnit::Where() const { return "unit '" + name() + "' (" + kTypeName + ")"; }
+
+std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
+  std::vector<cosim::ParameterProblem> problems;
+  const std::size_t needed = mode_ == Mode::kPath ? 2 : 1;
+  if (waypoints_m_.size() < needed) {
+    problems.push_back({"waypoints", std::nullopt,
+                        std::string(mode_ == Mode::kPath ? "a path" : "hold") + " needs at least " +
+                            std::to_string(needed) + " waypoint(s), got " +
+                            std::to_string(waypoints_m_.size())});
+  }
+  for (std::size_t k = 0; k < waypoints_m_.size(); ++k) {
+    if (!std::isfinite(waypoints_m_[k][0]) || !std::isfinite(waypoints_m_[k][1])) {
+      problems.push_back({"waypoints", k,
+                          "must be finite, got (" + FormatNumber(waypoints_m_[k][0]) + ", " +
+                              FormatNumber(waypoints_m_[k][1]) + ")"});
+    } else if (mode_ == Mode::kPath && k > 0 && !(cumulative_m_[k] > cumulative_m_[k - 1])) {
+      problems.push_back({"waypoints", k, "repeats the previous waypoint (zero-length segment)"});
+    }
+  }
+  const auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
+  const auto non_negative = [](double x) { return x >= 0.0 && std::isfinite(x); };
+  const auto rule = [&](const char* var, double value, auto ok, const char* expected) {
+    if (!ok(value)) {
+      problems.push_back(
+          {var, std::nullopt, std::string(expected) + ", got " + FormatNumber(value)});
+    }
+  };
+  constexpr const char* kPositive = "must be positive and finite";
+  constexpr const char* kNonNegative = "must be zero or positive and finite";
+  rule("speed", speed_, positive, kPositive);
+  rule("acceleration", acceleration_, positive, kPositive);
+  rule(
+      "yaw", yaw_, [](double x) { return std::isfinite(x); }, "must be finite");
+  rule("k_cross", k_cross_, non_negative, kNonNegative);
+  rule("k_position", k_position_, positive, kPositive);
+  rule("k_yaw", k_yaw_, non_negative, kNonNegative);
+  rule("max_speed", max_speed_, positive, kPositive);
+  rule("max_yaw_rate", max_yaw_rate_, non_negative, kNonNegative);
+  rule("goal_tolerance", goal_tolerance_, positive, kPositive);
+  return problems;
+}
+
+void PathFollowerUnit::Validate() const {
+  const auto problems = CheckParameters();
+  if (problems.empty()) return;
+  std::string text = Where() + ": ";
+  for (std::size_t p = 0; p < problems.size(); ++p) {
+    const auto& problem = problems[p];
+    if (p > 0) text += "; ";
+    text += "parameter '" + problem.variable +
+            (problem.index ? "[" + std::to_string(*problem.index) + "]" : "") + "' " +
+            problem.message;
+  }
+  throw cosim::UnitError(text);
+}
+
+void PathFollowerUnit::Initialize() {
+  Validate();
+  ramp_mps_ = 0.0;
+  done_latched_ = false;
+  initialized_ = true;
+  ComputeOutputs();
+}
+
+PathFollowerUnit::Sample PathFollowerUnit::Evaluate() const {
+  Sample s;
+  const double x = pose_[0], y = pose_[1];
+  if (mode_ == Mode::kHold) {
+    const double ex = x - waypoints_m_[0][0], ey = y - waypoints_m_[0][1];
+    s.vx_map_mps = -k_position_ * ex;
+    s.vy_map_mps = -k_position_ * ey;
+    s.cross_track_m = std::hypot(ex, ey);
+    s.at_goal = s.cross_track_m <= goal_tolerance_;
+  } else {
+    // Nearest point over all segments (the first on a tie); the first and
+    // last segments extend beyond the ends, so that progress runs below 0
+    // before the start and past the length after the goal.
+    const std::size_t segments = waypoints_m_.size() - 1;
+    double best_dist2 = INFINITY;
+    for (std::size_t k = 0; k < segments; ++k) {
+      const auto& a = waypoints_m_[k];
+      const double len = cumulative_m_[k + 1] - cumulative_m_[k];
+      const double tx = (waypoints_m_[k + 1][0] - a[0]) / len;
+      const double ty = (waypoints_m_[k + 1][1] - a[1]) / len;
+      const double along = (x - a[0]) * tx + (y - a[1]) * ty;
+      const double lo = k == 0 ? -INFINITY : 0.0;
+      const double hi = k + 1 == segments ? INFINITY : len;
+      const double u = std::clamp(along, lo, hi);
+      const double cross = -(x - a[0]) * ty + (y - a[1]) * tx;
+      const double dist2 = (along - u) * (along - u) + cross * cross;
+      if (dist2 < best_dist2) {
+        best_dist2 = dist2;
+        s.progress_m = cumulative_m_[k] + u;
+        s.cross_track_m = cross;
+        const double remaining = length_m() - s.progress_m;
+        const double magnitude =
+            std::min({ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * std::abs(remaining)),
+                      k_position_ * std::abs(remaining)});
+        s.along_mps = std::copysign(magnitude, remaining);
+        s.vx_map_mps = tx * s.along_mps + ty * k_cross_ * cross;
+        s.vy_map_mps = ty * s.along_mps - tx * k_cross_ * cross;
+      }
+    }
+    const auto& goal = waypoints_m_.back();
+    s.at_goal = done_latched_ || std::hypot(x - goal[0], y - goal[1]) <= goal_tolerance_;
+    if (s.at_goal) {
+      s.vx_map_mps = s.vy_map_mps = s.along_mps = 0.0;
+    }
+  }
+  const double speed = std::hypot(s.vx_map_mps, s.vy_map_mps);
+  if (speed > max_speed_) {
+    s.vx_map_mps *= max_speed_ / speed;
+    s.vy_map_mps *= max_speed_ / speed;
+  }
+  if (!(mode_ == Mode::kPath && s.at_goal)) {
+    s.yaw_rate_rad_s =
+        std::clamp(k_yaw_ * WrapAngle(yaw_ - pose_[2]), -max_yaw_rate_, max_yaw_rate_);
+  }
+  return s;
+}
+
+void PathFollowerUnit::ComputeOutputs() {
+  const Sample s = Evaluate();
+  const double c = std::cos(pose_[2]), sn = std::sin(pose_[2]);
+  twist_command_[0] = c * s.vx_map_mps + sn * s.vy_map_mps;
+  twist_command_[1] = -sn * s.vx_map_mps + c * s.vy_map_mps;
+  twist_command_[2] = s.yaw_rate_rad_s;
+  cross_track_error_ = s.cross_track_m;
+  progress_ = s.progress_m;
+  done_ = s.at_goal;
+}
+
+cosim::StepResult PathFollowerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
+  ClearError();
+  if (!initialized_) return Fail(Where() + ": DoStep called before Initialize");
+  if (dt <= 0) {
+    return Fail(Where() + ": step size must be positive, got " + cosim::FormatSeconds(dt) +
+                " s at t = " + cosim::FormatSeconds(t) + " s");
+  }
+  for (std::size_t k = 0; k < pose_.size(); ++k) {
+    if (!std::isfinite(pose_[k])) {
+      return Fail(Where() + ": input 'pose[" + std::to_string(k) + "]' is " +
+                  FormatNumber(pose_[k]) + " at t = " + cosim::FormatSeconds(t) + " s");
+    }
+  }
+  const Sample s = Evaluate();
+  // The ramp continues from the speed actually commanded, so that it also
+  // restarts gently after a slow-down.
+  ramp_mps_ = std::min(speed_, std::abs(s.along_mps) + acceleration_ * cosim::NsToSeconds(dt));
+  if (mode_ == Mode::kPath && s.at_goal) done_latched_ = true;
+  ComputeOutputs();
+  return cosim::StepResult::kOk;
+}
+
+void PathFollowerUnit::SaveInternal(cosim::UnitState& state) const {
+  state.reals = {ramp_mps_};
+  state.integers = {done_latched_ ? 1 : 0, initialized_ ? 1 : 0};
+}
+
+void PathFollowerUnit::RestoreInternal(const cosim::UnitState& state) {
+  if (state.reals.size() != 1 || state.integers.size() != 2) {
+    throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
+                           " reals and " + std::to_string(state.integers.size()) +
+                           " integers, expected 1 and 2");
+  }
+  ramp_mps_ = state.reals[0];
+  done_latched_ = state.integers[0] != 0;
+  initialized_ = state.integers[1] != 0;
+}
+
+}  // namespace linesim::control

@@ -1,0 +1,100 @@
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "cosim/time.h"
+#include "cosim/unit.h"
+
+namespace linesim::control {
+
+/// Turns a pose (map frame) into a body twist command for an omnidirectional
+/// robot, as a sampled-data controller (run it at the wheel controller's
+/// rate). The robot keeps the heading `yaw` while it translates.
+///
+/// kPath follows the polyline of the waypoints: map-frame velocity
+///   t * v_along(s) + n * (-k_cross e),
+/// with t the unit tangent of the nearest segment, n its left normal, e the
+/// signed cross-track error (+ left of the path) and s the progress. v_along
+/// ramps up at `acceleration` from the start (a committed state), stays at
+/// `speed`, and comes down as min(sqrt(2 a d), k_position d) with d the
+/// distance left along the path (signed: past the goal it backs up). When
+/// the robot is within goal_tolerance of the last waypoint, done latches and
+/// the command is zero from then on.
+///
+/// kHold holds the first waypoint: velocity -k_position (p - p_ref); done
+/// says whether it is within goal_tolerance (it never latches).
+///
+/// In both modes the velocity is clamped to max_speed, the yaw rate is
+/// k_yaw wrap(yaw - yaw_measured) clamped to max_yaw_rate, and the
+/// velocity is rotated into base_link by -yaw_measured.
+class PathFollowerUnit : public cosim::Unit {
+ public:
+  static constexpr const char* kTypeName = "path_follower";
+
+  enum class Mode { kPath, kHold };
+
+  /// kPath needs at least two waypoints without zero-length segments, kHold
+  /// at least one (extra ones are ignored); CheckParameters reports them.
+  PathFollowerUnit(std::string name, Mode mode, std::vector<std::array<double, 2>> waypoints_m);
+
+  std::vector<cosim::ParameterProblem> CheckParameters() const override;
+  /// Validates (throws cosim::UnitError listing every problem), resets the
+  /// speed ramp and done, and computes the outputs. Idempotent.
+  void Initialize() override;
+  /// The outputs for the current pose; the state is not changed.
+  void UpdateOutputs() override { ComputeOutputs(); }
+  /// Commits the sample taken at t (speed ramp, done) and recomputes.
+  cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
+
+  Mode mode() const { return mode_; }
+  /// Length of the path (0 in hold mode).
+  double length_m() const { return cumulative_m_.empty() ? 0.0 : cumulative_m_.back(); }
+
+ protected:
+  void SaveInternal(cosim::UnitState& state) const override;
+  void RestoreInternal(const cosim::UnitState& state) override;
+
+ private:
+  struct Sample {
+    double vx_map_mps = 0.0, vy_map_mps = 0.0, yaw_rate_rad_s = 0.0;
+    double along_mps = 0.0;  // path mode: the along-track speed used
+    double cross_track_m = 0.0, progress_m = 0.0;
+    bool at_goal = false;
+  };
+  Sample Evaluate() const;
+  void ComputeOutputs();
+  void Validate() const;
+  std::string Where() const;
+
+  Mode mode_;
+  std::vector<std::array<double, 2>> waypoints_m_;
+  std::vector<double> cumulative_m_;  // path length at each waypoint
+
+  // Parameters.
+  double speed_ = 0.3;
+  double acceleration_ = 0.3;
+  double yaw_ = 0.0;
+  double k_cross_ = 1.0;
+  double k_position_ = 1.0;
+  double k_yaw_ = 1.0;
+  double max_speed_ = 0.5;
+  double max_yaw_rate_ = 0.5;
+  double goal_tolerance_ = 0.02;
+
+  // Input.
+  std::vector<double> pose_;
+  // Outputs.
+  std::vector<double> twist_command_;
+  double cross_track_error_ = 0.0;
+  double progress_ = 0.0;
+  bool done_ = false;
+
+  // State: the along-track speed the ramp allows at this sample, and done.
+  double ramp_mps_ = 0.0;
+  bool done_latched_ = false;
+  bool initialized_ = false;
+};
+
+}  // namespace linesim::control

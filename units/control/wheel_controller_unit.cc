@@ -1,0 +1,357 @@
+#include "units/control/wheel_controller_unit.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "units/control/wheel_kinematics.h"
+
+namespace linesim::control {
+
+namespace {
+
+std::string FormatNumber(double x) { return cosim::FormatValue(cosim::Value{x}); }
+
+// Default plant, Rob@Work 3 (FACTS.md) with the maxon RE 40 stand-in motor
+// of models/motors/raw3_{drive,steer}.yaml. The gearbox efficiencies are
+// the assumptions of those files.
+constexpr double kMotorConstant = 0.0302;  // k_t = k_e, V.s/rad
+constexpr double kResistanceOhm = 0.299;
+constexpr double kRotorInertiaKgm2 = 142e-7;
+constexpr double kDriveGear = 21.0;
+constexpr double kDriveEfficiency = 0.75;
+constexpr double kSteerGear = 4.0;
+constexpr double kSteerEfficiency = 0.9;
+// A quarter of the 120 kg robot on an 80 mm wheel, m r^2 = 0.192 kg.m^2,
+// plus the rotor seen through the gear (eta N^2 J_rotor = 0.0047).
+constexpr double kDriveInertiaKgm2 =
+    30.0 * 0.08 * 0.08 + kDriveEfficiency * kDriveGear * kDriveGear * kRotorInertiaKgm2;
+// Steering module about its vertical axis: an estimate of 0.01 kg.m^2 (a
+// few kg within about 5 cm of the axis), plus the rotor through the belt
+// (eta N^2 J_rotor = 2.0e-4).
+constexpr double kSteerInertiaKgm2 =
+    0.01 + kSteerEfficiency * kSteerGear * kSteerGear * kRotorInertiaKgm2;
+
+// Torque at the joint per volt at standstill: eta N k_t / R.
+constexpr double TorquePerVolt(double gear, double efficiency) {
+  return efficiency * gear * kMotorConstant / kResistanceOhm;
+}
+
+double SignedMin(double x, double limit) { return std::clamp(x, -limit, limit); }
+
+}  // namespace
+
+WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
+    : cosim::Unit(kTypeName, std::move(name)), wheel_count_(wheel_count) {
+  if (wheel_count < 1) {
+    throw cosim::UnitError(Where() + ": wheel_count must be at least 1, got " +
+                           std::to_string(wheel_count));
+  }
+  const auto n = static_cast<std::size_t>(wheel_count);
+  if (wheel_count == 4) {
+    // Steering axes W1..W4 from raw3-1 Platform.ini (FACTS.md).
+    wheel_x_ = {0.368, -0.368, -0.368, 0.368};
+    wheel_y_ = {0.186, 0.134, -0.186, -0.134};
+  } else {
+    wheel_x_.assign(n, 0.0);
+    wheel_y_.assign(n, 0.0);
+  }
+  // Back-EMF at the joint (k_e N): the voltage that holds a rate without load.
+  steer_feedforward_ = kMotorConstant * kSteerGear;
+  drive_feedforward_ = kMotorConstant * kDriveGear;
+  // J / (eta N k_t / R): the voltage that accelerates the nominal load.
+  steer_acceleration_feedforward_ = kSteerInertiaKgm2 / TorquePerVolt(kSteerGear, kSteerEfficiency);
+  drive_acceleration_feedforward_ = kDriveInertiaKgm2 / TorquePerVolt(kDriveGear, kDriveEfficiency);
+  // 1 m/s^2 at the wheel rim.
+  drive_max_acceleration_ = 1.0 / wheel_radius_;
+
+  twist_command_.assign(3, 0.0);
+  surface_velocity_.assign(2 * n, 0.0);
+  steer_angle_.assign(n, 0.0);
+  steer_rate_.assign(n, 0.0);
+  drive_rate_.assign(n, 0.0);
+  steer_voltage_.assign(n, 0.0);
+  drive_voltage_.assign(n, 0.0);
+  steer_target_.assign(n, 0.0);
+  drive_rate_target_.assign(n, 0.0);
+  for (auto* v : {&steer_ref_, &steer_next_, &steer_prev_rate_, &flip_angle_, &drive_ref_,
+                  &drive_next_, &drive_integral_}) {
+    v->assign(n, 0.0);
+  }
+
+  // Default gains, for the 20 ms period (sampled plant with zero-order
+  // hold, checked by simulation over the inertia ranges below):
+  //  - drive: back-EMF damping at the wheel eta N^2 k_t k_e / R = 1.01
+  //    N.m.s, so the loaded wheel (0.197 kg.m^2) has a 0.195 s time
+  //    constant, but a wheel off the ground (about 0.01 kg.m^2) has 10 ms,
+  //    shorter than the period. There the rate loop's sampled pole is about
+  //    -kp / (k_e N), so kp must stay well under 0.63 V.s/rad: kp 0.5 keeps
+  //    it at -0.5 airborne and 0.83 loaded; ki 5 V/rad adds an integrator
+  //    pole near 0.9 per sample (loaded) for load torques.
+  //  - steering: PD with kp 10 V/rad, kd 0.5 V.s/rad is well damped for a
+  //    joint inertia from 0.002 to 0.01 kg.m^2 (back-EMF damping 0.044
+  //    N.m.s at the joint); kd above about 0.7 goes unstable at 0.002.
+  auto& v = variables();
+  v.Parameter("wheel_x", "m", &wheel_x_, "steering axis x in base_link, per wheel");
+  v.Parameter("wheel_y", "m", &wheel_y_, "steering axis y in base_link, per wheel");
+  v.Parameter("wheel_radius", "m", &wheel_radius_, "wheel radius");
+  v.Parameter("compensation", &compensation_,
+              "subtract the surface velocity under each wheel from its command (paper 1 "
+              "Algorithm 1); false = the nominal controller");
+  v.Parameter("zero_speed_threshold", "m/s", &zero_speed_threshold_,
+              "below this contact speed a wheel keeps its heading and stops");
+  v.Parameter("steer_kp", "V/rad", &steer_kp_, "steering angle gain");
+  v.Parameter("steer_kd", "V.s/rad", &steer_kd_, "steering rate error gain");
+  v.Parameter("steer_feedforward", "V.s/rad", &steer_feedforward_,
+              "voltage per reference steering rate (back-EMF constant at the joint, k_e N)");
+  v.Parameter("steer_acceleration_feedforward", "V.s2/rad", &steer_acceleration_feedforward_,
+              "voltage per reference steering acceleration (joint inertia R / (eta N k_t))");
+  v.Parameter("steer_max_rate", "rad/s", &steer_max_rate_, "steering reference rate limit");
+  v.Parameter("steer_max_acceleration", "rad/s2", &steer_max_acceleration_,
+              "steering reference acceleration limit");
+  v.Parameter("drive_feedforward", "V.s/rad", &drive_feedforward_,
+              "voltage per reference wheel rate (back-EMF constant at the wheel, k_e N)");
+  v.Parameter("drive_acceleration_feedforward", "V.s2/rad", &drive_acceleration_feedforward_,
+              "voltage per reference wheel acceleration (load inertia R / (eta N k_t))");
+  v.Parameter("drive_kp", "V.s/rad", &drive_kp_, "wheel rate error gain");
+  v.Parameter("drive_ki", "V/rad", &drive_ki_, "wheel rate error integral gain");
+  v.Parameter("drive_max_rate", "rad/s", &drive_max_rate_,
+              "wheel rate limit; all wheels are scaled together to respect it");
+  v.Parameter("drive_max_acceleration", "rad/s2", &drive_max_acceleration_,
+              "wheel rate reference acceleration limit");
+  v.Parameter("max_voltage", "V", &max_voltage_, "supply voltage: outputs saturate at +-this");
+
+  v.Input("twist_command", "m/s", &twist_command_,
+          "body twist command in base_link: vx (m/s), vy (m/s), yaw rate (rad/s)");
+  v.Input("surface_velocity", "m/s", &surface_velocity_,
+          "absolute velocity of the floor under each wheel in base_link, interleaved "
+          "(vx0, vy0, vx1, vy1, ...)");
+  v.Input("steer_angle", "rad", &steer_angle_,
+          "measured steering angle per wheel (0 = rolling along +x, + counter-clockwise)");
+  v.Input("steer_rate", "rad/s", &steer_rate_, "measured steering rate per wheel");
+  v.Input("drive_rate", "rad/s", &drive_rate_,
+          "measured wheel rate per wheel (+ rolls forward along the heading)");
+
+  v.Output("steer_voltage", "V", &steer_voltage_,
+           "steering motor voltage per wheel (+ turns counter-clockwise seen from above)",
+           {"steer_angle", "steer_rate"});
+  v.Output("drive_voltage", "V", &drive_voltage_,
+           "drive motor voltage per wheel (+ drives forward)", {"drive_rate"});
+  v.Output("steer_target", "rad", &steer_target_,
+           "slew-limited steering reference at this sample, in (-pi, pi]", {});
+  v.Output("drive_rate_target", "rad/s", &drive_rate_target_,
+           "slew-limited wheel rate reference at this sample", {});
+}
+
+std::string WheelControllerUnit::Where() const {
+  return "unit '" + name() + "' (" + kTypeName + ")";
+}
+
+std::vector<cosim::ParameterProblem> WheelControllerUnit::CheckParameters() const {
+  std::vector<cosim::ParameterProblem> problems;
+  for (const auto& [var, p] : {std::pair{"wheel_x", &wheel_x_}, {"wheel_y", &wheel_y_}}) {
+    for (std::size_t k = 0; k < p->size(); ++k) {
+      if (!std::isfinite((*p)[k]))
+        problems.push_back({var, k, "must be finite, got " + FormatNumber((*p)[k])});
+    }
+  }
+  const auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
+  const auto non_negative = [](double x) { return x >= 0.0 && std::isfinite(x); };
+  const auto rule = [&](const char* var, double value, auto ok, const char* expected) {
+    if (!ok(value)) {
+      problems.push_back(
+          {var, std::nullopt, std::string(expected) + ", got " + FormatNumber(value)});
+    }
+  };
+  constexpr const char* kPositive = "must be positive and finite";
+  constexpr const char* kNonNegative = "must be zero or positive and finite";
+  rule("wheel_radius", wheel_radius_, positive, kPositive);
+  rule("zero_speed_threshold", zero_speed_threshold_, non_negative, kNonNegative);
+  rule("steer_kp", steer_kp_, non_negative, kNonNegative);
+  rule("steer_kd", steer_kd_, non_negative, kNonNegative);
+  rule("steer_feedforward", steer_feedforward_, non_negative, kNonNegative);
+  rule("steer_acceleration_feedforward", steer_acceleration_feedforward_, non_negative,
+       kNonNegative);
+  rule("steer_max_rate", steer_max_rate_, positive, kPositive);
+  rule("steer_max_acceleration", steer_max_acceleration_, positive, kPositive);
+  rule("drive_feedforward", drive_feedforward_, non_negative, kNonNegative);
+  rule("drive_acceleration_feedforward", drive_acceleration_feedforward_, non_negative,
+       kNonNegative);
+  rule("drive_kp", drive_kp_, non_negative, kNonNegative);
+  rule("drive_ki", drive_ki_, non_negative, kNonNegative);
+  rule("drive_max_rate", drive_max_rate_, positive, kPositive);
+  rule("drive_max_acceleration", drive_max_acceleration_, positive, kPositive);
+  rule("max_voltage", max_voltage_, positive, kPositive);
+  return problems;
+}
+
+void WheelControllerUnit::Validate() const {
+  const auto problems = CheckParameters();
+  if (problems.empty()) return;
+  std::string text = Where() + ": ";
+  for (std::size_t p = 0; p < problems.size(); ++p) {
+    const auto& problem = problems[p];
+    if (p > 0) text += "; ";
+    text += "parameter '" + problem.variable +
+            (problem.index ? "[" + std::to_string(*problem.index) + "]" : "") + "' " +
+            problem.message;
+  }
+  throw cosim::UnitError(text);
+}
+
+void WheelControllerUnit::Initialize() {
+  Validate();
+  // Start from where the wheels point, at rest, so nothing jumps at t = 0.
+  for (std::size_t i = 0; i < steer_ref_.size(); ++i) {
+    const double a = WrapAngle(steer_angle_[i]);
+    steer_ref_[i] = steer_next_[i] = flip_angle_[i] = a;
+    steer_prev_rate_[i] = 0.0;
+    drive_ref_[i] = drive_next_[i] = drive_integral_[i] = 0.0;
+  }
+  period_s_ = 0.0;
+  initialized_ = true;
+  ComputeOutputs();
+}
+
+WheelControllerUnit::Voltages WheelControllerUnit::Compute(std::size_t i) const {
+  double steer_rate_ref = 0.0, steer_accel_ref = 0.0, drive_accel_ref = 0.0;
+  if (period_s_ > 0.0) {
+    steer_rate_ref = WrapAngle(steer_next_[i] - steer_ref_[i]) / period_s_;
+    steer_accel_ref = (steer_rate_ref - steer_prev_rate_[i]) / period_s_;
+    drive_accel_ref = (drive_next_[i] - drive_ref_[i]) / period_s_;
+  }
+  const double steer_v = steer_kp_ * WrapAngle(steer_ref_[i] - steer_angle_[i]) +
+                         steer_kd_ * (steer_rate_ref - steer_rate_[i]) +
+                         steer_feedforward_ * steer_rate_ref +
+                         steer_acceleration_feedforward_ * steer_accel_ref;
+  // The back-EMF grows over the period with the reference: feed the mean.
+  const double drive_v = drive_feedforward_ * 0.5 * (drive_ref_[i] + drive_next_[i]) +
+                         drive_acceleration_feedforward_ * drive_accel_ref +
+                         drive_kp_ * (drive_ref_[i] - drive_rate_[i]) +
+                         drive_ki_ * drive_integral_[i];
+  return {steer_v, drive_v};
+}
+
+void WheelControllerUnit::ComputeOutputs() {
+  for (std::size_t i = 0; i < steer_voltage_.size(); ++i) {
+    const Voltages u = Compute(i);
+    steer_voltage_[i] = SignedMin(u.steer_v, max_voltage_);
+    drive_voltage_[i] = SignedMin(u.drive_v, max_voltage_);
+    steer_target_[i] = steer_ref_[i];
+    drive_rate_target_[i] = drive_ref_[i];
+  }
+}
+
+cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
+  ClearError();
+  if (!initialized_) return Fail(Where() + ": DoStep called before Initialize");
+  if (dt <= 0) {
+    return Fail(Where() + ": step size must be positive, got " + cosim::FormatSeconds(dt) +
+                " s at t = " + cosim::FormatSeconds(t) + " s");
+  }
+  for (const auto& [var, in] : {std::pair{"twist_command", &twist_command_},
+                                {"surface_velocity", &surface_velocity_},
+                                {"steer_angle", &steer_angle_},
+                                {"steer_rate", &steer_rate_},
+                                {"drive_rate", &drive_rate_}}) {
+    for (std::size_t k = 0; k < in->size(); ++k) {
+      if (!std::isfinite((*in)[k])) {
+        return Fail(Where() + ": input '" + var + "[" + std::to_string(k) + "]' is " +
+                    FormatNumber((*in)[k]) + " at t = " + cosim::FormatSeconds(t) + " s");
+      }
+    }
+  }
+  const double dt_s = cosim::NsToSeconds(dt);
+  const std::size_t n = steer_ref_.size();
+
+  // Set points of this sample: Eq. 1, Algorithm 1, flip rule.
+  const Eigen::Vector3d twist(twist_command_[0], twist_command_[1], twist_command_[2]);
+  std::vector<WheelSetpoint> setpoints(n);
+  double fastest_rad_s = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::Vector2d v = WheelVelocity(twist, {wheel_x_[i], wheel_y_[i]});
+    if (compensation_) {
+      v = CompensateSurface(v, {surface_velocity_[2 * i], surface_velocity_[2 * i + 1]});
+    }
+    setpoints[i] =
+        ToWheelSetpoint(v, wheel_radius_, steer_angle_[i], flip_angle_[i], zero_speed_threshold_);
+    fastest_rad_s = std::max(fastest_rad_s, std::abs(setpoints[i].drive_rate_rad_s));
+  }
+  // Scale all wheels alike, so that a too fast command keeps its direction
+  // and curvature instead of being distorted wheel by wheel.
+  const double scale = fastest_rad_s > drive_max_rate_ ? drive_max_rate_ / fastest_rad_s : 1.0;
+
+  for (std::size_t i = 0; i < n; ++i) {
+    // Drive integrator on the error of this sample; it stops while the
+    // output saturates in the error's direction (anti-windup) and never
+    // holds more than the full voltage.
+    const Voltages u = Compute(i);
+    const double error = drive_ref_[i] - drive_rate_[i];
+    if (!(std::abs(u.drive_v) > max_voltage_ && error * u.drive_v > 0.0)) {
+      drive_integral_[i] += error * dt_s;
+    }
+    if (drive_ki_ > 0.0) {
+      drive_integral_[i] = SignedMin(drive_integral_[i], max_voltage_ / drive_ki_);
+    }
+
+    // Steering reference: second-order slew towards the flip-rule heading,
+    // at the largest rate from which the acceleration limit still stops the
+    // discrete profile exactly at the target: rates (m + f) dv, (m - 1 + f)
+    // dv, ..., f dv cover dv dt ((m + 1) f + m (m + 1) / 2).
+    const double rate_now =
+        period_s_ > 0.0 ? WrapAngle(steer_next_[i] - steer_ref_[i]) / period_s_ : 0.0;
+    steer_prev_rate_[i] = rate_now;
+    steer_ref_[i] = steer_next_[i];
+    flip_angle_[i] = setpoints[i].steer_angle_rad;
+    const double gap = WrapAngle(flip_angle_[i] - steer_ref_[i]);
+    const double dv = steer_max_acceleration_ * dt_s;
+    const double steps = std::abs(gap) / (dv * dt_s);
+    const double m = std::floor(0.5 * (std::sqrt(1.0 + 8.0 * steps) - 1.0));
+    const double f = std::clamp((steps - 0.5 * m * (m + 1.0)) / (m + 1.0), 0.0, 1.0);
+    const double stoppable = (m + f) * dv;
+    const double wanted =
+        std::copysign(std::min({steer_max_rate_, stoppable, std::abs(gap) / dt_s}), gap);
+    const double rate_next = rate_now + SignedMin(wanted - rate_now, dv);
+    steer_next_[i] = WrapAngle(steer_ref_[i] + rate_next * dt_s);
+
+    // Drive reference: rate-limited ramp towards the scaled set point.
+    drive_ref_[i] = drive_next_[i];
+    const double drive_goal = SignedMin(scale * setpoints[i].drive_rate_rad_s, drive_max_rate_);
+    drive_next_[i] =
+        drive_ref_[i] + SignedMin(drive_goal - drive_ref_[i], drive_max_acceleration_ * dt_s);
+  }
+  period_s_ = dt_s;
+  ComputeOutputs();
+  return cosim::StepResult::kOk;
+}
+
+void WheelControllerUnit::SaveInternal(cosim::UnitState& state) const {
+  state.reals.clear();
+  for (const auto* v : {&steer_ref_, &steer_next_, &steer_prev_rate_, &flip_angle_, &drive_ref_,
+                        &drive_next_, &drive_integral_}) {
+    state.reals.insert(state.reals.end(), v->begin(), v->end());
+  }
+  state.reals.push_back(period_s_);
+  state.integers = {initialized_ ? 1 : 0};
+}
+
+void WheelControllerUnit::RestoreInternal(const cosim::UnitState& state) {
+  const std::size_t n = steer_ref_.size();
+  const std::size_t expected = 7 * n + 1;
+  if (state.reals.size() != expected || state.integers.size() != 1) {
+    throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
+                           " reals and " + std::to_string(state.integers.size()) +
+                           " integers, expected " + std::to_string(expected) + " and 1");
+  }
+  auto it = state.reals.begin();
+  for (auto* v : {&steer_ref_, &steer_next_, &steer_prev_rate_, &flip_angle_, &drive_ref_,
+                  &drive_next_, &drive_integral_}) {
+    std::copy(it, it + static_cast<std::ptrdiff_t>(n), v->begin());
+    it += static_cast<std::ptrdiff_t>(n);
+  }
+  period_s_ = *it;
+  initialized_ = state.integers[0] != 0;
+}
+
+}  // namespace linesim::control

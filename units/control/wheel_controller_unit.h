@@ -1,0 +1,111 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cosim/time.h"
+#include "cosim/unit.h"
+
+namespace linesim::control {
+
+/// The wheel controller of a robot with W independently steered and driven
+/// wheels (Rob@Work 3: W = 4), run as a sampled-data controller (20 ms in
+/// paper 1's robot). Per sample at time t:
+///  - feedback (UpdateOutputs, direct feedthrough): the motor voltages from
+///    the reference of this sample and the measured joint angles and rates;
+///  - reference (DoStep(t, dt)): the body twist command becomes a contact
+///    velocity per wheel (paper 1 Eq. 1), less the surface velocity under
+///    the wheel when compensation is on (Algorithm 1), then a steering
+///    angle and drive rate by the flip rule; both are slew-limited into the
+///    reference that the next samples track.
+/// So a new twist command reaches the voltages one sample later, while the
+/// measured joint states act at once. Outputs are meant to be held by the
+/// master over the period.
+///
+/// Steering voltage (PD plus feedforward, saturated at max_voltage):
+///   kp wrap(a_ref - a) + kd (r_ref - r) + k_ff r_ref + k_acc alpha_ref,
+/// with a_ref, r_ref, alpha_ref the slewed reference angle at the sample,
+/// its rate over the coming period and the change of that rate.
+/// Drive voltage (PI plus feedforward, saturated, conditional integration):
+///   k_ff mean(w_ref over the period) + k_acc dw_ref/dt + kp (w_ref - w) + ki I.
+/// The feedforward gains are the back-EMF constant and the load inertia
+/// seen through the gearbox, so a well-modelled wheel follows its reference
+/// without error and the feedback only corrects what the model misses.
+class WheelControllerUnit : public cosim::Unit {
+ public:
+  static constexpr const char* kTypeName = "wheel_controller";
+
+  /// Throws cosim::UnitError if wheel_count < 1. With 4 wheels the wheel
+  /// positions default to Rob@Work 3 (FACTS.md); otherwise they are zero and
+  /// must be set.
+  explicit WheelControllerUnit(std::string name, int wheel_count = 4);
+
+  std::vector<cosim::ParameterProblem> CheckParameters() const override;
+  /// Validates the parameters (throws cosim::UnitError listing every
+  /// problem), takes the measured steering angles as the reference, zero
+  /// drive reference and integrators, and computes the outputs. Idempotent.
+  void Initialize() override;
+  /// The voltages from the current joint measurements and the reference of
+  /// this sample; the state is not changed.
+  void UpdateOutputs() override { ComputeOutputs(); }
+  /// Commits the sample taken at t: drive integrators with the error at t,
+  /// the reference advanced to t + dt and the next one from the inputs at t.
+  cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
+
+  int wheel_count() const { return wheel_count_; }
+
+ protected:
+  void SaveInternal(cosim::UnitState& state) const override;
+  void RestoreInternal(const cosim::UnitState& state) override;
+
+ private:
+  struct Voltages {
+    double steer_v;
+    double drive_v;  // before saturation
+  };
+  Voltages Compute(std::size_t i) const;
+  void ComputeOutputs();
+  void Validate() const;
+  std::string Where() const;
+
+  int wheel_count_;
+
+  // Parameters.
+  std::vector<double> wheel_x_, wheel_y_;
+  double wheel_radius_ = 0.08;
+  bool compensation_ = true;
+  double zero_speed_threshold_ = 1e-3;
+  double steer_kp_ = 10.0;
+  double steer_kd_ = 0.5;
+  double steer_feedforward_ = 0.0;
+  double steer_acceleration_feedforward_ = 0.0;
+  double steer_max_rate_ = 10.0;
+  double steer_max_acceleration_ = 40.0;
+  double drive_feedforward_ = 0.0;
+  double drive_acceleration_feedforward_ = 0.0;
+  double drive_kp_ = 0.5;
+  double drive_ki_ = 5.0;
+  double drive_max_rate_ = 12.267;
+  double drive_max_acceleration_ = 12.5;
+  double max_voltage_ = 24.0;
+
+  // Inputs.
+  std::vector<double> twist_command_;
+  std::vector<double> surface_velocity_;
+  std::vector<double> steer_angle_, steer_rate_, drive_rate_;
+
+  // Outputs.
+  std::vector<double> steer_voltage_, drive_voltage_, steer_target_, drive_rate_target_;
+
+  // State, per wheel. The reference at this sample and at the next one
+  // (wrapped angles, rates), the reference steering rate over the previous
+  // period (for its acceleration), the last flip-rule heading and the drive
+  // integrator. period_s_ is the step that produced the next reference (0
+  // before the first step: no motion in the reference yet).
+  std::vector<double> steer_ref_, steer_next_, steer_prev_rate_, flip_angle_;
+  std::vector<double> drive_ref_, drive_next_, drive_integral_;
+  double period_s_ = 0.0;
+  bool initialized_ = false;
+};
+
+}  // namespace linesim::control
