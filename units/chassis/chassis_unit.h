@@ -19,7 +19,12 @@ namespace linesim::chassis {
 /// axis 2 the wheel axle. Wheels are spheres of the wheel radius (one
 /// contact point each, directly below the steering axis: no scrub torque
 /// when steering in place). Each wheel contact takes the surface velocity of
-/// the belt patch under it (units/chassis/floor_world.h).
+/// the belt patch under it, with Coulomb friction while it slides
+/// (units/chassis/floor_world.h). Input torques act between module and body
+/// (dBodyAddTorque in equal and opposite pairs about the body's vertical and
+/// the wheel's axle), with the viscous joint friction, every internal step;
+/// the brake is an ODE joint motor (target velocity 0, force limit
+/// brake_torque) on both hinge2 axes.
 ///
 /// Frames: map (x, y, z up) and base_link (x forward, y left), whose origin
 /// in x and y is the planform centre of the body, which is also its centre of

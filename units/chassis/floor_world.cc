@@ -152,46 +152,56 @@ void FloorWorld::Probe() {
 }
 
 void FloorWorld::MakeJoints(int n, double erp, double cfm) {
+  const auto tangent = [](const dReal* nrm, const double v[3], double out[3]) {
+    const double vn = v[0] * nrm[0] + v[1] * nrm[1] + v[2] * nrm[2];
+    for (int d = 0; d < 3; ++d) out[d] = v[d] - vn * nrm[d];
+    return std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
+  };
   for (int j = 0; j < n; ++j) {
     dContact& p = points_[static_cast<std::size_t>(j)];
+    const dReal* nrm = p.geom.normal;
     double vx = 0.0, vy = 0.0;
     SurfaceVelocity(SurfaceAt(p.geom.pos[0], p.geom.pos[1]), &vx, &vy);
-    // The surface velocity projected on the contact plane.
-    const dReal* nrm = p.geom.normal;
-    const double vn = vx * nrm[0] + vy * nrm[1];
-    double t[3] = {vx - vn * nrm[0], vy - vn * nrm[1], -vn * nrm[2]};
-    double speed = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-    if (speed > 0.0) {
-      for (double& e : t) e /= speed;
+    const double surface[3] = {vx, vy, 0.0};
+    // Slip of the body's contact point over the surface, at step start.
+    const dBodyID body = dGeomGetBody(p.geom.g1);
+    dVector3 point_v = {0.0, 0.0, 0.0, 0.0};
+    if (body) dBodyGetPointVel(body, p.geom.pos[0], p.geom.pos[1], p.geom.pos[2], point_v);
+    const double slip[3] = {point_v[0] - vx, point_v[1] - vy, point_v[2]};
+    double t1[3], fallback[3];
+    const double slip_mps = tangent(nrm, slip, t1);
+    const double surface_mps = tangent(nrm, surface, fallback);
+    if (slip_mps > kSlipAlignMps) {
+      for (double& e : t1) e /= slip_mps;
+    } else if (surface_mps > 0.0) {
+      for (int d = 0; d < 3; ++d) t1[d] = fallback[d] / surface_mps;
     } else {
-      // No surface motion: any tangent direction will do (friction is
-      // isotropic); map x projected on the plane, or y if x is the normal.
-      const double ax = std::abs(nrm[0]) < 0.9 ? 1.0 : 0.0;
-      const double ay = 1.0 - ax;
-      const double an = ax * nrm[0] + ay * nrm[1];
-      t[0] = ax - an * nrm[0];
-      t[1] = ay - an * nrm[1];
-      t[2] = -an * nrm[2];
-      const double len = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-      for (double& e : t) e /= len;
-      speed = 0.0;
+      // Sticking on a still surface: any tangent will do; map x on the
+      // plane, or map y if x is the normal.
+      const double axis[3] = {std::abs(nrm[0]) < 0.9 ? 1.0 : 0.0,
+                              std::abs(nrm[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+      const double len = tangent(nrm, axis, t1);
+      for (double& e : t1) e /= len;
     }
+    // ODE's second friction direction is normal x fdir1.
+    const double t2[3] = {nrm[1] * t1[2] - nrm[2] * t1[1], nrm[2] * t1[0] - nrm[0] * t1[2],
+                          nrm[0] * t1[1] - nrm[1] * t1[0]};
+    const bool sliding = slip_mps > kSlipAlignMps;
     p.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP | dContactMotion1 |
-                     dContactMotion2 | dContactFDir1;
+                     dContactMotion2 | dContactFDir1 | (sliding ? dContactMu2 : 0);
     p.surface.mu = surface_.mu;
+    p.surface.mu2 = 0.0;
     p.surface.soft_erp = erp;
     p.surface.soft_cfm = cfm;
-    p.surface.motion1 = speed;
-    p.surface.motion2 = 0.0;
+    p.surface.motion1 = surface[0] * t1[0] + surface[1] * t1[1];
+    p.surface.motion2 = surface[0] * t2[0] + surface[1] * t2[1];
     p.surface.motionN = 0.0;
     p.surface.bounce = 0.0;
     p.surface.bounce_vel = 0.0;
-    p.fdir1[0] = t[0];
-    p.fdir1[1] = t[1];
-    p.fdir1[2] = t[2];
+    for (int d = 0; d < 3; ++d) p.fdir1[d] = t1[d];
     const dJointID joint = dJointCreateContact(world_, group_, &p);
     // body1 = the moving geom's body, body2 = the static floor (0).
-    dJointAttach(joint, dGeomGetBody(p.geom.g1), dGeomGetBody(p.geom.g2));
+    dJointAttach(joint, body, dGeomGetBody(p.geom.g2));
   }
 }
 

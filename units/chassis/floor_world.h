@@ -61,11 +61,24 @@ struct GeomContact {
 /// it, else of the floor (zero), through ODE's contact surface motion.
 ///
 /// Sign of the surface motion: a contact joint enforces
-///   fdir1 . (v_body1 - v_body2) = motion1
+///   fdir_i . (v_body1 - v_body2) = motion_i   (i = 1, 2; fdir2 = n x fdir1)
 /// at the contact point. The moving geom's body is always attached as body1
-/// and the static floor as body2 (0), so with fdir1 along the surface
-/// velocity and motion1 = its speed, a sticking contact point moves with the
-/// surface.
+/// and the static floor as body2 (0), so with motion_i = fdir_i . v_surface
+/// a sticking contact point moves with the surface.
+///
+/// Friction: dContactApprox1 bounds each friction row by mu N on its own (a
+/// pyramid, not Coulomb's cone), so the rows' orientation matters. With
+/// fdir1 fixed along the belt and along map x on the floor, a braked robot
+/// straddling a belt edge turned at 0.267 rad/s with the scene along map x
+/// and at 0.222 rad/s with the same scene turned by 45 deg. So a contact
+/// point that slides over its surface faster than kSlipAlignMps (slip taken
+/// at the start of the step) gets one friction row along its slip with
+/// bound mu N and a frictionless second row (dContactMu2, mu2 = 0): Coulomb
+/// sliding friction, the same in any orientation (0.2305 rad/s for every
+/// turn of that scene; 0.229 rad/s from the quasi-static Coulomb balance).
+/// A slower (sticking) contact keeps both rows, fdir1 along the surface
+/// velocity, or map x on the still floor.
+///
 class FloorWorld {
  public:
   FloorWorld();
@@ -109,6 +122,10 @@ class FloorWorld {
  private:
   // A box on a plane gives at most 4 points; room for odd shapes.
   static constexpr int kMaxPoints = 8;
+  // Slip speed above which a contact slides (one friction row along the
+  // slip): far below any sliding speed of interest, far above ODE's
+  // residual velocity of a sticking contact (about 1e-12 m/s).
+  static constexpr double kSlipAlignMps = 1e-4;
 
   /// Collides geom i with the floor into points_; records contact(i) and
   /// returns the number of points.

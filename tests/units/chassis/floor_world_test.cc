@@ -110,6 +110,26 @@ TEST(FloorWorld, BoxFollowsBeltInAnyDirection) {
   }
 }
 
+// Guards against friction that depends on the direction of sliding in map
+// (ODE's dContactApprox1 pyramid would brake a diagonal slide with
+// sqrt(2) mu N). Analytic, Coulomb: a box sliding on the still floor
+// decelerates at mu g along its velocity, whatever that direction:
+// v(t) = v0 - mu g t, direction unchanged.
+TEST(FloorWorld, SlidingFrictionIsCoulombInAnyDirection) {
+  const double mu = 0.5, v0_mps = 1.0;
+  for (const double dir_rad : {0.0, std::numbers::pi / 4.0, 2.0}) {
+    SCOPED_TRACE(dir_rad);
+    FloorWorld f;
+    f.SetSurface({mu, 1e6, 1e4});
+    Box box(f, 0.0, 0.0, 2.0, 0.2);
+    dBodySetLinearVel(box.body, v0_mps * std::cos(dir_rad), v0_mps * std::sin(dir_rad), 0.0);
+    for (int i = 0; i < 100; ++i) ASSERT_TRUE(f.Step(kStepS));
+    const double v_mps = v0_mps - mu * kGravityMps2 * 0.1;
+    EXPECT_NEAR(std::hypot(box.vx(), box.vy()), v_mps, 0.01 * v_mps);
+    EXPECT_NEAR(std::atan2(box.vy(), box.vx()), dir_rad, 1e-6);
+  }
+}
+
 // Guards against a wrong inside test of a rotated patch (sign of the
 // across axis, half sizes) and belt indices. Geometry by hand: a 4 x 1 m
 // patch centred at (2, 1), length axis at 90 deg (along map y).
