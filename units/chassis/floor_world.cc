@@ -1,0 +1,226 @@
+#include "units/chassis/floor_world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace linesim::chassis {
+
+namespace {
+
+// ODE calls abort() after its error and debug handlers return (for example
+// on a non-finite quaternion), so the handlers throw instead.
+[[noreturn]] void ThrowOdeError(int num, const char* msg, va_list ap) {
+  char text[512];
+  std::vsnprintf(text, sizeof(text), msg, ap);
+  throw OdeError("ODE error " + std::to_string(num) + ": " + text);
+}
+
+bool InitOde() {
+  dSetErrorHandler(&ThrowOdeError);
+  dSetDebugHandler(&ThrowOdeError);
+  return dInitODE2(0) != 0;
+}
+
+}  // namespace
+
+void EnsureOdeForThisThread() {
+  // dInitODE2 may be called once per process only; a function-local static
+  // is initialised exactly once even under concurrent first calls.
+  static const bool initialized = InitOde();
+  // ODE ignores already allocated flags, but the flag saves the call.
+  thread_local bool allocated = false;
+  if (allocated) return;
+  if (!initialized) throw std::runtime_error("ODE: dInitODE2 failed");
+  if (dAllocateODEDataForThread(dAllocateMaskAll) == 0) {
+    throw std::runtime_error("ODE: dAllocateODEDataForThread failed");
+  }
+  allocated = true;
+}
+
+FloorWorld::FloorWorld() {
+  EnsureOdeForThisThread();
+  world_ = dWorldCreate();
+  dWorldSetGravity(world_, 0.0, 0.0, -kGravityMps2);
+  group_ = dJointGroupCreate(0);
+  // Not in a space: geoms are collided with the floor one by one.
+  floor_ = dCreatePlane(nullptr, 0.0, 0.0, 1.0, 0.0);
+}
+
+FloorWorld::~FloorWorld() {
+  EnsureOdeForThisThread();
+  dJointGroupDestroy(group_);
+  dGeomDestroy(floor_);
+  dWorldDestroy(world_);
+}
+
+void FloorWorld::SetBelts(std::vector<BeltPatch> belts) {
+  belts_ = std::move(belts);
+  belt_velocity_mps_.assign(belts_.size(), {0.0, 0.0});
+  belt_axes_.clear();
+  for (const BeltPatch& b : belts_) {
+    const double c = std::cos(b.direction_rad);
+    const double s = std::sin(b.direction_rad);
+    belt_axes_.push_back({c, s, -s, c});
+  }
+}
+
+void FloorWorld::SetBeltVelocity(int k, double vx_mps, double vy_mps) {
+  belt_velocity_mps_.at(static_cast<std::size_t>(k)) = {vx_mps, vy_mps};
+}
+
+int FloorWorld::AddGeom(dGeomID geom) {
+  geoms_.push_back(geom);
+  GeomContact c;
+  const dReal* p = dGeomGetPosition(geom);
+  c.x_m = p[0];
+  c.y_m = p[1];
+  contacts_.push_back(c);
+  return static_cast<int>(geoms_.size()) - 1;
+}
+
+void FloorWorld::ClearGeoms() {
+  geoms_.clear();
+  contacts_.clear();
+}
+
+int FloorWorld::SurfaceAt(double x_m, double y_m) const {
+  for (std::size_t k = 0; k < belts_.size(); ++k) {
+    const BeltPatch& b = belts_[k];
+    const auto& a = belt_axes_[k];
+    const double dx = x_m - b.center_x_m;
+    const double dy = y_m - b.center_y_m;
+    const double along = dx * a[0] + dy * a[1];
+    const double across = dx * a[2] + dy * a[3];
+    if (std::abs(along) <= 0.5 * b.length_m && std::abs(across) <= 0.5 * b.width_m) {
+      return static_cast<int>(k) + 1;
+    }
+  }
+  return 0;
+}
+
+void FloorWorld::SurfaceVelocity(int surface, double* vx_mps, double* vy_mps) const {
+  if (surface <= 0) {
+    *vx_mps = 0.0;
+    *vy_mps = 0.0;
+    return;
+  }
+  const auto& v = belt_velocity_mps_[static_cast<std::size_t>(surface - 1)];
+  *vx_mps = v[0];
+  *vy_mps = v[1];
+}
+
+int FloorWorld::Collide(int i) {
+  const dGeomID geom = geoms_[static_cast<std::size_t>(i)];
+  const int n = dCollide(geom, floor_, kMaxPoints, &points_[0].geom, sizeof(dContact));
+  GeomContact& c = contacts_[static_cast<std::size_t>(i)];
+  c.points = n;
+  c.depth_m = 0.0;
+  if (n == 0) {
+    const dReal* p = dGeomGetPosition(geom);
+    c.surface = -1;
+    c.x_m = p[0];
+    c.y_m = p[1];
+    return 0;
+  }
+  double sx = 0.0, sy = 0.0;
+  for (int j = 0; j < n; ++j) {
+    dContactGeom& g = points_[static_cast<std::size_t>(j)].geom;
+    // Make the moving geom g1 with the normal pointing into it (from the
+    // floor), whatever order the collider reports, so that the surface
+    // motion sign below holds.
+    if (g.g1 == floor_) {
+      std::swap(g.g1, g.g2);
+      for (int d = 0; d < 3; ++d) g.normal[d] = -g.normal[d];
+    }
+    sx += g.pos[0];
+    sy += g.pos[1];
+    c.depth_m = std::max(c.depth_m, static_cast<double>(g.depth));
+  }
+  c.x_m = sx / n;
+  c.y_m = sy / n;
+  c.surface = SurfaceAt(points_[0].geom.pos[0], points_[0].geom.pos[1]);
+  return n;
+}
+
+void FloorWorld::Probe() {
+  for (int i = 0; i < static_cast<int>(geoms_.size()); ++i) Collide(i);
+}
+
+void FloorWorld::MakeJoints(int n, double erp, double cfm) {
+  const auto tangent = [](const dReal* nrm, const double v[3], double out[3]) {
+    const double vn = v[0] * nrm[0] + v[1] * nrm[1] + v[2] * nrm[2];
+    for (int d = 0; d < 3; ++d) out[d] = v[d] - vn * nrm[d];
+    return std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
+  };
+  for (int j = 0; j < n; ++j) {
+    dContact& p = points_[static_cast<std::size_t>(j)];
+    const dReal* nrm = p.geom.normal;
+    double vx = 0.0, vy = 0.0;
+    SurfaceVelocity(SurfaceAt(p.geom.pos[0], p.geom.pos[1]), &vx, &vy);
+    const double surface[3] = {vx, vy, 0.0};
+    // Slip of the body's contact point over the surface, at step start.
+    const dBodyID body = dGeomGetBody(p.geom.g1);
+    dVector3 point_v = {0.0, 0.0, 0.0, 0.0};
+    if (body) dBodyGetPointVel(body, p.geom.pos[0], p.geom.pos[1], p.geom.pos[2], point_v);
+    const double slip[3] = {point_v[0] - vx, point_v[1] - vy, point_v[2]};
+    double t1[3], fallback[3];
+    const double slip_mps = tangent(nrm, slip, t1);
+    const double surface_mps = tangent(nrm, surface, fallback);
+    if (slip_mps > kSlipAlignMps) {
+      for (double& e : t1) e /= slip_mps;
+    } else if (surface_mps > 0.0) {
+      for (int d = 0; d < 3; ++d) t1[d] = fallback[d] / surface_mps;
+    } else {
+      // Sticking on a still surface: any tangent will do; map x on the
+      // plane, or map y if x is the normal.
+      const double axis[3] = {std::abs(nrm[0]) < 0.9 ? 1.0 : 0.0,
+                              std::abs(nrm[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+      const double len = tangent(nrm, axis, t1);
+      for (double& e : t1) e /= len;
+    }
+    // ODE's second friction direction is normal x fdir1.
+    const double t2[3] = {nrm[1] * t1[2] - nrm[2] * t1[1], nrm[2] * t1[0] - nrm[0] * t1[2],
+                          nrm[0] * t1[1] - nrm[1] * t1[0]};
+    const bool sliding = slip_mps > kSlipAlignMps;
+    p.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP | dContactMotion1 |
+                     dContactMotion2 | dContactFDir1 | (sliding ? dContactMu2 : 0);
+    p.surface.mu = surface_.mu;
+    p.surface.mu2 = 0.0;
+    p.surface.soft_erp = erp;
+    p.surface.soft_cfm = cfm;
+    p.surface.motion1 = surface[0] * t1[0] + surface[1] * t1[1];
+    p.surface.motion2 = surface[0] * t2[0] + surface[1] * t2[1];
+    p.surface.motionN = 0.0;
+    p.surface.bounce = 0.0;
+    p.surface.bounce_vel = 0.0;
+    for (int d = 0; d < 3; ++d) p.fdir1[d] = t1[d];
+    const dJointID joint = dJointCreateContact(world_, group_, &p);
+    // body1 = the moving geom's body, body2 = the static floor (0).
+    dJointAttach(joint, body, dGeomGetBody(p.geom.g2));
+  }
+}
+
+bool FloorWorld::Step(double h_s) {
+  // ODE's spring-damper equivalence for one implicit step of h:
+  // ERP = h kp / (h kp + kd), CFM = 1 / (h kp + kd).
+  const double hk = h_s * surface_.stiffness_n_per_m;
+  const double erp = hk / (hk + surface_.damping_n_s_per_m);
+  const double cfm = 1.0 / (hk + surface_.damping_n_s_per_m);
+  int ok = 0;
+  try {
+    for (int i = 0; i < static_cast<int>(geoms_.size()); ++i) MakeJoints(Collide(i), erp, cfm);
+    ok = dWorldStep(world_, h_s);
+  } catch (const OdeError&) {
+    dJointGroupEmpty(group_);
+    throw;
+  }
+  dJointGroupEmpty(group_);
+  return ok != 0;
+}
+
+}  // namespace linesim::chassis

@@ -1,0 +1,149 @@
+#pragma once
+
+// The ODE world of a factory floor with conveyor-belt patches. This header
+// exposes ODE types on purpose: it is used by the chassis unit's .cc and by
+// tests, never by the loader (units/chassis/chassis_unit.h keeps ODE out).
+
+#include <ode/ode.h>
+
+#include <array>
+#include <stdexcept>
+#include <vector>
+
+namespace linesim::chassis {
+
+/// Standard gravity, m/s^2, pointing along -z in every ODE world made here.
+inline constexpr double kGravityMps2 = 9.80665;
+
+/// An ODE error or failed internal check (ODE would abort the process).
+class OdeError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Initialises ODE once per process and allocates ODE's data for the calling
+/// thread. Call it in every thread before that thread touches ODE (units may
+/// be stepped from TBB workers); after the first call per thread it is a
+/// thread-local flag test. The first call also installs process-wide ODE
+/// error and debug handlers that throw OdeError instead of aborting; the
+/// world that threw must then be rebuilt.
+void EnsureOdeForThisThread();
+
+/// A rectangular belt patch in the map frame.
+struct BeltPatch {
+  double center_x_m = 0.0;
+  double center_y_m = 0.0;
+  double length_m = 1.0;       // along the belt direction
+  double width_m = 1.0;        // across it
+  double direction_rad = 0.0;  // of the length axis, counter-clockwise from map x
+};
+
+/// Contact parameters shared by every contact with the floor and the belts.
+struct ContactSurface {
+  double mu = 0.8;                 // Coulomb coefficient (dContactApprox1)
+  double stiffness_n_per_m = 1e6;  // per contact point
+  double damping_n_s_per_m = 1e4;  // per contact point
+};
+
+/// What one geom touched in the last collision pass.
+struct GeomContact {
+  int surface = -1;  // -1 none, 0 floor, k + 1 belt k (of the first contact point)
+  int points = 0;    // contact points found
+  double x_m = 0.0;  // mean contact point in map, or the geom position without contact
+  double y_m = 0.0;
+  double depth_m = 0.0;  // largest penetration
+};
+
+/// Owns the dWorld (gravity -z), a joint group for contacts and the static
+/// floor plane z = 0 with belt patches on it. Registered geoms (attached to
+/// bodies of this world) collide with the floor each step; every contact
+/// point takes the surface velocity of the first belt patch that contains
+/// it, else of the floor (zero), through ODE's contact surface motion.
+///
+/// Sign of the surface motion: a contact joint enforces
+///   fdir_i . (v_body1 - v_body2) = motion_i   (i = 1, 2; fdir2 = n x fdir1)
+/// at the contact point. The moving geom's body is always attached as body1
+/// and the static floor as body2 (0), so with motion_i = fdir_i . v_surface
+/// a sticking contact point moves with the surface.
+///
+/// Friction: dContactApprox1 bounds each friction row by mu N on its own (a
+/// pyramid, not Coulomb's cone), so the rows' orientation matters. With
+/// fdir1 fixed along the belt and along map x on the floor, a braked robot
+/// straddling a belt edge turned at 0.267 rad/s with the scene along map x
+/// and at 0.222 rad/s with the same scene turned by 45 deg. So a contact
+/// point that slides over its surface faster than kSlipAlignMps (slip taken
+/// at the start of the step) gets one friction row along its slip with
+/// bound mu N and a frictionless second row (dContactMu2, mu2 = 0): Coulomb
+/// sliding friction, the same in any orientation (0.2305 rad/s for every
+/// turn of that scene; 0.229 rad/s from the quasi-static Coulomb balance).
+/// A slower (sticking) contact keeps both rows, fdir1 along the surface
+/// velocity, or map x on the still floor.
+///
+class FloorWorld {
+ public:
+  FloorWorld();
+  ~FloorWorld();
+  FloorWorld(const FloorWorld&) = delete;
+  FloorWorld& operator=(const FloorWorld&) = delete;
+
+  dWorldID world() const { return world_; }
+
+  /// Replaces the belt patches; their velocities start at zero.
+  void SetBelts(std::vector<BeltPatch> belts);
+  int belt_count() const { return static_cast<int>(belts_.size()); }
+  /// Surface velocity of belt k in map, m/s.
+  void SetBeltVelocity(int k, double vx_mps, double vy_mps);
+  void SetSurface(const ContactSurface& surface) { surface_ = surface; }
+  const ContactSurface& surface() const { return surface_; }
+
+  /// Registers a geom attached to a body of this world; returns its index.
+  /// The caller keeps ownership and must remove it (ClearGeoms) before
+  /// destroying it.
+  int AddGeom(dGeomID geom);
+  void ClearGeoms();
+
+  /// Surface at map point (x, y): 0 floor, k + 1 for the first belt k that
+  /// contains it (edges included).
+  int SurfaceAt(double x_m, double y_m) const;
+  /// Velocity in map of a surface index as returned by SurfaceAt (zero for
+  /// the floor and for -1).
+  void SurfaceVelocity(int surface, double* vx_mps, double* vy_mps) const;
+
+  /// Collides every registered geom with the floor without making joints,
+  /// so that contact(i) describes the current positions.
+  void Probe();
+  /// One internal step of h_s seconds: collide, create the contact joints,
+  /// dWorldStep, empty the contact group. Returns false if dWorldStep
+  /// failed (out of memory); throws OdeError if ODE reports an error.
+  bool Step(double h_s);
+
+  const GeomContact& contact(int i) const { return contacts_[static_cast<std::size_t>(i)]; }
+
+ private:
+  // A box on a plane gives at most 4 points; room for odd shapes.
+  static constexpr int kMaxPoints = 8;
+  // Slip speed above which a contact slides (one friction row along the
+  // slip): far below any sliding speed of interest, far above ODE's
+  // residual velocity of a sticking contact (about 1e-12 m/s).
+  static constexpr double kSlipAlignMps = 1e-4;
+
+  /// Collides geom i with the floor into points_; records contact(i) and
+  /// returns the number of points.
+  int Collide(int i);
+  /// Contact joints for the n points of the last Collide.
+  void MakeJoints(int n, double erp, double cfm);
+
+  dWorldID world_ = nullptr;
+  dJointGroupID group_ = nullptr;
+  dGeomID floor_ = nullptr;
+  ContactSurface surface_;
+  std::vector<BeltPatch> belts_;
+  std::vector<std::array<double, 2>> belt_velocity_mps_;
+  // Per belt, the unit vectors along and across its length axis.
+  std::vector<std::array<double, 4>> belt_axes_;
+  std::vector<dGeomID> geoms_;
+  std::vector<GeomContact> contacts_;
+  std::array<dContact, kMaxPoints> points_{};
+};
+
+}  // namespace linesim::chassis
