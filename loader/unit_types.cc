@@ -3,6 +3,9 @@
 #include "cosim/closest_names.h"
 #include "units/motors/dc_motor_unit.h"
 #include "units/belt/belt_unit.h"
+#include "units/chassis/chassis_unit.h"
+#include "units/control/path_follower_unit.h"
+#include "units/control/wheel_controller_unit.h"
 #include "units/evaluation/path_deviation.h"
 #include "units/sources/step_signal.h"
 
@@ -92,6 +95,28 @@ std::vector<std::array<double, 2>> ReadPoints(const UnitBuildContext& c, const s
   return points;
 }
 
+std::unique_ptr<cosim::Unit> MakeChassis(const UnitBuildContext& c) {
+  const auto wheels = c.reader.Integer(c.parameters, c.path, "wheel_count", 4, 1, 16);
+  const auto belts = c.reader.Integer(c.parameters, c.path, "belt_count", 0, 0, 64);
+  return std::make_unique<chassis::ChassisUnit>(c.name, static_cast<int>(wheels),
+                                                static_cast<int>(belts));
+}
+
+std::unique_ptr<cosim::Unit> MakeWheelController(const UnitBuildContext& c) {
+  const auto wheels = c.reader.Integer(c.parameters, c.path, "wheel_count", 4, 1, 16);
+  return std::make_unique<control::WheelControllerUnit>(c.name, static_cast<int>(wheels));
+}
+
+std::unique_ptr<cosim::Unit> MakePathFollower(const UnitBuildContext& c) {
+  const std::string mode = c.reader.String(c.parameters, c.path, "mode", "path", {"path", "hold"});
+  std::vector<std::array<double, 2>> waypoints = ReadPoints(c, "waypoints", 1);
+  if (!c.parameters.IsDefined() || c.parameters.IsNull()) waypoints = {{0.0, 0.0}, {1.0, 0.0}};
+  return std::make_unique<control::PathFollowerUnit>(
+      c.name, mode == "hold" ? control::PathFollowerUnit::Mode::kHold
+                             : control::PathFollowerUnit::Mode::kPath,
+      std::move(waypoints));
+}
+
 std::unique_ptr<cosim::Unit> MakePathDeviation(const UnitBuildContext& c) {
   return std::make_unique<evaluation::PathDeviationUnit>(c.name, ReadPoints(c, "path", 1));
 }
@@ -157,6 +182,27 @@ const std::vector<UnitType>& UnitTypes() {
         {"schedules",
          "one list per belt of {time_s, on}: switching times of the line (default: none)"}},
        MakeBelt},
+      {chassis::ChassisUnit::kTypeName,
+       "robot body, steer+drive modules and wheel/floor/belt contact in ODE: each wheel "
+       "contact moves with the surface under it",
+       "chassis",
+       {{"wheel_count", "number of steer+drive modules (default 4)"},
+        {"belt_count", "number of belt patches in the floor (default 0)"},
+        {"model", "model file from models/chassis/ (name) or a path relative to the scenario"}},
+       MakeChassis},
+      {control::WheelControllerUnit::kTypeName,
+       "Rob@Work 3 wheel controller: Eq. 1, Algorithm 1 (surface compensation), flip rule, "
+       "steering and drive PD to motor voltages (paper 1, Sec. III)",
+       "",
+       {{"wheel_count", "number of steer+drive modules (default 4)"}},
+       MakeWheelController},
+      {control::PathFollowerUnit::kTypeName,
+       "follows a polyline at a cruise speed, or holds a point, keeping a heading; outputs a "
+       "body twist",
+       "",
+       {{"mode", "path (follow the waypoints, stop at the last) or hold (hold the first)"},
+        {"waypoints", "list of points [x, y] (m) in the map frame"}},
+       MakePathFollower},
       {evaluation::PathDeviationUnit::kTypeName,
        "ground-truth distance of the robot centre from its desired path or held point",
        "",

@@ -1,0 +1,160 @@
+#include "loader/robot_scenario.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <numbers>
+
+#include "loader/scenario.h"
+#include "scenario_test.h"
+
+namespace linesim::loader {
+namespace {
+
+using testing::WriteScenario;
+
+const std::string kCross = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
+
+std::string Issues(const std::string& file, const std::vector<std::string>& sets = {}) {
+  try {
+    LoadScenario(file, sets);
+  } catch (const ScenarioError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+bool Has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+double Param(const Scenario& s, const std::string& unit, const std::string& name,
+             std::size_t index = 0) {
+  const auto& v = s.system->unit(*s.system->FindUnit(unit)).variables();
+  const auto ref = *v.Find(name);
+  return v.info(ref).type == cosim::VarType::kRealArray ? v.GetRealElement(ref, index)
+                                                        : v.GetReal(ref);
+}
+
+bool BoolParam(const Scenario& s, const std::string& unit, const std::string& name) {
+  const auto& v = s.system->unit(*s.system->FindUnit(unit)).variables();
+  return v.GetBoolean(*v.Find(name));
+}
+
+// Guards the expansion: a robot scenario becomes belt, chassis, two motor
+// groups, the two controllers and the ground-truth monitor, wired as in
+// DESIGN.md's signal flow, with the controllers at the 20 ms cycle.
+TEST(RobotScenario, CrossLineExpandsIntoTheRobotUnits) {
+  const Scenario s = LoadScenario(kCross);
+  ASSERT_TRUE(s.robot);
+  for (const char* unit : {"belt", "chassis", "steer_motors", "drive_motors", "wheel_controller",
+                           "path_follower", "deviation"}) {
+    EXPECT_TRUE(s.system->FindUnit(unit)) << unit;
+  }
+  EXPECT_EQ(s.master->decimation(*s.system->FindUnit("wheel_controller")), 20);
+  EXPECT_EQ(s.master->decimation(*s.system->FindUnit("chassis")), 1);
+  EXPECT_EQ(s.robot->task, "path");
+  ASSERT_EQ(s.robot->path.size(), 2u);
+  ASSERT_EQ(s.robot->belts.size(), 1u);
+  EXPECT_EQ(s.robot->belts[0].width_m, 2.0);
+  std::vector<std::string> metrics;
+  for (const auto& m : s.metrics) metrics.push_back(m.name);
+  EXPECT_NE(std::find(metrics.begin(), metrics.end(), "max_path_deviation_m"), metrics.end());
+  // The belt geometry reaches both the belt and the chassis's contact patches.
+  EXPECT_EQ(Param(s, "chassis", "belt_width"), 2.0);
+  EXPECT_EQ(Param(s, "belt", "nominal_speed"), 0.10);
+}
+
+// Guards the dotted paths the issue reserves for --set and sweeps: each one
+// must reach the unit parameter it stands for.
+TEST(RobotScenario, ReservedOverridePathsReachTheUnits) {
+  const Scenario s = LoadScenario(
+      kCross, {"line.belts.0.speed_mps=0.15", "control.compensation=false",
+               "robot.pose.yaw_deg=30", "seed=7", "master.algorithm=jacobi",
+               "master.step_s=0.002", "sensing.surface_velocity=ground_truth",
+               "localization.source=ground_truth"});
+  EXPECT_EQ(Param(s, "belt", "nominal_speed"), 0.15);
+  EXPECT_FALSE(BoolParam(s, "wheel_controller", "compensation"));
+  EXPECT_NEAR(Param(s, "chassis", "initial_yaw"), 30.0 * std::numbers::pi / 180.0, 1e-15);
+  EXPECT_NEAR(Param(s, "path_follower", "yaw"), 30.0 * std::numbers::pi / 180.0, 1e-15);
+  EXPECT_EQ(s.seed, 7u);
+  EXPECT_EQ(s.master->options().algorithm, cosim::Algorithm::kJacobi);
+  EXPECT_EQ(s.master->options().base_step, 2'000'000);
+  // The controllers stay at 20 ms: 10 master steps of 2 ms.
+  EXPECT_EQ(s.master->decimation(*s.system->FindUnit("wheel_controller")), 10);
+}
+
+// Guards the hold task: the held point defaults to the start pose, and the
+// metrics are the drift ones.
+TEST(RobotScenario, HoldScenariosHoldTheStartPose) {
+  for (const char* file : {"hold_on_belt.yaml", "hold_straddle.yaml"}) {
+    const Scenario s = LoadScenario(std::string(LINESIM_SOURCE_DIR "/scenarios/") + file);
+    ASSERT_TRUE(s.robot);
+    EXPECT_EQ(s.robot->task, "hold");
+    ASSERT_EQ(s.robot->path.size(), 1u);
+    EXPECT_EQ(s.robot->path[0][0], Param(s, "chassis", "initial_x"));
+    EXPECT_EQ(s.robot->path[0][1], Param(s, "chassis", "initial_y"));
+    std::vector<std::string> metrics;
+    for (const auto& m : s.metrics) metrics.push_back(m.name);
+    for (const char* m : {"max_position_drift_m", "final_position_drift_m"}) {
+      EXPECT_NE(std::find(metrics.begin(), metrics.end(), m), metrics.end()) << file << " " << m;
+    }
+  }
+}
+
+// Guards against sensing/localization choices a later capability adds being
+// silently accepted now: the message lists what exists.
+TEST(RobotScenario, ReservedChoicesNotYetBuiltAreRefused) {
+  const std::string a = Issues(kCross, {"sensing.surface_velocity=px4flow"});
+  EXPECT_TRUE(Has(a, "sensing.surface_velocity")) << a;
+  EXPECT_TRUE(Has(a, "ground_truth")) << a;
+  const std::string b = Issues(kCross, {"localization.source=laser"});
+  EXPECT_TRUE(Has(b, "localization.source")) << b;
+}
+
+// Guards the robot-level checks: unknown keys name the closest, values out
+// of range and a bad task are reported with their key paths, all at once.
+TEST(RobotScenario, BadRobotLevelValuesAreListedWithKeyPaths) {
+  const std::string f = WriteScenario("robot_bad.yaml", R"(name: bad
+duration_s: 1
+robot: {model: raw3, pose: {x_m: 0, y_m: 0, yaw_degs: 10}}
+line:
+  belts:
+    - {center_x_m: 0, center_y_m: 0, length_m: -1, width_m: 2, speed_mps: 0.1}
+control: {compensation: maybe}
+task: {type: wander}
+)");
+  const std::string e = Issues(f);
+  EXPECT_TRUE(Has(e, "robot.pose.yaw_degs")) << e;
+  EXPECT_TRUE(Has(e, "robot.pose.yaw_deg")) << e;  // the closest key
+  EXPECT_TRUE(Has(e, "line.belts.0.length_m")) << e;
+  EXPECT_TRUE(Has(e, "control.compensation")) << e;
+  EXPECT_TRUE(Has(e, "task.type")) << e;
+  EXPECT_TRUE(Has(e, f)) << e;
+}
+
+// Guards an unknown robot model: named with the models that exist.
+TEST(RobotScenario, UnknownRobotModelNamesTheKnownOnes) {
+  const std::string e = Issues(kCross, {"robot.model=raw4"});
+  EXPECT_TRUE(Has(e, "robot.model")) << e;
+  EXPECT_TRUE(Has(e, "raw3")) << e;
+}
+
+// Guards the pass-through: `units.NAME.parameters` in a robot scenario
+// overrides the expansion (so every unit parameter is sweepable), and an
+// unknown parameter there is reported at that path.
+TEST(RobotScenario, UnitsSectionOverridesExpandedParameters) {
+  std::ifstream in(kCross);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string f = WriteScenario(
+      "robot_units.yaml", text + "units:\n  chassis:\n    parameters: {friction: 0.7}\n");
+  const Scenario s = LoadScenario(f, {"units.chassis.parameters.friction=0.5"});
+  EXPECT_EQ(Param(s, "chassis", "friction"), 0.5);
+  const std::string e = Issues(f, {"units.chassis.parameters.fricton=0.5"});
+  EXPECT_TRUE(Has(e, "units.chassis.parameters.fricton")) << e;
+}
+
+}  // namespace
+}  // namespace linesim::loader

@@ -1,0 +1,92 @@
+// The shipped paper-1 scenarios, run end to end through the real units
+// (belt, ODE chassis, CVODE motors, controllers) with compensation on (the
+// paper's modified system, Algorithm 1) and off (the nominal system).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cosim/observers.h"
+#include "loader/scenario.h"
+
+namespace linesim {
+namespace {
+
+std::map<std::string, double> RunScenario(const std::string& name, std::vector<std::string> sets) {
+  const std::string file = std::string(LINESIM_SOURCE_DIR "/scenarios/") + name + ".yaml";
+  loader::Scenario s = loader::LoadScenario(file, sets);
+  cosim::MetricsObserver metrics(s.metrics);
+  s.master->AddObserver(&metrics);
+  const cosim::RunResult result = s.master->Run();
+  EXPECT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors.front());
+  std::map<std::string, double> out;
+  for (const auto& [metric, value] : metrics.Results()) out[metric] = value;
+  std::cout << name;
+  for (const auto& set : sets) std::cout << " --set " << set;
+  for (const auto& [metric, value] : out) std::cout << "\n  " << metric << " = " << value;
+  std::cout << "\n";
+  return out;
+}
+
+// The path follower's gains (units/control defaults): cross-track and
+// position feedback k = 1/s. Without compensation the belt is an unmodelled
+// disturbance velocity v that a proportional loop can only cancel with a
+// standing error v/k: the analytic yardstick of the nominal system below.
+constexpr double kGain = 1.0;
+
+// Paper 1, Sec. VI-B: crossing a line at 10 cm/s, the modified system stays
+// within 4 cm of the path; the nominal one deviates "significantly". The
+// robot is on the belt for about (2 m + 1.03 m) / 0.3 m/s = 10 s, ten time
+// constants of the loop, so the nominal deviation nears v/k = 0.10 m (less
+// the part of the time only some wheels are on the belt). Both arrive: the
+// path is 4 m long.
+TEST(Paper1Scenarios, CrossLineCompensatedStaysWithin4cmNominalDoesNot) {
+  const auto on = RunScenario("cross_line", {"control.compensation=true"});
+  const auto off = RunScenario("cross_line", {"control.compensation=false"});
+  const double v_over_k = 0.10 / kGain;
+  EXPECT_LT(on.at("max_path_deviation_m"), 0.04);
+  EXPECT_GT(off.at("max_path_deviation_m"), 0.04);
+  EXPECT_GT(off.at("max_path_deviation_m"), 0.5 * v_over_k);
+  EXPECT_LT(off.at("max_path_deviation_m"), 1.2 * v_over_k);  // +-10 % belt speed
+  EXPECT_GT(off.at("max_path_deviation_m"), 3.0 * on.at("max_path_deviation_m"));
+  EXPECT_GT(on.at("final_progress_m"), 3.9);
+  EXPECT_GT(off.at("final_progress_m"), 3.9);
+}
+
+// Paper 1, Sec. VI-C: position hold with the line at about 0.20 m/s
+// switching on and off. Entirely on the belt, the nominal robot is carried
+// until its position loop balances the belt: drift v/k = 0.20 m (+-10 %
+// speed variation). With Algorithm 1 it stays put: we ask for a tenth of
+// that at worst (the belt starts at 0.5 m/s2 faster than the 20 ms
+// controller sees it) and a return to the point once the line runs
+// steadily.
+TEST(Paper1Scenarios, HoldOnBeltHoldsWithCompensation) {
+  const auto on = RunScenario("hold_on_belt", {"control.compensation=true"});
+  const auto off = RunScenario("hold_on_belt", {"control.compensation=false"});
+  const double v_over_k = 0.20 / kGain;
+  EXPECT_LT(on.at("max_position_drift_m"), 0.1 * v_over_k);
+  EXPECT_LT(on.at("final_position_drift_m"), 0.005);
+  EXPECT_GT(off.at("max_position_drift_m"), 0.85 * v_over_k);
+  EXPECT_LT(off.at("max_position_drift_m"), 1.15 * v_over_k);
+}
+
+// Straddling the edge only two wheels are dragged (the braked robot would
+// yaw, see the chassis tests): the nominal robot both drifts, about half of
+// v/k since half of the wheels push, and turns; the compensated one holds
+// position and heading.
+TEST(Paper1Scenarios, HoldStraddlingHoldsWithCompensation) {
+  const auto on = RunScenario("hold_straddle", {"control.compensation=true"});
+  const auto off = RunScenario("hold_straddle", {"control.compensation=false"});
+  const double v_over_k = 0.20 / kGain;
+  EXPECT_LT(on.at("max_position_drift_m"), 0.1 * v_over_k);
+  EXPECT_LT(on.at("final_position_drift_m"), 0.005);
+  EXPECT_LT(std::abs(on.at("final_yaw_rad")), 0.01);
+  EXPECT_GT(off.at("max_position_drift_m"), 0.3 * v_over_k);
+  EXPECT_GT(std::abs(off.at("final_yaw_rad")), 0.05);
+}
+
+}  // namespace
+}  // namespace linesim
