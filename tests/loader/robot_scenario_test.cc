@@ -49,7 +49,7 @@ bool BoolParam(const Scenario& s, const std::string& unit, const std::string& na
 TEST(RobotScenario, CrossLineExpandsIntoTheRobotUnits) {
   const Scenario s = LoadScenario(kCross);
   ASSERT_TRUE(s.robot);
-  for (const char* unit : {"belt", "chassis", "steer_motors", "drive_motors", "wheel_controller",
+  for (const char* unit : {"belt", "chassis", "motors", "wheel_controller",
                            "path_follower", "deviation"}) {
     EXPECT_TRUE(s.system->FindUnit(unit)) << unit;
   }
@@ -65,6 +65,12 @@ TEST(RobotScenario, CrossLineExpandsIntoTheRobotUnits) {
   // The belt geometry reaches both the belt and the chassis's contact patches.
   EXPECT_EQ(Param(s, "chassis", "belt_width"), 2.0);
   EXPECT_EQ(Param(s, "belt", "nominal_speed"), 0.10);
+  // One motor unit: steering motors 0-3 (belt ratio 4), drive motors 4-7
+  // (gear 21), each group from its model file (FACTS.md ratios).
+  EXPECT_EQ(Param(s, "motors", "gear_ratio", 0), 4.0);
+  EXPECT_EQ(Param(s, "motors", "gear_ratio", 3), 4.0);
+  EXPECT_EQ(Param(s, "motors", "gear_ratio", 4), 21.0);
+  EXPECT_EQ(Param(s, "motors", "gear_ratio", 7), 21.0);
 }
 
 // Guards the dotted paths the issue reserves for --set and sweeps: each one

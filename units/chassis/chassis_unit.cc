@@ -437,16 +437,18 @@ void ChassisUnit::Initialize() {
 }
 
 std::string ChassisUnit::NonFiniteState() const {
+  // Runs every step: the names are built only for a body that failed.
+  const auto who = [](std::size_t i) {
+    return i == 0 ? std::string("the body (outputs pose, velocity, body_velocity)")
+                  : "wheel module " + std::to_string(i - 1) + " (outputs steer_angle[" +
+                        std::to_string(i - 1) + "], steer_rate, drive_rate, wheel_contact)";
+  };
   for (std::size_t i = 0; i < ode_->BodyCount(); ++i) {
     const dBodyID b = ode_->Body(i);
-    const std::string who = i == 0 ? "the body (outputs pose, velocity, body_velocity)"
-                                   : "wheel module " + std::to_string(i - 1) +
-                                         " (outputs steer_angle[" + std::to_string(i - 1) +
-                                         "], steer_rate, drive_rate, wheel_contact)";
-    if (!AllFinite(dBodyGetPosition(b), 3)) return "position of " + who;
-    if (!AllFinite(dBodyGetQuaternion(b), 4)) return "orientation of " + who;
-    if (!AllFinite(dBodyGetLinearVel(b), 3)) return "linear velocity of " + who;
-    if (!AllFinite(dBodyGetAngularVel(b), 3)) return "angular velocity of " + who;
+    if (!AllFinite(dBodyGetPosition(b), 3)) return "position of " + who(i);
+    if (!AllFinite(dBodyGetQuaternion(b), 4)) return "orientation of " + who(i);
+    if (!AllFinite(dBodyGetLinearVel(b), 3)) return "linear velocity of " + who(i);
+    if (!AllFinite(dBodyGetAngularVel(b), 3)) return "angular velocity of " + who(i);
   }
   return {};
 }

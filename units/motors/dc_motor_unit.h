@@ -9,6 +9,9 @@
 #include "cosim/unit.h"
 #include "models/dc_motor_params.h"
 
+// SUNDIALS' matrix type, declared here so that its headers stay private.
+struct _generic_SUNMatrix;
+
 namespace linesim::motors {
 
 enum class MotorMode {
@@ -20,7 +23,7 @@ enum class MotorMode {
 };
 
 /// `count` brushed DC motors with gearboxes, integrated together in one
-/// SUNDIALS CVODE system (BDF, dense direct solver, analytic Jacobian).
+/// SUNDIALS CVODE system (BDF, band direct solver, analytic Jacobian).
 ///
 ///   L di/dt = V - R i - k_t w_r                     (both modes)
 ///   J_eff dw_r/dt = k_t i - b w_r + tau_load / (eta N)     (full mode)
@@ -76,9 +79,8 @@ class DcMotorUnit : public cosim::Unit {
   struct Sundials;
 
   void EvalRhs(double t_s, const double* y, double* ydot) const;
-  /// Column-major dense n x n Jacobian; only the 2x2 (or 1x1) diagonal
-  /// blocks are non-zero.
-  void FillJacobian(double* data) const;
+  /// The band Jacobian: only the 2x2 (or 1x1) diagonal blocks are non-zero.
+  void FillJacobian(::_generic_SUNMatrix* jac) const;
 
   void Validate() const;
   void ComputeCoefficients();
