@@ -112,6 +112,51 @@ TEST(Cli, BadInputExitsTwoAndWritesNothing) {
   }
 }
 
+const std::string kCrossLine = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
+
+// Guards the README's main job, shortened: a robot scenario runs, prints its
+// metric and writes the three plots as PNG files (signature bytes) beside
+// the summary, which lists them.
+TEST(Cli, RobotRunWritesPlots) {
+  const std::string out = Fresh("robot_run");
+  const Result r = Linesim("run " + kCrossLine + " --out " + out + " --set duration_s=2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("max_path_deviation_m"), std::string::npos) << r.out;
+  const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
+  EXPECT_EQ(summary["plots"]["files"].size(), 3u) << summary.dump();
+  for (const char* png : {"top_view.png", "error.png", "belt.png"}) {
+    EXPECT_EQ(ReadFile(fs::path(out) / png).substr(0, 8), "\x89PNG\r\n\x1a\n") << png;
+  }
+  EXPECT_TRUE(fs::exists(fs::path(out) / "plots.gp"));
+}
+
+// Guards the bad-input contract for robot-level keys too: exit 2, file and
+// key path named, nothing written.
+TEST(Cli, RobotLevelBadInputExitsTwo) {
+  const std::string out = Fresh("robot_bad");
+  const Result r = Linesim("run " + kCrossLine + " --out " + out +
+                           " --set line.belts.0.speed_mps=-0.1 --set task.type=wander");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("line.belts.0.speed_mps"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("task.type"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(kCrossLine), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// Guards determinism of a robot run (ODE, CVODE, the seeded belt): same
+// file and seed give the same bytes, under Jacobi with 2 threads too.
+TEST(Cli, RobotRunIsDeterministic) {
+  for (const std::string extra : {"", " --set master.algorithm=jacobi --set master.threads=2"}) {
+    const std::string a = Fresh("robot_det_a"), b = Fresh("robot_det_b");
+    const std::string args = " --set duration_s=3" + extra;
+    ASSERT_EQ(Linesim("run " + kCrossLine + " --out " + a + args).status, 0);
+    ASSERT_EQ(Linesim("run " + kCrossLine + " --out " + b + args).status, 0);
+    const std::string ca = ReadFile(fs::path(a) / "signals.csv");
+    EXPECT_GT(ca.size(), 1000u);
+    EXPECT_EQ(ca, ReadFile(fs::path(b) / "signals.csv")) << extra;
+  }
+}
+
 // Guards the --set path check from the command line.
 TEST(Cli, UnknownSetPathNamesClosest) {
   const std::string out = Fresh("bad_set");
