@@ -498,10 +498,10 @@ TEST(DcMotorUnit, FirstOrderHoldTracksAContinuouslyVaryingShaftSpeed) {
   };
   const Result zoh = run("zero_order", 1e-8);
   const Result foh = run("first_order", 1e-8);
-  const Result foh_loose = run("first_order", 1e-4);
+  const Result foh_loose = run("first_order", 1e-3);  // models/robots/raw3.yaml
   std::cout << "max |current error| over 1 s: zero-order " << zoh.max_error << " A ("
             << zoh.restarts << " restarts), first-order " << foh.max_error << " A ("
-            << foh.restarts << "), first-order rel_tol 1e-4 " << foh_loose.max_error << " A ("
+            << foh.restarts << "), first-order rel_tol 1e-3 " << foh_loose.max_error << " A ("
             << foh_loose.restarts << ")\n";
   // Zero-order lag of half a step: about k N A W (h/2) / R = 0.067 A.
   EXPECT_GT(zoh.max_error, 0.03);
