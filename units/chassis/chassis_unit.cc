@@ -157,6 +157,9 @@ ChassisUnit::ChassisUnit(std::string name, int wheel_count, int belt_count)
   v.Parameter("contact_stiffness", "N/m", &contact_stiffness_,
               "normal stiffness of one wheel contact");
   v.Parameter("contact_damping", "N.s/m", &contact_damping_, "normal damping of one wheel contact");
+  v.Parameter("slip_damping", "N.s/m", &slip_damping_,
+              "sliding contact: resistance to slip across its slip direction, bounded by "
+              "friction x normal force (damps a step-to-step swing of the slip direction)");
   v.Parameter("suspension_stiffness", "N/m", &suspension_stiffness_,
               "stiffness of a module along its steering axis (hinge2 suspension)");
   v.Parameter("suspension_damping", "N.s/m", &suspension_damping_,
@@ -251,6 +254,7 @@ std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
   scalar("friction", friction_, non_negative, kNonNegative);
   scalar("contact_stiffness", contact_stiffness_, positive, kPositive);
   scalar("contact_damping", contact_damping_, non_negative, kNonNegative);
+  scalar("slip_damping", slip_damping_, positive, kPositive);
   scalar("suspension_stiffness", suspension_stiffness_, positive, kPositive);
   scalar("suspension_damping", suspension_damping_, non_negative, kNonNegative);
   scalar("brake_torque", brake_torque_, non_negative, kNonNegative);
@@ -295,7 +299,7 @@ void ChassisUnit::Build() {
                      belt_direction_[k]});
   }
   f.SetBelts(std::move(belts));
-  f.SetSurface({friction_, contact_stiffness_, contact_damping_});
+  f.SetSurface({friction_, contact_stiffness_, contact_damping_, slip_damping_});
 
   // Start with the contacts pressed in by equal shares of the weight, so
   // that the settle has little to do. The suspension starts unloaded (its
@@ -422,10 +426,22 @@ void ChassisUnit::Settle() {
 }
 
 void ChassisUnit::Initialize() {
-  Validate();
-  initialized_ = false;
-  Build();
-  Settle();
+  std::vector<cosim::Value> parameters;
+  for (const auto& info : variables().infos()) {
+    if (info.causality == cosim::Causality::kParameter) {
+      parameters.push_back(variables().GetValue(info.ref));
+    }
+  }
+  // Settling uses only the parameters (belts still, joints held), so an
+  // unchanged, unstepped world is already what a rebuild would give.
+  if (!initialized_ || stepped_since_settle_ || parameters != settled_parameters_) {
+    Validate();
+    initialized_ = false;
+    Build();
+    Settle();
+    settled_parameters_ = std::move(parameters);
+    stepped_since_settle_ = false;
+  }
   FloorWorld& f = *ode_->floor;
   for (int k = 0; k < f.belt_count(); ++k) {
     const auto kk = static_cast<std::size_t>(k);
@@ -514,6 +530,7 @@ cosim::StepResult ChassisUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     }
   }
   EnsureOdeForThisThread();
+  stepped_since_settle_ = true;
   FloorWorld& f = *ode_->floor;
   for (int k = 0; k < f.belt_count(); ++k) {
     const auto kk = static_cast<std::size_t>(k);
@@ -560,6 +577,7 @@ void ChassisUnit::SaveInternal(cosim::UnitState& state) const {
 }
 
 void ChassisUnit::RestoreInternal(const cosim::UnitState& state) {
+  stepped_since_settle_ = true;
   const std::size_t bodies = static_cast<std::size_t>(wheel_count_) + 1;
   const bool init = state.integers.size() == 1 && state.integers[0] != 0;
   const std::size_t reals = init ? bodies * kRealsPerBody : 0;

@@ -98,6 +98,7 @@ class ChassisUnit : public cosim::Unit {
   double friction_ = 0.8;
   double contact_stiffness_ = 1e6;
   double contact_damping_ = 1e4;
+  double slip_damping_ = 1e5;
   double suspension_stiffness_ = 1e7;
   double suspension_damping_ = 1e4;
   double brake_torque_ = 30.0;
@@ -117,6 +118,12 @@ class ChassisUnit : public cosim::Unit {
   std::vector<double> wheel_surface_, wheel_surface_velocity_, wheel_contact_;
 
   bool initialized_ = false;
+  // The parameter values the world was last built and settled with, and
+  // whether it has stepped since: the master may call Initialize several
+  // times while it propagates initial values, and settling (300 ODE steps)
+  // need not be repeated when nothing it depends on changed.
+  std::vector<cosim::Value> settled_parameters_;
+  bool stepped_since_settle_ = true;
   std::unique_ptr<Ode> ode_;
 };
 

@@ -188,9 +188,9 @@ void FloorWorld::MakeJoints(int n, double erp, double cfm) {
                           nrm[0] * t1[1] - nrm[1] * t1[0]};
     const bool sliding = slip_mps > kSlipAlignMps;
     p.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP | dContactMotion1 |
-                     dContactMotion2 | dContactFDir1 | (sliding ? dContactMu2 : 0);
+                     dContactMotion2 | dContactFDir1 | (sliding ? dContactSlip2 : 0);
     p.surface.mu = surface_.mu;
-    p.surface.mu2 = 0.0;
+    p.surface.slip2 = 1.0 / surface_.slip_damping_n_s_per_m;
     p.surface.soft_erp = erp;
     p.surface.soft_cfm = cfm;
     p.surface.motion1 = surface[0] * t1[0] + surface[1] * t1[1];

@@ -43,6 +43,9 @@ struct ContactSurface {
   double mu = 0.8;                 // Coulomb coefficient (dContactApprox1)
   double stiffness_n_per_m = 1e6;  // per contact point
   double damping_n_s_per_m = 1e4;  // per contact point
+  // A sliding contact's resistance to sideways slip (across its slip
+  // direction), bounded by mu N; see FloorWorld.
+  double slip_damping_n_s_per_m = 1e5;
 };
 
 /// What one geom touched in the last collision pass.
@@ -73,9 +76,16 @@ struct GeomContact {
 /// and at 0.222 rad/s with the same scene turned by 45 deg. So a contact
 /// point that slides over its surface faster than kSlipAlignMps (slip taken
 /// at the start of the step) gets one friction row along its slip with
-/// bound mu N and a frictionless second row (dContactMu2, mu2 = 0): Coulomb
-/// sliding friction, the same in any orientation (0.2305 rad/s for every
-/// turn of that scene; 0.229 rad/s from the quasi-static Coulomb balance).
+/// bound mu N (Coulomb sliding friction, the same in any orientation:
+/// 0.2305 rad/s for every turn of that scene; 0.229 rad/s from the
+/// quasi-static Coulomb balance). Its second row, across the slip, is not
+/// left frictionless: taking the slip direction from the step's start, a
+/// free sideways row let a contact's slip swing by 90 degrees each step (a
+/// 2 ms limit cycle of the wheel rates, 8 % of their value, whenever a robot
+/// fought the belt). It is a damper instead (ODE force-dependent slip,
+/// dContactSlip2): force = slip_damping x sideways slip, bounded by mu N.
+/// At 1e5 N.s/m it cuts that cycle tenfold and keeps the straddle scene at
+/// 0.2304 rad/s; 1e6 would stiffen it into a pyramid again (0.213 rad/s).
 /// A slower (sticking) contact keeps both rows, fdir1 along the surface
 /// velocity, or map x on the still floor.
 ///

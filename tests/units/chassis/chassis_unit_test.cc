@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <cstring>
 #include <filesystem>
 #include <numbers>
@@ -430,6 +431,18 @@ TEST(ChassisUnit, InitializeIsIdempotent) {
   for (std::size_t k = 0; k < a.size(); ++k) EXPECT_TRUE(SameBits(a[k], b[k])) << k;
 }
 
+// Guards the settle cache in Initialize (repeated calls while the master
+// propagates initial values skip the rebuild): a parameter changed between
+// two calls must still take effect, here the start position.
+TEST(ChassisUnit, InitializeAgainHonoursChangedParameters) {
+  ChassisUnit u("robot", 4, 0);
+  u.Initialize();
+  Set(u, "initial_x", 2.5);
+  u.Initialize();
+  const auto& v = u.variables();
+  EXPECT_EQ(v.GetRealElement(*v.Find("pose"), 0), 2.5);
+}
+
 // ---------------------------------------------------------------------------
 // Errors.
 
@@ -528,6 +541,7 @@ TEST(ChassisUnit, VariableTable) {
                                           {"friction", C::kParameter, "1", 0},
                                           {"contact_stiffness", C::kParameter, "N/m", 0},
                                           {"contact_damping", C::kParameter, "N.s/m", 0},
+                                          {"slip_damping", C::kParameter, "N.s/m", 0},
                                           {"suspension_stiffness", C::kParameter, "N/m", 0},
                                           {"suspension_damping", C::kParameter, "N.s/m", 0},
                                           {"brake_torque", C::kParameter, "N.m", 0},
