@@ -26,4 +26,18 @@ void Unit::RestoreState(const UnitState& state) {
   RestoreInternal(state);
 }
 
+void Unit::ThrowIfBadParameters() const {
+  const auto problems = CheckParameters();
+  if (problems.empty()) return;
+  std::string text = Where() + ": ";
+  for (std::size_t p = 0; p < problems.size(); ++p) {
+    const auto& problem = problems[p];
+    if (p > 0) text += "; ";
+    text += "parameter '" + problem.variable +
+            (problem.index ? "[" + std::to_string(*problem.index) + "]" : "") + "' " +
+            problem.message;
+  }
+  throw UnitError(text);
+}
+
 }  // namespace linesim::cosim

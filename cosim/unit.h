@@ -80,6 +80,9 @@ class Unit {
   /// Why the last DoStep did not return kOk (empty when it did).
   const std::string& last_error() const { return last_error_; }
 
+  /// "unit 'name' (type)": how messages name this unit.
+  std::string Where() const { return "unit '" + name_ + "' (" + type_name_ + ")"; }
+
   /// Every declared variable plus the unit's internal state. A restored unit
   /// continues bit for bit like the one that was saved.
   UnitState SaveState() const;
@@ -89,6 +92,10 @@ class Unit {
   /// Internal state beyond the variable table; the default has none.
   virtual void SaveInternal(UnitState& state) const { (void)state; }
   virtual void RestoreInternal(const UnitState& state) { (void)state; }
+
+  /// For Initialize: throws UnitError naming the unit and every problem that
+  /// CheckParameters() reports, as "parameter 'x[i]' must be ...; ...".
+  void ThrowIfBadParameters() const;
 
   /// For DoStep: record why the step failed and return kError.
   StepResult Fail(std::string message) {

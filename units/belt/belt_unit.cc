@@ -91,8 +91,6 @@ BeltUnit::BeltUnit(std::string name, int belt_count, std::vector<std::vector<Swi
   v.Output("on", "1", &on_, "scheduled state: 1 on, 0 off (the speed ramps after a switch)", {});
 }
 
-std::string BeltUnit::Where() const { return "unit '" + name() + "' (" + kTypeName + ")"; }
-
 std::vector<cosim::ParameterProblem> BeltUnit::CheckParameters() const {
   std::vector<cosim::ParameterProblem> problems;
   const auto rule = [&](const char* var, const std::vector<double>& p, auto ok,
@@ -129,20 +127,6 @@ std::vector<cosim::ParameterProblem> BeltUnit::CheckParameters() const {
     }
   }
   return problems;
-}
-
-void BeltUnit::Validate() const {
-  const auto problems = CheckParameters();
-  if (problems.empty()) return;
-  std::string text = Where() + ": ";
-  for (std::size_t p = 0; p < problems.size(); ++p) {
-    const auto& problem = problems[p];
-    if (p > 0) text += "; ";
-    text += "parameter '" + problem.variable +
-            (problem.index ? "[" + std::to_string(*problem.index) + "]" : "") + "' " +
-            problem.message;
-  }
-  throw cosim::UnitError(text);
 }
 
 double BeltUnit::VariationSignal(int b, cosim::TimeNs t) const {
@@ -185,7 +169,7 @@ void BeltUnit::ComputeOutputs(cosim::TimeNs t) {
 void BeltUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }
 
 void BeltUnit::Initialize() {
-  Validate();
+  ThrowIfBadParameters();
   for (std::size_t b = 0; b < nominal_speed_.size(); ++b) {
     belt_speed_[b] = TargetSpeed(b, ScheduledOn(static_cast<int>(b), start_), start_);
   }

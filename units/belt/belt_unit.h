@@ -69,11 +69,9 @@ class BeltUnit : public cosim::Unit {
   void RestoreInternal(const cosim::UnitState& state) override;
 
  private:
-  void Validate() const;
   /// Speed the belt tends to at time t in the given scheduled state.
   double TargetSpeed(std::size_t b, bool on, cosim::TimeNs t) const;
   void ComputeOutputs(cosim::TimeNs t);
-  std::string Where() const;
 
   int belt_count_;
   std::vector<std::vector<Switch>> schedules_;

@@ -212,8 +212,6 @@ ChassisUnit::ChassisUnit(std::string name, int wheel_count, int belt_count)
 
 ChassisUnit::~ChassisUnit() = default;
 
-std::string ChassisUnit::Where() const { return "unit '" + name() + "' (" + kTypeName + ")"; }
-
 std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
   std::vector<cosim::ParameterProblem> problems;
   const auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
@@ -271,20 +269,6 @@ std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
   array("belt_width", belt_width_, positive, kPositive);
   array("belt_direction", belt_direction_, finite, "must be finite");
   return problems;
-}
-
-void ChassisUnit::Validate() const {
-  const auto problems = CheckParameters();
-  if (problems.empty()) return;
-  std::string text = Where() + ": ";
-  for (std::size_t p = 0; p < problems.size(); ++p) {
-    const auto& problem = problems[p];
-    if (p > 0) text += "; ";
-    text += "parameter '" + problem.variable +
-            (problem.index ? "[" + std::to_string(*problem.index) + "]" : "") + "' " +
-            problem.message;
-  }
-  throw cosim::UnitError(text);
 }
 
 void ChassisUnit::Build() {
@@ -435,7 +419,7 @@ void ChassisUnit::Initialize() {
   // Settling uses only the parameters (belts still, joints held), so an
   // unchanged, unstepped world is already what a rebuild would give.
   if (!initialized_ || stepped_since_settle_ || parameters != settled_parameters_) {
-    Validate();
+    ThrowIfBadParameters();
     initialized_ = false;
     Build();
     Settle();
@@ -590,7 +574,7 @@ void ChassisUnit::RestoreInternal(const cosim::UnitState& state) {
   if (!init) return;
   // Parameters came back with the variables: the same build as Initialize,
   // then every body state exactly as saved.
-  Validate();
+  ThrowIfBadParameters();
   Build();
   const double* r = state.reals.data();
   for (std::size_t i = 0; i < bodies; ++i, r += kRealsPerBody) {

@@ -66,7 +66,6 @@ class ChassisUnit : public cosim::Unit {
   // The ODE objects; defined in the .cc so that ODE stays private.
   struct Ode;
 
-  void Validate() const;
   /// Creates a fresh world with the robot at the initial pose (no settle).
   void Build();
   void Settle();
@@ -77,7 +76,6 @@ class ChassisUnit : public cosim::Unit {
   /// Empty when every body state is finite, else what is not.
   std::string NonFiniteState() const;
   void ComputeOutputs();
-  std::string Where() const;
 
   int wheel_count_;
   int belt_count_;

@@ -52,8 +52,6 @@ PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
            {"pose"});
 }
 
-std::string PathFollowerUnit::Where() const { return "unit '" + name() + "' (" + kTypeName + ")"; }
-
 std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
   std::vector<cosim::ParameterProblem> problems;
   const std::size_t needed = mode_ == Mode::kPath ? 2 : 1;
@@ -95,22 +93,8 @@ std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
   return problems;
 }
 
-void PathFollowerUnit::Validate() const {
-  const auto problems = CheckParameters();
-  if (problems.empty()) return;
-  std::string text = Where() + ": ";
-  for (std::size_t p = 0; p < problems.size(); ++p) {
-    const auto& problem = problems[p];
-    if (p > 0) text += "; ";
-    text += "parameter '" + problem.variable +
-            (problem.index ? "[" + std::to_string(*problem.index) + "]" : "") + "' " +
-            problem.message;
-  }
-  throw cosim::UnitError(text);
-}
-
 void PathFollowerUnit::Initialize() {
-  Validate();
+  ThrowIfBadParameters();
   ramp_mps_ = 0.0;
   done_latched_ = false;
   initialized_ = true;

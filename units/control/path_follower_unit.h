@@ -65,8 +65,6 @@ class PathFollowerUnit : public cosim::Unit {
   };
   Sample Evaluate() const;
   void ComputeOutputs();
-  void Validate() const;
-  std::string Where() const;
 
   Mode mode_;
   std::vector<std::array<double, 2>> waypoints_m_;

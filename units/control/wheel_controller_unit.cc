@@ -144,10 +144,6 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
            "slew-limited wheel rate reference at this sample", {});
 }
 
-std::string WheelControllerUnit::Where() const {
-  return "unit '" + name() + "' (" + kTypeName + ")";
-}
-
 std::vector<cosim::ParameterProblem> WheelControllerUnit::CheckParameters() const {
   std::vector<cosim::ParameterProblem> problems;
   for (const auto& [var, p] : {std::pair{"wheel_x", &wheel_x_}, {"wheel_y", &wheel_y_}}) {
@@ -186,22 +182,8 @@ std::vector<cosim::ParameterProblem> WheelControllerUnit::CheckParameters() cons
   return problems;
 }
 
-void WheelControllerUnit::Validate() const {
-  const auto problems = CheckParameters();
-  if (problems.empty()) return;
-  std::string text = Where() + ": ";
-  for (std::size_t p = 0; p < problems.size(); ++p) {
-    const auto& problem = problems[p];
-    if (p > 0) text += "; ";
-    text += "parameter '" + problem.variable +
-            (problem.index ? "[" + std::to_string(*problem.index) + "]" : "") + "' " +
-            problem.message;
-  }
-  throw cosim::UnitError(text);
-}
-
 void WheelControllerUnit::Initialize() {
-  Validate();
+  ThrowIfBadParameters();
   // Start from where the wheels point, at rest, so nothing jumps at t = 0.
   for (std::size_t i = 0; i < steer_ref_.size(); ++i) {
     const double a = WrapAngle(steer_angle_[i]);

@@ -65,8 +65,6 @@ class WheelControllerUnit : public cosim::Unit {
   };
   Voltages Compute(std::size_t i) const;
   void ComputeOutputs();
-  void Validate() const;
-  std::string Where() const;
 
   int wheel_count_;
 

@@ -193,8 +193,6 @@ DcMotorUnit::DcMotorUnit(std::string name, int count, MotorMode mode,
 
 DcMotorUnit::~DcMotorUnit() = default;
 
-std::string DcMotorUnit::Where() const { return "unit '" + name() + "' (" + kTypeName + ")"; }
-
 void DcMotorUnit::Check(int flag, const char* function, cosim::TimeNs t) const {
   if (flag >= 0) return;
   // The CVLS functions have their own flag names. Both return a malloc'ed
@@ -291,21 +289,6 @@ std::vector<cosim::ParameterProblem> DcMotorUnit::CheckParameters() const {
   return problems;
 }
 
-void DcMotorUnit::Validate() const {
-  const auto problems = CheckParameters();
-  if (problems.empty()) return;
-  // Every bad value at once, each as 'name[index]': what was expected.
-  std::string text = Where() + ": ";
-  for (std::size_t p = 0; p < problems.size(); ++p) {
-    const auto& problem = problems[p];
-    if (p > 0) text += "; ";
-    text += "parameter '" + problem.variable +
-            (problem.index ? "[" + std::to_string(*problem.index) + "]" : "") + "' " +
-            problem.message;
-  }
-  throw cosim::UnitError(text);
-}
-
 void DcMotorUnit::ComputeCoefficients() {
   const auto n = static_cast<std::size_t>(count_);
   di_di_.resize(n);
@@ -396,7 +379,7 @@ void DcMotorUnit::ComputeOutputs() {
 }
 
 void DcMotorUnit::Initialize() {
-  Validate();
+  ThrowIfBadParameters();
   ComputeCoefficients();
   SetTolerances();
   first_order_ = mode_ == MotorMode::kCurrentOnly && shaft_speed_hold_ == "first_order";
@@ -541,7 +524,7 @@ void DcMotorUnit::RestoreInternal(const cosim::UnitState& state) {
   previous_sample_time_ = state.integers[2];
   // Parameters came back with the variables: derive from them again.
   if (initialized_) {
-    Validate();
+    ThrowIfBadParameters();
     ComputeCoefficients();
     SetTolerances();
     first_order_ = mode_ == MotorMode::kCurrentOnly && shaft_speed_hold_ == "first_order";

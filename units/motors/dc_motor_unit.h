@@ -82,7 +82,6 @@ class DcMotorUnit : public cosim::Unit {
   /// The band Jacobian: only the 2x2 (or 1x1) diagonal blocks are non-zero.
   void FillJacobian(::_generic_SUNMatrix* jac) const;
 
-  void Validate() const;
   void ComputeCoefficients();
   void ComputeOutputs();
   bool InputsChanged() const;
@@ -95,7 +94,6 @@ class DcMotorUnit : public cosim::Unit {
   void Check(int flag, const char* function, cosim::TimeNs t) const;
   std::string WorstState() const;
   void SetTolerances();
-  std::string Where() const;
 
   int count_;
   MotorMode mode_;
