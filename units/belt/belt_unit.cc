@@ -6,13 +6,9 @@
 #include <random>
 #include <utility>
 
+#include "cosim/parameter_checks.h"
+
 namespace linesim::belt {
-
-namespace {
-
-std::string FormatNumber(double x) { return cosim::FormatValue(cosim::Value{x}); }
-
-}  // namespace
 
 BeltUnit::BeltUnit(std::string name, int belt_count, std::vector<std::vector<Switch>> schedules,
                    std::uint64_t seed)
@@ -92,41 +88,32 @@ BeltUnit::BeltUnit(std::string name, int belt_count, std::vector<std::vector<Swi
 }
 
 std::vector<cosim::ParameterProblem> BeltUnit::CheckParameters() const {
-  std::vector<cosim::ParameterProblem> problems;
-  const auto rule = [&](const char* var, const std::vector<double>& p, auto ok,
-                        const char* expected) {
-    for (std::size_t k = 0; k < p.size(); ++k) {
-      if (!ok(p[k]))
-        problems.push_back({var, k, std::string(expected) + ", got " + FormatNumber(p[k])});
-    }
-  };
-  const auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
-  const auto finite = [](double x) { return std::isfinite(x); };
-  rule("center_x", center_x_, finite, "must be finite");
-  rule("center_y", center_y_, finite, "must be finite");
-  rule("length", length_, positive, "must be positive and finite");
-  rule("width", width_, positive, "must be positive and finite");
-  rule("direction", direction_, finite, "must be finite");
-  rule("nominal_speed", nominal_speed_, positive, "must be positive and finite");
-  rule(
+  cosim::ParameterChecks c;
+  c.Finite("center_x", center_x_);
+  c.Finite("center_y", center_y_);
+  c.Positive("length", length_);
+  c.Positive("width", width_);
+  c.Finite("direction", direction_);
+  c.Positive("nominal_speed", nominal_speed_);
+  c.Check(
       "initially_on", initially_on_, [](double x) { return x == 0.0 || x == 1.0; },
       "must be 0 (off) or 1 (on)");
-  rule(
+  c.Check(
       "speed_variation", speed_variation_, [](double x) { return x >= 0.0 && x <= 0.5; },
       "must be in [0, 0.5]");
-  rule("variation_period", variation_period_, positive, "must be positive and finite");
-  rule("acceleration", acceleration_, positive, "must be positive and finite");
+  c.Positive("variation_period", variation_period_);
+  c.Positive("acceleration", acceleration_);
   for (std::size_t b = 0; b < schedules_.size(); ++b) {
     const auto& s = schedules_[b];
     for (std::size_t i = 1; i < s.size(); ++i) {
       if (s[i].time <= s[i - 1].time) {
-        problems.push_back({"schedules." + std::to_string(b), i,
-                            "switch times must increase, got " + cosim::FormatSeconds(s[i].time) +
-                                " s after " + cosim::FormatSeconds(s[i - 1].time) + " s"});
+        c.Add({"schedules." + std::to_string(b), i,
+               "switch times must increase, got " + cosim::FormatSeconds(s[i].time) +
+                   " s after " + cosim::FormatSeconds(s[i - 1].time) + " s"});
       }
     }
   }
-  return problems;
+  return c.Take();
 }
 
 double BeltUnit::VariationSignal(int b, cosim::TimeNs t) const {

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <utility>
 
+#include "cosim/parameter_checks.h"
 #include "units/chassis/floor_world.h"
 
 namespace linesim::chassis {
@@ -213,62 +214,44 @@ ChassisUnit::ChassisUnit(std::string name, int wheel_count, int belt_count)
 ChassisUnit::~ChassisUnit() = default;
 
 std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
-  std::vector<cosim::ParameterProblem> problems;
-  const auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
-  const auto non_negative = [](double x) { return x >= 0.0 && std::isfinite(x); };
-  const auto finite = [](double x) { return std::isfinite(x); };
-  const auto scalar = [&](const char* var, double x, auto ok, const char* expected) {
-    if (!ok(x))
-      problems.push_back({var, std::nullopt, std::string(expected) + ", got " + FormatNumber(x)});
-  };
-  const auto array = [&](const char* var, const std::vector<double>& p, auto ok,
-                         const char* expected) {
-    for (std::size_t k = 0; k < p.size(); ++k) {
-      if (!ok(p[k]))
-        problems.push_back({var, k, std::string(expected) + ", got " + FormatNumber(p[k])});
-    }
-  };
-  const char* kPositive = "must be positive and finite";
-  const char* kNonNegative = "must be zero or positive and finite";
-  scalar("body_length", body_length_, positive, kPositive);
-  scalar("body_width", body_width_, positive, kPositive);
-  scalar("body_height", body_height_, positive, kPositive);
-  scalar("mass", mass_, positive, kPositive);
-  scalar("module_mass", module_mass_, positive, kPositive);
-  if (positive(mass_) && positive(module_mass_) && !(wheel_count_ * module_mass_ < mass_)) {
-    problems.push_back({"module_mass", std::nullopt,
-                        "times " + std::to_string(wheel_count_) +
-                            " modules must be less than mass " + FormatNumber(mass_) + ", got " +
-                            FormatNumber(module_mass_)});
+  cosim::ParameterChecks c;
+  c.Positive("body_length", body_length_);
+  c.Positive("body_width", body_width_);
+  c.Positive("body_height", body_height_);
+  c.Positive("mass", mass_);
+  c.Positive("module_mass", module_mass_);
+  if (mass_ > 0.0 && module_mass_ > 0.0 && !(wheel_count_ * module_mass_ < mass_)) {
+    c.Add({"module_mass", std::nullopt,
+           "times " + std::to_string(wheel_count_) + " modules must be less than mass " +
+               FormatNumber(mass_) + ", got " + FormatNumber(module_mass_)});
   }
-  scalar("com_height", com_height_, positive, kPositive);
-  scalar("wheel_radius", wheel_radius_, positive, kPositive);
-  array("wheel_x", wheel_x_, finite, "must be finite");
-  array("wheel_y", wheel_y_, finite, "must be finite");
-  scalar("steer_rotor_inertia", steer_rotor_inertia_, non_negative, kNonNegative);
-  scalar("drive_rotor_inertia", drive_rotor_inertia_, non_negative, kNonNegative);
-  scalar("steer_friction", steer_friction_, non_negative, kNonNegative);
-  scalar("drive_friction", drive_friction_, non_negative, kNonNegative);
-  scalar("friction", friction_, non_negative, kNonNegative);
-  scalar("contact_stiffness", contact_stiffness_, positive, kPositive);
-  scalar("contact_damping", contact_damping_, non_negative, kNonNegative);
-  scalar("slip_damping", slip_damping_, positive, kPositive);
-  scalar("suspension_stiffness", suspension_stiffness_, positive, kPositive);
-  scalar("suspension_damping", suspension_damping_, non_negative, kNonNegative);
-  scalar("brake_torque", brake_torque_, non_negative, kNonNegative);
+  c.Positive("com_height", com_height_);
+  c.Positive("wheel_radius", wheel_radius_);
+  c.Finite("wheel_x", wheel_x_);
+  c.Finite("wheel_y", wheel_y_);
+  c.NonNegative("steer_rotor_inertia", steer_rotor_inertia_);
+  c.NonNegative("drive_rotor_inertia", drive_rotor_inertia_);
+  c.NonNegative("steer_friction", steer_friction_);
+  c.NonNegative("drive_friction", drive_friction_);
+  c.NonNegative("friction", friction_);
+  c.Positive("contact_stiffness", contact_stiffness_);
+  c.NonNegative("contact_damping", contact_damping_);
+  c.Positive("slip_damping", slip_damping_);
+  c.Positive("suspension_stiffness", suspension_stiffness_);
+  c.NonNegative("suspension_damping", suspension_damping_);
+  c.NonNegative("brake_torque", brake_torque_);
   if (substeps_ < 1 || substeps_ > 1000) {
-    problems.push_back(
-        {"substeps", std::nullopt, "must be 1 to 1000, got " + std::to_string(substeps_)});
+    c.Add({"substeps", std::nullopt, "must be 1 to 1000, got " + std::to_string(substeps_)});
   }
-  scalar("initial_x", initial_x_, finite, "must be finite");
-  scalar("initial_y", initial_y_, finite, "must be finite");
-  scalar("initial_yaw", initial_yaw_, finite, "must be finite");
-  array("belt_center_x", belt_center_x_, finite, "must be finite");
-  array("belt_center_y", belt_center_y_, finite, "must be finite");
-  array("belt_length", belt_length_, positive, kPositive);
-  array("belt_width", belt_width_, positive, kPositive);
-  array("belt_direction", belt_direction_, finite, "must be finite");
-  return problems;
+  c.Finite("initial_x", initial_x_);
+  c.Finite("initial_y", initial_y_);
+  c.Finite("initial_yaw", initial_yaw_);
+  c.Finite("belt_center_x", belt_center_x_);
+  c.Finite("belt_center_y", belt_center_y_);
+  c.Positive("belt_length", belt_length_);
+  c.Positive("belt_width", belt_width_);
+  c.Finite("belt_direction", belt_direction_);
+  return c.Take();
 }
 
 void ChassisUnit::Build() {

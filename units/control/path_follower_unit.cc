@@ -4,6 +4,7 @@
 #include <cmath>
 #include <utility>
 
+#include "cosim/parameter_checks.h"
 #include "units/control/wheel_kinematics.h"
 
 namespace linesim::control {
@@ -70,26 +71,17 @@ std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
       problems.push_back({"waypoints", k, "repeats the previous waypoint (zero-length segment)"});
     }
   }
-  const auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
-  const auto non_negative = [](double x) { return x >= 0.0 && std::isfinite(x); };
-  const auto rule = [&](const char* var, double value, auto ok, const char* expected) {
-    if (!ok(value)) {
-      problems.push_back(
-          {var, std::nullopt, std::string(expected) + ", got " + FormatNumber(value)});
-    }
-  };
-  constexpr const char* kPositive = "must be positive and finite";
-  constexpr const char* kNonNegative = "must be zero or positive and finite";
-  rule("speed", speed_, positive, kPositive);
-  rule("acceleration", acceleration_, positive, kPositive);
-  rule(
-      "yaw", yaw_, [](double x) { return std::isfinite(x); }, "must be finite");
-  rule("k_cross", k_cross_, non_negative, kNonNegative);
-  rule("k_position", k_position_, positive, kPositive);
-  rule("k_yaw", k_yaw_, non_negative, kNonNegative);
-  rule("max_speed", max_speed_, positive, kPositive);
-  rule("max_yaw_rate", max_yaw_rate_, non_negative, kNonNegative);
-  rule("goal_tolerance", goal_tolerance_, positive, kPositive);
+  cosim::ParameterChecks c;
+  c.Positive("speed", speed_);
+  c.Positive("acceleration", acceleration_);
+  c.Finite("yaw", yaw_);
+  c.NonNegative("k_cross", k_cross_);
+  c.Positive("k_position", k_position_);
+  c.NonNegative("k_yaw", k_yaw_);
+  c.Positive("max_speed", max_speed_);
+  c.NonNegative("max_yaw_rate", max_yaw_rate_);
+  c.Positive("goal_tolerance", goal_tolerance_);
+  for (auto& problem : c.Take()) problems.push_back(std::move(problem));
   return problems;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <utility>
 
+#include "cosim/parameter_checks.h"
 #include "units/control/wheel_kinematics.h"
 
 namespace linesim::control {
@@ -145,41 +146,25 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
 }
 
 std::vector<cosim::ParameterProblem> WheelControllerUnit::CheckParameters() const {
-  std::vector<cosim::ParameterProblem> problems;
-  for (const auto& [var, p] : {std::pair{"wheel_x", &wheel_x_}, {"wheel_y", &wheel_y_}}) {
-    for (std::size_t k = 0; k < p->size(); ++k) {
-      if (!std::isfinite((*p)[k]))
-        problems.push_back({var, k, "must be finite, got " + FormatNumber((*p)[k])});
-    }
-  }
-  const auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
-  const auto non_negative = [](double x) { return x >= 0.0 && std::isfinite(x); };
-  const auto rule = [&](const char* var, double value, auto ok, const char* expected) {
-    if (!ok(value)) {
-      problems.push_back(
-          {var, std::nullopt, std::string(expected) + ", got " + FormatNumber(value)});
-    }
-  };
-  constexpr const char* kPositive = "must be positive and finite";
-  constexpr const char* kNonNegative = "must be zero or positive and finite";
-  rule("wheel_radius", wheel_radius_, positive, kPositive);
-  rule("zero_speed_threshold", zero_speed_threshold_, non_negative, kNonNegative);
-  rule("steer_kp", steer_kp_, non_negative, kNonNegative);
-  rule("steer_kd", steer_kd_, non_negative, kNonNegative);
-  rule("steer_feedforward", steer_feedforward_, non_negative, kNonNegative);
-  rule("steer_acceleration_feedforward", steer_acceleration_feedforward_, non_negative,
-       kNonNegative);
-  rule("steer_max_rate", steer_max_rate_, positive, kPositive);
-  rule("steer_max_acceleration", steer_max_acceleration_, positive, kPositive);
-  rule("drive_feedforward", drive_feedforward_, non_negative, kNonNegative);
-  rule("drive_acceleration_feedforward", drive_acceleration_feedforward_, non_negative,
-       kNonNegative);
-  rule("drive_kp", drive_kp_, non_negative, kNonNegative);
-  rule("drive_ki", drive_ki_, non_negative, kNonNegative);
-  rule("drive_max_rate", drive_max_rate_, positive, kPositive);
-  rule("drive_max_acceleration", drive_max_acceleration_, positive, kPositive);
-  rule("max_voltage", max_voltage_, positive, kPositive);
-  return problems;
+  cosim::ParameterChecks c;
+  c.Finite("wheel_x", wheel_x_);
+  c.Finite("wheel_y", wheel_y_);
+  c.Positive("wheel_radius", wheel_radius_);
+  c.NonNegative("zero_speed_threshold", zero_speed_threshold_);
+  c.NonNegative("steer_kp", steer_kp_);
+  c.NonNegative("steer_kd", steer_kd_);
+  c.NonNegative("steer_feedforward", steer_feedforward_);
+  c.NonNegative("steer_acceleration_feedforward", steer_acceleration_feedforward_);
+  c.Positive("steer_max_rate", steer_max_rate_);
+  c.Positive("steer_max_acceleration", steer_max_acceleration_);
+  c.NonNegative("drive_feedforward", drive_feedforward_);
+  c.NonNegative("drive_acceleration_feedforward", drive_acceleration_feedforward_);
+  c.NonNegative("drive_kp", drive_kp_);
+  c.NonNegative("drive_ki", drive_ki_);
+  c.Positive("drive_max_rate", drive_max_rate_);
+  c.Positive("drive_max_acceleration", drive_max_acceleration_);
+  c.Positive("max_voltage", max_voltage_);
+  return c.Take();
 }
 
 void WheelControllerUnit::Initialize() {

@@ -12,6 +12,8 @@
 #include <cstring>
 #include <utility>
 
+#include "cosim/parameter_checks.h"
+
 namespace linesim::motors {
 
 namespace {
@@ -252,41 +254,28 @@ std::string DcMotorUnit::WorstState() const {
 }
 
 std::vector<cosim::ParameterProblem> DcMotorUnit::CheckParameters() const {
-  std::vector<cosim::ParameterProblem> problems;
-  const auto rule = [&](const char* var, const std::vector<double>& p, auto ok,
-                        const char* expected) {
-    for (std::size_t k = 0; k < p.size(); ++k) {
-      if (!ok(p[k]))
-        problems.push_back({var, k, std::string(expected) + ", got " + FormatNumber(p[k])});
-    }
-  };
-  const auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
-  const auto non_negative = [](double x) { return x >= 0.0 && std::isfinite(x); };
-  const auto finite = [](double x) { return std::isfinite(x); };
-  const auto efficiency = [](double x) { return x > 0.0 && x <= 1.0; };
-  rule("resistance", resistance_, positive, "must be positive and finite");
-  rule("inductance", inductance_, positive, "must be positive and finite");
-  rule("torque_constant", torque_constant_, positive, "must be positive and finite");
-  rule("rotor_inertia", rotor_inertia_, positive, "must be positive and finite");
-  rule("viscous_friction", viscous_friction_, non_negative, "must be zero or positive and finite");
-  rule("gear_ratio", gear_ratio_, positive, "must be positive and finite");
-  rule("gear_efficiency", gear_efficiency_, efficiency, "must be in (0, 1]");
-  rule("initial_current", initial_current_, finite, "must be finite");
+  cosim::ParameterChecks c;
+  c.Positive("resistance", resistance_);
+  c.Positive("inductance", inductance_);
+  c.Positive("torque_constant", torque_constant_);
+  c.Positive("rotor_inertia", rotor_inertia_);
+  c.NonNegative("viscous_friction", viscous_friction_);
+  c.Positive("gear_ratio", gear_ratio_);
+  c.Check(
+      "gear_efficiency", gear_efficiency_, [](double x) { return x > 0.0 && x <= 1.0; },
+      "must be in (0, 1]");
+  c.Finite("initial_current", initial_current_);
   if (mode_ == MotorMode::kFull) {
-    rule("load_inertia", load_inertia_, non_negative, "must be zero or positive and finite");
-    rule("initial_speed", initial_speed_, finite, "must be finite");
+    c.NonNegative("load_inertia", load_inertia_);
+    c.Finite("initial_speed", initial_speed_);
   }
   if (shaft_speed_hold_ != "zero_order" && shaft_speed_hold_ != "first_order") {
-    problems.push_back({"shaft_speed_hold", std::nullopt,
-                        "must be zero_order or first_order, got '" + shaft_speed_hold_ + "'"});
+    c.Add({"shaft_speed_hold", std::nullopt,
+           "must be zero_order or first_order, got '" + shaft_speed_hold_ + "'"});
   }
-  for (const auto& [var, value] : {std::pair{"rel_tol", rel_tol_}, {"abs_tol", abs_tol_}}) {
-    if (!positive(value)) {
-      problems.push_back(
-          {var, std::nullopt, "must be positive and finite, got " + FormatNumber(value)});
-    }
-  }
-  return problems;
+  c.Positive("rel_tol", rel_tol_);
+  c.Positive("abs_tol", abs_tol_);
+  return c.Take();
 }
 
 void DcMotorUnit::ComputeCoefficients() {
