@@ -1,5 +1,7 @@
 #include "app/commands.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -7,7 +9,6 @@
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
-#include <yaml-cpp/yaml.h>
 #include <sstream>
 
 #include "cosim/observers.h"
@@ -96,8 +97,8 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
                                     "chassis.wheel_contact[" + std::to_string(2 * w + 1) + "]");
   }
   spec.error_column = "deviation.deviation";
-  spec.error_label = robot.task == "path" ? "deviation from the path (m)"
-                                          : "drift from the held position (m)";
+  spec.error_label =
+      robot.task == "path" ? "deviation from the path (m)" : "drift from the held position (m)";
   for (std::size_t b = 0; b < robot.belts.size(); ++b) {
     spec.belt_speed_columns.push_back("belt.speed[" + std::to_string(b) + "]");
     spec.belt_on_columns.push_back("belt.on[" + std::to_string(b) + "]");

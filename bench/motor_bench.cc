@@ -28,9 +28,9 @@ constexpr int kMotors = 8;
 constexpr TimeNs kMs = 1'000'000;
 
 enum class Inputs {
-  kConstant,       // voltage set once: CVODE never restarts
-  kEvery20ms,      // new voltage every 20 ms (the controller cycle)
-  kEveryStep,      // new voltage every communication step
+  kConstant,        // voltage set once: CVODE never restarts
+  kEvery20ms,       // new voltage every 20 ms (the controller cycle)
+  kEveryStep,       // new voltage every communication step
   kSpeedEveryStep,  // current-only: shaft speed changes every step
   kRobot            // current-only: shaft speed every step, voltage every 20 ms
 };
@@ -141,16 +141,31 @@ void Register() {
        Inputs::kSpeedEveryStep},
       // The robot's case: voltage from the 20 ms controller, shaft speed from
       // the 1 ms physics, held to first order without restarts.
-      {"BM_Motor8CurrentOnly/1ms_speed_change_first_order", MotorMode::kCurrentOnly, kMs,
-       Inputs::kSpeedEveryStep, {"first_order", 1e-8}},
-      {"BM_Motor8CurrentOnly/1ms_robot_zoh_rtol1e-6", MotorMode::kCurrentOnly, kMs,
-       Inputs::kRobot, {"zero_order", 1e-6}},
-      {"BM_Motor8CurrentOnly/1ms_robot_first_order_rtol1e-8", MotorMode::kCurrentOnly, kMs,
-       Inputs::kRobot, {"first_order", 1e-8}},
-      {"BM_Motor8CurrentOnly/1ms_robot_first_order_rtol1e-6", MotorMode::kCurrentOnly, kMs,
-       Inputs::kRobot, {"first_order", 1e-6}},
-      {"BM_Motor8CurrentOnly/1ms_robot_first_order_rtol1e-4", MotorMode::kCurrentOnly, kMs,
-       Inputs::kRobot, {"first_order", 1e-4}},
+      {"BM_Motor8CurrentOnly/1ms_speed_change_first_order",
+       MotorMode::kCurrentOnly,
+       kMs,
+       Inputs::kSpeedEveryStep,
+       {"first_order", 1e-8}},
+      {"BM_Motor8CurrentOnly/1ms_robot_zoh_rtol1e-6",
+       MotorMode::kCurrentOnly,
+       kMs,
+       Inputs::kRobot,
+       {"zero_order", 1e-6}},
+      {"BM_Motor8CurrentOnly/1ms_robot_first_order_rtol1e-8",
+       MotorMode::kCurrentOnly,
+       kMs,
+       Inputs::kRobot,
+       {"first_order", 1e-8}},
+      {"BM_Motor8CurrentOnly/1ms_robot_first_order_rtol1e-6",
+       MotorMode::kCurrentOnly,
+       kMs,
+       Inputs::kRobot,
+       {"first_order", 1e-6}},
+      {"BM_Motor8CurrentOnly/1ms_robot_first_order_rtol1e-4",
+       MotorMode::kCurrentOnly,
+       kMs,
+       Inputs::kRobot,
+       {"first_order", 1e-4}},
   };
   for (const Case& c : kCases) {
     benchmark::RegisterBenchmark(c.name, [c](benchmark::State& s) {

@@ -43,7 +43,7 @@ void BM_Scenario(benchmark::State& state, const std::string& file,
   }
 }
 
-#define LINESIM_SCENARIO(name, file, ...)                                                    \
+#define LINESIM_SCENARIO(name, file, ...)                                                  \
   BENCHMARK_CAPTURE(BM_Scenario, name, std::string(LINESIM_SOURCE_DIR "/scenarios/" file), \
                     std::vector<std::string>{__VA_ARGS__})                                 \
       ->Unit(benchmark::kMillisecond)                                                      \

@@ -14,8 +14,8 @@ bool IsFinite(double x) { return std::isfinite(x); }
 
 }  // namespace
 
-void ParameterChecks::Add(const char* name, std::optional<std::size_t> index,
-                          const char* expected, double value) {
+void ParameterChecks::Add(const char* name, std::optional<std::size_t> index, const char* expected,
+                          double value) {
   problems_.push_back({name, index, std::string(expected) + ", got " + FormatValue(Value{value})});
 }
 

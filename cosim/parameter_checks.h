@@ -39,8 +39,7 @@ class ParameterChecks {
   std::vector<ParameterProblem> Take() { return std::move(problems_); }
 
  private:
-  void Add(const char* name, std::optional<std::size_t> index, const char* expected,
-           double value);
+  void Add(const char* name, std::optional<std::size_t> index, const char* expected, double value);
 
   std::vector<ParameterProblem> problems_;
 };

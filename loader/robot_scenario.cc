@@ -64,10 +64,10 @@ class Expander {
       : root_(root), r_(r), info_(info) {}
 
   YAML::Node Expand() {
-    r_.CheckKeys(root_, "",
-                 {"name", "description", "duration_s", "seed", "master", "robot", "line",
-                  "control", "task", "sensing", "localization", "units", "connections",
-                  "recording", "metrics"});
+    r_.CheckKeys(
+        root_, "",
+        {"name", "description", "duration_s", "seed", "master", "robot", "line", "control", "task",
+         "sensing", "localization", "units", "connections", "recording", "metrics"});
     for (const char* key : {"name", "description", "duration_s", "seed", "master"}) {
       if (Child(root_, key).IsDefined()) out_[key] = Child(root_, key);
     }
@@ -212,10 +212,10 @@ class Expander {
         const std::string path = JoinPath("line.belts", std::to_string(i));
         const YAML::Node b = belts[i];
         if (!r_.ExpectMap(b, path)) continue;
-        r_.CheckKeys(b, path,
-                     {"center_x_m", "center_y_m", "length_m", "width_m", "direction_deg",
-                      "speed_mps", "speed_variation", "variation_period_s", "acceleration_mps2",
-                      "schedule"});
+        r_.CheckKeys(
+            b, path,
+            {"center_x_m", "center_y_m", "length_m", "width_m", "direction_deg", "speed_mps",
+             "speed_variation", "variation_period_s", "acceleration_mps2", "schedule"});
         RobotInfo::Belt belt{};
         belt.center_x_m = r_.Real(b, path, "center_x_m", std::nullopt, {-1e6, 1e6});
         belt.center_y_m = r_.Real(b, path, "center_y_m", std::nullopt, {-1e6, 1e6});
@@ -331,9 +331,9 @@ class Expander {
   }
 
   void Task() {
-    const YAML::Node task = Section(root_, "", "task",
-                                    {"type", "waypoints", "point", "speed_mps",
-                                     "acceleration_mps2", "yaw_deg"});
+    const YAML::Node task =
+        Section(root_, "", "task",
+                {"type", "waypoints", "point", "speed_mps", "acceleration_mps2", "yaw_deg"});
     info_.task = r_.String(task, "task", "type", std::nullopt, {"path", "hold"});
     Unit(kPathFollower)["type"] = "path_follower";
     YAML::Node p = Params(kPathFollower);
@@ -347,8 +347,8 @@ class Expander {
           r_.Error(waypoints, "task.waypoints", "expected at least two points [x, y]");
         }
         for (std::size_t i = 0; i < waypoints.size(); ++i) {
-          if (auto pt = ReadPoint(waypoints[i], JoinPath("task.waypoints", std::to_string(i)),
-                                  r_)) {
+          if (auto pt =
+                  ReadPoint(waypoints[i], JoinPath("task.waypoints", std::to_string(i)), r_)) {
             info_.path.push_back(*pt);
           }
         }
@@ -418,8 +418,8 @@ class Expander {
     for (const char* v :
          {"chassis.pose", "chassis.velocity", "chassis.steer_angle", "chassis.drive_rate",
           "chassis.wheel_surface", "chassis.wheel_contact", "path_follower.twist_command",
-          "wheel_controller.steer_voltage", "wheel_controller.drive_voltage",
-          "motors.current", "deviation.deviation"}) {
+          "wheel_controller.steer_voltage", "wheel_controller.drive_voltage", "motors.current",
+          "deviation.deviation"}) {
       vars.push_back(v);
     }
     if (!info_.belts.empty()) {

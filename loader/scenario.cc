@@ -436,9 +436,10 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
   }
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) {
-    throw ScenarioError({{file, 0, "",
-                          fs::exists(file, ec) ? "is not a file (a folder?): expected a YAML file"
-                                               : "cannot read the file (missing or not readable)"}});
+    throw ScenarioError(
+        {{file, 0, "",
+          fs::exists(file, ec) ? "is not a file (a folder?): expected a YAML file"
+                               : "cannot read the file (missing or not readable)"}});
   }
   YAML::Node tree;
   try {

@@ -1,12 +1,12 @@
 #include "loader/unit_types.h"
 
 #include "cosim/closest_names.h"
-#include "units/motors/dc_motor_unit.h"
 #include "units/belt/belt_unit.h"
 #include "units/chassis/chassis_unit.h"
 #include "units/control/path_follower_unit.h"
 #include "units/control/wheel_controller_unit.h"
 #include "units/evaluation/path_deviation.h"
+#include "units/motors/dc_motor_unit.h"
 #include "units/sources/step_signal.h"
 
 namespace linesim::loader {
@@ -38,8 +38,7 @@ std::unique_ptr<cosim::Unit> MakeStepSignal(const UnitBuildContext& c) {
       r.CheckKeys(item, item_path, {"time_s", "value"});
       sources::StepSignalUnit::Step step;
       // Bounded like duration_s, so that the time fits in int64 nanoseconds.
-      step.time =
-          cosim::SecondsToNs(r.Real(item, item_path, "time_s", std::nullopt, {0.0, 1e7}));
+      step.time = cosim::SecondsToNs(r.Real(item, item_path, "time_s", std::nullopt, {0.0, 1e7}));
       const YAML::Node value = Child(item, "value");
       const std::string value_path = JoinPath(item_path, "value");
       if (!value.IsDefined()) {
@@ -111,10 +110,11 @@ std::unique_ptr<cosim::Unit> MakePathFollower(const UnitBuildContext& c) {
   const std::string mode = c.reader.String(c.parameters, c.path, "mode", "path", {"path", "hold"});
   std::vector<std::array<double, 2>> waypoints = ReadPoints(c, "waypoints", 1);
   if (!c.parameters.IsDefined() || c.parameters.IsNull()) waypoints = {{0.0, 0.0}, {1.0, 0.0}};
-  return std::make_unique<control::PathFollowerUnit>(
-      c.name, mode == "hold" ? control::PathFollowerUnit::Mode::kHold
-                             : control::PathFollowerUnit::Mode::kPath,
-      std::move(waypoints));
+  return std::make_unique<control::PathFollowerUnit>(c.name,
+                                                     mode == "hold"
+                                                         ? control::PathFollowerUnit::Mode::kHold
+                                                         : control::PathFollowerUnit::Mode::kPath,
+                                                     std::move(waypoints));
 }
 
 std::unique_ptr<cosim::Unit> MakePathDeviation(const UnitBuildContext& c) {
@@ -145,8 +145,8 @@ std::unique_ptr<cosim::Unit> MakeBelt(const UnitBuildContext& c) {
         r.CheckKeys(item, item_path, {"time_s", "on"});
         // Bounded like duration_s, so that the time fits in int64 nanoseconds.
         const double t = r.Real(item, item_path, "time_s", std::nullopt, {0.0, 1e7});
-        schedules.back().push_back({cosim::SecondsToNs(t), r.Boolean(item, item_path, "on",
-                                                                     std::nullopt)});
+        schedules.back().push_back(
+            {cosim::SecondsToNs(t), r.Boolean(item, item_path, "on", std::nullopt)});
       }
     }
   }

@@ -15,7 +15,8 @@ TEST(ParameterChecks, RulesNameTheVariableTheElementAndTheValue) {
   c.Positive("mass", 0.0);
   c.NonNegative("friction", std::vector<double>{0.0, -1.0, 2.0});
   c.Finite("x", std::numeric_limits<double>::infinity());
-  c.Check("eta", 1.5, [](double v) { return v > 0.0 && v <= 1.0; }, "must be in (0, 1]");
+  c.Check(
+      "eta", 1.5, [](double v) { return v > 0.0 && v <= 1.0; }, "must be in (0, 1]");
   c.Positive("fine", 3.0);
   const auto problems = c.Take();
   ASSERT_EQ(problems.size(), 4u);

@@ -49,8 +49,8 @@ bool BoolParam(const Scenario& s, const std::string& unit, const std::string& na
 TEST(RobotScenario, CrossLineExpandsIntoTheRobotUnits) {
   const Scenario s = LoadScenario(kCross);
   ASSERT_TRUE(s.robot);
-  for (const char* unit : {"belt", "chassis", "motors", "wheel_controller",
-                           "path_follower", "deviation"}) {
+  for (const char* unit :
+       {"belt", "chassis", "motors", "wheel_controller", "path_follower", "deviation"}) {
     EXPECT_TRUE(s.system->FindUnit(unit)) << unit;
   }
   EXPECT_EQ(s.master->decimation(*s.system->FindUnit("wheel_controller")), 20);
@@ -77,10 +77,9 @@ TEST(RobotScenario, CrossLineExpandsIntoTheRobotUnits) {
 // must reach the unit parameter it stands for.
 TEST(RobotScenario, ReservedOverridePathsReachTheUnits) {
   const Scenario s = LoadScenario(
-      kCross, {"line.belts.0.speed_mps=0.15", "control.compensation=false",
-               "robot.pose.yaw_deg=30", "seed=7", "master.algorithm=jacobi",
-               "master.step_s=0.002", "sensing.surface_velocity=ground_truth",
-               "localization.source=ground_truth"});
+      kCross, {"line.belts.0.speed_mps=0.15", "control.compensation=false", "robot.pose.yaw_deg=30",
+               "seed=7", "master.algorithm=jacobi", "master.step_s=0.002",
+               "sensing.surface_velocity=ground_truth", "localization.source=ground_truth"});
   EXPECT_EQ(Param(s, "belt", "nominal_speed"), 0.15);
   EXPECT_FALSE(BoolParam(s, "wheel_controller", "compensation"));
   EXPECT_NEAR(Param(s, "chassis", "initial_yaw"), 30.0 * std::numbers::pi / 180.0, 1e-15);

@@ -108,8 +108,8 @@ std::vector<cosim::ParameterProblem> BeltUnit::CheckParameters() const {
     for (std::size_t i = 1; i < s.size(); ++i) {
       if (s[i].time <= s[i - 1].time) {
         c.Add({"schedules." + std::to_string(b), i,
-               "switch times must increase, got " + cosim::FormatSeconds(s[i].time) +
-                   " s after " + cosim::FormatSeconds(s[i - 1].time) + " s"});
+               "switch times must increase, got " + cosim::FormatSeconds(s[i].time) + " s after " +
+                   cosim::FormatSeconds(s[i - 1].time) + " s"});
       }
     }
   }

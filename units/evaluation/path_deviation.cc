@@ -33,8 +33,7 @@ PathDeviationUnit::PathDeviationUnit(std::string name, std::vector<std::array<do
   v.Input("pose", "m", &pose_, "true pose x, y (m), yaw (rad) in the map frame");
   v.Output("deviation", "m", &deviation_,
            "distance of the robot centre from the desired path or held point", {"pose"});
-  v.Output("progress", "m", &progress_, "arc length of the nearest point along the path",
-           {"pose"});
+  v.Output("progress", "m", &progress_, "arc length of the nearest point along the path", {"pose"});
 }
 
 std::vector<cosim::ParameterProblem> PathDeviationUnit::CheckParameters() const {

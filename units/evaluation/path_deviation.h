@@ -15,8 +15,7 @@ struct PathDistance {
   double distance_m;
   double progress_m;
 };
-PathDistance DistanceToPath(const std::vector<std::array<double, 2>>& path, double x_m,
-                            double y_m);
+PathDistance DistanceToPath(const std::vector<std::array<double, 2>>& path, double x_m, double y_m);
 
 /// Ground-truth evaluation of a robot task: how far the robot's centre is
 /// from the desired path (a crossing) or from the held point (a position

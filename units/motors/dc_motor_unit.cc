@@ -492,8 +492,7 @@ void DcMotorUnit::SaveInternal(cosim::UnitState& state) const {
   // The first-order hold's previous sample decides the next slope, so it is
   // state too.
   state.reals = y_;
-  state.reals.insert(state.reals.end(), previous_shaft_speed_.begin(),
-                     previous_shaft_speed_.end());
+  state.reals.insert(state.reals.end(), previous_shaft_speed_.begin(), previous_shaft_speed_.end());
   state.integers = {end_time_, initialized_ ? 1 : 0, previous_sample_time_};
   restart_pending_ = true;
 }

@@ -6,9 +6,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <iostream>
 #include <cstring>
 #include <filesystem>
+#include <iostream>
 #include <numbers>
 #include <string>
 #include <variant>

@@ -468,7 +468,8 @@ TEST(DcMotorUnit, FirstOrderHoldTracksAContinuouslyVaryingShaftSpeed) {
   const auto exact = [&](double t) {
     const double z2 = r * r + l * l * omega * omega;
     const auto ip = [&](double s) {
-      return -(k * n * amplitude / z2) * (r * std::sin(omega * s) - l * omega * std::cos(omega * s));
+      return -(k * n * amplitude / z2) *
+             (r * std::sin(omega * s) - l * omega * std::cos(omega * s));
     };
     return volts / r + ip(t) - (volts / r + ip(0.0)) * std::exp(-t * r / l);
   };
@@ -500,9 +501,9 @@ TEST(DcMotorUnit, FirstOrderHoldTracksAContinuouslyVaryingShaftSpeed) {
   const Result foh = run("first_order", 1e-8);
   const Result foh_loose = run("first_order", 1e-3);  // models/robots/raw3.yaml
   std::cout << "max |current error| over 1 s: zero-order " << zoh.max_error << " A ("
-            << zoh.restarts << " restarts), first-order " << foh.max_error << " A ("
-            << foh.restarts << "), first-order rel_tol 1e-3 " << foh_loose.max_error << " A ("
-            << foh_loose.restarts << ")\n";
+            << zoh.restarts << " restarts), first-order " << foh.max_error << " A (" << foh.restarts
+            << "), first-order rel_tol 1e-3 " << foh_loose.max_error << " A (" << foh_loose.restarts
+            << ")\n";
   // Zero-order lag of half a step: about k N A W (h/2) / R = 0.067 A.
   EXPECT_GT(zoh.max_error, 0.03);
   EXPECT_LT(foh.max_error, 0.1 * zoh.max_error);
@@ -605,8 +606,7 @@ TEST(DcMotorUnit, IntegratorFailureNamesTheStateToBlame) {
     u.DoStep(0, kMs);
     FAIL() << "no error";
   } catch (const cosim::UnitError& e) {
-    EXPECT_NE(std::string(e.what()).find("the derivative of current[1] is inf"),
-              std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("the derivative of current[1] is inf"), std::string::npos)
         << e.what();
   }
 }
