@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "cosim/closest_names.h"
+#include "cosim/variable_table.h"
 #include "models/models_dir.h"
 
 namespace linesim::loader {
@@ -26,18 +27,18 @@ constexpr const char* kWheelController = "wheel_controller";
 constexpr const char* kPathFollower = "path_follower";
 constexpr const char* kDeviation = "deviation";
 
-YAML::Node Point(double x, double y) {
-  YAML::Node p(YAML::NodeType::Sequence);
-  p.push_back(x);
-  p.push_back(y);
-  return p;
-}
+// A number as the shortest text that reads back to it, so that the
+// expansion `linesim inspect` prints shows 0.9 rather than 0.90000000000000002.
+YAML::Node Num(double x) { return YAML::Node(cosim::FormatValue(cosim::Value{x})); }
 
 YAML::Node List(const std::vector<double>& values) {
   YAML::Node list(YAML::NodeType::Sequence);
-  for (double v : values) list.push_back(v);
+  list.SetStyle(YAML::EmitterStyle::Flow);
+  for (double v : values) list.push_back(Num(v));
   return list;
 }
+
+YAML::Node Point(double x, double y) { return List({x, y}); }
 
 // Reads an [x, y] pair at `path`.
 std::optional<std::array<double, 2>> ReadPoint(const YAML::Node& node, const std::string& path,
@@ -87,6 +88,7 @@ class Expander {
   YAML::Node Params(const char* name) { return out_["units"][name]["parameters"]; }
   void Connect(const std::string& from, const std::string& to) {
     YAML::Node c;
+    c.SetStyle(YAML::EmitterStyle::Flow);
     c["from"] = from;
     c["to"] = to;
     out_["connections"].push_back(c);
@@ -137,9 +139,9 @@ class Expander {
 
     Unit(kChassis)["type"] = "chassis";
     MergeInto(Params(kChassis), Child(units, kChassis));
-    Params(kChassis)["initial_x"] = x_m_;
-    Params(kChassis)["initial_y"] = y_m_;
-    Params(kChassis)["initial_yaw"] = yaw_rad_;
+    Params(kChassis)["initial_x"] = Num(x_m_);
+    Params(kChassis)["initial_y"] = Num(y_m_);
+    Params(kChassis)["initial_yaw"] = Num(yaw_rad_);
     Motors(robot_model, Child(units, kMotors));
     controller_defaults_ = Child(units, kWheelController);
     follower_defaults_ = Child(units, kPathFollower);
@@ -259,7 +261,7 @@ class Expander {
               continue;
             }
             YAML::Node s;
-            s["time_s"] = t;
+            s["time_s"] = Num(t);
             s["on"] = on;
             switches.push_back(s);
           }
@@ -299,7 +301,9 @@ class Expander {
     const bool compensation = r_.Boolean(control, "control", "compensation", true);
     // FACTS.md: the Rob@Work 3 control cycle is 20 ms.
     period_s_ = r_.Real(control, "control", "period_s", 0.02, {0.0, 10.0, true});
-    for (const char* name : {kWheelController, kPathFollower}) Unit(name)["step_s"] = period_s_;
+    for (const char* name : {kWheelController, kPathFollower}) {
+      Unit(name)["step_s"] = Num(period_s_);
+    }
     Unit(kWheelController)["type"] = "wheel_controller";
     MergeInto(Params(kWheelController), controller_defaults_);
     Params(kWheelController)["compensation"] = compensation;
@@ -354,7 +358,7 @@ class Expander {
         }
       }
       p["mode"] = "path";
-      p["speed"] = r_.Real(task, "task", "speed_mps", 0.3, {0.0, 1.2, true});  // Table I max
+      p["speed"] = Num(r_.Real(task, "task", "speed_mps", 0.3, {0.0, 1.2, true}));  // Table I max
     } else if (info_.task == "hold") {
       std::array<double, 2> point{x_m_, y_m_};
       if (Child(task, "point").IsDefined()) {
@@ -364,13 +368,14 @@ class Expander {
       p["mode"] = "hold";
     }
     if (Child(task, "acceleration_mps2").IsDefined()) {
-      p["acceleration"] = r_.Real(task, "task", "acceleration_mps2", 0.3, {0.0, 10.0, true});
+      p["acceleration"] = Num(r_.Real(task, "task", "acceleration_mps2", 0.3, {0.0, 10.0, true}));
     }
     // The robot is omnidirectional: it keeps this heading while it moves.
-    p["yaw"] = Child(task, "yaw_deg").IsDefined()
-                   ? r_.Real(task, "task", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad
-                   : yaw_rad_;
+    p["yaw"] = Num(Child(task, "yaw_deg").IsDefined()
+                       ? r_.Real(task, "task", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad
+                       : yaw_rad_);
     YAML::Node waypoints(YAML::NodeType::Sequence);
+    waypoints.SetStyle(YAML::EmitterStyle::Flow);
     for (const auto& pt : info_.path) waypoints.push_back(Point(pt[0], pt[1]));
     p["waypoints"] = waypoints;
 
@@ -415,6 +420,7 @@ class Expander {
       return;
     }
     YAML::Node vars(YAML::NodeType::Sequence);
+    vars.SetStyle(YAML::EmitterStyle::Flow);
     for (const char* v :
          {"chassis.pose", "chassis.velocity", "chassis.steer_angle", "chassis.drive_rate",
           "chassis.wheel_surface", "chassis.wheel_contact", "path_follower.twist_command",
@@ -428,7 +434,7 @@ class Expander {
     }
     out_["recording"]["variables"] = vars;
     // 100 Hz is enough for the plots and keeps signals.csv small.
-    out_["recording"]["interval_s"] = 0.01;
+    out_["recording"]["interval_s"] = Num(0.01);
   }
 
   void Metrics() {

@@ -73,6 +73,23 @@ TEST(RobotScenario, CrossLineExpandsIntoTheRobotUnits) {
   EXPECT_EQ(Param(s, "motors", "gear_ratio", 7), 21.0);
 }
 
+// Guards `linesim inspect`'s promise that the expansion is a system-level
+// scenario of its own: written out and loaded again, it builds the same
+// units, connections and metrics.
+TEST(RobotScenario, ExpansionLoadsAsASystemScenario) {
+  const Scenario robot = LoadScenario(kCross);
+  YAML::Emitter out;
+  out << robot.expanded;
+  const std::string f = WriteScenario("expanded.yaml", out.c_str());
+  const Scenario system = LoadScenario(f);
+  EXPECT_FALSE(system.robot);
+  EXPECT_EQ(system.system->UnitNames(), robot.system->UnitNames());
+  EXPECT_EQ(system.system->connections().size(), robot.system->connections().size());
+  EXPECT_EQ(system.metrics.size(), robot.metrics.size());
+  EXPECT_EQ(Param(system, "motors", "gear_ratio", 4), 21.0);
+  EXPECT_EQ(Param(system, "chassis", "initial_yaw"), Param(robot, "chassis", "initial_yaw"));
+}
+
 // Guards the dotted paths the issue reserves for --set and sweeps: each one
 // must reach the unit parameter it stands for.
 TEST(RobotScenario, ReservedOverridePathsReachTheUnits) {
