@@ -433,8 +433,12 @@ class Expander {
       vars.push_back("belt.on");
     }
     out_["recording"]["variables"] = vars;
-    // 100 Hz is enough for the plots and keeps signals.csv small.
-    out_["recording"]["interval_s"] = Num(0.01);
+    // About 100 Hz is enough for the plots and keeps signals.csv small; it
+    // must be a whole number of master steps (the master refuses bad steps).
+    const double step_s = Child(Child(root_, "master"), "step_s").as<double>(0.001);
+    const double interval_s = step_s > 0.0 && step_s < 0.01 ? std::ceil(0.01 / step_s - 1e-9) * step_s
+                                                            : step_s;
+    out_["recording"]["interval_s"] = Num(interval_s);
   }
 
   void Metrics() {
