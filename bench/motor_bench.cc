@@ -38,12 +38,14 @@ enum class Inputs {
 struct Options {
   std::string hold = "zero_order";  // current-only: shaft_speed_hold
   double rel_tol = 1e-8;            // the unit's default
+  double abs_tol = 1e-10;           // the unit's default
 };
 
 std::unique_ptr<DcMotorUnit> MakeUnit(MotorMode mode, const Options& options) {
   auto u = std::make_unique<DcMotorUnit>("motors", kMotors, mode);
   auto& v = u->variables();
   v.SetReal(*v.Find("rel_tol"), options.rel_tol);
+  v.SetReal(*v.Find("abs_tol"), options.abs_tol);
   if (mode == MotorMode::kCurrentOnly) v.SetString(*v.Find("shaft_speed_hold"), options.hold);
   // Motors 0-3 drive (gear 21, eta 0.75), 4-7 steer (belt 4, eta 0.9), as in
   // models/motors/raw3_*.yaml; the loads are rough wheel / module inertias.
@@ -166,6 +168,12 @@ void Register() {
        kMs,
        Inputs::kRobot,
        {"first_order", 1e-4}},
+      // The settings of models/robots/raw3.yaml.
+      {"BM_Motor8CurrentOnly/1ms_robot_raw3_settings",
+       MotorMode::kCurrentOnly,
+       kMs,
+       Inputs::kRobot,
+       {"first_order", 1e-3, 1e-4}},
   };
   for (const Case& c : kCases) {
     benchmark::RegisterBenchmark(c.name, [c](benchmark::State& s) {
