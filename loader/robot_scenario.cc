@@ -80,6 +80,12 @@ class Expander {
     Passthrough();
     Recording();
     Metrics();
+    // The file's own connections and metrics come first, so that a problem
+    // found in them later carries the index they have in the file.
+    YAML::Node connections(YAML::NodeType::Sequence);
+    for (const auto& c : user_connections_) connections.push_back(c);
+    for (const auto& c : connections_) connections.push_back(c);
+    out_["connections"] = connections;
     return out_;
   }
 
@@ -91,7 +97,7 @@ class Expander {
     c.SetStyle(YAML::EmitterStyle::Flow);
     c["from"] = from;
     c["to"] = to;
-    out_["connections"].push_back(c);
+    connections_.push_back(c);
   }
 
   // A section that must be a map if present; an empty map if absent.
@@ -410,7 +416,7 @@ class Expander {
     const YAML::Node connections = Child(root_, "connections");
     if (connections.IsDefined() && !connections.IsNull() &&
         r_.ExpectSequence(connections, "connections")) {
-      for (const auto& c : connections) out_["connections"].push_back(c);
+      for (const auto& c : connections) user_connections_.push_back(c);
     }
   }
 
@@ -436,13 +442,17 @@ class Expander {
     // About 100 Hz is enough for the plots and keeps signals.csv small; it
     // must be a whole number of master steps (the master refuses bad steps).
     const double step_s = Child(Child(root_, "master"), "step_s").as<double>(0.001);
-    const double interval_s = step_s > 0.0 && step_s < 0.01 ? std::ceil(0.01 / step_s - 1e-9) * step_s
-                                                            : step_s;
+    const double interval_s =
+        step_s > 0.0 && step_s < 0.01 ? std::ceil(0.01 / step_s - 1e-9) * step_s : step_s;
     out_["recording"]["interval_s"] = Num(interval_s);
   }
 
   void Metrics() {
     YAML::Node metrics(YAML::NodeType::Sequence);
+    const YAML::Node extra = Child(root_, "metrics");
+    if (extra.IsDefined() && !extra.IsNull() && r_.ExpectSequence(extra, "metrics")) {
+      for (const auto& m : extra) metrics.push_back(m);
+    }
     const auto add = [&](const char* name, const char* of, const char* reduce) {
       YAML::Node m;
       m["name"] = name;
@@ -459,10 +469,6 @@ class Expander {
       add("final_position_drift_m", "deviation.deviation", "final");
     }
     add("final_yaw_rad", "chassis.pose[2]", "final");
-    const YAML::Node extra = Child(root_, "metrics");
-    if (extra.IsDefined() && !extra.IsNull() && r_.ExpectSequence(extra, "metrics")) {
-      for (const auto& m : extra) metrics.push_back(m);
-    }
     out_["metrics"] = metrics;
   }
 
@@ -470,6 +476,7 @@ class Expander {
   YamlReader& r_;
   RobotInfo& info_;
   YAML::Node out_{YAML::NodeType::Map};
+  std::vector<YAML::Node> user_connections_, connections_;
   YAML::Node controller_defaults_, follower_defaults_;
   double x_m_ = 0, y_m_ = 0, yaw_rad_ = 0, period_s_ = 0.02;
 };

@@ -157,6 +157,22 @@ task: {type: wander}
   EXPECT_TRUE(Has(e, f)) << e;
 }
 
+// Guards the file's own connections and metrics in a robot scenario: a bad
+// one is reported at its index and line in the file, not at its place in
+// the longer expansion.
+TEST(RobotScenario, OwnConnectionsAndMetricsKeepTheirKeyPaths) {
+  std::ifstream in(kCross);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string a = Issues(WriteScenario(
+      "robot_conn.yaml", text + "connections:\n  - {from: chassis.pose, to: deviation.poses}\n"));
+  EXPECT_TRUE(Has(a, "connections.0: ")) << a;
+  EXPECT_TRUE(Has(a, "poses")) << a;
+  const std::string b = Issues(
+      WriteScenario("robot_metric.yaml",
+                    text + "metrics:\n  - {name: top_speed, of: chassis.speed, reduce: max}\n"));
+  EXPECT_TRUE(Has(b, "metrics.0.of")) << b;
+}
+
 // Guards an unknown robot model: named with the models that exist.
 TEST(RobotScenario, UnknownRobotModelNamesTheKnownOnes) {
   const std::string e = Issues(kCross, {"robot.model=raw4"});
