@@ -271,7 +271,12 @@ class Builder {
       if (const auto value = r_.AsString(Child(params, "model"), model_path)) {
         const fs::path file = ModelFile(*value, type->model_folder, s_.file);
         YAML::Node model;
+        std::error_code ec;
         try {
+          // yaml-cpp would leak its stream buffer reading a folder: check first.
+          if (fs::is_directory(file, ec)) {
+            throw std::runtime_error("it is a folder, not a YAML file");
+          }
           model = YAML::LoadFile(file.string());
         } catch (const YAML::BadFile&) {
           r_.Error(Child(params, "model"), model_path,
