@@ -247,6 +247,14 @@ std::string Script(const RobotPlotSpec& spec, const Signals& signals, const fs::
     if (x && y) view.Add(*x, *y);
   }
   if (iyaw > 0) {
+    // A robot standing still would get its labels printed over each other:
+    // an instant closer than a quarter body length to the last label joins
+    // it ("t = 0 / 6 / 12 s"; commas would split the data line).
+    struct Label {
+      Point at;
+      std::string times;
+    };
+    std::vector<Label> placed;
     for (std::size_t row : EvenlySpaced(signals.lines.size(), spec.footprint_count)) {
       const auto fields = SplitCsv(signals.lines[row]);
       const auto get = [&](int col) -> std::optional<double> {
@@ -261,7 +269,16 @@ std::string Script(const RobotPlotSpec& spec, const Signals& signals, const fs::
       outlines += Num(*x) + "," + Num(*y) + "\n" +
                   Num(*x + 0.5 * spec.body_length_m * std::cos(*yaw)) + "," +
                   Num(*y + 0.5 * spec.body_length_m * std::sin(*yaw)) + "\n\n";
-      if (t) labels += Num(*x) + "," + Num(*y) + ",t = " + Num(*t) + " s\n";
+      if (t) {
+        const bool crowded =
+            !placed.empty() && std::hypot(*x - placed.back().at.x, *y - placed.back().at.y) <
+                                   0.25 * spec.body_length_m;
+        if (crowded) {
+          placed.back().times += " / " + Num(*t);
+        } else {
+          placed.push_back({{*x, *y}, Num(*t)});
+        }
+      }
       for (const auto& [wx, wy] : wheels) {
         const auto px = get(wx), py = get(wy);
         if (px && py) {
@@ -269,6 +286,9 @@ std::string Script(const RobotPlotSpec& spec, const Signals& signals, const fs::
           view.Add(*px, *py);
         }
       }
+    }
+    for (const auto& [at, times] : placed) {
+      labels += Num(at.x) + "," + Num(at.y) + ",t = " + times + " s\n";
     }
   }
   if (!belts.empty()) AppendBlock(s, "belts", belts);

@@ -35,7 +35,7 @@ class RobotPlotsTest : public ::testing::Test {
   // crossing a belt along +y over 30 s, recorded every 10 ms (3001 rows, the
   // size the brief asks to plot quickly), wheels at the raw3-1 steering axes
   // (FACTS.md), a belt that runs from 0 to 10 s and ramps up at 0.5 m/s^2.
-  void WriteSignals() const {
+  void WriteSignals(double speed_mps = 0.1) const {
     std::ofstream out(dir_ / "signals.csv");
     out << "time,chassis.pose[0],chassis.pose[1],chassis.pose[2]";
     for (int w = 0; w < 4; ++w)
@@ -45,7 +45,7 @@ class RobotPlotsTest : public ::testing::Test {
     const double wheel_y[4] = {0.186, 0.134, -0.186, -0.134};
     for (int k = 0; k <= 3000; ++k) {
       const double t = 0.01 * k;
-      const double x = 0.02 * std::sin(t), y = -1.5 + 0.1 * t, yaw = 0.5 * std::numbers::pi;
+      const double x = 0.02 * std::sin(t), y = -1.5 + speed_mps * t, yaw = 0.5 * std::numbers::pi;
       out << t << "," << x << "," << y << "," << yaw;
       for (int w = 0; w < 4; ++w) {
         out << "," << x + std::cos(yaw) * wheel_x[w] - std::sin(yaw) * wheel_y[w] << ","
@@ -166,6 +166,16 @@ TEST_F(RobotPlotsTest, WritesOnlyWhatTheSpecAsksFor) {
   const std::string script = ReadAll(dir_ / "plots.gp");
   EXPECT_NE(script.find("hold target"), std::string::npos);
   EXPECT_EQ(script.find("$outlines"), std::string::npos);
+}
+
+// Guards the top view of a robot that holds its place (the hold
+// scenarios): its five time labels would be printed over each other, so
+// they join into one (without commas, the data separator).
+TEST_F(RobotPlotsTest, StandingRobotGetsOneJoinedTimeLabel) {
+  WriteSignals(0.0);
+  WriteRobotPlots(dir_.string(), Spec());
+  const std::string script = ReadAll(dir_ / "plots.gp");
+  EXPECT_NE(script.find(",t = 0 / 7.5 / 15 / 22.5 / 30 s\n"), std::string::npos) << script;
 }
 
 // Guards against a missing signals.csv or gnuplot being reported as
