@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "cosim/closest_names.h"
+#include "cosim/time.h"
 #include "cosim/variable_table.h"
 #include "models/models_dir.h"
 
@@ -100,6 +101,9 @@ class Expander {
     connections_.push_back(c);
   }
 
+  // The master step as written (the system loader checks it); 1 ms if absent.
+  double MasterStepS() const { return Child(Child(root_, "master"), "step_s").as<double>(0.001); }
+
   // A section that must be a map if present; an empty map if absent.
   YAML::Node Section(const YAML::Node& parent, const std::string& path, const std::string& key,
                      const std::vector<std::string>& keys) {
@@ -113,9 +117,6 @@ class Expander {
 
   void Robot() {
     const YAML::Node robot = Section(root_, "", "robot", {"model", "pose"});
-    if (!Child(root_, "robot").IsMap()) {
-      r_.Error(Child(root_, "robot"), "robot", "expected a map with model and pose");
-    }
     const std::string model = r_.String(robot, "robot", "model", "raw3");
     const YAML::Node pose = Section(robot, "robot", "pose", {"x_m", "y_m", "yaw_deg"});
     x_m_ = r_.Real(pose, "robot.pose", "x_m", 0.0, {-1e6, 1e6});
@@ -127,7 +128,7 @@ class Expander {
     YAML::Node robot_model;
     try {
       robot_model = YAML::LoadFile(file.string());
-    } catch (const std::exception& e) {
+    } catch (const YAML::BadFile&) {
       std::vector<std::string> names;
       std::error_code ec;
       for (const auto& entry :
@@ -135,7 +136,11 @@ class Expander {
         if (entry.path().extension() == ".yaml") names.push_back(entry.path().stem().string());
       }
       r_.Error(Child(robot, "model"), "robot.model",
-               "cannot read robot model " + file.string() + cosim::ClosestHint(model, names));
+               "no robot model " + file.string() + cosim::ClosestHint(model, names));
+      return;
+    } catch (const std::exception& e) {
+      r_.Error(Child(robot, "model"), "robot.model",
+               "cannot read robot model " + file.string() + ": " + e.what());
       return;
     }
     const YAML::Node units = Child(robot_model, "units");
@@ -183,9 +188,14 @@ class Expander {
         if (key == "source" || key == "description") continue;
         auto& values = arrays[key];
         values.resize(static_cast<std::size_t>(2 * w), std::numeric_limits<double>::quiet_NaN());
-        for (int k = 0; k < w; ++k) {
-          values[static_cast<std::size_t>(group * w + k)] = kv.second.as<double>();
+        double value = 0.0;
+        if (!kv.second.IsScalar() || !YAML::convert<double>::decode(kv.second, value)) {
+          r_.Error(Child(root_, "robot"), "robot.model",
+                   "motor model " + file.string() + ", key '" + key + "': expected a number, got " +
+                       Describe(kv.second));
+          return;
         }
+        for (int k = 0; k < w; ++k) values[static_cast<std::size_t>(group * w + k)] = value;
       }
     }
     for (const auto& [key, values] : arrays) {
@@ -307,6 +317,12 @@ class Expander {
     const bool compensation = r_.Boolean(control, "control", "compensation", true);
     // FACTS.md: the Rob@Work 3 control cycle is 20 ms.
     period_s_ = r_.Real(control, "control", "period_s", 0.02, {0.0, 10.0, true});
+    const cosim::TimeNs step = cosim::SecondsToNs(MasterStepS());
+    if (step > 0 && cosim::SecondsToNs(period_s_) % step != 0) {
+      r_.Error(Child(control, "period_s"), "control.period_s",
+               "expected a whole multiple of master.step_s (" + cosim::FormatSeconds(step) +
+                   " s), got " + cosim::FormatSeconds(cosim::SecondsToNs(period_s_)) + " s");
+    }
     for (const char* name : {kWheelController, kPathFollower}) {
       Unit(name)["step_s"] = Num(period_s_);
     }
@@ -441,7 +457,7 @@ class Expander {
     out_["recording"]["variables"] = vars;
     // About 100 Hz is enough for the plots and keeps signals.csv small; it
     // must be a whole number of master steps (the master refuses bad steps).
-    const double step_s = Child(Child(root_, "master"), "step_s").as<double>(0.001);
+    const double step_s = MasterStepS();
     const double interval_s =
         step_s > 0.0 && step_s < 0.01 ? std::ceil(0.01 / step_s - 1e-9) * step_s : step_s;
     out_["recording"]["interval_s"] = Num(interval_s);

@@ -173,6 +173,15 @@ TEST(RobotScenario, OwnConnectionsAndMetricsKeepTheirKeyPaths) {
   EXPECT_TRUE(Has(b, "metrics.0.of")) << b;
 }
 
+// Guards the controller period against the master step: a period that is
+// not a whole number of steps is reported at control.period_s, not at the
+// expanded units it would have broken.
+TEST(RobotScenario, ControlPeriodMustBeAMultipleOfTheMasterStep) {
+  const std::string e = Issues(kCross, {"control.period_s=0.0153"});
+  EXPECT_TRUE(Has(e, "control.period_s")) << e;
+  EXPECT_FALSE(Has(e, "units.wheel_controller")) << e;
+}
+
 // Guards an unknown robot model: named with the models that exist.
 TEST(RobotScenario, UnknownRobotModelNamesTheKnownOnes) {
   const std::string e = Issues(kCross, {"robot.model=raw4"});
