@@ -155,16 +155,27 @@ bool Master::Transfer(const Link& link) {
   return false;
 }
 
-void Master::RecordError(std::size_t u, TimeNs t, const std::string& cause) {
-  const Unit& unit = system_.unit(u);
-  const std::string who = "unit '" + unit.name() + "' (" + unit.type_name() + ")";
-  // A unit's own error may already name it (solver helpers do).
-  const auto colon = cause.find(": ");
-  const bool named =
-      cause.rfind("unit '" + unit.name() + "'", 0) == 0 && colon != std::string::npos;
+void Master::RecordError(std::size_t u, TimeNs t, const std::string& phase,
+                         const std::string& cause) {
+  // Units name themselves in their messages, so that a unit used on its own
+  // reports clearly; here the master names it once, in front.
+  const std::string who = system_.unit(u).Where();
+  const std::string prefix = who + ": ";
+  const std::string what = cause.starts_with(prefix) ? cause.substr(prefix.size()) : cause;
   errors_.push_back(who + " at t = " + FormatSeconds(t) +
-                    " s: " + (named ? cause.substr(colon + 2) : cause));
+                    " s: " + (phase.empty() ? "" : phase + ": ") + what);
   failed_ = true;
+}
+
+bool Master::InitializeUnit(std::size_t u) {
+  try {
+    const ScopedTimer timer(options_.profile, unit_wall_seconds_[u]);
+    system_.unit(u).Initialize();
+    return true;
+  } catch (const std::exception& e) {
+    RecordError(u, time_, "initialize failed", e.what());
+    return false;
+  }
 }
 
 bool Master::CheckOutputs(std::size_t u, TimeNs t) {
@@ -174,7 +185,7 @@ bool Master::CheckOutputs(std::size_t u, TimeNs t) {
     if (info.type == VarType::kReal) {
       const double v = table.GetReal(ref);
       if (!std::isfinite(v)) {
-        RecordError(u, t, "output '" + info.name + "' is " + FormatValue(v));
+        RecordError(u, t, "", "output '" + info.name + "' is " + FormatValue(v));
         return false;
       }
     } else {
@@ -182,7 +193,7 @@ bool Master::CheckOutputs(std::size_t u, TimeNs t) {
       for (std::size_t i = 0; i < values.size(); ++i) {
         if (!std::isfinite(values[i])) {
           RecordError(
-              u, t,
+              u, t, "",
               "output '" + info.name + "[" + std::to_string(i) + "]' is " + FormatValue(values[i]));
           return false;
         }
@@ -222,7 +233,7 @@ bool Master::UpdateUnitOutputs(std::size_t u, TimeNs t) {
     const ScopedTimer timer(options_.profile, unit_wall_seconds_[u]);
     system_.unit(u).UpdateOutputs();
   } catch (const std::exception& e) {
-    RecordError(u, t, std::string("updating outputs from new inputs failed: ") + e.what());
+    RecordError(u, t, "updating outputs from new inputs failed", e.what());
     return false;
   }
   return CheckOutputs(u, t);
@@ -230,23 +241,21 @@ bool Master::UpdateUnitOutputs(std::size_t u, TimeNs t) {
 
 void Master::PropagateInitialValues() {
   // Outputs with direct feedthrough depend on inputs, which come from other
-  // units' outputs: repeat transfer + Initialize until nothing changes. With
-  // no algebraic loop this settles within (longest feedthrough chain + 1)
-  // passes.
+  // units' outputs: repeat transfer + Initialize of the units whose inputs
+  // changed until nothing changes. Start() initialized every unit before the
+  // first transfer; with no algebraic loop this settles within (longest
+  // feedthrough chain + 1) passes.
   const std::size_t n = system_.unit_count();
+  std::vector<bool> changed(n);
   for (std::size_t pass = 0; pass <= n + 1; ++pass) {
-    bool changed = false;
-    for (const Link& link : system_.links()) changed |= Transfer(link);
-    if (!changed && pass > 0) return;
+    std::fill(changed.begin(), changed.end(), false);
+    bool any = false;
+    for (const Link& link : system_.links()) {
+      if (Transfer(link)) changed[link.to_unit] = any = true;
+    }
+    if (!any) return;
     for (std::size_t u = 0; u < n; ++u) {
-      // Name the unit, as the first Initialize pass in Start() does.
-      try {
-        const ScopedTimer timer(options_.profile, unit_wall_seconds_[u]);
-        system_.unit(u).Initialize();
-      } catch (const std::exception& e) {
-        RecordError(u, time_, std::string("initialize failed: ") + e.what());
-        return;
-      }
+      if (changed[u] && !InitializeUnit(u)) return;
     }
   }
   throw UnitError("initial values did not settle after " + std::to_string(n + 2) + " passes");
@@ -271,18 +280,12 @@ void Master::Start() {
       const ScopedTimer unit_timer(options_.profile, unit_wall_seconds_[u]);
       system_.unit(u).Setup(options_.start, options_.stop);
     } catch (const std::exception& e) {
-      RecordError(u, time_, std::string("setup failed: ") + e.what());
+      RecordError(u, time_, "setup failed", e.what());
     }
   }
   if (!failed_) {
     try {
-      for (std::size_t u = 0; u < n; ++u) {
-        try {
-          system_.unit(u).Initialize();
-        } catch (const std::exception& e) {
-          RecordError(u, time_, std::string("initialize failed: ") + e.what());
-        }
-      }
+      for (std::size_t u = 0; u < n; ++u) InitializeUnit(u);
       if (!failed_) PropagateInitialValues();
     } catch (const std::exception& e) {
       errors_.push_back(std::string("initialization at t = ") + FormatSeconds(time_) +
@@ -292,7 +295,16 @@ void Master::Start() {
   }
   for (std::size_t u = 0; u < n && !failed_; ++u) CheckOutputs(u, time_);
   started_ = true;
-  for (Observer* o : observers_) o->OnStart(*this);
+  // An observer that refuses the run (say, a recording interval off the
+  // master's steps) fails it like a unit would: the units still terminate.
+  for (Observer* o : observers_) {
+    try {
+      o->OnStart(*this);
+    } catch (const std::exception& e) {
+      errors_.push_back(std::string("observer at start: ") + e.what());
+      failed_ = true;
+    }
+  }
   if (!failed_) Notify(time_);
 }
 
@@ -333,8 +345,12 @@ bool Master::Step() {
     if (!UpdateUnitOutputs(u, t)) {
       return false;
     }
-    for (std::size_t l : links_from_[u]) {
-      if (at_point(links[l].to_unit)) Transfer(links[l]);
+    // Gauss-Seidel transfers into each unit right before it updates or
+    // steps; only Jacobi needs the new outputs passed on here.
+    if (jacobi) {
+      for (std::size_t l : links_from_[u]) {
+        if (at_point(links[l].to_unit)) Transfer(links[l]);
+      }
     }
   }
 
@@ -369,7 +385,7 @@ bool Master::Step() {
   if (!ok) {
     for (std::size_t u : due_) {
       if (!pending_errors_[u].empty()) {
-        RecordError(u, t, pending_errors_[u]);
+        RecordError(u, t, "", pending_errors_[u]);
         pending_errors_[u].clear();
       }
     }
@@ -393,7 +409,7 @@ RunResult Master::Finish() {
     try {
       system_.unit(u).Terminate();
     } catch (const std::exception& e) {
-      RecordError(u, time_, std::string("terminate failed: ") + e.what());
+      RecordError(u, time_, "terminate failed", e.what());
     }
   }
   for (Observer* o : observers_) o->OnEnd(time_, !failed_);

@@ -89,7 +89,10 @@ class Master {
   bool StepUnit(std::size_t u, TimeNs t, TimeNs dt);
   bool CheckOutputs(std::size_t u, TimeNs t);
   bool UpdateUnitOutputs(std::size_t u, TimeNs t);
-  void RecordError(std::size_t u, TimeNs t, const std::string& cause);
+  /// "unit 'u' (type) at t = ... s: phase: cause", the unit named once.
+  void RecordError(std::size_t u, TimeNs t, const std::string& phase, const std::string& cause);
+  /// Initialize with profiling; a failure is recorded and returns false.
+  bool InitializeUnit(std::size_t u);
   void Notify(TimeNs t);
 
   System& system_;

@@ -97,6 +97,12 @@ class Unit {
   /// CheckParameters() reports, as "parameter 'x[i]' must be ...; ...".
   void ThrowIfBadParameters() const;
 
+  /// For DoStep: true when every Real input (each element of an array) is
+  /// finite; otherwise records "input 'x[k]' is nan at t = ..." as the
+  /// step's error and returns false. Connected inputs come from outputs the
+  /// master checks; this catches start values and units stepped by hand.
+  bool InputsFinite(TimeNs t);
+
   /// For DoStep: record why the step failed and return kError.
   StepResult Fail(std::string message) {
     last_error_ = std::move(message);

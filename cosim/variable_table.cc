@@ -51,19 +51,15 @@ std::string_view ToString(Variability v) {
   return "?";
 }
 
-namespace {
-
-std::string FormatReal(double x) {
+std::string FormatValue(double x) {
   char buf[32];
   auto res = std::to_chars(buf, buf + sizeof buf, x);
   return std::string(buf, res.ptr);
 }
 
-}  // namespace
-
 std::string FormatValue(const Value& v) {
   struct Visitor {
-    std::string operator()(double x) const { return FormatReal(x); }
+    std::string operator()(double x) const { return FormatValue(x); }
     std::string operator()(std::int64_t x) const { return std::to_string(x); }
     std::string operator()(bool x) const { return x ? "true" : "false"; }
     std::string operator()(const std::string& x) const { return "\"" + x + "\""; }
@@ -71,7 +67,7 @@ std::string FormatValue(const Value& v) {
       std::string out = "[";
       for (std::size_t i = 0; i < x.size(); ++i) {
         if (i) out += ", ";
-        out += FormatReal(x[i]);
+        out += FormatValue(x[i]);
       }
       return out + "]";
     }

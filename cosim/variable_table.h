@@ -32,6 +32,9 @@ using Value = std::variant<double, std::int64_t, bool, std::string, std::vector<
 
 /// Human-readable rendering of a value ("1.5", "[1, 2]", "true", "\"x\"").
 std::string FormatValue(const Value& v);
+/// A number as the shortest text that reads back to it ("0.1", "1e-05",
+/// "nan"): for messages, files and the YAML the loader writes.
+std::string FormatValue(double x);
 
 struct VariableInfo {
   ValueRef ref = 0;

@@ -17,7 +17,6 @@
 namespace linesim::cosim {
 namespace {
 
-using test_units::ExactSeconds;
 using test_units::FaultyUnit;
 using test_units::PassThrough;
 using test_units::RampSource;
@@ -125,6 +124,8 @@ TEST(MasterConfig, RefusesAUnitStepThatIsNotAMultipleOfTheBaseStep) {
     ASSERT_EQ(e.problems().size(), 1u) << e.what();
     EXPECT_THAT(e.problems()[0].message, HasSubstr("unit 'odd'"));
     EXPECT_THAT(e.problems()[0].message, HasSubstr("0.0015 s is not an integer multiple"));
+    // The loader points at the unit's step_s line through this index.
+    EXPECT_EQ(e.problems()[0].unit, 1u);
   }
 }
 
@@ -147,6 +148,8 @@ TEST(MasterConfig, RefusesADurationThatAUnitStepDoesNotDivide) {
     EXPECT_THAT(e.problems()[0].message, HasSubstr("unit 'every3ms'"));
     EXPECT_THAT(e.problems()[0].message, HasSubstr("does not divide the duration 0.01 s"));
     EXPECT_THAT(e.problems()[1].message, HasSubstr("unit 'every4ms'"));
+    EXPECT_EQ(e.problems()[0].unit, 0u);
+    EXPECT_EQ(e.problems()[1].unit, 2u);
   }
 }
 
@@ -324,6 +327,69 @@ TEST(MasterErrors, DiscardedStepStopsTheRun) {
   EXPECT_THAT(run.result.errors[0], HasSubstr("discarded the step (tolerance not met)"));
 }
 
+// Refuses a non-finite input in its step (Unit::InputsFinite).
+class StrictSink : public Unit {
+ public:
+  StrictSink() : Unit("Strict", "strict") { variables().Input("u", "s", &u_, "checked input"); }
+  StepResult DoStep(TimeNs t, TimeNs) override {
+    ClearError();
+    return InputsFinite(t) ? StepResult::kOk : StepResult::kError;
+  }
+
+ private:
+  double u_ = 0.0;
+};
+
+// Guards against: Gauss-Seidel blaming a NaN on the unit that received it.
+// The sink steps after the faulty unit and would fail on the NaN input; each
+// unit is checked before the next consumes its outputs, so only 'bad' is
+// named.
+TEST(MasterGuard, GaussSeidelBlamesTheUnitThatMadeTheNaN) {
+  System system;
+  system.Add(std::make_unique<FaultyUnit>("bad", FaultyUnit::Mode::kNaN, 3 * kMs));
+  system.Add(std::make_unique<StrictSink>());
+  system.Connect("bad.y", "strict.u");
+  MasterOptions o;
+  o.algorithm = Algorithm::kGaussSeidel;
+  o.stop = 10 * kMs;
+  Master master(system, o);
+  const RunResult r = master.Run();
+  EXPECT_FALSE(r.ok);
+  ASSERT_EQ(r.errors.size(), 1u) << r.errors[0];
+  EXPECT_EQ(r.errors[0], "unit 'bad' (Faulty) at t = 0.003 s: output 'y' is nan");
+}
+
+// Guards Unit::InputsFinite: a non-finite input fails the step with the
+// input's name, its value and the time.
+TEST(UnitInputs, NonFiniteInputFailsTheStepByName) {
+  StrictSink sink;
+  sink.variables().SetReal(*sink.variables().Find("u"), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(sink.DoStep(2 * kMs, kMs), StepResult::kError);
+  EXPECT_EQ(sink.last_error(), "unit 'strict' (Strict): input 'u' is inf at t = 0.002 s");
+}
+
+// A unit whose messages name it, as units used on their own do.
+class SelfNamingUnit : public Unit {
+ public:
+  SelfNamingUnit() : Unit("SelfNaming", "w") {}
+  void Initialize() override { throw UnitError(Where() + ": not ready"); }
+  StepResult DoStep(TimeNs, TimeNs) override { return StepResult::kOk; }
+};
+
+// Guards against: the unit named twice when its own message already names
+// it, in any phase (here Initialize, where the master adds the phase).
+TEST(MasterErrors, UnitIsNamedOnceWithThePhase) {
+  System system;
+  system.Add(std::make_unique<SelfNamingUnit>());
+  MasterOptions o;
+  o.stop = 10 * kMs;
+  Master master(system, o);
+  const RunResult r = master.Run();
+  EXPECT_FALSE(r.ok);
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_EQ(r.errors[0], "unit 'w' (SelfNaming) at t = 0 s: initialize failed: not ready");
+}
+
 // Guards against: a failure inside a parallel Jacobi step being lost or
 // reported without the unit name.
 TEST(MasterErrors, FailureInParallelJacobiIsReported) {
@@ -361,7 +427,7 @@ TEST(MasterStepwise, StepReturnsFalseAtTheStopTimeAndStaysThere) {
   EXPECT_TRUE(r.ok);
   EXPECT_EQ(r.base_steps, 3);
   const auto& t = system.unit(0).variables();
-  EXPECT_EQ(t.GetReal(*t.Find("value")), ExactSeconds(3 * kMs));
+  EXPECT_EQ(t.GetReal(*t.Find("value")), NsToSeconds(3 * kMs));
 }
 
 // Guards against: the master's own start time being ignored (units stepped

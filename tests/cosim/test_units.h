@@ -30,10 +30,6 @@ Eigen::Matrix<double, N, 1> ExactZohStep(const Eigen::Matrix<double, N, N>& a,
   return e.template topLeftCorner<N, N>() * x + e.template topRightCorner<N, 1>();
 }
 
-/// Time in seconds as the correctly rounded quotient t / 1e9, so that 6 ms is
-/// the double nearest 0.006 and tests can compare against decimal literals.
-inline double ExactSeconds(TimeNs t) { return static_cast<double>(t) / 1e9; }
-
 /// The two-mass-spring-damper: wall -k1,d1- m1 -k2,d2- m2.
 struct TwoMassParams {
   double m1_kg = 1.0;
@@ -188,7 +184,7 @@ class RampSource : public Unit {
   std::vector<StepCall> calls;
 
  private:
-  double Evaluate(TimeNs t) const { return offset_ + slope_ * ExactSeconds(t); }
+  double Evaluate(TimeNs t) const { return offset_ + slope_ * NsToSeconds(t); }
   double slope_;
   double offset_;
   double value_ = 0.0;
@@ -314,7 +310,7 @@ class FaultyUnit : public Unit {
   }
   StepResult DoStep(TimeNs t, TimeNs dt) override {
     ClearError();
-    y_ = ExactSeconds(t + dt);
+    y_ = NsToSeconds(t + dt);
     // NaN and Inf are outputs at the end of the step; the other failures
     // happen in the step that starts at fail_time.
     switch (mode_) {

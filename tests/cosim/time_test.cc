@@ -60,8 +60,13 @@ TEST(FormatSeconds, ExtremeValues) {
 
 // Guards against: a wrong scale factor in the other direction.
 TEST(NsToSeconds, ScalesByOneBillion) {
-  EXPECT_DOUBLE_EQ(NsToSeconds(1'500'000'000), 1.5);
-  EXPECT_DOUBLE_EQ(NsToSeconds(-2'000'000), -0.002);
+  EXPECT_EQ(NsToSeconds(1'500'000'000), 1.5);
+  EXPECT_EQ(NsToSeconds(-2'000'000), -0.002);
+  // Correctly rounded: the nearest doubles to the decimals (9, 11, 13 ms
+  // are among those t * 1e-9 misses by one unit in the last place).
+  EXPECT_EQ(NsToSeconds(9'000'000), 0.009);
+  EXPECT_EQ(NsToSeconds(11'000'000), 0.011);
+  EXPECT_EQ(NsToSeconds(13'000'000), 0.013);
   EXPECT_EQ(NsToSeconds(0), 0.0);
 }
 

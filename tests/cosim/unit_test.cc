@@ -116,18 +116,20 @@ TEST(UnitState, AllVariableTypesRoundTrip) {
   }
 }
 
-// Guards against: restoring a snapshot of another unit type, which would
-// assign variables by position into the wrong meaning. The message names
-// the unit.
+// Guards against: restoring a snapshot of another unit type or of another
+// size, which would assign variables by position into the wrong meaning.
+// The message names the unit.
 TEST(UnitState, RestoringAStateOfTheWrongSizeThrows) {
   Mass1Unit mass1(TwoMassParams{});
   CouplingUnit coupling(TwoMassParams{});
-  PortsUnit ports("ports");  // 14 variables against mass 1's 8
+  UnitState truncated = mass1.SaveState();  // right type, one variable short
+  truncated.variables.pop_back();
   try {
-    mass1.RestoreState(ports.SaveState());
+    mass1.RestoreState(truncated);
     FAIL() << "expected std::invalid_argument";
   } catch (const std::invalid_argument& e) {
-    EXPECT_THAT(e.what(), HasSubstr("unit 'mass1'"));
+    EXPECT_THAT(e.what(), HasSubstr("state of " + std::to_string(truncated.variables.size()) +
+                                    " variables restored into unit 'mass1'"));
   }
   UnitState empty;
   EXPECT_THROW(coupling.RestoreState(empty), std::invalid_argument);

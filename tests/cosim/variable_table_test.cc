@@ -216,8 +216,8 @@ TEST(VariableTable, DependsOnMustNameAnEarlierInput) {
 TEST(FormatValue, RendersEveryType) {
   EXPECT_EQ(FormatValue(1.5), "1.5");
   EXPECT_EQ(FormatValue(0.1), "0.1");
-  EXPECT_EQ(FormatValue(std::int64_t{-7}), "-7");
-  EXPECT_EQ(FormatValue(true), "true");
+  EXPECT_EQ(FormatValue(Value{std::int64_t{-7}}), "-7");
+  EXPECT_EQ(FormatValue(Value{true}), "true");
   EXPECT_EQ(FormatValue(std::string("x")), "\"x\"");
   EXPECT_EQ(FormatValue(std::vector<double>{1.0, 2.5}), "[1, 2.5]");
   EXPECT_EQ(FormatValue(std::vector<double>{}), "[]");
