@@ -18,8 +18,6 @@ namespace linesim::motors {
 
 namespace {
 
-std::string FormatNumber(double x) { return cosim::FormatValue(cosim::Value{x}); }
-
 // Bitwise, so that -0.0 vs 0.0 or a NaN payload also count as a change.
 bool SameBits(const std::vector<double>& a, const std::vector<double>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
@@ -69,8 +67,7 @@ struct DcMotorUnit::Sundials {
   }
 };
 
-DcMotorUnit::DcMotorUnit(std::string name, int count, MotorMode mode,
-                         const models::DcMotorParams& defaults)
+DcMotorUnit::DcMotorUnit(std::string name, int count, MotorMode mode)
     : cosim::Unit(kTypeName, std::move(name)),
       count_(count),
       mode_(mode),
@@ -80,6 +77,7 @@ DcMotorUnit::DcMotorUnit(std::string name, int count, MotorMode mode,
   }
   const auto n = static_cast<std::size_t>(count);
   const bool full = mode_ == MotorMode::kFull;
+  const models::DcMotorParams defaults;
   resistance_.assign(n, defaults.resistance_ohm);
   inductance_.assign(n, defaults.inductance_h);
   torque_constant_.assign(n, defaults.torque_constant_nm_per_a);
@@ -226,7 +224,7 @@ std::string DcMotorUnit::WorstState() const {
   EvalRhs(cosim::NsToSeconds(end_time_), y_.data(), ydot.data());
   for (std::size_t j = 0; j < y_.size(); ++j) {
     if (!std::isfinite(ydot[j])) {
-      return "the derivative of " + state_name(j) + " is " + FormatNumber(ydot[j]) +
+      return "the derivative of " + state_name(j) + " is " + cosim::FormatValue(ydot[j]) +
              " (check the inputs)";
     }
   }
@@ -269,7 +267,8 @@ std::vector<cosim::ParameterProblem> DcMotorUnit::CheckParameters() const {
     c.NonNegative("load_inertia", load_inertia_);
     c.Finite("initial_speed", initial_speed_);
   }
-  if (shaft_speed_hold_ != "zero_order" && shaft_speed_hold_ != "first_order") {
+  if (mode_ == MotorMode::kCurrentOnly && shaft_speed_hold_ != "zero_order" &&
+      shaft_speed_hold_ != "first_order") {
     c.Add({"shaft_speed_hold", std::nullopt,
            "must be zero_order or first_order, got '" + shaft_speed_hold_ + "'"});
   }
@@ -367,11 +366,15 @@ void DcMotorUnit::ComputeOutputs() {
   }
 }
 
-void DcMotorUnit::Initialize() {
+void DcMotorUnit::DeriveFromParameters() {
   ThrowIfBadParameters();
   ComputeCoefficients();
   SetTolerances();
   first_order_ = mode_ == MotorMode::kCurrentOnly && shaft_speed_hold_ == "first_order";
+}
+
+void DcMotorUnit::Initialize() {
+  DeriveFromParameters();
   previous_sample_time_ = -1;
   for (int k = 0; k < count_; ++k) {
     const auto kk = static_cast<std::size_t>(k);
@@ -398,10 +401,10 @@ void DcMotorUnit::HoldInputs(cosim::TimeNs t) {
   held_voltage_ = voltage_;
   held_load_torque_ = load_torque_;
   if (first_order_) {
-    // Slope from the previous sample, if it was taken one step ago (after a
-    // restore or a time jump there is none yet: hold to zero order once).
-    const bool have_previous = previous_sample_time_ >= 0 && previous_sample_time_ < t &&
-                               held_shaft_speed_.size() == shaft_speed_.size();
+    // Slope from the previous sample (saved with the state, so a restored
+    // unit continues alike); before the first sample, or after a jump back
+    // in time, hold to zero order once.
+    const bool have_previous = previous_sample_time_ >= 0 && previous_sample_time_ < t;
     const double span_s = cosim::NsToSeconds(t - previous_sample_time_);
     for (std::size_t k = 0; k < shaft_speed_.size(); ++k) {
       shaft_slope_[k] = have_previous ? (shaft_speed_[k] - previous_shaft_speed_[k]) / span_s : 0.0;
@@ -431,25 +434,9 @@ int DcMotorUnit::Integrate(cosim::TimeNs t, double t0_s, double t1_s, bool resta
 
 cosim::StepResult DcMotorUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
+  // The right-hand side's coefficients exist only after Initialize.
   if (!initialized_) return Fail(Where() + ": DoStep called before Initialize");
-  if (dt <= 0) {
-    return Fail(Where() + ": step size must be positive, got " + cosim::FormatSeconds(dt) +
-                " s at t = " + cosim::FormatSeconds(t) + " s");
-  }
-  const auto check_finite = [&](const char* var, const std::vector<double>& in) {
-    for (std::size_t k = 0; k < in.size(); ++k) {
-      if (!std::isfinite(in[k])) {
-        Fail(Where() + ": input '" + var + "[" + std::to_string(k) + "]' is " +
-             FormatNumber(in[k]) + " at t = " + cosim::FormatSeconds(t) + " s");
-        return false;
-      }
-    }
-    return true;
-  };
-  if (!check_finite("voltage", voltage_) || !check_finite("load_torque", load_torque_) ||
-      !check_finite("shaft_speed", shaft_speed_)) {
-    return cosim::StepResult::kError;
-  }
+  if (!InputsFinite(t)) return cosim::StepResult::kError;
 
   // Time in CVODE is double seconds converted from the integer ns each step,
   // never accumulated.
@@ -511,12 +498,7 @@ void DcMotorUnit::RestoreInternal(const cosim::UnitState& state) {
   initialized_ = state.integers[1] != 0;
   previous_sample_time_ = state.integers[2];
   // Parameters came back with the variables: derive from them again.
-  if (initialized_) {
-    ThrowIfBadParameters();
-    ComputeCoefficients();
-    SetTolerances();
-    first_order_ = mode_ == MotorMode::kCurrentOnly && shaft_speed_hold_ == "first_order";
-  }
+  if (initialized_) DeriveFromParameters();
   restart_pending_ = true;
 }
 

@@ -46,9 +46,9 @@ class DcMotorUnit : public cosim::Unit {
   static constexpr const char* kTypeName = "dc_motor";
 
   /// Throws cosim::UnitError if count < 1. Every motor starts with the
-  /// parameters in `defaults`; change them per motor through the table.
-  DcMotorUnit(std::string name, int count, MotorMode mode,
-              const models::DcMotorParams& defaults = {});
+  /// datasheet parameters of models::DcMotorParams; change them per motor
+  /// through the table (or a model file).
+  DcMotorUnit(std::string name, int count, MotorMode mode);
   ~DcMotorUnit() override;
 
   /// Validates the parameters (throws cosim::UnitError naming the unit, the
@@ -82,6 +82,9 @@ class DcMotorUnit : public cosim::Unit {
   /// The band Jacobian: only the 2x2 (or 1x1) diagonal blocks are non-zero.
   void FillJacobian(::_generic_SUNMatrix* jac) const;
 
+  /// Checks the parameters (throws) and derives from them what the
+  /// integration needs: coefficients, tolerances, the hold.
+  void DeriveFromParameters();
   void ComputeCoefficients();
   void ComputeOutputs();
   bool InputsChanged() const;

@@ -53,8 +53,13 @@ std::vector<double> Get(const DcMotorUnit& u, const std::string& name) {
 //   Phi(t) = (e^(l1 t) (A - l2 I) - e^(l2 t) (A - l1 I)) / (l1 - l2).
 // Eigen is used for the 2x2 linear algebra only, not for the exponential.
 struct Motor {
-  double r = 0.299, l = 0.0823e-3, kt = 30.2e-3, j = 142e-7;
-  double b = 30.2e-3 * 0.137 / (7580.0 * 2.0 * std::numbers::pi / 60.0);
+  // The unit's defaults (maxon RE 40 148877 datasheet, checked against the
+  // datasheet in DefaultsAreTheMaxonRe40DataSheet).
+  double r = models::DcMotorParams{}.resistance_ohm;
+  double l = models::DcMotorParams{}.inductance_h;
+  double kt = models::DcMotorParams{}.torque_constant_nm_per_a;
+  double j = models::DcMotorParams{}.rotor_inertia_kgm2;
+  double b = models::DcMotorParams{}.viscous_friction_nms_per_rad;
   double n = 1.0, eta = 1.0, j_load = 0.0;
 
   double JEff() const { return j + j_load / (eta * n * n); }
@@ -452,6 +457,35 @@ TEST(DcMotorUnit, SaveStepRestoreStepIsBitForBitCurrentOnlyFirstOrderHold) {
   CheckSaveRestoreBitForBit(MotorMode::kCurrentOnly, "first_order");
 }
 
+// Guards the first-order hold's slope across a restore into a fresh unit:
+// the shaft speed ramps, so the slope at the first step after the save
+// (from the saved previous sample) is not zero; a unit that lost that
+// sample would hold to zero order there and drift off bit by bit.
+TEST(DcMotorUnit, FreshUnitRestoredUnderFirstOrderHoldKeepsTheSlope) {
+  const auto make = [] {
+    auto u = std::make_unique<DcMotorUnit>("m", 1, MotorMode::kCurrentOnly);
+    u->variables().SetString(*u->variables().Find("shaft_speed_hold"), "first_order");
+    SetAll(*u, "gear_ratio", 21.0);
+    SetAll(*u, "voltage", 12.0);
+    return u;
+  };
+  const auto step = [](DcMotorUnit& u, int k) {
+    SetAll(u, "shaft_speed", 0.5 * k);  // a ramp: every step has a slope
+    EXPECT_EQ(u.DoStep(k * kMs, kMs), cosim::StepResult::kOk) << u.last_error();
+    return Get(u, "current")[0];
+  };
+  auto original = make();
+  original->Initialize();
+  for (int k = 0; k < 5; ++k) step(*original, k);
+  const cosim::UnitState saved = original->SaveState();
+  auto fresh = make();
+  fresh->RestoreState(saved);
+  for (int k = 5; k < 15; ++k) {
+    const double a = step(*original, k), b = step(*fresh, k);
+    EXPECT_EQ(std::memcmp(&a, &b, sizeof a), 0) << "step " << k << ": " << a << " vs " << b;
+  }
+}
+
 // Current-only motor driven by a continuously varying shaft speed
 // w(t) = A sin(W t) sampled every 1 ms, against the exact solution of the
 // continuous problem L i' = V - R i - k N w(t), i(0) = 0:
@@ -508,7 +542,9 @@ TEST(DcMotorUnit, FirstOrderHoldTracksAContinuouslyVaryingShaftSpeed) {
   // Zero-order lag of half a step: about k N A W (h/2) / R = 0.067 A.
   EXPECT_GT(zoh.max_error, 0.03);
   EXPECT_LT(foh.max_error, 0.1 * zoh.max_error);
-  EXPECT_LT(foh_loose.max_error, 0.1 * zoh.max_error);
+  // models/robots/raw3.yaml justifies its loose tolerances by this: under
+  // 1 % of the zero-order hold's error.
+  EXPECT_LT(foh_loose.max_error, 0.01 * zoh.max_error);
   EXPECT_EQ(foh.restarts, 1);  // the voltage never changes after the start
   EXPECT_EQ(zoh.restarts, 1000);
 }
@@ -681,7 +717,11 @@ TEST(DcMotorUnit, CurrentOnlyInALoopThroughTheMasterFollowsFullModel) {
   ASSERT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors.front());
   EXPECT_EQ(result.end_time, opt.stop);
   std::cout << "current-only + rigid load via master: max rel speed error " << err / max_w << "\n";
-  EXPECT_LE(err / max_w, 0.01);
+  // The load is integrated by explicit Euler with the torque held over each
+  // h = 0.2 ms step: for the coupled lag of time constant
+  // tau = J / (eta N^2 k_t^2 / R) = 0.192 / 1.009 = 0.19 s its relative error
+  // is about h / (2 tau) = 5.3e-4; allow four times that.
+  EXPECT_LE(err / max_w, 2e-3);
 }
 
 // ---------------------------------------------------------------------------
