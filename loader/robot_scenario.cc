@@ -293,10 +293,6 @@ class Expander {
     YAML::Node p = Params(kBelt);
     p["count"] = count;
     p["schedules"] = schedules;
-    p["center_x"] = List(cx);
-    p["center_y"] = List(cy);
-    p["length"] = List(length);
-    p["width"] = List(width);
     p["direction"] = List(direction);
     p["nominal_speed"] = List(speed);
     p["speed_variation"] = List(variation);

@@ -47,10 +47,6 @@ BeltUnit::BeltUnit(std::string name, int belt_count, std::vector<std::vector<Swi
   // +-10 % of Sec. II. The 20 s variation period and the 0.5 m/s^2 ramp are
   // assumptions (no source gives them): a line drive ramps up within a
   // fraction of a second.
-  center_x_.assign(n, 0.0);
-  center_y_.assign(n, 0.0);
-  length_.assign(n, 10.0);
-  width_.assign(n, 1.0);
   direction_.assign(n, 0.0);
   nominal_speed_.assign(n, 0.1);
   initially_on_.assign(n, 1.0);
@@ -62,12 +58,6 @@ BeltUnit::BeltUnit(std::string name, int belt_count, std::vector<std::vector<Swi
   on_.assign(n, 0.0);
 
   auto& v = variables();
-  v.Parameter("center_x", "m", &center_x_,
-              "x of the belt rectangle's centre in the map frame (informational: the chassis "
-              "has its own copy)");
-  v.Parameter("center_y", "m", &center_y_, "y of the belt rectangle's centre in the map frame");
-  v.Parameter("length", "m", &length_, "extent of the rectangle along the direction of motion");
-  v.Parameter("width", "m", &width_, "extent of the rectangle across the direction of motion");
   v.Parameter("direction", "rad", &direction_,
               "direction of motion in the map frame, counter-clockwise from x");
   v.Parameter("nominal_speed", "m/s", &nominal_speed_, "speed while on before the variation (> 0)");
@@ -89,10 +79,6 @@ BeltUnit::BeltUnit(std::string name, int belt_count, std::vector<std::vector<Swi
 
 std::vector<cosim::ParameterProblem> BeltUnit::CheckParameters() const {
   cosim::ParameterChecks c;
-  c.Finite("center_x", center_x_);
-  c.Finite("center_y", center_y_);
-  c.Positive("length", length_);
-  c.Positive("width", width_);
   c.Finite("direction", direction_);
   c.Positive("nominal_speed", nominal_speed_);
   c.Check(
@@ -141,7 +127,6 @@ bool BeltUnit::ScheduledOn(int b, cosim::TimeNs t) const {
 
 double BeltUnit::TargetSpeed(std::size_t b, bool on, cosim::TimeNs t) const {
   if (!on) return 0.0;
-  if (speed_variation_[b] == 0.0) return nominal_speed_[b];  // exactly nominal
   return nominal_speed_[b] * (1.0 + speed_variation_[b] * VariationSignal(static_cast<int>(b), t));
 }
 
@@ -161,16 +146,10 @@ void BeltUnit::Initialize() {
     belt_speed_[b] = TargetSpeed(b, ScheduledOn(static_cast<int>(b), start_), start_);
   }
   ComputeOutputs(start_);
-  initialized_ = true;
 }
 
 cosim::StepResult BeltUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
-  if (!initialized_) return Fail(Where() + ": DoStep called before Initialize");
-  if (dt <= 0) {
-    return Fail(Where() + ": step size must be positive, got " + cosim::FormatSeconds(dt) +
-                " s at t = " + cosim::FormatSeconds(t) + " s");
-  }
   const cosim::TimeNs t_end = t + dt;
   for (std::size_t b = 0; b < nominal_speed_.size(); ++b) {
     // Sub-steps end at each switch inside (t, t_end), so that a ramp starts
@@ -204,21 +183,20 @@ cosim::StepResult BeltUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
 void BeltUnit::SaveInternal(cosim::UnitState& state) const {
   state.reals = period_factors_;
   state.reals.insert(state.reals.end(), phases_rad_.begin(), phases_rad_.end());
-  state.integers = {start_, initialized_ ? 1 : 0};
+  state.integers = {start_};
 }
 
 void BeltUnit::RestoreInternal(const cosim::UnitState& state) {
   const std::size_t terms = period_factors_.size();
-  if (state.reals.size() != 2 * terms || state.integers.size() != 2) {
+  if (state.reals.size() != 2 * terms || state.integers.size() != 1) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
-                           " integers, expected " + std::to_string(2 * terms) + " and 2");
+                           " integers, expected " + std::to_string(2 * terms) + " and 1");
   }
   const auto middle = state.reals.begin() + static_cast<std::ptrdiff_t>(terms);
   period_factors_.assign(state.reals.begin(), middle);
   phases_rad_.assign(middle, state.reals.end());
   start_ = state.integers[0];
-  initialized_ = state.integers[1] != 0;
 }
 
 }  // namespace linesim::belt

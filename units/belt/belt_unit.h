@@ -79,14 +79,13 @@ class BeltUnit : public cosim::Unit {
   std::vector<double> period_factors_, phases_rad_;
 
   // Parameters, one element per belt.
-  std::vector<double> center_x_, center_y_, length_, width_, direction_, nominal_speed_,
-      initially_on_, speed_variation_, variation_period_, acceleration_;
+  std::vector<double> direction_, nominal_speed_, initially_on_, speed_variation_,
+      variation_period_, acceleration_;
 
   // Outputs.
   std::vector<double> velocity_, belt_speed_, on_;
 
   cosim::TimeNs start_ = 0;
-  bool initialized_ = false;
 };
 
 }  // namespace linesim::belt

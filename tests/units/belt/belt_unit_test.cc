@@ -214,8 +214,9 @@ TEST(BeltUnit, RestoredUnitContinuesBitForBit) {
   }
 }
 
-// Guards against a variation of 0 still adding rounding noise: the speed is
-// then exactly the nominal value (the test of paper 1's uniform-speed case).
+// Guards the uniform-speed case (paper 1 validates at constant speed): with
+// a variation of 0 nothing else may move the speed (no noise term, no
+// drift of the slew), so it is exactly the nominal value.
 TEST(BeltUnit, ZeroVariationGivesExactlyNominalSpeed) {
   BeltUnit u("belt", 1, {}, 3);
   SetAll(u, "nominal_speed", 0.1);
@@ -232,8 +233,7 @@ TEST(BeltUnit, ZeroVariationGivesExactlyNominalSpeed) {
 TEST(BeltUnit, RefusesBadParametersNamingVariableAndBelt) {
   BeltUnit u("line", 2, {{}, {{2 * kS, true}, {1 * kS, false}}}, 0);
   SetArray(u, "nominal_speed", {0.1, 0.0});
-  SetArray(u, "width", {-1.0, 1.0});
-  SetArray(u, "length", {1.0, 0.0});
+  SetArray(u, "direction", {0.0, NAN});
   SetArray(u, "speed_variation", {0.6, 0.1});
   SetArray(u, "acceleration", {0.5, 0.0});
   SetArray(u, "initially_on", {0.5, 1.0});
@@ -241,10 +241,9 @@ TEST(BeltUnit, RefusesBadParametersNamingVariableAndBelt) {
   const auto problems = u.CheckParameters();
   std::vector<std::string> found;
   for (const auto& p : problems) found.push_back(p.variable + "[" + std::to_string(*p.index) + "]");
-  EXPECT_EQ(found,
-            (std::vector<std::string>{"length[1]", "width[0]", "nominal_speed[1]",
-                                      "initially_on[0]", "speed_variation[0]",
-                                      "variation_period[0]", "acceleration[1]", "schedules.1[1]"}));
+  EXPECT_EQ(found, (std::vector<std::string>{"direction[1]", "nominal_speed[1]", "initially_on[0]",
+                                             "speed_variation[0]", "variation_period[0]",
+                                             "acceleration[1]", "schedules.1[1]"}));
   EXPECT_NE(problems.back().message.find("increase"), std::string::npos);
   u.Setup(0, kS);
   try {
