@@ -54,7 +54,6 @@ void PathDeviationUnit::Evaluate() {
 }
 
 cosim::StepResult PathDeviationUnit::DoStep(cosim::TimeNs, cosim::TimeNs) {
-  Evaluate();
   return cosim::StepResult::kOk;
 }
 

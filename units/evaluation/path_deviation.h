@@ -29,7 +29,12 @@ class PathDeviationUnit : public cosim::Unit {
   PathDeviationUnit(std::string name, std::vector<std::array<double, 2>> path);
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
-  void Initialize() override { Evaluate(); }
+  void Initialize() override {
+    ThrowIfBadParameters();
+    Evaluate();
+  }
+  /// The deviation follows the pose at each communication point; the step
+  /// itself has nothing to advance.
   void UpdateOutputs() override { Evaluate(); }
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
 

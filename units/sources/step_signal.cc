@@ -1,21 +1,22 @@
 #include "units/sources/step_signal.h"
 
-#include <stdexcept>
+#include <string>
 
 namespace linesim::sources {
 
 StepSignalUnit::StepSignalUnit(std::string name, int count, std::string unit,
                                std::vector<Step> steps)
-    : cosim::Unit(kTypeName, std::move(name)),
-      steps_(std::move(steps)),
-      initial_(static_cast<std::size_t>(count), 0.0),
-      value_(static_cast<std::size_t>(count), 0.0) {
-  if (count < 1) throw std::invalid_argument("step_signal needs at least one channel");
+    : cosim::Unit(kTypeName, std::move(name)), steps_(std::move(steps)) {
+  if (count < 1) {
+    throw cosim::UnitError(Where() + ": needs at least one channel, got " + std::to_string(count));
+  }
+  initial_.assign(static_cast<std::size_t>(count), 0.0);
+  value_.assign(static_cast<std::size_t>(count), 0.0);
   for (std::size_t i = 0; i < steps_.size(); ++i) {
     if (steps_[i].value.size() != value_.size()) {
-      throw std::invalid_argument("step " + std::to_string(i) + " has " +
-                                  std::to_string(steps_[i].value.size()) + " values, expected " +
-                                  std::to_string(value_.size()));
+      throw cosim::UnitError(Where() + ": step " + std::to_string(i) + " has " +
+                             std::to_string(steps_[i].value.size()) + " values, expected " +
+                             std::to_string(value_.size()));
     }
   }
   auto& v = variables();
@@ -46,7 +47,10 @@ void StepSignalUnit::Evaluate(cosim::TimeNs t) {
 
 void StepSignalUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }
 
-void StepSignalUnit::Initialize() { Evaluate(start_); }
+void StepSignalUnit::Initialize() {
+  ThrowIfBadParameters();
+  Evaluate(start_);
+}
 
 cosim::StepResult StepSignalUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   Evaluate(t + dt);

@@ -47,12 +47,15 @@ TEST(PathDeviationUnit, OutputsFollowThePose) {
   EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("deviation")), 0.04);
   EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("progress")), 3.0);
   EXPECT_EQ(u.DoStep(0, 1'000'000), cosim::StepResult::kOk);
+  EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("deviation")), 0.04);
 }
 
-// Guards against an empty path being accepted (every distance would be NaN).
+// Guards against an empty path being accepted (every distance would be NaN),
+// also when the unit is initialized without the loader's check.
 TEST(PathDeviationUnit, RefusesAnEmptyPath) {
   PathDeviationUnit u("monitor", {});
   EXPECT_EQ(u.CheckParameters().size(), 1u);
+  EXPECT_THROW(u.Initialize(), cosim::UnitError);
 }
 
 }  // namespace

@@ -35,6 +35,21 @@ TEST(StepSignalUnit, RefusesDecreasingStepTimes) {
   EXPECT_EQ(problems[0].variable, "steps");
   EXPECT_EQ(problems[0].index, 1u);
   EXPECT_NE(problems[0].message.find("increase"), std::string::npos);
+  // Also without the loader: Initialize refuses them.
+  EXPECT_THROW(u.Initialize(), cosim::UnitError);
+}
+
+// Guards the constructor against a bad channel count (a negative count used
+// to size vectors before it was checked) and against steps with the wrong
+// number of values: both are errors that name the unit.
+TEST(StepSignalUnit, RefusesBadCountsNamingTheUnit) {
+  try {
+    StepSignalUnit u("s", -1, "V", {});
+    FAIL() << "count -1 accepted";
+  } catch (const cosim::UnitError& e) {
+    EXPECT_NE(std::string(e.what()).find("unit 's' (step_signal)"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(StepSignalUnit("s", 2, "V", {{0, {1.0}}}), cosim::UnitError);
 }
 
 // Guards against the output unit of measure being lost (connections check it).
