@@ -46,7 +46,7 @@ class ChassisUnit : public cosim::Unit {
   /// wheel_count >= 1 modules and belt_count >= 0 belt patches (structural:
   /// they size the arrays; with no belts there are no belt parameters and no
   /// belt_velocity input). Throws cosim::UnitError otherwise.
-  explicit ChassisUnit(std::string name, int wheel_count = 4, int belt_count = 1);
+  ChassisUnit(std::string name, int wheel_count, int belt_count);
   ~ChassisUnit() override;
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;

@@ -1,6 +1,5 @@
 #include "units/chassis/floor_world.h"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -119,7 +118,6 @@ int FloorWorld::Collide(int i) {
   const int n = dCollide(geom, floor_, kMaxPoints, &points_[0].geom, sizeof(dContact));
   GeomContact& c = contacts_[static_cast<std::size_t>(i)];
   c.points = n;
-  c.depth_m = 0.0;
   if (n == 0) {
     const dReal* p = dGeomGetPosition(geom);
     c.surface = -1;
@@ -139,7 +137,6 @@ int FloorWorld::Collide(int i) {
     }
     sx += g.pos[0];
     sy += g.pos[1];
-    c.depth_m = std::max(c.depth_m, static_cast<double>(g.depth));
   }
   c.x_m = sx / n;
   c.y_m = sy / n;

@@ -54,7 +54,6 @@ struct GeomContact {
   int points = 0;    // contact points found
   double x_m = 0.0;  // mean contact point in map, or the geom position without contact
   double y_m = 0.0;
-  double depth_m = 0.0;  // largest penetration
 };
 
 /// Owns the dWorld (gravity -z), a joint group for contacts and the static

@@ -1,7 +1,6 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <span>
 
 namespace linesim::control {
 
@@ -40,13 +39,5 @@ struct WheelSetpoint {
 /// heading is undefined: the wheel keeps `last_target` and stops.
 WheelSetpoint ToWheelSetpoint(const Eigen::Vector2d& velocity_mps, double radius_m,
                               double angle_now_rad, double last_target_rad, double zero_speed_mps);
-
-/// The inverse of Eq. 1 for several wheels (forward kinematics, odometry):
-/// the body twist (vx, vy, yaw rate) that best explains the wheel set points
-/// in the least-squares sense. Needs at least two wheels at different
-/// positions; otherwise the yaw rate is not observable and the result is
-/// the minimum-norm solution.
-Eigen::Vector3d BodyTwist(std::span<const Eigen::Vector2d> positions_m,
-                          std::span<const WheelSetpoint> wheels, double radius_m);
 
 }  // namespace linesim::control
