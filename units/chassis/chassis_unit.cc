@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "cosim/parameter_checks.h"
+#include "models/angle.h"
 #include "units/chassis/floor_world.h"
 
 namespace linesim::chassis {
@@ -24,14 +25,6 @@ constexpr double kSettleHoldTorqueNm = 1e4;
 // Reals saved per body: position 3, quaternion 4, linear and angular
 // velocity 3 each.
 constexpr std::size_t kRealsPerBody = 13;
-
-std::string FormatNumber(double x) { return cosim::FormatValue(cosim::Value{x}); }
-
-// To (-pi, pi].
-double WrapAngle(double a_rad) {
-  a_rad = std::remainder(a_rad, 2.0 * kPi);
-  return a_rad <= -kPi ? a_rad + 2.0 * kPi : a_rad;
-}
 
 // Column c of an ODE rotation matrix (3 rows of 4).
 void Column(const dReal* r, int c, double out[3]) {
@@ -223,7 +216,7 @@ std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
   if (mass_ > 0.0 && module_mass_ > 0.0 && !(wheel_count_ * module_mass_ < mass_)) {
     c.Add({"module_mass", std::nullopt,
            "times " + std::to_string(wheel_count_) + " modules must be less than mass " +
-               FormatNumber(mass_) + ", got " + FormatNumber(module_mass_)});
+               cosim::FormatValue(mass_) + ", got " + cosim::FormatValue(module_mass_)});
   }
   c.Positive("com_height", com_height_);
   c.Positive("wheel_radius", wheel_radius_);
@@ -446,7 +439,7 @@ void ChassisUnit::ComputeOutputs() {
   const double c = std::cos(yaw), s = std::sin(yaw);
   pose_[0] = pb[0];
   pose_[1] = pb[1];
-  pose_[2] = WrapAngle(yaw);
+  pose_[2] = models::WrapAngle(yaw);
   velocity_[0] = vb[0];
   velocity_[1] = vb[1];
   velocity_[2] = wb[2];
@@ -462,7 +455,7 @@ void ChassisUnit::ComputeOutputs() {
     const dBodyID w = o.wheels[k];
     Column(dBodyGetRotation(w), 1, axle);
     // Heading = axle x up; in base_link: (ax_y, -ax_x) of the axle there.
-    steer_angle_[k] = WrapAngle(std::atan2(-Dot(axle, ex), Dot(axle, ey)));
+    steer_angle_[k] = models::WrapAngle(std::atan2(-Dot(axle, ex), Dot(axle, ey)));
     const dReal* ww = dBodyGetAngularVel(w);
     const double rel[3] = {ww[0] - wb[0], ww[1] - wb[1], ww[2] - wb[2]};
     steer_rate_[k] = Dot(ez, rel);
@@ -492,7 +485,7 @@ cosim::StepResult ChassisUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     for (std::size_t k = 0; k < in->size(); ++k) {
       if (!std::isfinite((*in)[k])) {
         return Fail(Where() + ": input '" + var + "[" + std::to_string(k) + "]' is " +
-                    FormatNumber((*in)[k]) + at());
+                    cosim::FormatValue((*in)[k]) + at());
       }
     }
   }

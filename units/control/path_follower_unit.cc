@@ -5,15 +5,9 @@
 #include <utility>
 
 #include "cosim/parameter_checks.h"
-#include "units/control/wheel_kinematics.h"
+#include "models/angle.h"
 
 namespace linesim::control {
-
-namespace {
-
-std::string FormatNumber(double x) { return cosim::FormatValue(cosim::Value{x}); }
-
-}  // namespace
 
 PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
                                    std::vector<std::array<double, 2>> waypoints_m)
@@ -54,24 +48,23 @@ PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
 }
 
 std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
-  std::vector<cosim::ParameterProblem> problems;
+  cosim::ParameterChecks c;
   const std::size_t needed = mode_ == Mode::kPath ? 2 : 1;
   if (waypoints_m_.size() < needed) {
-    problems.push_back({"waypoints", std::nullopt,
-                        std::string(mode_ == Mode::kPath ? "a path" : "hold") + " needs at least " +
-                            std::to_string(needed) + " waypoint(s), got " +
-                            std::to_string(waypoints_m_.size())});
+    c.Add({"waypoints", std::nullopt,
+           std::string(mode_ == Mode::kPath ? "a path" : "hold") + " needs at least " +
+               std::to_string(needed) + " waypoint(s), got " +
+               std::to_string(waypoints_m_.size())});
   }
   for (std::size_t k = 0; k < waypoints_m_.size(); ++k) {
     if (!std::isfinite(waypoints_m_[k][0]) || !std::isfinite(waypoints_m_[k][1])) {
-      problems.push_back({"waypoints", k,
-                          "must be finite, got (" + FormatNumber(waypoints_m_[k][0]) + ", " +
-                              FormatNumber(waypoints_m_[k][1]) + ")"});
+      c.Add({"waypoints", k,
+             "must be finite, got (" + cosim::FormatValue(waypoints_m_[k][0]) + ", " +
+                 cosim::FormatValue(waypoints_m_[k][1]) + ")"});
     } else if (mode_ == Mode::kPath && k > 0 && !(cumulative_m_[k] > cumulative_m_[k - 1])) {
-      problems.push_back({"waypoints", k, "repeats the previous waypoint (zero-length segment)"});
+      c.Add({"waypoints", k, "repeats the previous waypoint (zero-length segment)"});
     }
   }
-  cosim::ParameterChecks c;
   c.Positive("speed", speed_);
   c.Positive("acceleration", acceleration_);
   c.Finite("yaw", yaw_);
@@ -81,8 +74,7 @@ std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
   c.Positive("max_speed", max_speed_);
   c.NonNegative("max_yaw_rate", max_yaw_rate_);
   c.Positive("goal_tolerance", goal_tolerance_);
-  for (auto& problem : c.Take()) problems.push_back(std::move(problem));
-  return problems;
+  return c.Take();
 }
 
 void PathFollowerUnit::Initialize() {
@@ -145,7 +137,7 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate() const {
   }
   if (!(mode_ == Mode::kPath && s.at_goal)) {
     s.yaw_rate_rad_s =
-        std::clamp(k_yaw_ * WrapAngle(yaw_ - pose_[2]), -max_yaw_rate_, max_yaw_rate_);
+        std::clamp(k_yaw_ * models::WrapAngle(yaw_ - pose_[2]), -max_yaw_rate_, max_yaw_rate_);
   }
   return s;
 }
@@ -171,7 +163,7 @@ cosim::StepResult PathFollowerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   for (std::size_t k = 0; k < pose_.size(); ++k) {
     if (!std::isfinite(pose_[k])) {
       return Fail(Where() + ": input 'pose[" + std::to_string(k) + "]' is " +
-                  FormatNumber(pose_[k]) + " at t = " + cosim::FormatSeconds(t) + " s");
+                  cosim::FormatValue(pose_[k]) + " at t = " + cosim::FormatSeconds(t) + " s");
     }
   }
   const Sample s = Evaluate();

@@ -12,8 +12,6 @@ namespace linesim::control {
 
 namespace {
 
-std::string FormatNumber(double x) { return cosim::FormatValue(cosim::Value{x}); }
-
 // Default plant, Rob@Work 3 (FACTS.md) with the maxon RE 40 stand-in motor
 // of models/motors/raw3_{drive,steer}.yaml. The gearbox efficiencies are
 // the assumptions of those files.
@@ -225,7 +223,7 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
     for (std::size_t k = 0; k < in->size(); ++k) {
       if (!std::isfinite((*in)[k])) {
         return Fail(Where() + ": input '" + var + "[" + std::to_string(k) + "]' is " +
-                    FormatNumber((*in)[k]) + " at t = " + cosim::FormatSeconds(t) + " s");
+                    cosim::FormatValue((*in)[k]) + " at t = " + cosim::FormatSeconds(t) + " s");
       }
     }
   }

@@ -5,13 +5,6 @@
 
 namespace linesim::control {
 
-double WrapAngle(double angle_rad) {
-  constexpr double kPi = std::numbers::pi;
-  // remainder() maps to [-pi, pi]; -pi is moved to +pi for a unique value.
-  const double a = std::remainder(angle_rad, 2.0 * kPi);
-  return a <= -kPi ? a + 2.0 * kPi : a;
-}
-
 Eigen::Vector2d WheelVelocity(const Eigen::Vector3d& twist, const Eigen::Vector2d& position_m) {
   return {twist[0] - twist[2] * position_m[1], twist[1] + twist[2] * position_m[0]};
 }

@@ -2,10 +2,12 @@
 
 #include <Eigen/Dense>
 
+#include "models/angle.h"
+
 namespace linesim::control {
 
-/// An angle wrapped to (-pi, pi].
-double WrapAngle(double angle_rad);
+/// An angle wrapped to (-pi, pi] (the one definition the units share).
+using models::WrapAngle;
 
 /// Paper 1, Eq. 1: the velocity of the contact of a wheel whose steering axis
 /// is at `position_m` (base_link) when the body moves with `twist`

@@ -24,6 +24,8 @@ const std::array<Eigen::Vector2d, 4> kWheels = {
 
 // Guards against a wrap that leaves -pi (two names for one heading) or
 // drifts multiples of 2 pi. Definition: result in (-pi, pi], same angle.
+// control::WrapAngle is models::WrapAngle, which the chassis and the path
+// follower use too, so this covers every unit's wrap.
 TEST(WrapAngle, MapsIntoHalfOpenInterval) {
   EXPECT_EQ(WrapAngle(kPi), kPi);
   EXPECT_EQ(WrapAngle(-kPi), kPi);
