@@ -310,10 +310,7 @@ void ChassisUnit::Build() {
 
 void ChassisUnit::SetSuspension(double h_s) {
   if (h_s == ode_->suspension_h_s) return;
-  // The spring-damper equivalence of ERP and CFM (as for the contacts).
-  const double hk = h_s * suspension_stiffness_;
-  const double erp = hk / (hk + suspension_damping_);
-  const double cfm = 1.0 / (hk + suspension_damping_);
+  const auto [erp, cfm] = ErpCfm(h_s, suspension_stiffness_, suspension_damping_);
   for (dJointID j : ode_->joints) {
     dJointSetHinge2Param(j, dParamSuspensionERP, erp);
     dJointSetHinge2Param(j, dParamSuspensionCFM, cfm);

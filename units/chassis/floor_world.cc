@@ -203,11 +203,7 @@ void FloorWorld::MakeJoints(int n, double erp, double cfm) {
 }
 
 bool FloorWorld::Step(double h_s) {
-  // ODE's spring-damper equivalence for one implicit step of h:
-  // ERP = h kp / (h kp + kd), CFM = 1 / (h kp + kd).
-  const double hk = h_s * surface_.stiffness_n_per_m;
-  const double erp = hk / (hk + surface_.damping_n_s_per_m);
-  const double cfm = 1.0 / (hk + surface_.damping_n_s_per_m);
+  const auto [erp, cfm] = ErpCfm(h_s, surface_.stiffness_n_per_m, surface_.damping_n_s_per_m);
   int ok = 0;
   try {
     for (int i = 0; i < static_cast<int>(geoms_.size()); ++i) MakeJoints(Collide(i), erp, cfm);

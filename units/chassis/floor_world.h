@@ -29,6 +29,19 @@ class OdeError : public std::runtime_error {
 /// world that threw must then be rebuilt.
 void EnsureOdeForThisThread();
 
+struct SoftParams {
+  double erp;
+  double cfm;
+};
+/// ODE's ERP and CFM that make a constraint a spring of stiffness k (N/m or
+/// N.m/rad) with damping d, for one implicit step of h_s seconds (ODE
+/// manual, "How To Use ERP and CFM"): ERP = h k / (h k + d),
+/// CFM = 1 / (h k + d). Used for the contacts and the suspension.
+inline SoftParams ErpCfm(double h_s, double k, double d) {
+  const double hk = h_s * k;
+  return {hk / (hk + d), 1.0 / (hk + d)};
+}
+
 /// A rectangular belt patch in the map frame.
 struct BeltPatch {
   double center_x_m = 0.0;

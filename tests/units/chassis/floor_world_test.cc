@@ -144,6 +144,19 @@ TEST(FloorWorld, SurfaceAtRotatedPatches) {
   EXPECT_EQ(f.SurfaceAt(6.0, 0.0), 0);  // outside both
 }
 
+// Guards against a slip in the one spring-damper formula the contacts and
+// the suspension share. By hand, the contact defaults at 1 ms: h k = 1000,
+// ERP = 1000 / (1000 + 1e4) = 1/11, CFM = 1 / 11000; no damping gives
+// ERP 1 and CFM 1 / (h k).
+TEST(FloorWorld, ErpCfmOfASpringDamper) {
+  const SoftParams p = ErpCfm(1e-3, 1e6, 1e4);
+  EXPECT_DOUBLE_EQ(p.erp, 1.0 / 11.0);
+  EXPECT_DOUBLE_EQ(p.cfm, 1.0 / 11000.0);
+  const SoftParams stiff = ErpCfm(1e-3, 1e7, 0.0);
+  EXPECT_EQ(stiff.erp, 1.0);
+  EXPECT_DOUBLE_EQ(stiff.cfm, 1e-4);
+}
+
 // Guards against geoms that are not on the floor being reported as
 // touching it.
 TEST(FloorWorld, NoContactAboveTheFloor) {
