@@ -471,21 +471,14 @@ void ChassisUnit::ComputeOutputs() {
 cosim::StepResult ChassisUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
   const auto at = [&]() { return " at t = " + cosim::FormatSeconds(t) + " s"; };
-  if (!initialized_) return Fail(Where() + ": DoStep called before Initialize");
-  if (dt <= 0) {
-    return Fail(Where() + ": step size must be positive, got " + cosim::FormatSeconds(dt) + " s" +
-                at());
+  // The master initialises every unit before stepping it, but after a failed
+  // step the ODE world may be inconsistent (initialized_ is cleared there),
+  // and it is not rebuilt until Initialize or RestoreState: refuse to step it.
+  if (!initialized_) {
+    return Fail(Where() + ": the ODE world needs Initialize or RestoreState (after a failed " +
+                "step, or never initialised)" + at());
   }
-  for (const auto& [var, in] : {std::pair{"steer_torque", &steer_torque_},
-                                {"drive_torque", &drive_torque_},
-                                {"belt_velocity", &belt_velocity_}}) {
-    for (std::size_t k = 0; k < in->size(); ++k) {
-      if (!std::isfinite((*in)[k])) {
-        return Fail(Where() + ": input '" + var + "[" + std::to_string(k) + "]' is " +
-                    cosim::FormatValue((*in)[k]) + at());
-      }
-    }
-  }
+  if (!InputsFinite(t)) return cosim::StepResult::kError;
   EnsureOdeForThisThread();
   stepped_since_settle_ = true;
   FloorWorld& f = *ode_->floor;

@@ -81,7 +81,6 @@ void PathFollowerUnit::Initialize() {
   ThrowIfBadParameters();
   ramp_mps_ = 0.0;
   done_latched_ = false;
-  initialized_ = true;
   ComputeOutputs();
 }
 
@@ -155,17 +154,7 @@ void PathFollowerUnit::ComputeOutputs() {
 
 cosim::StepResult PathFollowerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
-  if (!initialized_) return Fail(Where() + ": DoStep called before Initialize");
-  if (dt <= 0) {
-    return Fail(Where() + ": step size must be positive, got " + cosim::FormatSeconds(dt) +
-                " s at t = " + cosim::FormatSeconds(t) + " s");
-  }
-  for (std::size_t k = 0; k < pose_.size(); ++k) {
-    if (!std::isfinite(pose_[k])) {
-      return Fail(Where() + ": input 'pose[" + std::to_string(k) + "]' is " +
-                  cosim::FormatValue(pose_[k]) + " at t = " + cosim::FormatSeconds(t) + " s");
-    }
-  }
+  if (!InputsFinite(t)) return cosim::StepResult::kError;
   const Sample s = Evaluate();
   // The ramp continues from the speed actually commanded, so that it also
   // restarts gently after a slow-down.
@@ -177,18 +166,17 @@ cosim::StepResult PathFollowerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
 
 void PathFollowerUnit::SaveInternal(cosim::UnitState& state) const {
   state.reals = {ramp_mps_};
-  state.integers = {done_latched_ ? 1 : 0, initialized_ ? 1 : 0};
+  state.integers = {done_latched_ ? 1 : 0};
 }
 
 void PathFollowerUnit::RestoreInternal(const cosim::UnitState& state) {
-  if (state.reals.size() != 1 || state.integers.size() != 2) {
+  if (state.reals.size() != 1 || state.integers.size() != 1) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
-                           " integers, expected 1 and 2");
+                           " integers, expected 1 and 1");
   }
   ramp_mps_ = state.reals[0];
   done_latched_ = state.integers[0] != 0;
-  initialized_ = state.integers[1] != 0;
 }
 
 }  // namespace linesim::control

@@ -92,7 +92,6 @@ class PathFollowerUnit : public cosim::Unit {
   // State: the along-track speed the ramp allows at this sample, and done.
   double ramp_mps_ = 0.0;
   bool done_latched_ = false;
-  bool initialized_ = false;
 };
 
 }  // namespace linesim::control

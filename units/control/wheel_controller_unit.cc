@@ -175,7 +175,6 @@ void WheelControllerUnit::Initialize() {
     drive_ref_[i] = drive_next_[i] = drive_integral_[i] = 0.0;
   }
   period_s_ = 0.0;
-  initialized_ = true;
   ComputeOutputs();
 }
 
@@ -210,23 +209,7 @@ void WheelControllerUnit::ComputeOutputs() {
 
 cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
-  if (!initialized_) return Fail(Where() + ": DoStep called before Initialize");
-  if (dt <= 0) {
-    return Fail(Where() + ": step size must be positive, got " + cosim::FormatSeconds(dt) +
-                " s at t = " + cosim::FormatSeconds(t) + " s");
-  }
-  for (const auto& [var, in] : {std::pair{"twist_command", &twist_command_},
-                                {"surface_velocity", &surface_velocity_},
-                                {"steer_angle", &steer_angle_},
-                                {"steer_rate", &steer_rate_},
-                                {"drive_rate", &drive_rate_}}) {
-    for (std::size_t k = 0; k < in->size(); ++k) {
-      if (!std::isfinite((*in)[k])) {
-        return Fail(Where() + ": input '" + var + "[" + std::to_string(k) + "]' is " +
-                    cosim::FormatValue((*in)[k]) + " at t = " + cosim::FormatSeconds(t) + " s");
-      }
-    }
-  }
+  if (!InputsFinite(t)) return cosim::StepResult::kError;
   const double dt_s = cosim::NsToSeconds(dt);
   const std::size_t n = steer_ref_.size();
 
@@ -298,16 +281,16 @@ void WheelControllerUnit::SaveInternal(cosim::UnitState& state) const {
     state.reals.insert(state.reals.end(), v->begin(), v->end());
   }
   state.reals.push_back(period_s_);
-  state.integers = {initialized_ ? 1 : 0};
+  state.integers.clear();
 }
 
 void WheelControllerUnit::RestoreInternal(const cosim::UnitState& state) {
   const std::size_t n = steer_ref_.size();
   const std::size_t expected = 7 * n + 1;
-  if (state.reals.size() != expected || state.integers.size() != 1) {
+  if (state.reals.size() != expected || !state.integers.empty()) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
-                           " integers, expected " + std::to_string(expected) + " and 1");
+                           " integers, expected " + std::to_string(expected) + " and 0");
   }
   auto it = state.reals.begin();
   for (auto* v : {&steer_ref_, &steer_next_, &steer_prev_rate_, &flip_angle_, &drive_ref_,
@@ -316,7 +299,6 @@ void WheelControllerUnit::RestoreInternal(const cosim::UnitState& state) {
     it += static_cast<std::ptrdiff_t>(n);
   }
   period_s_ = *it;
-  initialized_ = state.integers[0] != 0;
 }
 
 }  // namespace linesim::control
