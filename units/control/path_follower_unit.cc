@@ -47,6 +47,15 @@ PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
            {"pose"});
 }
 
+bool PathFollowerUnit::ZeroSegment(std::size_t k) const {
+  // Evaluate divides by the growth of cumulative_m_, so a segment too short
+  // to grow the sum is as bad as a zero one. After a non-finite waypoint the
+  // sum is NaN, and only the segment itself can be judged.
+  if (std::isfinite(cumulative_m_[k - 1])) return !(cumulative_m_[k] > cumulative_m_[k - 1]);
+  return !(std::hypot(waypoints_m_[k][0] - waypoints_m_[k - 1][0],
+                      waypoints_m_[k][1] - waypoints_m_[k - 1][1]) > 0.0);
+}
+
 std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
   cosim::ParameterChecks c;
   const std::size_t needed = mode_ == Mode::kPath ? 2 : 1;
@@ -56,12 +65,15 @@ std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
                std::to_string(needed) + " waypoint(s), got " +
                std::to_string(waypoints_m_.size())});
   }
+  const auto finite = [&](std::size_t k) {
+    return std::isfinite(waypoints_m_[k][0]) && std::isfinite(waypoints_m_[k][1]);
+  };
   for (std::size_t k = 0; k < waypoints_m_.size(); ++k) {
-    if (!std::isfinite(waypoints_m_[k][0]) || !std::isfinite(waypoints_m_[k][1])) {
+    if (!finite(k)) {
       c.Add({"waypoints", k,
              "must be finite, got (" + cosim::FormatValue(waypoints_m_[k][0]) + ", " +
                  cosim::FormatValue(waypoints_m_[k][1]) + ")"});
-    } else if (mode_ == Mode::kPath && k > 0 && !(cumulative_m_[k] > cumulative_m_[k - 1])) {
+    } else if (mode_ == Mode::kPath && k > 0 && finite(k - 1) && ZeroSegment(k)) {
       c.Add({"waypoints", k, "repeats the previous waypoint (zero-length segment)"});
     }
   }

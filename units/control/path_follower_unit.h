@@ -63,6 +63,9 @@ class PathFollowerUnit : public cosim::Unit {
     double cross_track_m = 0.0, progress_m = 0.0;
     bool at_goal = false;
   };
+  /// Whether the segment into waypoint k (> 0, both ends finite) has no
+  /// length.
+  bool ZeroSegment(std::size_t k) const;
   Sample Evaluate() const;
   void ComputeOutputs();
 

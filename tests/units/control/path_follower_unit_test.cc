@@ -249,6 +249,17 @@ TEST(PathFollowerUnit, CheckParametersRejectsBadValues) {
   PathFollowerUnit repeat("repeat", Mode::kPath, {{0, 0}, {1, 0}, {1, 0}});
   ASSERT_EQ(repeat.CheckParameters().size(), 1u);
   EXPECT_EQ(repeat.CheckParameters()[0].index, 2u);
+  // A non-finite waypoint is reported once: the segment after it is judged
+  // by its own ends (here 1 m long), the repeat after that still is.
+  PathFollowerUnit nan("nan", Mode::kPath, {{0, 0}, {NAN, 0}, {1, 0}, {1, 0}});
+  const auto nan_problems = nan.CheckParameters();
+  ASSERT_EQ(nan_problems.size(), 2u);
+  EXPECT_EQ(nan_problems[0].index, 1u);
+  EXPECT_NE(nan_problems[0].message.find("must be finite, got (nan, 0)"), std::string::npos)
+      << nan_problems[0].message;
+  EXPECT_EQ(nan_problems[1].index, 3u);
+  EXPECT_NE(nan_problems[1].message.find("repeats the previous waypoint"), std::string::npos)
+      << nan_problems[1].message;
   PathFollowerUnit none("none", Mode::kHold, {});
   EXPECT_EQ(none.CheckParameters().size(), 1u);
   PathFollowerUnit bad("bad", Mode::kHold, {{0, 0}});
