@@ -93,10 +93,38 @@ void PathFollowerUnit::Initialize() {
   ThrowIfBadParameters();
   ramp_mps_ = 0.0;
   done_latched_ = false;
-  ComputeOutputs();
+  ComputeOutputs(FindNearest());
 }
 
-PathFollowerUnit::Sample PathFollowerUnit::Evaluate() const {
+PathFollowerUnit::Nearest PathFollowerUnit::FindNearest() const {
+  Nearest n;
+  if (mode_ != Mode::kPath) return n;
+  // Nearest point over all segments (the first on a tie); the first and
+  // last segments extend beyond the ends, so that progress runs below 0
+  // before the start and past the length after the goal.
+  const double x = pose_[0], y = pose_[1];
+  const std::size_t segments = waypoints_m_.size() - 1;
+  double best_dist2 = INFINITY;
+  for (std::size_t k = 0; k < segments; ++k) {
+    const auto& a = waypoints_m_[k];
+    const double len = cumulative_m_[k + 1] - cumulative_m_[k];
+    const double tx = (waypoints_m_[k + 1][0] - a[0]) / len;
+    const double ty = (waypoints_m_[k + 1][1] - a[1]) / len;
+    const double along = (x - a[0]) * tx + (y - a[1]) * ty;
+    const double lo = k == 0 ? -INFINITY : 0.0;
+    const double hi = k + 1 == segments ? INFINITY : len;
+    const double u = std::clamp(along, lo, hi);
+    const double cross = -(x - a[0]) * ty + (y - a[1]) * tx;
+    const double dist2 = (along - u) * (along - u) + cross * cross;
+    if (dist2 < best_dist2) {
+      best_dist2 = dist2;
+      n = {true, tx, ty, cumulative_m_[k] + u, cross};
+    }
+  }
+  return n;
+}
+
+PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const Nearest& n) const {
   Sample s;
   const double x = pose_[0], y = pose_[1];
   if (mode_ == Mode::kHold) {
@@ -106,34 +134,16 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate() const {
     s.cross_track_m = std::hypot(ex, ey);
     s.at_goal = s.cross_track_m <= goal_tolerance_;
   } else {
-    // Nearest point over all segments (the first on a tie); the first and
-    // last segments extend beyond the ends, so that progress runs below 0
-    // before the start and past the length after the goal.
-    const std::size_t segments = waypoints_m_.size() - 1;
-    double best_dist2 = INFINITY;
-    for (std::size_t k = 0; k < segments; ++k) {
-      const auto& a = waypoints_m_[k];
-      const double len = cumulative_m_[k + 1] - cumulative_m_[k];
-      const double tx = (waypoints_m_[k + 1][0] - a[0]) / len;
-      const double ty = (waypoints_m_[k + 1][1] - a[1]) / len;
-      const double along = (x - a[0]) * tx + (y - a[1]) * ty;
-      const double lo = k == 0 ? -INFINITY : 0.0;
-      const double hi = k + 1 == segments ? INFINITY : len;
-      const double u = std::clamp(along, lo, hi);
-      const double cross = -(x - a[0]) * ty + (y - a[1]) * tx;
-      const double dist2 = (along - u) * (along - u) + cross * cross;
-      if (dist2 < best_dist2) {
-        best_dist2 = dist2;
-        s.progress_m = cumulative_m_[k] + u;
-        s.cross_track_m = cross;
-        const double remaining = length_m() - s.progress_m;
-        const double magnitude =
-            std::min({ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * std::abs(remaining)),
-                      k_position_ * std::abs(remaining)});
-        s.along_mps = std::copysign(magnitude, remaining);
-        s.vx_map_mps = tx * s.along_mps + ty * k_cross_ * cross;
-        s.vy_map_mps = ty * s.along_mps - tx * k_cross_ * cross;
-      }
+    if (n.found) {
+      s.progress_m = n.progress_m;
+      s.cross_track_m = n.cross_track_m;
+      const double remaining = length_m() - s.progress_m;
+      const double magnitude =
+          std::min({ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * std::abs(remaining)),
+                    k_position_ * std::abs(remaining)});
+      s.along_mps = std::copysign(magnitude, remaining);
+      s.vx_map_mps = n.tx * s.along_mps + n.ty * k_cross_ * n.cross_track_m;
+      s.vy_map_mps = n.ty * s.along_mps - n.tx * k_cross_ * n.cross_track_m;
     }
     const auto& goal = waypoints_m_.back();
     s.at_goal = done_latched_ || std::hypot(x - goal[0], y - goal[1]) <= goal_tolerance_;
@@ -153,8 +163,8 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate() const {
   return s;
 }
 
-void PathFollowerUnit::ComputeOutputs() {
-  const Sample s = Evaluate();
+void PathFollowerUnit::ComputeOutputs(const Nearest& n) {
+  const Sample s = Evaluate(n);
   const double c = std::cos(pose_[2]), sn = std::sin(pose_[2]);
   twist_command_[0] = c * s.vx_map_mps + sn * s.vy_map_mps;
   twist_command_[1] = -sn * s.vx_map_mps + c * s.vy_map_mps;
@@ -167,12 +177,14 @@ void PathFollowerUnit::ComputeOutputs() {
 cosim::StepResult PathFollowerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
   if (!InputsFinite(t)) return cosim::StepResult::kError;
-  const Sample s = Evaluate();
+  // The pose is the same before and after the commit: one search.
+  const Nearest n = FindNearest();
+  const Sample s = Evaluate(n);
   // The ramp continues from the speed actually commanded, so that it also
   // restarts gently after a slow-down.
   ramp_mps_ = std::min(speed_, std::abs(s.along_mps) + acceleration_ * cosim::NsToSeconds(dt));
   if (mode_ == Mode::kPath && s.at_goal) done_latched_ = true;
-  ComputeOutputs();
+  ComputeOutputs(n);
   return cosim::StepResult::kOk;
 }
 

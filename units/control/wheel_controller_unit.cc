@@ -75,7 +75,7 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
   steer_target_.assign(n, 0.0);
   drive_rate_target_.assign(n, 0.0);
   for (auto* v : {&steer_ref_, &steer_next_, &steer_prev_rate_, &flip_angle_, &drive_ref_,
-                  &drive_next_, &drive_integral_}) {
+                  &drive_next_, &drive_integral_, &drive_setpoint_}) {
     v->assign(n, 0.0);
   }
 
@@ -213,18 +213,20 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
   const double dt_s = cosim::NsToSeconds(dt);
   const std::size_t n = steer_ref_.size();
 
-  // Set points of this sample: Eq. 1, Algorithm 1, flip rule.
+  // Set points of this sample: Eq. 1, Algorithm 1, flip rule (from the
+  // last flip-rule heading, which the set point then replaces).
   const Eigen::Vector3d twist(twist_command_[0], twist_command_[1], twist_command_[2]);
-  std::vector<WheelSetpoint> setpoints(n);
   double fastest_rad_s = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     Eigen::Vector2d v = WheelVelocity(twist, {wheel_x_[i], wheel_y_[i]});
     if (compensation_) {
       v = CompensateSurface(v, {surface_velocity_[2 * i], surface_velocity_[2 * i + 1]});
     }
-    setpoints[i] =
+    const WheelSetpoint setpoint =
         ToWheelSetpoint(v, wheel_radius_, steer_angle_[i], flip_angle_[i], zero_speed_threshold_);
-    fastest_rad_s = std::max(fastest_rad_s, std::abs(setpoints[i].drive_rate_rad_s));
+    flip_angle_[i] = setpoint.steer_angle_rad;
+    drive_setpoint_[i] = setpoint.drive_rate_rad_s;
+    fastest_rad_s = std::max(fastest_rad_s, std::abs(setpoint.drive_rate_rad_s));
   }
   // Scale all wheels alike, so that a too fast command keeps its direction
   // and curvature instead of being distorted wheel by wheel.
@@ -233,7 +235,8 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
   for (std::size_t i = 0; i < n; ++i) {
     // Drive integrator on the error of this sample; it stops while the
     // output saturates in the error's direction (anti-windup) and never
-    // holds more than the full voltage.
+    // holds more than the full voltage. Computed again, not taken from
+    // UpdateOutputs: Gauss-Seidel transfers new inputs right before DoStep.
     const Voltages u = Compute(i);
     const double error = drive_ref_[i] - drive_rate_[i];
     if (!(std::abs(u.drive_v) > max_voltage_ && error * u.drive_v > 0.0)) {
@@ -251,7 +254,6 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
         period_s_ > 0.0 ? WrapAngle(steer_next_[i] - steer_ref_[i]) / period_s_ : 0.0;
     steer_prev_rate_[i] = rate_now;
     steer_ref_[i] = steer_next_[i];
-    flip_angle_[i] = setpoints[i].steer_angle_rad;
     const double gap = WrapAngle(flip_angle_[i] - steer_ref_[i]);
     const double dv = steer_max_acceleration_ * dt_s;
     const double steps = std::abs(gap) / (dv * dt_s);
@@ -265,7 +267,7 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
 
     // Drive reference: rate-limited ramp towards the scaled set point.
     drive_ref_[i] = drive_next_[i];
-    const double drive_goal = SignedMin(scale * setpoints[i].drive_rate_rad_s, drive_max_rate_);
+    const double drive_goal = SignedMin(scale * drive_setpoint_[i], drive_max_rate_);
     drive_next_[i] =
         drive_ref_[i] + SignedMin(drive_goal - drive_ref_[i], drive_max_acceleration_ * dt_s);
   }
