@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "cosim/parameter_checks.h"
+#include "models/dc_motor_params.h"
 #include "units/control/wheel_kinematics.h"
 
 namespace linesim::control {
@@ -13,11 +14,13 @@ namespace linesim::control {
 namespace {
 
 // Default plant, Rob@Work 3 (FACTS.md) with the maxon RE 40 stand-in motor
-// of models/motors/raw3_{drive,steer}.yaml. The gearbox efficiencies are
-// the assumptions of those files.
-constexpr double kMotorConstant = 0.0302;  // k_t = k_e, V.s/rad
-constexpr double kResistanceOhm = 0.299;
-constexpr double kRotorInertiaKgm2 = 142e-7;
+// of models::DcMotorParams and the gears of models/motors/raw3_drive.yaml
+// (21, efficiency 0.75) and raw3_steer.yaml (belt 4, efficiency 0.9); the
+// efficiencies are the assumptions of those files.
+constexpr models::DcMotorParams kMotor{};
+constexpr double kMotorConstant = kMotor.torque_constant_nm_per_a;  // k_t = k_e, V.s/rad
+constexpr double kResistanceOhm = kMotor.resistance_ohm;
+constexpr double kRotorInertiaKgm2 = kMotor.rotor_inertia_kgm2;
 constexpr double kDriveGear = 21.0;
 constexpr double kDriveEfficiency = 0.75;
 constexpr double kSteerGear = 4.0;

@@ -14,6 +14,7 @@
 #include "cosim/master.h"
 #include "cosim/system.h"
 #include "cosim/time.h"
+#include "models/dc_motor_params.h"
 #include "units/motors/dc_motor_unit.h"
 
 namespace linesim::control {
@@ -133,6 +134,10 @@ TEST(WheelControllerUnit, DefaultsComeFromRobAtWork3) {
   EXPECT_NEAR(GetScalar(u, "drive_acceleration_feedforward"),
               j_drive * 0.299 / (0.75 * 21 * 0.0302), 1e-12);
   EXPECT_TRUE(u.variables().GetBoolean(*u.variables().Find("compensation")));
+  // Taken from the motor model, so the two cannot drift apart.
+  const models::DcMotorParams re40;
+  EXPECT_EQ(GetScalar(u, "drive_feedforward"), re40.torque_constant_nm_per_a * 21.0);
+  EXPECT_EQ(GetScalar(u, "steer_feedforward"), re40.torque_constant_nm_per_a * 4.0);
 }
 
 // ---------------------------------------------------------------------------
