@@ -237,6 +237,27 @@ TEST(PathFollowerUnit, SaveStepRestoreStepIsBitForBit) {
   EXPECT_EQ(std::memcmp(first.data(), third.data(), first.size() * sizeof(double)), 0);
 }
 
+// Guards the unit's own check of its internal state (the variable count
+// matches, so only RestoreInternal can refuse): the ramp speed and done.
+TEST(PathFollowerUnit, RestoreRefusesTruncatedInternalState) {
+  PathFollowerUnit u("follow", Mode::kPath, {{0, 0}, {1, 0}});
+  u.Initialize();
+  const cosim::UnitState saved = u.SaveState();
+  cosim::UnitState no_reals = saved;
+  no_reals.reals.clear();
+  cosim::UnitState no_integers = saved;
+  no_integers.integers.clear();
+  for (const auto* bad : {&no_reals, &no_integers}) {
+    try {
+      u.RestoreState(*bad);
+      ADD_FAILURE() << "restored a truncated state";
+    } catch (const cosim::UnitError& e) {
+      EXPECT_NE(std::string(e.what()).find("expected 1 and 1"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(u.RestoreState(saved));
+}
+
 // Guards against paths that cannot be followed and gains that would
 // divide by zero or run away being accepted before time zero.
 TEST(PathFollowerUnit, CheckParametersRejectsBadValues) {

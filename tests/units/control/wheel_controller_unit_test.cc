@@ -501,6 +501,33 @@ TEST(WheelControllerUnit, SaveStepRestoreStepIsBitForBit) {
   EXPECT_THROW(six.RestoreState(saved), std::exception);
 }
 
+// Guards the unit's own check of its internal state (the variable count
+// matches, so only RestoreInternal can refuse): 7 reals per wheel and the
+// period, no integers.
+TEST(WheelControllerUnit, RestoreRefusesTruncatedInternalState) {
+  WheelControllerUnit u("ctl");
+  u.Initialize();
+  const cosim::UnitState saved = u.SaveState();
+  ASSERT_EQ(saved.reals.size(), 7u * 4u + 1u);
+  ASSERT_TRUE(saved.integers.empty());
+  cosim::UnitState short_reals = saved;
+  short_reals.reals.pop_back();
+  cosim::UnitState extra_integer = saved;
+  extra_integer.integers.push_back(1);
+  for (const auto* bad : {&short_reals, &extra_integer}) {
+    try {
+      u.RestoreState(*bad);
+      ADD_FAILURE() << "restored a state of " << bad->reals.size() << " reals";
+    } catch (const cosim::UnitError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("unit 'ctl' (wheel_controller): saved state has"), std::string::npos)
+          << what;
+      EXPECT_NE(what.find("expected 29 and 0"), std::string::npos) << what;
+    }
+  }
+  EXPECT_NO_THROW(u.RestoreState(saved));
+}
+
 // ---------------------------------------------------------------------------
 // Guards against bad parameters reaching the loop (division by zero in the
 // slew, a negative limit) and against reporting only the first one.
