@@ -3,6 +3,7 @@
 #include <ode/ode.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <utility>
 
@@ -55,6 +56,8 @@ struct ChassisUnit::Ode {
   std::vector<dGeomID> geoms;
   // Internal step for which the suspension ERP/CFM were set (0: not yet).
   double suspension_h_s = 0.0;
+  // Force limit the joint motors were set to (NaN: not yet).
+  double motor_fmax_nm = std::numeric_limits<double>::quiet_NaN();
 
   Ode() = default;
   Ode(const Ode&) = delete;
@@ -73,6 +76,7 @@ struct ChassisUnit::Ode {
     body = nullptr;
     floor.reset();
     suspension_h_s = 0.0;
+    motor_fmax_nm = std::numeric_limits<double>::quiet_NaN();
   }
 
   // Every body, the base first.
@@ -321,6 +325,8 @@ void ChassisUnit::SetSuspension(double h_s) {
 void ChassisUnit::SetJointMotors(bool hold, double max_torque_nm) {
   // A joint motor with target velocity 0 and force limit 0 adds no row.
   const double fmax = hold ? max_torque_nm : 0.0;
+  if (fmax == ode_->motor_fmax_nm) return;
+  ode_->motor_fmax_nm = fmax;
   for (dJointID j : ode_->joints) {
     dJointSetHinge2Param(j, dParamVel, 0.0);
     dJointSetHinge2Param(j, dParamFMax, fmax);
@@ -380,6 +386,8 @@ void ChassisUnit::Settle() {
     dBodySetLinearVel(b, 0.0, 0.0, 0.0);
     dBodySetAngularVel(b, 0.0, 0.0, 0.0);
   }
+  // The contacts at the moved positions, for the outputs and the first step.
+  f.Probe();
 }
 
 void ChassisUnit::Initialize() {
@@ -404,7 +412,6 @@ void ChassisUnit::Initialize() {
     const auto kk = static_cast<std::size_t>(k);
     f.SetBeltVelocity(k, belt_velocity_[2 * kk], belt_velocity_[2 * kk + 1]);
   }
-  f.Probe();
   ComputeOutputs();
   initialized_ = true;
 }
@@ -505,7 +512,7 @@ cosim::StepResult ChassisUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     initialized_ = false;
     return Fail(Where() + ": ODE state went non-finite" + at() + ": " + bad);
   }
-  f.Probe();
+  // FloorWorld::Step collided at the new positions already.
   ComputeOutputs();
   return cosim::StepResult::kOk;
 }
@@ -557,6 +564,7 @@ void ChassisUnit::RestoreInternal(const cosim::UnitState& state) {
     dBodySetLinearVel(b, r[7], r[8], r[9]);
     dBodySetAngularVel(b, r[10], r[11], r[12]);
   }
+  // The contacts at the restored positions, for the next step.
   ode_->floor->Probe();
   initialized_ = true;
 }

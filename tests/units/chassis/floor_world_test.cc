@@ -77,7 +77,10 @@ TEST(FloorWorld, BoxOnBeltReachesBeltSpeedAfterCoulombTime) {
   EXPECT_NEAR(on_floor.y(), 1.0, 1e-9);
 
   // Contact reports: belt 0 is surface 1, the floor 0; contact point is the
-  // centre of the four corners.
+  // centre of the four corners. Step collided at its end, so they describe
+  // the positions after it without a Probe (which finds the same).
+  EXPECT_NEAR(f.contact(0).x_m, on_belt.x(), 1e-9);
+  EXPECT_NEAR(f.contact(1).y_m, on_floor.y(), 1e-9);
   f.Probe();
   EXPECT_EQ(f.contact(0).surface, 1);
   EXPECT_EQ(f.contact(0).points, 4);
