@@ -3,10 +3,12 @@
 #include <ode/ode.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <utility>
 
 #include "cosim/parameter_checks.h"
+#include "models/angle.h"
 #include "units/chassis/floor_world.h"
 
 namespace linesim::chassis {
@@ -24,14 +26,6 @@ constexpr double kSettleHoldTorqueNm = 1e4;
 // Reals saved per body: position 3, quaternion 4, linear and angular
 // velocity 3 each.
 constexpr std::size_t kRealsPerBody = 13;
-
-std::string FormatNumber(double x) { return cosim::FormatValue(cosim::Value{x}); }
-
-// To (-pi, pi].
-double WrapAngle(double a_rad) {
-  a_rad = std::remainder(a_rad, 2.0 * kPi);
-  return a_rad <= -kPi ? a_rad + 2.0 * kPi : a_rad;
-}
 
 // Column c of an ODE rotation matrix (3 rows of 4).
 void Column(const dReal* r, int c, double out[3]) {
@@ -62,6 +56,8 @@ struct ChassisUnit::Ode {
   std::vector<dGeomID> geoms;
   // Internal step for which the suspension ERP/CFM were set (0: not yet).
   double suspension_h_s = 0.0;
+  // Force limit the joint motors were set to (NaN: not yet).
+  double motor_fmax_nm = std::numeric_limits<double>::quiet_NaN();
 
   Ode() = default;
   Ode(const Ode&) = delete;
@@ -80,6 +76,7 @@ struct ChassisUnit::Ode {
     body = nullptr;
     floor.reset();
     suspension_h_s = 0.0;
+    motor_fmax_nm = std::numeric_limits<double>::quiet_NaN();
   }
 
   // Every body, the base first.
@@ -223,7 +220,7 @@ std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
   if (mass_ > 0.0 && module_mass_ > 0.0 && !(wheel_count_ * module_mass_ < mass_)) {
     c.Add({"module_mass", std::nullopt,
            "times " + std::to_string(wheel_count_) + " modules must be less than mass " +
-               FormatNumber(mass_) + ", got " + FormatNumber(module_mass_)});
+               cosim::FormatValue(mass_) + ", got " + cosim::FormatValue(module_mass_)});
   }
   c.Positive("com_height", com_height_);
   c.Positive("wheel_radius", wheel_radius_);
@@ -317,10 +314,7 @@ void ChassisUnit::Build() {
 
 void ChassisUnit::SetSuspension(double h_s) {
   if (h_s == ode_->suspension_h_s) return;
-  // The spring-damper equivalence of ERP and CFM (as for the contacts).
-  const double hk = h_s * suspension_stiffness_;
-  const double erp = hk / (hk + suspension_damping_);
-  const double cfm = 1.0 / (hk + suspension_damping_);
+  const auto [erp, cfm] = ErpCfm(h_s, suspension_stiffness_, suspension_damping_);
   for (dJointID j : ode_->joints) {
     dJointSetHinge2Param(j, dParamSuspensionERP, erp);
     dJointSetHinge2Param(j, dParamSuspensionCFM, cfm);
@@ -331,6 +325,8 @@ void ChassisUnit::SetSuspension(double h_s) {
 void ChassisUnit::SetJointMotors(bool hold, double max_torque_nm) {
   // A joint motor with target velocity 0 and force limit 0 adds no row.
   const double fmax = hold ? max_torque_nm : 0.0;
+  if (fmax == ode_->motor_fmax_nm) return;
+  ode_->motor_fmax_nm = fmax;
   for (dJointID j : ode_->joints) {
     dJointSetHinge2Param(j, dParamVel, 0.0);
     dJointSetHinge2Param(j, dParamFMax, fmax);
@@ -390,6 +386,8 @@ void ChassisUnit::Settle() {
     dBodySetLinearVel(b, 0.0, 0.0, 0.0);
     dBodySetAngularVel(b, 0.0, 0.0, 0.0);
   }
+  // The contacts at the moved positions, for the outputs and the first step.
+  f.Probe();
 }
 
 void ChassisUnit::Initialize() {
@@ -414,7 +412,6 @@ void ChassisUnit::Initialize() {
     const auto kk = static_cast<std::size_t>(k);
     f.SetBeltVelocity(k, belt_velocity_[2 * kk], belt_velocity_[2 * kk + 1]);
   }
-  f.Probe();
   ComputeOutputs();
   initialized_ = true;
 }
@@ -446,7 +443,7 @@ void ChassisUnit::ComputeOutputs() {
   const double c = std::cos(yaw), s = std::sin(yaw);
   pose_[0] = pb[0];
   pose_[1] = pb[1];
-  pose_[2] = WrapAngle(yaw);
+  pose_[2] = models::WrapAngle(yaw);
   velocity_[0] = vb[0];
   velocity_[1] = vb[1];
   velocity_[2] = wb[2];
@@ -462,7 +459,7 @@ void ChassisUnit::ComputeOutputs() {
     const dBodyID w = o.wheels[k];
     Column(dBodyGetRotation(w), 1, axle);
     // Heading = axle x up; in base_link: (ax_y, -ax_x) of the axle there.
-    steer_angle_[k] = WrapAngle(std::atan2(-Dot(axle, ex), Dot(axle, ey)));
+    steer_angle_[k] = models::WrapAngle(std::atan2(-Dot(axle, ex), Dot(axle, ey)));
     const dReal* ww = dBodyGetAngularVel(w);
     const double rel[3] = {ww[0] - wb[0], ww[1] - wb[1], ww[2] - wb[2]};
     steer_rate_[k] = Dot(ez, rel);
@@ -481,21 +478,14 @@ void ChassisUnit::ComputeOutputs() {
 cosim::StepResult ChassisUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
   const auto at = [&]() { return " at t = " + cosim::FormatSeconds(t) + " s"; };
-  if (!initialized_) return Fail(Where() + ": DoStep called before Initialize");
-  if (dt <= 0) {
-    return Fail(Where() + ": step size must be positive, got " + cosim::FormatSeconds(dt) + " s" +
-                at());
+  // The master initialises every unit before stepping it, but after a failed
+  // step the ODE world may be inconsistent (initialized_ is cleared there),
+  // and it is not rebuilt until Initialize or RestoreState: refuse to step it.
+  if (!initialized_) {
+    return Fail(Where() + ": the ODE world needs Initialize or RestoreState (after a failed " +
+                "step, or never initialised)" + at());
   }
-  for (const auto& [var, in] : {std::pair{"steer_torque", &steer_torque_},
-                                {"drive_torque", &drive_torque_},
-                                {"belt_velocity", &belt_velocity_}}) {
-    for (std::size_t k = 0; k < in->size(); ++k) {
-      if (!std::isfinite((*in)[k])) {
-        return Fail(Where() + ": input '" + var + "[" + std::to_string(k) + "]' is " +
-                    FormatNumber((*in)[k]) + at());
-      }
-    }
-  }
+  if (!InputsFinite(t)) return cosim::StepResult::kError;
   EnsureOdeForThisThread();
   stepped_since_settle_ = true;
   FloorWorld& f = *ode_->floor;
@@ -522,7 +512,7 @@ cosim::StepResult ChassisUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     initialized_ = false;
     return Fail(Where() + ": ODE state went non-finite" + at() + ": " + bad);
   }
-  f.Probe();
+  // FloorWorld::Step collided at the new positions already.
   ComputeOutputs();
   return cosim::StepResult::kOk;
 }
@@ -574,6 +564,7 @@ void ChassisUnit::RestoreInternal(const cosim::UnitState& state) {
     dBodySetLinearVel(b, r[7], r[8], r[9]);
     dBodySetAngularVel(b, r[10], r[11], r[12]);
   }
+  // The contacts at the restored positions, for the next step.
   ode_->floor->Probe();
   initialized_ = true;
 }

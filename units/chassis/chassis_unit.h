@@ -7,6 +7,7 @@
 
 #include "cosim/time.h"
 #include "cosim/unit.h"
+#include "models/dc_motor_params.h"
 
 namespace linesim::chassis {
 
@@ -46,7 +47,7 @@ class ChassisUnit : public cosim::Unit {
   /// wheel_count >= 1 modules and belt_count >= 0 belt patches (structural:
   /// they size the arrays; with no belts there are no belt parameters and no
   /// belt_velocity input). Throws cosim::UnitError otherwise.
-  explicit ChassisUnit(std::string name, int wheel_count = 4, int belt_count = 1);
+  ChassisUnit(std::string name, int wheel_count, int belt_count);
   ~ChassisUnit() override;
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
@@ -89,8 +90,10 @@ class ChassisUnit : public cosim::Unit {
   double com_height_ = 0.13;
   double wheel_radius_ = 0.080;
   std::vector<double> wheel_x_, wheel_y_;
-  double steer_rotor_inertia_ = 142e-7 * 4.0 * 4.0;
-  double drive_rotor_inertia_ = 142e-7 * 21.0 * 21.0;
+  // The RE 40 rotor (models::DcMotorParams) through the steer belt 4 and the
+  // drive gear 21 (models/motors/raw3_steer.yaml, raw3_drive.yaml).
+  double steer_rotor_inertia_ = models::DcMotorParams{}.rotor_inertia_kgm2 * 4.0 * 4.0;
+  double drive_rotor_inertia_ = models::DcMotorParams{}.rotor_inertia_kgm2 * 21.0 * 21.0;
   double steer_friction_ = 0.01;
   double drive_friction_ = 0.01;
   double friction_ = 0.8;

@@ -1,6 +1,5 @@
 #include "units/chassis/floor_world.h"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -60,6 +59,7 @@ FloorWorld::~FloorWorld() {
 
 void FloorWorld::SetBelts(std::vector<BeltPatch> belts) {
   belts_ = std::move(belts);
+  collided_ = false;
   belt_velocity_mps_.assign(belts_.size(), {0.0, 0.0});
   belt_axes_.clear();
   for (const BeltPatch& b : belts_) {
@@ -80,12 +80,16 @@ int FloorWorld::AddGeom(dGeomID geom) {
   c.x_m = p[0];
   c.y_m = p[1];
   contacts_.push_back(c);
+  points_.emplace_back();
+  collided_ = false;
   return static_cast<int>(geoms_.size()) - 1;
 }
 
 void FloorWorld::ClearGeoms() {
   geoms_.clear();
   contacts_.clear();
+  points_.clear();
+  collided_ = false;
 }
 
 int FloorWorld::SurfaceAt(double x_m, double y_m) const {
@@ -114,22 +118,23 @@ void FloorWorld::SurfaceVelocity(int surface, double* vx_mps, double* vy_mps) co
   *vy_mps = v[1];
 }
 
-int FloorWorld::Collide(int i) {
-  const dGeomID geom = geoms_[static_cast<std::size_t>(i)];
-  const int n = dCollide(geom, floor_, kMaxPoints, &points_[0].geom, sizeof(dContact));
-  GeomContact& c = contacts_[static_cast<std::size_t>(i)];
+void FloorWorld::Collide(std::size_t i) {
+  const dGeomID geom = geoms_[i];
+  Points& pts = points_[i];
+  const int n = dCollide(geom, floor_, kMaxPoints, &pts.contact[0].geom, sizeof(dContact));
+  pts.count = n;
+  GeomContact& c = contacts_[i];
   c.points = n;
-  c.depth_m = 0.0;
   if (n == 0) {
     const dReal* p = dGeomGetPosition(geom);
     c.surface = -1;
     c.x_m = p[0];
     c.y_m = p[1];
-    return 0;
+    return;
   }
   double sx = 0.0, sy = 0.0;
-  for (int j = 0; j < n; ++j) {
-    dContactGeom& g = points_[static_cast<std::size_t>(j)].geom;
+  for (std::size_t j = 0; j < static_cast<std::size_t>(n); ++j) {
+    dContactGeom& g = pts.contact[j].geom;
     // Make the moving geom g1 with the normal pointing into it (from the
     // floor), whatever order the collider reports, so that the surface
     // motion sign below holds.
@@ -137,31 +142,32 @@ int FloorWorld::Collide(int i) {
       std::swap(g.g1, g.g2);
       for (int d = 0; d < 3; ++d) g.normal[d] = -g.normal[d];
     }
+    pts.surface[j] = SurfaceAt(g.pos[0], g.pos[1]);
     sx += g.pos[0];
     sy += g.pos[1];
-    c.depth_m = std::max(c.depth_m, static_cast<double>(g.depth));
   }
   c.x_m = sx / n;
   c.y_m = sy / n;
-  c.surface = SurfaceAt(points_[0].geom.pos[0], points_[0].geom.pos[1]);
-  return n;
+  c.surface = pts.surface[0];
 }
 
 void FloorWorld::Probe() {
-  for (int i = 0; i < static_cast<int>(geoms_.size()); ++i) Collide(i);
+  for (std::size_t i = 0; i < geoms_.size(); ++i) Collide(i);
+  collided_ = true;
 }
 
-void FloorWorld::MakeJoints(int n, double erp, double cfm) {
+void FloorWorld::MakeJoints(std::size_t i, double erp, double cfm) {
   const auto tangent = [](const dReal* nrm, const double v[3], double out[3]) {
     const double vn = v[0] * nrm[0] + v[1] * nrm[1] + v[2] * nrm[2];
     for (int d = 0; d < 3; ++d) out[d] = v[d] - vn * nrm[d];
     return std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
   };
-  for (int j = 0; j < n; ++j) {
-    dContact& p = points_[static_cast<std::size_t>(j)];
+  Points& pts = points_[i];
+  for (std::size_t j = 0; j < static_cast<std::size_t>(pts.count); ++j) {
+    dContact& p = pts.contact[j];
     const dReal* nrm = p.geom.normal;
     double vx = 0.0, vy = 0.0;
-    SurfaceVelocity(SurfaceAt(p.geom.pos[0], p.geom.pos[1]), &vx, &vy);
+    SurfaceVelocity(pts.surface[j], &vx, &vy);
     const double surface[3] = {vx, vy, 0.0};
     // Slip of the body's contact point over the surface, at step start.
     const dBodyID body = dGeomGetBody(p.geom.g1);
@@ -206,20 +212,21 @@ void FloorWorld::MakeJoints(int n, double erp, double cfm) {
 }
 
 bool FloorWorld::Step(double h_s) {
-  // ODE's spring-damper equivalence for one implicit step of h:
-  // ERP = h kp / (h kp + kd), CFM = 1 / (h kp + kd).
-  const double hk = h_s * surface_.stiffness_n_per_m;
-  const double erp = hk / (hk + surface_.damping_n_s_per_m);
-  const double cfm = 1.0 / (hk + surface_.damping_n_s_per_m);
+  const auto [erp, cfm] = ErpCfm(h_s, surface_.stiffness_n_per_m, surface_.damping_n_s_per_m);
   int ok = 0;
   try {
-    for (int i = 0; i < static_cast<int>(geoms_.size()); ++i) MakeJoints(Collide(i), erp, cfm);
+    if (!collided_) Probe();
+    for (std::size_t i = 0; i < geoms_.size(); ++i) MakeJoints(i, erp, cfm);
     ok = dWorldStep(world_, h_s);
+    dJointGroupEmpty(group_);
+    // At the new positions: for contact(i) now and the next step's joints.
+    if (ok != 0) Probe();
   } catch (const OdeError&) {
     dJointGroupEmpty(group_);
+    collided_ = false;
     throw;
   }
-  dJointGroupEmpty(group_);
+  if (ok == 0) collided_ = false;
   return ok != 0;
 }
 

@@ -29,6 +29,19 @@ class OdeError : public std::runtime_error {
 /// world that threw must then be rebuilt.
 void EnsureOdeForThisThread();
 
+struct SoftParams {
+  double erp;
+  double cfm;
+};
+/// ODE's ERP and CFM that make a constraint a spring of stiffness k (N/m or
+/// N.m/rad) with damping d, for one implicit step of h_s seconds (ODE
+/// manual, "How To Use ERP and CFM"): ERP = h k / (h k + d),
+/// CFM = 1 / (h k + d). Used for the contacts and the suspension.
+inline SoftParams ErpCfm(double h_s, double k, double d) {
+  const double hk = h_s * k;
+  return {hk / (hk + d), 1.0 / (hk + d)};
+}
+
 /// A rectangular belt patch in the map frame.
 struct BeltPatch {
   double center_x_m = 0.0;
@@ -48,20 +61,22 @@ struct ContactSurface {
   double slip_damping_n_s_per_m = 1e5;
 };
 
-/// What one geom touched in the last collision pass.
+/// What one geom touched in the last collision pass (the end of the last
+/// Step, or Probe).
 struct GeomContact {
   int surface = -1;  // -1 none, 0 floor, k + 1 belt k (of the first contact point)
   int points = 0;    // contact points found
   double x_m = 0.0;  // mean contact point in map, or the geom position without contact
   double y_m = 0.0;
-  double depth_m = 0.0;  // largest penetration
 };
 
 /// Owns the dWorld (gravity -z), a joint group for contacts and the static
 /// floor plane z = 0 with belt patches on it. Registered geoms (attached to
-/// bodies of this world) collide with the floor each step; every contact
-/// point takes the surface velocity of the first belt patch that contains
-/// it, else of the floor (zero), through ODE's contact surface motion.
+/// bodies of this world) collide with the floor once per step, at its end:
+/// the points serve contact(i) and the next step's contact joints. Every
+/// contact point takes the surface velocity of the first belt patch that
+/// contains it, else of the floor (zero), through ODE's contact surface
+/// motion.
 ///
 /// Sign of the surface motion: a contact joint enforces
 ///   fdir_i . (v_body1 - v_body2) = motion_i   (i = 1, 2; fdir2 = n x fdir1)
@@ -119,12 +134,15 @@ class FloorWorld {
   /// the floor and for -1).
   void SurfaceVelocity(int surface, double* vx_mps, double* vy_mps) const;
 
-  /// Collides every registered geom with the floor without making joints,
-  /// so that contact(i) describes the current positions.
+  /// Collides every registered geom with the floor at the current
+  /// positions without making joints, so that contact(i) and the next Step
+  /// use them. Call it after moving bodies by hand (positions, rotations);
+  /// registering geoms or changing belts makes the next Step collide first.
   void Probe();
-  /// One internal step of h_s seconds: collide, create the contact joints,
-  /// dWorldStep, empty the contact group. Returns false if dWorldStep
-  /// failed (out of memory); throws OdeError if ODE reports an error.
+  /// One internal step of h_s seconds: contact joints from the last
+  /// collision pass, dWorldStep, empty the contact group, collide at the new
+  /// positions. Returns false if dWorldStep failed (out of memory); throws
+  /// OdeError if ODE reports an error.
   bool Step(double h_s);
 
   const GeomContact& contact(int i) const { return contacts_[static_cast<std::size_t>(i)]; }
@@ -137,11 +155,18 @@ class FloorWorld {
   // residual velocity of a sticking contact (about 1e-12 m/s).
   static constexpr double kSlipAlignMps = 1e-4;
 
-  /// Collides geom i with the floor into points_; records contact(i) and
-  /// returns the number of points.
-  int Collide(int i);
-  /// Contact joints for the n points of the last Collide.
-  void MakeJoints(int n, double erp, double cfm);
+  // The contact points of one geom from its last Collide, and the surface
+  // (as SurfaceAt) under each.
+  struct Points {
+    std::array<dContact, kMaxPoints> contact{};
+    std::array<int, kMaxPoints> surface{};
+    int count = 0;
+  };
+
+  /// Collides geom i with the floor into points_[i] and records contact(i).
+  void Collide(std::size_t i);
+  /// Contact joints for the points of geom i.
+  void MakeJoints(std::size_t i, double erp, double cfm);
 
   dWorldID world_ = nullptr;
   dJointGroupID group_ = nullptr;
@@ -153,7 +178,10 @@ class FloorWorld {
   std::vector<std::array<double, 4>> belt_axes_;
   std::vector<dGeomID> geoms_;
   std::vector<GeomContact> contacts_;
-  std::array<dContact, kMaxPoints> points_{};
+  std::vector<Points> points_;
+  // Whether points_ hold the current positions of every geom (a Probe or
+  // Step since the last AddGeom, ClearGeoms or SetBelts).
+  bool collided_ = false;
 };
 
 }  // namespace linesim::chassis

@@ -5,15 +5,9 @@
 #include <utility>
 
 #include "cosim/parameter_checks.h"
-#include "units/control/wheel_kinematics.h"
+#include "models/angle.h"
 
 namespace linesim::control {
-
-namespace {
-
-std::string FormatNumber(double x) { return cosim::FormatValue(cosim::Value{x}); }
-
-}  // namespace
 
 PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
                                    std::vector<std::array<double, 2>> waypoints_m)
@@ -53,25 +47,36 @@ PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
            {"pose"});
 }
 
+bool PathFollowerUnit::ZeroSegment(std::size_t k) const {
+  // Evaluate divides by the growth of cumulative_m_, so a segment too short
+  // to grow the sum is as bad as a zero one. After a non-finite waypoint the
+  // sum is NaN, and only the segment itself can be judged.
+  if (std::isfinite(cumulative_m_[k - 1])) return !(cumulative_m_[k] > cumulative_m_[k - 1]);
+  return !(std::hypot(waypoints_m_[k][0] - waypoints_m_[k - 1][0],
+                      waypoints_m_[k][1] - waypoints_m_[k - 1][1]) > 0.0);
+}
+
 std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
-  std::vector<cosim::ParameterProblem> problems;
+  cosim::ParameterChecks c;
   const std::size_t needed = mode_ == Mode::kPath ? 2 : 1;
   if (waypoints_m_.size() < needed) {
-    problems.push_back({"waypoints", std::nullopt,
-                        std::string(mode_ == Mode::kPath ? "a path" : "hold") + " needs at least " +
-                            std::to_string(needed) + " waypoint(s), got " +
-                            std::to_string(waypoints_m_.size())});
+    c.Add({"waypoints", std::nullopt,
+           std::string(mode_ == Mode::kPath ? "a path" : "hold") + " needs at least " +
+               std::to_string(needed) + " waypoint(s), got " +
+               std::to_string(waypoints_m_.size())});
   }
+  const auto finite = [&](std::size_t k) {
+    return std::isfinite(waypoints_m_[k][0]) && std::isfinite(waypoints_m_[k][1]);
+  };
   for (std::size_t k = 0; k < waypoints_m_.size(); ++k) {
-    if (!std::isfinite(waypoints_m_[k][0]) || !std::isfinite(waypoints_m_[k][1])) {
-      problems.push_back({"waypoints", k,
-                          "must be finite, got (" + FormatNumber(waypoints_m_[k][0]) + ", " +
-                              FormatNumber(waypoints_m_[k][1]) + ")"});
-    } else if (mode_ == Mode::kPath && k > 0 && !(cumulative_m_[k] > cumulative_m_[k - 1])) {
-      problems.push_back({"waypoints", k, "repeats the previous waypoint (zero-length segment)"});
+    if (!finite(k)) {
+      c.Add({"waypoints", k,
+             "must be finite, got (" + cosim::FormatValue(waypoints_m_[k][0]) + ", " +
+                 cosim::FormatValue(waypoints_m_[k][1]) + ")"});
+    } else if (mode_ == Mode::kPath && k > 0 && finite(k - 1) && ZeroSegment(k)) {
+      c.Add({"waypoints", k, "repeats the previous waypoint (zero-length segment)"});
     }
   }
-  cosim::ParameterChecks c;
   c.Positive("speed", speed_);
   c.Positive("acceleration", acceleration_);
   c.Finite("yaw", yaw_);
@@ -81,19 +86,45 @@ std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
   c.Positive("max_speed", max_speed_);
   c.NonNegative("max_yaw_rate", max_yaw_rate_);
   c.Positive("goal_tolerance", goal_tolerance_);
-  for (auto& problem : c.Take()) problems.push_back(std::move(problem));
-  return problems;
+  return c.Take();
 }
 
 void PathFollowerUnit::Initialize() {
   ThrowIfBadParameters();
   ramp_mps_ = 0.0;
   done_latched_ = false;
-  initialized_ = true;
-  ComputeOutputs();
+  ComputeOutputs(FindNearest());
 }
 
-PathFollowerUnit::Sample PathFollowerUnit::Evaluate() const {
+PathFollowerUnit::Nearest PathFollowerUnit::FindNearest() const {
+  Nearest n;
+  if (mode_ != Mode::kPath) return n;
+  // Nearest point over all segments (the first on a tie); the first and
+  // last segments extend beyond the ends, so that progress runs below 0
+  // before the start and past the length after the goal.
+  const double x = pose_[0], y = pose_[1];
+  const std::size_t segments = waypoints_m_.size() - 1;
+  double best_dist2 = INFINITY;
+  for (std::size_t k = 0; k < segments; ++k) {
+    const auto& a = waypoints_m_[k];
+    const double len = cumulative_m_[k + 1] - cumulative_m_[k];
+    const double tx = (waypoints_m_[k + 1][0] - a[0]) / len;
+    const double ty = (waypoints_m_[k + 1][1] - a[1]) / len;
+    const double along = (x - a[0]) * tx + (y - a[1]) * ty;
+    const double lo = k == 0 ? -INFINITY : 0.0;
+    const double hi = k + 1 == segments ? INFINITY : len;
+    const double u = std::clamp(along, lo, hi);
+    const double cross = -(x - a[0]) * ty + (y - a[1]) * tx;
+    const double dist2 = (along - u) * (along - u) + cross * cross;
+    if (dist2 < best_dist2) {
+      best_dist2 = dist2;
+      n = {true, tx, ty, cumulative_m_[k] + u, cross};
+    }
+  }
+  return n;
+}
+
+PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const Nearest& n) const {
   Sample s;
   const double x = pose_[0], y = pose_[1];
   if (mode_ == Mode::kHold) {
@@ -103,34 +134,16 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate() const {
     s.cross_track_m = std::hypot(ex, ey);
     s.at_goal = s.cross_track_m <= goal_tolerance_;
   } else {
-    // Nearest point over all segments (the first on a tie); the first and
-    // last segments extend beyond the ends, so that progress runs below 0
-    // before the start and past the length after the goal.
-    const std::size_t segments = waypoints_m_.size() - 1;
-    double best_dist2 = INFINITY;
-    for (std::size_t k = 0; k < segments; ++k) {
-      const auto& a = waypoints_m_[k];
-      const double len = cumulative_m_[k + 1] - cumulative_m_[k];
-      const double tx = (waypoints_m_[k + 1][0] - a[0]) / len;
-      const double ty = (waypoints_m_[k + 1][1] - a[1]) / len;
-      const double along = (x - a[0]) * tx + (y - a[1]) * ty;
-      const double lo = k == 0 ? -INFINITY : 0.0;
-      const double hi = k + 1 == segments ? INFINITY : len;
-      const double u = std::clamp(along, lo, hi);
-      const double cross = -(x - a[0]) * ty + (y - a[1]) * tx;
-      const double dist2 = (along - u) * (along - u) + cross * cross;
-      if (dist2 < best_dist2) {
-        best_dist2 = dist2;
-        s.progress_m = cumulative_m_[k] + u;
-        s.cross_track_m = cross;
-        const double remaining = length_m() - s.progress_m;
-        const double magnitude =
-            std::min({ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * std::abs(remaining)),
-                      k_position_ * std::abs(remaining)});
-        s.along_mps = std::copysign(magnitude, remaining);
-        s.vx_map_mps = tx * s.along_mps + ty * k_cross_ * cross;
-        s.vy_map_mps = ty * s.along_mps - tx * k_cross_ * cross;
-      }
+    if (n.found) {
+      s.progress_m = n.progress_m;
+      s.cross_track_m = n.cross_track_m;
+      const double remaining = length_m() - s.progress_m;
+      const double magnitude =
+          std::min({ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * std::abs(remaining)),
+                    k_position_ * std::abs(remaining)});
+      s.along_mps = std::copysign(magnitude, remaining);
+      s.vx_map_mps = n.tx * s.along_mps + n.ty * k_cross_ * n.cross_track_m;
+      s.vy_map_mps = n.ty * s.along_mps - n.tx * k_cross_ * n.cross_track_m;
     }
     const auto& goal = waypoints_m_.back();
     s.at_goal = done_latched_ || std::hypot(x - goal[0], y - goal[1]) <= goal_tolerance_;
@@ -145,13 +158,13 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate() const {
   }
   if (!(mode_ == Mode::kPath && s.at_goal)) {
     s.yaw_rate_rad_s =
-        std::clamp(k_yaw_ * WrapAngle(yaw_ - pose_[2]), -max_yaw_rate_, max_yaw_rate_);
+        std::clamp(k_yaw_ * models::WrapAngle(yaw_ - pose_[2]), -max_yaw_rate_, max_yaw_rate_);
   }
   return s;
 }
 
-void PathFollowerUnit::ComputeOutputs() {
-  const Sample s = Evaluate();
+void PathFollowerUnit::ComputeOutputs(const Nearest& n) {
+  const Sample s = Evaluate(n);
   const double c = std::cos(pose_[2]), sn = std::sin(pose_[2]);
   twist_command_[0] = c * s.vx_map_mps + sn * s.vy_map_mps;
   twist_command_[1] = -sn * s.vx_map_mps + c * s.vy_map_mps;
@@ -163,40 +176,31 @@ void PathFollowerUnit::ComputeOutputs() {
 
 cosim::StepResult PathFollowerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
-  if (!initialized_) return Fail(Where() + ": DoStep called before Initialize");
-  if (dt <= 0) {
-    return Fail(Where() + ": step size must be positive, got " + cosim::FormatSeconds(dt) +
-                " s at t = " + cosim::FormatSeconds(t) + " s");
-  }
-  for (std::size_t k = 0; k < pose_.size(); ++k) {
-    if (!std::isfinite(pose_[k])) {
-      return Fail(Where() + ": input 'pose[" + std::to_string(k) + "]' is " +
-                  FormatNumber(pose_[k]) + " at t = " + cosim::FormatSeconds(t) + " s");
-    }
-  }
-  const Sample s = Evaluate();
+  if (!InputsFinite(t)) return cosim::StepResult::kError;
+  // The pose is the same before and after the commit: one search.
+  const Nearest n = FindNearest();
+  const Sample s = Evaluate(n);
   // The ramp continues from the speed actually commanded, so that it also
   // restarts gently after a slow-down.
   ramp_mps_ = std::min(speed_, std::abs(s.along_mps) + acceleration_ * cosim::NsToSeconds(dt));
   if (mode_ == Mode::kPath && s.at_goal) done_latched_ = true;
-  ComputeOutputs();
+  ComputeOutputs(n);
   return cosim::StepResult::kOk;
 }
 
 void PathFollowerUnit::SaveInternal(cosim::UnitState& state) const {
   state.reals = {ramp_mps_};
-  state.integers = {done_latched_ ? 1 : 0, initialized_ ? 1 : 0};
+  state.integers = {done_latched_ ? 1 : 0};
 }
 
 void PathFollowerUnit::RestoreInternal(const cosim::UnitState& state) {
-  if (state.reals.size() != 1 || state.integers.size() != 2) {
+  if (state.reals.size() != 1 || state.integers.size() != 1) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
-                           " integers, expected 1 and 2");
+                           " integers, expected 1 and 1");
   }
   ramp_mps_ = state.reals[0];
   done_latched_ = state.integers[0] != 0;
-  initialized_ = state.integers[1] != 0;
 }
 
 }  // namespace linesim::control

@@ -44,7 +44,7 @@ class PathFollowerUnit : public cosim::Unit {
   /// speed ramp and done, and computes the outputs. Idempotent.
   void Initialize() override;
   /// The outputs for the current pose; the state is not changed.
-  void UpdateOutputs() override { ComputeOutputs(); }
+  void UpdateOutputs() override { ComputeOutputs(FindNearest()); }
   /// Commits the sample taken at t (speed ramp, done) and recomputes.
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
 
@@ -63,8 +63,20 @@ class PathFollowerUnit : public cosim::Unit {
     double cross_track_m = 0.0, progress_m = 0.0;
     bool at_goal = false;
   };
-  Sample Evaluate() const;
-  void ComputeOutputs();
+  /// Whether the segment into waypoint k (> 0, both ends finite) has no
+  /// length.
+  bool ZeroSegment(std::size_t k) const;
+  // Path mode: the nearest path point to the pose (found is false in hold
+  // mode, or when no distance compares below infinity).
+  struct Nearest {
+    bool found = false;
+    double tx = 0.0, ty = 0.0;  // unit tangent of its segment
+    double progress_m = 0.0, cross_track_m = 0.0;
+  };
+  Nearest FindNearest() const;
+  /// The command for the pose whose nearest path point is n, from the state.
+  Sample Evaluate(const Nearest& n) const;
+  void ComputeOutputs(const Nearest& n);
 
   Mode mode_;
   std::vector<std::array<double, 2>> waypoints_m_;
@@ -92,7 +104,6 @@ class PathFollowerUnit : public cosim::Unit {
   // State: the along-track speed the ramp allows at this sample, and done.
   double ramp_mps_ = 0.0;
   bool done_latched_ = false;
-  bool initialized_ = false;
 };
 
 }  // namespace linesim::control

@@ -6,20 +6,21 @@
 #include <utility>
 
 #include "cosim/parameter_checks.h"
+#include "models/dc_motor_params.h"
 #include "units/control/wheel_kinematics.h"
 
 namespace linesim::control {
 
 namespace {
 
-std::string FormatNumber(double x) { return cosim::FormatValue(cosim::Value{x}); }
-
 // Default plant, Rob@Work 3 (FACTS.md) with the maxon RE 40 stand-in motor
-// of models/motors/raw3_{drive,steer}.yaml. The gearbox efficiencies are
-// the assumptions of those files.
-constexpr double kMotorConstant = 0.0302;  // k_t = k_e, V.s/rad
-constexpr double kResistanceOhm = 0.299;
-constexpr double kRotorInertiaKgm2 = 142e-7;
+// of models::DcMotorParams and the gears of models/motors/raw3_drive.yaml
+// (21, efficiency 0.75) and raw3_steer.yaml (belt 4, efficiency 0.9); the
+// efficiencies are the assumptions of those files.
+constexpr models::DcMotorParams kMotor{};
+constexpr double kMotorConstant = kMotor.torque_constant_nm_per_a;  // k_t = k_e, V.s/rad
+constexpr double kResistanceOhm = kMotor.resistance_ohm;
+constexpr double kRotorInertiaKgm2 = kMotor.rotor_inertia_kgm2;
 constexpr double kDriveGear = 21.0;
 constexpr double kDriveEfficiency = 0.75;
 constexpr double kSteerGear = 4.0;
@@ -77,7 +78,7 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
   steer_target_.assign(n, 0.0);
   drive_rate_target_.assign(n, 0.0);
   for (auto* v : {&steer_ref_, &steer_next_, &steer_prev_rate_, &flip_angle_, &drive_ref_,
-                  &drive_next_, &drive_integral_}) {
+                  &drive_next_, &drive_integral_, &drive_setpoint_}) {
     v->assign(n, 0.0);
   }
 
@@ -177,7 +178,6 @@ void WheelControllerUnit::Initialize() {
     drive_ref_[i] = drive_next_[i] = drive_integral_[i] = 0.0;
   }
   period_s_ = 0.0;
-  initialized_ = true;
   ComputeOutputs();
 }
 
@@ -212,38 +212,24 @@ void WheelControllerUnit::ComputeOutputs() {
 
 cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
-  if (!initialized_) return Fail(Where() + ": DoStep called before Initialize");
-  if (dt <= 0) {
-    return Fail(Where() + ": step size must be positive, got " + cosim::FormatSeconds(dt) +
-                " s at t = " + cosim::FormatSeconds(t) + " s");
-  }
-  for (const auto& [var, in] : {std::pair{"twist_command", &twist_command_},
-                                {"surface_velocity", &surface_velocity_},
-                                {"steer_angle", &steer_angle_},
-                                {"steer_rate", &steer_rate_},
-                                {"drive_rate", &drive_rate_}}) {
-    for (std::size_t k = 0; k < in->size(); ++k) {
-      if (!std::isfinite((*in)[k])) {
-        return Fail(Where() + ": input '" + var + "[" + std::to_string(k) + "]' is " +
-                    FormatNumber((*in)[k]) + " at t = " + cosim::FormatSeconds(t) + " s");
-      }
-    }
-  }
+  if (!InputsFinite(t)) return cosim::StepResult::kError;
   const double dt_s = cosim::NsToSeconds(dt);
   const std::size_t n = steer_ref_.size();
 
-  // Set points of this sample: Eq. 1, Algorithm 1, flip rule.
+  // Set points of this sample: Eq. 1, Algorithm 1, flip rule (from the
+  // last flip-rule heading, which the set point then replaces).
   const Eigen::Vector3d twist(twist_command_[0], twist_command_[1], twist_command_[2]);
-  std::vector<WheelSetpoint> setpoints(n);
   double fastest_rad_s = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     Eigen::Vector2d v = WheelVelocity(twist, {wheel_x_[i], wheel_y_[i]});
     if (compensation_) {
       v = CompensateSurface(v, {surface_velocity_[2 * i], surface_velocity_[2 * i + 1]});
     }
-    setpoints[i] =
+    const WheelSetpoint setpoint =
         ToWheelSetpoint(v, wheel_radius_, steer_angle_[i], flip_angle_[i], zero_speed_threshold_);
-    fastest_rad_s = std::max(fastest_rad_s, std::abs(setpoints[i].drive_rate_rad_s));
+    flip_angle_[i] = setpoint.steer_angle_rad;
+    drive_setpoint_[i] = setpoint.drive_rate_rad_s;
+    fastest_rad_s = std::max(fastest_rad_s, std::abs(setpoint.drive_rate_rad_s));
   }
   // Scale all wheels alike, so that a too fast command keeps its direction
   // and curvature instead of being distorted wheel by wheel.
@@ -252,7 +238,8 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
   for (std::size_t i = 0; i < n; ++i) {
     // Drive integrator on the error of this sample; it stops while the
     // output saturates in the error's direction (anti-windup) and never
-    // holds more than the full voltage.
+    // holds more than the full voltage. Computed again, not taken from
+    // UpdateOutputs: Gauss-Seidel transfers new inputs right before DoStep.
     const Voltages u = Compute(i);
     const double error = drive_ref_[i] - drive_rate_[i];
     if (!(std::abs(u.drive_v) > max_voltage_ && error * u.drive_v > 0.0)) {
@@ -270,7 +257,6 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
         period_s_ > 0.0 ? WrapAngle(steer_next_[i] - steer_ref_[i]) / period_s_ : 0.0;
     steer_prev_rate_[i] = rate_now;
     steer_ref_[i] = steer_next_[i];
-    flip_angle_[i] = setpoints[i].steer_angle_rad;
     const double gap = WrapAngle(flip_angle_[i] - steer_ref_[i]);
     const double dv = steer_max_acceleration_ * dt_s;
     const double steps = std::abs(gap) / (dv * dt_s);
@@ -284,7 +270,7 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
 
     // Drive reference: rate-limited ramp towards the scaled set point.
     drive_ref_[i] = drive_next_[i];
-    const double drive_goal = SignedMin(scale * setpoints[i].drive_rate_rad_s, drive_max_rate_);
+    const double drive_goal = SignedMin(scale * drive_setpoint_[i], drive_max_rate_);
     drive_next_[i] =
         drive_ref_[i] + SignedMin(drive_goal - drive_ref_[i], drive_max_acceleration_ * dt_s);
   }
@@ -300,16 +286,16 @@ void WheelControllerUnit::SaveInternal(cosim::UnitState& state) const {
     state.reals.insert(state.reals.end(), v->begin(), v->end());
   }
   state.reals.push_back(period_s_);
-  state.integers = {initialized_ ? 1 : 0};
+  state.integers.clear();
 }
 
 void WheelControllerUnit::RestoreInternal(const cosim::UnitState& state) {
   const std::size_t n = steer_ref_.size();
   const std::size_t expected = 7 * n + 1;
-  if (state.reals.size() != expected || state.integers.size() != 1) {
+  if (state.reals.size() != expected || !state.integers.empty()) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
-                           " integers, expected " + std::to_string(expected) + " and 1");
+                           " integers, expected " + std::to_string(expected) + " and 0");
   }
   auto it = state.reals.begin();
   for (auto* v : {&steer_ref_, &steer_next_, &steer_prev_rate_, &flip_angle_, &drive_ref_,
@@ -318,7 +304,6 @@ void WheelControllerUnit::RestoreInternal(const cosim::UnitState& state) {
     it += static_cast<std::ptrdiff_t>(n);
   }
   period_s_ = *it;
-  initialized_ = state.integers[0] != 0;
 }
 
 }  // namespace linesim::control

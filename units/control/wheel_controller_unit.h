@@ -103,7 +103,8 @@ class WheelControllerUnit : public cosim::Unit {
   std::vector<double> steer_ref_, steer_next_, steer_prev_rate_, flip_angle_;
   std::vector<double> drive_ref_, drive_next_, drive_integral_;
   double period_s_ = 0.0;
-  bool initialized_ = false;
+  // DoStep's scratch (not state): the flip-rule drive rate of this sample.
+  std::vector<double> drive_setpoint_;
 };
 
 }  // namespace linesim::control

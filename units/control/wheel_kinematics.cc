@@ -2,16 +2,8 @@
 
 #include <cmath>
 #include <numbers>
-#include <stdexcept>
 
 namespace linesim::control {
-
-double WrapAngle(double angle_rad) {
-  constexpr double kPi = std::numbers::pi;
-  // remainder() maps to [-pi, pi]; -pi is moved to +pi for a unique value.
-  const double a = std::remainder(angle_rad, 2.0 * kPi);
-  return a <= -kPi ? a + 2.0 * kPi : a;
-}
 
 Eigen::Vector2d WheelVelocity(const Eigen::Vector3d& twist, const Eigen::Vector2d& position_m) {
   return {twist[0] - twist[2] * position_m[1], twist[1] + twist[2] * position_m[0]};
@@ -32,25 +24,6 @@ WheelSetpoint ToWheelSetpoint(const Eigen::Vector2d& velocity_mps, double radius
   const double rate = speed_mps / radius_m;
   if (cost(backward) < cost(forward)) return {backward, -rate};
   return {WrapAngle(forward), rate};
-}
-
-Eigen::Vector3d BodyTwist(std::span<const Eigen::Vector2d> positions_m,
-                          std::span<const WheelSetpoint> wheels, double radius_m) {
-  if (positions_m.size() != wheels.size() || wheels.empty()) {
-    throw std::invalid_argument("BodyTwist needs one position per wheel and at least one wheel");
-  }
-  const auto n = static_cast<Eigen::Index>(wheels.size());
-  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(2 * n, 3);
-  Eigen::VectorXd b(2 * n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    const double v_mps = wheels[k].drive_rate_rad_s * radius_m;
-    a.row(2 * i) << 1.0, 0.0, -positions_m[k][1];
-    a.row(2 * i + 1) << 0.0, 1.0, positions_m[k][0];
-    b[2 * i] = v_mps * std::cos(wheels[k].steer_angle_rad);
-    b[2 * i + 1] = v_mps * std::sin(wheels[k].steer_angle_rad);
-  }
-  return a.completeOrthogonalDecomposition().solve(b);
 }
 
 }  // namespace linesim::control

@@ -1,12 +1,13 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <span>
+
+#include "models/angle.h"
 
 namespace linesim::control {
 
-/// An angle wrapped to (-pi, pi].
-double WrapAngle(double angle_rad);
+/// An angle wrapped to (-pi, pi] (the one definition the units share).
+using models::WrapAngle;
 
 /// Paper 1, Eq. 1: the velocity of the contact of a wheel whose steering axis
 /// is at `position_m` (base_link) when the body moves with `twist`
@@ -40,13 +41,5 @@ struct WheelSetpoint {
 /// heading is undefined: the wheel keeps `last_target` and stops.
 WheelSetpoint ToWheelSetpoint(const Eigen::Vector2d& velocity_mps, double radius_m,
                               double angle_now_rad, double last_target_rad, double zero_speed_mps);
-
-/// The inverse of Eq. 1 for several wheels (forward kinematics, odometry):
-/// the body twist (vx, vy, yaw rate) that best explains the wheel set points
-/// in the least-squares sense. Needs at least two wheels at different
-/// positions; otherwise the yaw rate is not observable and the result is
-/// the minimum-norm solution.
-Eigen::Vector3d BodyTwist(std::span<const Eigen::Vector2d> positions_m,
-                          std::span<const WheelSetpoint> wheels, double radius_m);
 
 }  // namespace linesim::control

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <iostream>
 #include <numbers>
 #include <string>
 #include <variant>
@@ -411,6 +410,42 @@ TEST(ChassisUnit, SaveRestoreIsBitForBit) {
   }
 }
 
+// Guards the unit's own check of its internal state (the variable count
+// matches, so only RestoreInternal can refuse): an initialised state holds
+// 13 reals per body (position 3, quaternion 4, linear and angular velocity
+// 3 each) for the body and 4 modules, and one integer; one saved before
+// Initialize holds no reals.
+TEST(ChassisUnit, RestoreRefusesTruncatedInternalState) {
+  ChassisUnit u("robot", 4, 0);
+  const cosim::UnitState before_init = u.SaveState();
+  ASSERT_TRUE(before_init.reals.empty());
+  u.Initialize();
+  const cosim::UnitState saved = u.SaveState();
+  ASSERT_EQ(saved.reals.size(), 13u * 5u);
+  ASSERT_EQ(saved.integers.size(), 1u);
+  cosim::UnitState short_reals = saved;
+  short_reals.reals.pop_back();
+  cosim::UnitState no_integers = saved;
+  no_integers.integers.clear();
+  cosim::UnitState reals_without_init = before_init;
+  reals_without_init.reals = saved.reals;
+  for (const auto* bad : {&short_reals, &no_integers, &reals_without_init}) {
+    ChassisUnit fresh("robot", 4, 0);
+    try {
+      fresh.RestoreState(*bad);
+      ADD_FAILURE() << "restored a state of " << bad->reals.size() << " reals and "
+                    << bad->integers.size() << " integers";
+    } catch (const cosim::UnitError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("unit 'robot' (chassis): saved state has"), std::string::npos) << what;
+    }
+  }
+  ChassisUnit fresh("robot", 4, 0);
+  EXPECT_NO_THROW(fresh.RestoreState(saved));
+  TimeNs t = 0;
+  Advance(fresh, t, 10);
+}
+
 // Guards against Initialize depending on what ran before it (the master may
 // call it several times).
 TEST(ChassisUnit, InitializeIsIdempotent) {
@@ -495,7 +530,6 @@ TEST(ChassisUnit, NonFiniteInputOrStateFails) {
   EXPECT_EQ(u.DoStep(0, kMs), cosim::StepResult::kError);
   EXPECT_NE(u.last_error().find("input 'drive_torque[1]' is nan"), std::string::npos)
       << u.last_error();
-  EXPECT_EQ(u.DoStep(0, 0), cosim::StepResult::kError);
   // A finite but absurd torque overflows the ODE state.
   SetArray(u, "drive_torque", {0.0, 0.0, 1e308, 0.0});
   EXPECT_EQ(u.DoStep(0, kMs), cosim::StepResult::kError);
@@ -507,6 +541,8 @@ TEST(ChassisUnit, NonFiniteInputOrStateFails) {
   EXPECT_NE(u.last_error().find("(outputs "), std::string::npos) << u.last_error();
   // The unit refuses to go on until it is initialised again.
   EXPECT_EQ(u.DoStep(kMs, kMs), cosim::StepResult::kError);
+  EXPECT_NE(u.last_error().find("needs Initialize or RestoreState"), std::string::npos)
+      << u.last_error();
   SetArray(u, "drive_torque", {0.0, 0.0, 0.0, 0.0});
   u.Initialize();
   EXPECT_EQ(u.DoStep(0, kMs), cosim::StepResult::kOk) << u.last_error();

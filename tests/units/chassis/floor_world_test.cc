@@ -77,7 +77,10 @@ TEST(FloorWorld, BoxOnBeltReachesBeltSpeedAfterCoulombTime) {
   EXPECT_NEAR(on_floor.y(), 1.0, 1e-9);
 
   // Contact reports: belt 0 is surface 1, the floor 0; contact point is the
-  // centre of the four corners.
+  // centre of the four corners. Step collided at its end, so they describe
+  // the positions after it without a Probe (which finds the same).
+  EXPECT_NEAR(f.contact(0).x_m, on_belt.x(), 1e-9);
+  EXPECT_NEAR(f.contact(1).y_m, on_floor.y(), 1e-9);
   f.Probe();
   EXPECT_EQ(f.contact(0).surface, 1);
   EXPECT_EQ(f.contact(0).points, 4);
@@ -142,6 +145,19 @@ TEST(FloorWorld, SurfaceAtRotatedPatches) {
   EXPECT_EQ(f.SurfaceAt(2.6, 1.0), 2);    // 0.6 across: outside belt 0, inside belt 1
   EXPECT_EQ(f.SurfaceAt(2.0, 3.1), 2);
   EXPECT_EQ(f.SurfaceAt(6.0, 0.0), 0);  // outside both
+}
+
+// Guards against a slip in the one spring-damper formula the contacts and
+// the suspension share. By hand, the contact defaults at 1 ms: h k = 1000,
+// ERP = 1000 / (1000 + 1e4) = 1/11, CFM = 1 / 11000; no damping gives
+// ERP 1 and CFM 1 / (h k).
+TEST(FloorWorld, ErpCfmOfASpringDamper) {
+  const SoftParams p = ErpCfm(1e-3, 1e6, 1e4);
+  EXPECT_DOUBLE_EQ(p.erp, 1.0 / 11.0);
+  EXPECT_DOUBLE_EQ(p.cfm, 1.0 / 11000.0);
+  const SoftParams stiff = ErpCfm(1e-3, 1e7, 0.0);
+  EXPECT_EQ(stiff.erp, 1.0);
+  EXPECT_DOUBLE_EQ(stiff.cfm, 1e-4);
 }
 
 // Guards against geoms that are not on the floor being reported as

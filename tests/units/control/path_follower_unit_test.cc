@@ -237,6 +237,27 @@ TEST(PathFollowerUnit, SaveStepRestoreStepIsBitForBit) {
   EXPECT_EQ(std::memcmp(first.data(), third.data(), first.size() * sizeof(double)), 0);
 }
 
+// Guards the unit's own check of its internal state (the variable count
+// matches, so only RestoreInternal can refuse): the ramp speed and done.
+TEST(PathFollowerUnit, RestoreRefusesTruncatedInternalState) {
+  PathFollowerUnit u("follow", Mode::kPath, {{0, 0}, {1, 0}});
+  u.Initialize();
+  const cosim::UnitState saved = u.SaveState();
+  cosim::UnitState no_reals = saved;
+  no_reals.reals.clear();
+  cosim::UnitState no_integers = saved;
+  no_integers.integers.clear();
+  for (const auto* bad : {&no_reals, &no_integers}) {
+    try {
+      u.RestoreState(*bad);
+      ADD_FAILURE() << "restored a truncated state";
+    } catch (const cosim::UnitError& e) {
+      EXPECT_NE(std::string(e.what()).find("expected 1 and 1"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(u.RestoreState(saved));
+}
+
 // Guards against paths that cannot be followed and gains that would
 // divide by zero or run away being accepted before time zero.
 TEST(PathFollowerUnit, CheckParametersRejectsBadValues) {
@@ -249,6 +270,17 @@ TEST(PathFollowerUnit, CheckParametersRejectsBadValues) {
   PathFollowerUnit repeat("repeat", Mode::kPath, {{0, 0}, {1, 0}, {1, 0}});
   ASSERT_EQ(repeat.CheckParameters().size(), 1u);
   EXPECT_EQ(repeat.CheckParameters()[0].index, 2u);
+  // A non-finite waypoint is reported once: the segment after it is judged
+  // by its own ends (here 1 m long), the repeat after that still is.
+  PathFollowerUnit nan("nan", Mode::kPath, {{0, 0}, {NAN, 0}, {1, 0}, {1, 0}});
+  const auto nan_problems = nan.CheckParameters();
+  ASSERT_EQ(nan_problems.size(), 2u);
+  EXPECT_EQ(nan_problems[0].index, 1u);
+  EXPECT_NE(nan_problems[0].message.find("must be finite, got (nan, 0)"), std::string::npos)
+      << nan_problems[0].message;
+  EXPECT_EQ(nan_problems[1].index, 3u);
+  EXPECT_NE(nan_problems[1].message.find("repeats the previous waypoint"), std::string::npos)
+      << nan_problems[1].message;
   PathFollowerUnit none("none", Mode::kHold, {});
   EXPECT_EQ(none.CheckParameters().size(), 1u);
   PathFollowerUnit bad("bad", Mode::kHold, {{0, 0}});

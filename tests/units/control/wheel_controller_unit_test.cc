@@ -14,6 +14,7 @@
 #include "cosim/master.h"
 #include "cosim/system.h"
 #include "cosim/time.h"
+#include "models/dc_motor_params.h"
 #include "units/motors/dc_motor_unit.h"
 
 namespace linesim::control {
@@ -133,6 +134,10 @@ TEST(WheelControllerUnit, DefaultsComeFromRobAtWork3) {
   EXPECT_NEAR(GetScalar(u, "drive_acceleration_feedforward"),
               j_drive * 0.299 / (0.75 * 21 * 0.0302), 1e-12);
   EXPECT_TRUE(u.variables().GetBoolean(*u.variables().Find("compensation")));
+  // Taken from the motor model, so the two cannot drift apart.
+  const models::DcMotorParams re40;
+  EXPECT_EQ(GetScalar(u, "drive_feedforward"), re40.torque_constant_nm_per_a * 21.0);
+  EXPECT_EQ(GetScalar(u, "steer_feedforward"), re40.torque_constant_nm_per_a * 4.0);
 }
 
 // ---------------------------------------------------------------------------
@@ -494,6 +499,33 @@ TEST(WheelControllerUnit, SaveStepRestoreStepIsBitForBit) {
   }
   WheelControllerUnit six("ctl", 6);
   EXPECT_THROW(six.RestoreState(saved), std::exception);
+}
+
+// Guards the unit's own check of its internal state (the variable count
+// matches, so only RestoreInternal can refuse): 7 reals per wheel and the
+// period, no integers.
+TEST(WheelControllerUnit, RestoreRefusesTruncatedInternalState) {
+  WheelControllerUnit u("ctl");
+  u.Initialize();
+  const cosim::UnitState saved = u.SaveState();
+  ASSERT_EQ(saved.reals.size(), 7u * 4u + 1u);
+  ASSERT_TRUE(saved.integers.empty());
+  cosim::UnitState short_reals = saved;
+  short_reals.reals.pop_back();
+  cosim::UnitState extra_integer = saved;
+  extra_integer.integers.push_back(1);
+  for (const auto* bad : {&short_reals, &extra_integer}) {
+    try {
+      u.RestoreState(*bad);
+      ADD_FAILURE() << "restored a state of " << bad->reals.size() << " reals";
+    } catch (const cosim::UnitError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("unit 'ctl' (wheel_controller): saved state has"), std::string::npos)
+          << what;
+      EXPECT_NE(what.find("expected 29 and 0"), std::string::npos) << what;
+    }
+  }
+  EXPECT_NO_THROW(u.RestoreState(saved));
 }
 
 // ---------------------------------------------------------------------------
