@@ -92,8 +92,11 @@ class ChassisUnit : public cosim::Unit {
   std::vector<double> wheel_x_, wheel_y_;
   // The RE 40 rotor (models::DcMotorParams) through the steer belt 4 and the
   // drive gear 21 (models/motors/raw3_steer.yaml, raw3_drive.yaml).
-  double steer_rotor_inertia_ = models::DcMotorParams{}.rotor_inertia_kgm2 * 4.0 * 4.0;
-  double drive_rotor_inertia_ = models::DcMotorParams{}.rotor_inertia_kgm2 * 21.0 * 21.0;
+  // eta N^2 J_rotor: the rotor as the dc_motor unit's full-mode equations
+  // see it from the output (J_eff = J + J_load / (eta N^2)); steer belt 4 at
+  // 0.9, drive gear 21 at 0.75 (models/motors/raw3_*.yaml).
+  double steer_rotor_inertia_ = 0.9 * 4.0 * 4.0 * models::DcMotorParams{}.rotor_inertia_kgm2;
+  double drive_rotor_inertia_ = 0.75 * 21.0 * 21.0 * models::DcMotorParams{}.rotor_inertia_kgm2;
   double steer_friction_ = 0.01;
   double drive_friction_ = 0.01;
   double friction_ = 0.8;

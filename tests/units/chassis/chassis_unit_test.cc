@@ -30,8 +30,10 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kMassKg = 120.0;
 constexpr double kModuleMassKg = 5.0;
 constexpr double kWheelRadiusM = 0.080;
-constexpr double kDriveRotorKgm2 = 142e-7 * 21.0 * 21.0;
-constexpr double kSteerRotorKgm2 = 142e-7 * 4.0 * 4.0;
+// eta N^2 J_rotor (maxon RE 40: 142 g.cm^2; gears and efficiencies of
+// models/motors/raw3_*.yaml).
+constexpr double kDriveRotorKgm2 = 0.75 * 21.0 * 21.0 * 142e-7;
+constexpr double kSteerRotorKgm2 = 0.9 * 4.0 * 4.0 * 142e-7;
 constexpr double kWheelXM[4] = {0.368, -0.368, -0.368, 0.368};
 constexpr double kWheelYM[4] = {0.186, 0.134, -0.186, -0.134};
 
