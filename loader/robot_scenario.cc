@@ -101,8 +101,17 @@ class Expander {
     connections_.push_back(c);
   }
 
-  // The master step as written (the system loader checks it); 1 ms if absent.
-  double MasterStepS() const { return Child(Child(root_, "master"), "step_s").as<double>(0.001); }
+  // The master step as written when it is a usable one; 1 ms if absent or
+  // bad (the system loader reports a bad one at master.step_s).
+  double MasterStepS() const {
+    const YAML::Node node = Child(Child(root_, "master"), "step_s");
+    double step_s = 0.0;
+    if (node.IsScalar() && YAML::convert<double>::decode(node, step_s) && step_s > 0.0 &&
+        step_s <= 10.0) {
+      return step_s;
+    }
+    return 0.001;
+  }
 
   // A section that must be a map if present; an empty map if absent.
   YAML::Node Section(const YAML::Node& parent, const std::string& path, const std::string& key,

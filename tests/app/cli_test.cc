@@ -157,6 +157,27 @@ TEST(Cli, RobotRunIsDeterministic) {
   }
 }
 
+// Guards against a master step that no int64 nanosecond count holds (or no
+// number at all) aborting the program in the robot expansion: it is bad
+// input, reported at master.step_s.
+TEST(Cli, UnusableMasterStepOfARobotScenarioIsBadInput) {
+  for (const char* step : {"1e10", ".nan"}) {
+    const Result r = Linesim("inspect " + kCrossLine + " --set master.step_s=" + step);
+    EXPECT_EQ(r.status, 2) << step << ": " << r.err;
+    EXPECT_NE(r.err.find("master.step_s (set on the command line)"), std::string::npos)
+        << step << ": " << r.err;
+  }
+}
+
+// Guards the last resort: an exception no command expects (here the file
+// system refusing a name longer than a path may be) ends with a message and
+// the bad-input status, not an abort.
+TEST(Cli, UnexpectedExceptionIsReportedNotAnAbort) {
+  const Result r = Linesim("inspect " + std::string(5000, 'a'));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("linesim: ", 0), 0u) << r.err;
+}
+
 // Guards the --set path check from the command line.
 TEST(Cli, UnknownSetPathNamesClosest) {
   const std::string out = Fresh("bad_set");
