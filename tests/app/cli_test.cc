@@ -215,6 +215,23 @@ connections:
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 11) << csv;
 }
 
+// Guards against a lost signals.csv passing for a good run: when its writes
+// fail (here a full disk: the file is /dev/full) the run fails, exit 1, and
+// the summary and the message name the file.
+TEST(Cli, FailedSignalsWriteFailsTheRun) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const std::string out = Fresh("disk_full");
+  fs::create_directories(out);
+  fs::create_symlink("/dev/full", fs::path(out) / "signals.csv");
+  const Result r = Linesim("run " + kMotorStep + " --out " + out);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("cannot write " + out + "/signals.csv"), std::string::npos) << r.err;
+  const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
+  EXPECT_EQ(summary["status"], "failed");
+  ASSERT_EQ(summary["errors"].size(), 1u) << summary.dump();
+  EXPECT_NE(summary["errors"][0].get<std::string>().find("signals.csv"), std::string::npos);
+}
+
 // Guards `inspect` on a type and on a file, and an unknown type.
 TEST(Cli, InspectTypeAndFile) {
   const Result type = Linesim("inspect dc_motor");
