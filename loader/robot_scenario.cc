@@ -106,7 +106,7 @@ class Expander {
   double MasterStepS() const {
     const YAML::Node node = Child(Child(root_, "master"), "step_s");
     double step_s = 0.0;
-    if (node.IsScalar() && YAML::convert<double>::decode(node, step_s) && step_s > 0.0 &&
+    if (node.IsScalar() && YAML::convert<double>::decode(node, step_s) && step_s >= 1e-9 &&
         step_s <= 10.0) {
       return step_s;
     }
@@ -269,24 +269,25 @@ class Expander {
         const std::string schedule_path = JoinPath(path, "schedule");
         if (schedule.IsDefined() && !schedule.IsNull() &&
             r_.ExpectSequence(schedule, schedule_path)) {
-          double last_s = -1.0;
+          cosim::TimeNs last = -1;
           for (std::size_t k = 0; k < schedule.size(); ++k) {
             const std::string item_path = JoinPath(schedule_path, std::to_string(k));
             if (!r_.ExpectMap(schedule[k], item_path)) continue;
             r_.CheckKeys(schedule[k], item_path, {"time_s", "on"});
-            const double t = r_.Real(schedule[k], item_path, "time_s", std::nullopt, {0.0, 1e7});
+            const cosim::TimeNs t =
+                r_.Time(schedule[k], item_path, "time_s", std::nullopt, {0.0, 1e7});
             const bool on = r_.Boolean(schedule[k], item_path, "on", std::nullopt);
-            if (t <= last_s) {
+            if (t <= last) {
               r_.Error(Child(schedule[k], "time_s"), JoinPath(item_path, "time_s"),
                        "switching times must increase");
             }
-            last_s = t;
-            if (t == 0.0) {
+            last = t;
+            if (t == 0) {
               initially_on = on;
               continue;
             }
             YAML::Node s;
-            s["time_s"] = Num(t);
+            s["time_s"] = Num(cosim::NsToSeconds(t));
             s["on"] = on;
             switches.push_back(s);
           }
@@ -325,15 +326,15 @@ class Expander {
     const YAML::Node control = Section(root_, "", "control", {"compensation", "period_s"});
     const bool compensation = r_.Boolean(control, "control", "compensation", true);
     // FACTS.md: the Rob@Work 3 control cycle is 20 ms.
-    period_s_ = r_.Real(control, "control", "period_s", 0.02, {0.0, 10.0, true});
+    const cosim::TimeNs period = r_.Time(control, "control", "period_s", 0.02, {0.0, 10.0, true});
     const cosim::TimeNs step = cosim::SecondsToNs(MasterStepS());
-    if (step > 0 && cosim::SecondsToNs(period_s_) % step != 0) {
+    if (period % step != 0) {
       r_.Error(Child(control, "period_s"), "control.period_s",
                "expected a whole multiple of master.step_s (" + cosim::FormatSeconds(step) +
-                   " s), got " + cosim::FormatSeconds(cosim::SecondsToNs(period_s_)) + " s");
+                   " s), got " + cosim::FormatSeconds(period) + " s");
     }
     for (const char* name : {kWheelController, kPathFollower}) {
-      Unit(name)["step_s"] = Num(period_s_);
+      Unit(name)["step_s"] = Num(cosim::NsToSeconds(period));
     }
     Unit(kWheelController)["type"] = "wheel_controller";
     MergeInto(Params(kWheelController), controller_defaults_);
@@ -503,7 +504,7 @@ class Expander {
   YAML::Node out_{YAML::NodeType::Map};
   std::vector<YAML::Node> user_connections_, connections_;
   YAML::Node controller_defaults_, follower_defaults_;
-  double x_m_ = 0, y_m_ = 0, yaw_rad_ = 0, period_s_ = 0.02;
+  double x_m_ = 0, y_m_ = 0, yaw_rad_ = 0;
 };
 
 }  // namespace

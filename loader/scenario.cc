@@ -149,11 +149,13 @@ class Builder {
                   "recording", "metrics"});
     s_.name = r_.String(root, "", "name", fs::path(s_.file).stem().string());
     s_.description = r_.String(root, "", "description", "");
-    s_.duration_s = r_.Real(root, "", "duration_s", std::nullopt, {0.0, 1e7, true});
+    cosim::MasterOptions options;
+    options.start = 0;
+    options.stop = r_.Time(root, "", "duration_s", std::nullopt, {0.0, 1e7, true});
+    s_.duration_s = cosim::NsToSeconds(options.stop);
     s_.seed = static_cast<std::uint64_t>(
         r_.Integer(root, "", "seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
 
-    cosim::MasterOptions options;
     const std::size_t issues_before_master = r_.issues().size();
     const YAML::Node master = Child(root, "master");
     if (master.IsDefined() && !master.IsNull() && r_.ExpectMap(master, "master")) {
@@ -164,15 +166,8 @@ class Builder {
         r_.String(master_map, "master", "algorithm", "gauss_seidel", {"jacobi", "gauss_seidel"});
     options.algorithm =
         algorithm == "jacobi" ? cosim::Algorithm::kJacobi : cosim::Algorithm::kGaussSeidel;
-    const double step_s = r_.Real(master_map, "master", "step_s", 0.001, {0.0, 10.0, true});
-    options.base_step = cosim::SecondsToNs(step_s);
-    if (options.base_step <= 0) {
-      r_.Error(Child(master_map, "step_s"), "master.step_s",
-               "step is below one nanosecond: expected at least 1e-9");
-    }
+    options.base_step = r_.Time(master_map, "master", "step_s", 0.001, {0.0, 10.0, true});
     options.threads = static_cast<int>(r_.Integer(master_map, "master", "threads", 1, 1, 256));
-    options.start = 0;
-    options.stop = cosim::SecondsToNs(s_.duration_s);
     if (options.base_step > 0 && options.stop > 0 && options.stop % options.base_step != 0) {
       r_.Error(Child(root, "duration_s"), "duration_s",
                "duration " + cosim::FormatSeconds(options.stop) +
@@ -243,10 +238,8 @@ class Builder {
       r_.Error(Child(spec, "type"), JoinPath(path, "type"), UnknownTypeMessage(type_name));
       return;
     }
-    cosim::TimeNs step = 0;
-    if (Child(spec, "step_s").IsDefined()) {
-      step = cosim::SecondsToNs(r_.Real(spec, path, "step_s", 0.0, {0.0, 1e6, true}));
-    }
+    // 0: the master step.
+    const cosim::TimeNs step = r_.Time(spec, path, "step_s", 0.0, {0.0, 1e6, true});
     const YAML::Node params = Child(spec, "parameters");
     const std::string params_path = JoinPath(path, "parameters");
     if (params.IsDefined() && !params.IsNull() && !r_.ExpectMap(params, params_path)) return;
@@ -355,8 +348,8 @@ class Builder {
     } else if (r_.ExpectMap(rec, "recording")) {
       r_.CheckKeys(rec, "recording", {"variables", "interval_s"});
       if (Child(rec, "interval_s").IsDefined()) {
-        s_.record_interval =
-            cosim::SecondsToNs(r_.Real(rec, "recording", "interval_s", 0.0, {0.0, 1e7, true}));
+        s_.record_interval = r_.Time(rec, "recording", "interval_s",
+                                     cosim::NsToSeconds(options.base_step), {0.0, 1e7, true});
         if (s_.record_interval % options.base_step != 0) {
           r_.Error(Child(rec, "interval_s"), "recording.interval_s",
                    "expected a whole multiple of master.step_s (" +

@@ -37,8 +37,7 @@ std::unique_ptr<cosim::Unit> MakeStepSignal(const UnitBuildContext& c) {
       if (!r.ExpectMap(item, item_path)) continue;
       r.CheckKeys(item, item_path, {"time_s", "value"});
       sources::StepSignalUnit::Step step;
-      // Bounded like duration_s, so that the time fits in int64 nanoseconds.
-      step.time = cosim::SecondsToNs(r.Real(item, item_path, "time_s", std::nullopt, {0.0, 1e7}));
+      step.time = r.Time(item, item_path, "time_s", std::nullopt, {0.0, 1e7});
       const YAML::Node value = Child(item, "value");
       const std::string value_path = JoinPath(item_path, "value");
       if (!value.IsDefined()) {
@@ -143,10 +142,8 @@ std::unique_ptr<cosim::Unit> MakeBelt(const UnitBuildContext& c) {
         const std::string item_path = JoinPath(belt_path, std::to_string(i));
         if (!r.ExpectMap(item, item_path)) continue;
         r.CheckKeys(item, item_path, {"time_s", "on"});
-        // Bounded like duration_s, so that the time fits in int64 nanoseconds.
-        const double t = r.Real(item, item_path, "time_s", std::nullopt, {0.0, 1e7});
-        schedules.back().push_back(
-            {cosim::SecondsToNs(t), r.Boolean(item, item_path, "on", std::nullopt)});
+        const cosim::TimeNs t = r.Time(item, item_path, "time_s", std::nullopt, {0.0, 1e7});
+        schedules.back().push_back({t, r.Boolean(item, item_path, "on", std::nullopt)});
       }
     }
   }

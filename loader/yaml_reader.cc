@@ -130,6 +130,33 @@ double YamlReader::Real(const YAML::Node& map, const std::string& path, const st
   return AsReal(node, JoinPath(path, key), range).value_or(fallback.value_or(0.0));
 }
 
+cosim::TimeNs YamlReader::Time(const YAML::Node& map, const std::string& path,
+                               const std::string& key, std::optional<double> fallback,
+                               Range range) {
+  // Fallbacks are the caller's own values, in range by construction.
+  const cosim::TimeNs otherwise = fallback ? cosim::SecondsToNs(*fallback) : 0;
+  const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
+  if (!node.IsDefined() || node.IsNull()) return otherwise;
+  const std::string p = JoinPath(path, key);
+  const auto seconds = AsReal(node, p, range);
+  if (!seconds) return otherwise;
+  // int64 nanoseconds end at 9.22e18 ns; SecondsToNs refuses above 9.2e18.
+  constexpr double kMaxSeconds = 9.2e9;
+  if (std::abs(*seconds) > kMaxSeconds) {
+    Error(node, p,
+          "value " + node.Scalar() + " is out of range: a time must be within +-9.2e9 s " +
+              "(int64 nanoseconds)");
+    return otherwise;
+  }
+  if (*seconds != 0.0 && std::abs(*seconds) < 1e-9) {
+    Error(node, p,
+          "value " + node.Scalar() + " is below one nanosecond, the time resolution: expected " +
+              (range.min_exclusive && range.min == 0.0 ? "" : "0 or ") + "at least 1e-9 s");
+    return otherwise;
+  }
+  return cosim::SecondsToNs(*seconds);
+}
+
 std::int64_t YamlReader::Integer(const YAML::Node& map, const std::string& path,
                                  const std::string& key, std::optional<std::int64_t> fallback,
                                  std::int64_t min, std::int64_t max) {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "cosim/time.h"
 #include "loader/scenario_error.h"
 
 namespace linesim::loader {
@@ -48,6 +49,11 @@ class YamlReader {
   /// A key of `map`; when absent, `fallback` (or an issue if none is given).
   double Real(const YAML::Node& map, const std::string& path, const std::string& key,
               std::optional<double> fallback, Range range = {});
+  /// A time in seconds (`fallback` and `range` too) as integer nanoseconds.
+  /// Besides the range, refuses a nonzero time below 1 ns (it would round
+  /// to 0 or 1 ns silently) and one too large for int64 nanoseconds.
+  cosim::TimeNs Time(const YAML::Node& map, const std::string& path, const std::string& key,
+                     std::optional<double> fallback, Range range = {});
   std::int64_t Integer(const YAML::Node& map, const std::string& path, const std::string& key,
                        std::optional<std::int64_t> fallback, std::int64_t min, std::int64_t max);
   bool Boolean(const YAML::Node& map, const std::string& path, const std::string& key,

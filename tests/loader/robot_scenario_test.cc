@@ -182,6 +182,21 @@ TEST(RobotScenario, ControlPeriodMustBeAMultipleOfTheMasterStep) {
   EXPECT_FALSE(Has(e, "units.wheel_controller")) << e;
 }
 
+// Guards the robot-level times against the 1 ns resolution: a control
+// period or a switching time below it is refused at its own key.
+TEST(RobotScenario, TimesBelowOneNanosecondAreRefusedAtTheirKeys) {
+  const std::string e =
+      Issues(kCross, {"control.period_s=1.0e-12", "line.belts.0.schedule.0.time_s=1.0e-10"});
+  EXPECT_TRUE(Has(e,
+                  "control.period_s (set on the command line): value 1.0e-12 is below one "
+                  "nanosecond"))
+      << e;
+  EXPECT_TRUE(Has(e,
+                  "line.belts.0.schedule.0.time_s (set on the command line): value 1.0e-10 is "
+                  "below one nanosecond"))
+      << e;
+}
+
 // Guards an unknown robot model: named with the models that exist.
 TEST(RobotScenario, UnknownRobotModelNamesTheKnownOnes) {
   const std::string e = Issues(kCross, {"robot.model=raw4"});

@@ -124,6 +124,44 @@ units:
       << all;
 }
 
+// Guards against times below the 1 ns resolution silently becoming 0 (a
+// unit step of 0 is "the master step"; a step time of 0 is the start): every
+// time key of a system scenario refuses them at its key.
+TEST(LoadScenario, TimesBelowOneNanosecondAreRefusedAtTheirKeys) {
+  const std::string f = WriteScenario("tiny_times.yaml", R"(duration_s: 0.01
+master: {step_s: 1.0e-12}
+units:
+  supply:
+    type: step_signal
+    step_s: 1.0e-10
+    parameters: {steps: [{time_s: 5.0e-10, value: 1}]}
+  belt:
+    type: belt
+    parameters: {schedules: [[{time_s: 1.0e-11, on: false}]]}
+recording: {interval_s: 2.0e-10}
+)");
+  const std::string all = Issues(f);
+  for (const char* key : {":2: master.step_s", ":6: units.supply.step_s",
+                          ":7: units.supply.parameters.steps.0.time_s",
+                          ":10: units.belt.parameters.schedules.0.0.time_s"}) {
+    EXPECT_TRUE(Has(all, f + std::string(key) + ": value ")) << key << "\n" << all;
+  }
+  EXPECT_EQ(std::count(all.begin(), all.end(), '\n') + 1, 4) << all;
+  EXPECT_TRUE(Has(all, "below one nanosecond")) << all;
+  // The recording is checked once the units are built.
+  const std::vector<std::string> good = {"master.step_s=0.001", "units.supply.step_s=0.001",
+                                         "units.supply.parameters.steps.0.time_s=0",
+                                         "units.belt.parameters.schedules.0.0.time_s=0"};
+  const std::string rec = Issues(f, good);
+  EXPECT_TRUE(Has(rec, f + ":11: recording.interval_s: value 2.0e-10 is below one nanosecond"))
+      << rec;
+  std::vector<std::string> sets = good;
+  sets.push_back("duration_s=1.0e-10");
+  const std::string d = Issues(f, sets);
+  EXPECT_TRUE(Has(d, "duration_s (set on the command line): value 1.0e-10 is below one nanosecond"))
+      << d;
+}
+
 // Guards the parameter path: a value of the wrong shape or an unknown name
 // is refused with what was expected.
 TEST(LoadScenario, ParameterValuesAreChecked) {
@@ -183,7 +221,7 @@ units:
 )");
   const std::string all = Issues(f);
   EXPECT_TRUE(Has(all, f + ":1: duration_s: duration 0.0105 s is not a whole number of master "
-                       "steps (master.step_s = 0.001 s)"))
+                           "steps (master.step_s = 0.001 s)"))
       << all;
 }
 
