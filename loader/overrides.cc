@@ -5,7 +5,6 @@
 #include <charconv>
 #include <optional>
 
-#include "cosim/closest_names.h"
 #include "loader/yaml_reader.h"
 
 namespace linesim::loader {
@@ -98,13 +97,9 @@ void ApplyOverrides(YAML::Node& root, const std::vector<Override>& overrides,
         } else if (!exists) {
           std::vector<std::string> keys;
           for (const auto& kv : cnode) keys.push_back(kv.first.Scalar());
-          std::string hint;
-          for (const auto& c : cosim::ClosestNames(key, keys)) {
-            hint += (hint.empty() ? "" : ", ") + JoinPath(walked, c);
-          }
           const bool item_next = i + 2 == parts.size() && IsIndex(parts[i + 1]);
           report("no key '" + key + "' at '" + (walked.empty() ? "(top)" : walked) + "'" +
-                 (hint.empty() ? "" : "; closest: " + hint) +
+                 ClosestPathsHint(walked, key, keys) +
                  (item_next ? "; one item can be set only where the file writes the list: "
                               "set the whole value instead, e.g. " +
                                   JoinPath(walked, key) + "=[...]"

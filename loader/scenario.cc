@@ -105,14 +105,10 @@ void ApplyParameters(cosim::Unit& unit, const YAML::Node& map, const std::string
     const std::string key_path = JoinPath(path, key);
     const auto ref = unit.variables().Find(key);
     if (!ref || unit.variables().info(*ref).causality != cosim::Causality::kParameter) {
-      std::string hint;
-      for (const auto& c : cosim::ClosestNames(key, allowed)) {
-        hint += (hint.empty() ? "" : ", ") + JoinPath(path, c);
-      }
       r.Error(kv.first, key_path,
               "unknown parameter of a " + unit.type_name() + " unit" +
-                  (hint.empty() ? "" : "; closest: " + hint) + " (linesim inspect " +
-                  unit.type_name() + " lists them)");
+                  ClosestPathsHint(path, key, allowed) + " (linesim inspect " + unit.type_name() +
+                  " lists them)");
       continue;
     }
     ApplyParameter(unit, unit.variables().info(*ref), kv.second, key_path, r);

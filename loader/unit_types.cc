@@ -223,10 +223,8 @@ std::vector<std::string> UnitTypeNames() {
 }
 
 std::string UnknownTypeMessage(const std::string& name) {
-  std::string all;
-  for (const auto& n : UnitTypeNames()) all += (all.empty() ? "" : ", ") + n;
   return "unknown unit type '" + name + "'" + cosim::ClosestHint(name, UnitTypeNames()) +
-         "; known types: " + all;
+         "; known types: " + JoinNames(UnitTypeNames());
 }
 
 }  // namespace linesim::loader

@@ -10,6 +10,19 @@ std::string JoinPath(const std::string& path, const std::string& key) {
   return path.empty() ? key : path + "." + key;
 }
 
+std::string ClosestPathsHint(const std::string& path, const std::string& name,
+                             const std::vector<std::string>& candidates) {
+  std::vector<std::string> paths;
+  for (const auto& c : cosim::ClosestNames(name, candidates)) paths.push_back(JoinPath(path, c));
+  return paths.empty() ? "" : "; closest: " + JoinNames(paths);
+}
+
+std::string JoinNames(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
 YAML::Node Child(const YAML::Node& map, const std::string& key) {
   if (map.IsDefined() && map.IsMap()) {
     for (const auto& kv : map) {
@@ -73,14 +86,9 @@ void YamlReader::CheckKeys(const YAML::Node& map, const std::string& path,
     bool known = false;
     for (const auto& a : allowed) known |= (a == key);
     if (known) continue;
-    std::vector<std::string> close = cosim::ClosestNames(key, allowed);
-    std::string hint;
-    for (const auto& c : close) hint += (hint.empty() ? "" : ", ") + JoinPath(path, c);
-    std::string expected;
-    for (const auto& a : allowed) expected += (expected.empty() ? "" : ", ") + a;
     Error(kv.first, JoinPath(path, key),
-          "unknown key" + (hint.empty() ? "" : "; closest: " + hint) +
-              "; expected one of: " + expected);
+          "unknown key" + ClosestPathsHint(path, key, allowed) +
+              "; expected one of: " + JoinNames(allowed));
   }
 }
 
@@ -201,11 +209,9 @@ std::string YamlReader::String(const YAML::Node& map, const std::string& path,
     bool found = false;
     for (const auto& a : allowed) found |= (a == *s);
     if (!found) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      Error(
-          node, p,
-          "'" + *s + "' is not allowed: expected one of " + list + cosim::ClosestHint(*s, allowed));
+      Error(node, p,
+            "'" + *s + "' is not allowed: expected one of " + JoinNames(allowed) +
+                cosim::ClosestHint(*s, allowed));
       return fallback.value_or(allowed.front());
     }
   }

@@ -17,6 +17,14 @@ namespace linesim::loader {
 /// "a.b" + "c" -> "a.b.c".
 std::string JoinPath(const std::string& path, const std::string& key);
 
+/// "; closest: path.a, path.b" with the candidates close to `name` as full
+/// paths under `path`, or "" when none is close.
+std::string ClosestPathsHint(const std::string& path, const std::string& name,
+                             const std::vector<std::string>& candidates);
+
+/// "a, b, c".
+std::string JoinNames(const std::vector<std::string>& names);
+
 /// Accepted interval of a number.
 struct Range {
   double min = -std::numeric_limits<double>::infinity();
