@@ -23,67 +23,51 @@ struct ParameterOrigin {
   std::string path;
 };
 
-// Converts a YAML value to the declared type of a unit variable and sets it.
+// Converts a YAML value to the declared type of a unit variable and sets it;
+// a value that does not convert is reported at `path`.
 void ApplyParameter(cosim::Unit& unit, const cosim::VariableInfo& info, const YAML::Node& node,
                     const std::string& path, YamlReader& r) {
-  cosim::Value value;
-  bool ok = false;
-  std::string expected;
+  constexpr auto kAny = std::numeric_limits<std::int64_t>::max();
+  std::optional<cosim::Value> value;
   switch (info.type) {
-    case cosim::VarType::kReal: {
-      double v;
-      ok = node.IsScalar() && YAML::convert<double>::decode(node, v);
-      value = v;
-      expected = "a number";
+    case cosim::VarType::kReal:
+      if (const auto v = r.AsReal(node, path)) value = *v;
       break;
-    }
-    case cosim::VarType::kInteger: {
-      std::int64_t v;
-      ok = node.IsScalar() && YAML::convert<std::int64_t>::decode(node, v);
-      value = v;
-      expected = "an integer";
+    case cosim::VarType::kInteger:
+      if (const auto v = r.AsInteger(node, path, -kAny - 1, kAny)) value = *v;
       break;
-    }
-    case cosim::VarType::kBoolean: {
-      bool v;
-      ok = node.IsScalar() && YAML::convert<bool>::decode(node, v);
-      value = v;
-      expected = "true or false";
+    case cosim::VarType::kBoolean:
+      if (const auto v = r.AsBoolean(node, path)) value = *v;
       break;
-    }
     case cosim::VarType::kString:
-      ok = node.IsScalar();
-      if (ok) value = node.Scalar();
-      expected = "a text value";
+      if (const auto v = r.AsString(node, path)) value = *v;
       break;
     case cosim::VarType::kRealArray: {
-      expected =
+      const std::string expected =
           "a number (for every element) or a list of " + std::to_string(info.size) + " numbers";
-      double v;
-      if (node.IsScalar() && YAML::convert<double>::decode(node, v)) {
-        value = v;
-        ok = true;
-      } else if (node.IsSequence() && node.size() == info.size) {
+      if (node.IsSequence() && node.size() == info.size) {
         std::vector<double> list(info.size);
-        ok = true;
-        for (std::size_t i = 0; i < info.size && ok; ++i) {
-          ok = node[i].IsScalar() && YAML::convert<double>::decode(node[i], list[i]);
+        bool ok = true;
+        for (std::size_t i = 0; i < info.size; ++i) {
+          const auto v = r.AsReal(node[i], JoinPath(path, std::to_string(i)));
+          ok = ok && v.has_value();
+          list[i] = v.value_or(0.0);
         }
-        value = std::move(list);
+        if (ok) value = std::move(list);
       } else if (node.IsSequence()) {
         r.Error(node, path,
                 "expected " + expected + ", got a list of " + std::to_string(node.size()));
-        return;
+      } else if (const auto v = YamlReader::DecodeReal(node)) {
+        value = *v;
+      } else {
+        r.Error(node, path, "expected " + expected + " (" + info.unit + "), got " + Describe(node));
       }
       break;
     }
   }
-  if (!ok) {
-    r.Error(node, path, "expected " + expected + " (" + info.unit + "), got " + Describe(node));
-    return;
-  }
+  if (!value) return;
   try {
-    unit.variables().SetValue(info.ref, value);
+    unit.variables().SetValue(info.ref, *value);
   } catch (const std::exception& e) {
     r.Error(node, path, e.what());
   }

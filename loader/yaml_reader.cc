@@ -101,13 +101,22 @@ const YAML::Node YamlReader::Lookup(const YAML::Node& map, const std::string& pa
   return node;
 }
 
-std::optional<double> YamlReader::AsReal(const YAML::Node& node, const std::string& path,
-                                         Range range) {
+std::optional<double> YamlReader::DecodeReal(const YAML::Node& node) {
   double v = 0;
   if (!node.IsScalar() || !YAML::convert<double>::decode(node, v) || std::isnan(v)) {
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::optional<double> YamlReader::AsReal(const YAML::Node& node, const std::string& path,
+                                         Range range) {
+  const std::optional<double> decoded = DecodeReal(node);
+  if (!decoded) {
     Error(node, path, "expected a number, got " + Describe(node));
     return std::nullopt;
   }
+  const double v = *decoded;
   const bool below = range.min_exclusive ? v <= range.min : v < range.min;
   if (below || v > range.max) {
     std::string want;
@@ -165,36 +174,44 @@ cosim::TimeNs YamlReader::Time(const YAML::Node& map, const std::string& path,
   return cosim::SecondsToNs(*seconds);
 }
 
+std::optional<std::int64_t> YamlReader::AsInteger(const YAML::Node& node, const std::string& path,
+                                                  std::int64_t min, std::int64_t max) {
+  std::int64_t v = 0;
+  if (!node.IsScalar() || !YAML::convert<std::int64_t>::decode(node, v)) {
+    Error(node, path, "expected an integer, got " + Describe(node));
+    return std::nullopt;
+  }
+  if (v < min || v > max) {
+    Error(node, path,
+          "value " + std::to_string(v) + " is out of range: expected an integer from " +
+              std::to_string(min) + " to " + std::to_string(max));
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::optional<bool> YamlReader::AsBoolean(const YAML::Node& node, const std::string& path) {
+  bool v = false;
+  if (!node.IsScalar() || !YAML::convert<bool>::decode(node, v)) {
+    Error(node, path, "expected true or false, got " + Describe(node));
+    return std::nullopt;
+  }
+  return v;
+}
+
 std::int64_t YamlReader::Integer(const YAML::Node& map, const std::string& path,
                                  const std::string& key, std::optional<std::int64_t> fallback,
                                  std::int64_t min, std::int64_t max) {
   const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
   if (!node.IsDefined() || node.IsNull()) return fallback.value_or(0);
-  std::int64_t v = 0;
-  const std::string p = JoinPath(path, key);
-  if (!node.IsScalar() || !YAML::convert<std::int64_t>::decode(node, v)) {
-    Error(node, p, "expected an integer, got " + Describe(node));
-    return fallback.value_or(0);
-  }
-  if (v < min || v > max) {
-    Error(node, p,
-          "value " + std::to_string(v) + " is out of range: expected an integer from " +
-              std::to_string(min) + " to " + std::to_string(max));
-    return fallback.value_or(0);
-  }
-  return v;
+  return AsInteger(node, JoinPath(path, key), min, max).value_or(fallback.value_or(0));
 }
 
 bool YamlReader::Boolean(const YAML::Node& map, const std::string& path, const std::string& key,
                          std::optional<bool> fallback) {
   const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
   if (!node.IsDefined() || node.IsNull()) return fallback.value_or(false);
-  bool v = false;
-  if (!node.IsScalar() || !YAML::convert<bool>::decode(node, v)) {
-    Error(node, JoinPath(path, key), "expected true or false, got " + Describe(node));
-    return fallback.value_or(false);
-  }
-  return v;
+  return AsBoolean(node, JoinPath(path, key)).value_or(fallback.value_or(false));
 }
 
 std::string YamlReader::String(const YAML::Node& map, const std::string& path,

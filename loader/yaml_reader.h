@@ -46,6 +46,8 @@ class YamlReader {
   std::vector<Issue>& mutable_issues() { return issues_; }
   const std::string& file() const { return file_; }
   static int LineOf(const YAML::Node& node);
+  /// A scalar that reads as a number other than NaN, without reporting.
+  static std::optional<double> DecodeReal(const YAML::Node& node);
 
   bool ExpectMap(const YAML::Node& node, const std::string& path);
   bool ExpectSequence(const YAML::Node& node, const std::string& path);
@@ -71,8 +73,12 @@ class YamlReader {
                      std::optional<std::string> fallback,
                      const std::vector<std::string>& allowed = {});
 
-  /// Scalar readers for a node already looked up.
+  /// Scalar readers for a node already looked up; each reports a bad value
+  /// at `path` and returns nothing.
   std::optional<double> AsReal(const YAML::Node& node, const std::string& path, Range range = {});
+  std::optional<std::int64_t> AsInteger(const YAML::Node& node, const std::string& path,
+                                        std::int64_t min, std::int64_t max);
+  std::optional<bool> AsBoolean(const YAML::Node& node, const std::string& path);
   std::optional<std::string> AsString(const YAML::Node& node, const std::string& path);
 
  private:

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
+
 #include "loader/unit_types.h"
 #include "scenario_test.h"
 
@@ -182,6 +185,32 @@ units:
       << all;
   EXPECT_TRUE(Has(all, "units.motor.parameters.gear_ratio: expected a number (for every element)"))
       << all;
+}
+
+// Guards parameters against NaN: it is no number, for a Real parameter
+// (the standard message), for a whole array and for one element of it.
+TEST(LoadScenario, NanParameterIsRefused) {
+  const std::string f = WriteScenario("nan.yaml", kValidScenario);
+  const std::string all = Issues(
+      f, {"units.motor.parameters.resistance=.nan", "units.motor.parameters.inductance=[.nan]"});
+  EXPECT_TRUE(Has(all,
+                  "units.motor.parameters.resistance (set on the command line): expected a "
+                  "number (for every element) or a list of 1 numbers (Ohm), got '.nan'"))
+      << all;
+  EXPECT_TRUE(Has(all,
+                  "units.motor.parameters.inductance.0 (set on the command line): expected a "
+                  "number, got '.nan'"))
+      << all;
+  // A Real (not array) parameter: the chassis's friction, in a robot scenario.
+  std::ifstream in(LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string g = WriteScenario(
+      "nan_robot.yaml", text + "units:\n  chassis:\n    parameters: {friction: 0.7}\n");
+  const std::string robot = Issues(g, {"units.chassis.parameters.friction=.nan"});
+  EXPECT_TRUE(Has(robot,
+                  "units.chassis.parameters.friction (set on the command line): expected a "
+                  "number, got '.nan'"))
+      << robot;
 }
 
 // Guards unit names: they are the first part of every connection path, so
