@@ -18,7 +18,7 @@ namespace {
 
 // Where a parameter's value came from, to point at it if the unit refuses it.
 struct ParameterOrigin {
-  YamlReader* reader;
+  std::string file;
   YAML::Node node;
   std::string path;
 };
@@ -96,7 +96,7 @@ void ApplyParameters(cosim::Unit& unit, const YAML::Node& map, const std::string
       continue;
     }
     ApplyParameter(unit, unit.variables().info(*ref), kv.second, key_path, r);
-    origins[key] = {&r, kv.second, key_path};
+    origins[key] = {r.file(), kv.second, key_path};
   }
 }
 
@@ -263,14 +263,10 @@ class Builder {
                    "cannot read model file " + file.string() + ": " + e.what());
         }
         if (model.IsDefined()) {
-          // Kept alive: parameter origins point into it for later checks.
-          model_readers_.push_back(std::make_unique<YamlReader>(file.string()));
-          YamlReader& mr = *model_readers_.back();
-          if (mr.ExpectMap(model, "")) {
-            ApplyParameters(*unit, model, "", {"source", "description"}, mr, origins);
+          const YamlReader::InFile in_model(r_, file.string());
+          if (r_.ExpectMap(model, "")) {
+            ApplyParameters(*unit, model, "", {"source", "description"}, r_, origins);
           }
-          for (auto& issue : mr.mutable_issues()) r_.mutable_issues().push_back(issue);
-          mr.mutable_issues().clear();
         }
       }
     }
@@ -279,13 +275,8 @@ class Builder {
     for (const auto& p : unit->CheckParameters()) {
       const std::string suffix = p.index ? "." + std::to_string(*p.index) : "";
       if (auto it = origins.find(p.variable); it != origins.end()) {
-        YamlReader& where = *it->second.reader;
-        const std::size_t n = where.issues().size();
-        where.Error(it->second.node, it->second.path + suffix, p.message);
-        if (&where != &r_) {
-          r_.mutable_issues().push_back(where.issues()[n]);
-          where.mutable_issues().clear();
-        }
+        const ParameterOrigin& origin = it->second;
+        r_.Error(origin.file, origin.node, origin.path + suffix, p.message);
       } else {
         r_.Error(params.IsDefined() ? params : spec, JoinPath(params_path, p.variable) + suffix,
                  p.message);
@@ -391,7 +382,6 @@ class Builder {
 
   Scenario& s_;
   YamlReader& r_;
-  std::vector<std::unique_ptr<YamlReader>> model_readers_;
   // Name and YAML node of each unit added to the system, in system order.
   std::vector<std::pair<std::string, YAML::Node>> unit_nodes_;
 };
@@ -434,7 +424,7 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
   std::set<std::string> overridden;
   for (const auto& o : s.overrides) overridden.insert(o.path);
   YamlReader reader(file, overridden);
-  for (auto& i : issues) reader.mutable_issues().push_back(i);
+  reader.Add(issues);
   if (IsRobotScenario(tree)) {
     RobotInfo info;
     s.expanded = ExpandRobotScenario(tree, reader, info);

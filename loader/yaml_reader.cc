@@ -42,7 +42,7 @@ std::string Describe(const YAML::Node& node) {
 }
 
 YamlReader::YamlReader(std::string file, std::set<std::string> overridden)
-    : file_(std::move(file)), overridden_(std::move(overridden)) {}
+    : file_(file), own_file_(std::move(file)), overridden_(std::move(overridden)) {}
 
 int YamlReader::LineOf(const YAML::Node& node) {
   if (!node.IsDefined() || node.Mark().is_null()) return 0;
@@ -57,11 +57,20 @@ bool YamlReader::FromCommandLine(const std::string& path) const {
 }
 
 void YamlReader::Error(const YAML::Node& at, const std::string& path, std::string message) {
+  Error(file_, at, path, std::move(message));
+}
+
+void YamlReader::Add(const std::vector<Issue>& issues) {
+  issues_.insert(issues_.end(), issues.begin(), issues.end());
+}
+
+void YamlReader::Error(const std::string& file, const YAML::Node& at, const std::string& path,
+                       std::string message) {
   Issue issue;
-  issue.file = file_;
+  issue.file = file;
   issue.key_path = path;
   issue.message = std::move(message);
-  issue.from_command_line = FromCommandLine(path);
+  issue.from_command_line = file == own_file_ && FromCommandLine(path);
   issue.line = issue.from_command_line ? 0 : LineOf(at);
   issues_.push_back(std::move(issue));
 }

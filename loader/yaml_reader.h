@@ -41,10 +41,29 @@ class YamlReader {
   YamlReader(std::string file, std::set<std::string> overridden = {});
 
   void Error(const YAML::Node& at, const std::string& path, std::string message);
+  /// An issue of another file than the reader's (a model file it read).
+  void Error(const std::string& file, const YAML::Node& at, const std::string& path,
+             std::string message);
+  void Add(const std::vector<Issue>& issues);
   bool ok() const { return issues_.empty(); }
   const std::vector<Issue>& issues() const { return issues_; }
-  std::vector<Issue>& mutable_issues() { return issues_; }
+  /// The file the reader's issues are of: its own, or the one an InFile
+  /// guard names.
   const std::string& file() const { return file_; }
+
+  /// While it exists, the reader reads another file (a model file read for
+  /// the scenario): its issues name that file, never the command line.
+  class InFile {
+   public:
+    InFile(YamlReader& r, std::string file) : r_(r), saved_(r.file_) { r_.file_ = std::move(file); }
+    ~InFile() { r_.file_ = std::move(saved_); }
+    InFile(const InFile&) = delete;
+    InFile& operator=(const InFile&) = delete;
+
+   private:
+    YamlReader& r_;
+    std::string saved_;
+  };
   static int LineOf(const YAML::Node& node);
   /// A scalar that reads as a number other than NaN, without reporting.
   static std::optional<double> DecodeReal(const YAML::Node& node);
@@ -87,6 +106,7 @@ class YamlReader {
                           bool required);
 
   std::string file_;
+  const std::string own_file_;
   std::set<std::string> overridden_;
   std::vector<Issue> issues_;
 };

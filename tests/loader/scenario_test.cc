@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 
@@ -13,6 +14,7 @@ namespace {
 
 using testing::kValidScenario;
 using testing::WriteScenario;
+namespace fs = std::filesystem;
 
 // Every issue of an error, one per line, for matching in assertions.
 std::string Issues(const std::string& file, const std::vector<std::string>& sets = {}) {
@@ -311,6 +313,27 @@ units:
     parameters: {model: ./}
 )");
   EXPECT_TRUE(Has(Issues(g), "units.motor.parameters.model: cannot read model file")) << Issues(g);
+}
+
+// Guards model files' own problems: named at the model file's line and key
+// (not the scenario's), also when the unit's check refuses a value.
+TEST(LoadScenario, ModelFileProblemsNameTheModelFile) {
+  const std::string model = WriteScenario("bad_motor.yaml", R"(description: broken motor
+resistance: -1
+inductanse: 1
+gear_ratio: .nan
+)");
+  const std::string f = WriteScenario("uses_bad_motor.yaml", R"(duration_s: 0.01
+units:
+  motor:
+    type: dc_motor
+    parameters: {model: )" + fs::path(model).filename().string() +
+                                                                 "}\n");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, model + ":3: inductanse: unknown parameter of a dc_motor unit")) << all;
+  EXPECT_TRUE(Has(all, model + ":4: gear_ratio: expected a number")) << all;
+  EXPECT_TRUE(Has(all, model + ":2: resistance.0:")) << all;
+  EXPECT_FALSE(Has(all, "set on the command line")) << all;
 }
 
 // Guards the shipped motor model files: each loads in both motor modes (a
