@@ -1,19 +1,15 @@
 #include "loader/robot_scenario.h"
 
 #include <cmath>
-#include <filesystem>
 #include <limits>
 #include <map>
 #include <numbers>
 
-#include "cosim/closest_names.h"
 #include "cosim/time.h"
 #include "cosim/variable_table.h"
-#include "models/models_dir.h"
+#include "loader/yaml_files.h"
 
 namespace linesim::loader {
-
-namespace fs = std::filesystem;
 
 namespace {
 
@@ -133,25 +129,10 @@ class Expander {
     yaw_rad_ = r_.Real(pose, "robot.pose", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad;
 
     // The robot model file names the models of each unit and their settings.
-    const fs::path file = fs::path(models::ModelsDir()) / "robots" / (model + ".yaml");
-    YAML::Node robot_model;
-    try {
-      robot_model = YAML::LoadFile(file.string());
-    } catch (const YAML::BadFile&) {
-      std::vector<std::string> names;
-      std::error_code ec;
-      for (const auto& entry :
-           fs::directory_iterator(fs::path(models::ModelsDir()) / "robots", ec)) {
-        if (entry.path().extension() == ".yaml") names.push_back(entry.path().stem().string());
-      }
-      r_.Error(Child(robot, "model"), "robot.model",
-               "no robot model " + file.string() + cosim::ClosestHint(model, names));
-      return;
-    } catch (const std::exception& e) {
-      r_.Error(Child(robot, "model"), "robot.model",
-               "cannot read robot model " + file.string() + ": " + e.what());
-      return;
-    }
+    const YAML::Node robot_model =
+        LoadModel(r_, Child(robot, "model"), "robot.model", "robot model", model, "robots",
+                  r_.file(), &robot_file_);
+    if (!robot_model.IsDefined()) return;
     const YAML::Node units = Child(robot_model, "units");
     info_.body_length_m = Child(Child(robot_model, "plot"), "body_length_m").as<double>(1.03);
     info_.body_width_m = Child(Child(robot_model, "plot"), "body_width_m").as<double>(0.57);
@@ -182,16 +163,11 @@ class Expander {
     const char* keys[2] = {"steer_motor_model", "drive_motor_model"};
     for (int group = 0; group < 2; ++group) {
       const std::string name = Child(robot_model, keys[group]).as<std::string>("");
-      const fs::path file = fs::path(models::ModelsDir()) / "motors" / (name + ".yaml");
-      YAML::Node model;
-      try {
-        model = YAML::LoadFile(file.string());
-      } catch (const std::exception& e) {
-        r_.Error(Child(root_, "robot"), "robot.model",
-                 "the robot model's " + std::string(keys[group]) + " '" + name +
-                     "' cannot be read from " + file.string() + ": " + e.what());
-        return;
-      }
+      std::string file;
+      const YAML::Node model = LoadModel(r_, Child(root_, "robot"), "robot.model",
+                                         "the robot model's " + std::string(keys[group]), name,
+                                         "motors", robot_file_, &file);
+      if (!model.IsDefined()) return;
       for (const auto& kv : model) {
         const std::string key = kv.first.Scalar();
         if (key == "source" || key == "description") continue;
@@ -200,7 +176,7 @@ class Expander {
         double value = 0.0;
         if (!kv.second.IsScalar() || !YAML::convert<double>::decode(kv.second, value)) {
           r_.Error(Child(root_, "robot"), "robot.model",
-                   "motor model " + file.string() + ", key '" + key + "': expected a number, got " +
+                   "motor model " + file + ", key '" + key + "': expected a number, got " +
                        Describe(kv.second));
           return;
         }
@@ -505,6 +481,7 @@ class Expander {
   std::vector<YAML::Node> user_connections_, connections_;
   YAML::Node controller_defaults_, follower_defaults_;
   double x_m_ = 0, y_m_ = 0, yaw_rad_ = 0;
+  std::string robot_file_;
 };
 
 }  // namespace

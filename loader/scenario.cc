@@ -7,8 +7,8 @@
 #include "cosim/closest_names.h"
 #include "cosim/seed.h"
 #include "loader/unit_types.h"
+#include "loader/yaml_files.h"
 #include "loader/yaml_reader.h"
-#include "models/models_dir.h"
 
 namespace linesim::loader {
 
@@ -98,24 +98,6 @@ void ApplyParameters(cosim::Unit& unit, const YAML::Node& map, const std::string
     ApplyParameter(unit, unit.variables().info(*ref), kv.second, key_path, r);
     origins[key] = {r.file(), kv.second, key_path};
   }
-}
-
-fs::path ModelFile(const std::string& value, const std::string& folder,
-                   const std::string& scenario_file) {
-  const bool is_path =
-      value.find('/') != std::string::npos || value.ends_with(".yaml") || value.ends_with(".yml");
-  if (is_path) return fs::path(scenario_file).parent_path() / value;
-  return fs::path(models::ModelsDir()) / folder / (value + ".yaml");
-}
-
-std::vector<std::string> ModelNames(const std::string& folder) {
-  std::vector<std::string> names;
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator(fs::path(models::ModelsDir()) / folder, ec)) {
-    if (e.path().extension() == ".yaml") names.push_back(e.path().stem().string());
-  }
-  std::sort(names.begin(), names.end());
-  return names;
 }
 
 class Builder {
@@ -242,28 +224,11 @@ class Builder {
     if (params.IsMap() && Child(params, "model").IsDefined() && !type->model_folder.empty()) {
       const std::string model_path = JoinPath(params_path, "model");
       if (const auto value = r_.AsString(Child(params, "model"), model_path)) {
-        const fs::path file = ModelFile(*value, type->model_folder, s_.file);
-        YAML::Node model;
-        std::error_code ec;
-        try {
-          // yaml-cpp would leak its stream buffer reading a folder: check first.
-          if (fs::is_directory(file, ec)) {
-            throw std::runtime_error("it is a folder, not a YAML file");
-          }
-          model = YAML::LoadFile(file.string());
-        } catch (const YAML::BadFile&) {
-          r_.Error(Child(params, "model"), model_path,
-                   "no model file " + file.string() +
-                       cosim::ClosestHint(*value, ModelNames(type->model_folder)));
-        } catch (const YAML::Exception& e) {
-          r_.Error(Child(params, "model"), model_path,
-                   "model file " + file.string() + " is not valid YAML: " + e.what());
-        } catch (const std::exception& e) {  // a folder, an unreadable file
-          r_.Error(Child(params, "model"), model_path,
-                   "cannot read model file " + file.string() + ": " + e.what());
-        }
+        std::string file;
+        const YAML::Node model = LoadModel(r_, Child(params, "model"), model_path, "model", *value,
+                                           type->model_folder, s_.file, &file);
         if (model.IsDefined()) {
-          const YamlReader::InFile in_model(r_, file.string());
+          const YamlReader::InFile in_model(r_, file);
           if (r_.ExpectMap(model, "")) {
             ApplyParameters(*unit, model, "", {"source", "description"}, r_, origins);
           }
@@ -402,24 +367,20 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
       }
     }
   }
-  std::error_code ec;
-  if (!fs::is_regular_file(file, ec)) {
-    throw ScenarioError(
-        {{file, 0, "",
-          fs::exists(file, ec) ? "is not a file (a folder?): expected a YAML file"
-                               : "cannot read the file (missing or not readable)"}});
+  YamlFile loaded = LoadYamlFile(file);
+  switch (loaded.problem) {
+    case YamlFile::Problem::kNone:
+      break;
+    case YamlFile::Problem::kMissing:
+      throw ScenarioError({{file, 0, "", "cannot read the file (missing or not readable)"}});
+    case YamlFile::Problem::kFolder:
+      throw ScenarioError({{file, 0, "", "is not a file (a folder?): expected a YAML file"}});
+    case YamlFile::Problem::kInvalid:
+      throw ScenarioError({{file, loaded.line, "", "not valid YAML: " + loaded.detail}});
+    case YamlFile::Problem::kUnreadable:
+      throw ScenarioError({{file, 0, "", "cannot read the file: " + loaded.detail}});
   }
-  YAML::Node tree;
-  try {
-    tree = YAML::LoadFile(file);
-  } catch (const YAML::BadFile&) {
-    throw ScenarioError({{file, 0, "", "cannot read the file (missing or not readable)"}});
-  } catch (const YAML::ParserException& e) {
-    throw ScenarioError(
-        {{file, e.mark.is_null() ? 0 : e.mark.line + 1, "", "not valid YAML: " + e.msg}});
-  } catch (const std::exception& e) {
-    throw ScenarioError({{file, 0, "", std::string("cannot read the file: ") + e.what()}});
-  }
+  YAML::Node tree = loaded.root;
   ApplyOverrides(tree, s.overrides, file, issues);
   std::set<std::string> overridden;
   for (const auto& o : s.overrides) overridden.insert(o.path);
