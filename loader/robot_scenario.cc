@@ -83,6 +83,7 @@ class Expander {
     for (const auto& c : user_connections_) connections.push_back(c);
     for (const auto& c : connections_) connections.push_back(c);
     out_["connections"] = connections;
+    r_.SetOrigins(std::move(origins_));
     return out_;
   }
 
@@ -107,6 +108,15 @@ class Expander {
       return step_s;
     }
     return 0.001;
+  }
+
+  // Records that the expansion's `expanded` path holds a value derived from
+  // the robot-level key `key` of `parent` (at `path`), so that a problem
+  // found there is reported where the user can change it.
+  void Derived(const std::string& expanded, const YAML::Node& parent, const std::string& path,
+               const std::string& key) {
+    const YAML::Node node = Child(parent, key);
+    origins_[expanded] = {node.IsDefined() ? node : parent, JoinPath(path, key)};
   }
 
   // A section that must be a map if present; an empty map if absent.
@@ -143,6 +153,9 @@ class Expander {
     Params(kChassis)["initial_x"] = Num(x_m_);
     Params(kChassis)["initial_y"] = Num(y_m_);
     Params(kChassis)["initial_yaw"] = Num(yaw_rad_);
+    Derived("units.chassis.parameters.initial_x", pose, "robot.pose", "x_m");
+    Derived("units.chassis.parameters.initial_y", pose, "robot.pose", "y_m");
+    Derived("units.chassis.parameters.initial_yaw", pose, "robot.pose", "yaw_deg");
     Motors(robot_model, Child(units, kMotors));
     controller_defaults_ = Child(units, kWheelController);
     follower_defaults_ = Child(units, kPathFollower);
@@ -226,6 +239,25 @@ class Expander {
         belt.width_m = r_.Real(b, path, "width_m", std::nullopt, {0.0, 1e3, true});
         belt.direction_rad = r_.Real(b, path, "direction_deg", 0.0, {-360, 360}) * kDegToRad;
         info_.belts.push_back(belt);
+        const std::string index = "." + std::to_string(i);
+        for (const auto& [unit, parameter, key] : std::vector<std::array<std::string, 3>>{
+                 {"belt", "center_x", "center_x_m"},
+                 {"belt", "center_y", "center_y_m"},
+                 {"belt", "length", "length_m"},
+                 {"belt", "width", "width_m"},
+                 {"belt", "direction", "direction_deg"},
+                 {"belt", "nominal_speed", "speed_mps"},
+                 {"belt", "speed_variation", "speed_variation"},
+                 {"belt", "variation_period", "variation_period_s"},
+                 {"belt", "acceleration", "acceleration_mps2"},
+                 {"belt", "initially_on", "schedule"},
+                 {"chassis", "belt_center_x", "center_x_m"},
+                 {"chassis", "belt_center_y", "center_y_m"},
+                 {"chassis", "belt_length", "length_m"},
+                 {"chassis", "belt_width", "width_m"},
+                 {"chassis", "belt_direction", "direction_deg"}}) {
+          Derived("units." + unit + ".parameters." + parameter + index, b, path, key);
+        }
         cx.push_back(belt.center_x_m);
         cy.push_back(belt.center_y_m);
         length.push_back(belt.length_m);
@@ -303,14 +335,11 @@ class Expander {
     const bool compensation = r_.Boolean(control, "control", "compensation", true);
     // FACTS.md: the Rob@Work 3 control cycle is 20 ms.
     const cosim::TimeNs period = r_.Time(control, "control", "period_s", 0.02, {0.0, 10.0, true});
-    const cosim::TimeNs step = cosim::SecondsToNs(MasterStepS());
-    if (period % step != 0) {
-      r_.Error(Child(control, "period_s"), "control.period_s",
-               "expected a whole multiple of master.step_s (" + cosim::FormatSeconds(step) +
-                   " s), got " + cosim::FormatSeconds(period) + " s");
-    }
+    // The master checks the controllers' step against its own; its
+    // problems are reported here, where the step comes from.
     for (const char* name : {kWheelController, kPathFollower}) {
       Unit(name)["step_s"] = Num(cosim::NsToSeconds(period));
+      Derived(JoinPath(JoinPath("units", name), "step_s"), control, "control", "period_s");
     }
     Unit(kWheelController)["type"] = "wheel_controller";
     MergeInto(Params(kWheelController), controller_defaults_);
@@ -400,6 +429,22 @@ class Expander {
       for (const auto& kv : units) {
         const std::string name = kv.first.Scalar();
         const std::string path = JoinPath("units", name);
+        // What the file sets here is no longer derived from robot-level keys.
+        if (kv.second.IsMap()) {
+          for (const auto& item : kv.second) {
+            const std::string key = JoinPath(path, item.first.Scalar());
+            std::vector<std::string> written = {key};
+            if (item.first.Scalar() == "parameters" && item.second.IsMap()) {
+              written.clear();
+              for (const auto& p : item.second) written.push_back(JoinPath(key, p.first.Scalar()));
+            }
+            for (const auto& w : written) {
+              std::erase_if(origins_, [&](const auto& o) {
+                return o.first == w || o.first.starts_with(w + ".");
+              });
+            }
+          }
+        }
         YAML::Node target = out_["units"][name];
         if (!kv.second.IsMap()) {
           r_.ExpectMap(kv.second, path);
@@ -482,6 +527,7 @@ class Expander {
   YAML::Node controller_defaults_, follower_defaults_;
   double x_m_ = 0, y_m_ = 0, yaw_rad_ = 0;
   std::string robot_file_;
+  std::map<std::string, Origin> origins_;
 };
 
 }  // namespace

@@ -66,12 +66,14 @@ void YamlReader::Add(const std::vector<Issue>& issues) {
 
 void YamlReader::Error(const std::string& file, const YAML::Node& at, const std::string& path,
                        std::string message) {
+  const auto origin = file == own_file_ ? origins_.find(path) : origins_.end();
+  const bool translated = origin != origins_.end();
   Issue issue;
   issue.file = file;
-  issue.key_path = path;
+  issue.key_path = translated ? origin->second.path : path;
   issue.message = std::move(message);
-  issue.from_command_line = file == own_file_ && FromCommandLine(path);
-  issue.line = issue.from_command_line ? 0 : LineOf(at);
+  issue.from_command_line = file == own_file_ && FromCommandLine(issue.key_path);
+  issue.line = issue.from_command_line ? 0 : LineOf(translated ? origin->second.node : at);
   issues_.push_back(std::move(issue));
 }
 

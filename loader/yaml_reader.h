@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -32,6 +33,13 @@ struct Range {
   bool min_exclusive = false;
 };
 
+/// Where a value of a generated tree came from: the node and the key path
+/// of what the user wrote.
+struct Origin {
+  YAML::Node node;
+  std::string path;
+};
+
 /// Reads a YAML tree and collects issues with file, line and key path
 /// instead of stopping at the first one.
 class YamlReader {
@@ -45,6 +53,9 @@ class YamlReader {
   void Error(const std::string& file, const YAML::Node& at, const std::string& path,
              std::string message);
   void Add(const std::vector<Issue>& issues);
+  /// From now on an issue of the reader's own file at a key path in
+  /// `origins` (a generated tree's path) is reported at its origin instead.
+  void SetOrigins(std::map<std::string, Origin> origins) { origins_ = std::move(origins); }
   bool ok() const { return issues_.empty(); }
   const std::vector<Issue>& issues() const { return issues_; }
   /// The file the reader's issues are of: its own, or the one an InFile
@@ -108,6 +119,7 @@ class YamlReader {
   std::string file_;
   const std::string own_file_;
   std::set<std::string> overridden_;
+  std::map<std::string, Origin> origins_;
   std::vector<Issue> issues_;
 };
 

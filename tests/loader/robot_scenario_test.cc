@@ -182,6 +182,26 @@ TEST(RobotScenario, ControlPeriodMustBeAMultipleOfTheMasterStep) {
   EXPECT_FALSE(Has(e, "units.wheel_controller")) << e;
 }
 
+// Guards the depth of master problems: a duration the controllers' period
+// does not divide is reported at the key the period comes from (with its
+// line), not at an expanded unit the file does not have; a unit step the
+// file sets itself under units: is reported there.
+TEST(RobotScenario, MasterProblemsOfExpandedUnitsPointAtRobotLevelKeys) {
+  const std::string e = Issues(kCross, {"duration_s=20.01"});
+  EXPECT_TRUE(Has(e, kCross + ":24: control.period_s: unit 'wheel_controller' step 0.02 s does "
+                              "not divide the duration 20.01 s"))
+      << e;
+  EXPECT_FALSE(Has(e, "units.")) << e;
+  std::ifstream in(kCross);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string f = WriteScenario("robot_own_step.yaml",
+                                      text + "units:\n  wheel_controller:\n    step_s: 0.0153\n");
+  const std::string g = Issues(f);
+  EXPECT_TRUE(Has(g, f + ":35: units.wheel_controller.step_s: unit 'wheel_controller' step 0.0153"))
+      << g;
+  EXPECT_FALSE(Has(g, "control.period_s")) << g;
+}
+
 // Guards the robot-level times against the 1 ns resolution: a control
 // period or a switching time below it is refused at its own key.
 TEST(RobotScenario, TimesBelowOneNanosecondAreRefusedAtTheirKeys) {
