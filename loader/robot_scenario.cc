@@ -37,19 +37,6 @@ YAML::Node List(const std::vector<double>& values) {
 
 YAML::Node Point(double x, double y) { return List({x, y}); }
 
-// Reads an [x, y] pair at `path`.
-std::optional<std::array<double, 2>> ReadPoint(const YAML::Node& node, const std::string& path,
-                                               YamlReader& r) {
-  if (!node.IsSequence() || node.size() != 2) {
-    r.Error(node, path, "expected a point [x, y] in metres, got " + Describe(node));
-    return std::nullopt;
-  }
-  const auto x = r.AsReal(node[0], JoinPath(path, "0"), {-1e6, 1e6});
-  const auto y = r.AsReal(node[1], JoinPath(path, "1"), {-1e6, 1e6});
-  if (!x || !y) return std::nullopt;
-  return std::array<double, 2>{*x, *y};
-}
-
 // Copies every key of `from` into `to` (both maps), the later one winning.
 void MergeInto(YAML::Node to, const YAML::Node& from) {
   if (!from.IsMap()) return;
@@ -119,6 +106,16 @@ class Expander {
     origins_[expanded] = {node.IsDefined() ? node : parent, JoinPath(path, key)};
   }
 
+  // A chassis parameter as the chassis unit will get it; undefined if
+  // nothing sets it.
+  YAML::Node ChassisValue(const std::string& key) const {
+    for (const YAML::Node& source : {user_chassis_, robot_chassis_, chassis_model_}) {
+      const YAML::Node v = Child(source, key);
+      if (v.IsDefined() && !v.IsNull()) return v;
+    }
+    return YAML::Node(YAML::NodeType::Undefined);
+  }
+
   // A section that must be a map if present; an empty map if absent.
   YAML::Node Section(const YAML::Node& parent, const std::string& path, const std::string& key,
                      const std::vector<std::string>& keys) {
@@ -144,9 +141,33 @@ class Expander {
                   r_.file(), &robot_file_);
     if (!robot_model.IsDefined()) return;
     const YAML::Node units = Child(robot_model, "units");
-    info_.body_length_m = Child(Child(robot_model, "plot"), "body_length_m").as<double>(1.03);
-    info_.body_width_m = Child(Child(robot_model, "plot"), "body_width_m").as<double>(0.57);
-    info_.wheel_count = 4;
+    {
+      const YamlReader::InFile in_model(r_, robot_file_);
+      const YAML::Node plot = Child(robot_model, "plot");
+      info_.body_length_m =
+          r_.Real(plot, "plot", "body_length_m", std::nullopt, {0.0, 100.0, true});
+      info_.body_width_m = r_.Real(plot, "plot", "body_width_m", std::nullopt, {0.0, 100.0, true});
+    }
+
+    // The chassis as it will be built: the file's own units.chassis, the
+    // robot model's chassis settings, the chassis model file they name.
+    user_chassis_ = Child(Child(Child(root_, "units"), kChassis), "parameters");
+    robot_chassis_ = Child(units, kChassis);
+    const YAML::Node chassis_model = ChassisValue("model");
+    if (chassis_model.IsScalar()) {
+      // The chassis unit reports a bad model file itself, once.
+      YamlReader quiet(r_.file());
+      chassis_model_ = LoadModel(quiet, chassis_model, "", "model", chassis_model.Scalar(),
+                                 "chassis", r_.file());
+    }
+    std::int64_t wheels = 4;  // the chassis unit's default
+    if (const YAML::Node n = ChassisValue("wheel_count");
+        n.IsScalar() && YAML::convert<std::int64_t>::decode(n, wheels) && wheels >= 1 &&
+        wheels <= 16) {
+      info_.wheel_count = static_cast<int>(wheels);
+    } else {
+      info_.wheel_count = 4;  // a bad count is the chassis unit's to report
+    }
 
     Unit(kChassis)["type"] = "chassis";
     MergeInto(Params(kChassis), Child(units, kChassis));
@@ -206,6 +227,28 @@ class Expander {
         }
       }
       p[key] = List(values);
+    }
+    // What the chassis and the controller need to know of the motors, from
+    // the same model files: the rotor inertia seen at the joint through the
+    // gear, eta N^2 J_rotor (the dc_motor full mode's J_eff = J_rotor +
+    // J_load / (eta N^2), seen from the load), and the back-EMF at the joint,
+    // k_e N = k_t N (SI units), the voltage that holds a joint rate unloaded.
+    const auto group_value = [&](const char* key, int group) {
+      const auto it = arrays.find(key);
+      return it == arrays.end() ? std::numeric_limits<double>::quiet_NaN()
+                                : it->second[static_cast<std::size_t>(group * w)];
+    };
+    const char* joints[2] = {"steer", "drive"};
+    for (int group = 0; group < 2; ++group) {
+      const double j = group_value("rotor_inertia", group);
+      const double n = group_value("gear_ratio", group);
+      const double eta = group_value("gear_efficiency", group);
+      const double k_t = group_value("torque_constant", group);
+      const std::string joint = joints[group];
+      if (std::isfinite(eta * n * n * j)) {
+        Params(kChassis)[joint + "_rotor_inertia"] = Num(eta * n * n * j);
+      }
+      if (std::isfinite(k_t * n)) feedforward_[joint + "_feedforward"] = Num(k_t * n);
     }
     MergeInto(p, settings);
     for (int k = 0; k < w; ++k) {
@@ -342,7 +385,21 @@ class Expander {
       Derived(JoinPath(JoinPath("units", name), "step_s"), control, "control", "period_s");
     }
     Unit(kWheelController)["type"] = "wheel_controller";
-    MergeInto(Params(kWheelController), controller_defaults_);
+    YAML::Node controller = Params(kWheelController);
+    controller["wheel_count"] = info_.wheel_count;
+    // The controller's robot is the chassis's: the same geometry, from the
+    // same model file and settings.
+    for (const char* key : {"wheel_x", "wheel_y", "wheel_radius"}) {
+      const YAML::Node value = ChassisValue(key);
+      if (!value.IsDefined()) continue;
+      controller[key] = YAML::Clone(value);
+      if (Child(user_chassis_, key).IsDefined()) {
+        const std::string from = JoinPath("units.chassis.parameters", key);
+        origins_[JoinPath("units.wheel_controller.parameters", key)] = {value, from};
+      }
+    }
+    MergeInto(controller, feedforward_);
+    MergeInto(controller, controller_defaults_);
     Params(kWheelController)["compensation"] = compensation;
     for (int k = 0; k < info_.wheel_count; ++k) {
       const std::string s = "[" + std::to_string(k) + "]";
@@ -388,8 +445,8 @@ class Expander {
           r_.Error(waypoints, "task.waypoints", "expected at least two points [x, y]");
         }
         for (std::size_t i = 0; i < waypoints.size(); ++i) {
-          if (auto pt =
-                  ReadPoint(waypoints[i], JoinPath("task.waypoints", std::to_string(i)), r_)) {
+          if (auto pt = r_.AsPoint(waypoints[i], JoinPath("task.waypoints", std::to_string(i)),
+                                   {-1e6, 1e6})) {
             info_.path.push_back(*pt);
           }
         }
@@ -399,7 +456,7 @@ class Expander {
     } else if (info_.task == "hold") {
       std::array<double, 2> point{x_m_, y_m_};
       if (Child(task, "point").IsDefined()) {
-        if (auto pt = ReadPoint(Child(task, "point"), "task.point", r_)) point = *pt;
+        if (auto pt = r_.AsPoint(Child(task, "point"), "task.point", {-1e6, 1e6})) point = *pt;
       }
       info_.path.push_back(point);
       p["mode"] = "hold";
@@ -525,6 +582,8 @@ class Expander {
   YAML::Node out_{YAML::NodeType::Map};
   std::vector<YAML::Node> user_connections_, connections_;
   YAML::Node controller_defaults_, follower_defaults_;
+  YAML::Node user_chassis_, robot_chassis_, chassis_model_;
+  YAML::Node feedforward_{YAML::NodeType::Map};
   double x_m_ = 0, y_m_ = 0, yaw_rad_ = 0;
   std::string robot_file_;
   std::map<std::string, Origin> origins_;

@@ -81,14 +81,9 @@ std::vector<std::array<double, 2>> ReadPoints(const UnitBuildContext& c, const s
     c.reader.Error(list, path, "expected at least " + std::to_string(min_points) + " points");
   }
   for (std::size_t i = 0; i < list.size(); ++i) {
-    const std::string item_path = JoinPath(path, std::to_string(i));
-    if (!list[i].IsSequence() || list[i].size() != 2) {
-      c.reader.Error(list[i], item_path, "expected a point [x, y], got " + Describe(list[i]));
-      continue;
+    if (auto p = c.reader.AsPoint(list[i], JoinPath(path, std::to_string(i)))) {
+      points.push_back(*p);
     }
-    const auto x = c.reader.AsReal(list[i][0], JoinPath(item_path, "0"));
-    const auto y = c.reader.AsReal(list[i][1], JoinPath(item_path, "1"));
-    if (x && y) points.push_back({*x, *y});
   }
   return points;
 }

@@ -151,6 +151,18 @@ std::optional<std::string> YamlReader::AsString(const YAML::Node& node, const st
   return node.Scalar();
 }
 
+std::optional<std::array<double, 2>> YamlReader::AsPoint(const YAML::Node& node,
+                                                         const std::string& path, Range range) {
+  if (!node.IsSequence() || node.size() != 2) {
+    Error(node, path, "expected a point [x, y] (m), got " + Describe(node));
+    return std::nullopt;
+  }
+  const auto x = AsReal(node[0], JoinPath(path, "0"), range);
+  const auto y = AsReal(node[1], JoinPath(path, "1"), range);
+  if (!x || !y) return std::nullopt;
+  return std::array<double, 2>{*x, *y};
+}
+
 double YamlReader::Real(const YAML::Node& map, const std::string& path, const std::string& key,
                         std::optional<double> fallback, Range range) {
   const YAML::Node node = Lookup(map, path, key, !fallback.has_value());

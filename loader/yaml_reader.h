@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <map>
@@ -110,6 +111,9 @@ class YamlReader {
                                         std::int64_t min, std::int64_t max);
   std::optional<bool> AsBoolean(const YAML::Node& node, const std::string& path);
   std::optional<std::string> AsString(const YAML::Node& node, const std::string& path);
+  /// A point [x, y] in metres, each coordinate in `range`.
+  std::optional<std::array<double, 2>> AsPoint(const YAML::Node& node, const std::string& path,
+                                               Range range = {});
 
  private:
   bool FromCommandLine(const std::string& path) const;

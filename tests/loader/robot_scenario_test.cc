@@ -73,6 +73,56 @@ TEST(RobotScenario, CrossLineExpandsIntoTheRobotUnits) {
   EXPECT_EQ(Param(s, "motors", "gear_ratio", 7), 21.0);
 }
 
+// Guards the robot as one: the controller's geometry is the chassis's (one
+// --set changes both), and what the chassis and the controller know of the
+// motors comes from the motor model files (raw3_steer: RE 40 rotor 1.42e-5
+// kg.m2, k_t 0.0302 N.m/A, belt 4 at eta 0.9; raw3_drive: gear 21 at eta
+// 0.75): joint inertia eta N^2 J_rotor, back-EMF feed-forward k_t N.
+TEST(RobotScenario, ControllerAndChassisShareGeometryAndMotorData) {
+  const Scenario s = LoadScenario(kCross);
+  EXPECT_DOUBLE_EQ(Param(s, "chassis", "steer_rotor_inertia"), 0.9 * 4 * 4 * 1.42e-5);
+  EXPECT_DOUBLE_EQ(Param(s, "chassis", "drive_rotor_inertia"), 0.75 * 21 * 21 * 1.42e-5);
+  EXPECT_DOUBLE_EQ(Param(s, "wheel_controller", "steer_feedforward"), 0.0302 * 4);
+  EXPECT_DOUBLE_EQ(Param(s, "wheel_controller", "drive_feedforward"), 0.0302 * 21);
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(Param(s, "wheel_controller", "wheel_x", k), Param(s, "chassis", "wheel_x", k));
+    EXPECT_EQ(Param(s, "wheel_controller", "wheel_y", k), Param(s, "chassis", "wheel_y", k));
+  }
+  EXPECT_EQ(Param(s, "wheel_controller", "wheel_radius"), 0.08);  // raw3_chassis.yaml
+  std::ifstream in(kCross);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string f = WriteScenario(
+      "robot_radius.yaml", text + "units:\n  chassis:\n    parameters: {wheel_radius: 0.08}\n");
+  const Scenario t = LoadScenario(f, {"units.chassis.parameters.wheel_radius=0.1"});
+  EXPECT_EQ(Param(t, "chassis", "wheel_radius"), 0.1);
+  EXPECT_EQ(Param(t, "wheel_controller", "wheel_radius"), 0.1);
+}
+
+// Guards the wheel count: taken from the chassis's parameters (default 4),
+// it sets the motor count, the controller's modules, the wiring and the
+// plots' wheels.
+TEST(RobotScenario, WheelCountComesFromTheChassis) {
+  std::ifstream in(kCross);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const int wheels : {4, 2}) {
+    const YAML::Node root = YAML::Load(text + "units:\n  chassis:\n    parameters: {wheel_count: " +
+                                       std::to_string(wheels) + "}\n");
+    YamlReader reader("robot.yaml");
+    RobotInfo info;
+    const YAML::Node expanded = ExpandRobotScenario(root, reader, info);
+    EXPECT_TRUE(reader.ok()) << wheels;
+    EXPECT_EQ(info.wheel_count, wheels);
+    EXPECT_EQ(expanded["units"]["motors"]["parameters"]["count"].as<int>(), 2 * wheels);
+    EXPECT_EQ(expanded["units"]["wheel_controller"]["parameters"]["wheel_count"].as<int>(), wheels);
+    std::size_t to_motors = 0;
+    for (const auto& c : expanded["connections"]) {
+      to_motors += c["to"].as<std::string>().starts_with("motors.voltage[");
+    }
+    EXPECT_EQ(to_motors, static_cast<std::size_t>(2 * wheels));
+  }
+  EXPECT_EQ(LoadScenario(kCross).robot->wheel_count, 4);
+}
+
 // Guards `linesim inspect`'s promise that the expansion is a system-level
 // scenario of its own: written out and loaded again, it builds the same
 // units, connections and metrics.
