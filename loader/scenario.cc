@@ -277,10 +277,12 @@ class Builder {
   }
 
   void BuildRecording(const YAML::Node& rec, const cosim::MasterOptions& options) {
-    std::vector<std::string> names;
+    std::vector<cosim::Probe> probes;
     s_.record_interval = options.base_step;
     if (!rec.IsDefined() || rec.IsNull()) {
+      std::vector<std::string> names;
       for (const auto& n : s_.system->UnitNames()) names.push_back(n + ".*");
+      probes = cosim::ResolveProbes(*s_.system, names);
     } else if (r_.ExpectMap(rec, "recording")) {
       r_.CheckKeys(rec, "recording", {"variables", "interval_s"});
       if (Child(rec, "interval_s").IsDefined()) {
@@ -296,9 +298,9 @@ class Builder {
       if (vars.IsDefined() && r_.ExpectSequence(vars, "recording.variables")) {
         for (std::size_t i = 0; i < vars.size(); ++i) {
           if (auto v = r_.AsString(vars[i], "recording.variables." + std::to_string(i))) {
-            names.push_back(*v);
             try {
-              cosim::ResolveProbes(*s_.system, {*v});
+              const auto resolved = cosim::ResolveProbes(*s_.system, {*v});
+              probes.insert(probes.end(), resolved.begin(), resolved.end());
             } catch (const cosim::ConfigError& e) {
               r_.Error(vars[i], "recording.variables." + std::to_string(i), e.what());
             }
@@ -306,7 +308,7 @@ class Builder {
         }
       }
     }
-    if (r_.ok()) s_.recorded = cosim::ResolveProbes(*s_.system, names);
+    if (r_.ok()) s_.recorded = std::move(probes);
   }
 
   void BuildMetrics(const YAML::Node& list) {
