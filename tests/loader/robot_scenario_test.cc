@@ -13,22 +13,11 @@
 namespace linesim::loader {
 namespace {
 
+using testing::Has;
+using testing::Issues;
 using testing::WriteScenario;
 
 const std::string kCross = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
-
-std::string Issues(const std::string& file, const std::vector<std::string>& sets = {}) {
-  try {
-    LoadScenario(file, sets);
-  } catch (const ScenarioError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
-
-bool Has(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 double Param(const Scenario& s, const std::string& unit, const std::string& name,
              std::size_t index = 0) {
@@ -200,7 +189,7 @@ task: {type: wander}
 )");
   const std::string e = Issues(f);
   EXPECT_TRUE(Has(e, "robot.pose.yaw_degs")) << e;
-  EXPECT_TRUE(Has(e, "robot.pose.yaw_deg")) << e;  // the closest key
+  EXPECT_TRUE(Has(e, "closest: robot.pose.yaw_deg")) << e;
   EXPECT_TRUE(Has(e, "line.belts.0.length_m")) << e;
   EXPECT_TRUE(Has(e, "control.compensation")) << e;
   EXPECT_TRUE(Has(e, "task.type")) << e;

@@ -12,23 +12,11 @@
 namespace linesim::loader {
 namespace {
 
+using testing::Has;
+using testing::Issues;
 using testing::kValidScenario;
 using testing::WriteScenario;
 namespace fs = std::filesystem;
-
-// Every issue of an error, one per line, for matching in assertions.
-std::string Issues(const std::string& file, const std::vector<std::string>& sets = {}) {
-  try {
-    LoadScenario(file, sets);
-  } catch (const ScenarioError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
-
-bool Has(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 // Guards the shipped example: it must load, with its units, connections and
 // master settings as written in the file.
@@ -57,6 +45,10 @@ TEST(LoadScenario, OverridesChangeValues) {
   EXPECT_EQ(s.master->options().algorithm, cosim::Algorithm::kGaussSeidel);
   const auto& m = s.system->unit(*s.system->FindUnit("motor")).variables();
   EXPECT_EQ(m.GetRealElement(*m.Find("resistance"), 0), 0.5);
+  // The supply's one step (at 2 ms, 12 V in the file) now gives 6 V.
+  ASSERT_TRUE(s.master->Run().ok);
+  const auto& supply = s.system->unit(*s.system->FindUnit("supply")).variables();
+  EXPECT_EQ(supply.GetRealElement(*supply.Find("value"), 0), 6.0);
 }
 
 // Guards against a typo in --set going unnoticed: it names the closest path.
