@@ -146,14 +146,23 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   csv.close();
+  // A full disk shows only here (buffered writes fail late): a run whose
+  // signals were lost has failed, whatever the units did.
+  cosim::RunResult outcome = result;
+  const bool csv_written = !csv.fail();
+  if (!csv_written) {
+    outcome.ok = false;
+    outcome.errors.push_back("cannot write " + csv_path.string() +
+                             " (disk full or not writable): the signals are incomplete");
+  }
 
   const cosim::MasterOptions& options = s.master->options();
   const double simulated_s = cosim::NsToSeconds(result.end_time - options.start);
   Json summary;
   summary["scenario"] = s.name;
   summary["file"] = file;
-  summary["status"] = result.ok ? "ok" : "failed";
-  summary["errors"] = result.errors;
+  summary["status"] = outcome.ok ? "ok" : "failed";
+  summary["errors"] = outcome.errors;
   Json settings;
   settings["duration_s"] = s.duration_s;
   settings["seed"] = s.seed;
@@ -200,7 +209,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
                           {"columns", columns}};
   // Robot runs are drawn (also a failed one: the plots show how it failed).
   std::vector<std::string> pictures;
-  if (s.robot && recorder.rows() > 0) {
+  if (s.robot && recorder.rows() > 0 && csv_written) {
     try {
       for (const auto& p : plots::WriteRobotPlots(dir.string(), PlotSpec(s))) {
         pictures.push_back(fs::path(p).filename().string());
@@ -219,7 +228,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
     return kExitRunFailed;
   }
 
-  std::cout << s.name << ": " << (result.ok ? "ok" : "FAILED") << ", "
+  std::cout << s.name << ": " << (outcome.ok ? "ok" : "FAILED") << ", "
             << cosim::FormatSeconds(result.end_time - options.start) << " s simulated in "
             << std::setprecision(3) << wall_s << " s wall (" << std::setprecision(4)
             << simulated_s / wall_s << "x real time)\n";
@@ -234,8 +243,8 @@ int RunCommand(const std::string& file, const std::string& out_dir,
             << recorder.rows() << " rows)";
   for (const auto& p : pictures) std::cout << ", " << p;
   std::cout << "\n";
-  for (const auto& e : result.errors) std::cerr << "linesim: " << e << "\n";
-  return result.ok ? kExitOk : kExitRunFailed;
+  for (const auto& e : outcome.errors) std::cerr << "linesim: " << e << "\n";
+  return outcome.ok ? kExitOk : kExitRunFailed;
 }
 
 int InspectCommand(const std::string& what, const std::vector<std::string>& set_args) {

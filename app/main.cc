@@ -27,14 +27,18 @@ int main(int argc, char** argv) {
 
   try {
     cli.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return cli.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return cli.exit(e);
   } catch (const CLI::ParseError& e) {
-    cli.exit(e);
+    // Help is a success (cli.exit returns 0); a usage error is bad input.
+    const int status = cli.exit(e);
+    return status == 0 ? kExitOk : kExitBadInput;
+  }
+  // The commands report what they expect; anything else escaping is still
+  // answered with a message and an exit status, never an abort.
+  try {
+    if (run->parsed()) return RunCommand(run_file, out_dir, run_sets);
+    return InspectCommand(what, inspect_sets);
+  } catch (const std::exception& e) {
+    std::cerr << "linesim: " << e.what() << "\n";
     return kExitBadInput;
   }
-  if (run->parsed()) return RunCommand(run_file, out_dir, run_sets);
-  return InspectCommand(what, inspect_sets);
 }

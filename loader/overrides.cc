@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
+#include <optional>
 
-#include "cosim/closest_names.h"
 #include "loader/yaml_reader.h"
 
 namespace linesim::loader {
@@ -26,6 +27,15 @@ bool IsIndex(const std::string& s) {
   return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
     return std::isdigit(static_cast<unsigned char>(c));
   });
+}
+
+// The list index `s` stands for, if it is one below `size`.
+std::optional<std::size_t> IndexBelow(const std::string& s, std::size_t size) {
+  if (!IsIndex(s)) return std::nullopt;
+  std::size_t index = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), index);
+  if (ec != std::errc() || end != s.data() + s.size() || index >= size) return std::nullopt;
+  return index;
 }
 
 }  // namespace
@@ -66,18 +76,18 @@ void ApplyOverrides(YAML::Node& root, const std::vector<Override>& overrides,
       const std::string& key = parts[i];
       const bool last = i + 1 == parts.size();
       if (node.IsSequence()) {
-        if (!IsIndex(key) || std::stoul(key) >= node.size()) {
+        const std::optional<std::size_t> index = IndexBelow(key, node.size());
+        if (!index) {
           report("'" + JoinPath(walked, key) + "' is not an item of the list at '" + walked +
                  "', which has " + std::to_string(node.size()) + " items (0 to " +
                  std::to_string(node.size() == 0 ? 0 : node.size() - 1) + ")");
           ok = false;
           break;
         }
-        const std::size_t index = std::stoul(key);
         if (last) {
-          node[index] = value;
+          node[*index] = value;
         } else {
-          node.reset(node[index]);
+          node.reset(node[*index]);
         }
       } else if (node.IsMap() || (node.IsNull() && last)) {
         const YAML::Node& cnode = node;
@@ -87,13 +97,9 @@ void ApplyOverrides(YAML::Node& root, const std::vector<Override>& overrides,
         } else if (!exists) {
           std::vector<std::string> keys;
           for (const auto& kv : cnode) keys.push_back(kv.first.Scalar());
-          std::string hint;
-          for (const auto& c : cosim::ClosestNames(key, keys)) {
-            hint += (hint.empty() ? "" : ", ") + JoinPath(walked, c);
-          }
           const bool item_next = i + 2 == parts.size() && IsIndex(parts[i + 1]);
           report("no key '" + key + "' at '" + (walked.empty() ? "(top)" : walked) + "'" +
-                 (hint.empty() ? "" : "; closest: " + hint) +
+                 ClosestPathsHint(walked, key, keys) +
                  (item_next ? "; one item can be set only where the file writes the list: "
                               "set the whole value instead, e.g. " +
                                   JoinPath(walked, key) + "=[...]"

@@ -1,19 +1,15 @@
 #include "loader/robot_scenario.h"
 
 #include <cmath>
-#include <filesystem>
 #include <limits>
 #include <map>
 #include <numbers>
 
-#include "cosim/closest_names.h"
 #include "cosim/time.h"
 #include "cosim/variable_table.h"
-#include "models/models_dir.h"
+#include "loader/yaml_files.h"
 
 namespace linesim::loader {
-
-namespace fs = std::filesystem;
 
 namespace {
 
@@ -40,19 +36,6 @@ YAML::Node List(const std::vector<double>& values) {
 }
 
 YAML::Node Point(double x, double y) { return List({x, y}); }
-
-// Reads an [x, y] pair at `path`.
-std::optional<std::array<double, 2>> ReadPoint(const YAML::Node& node, const std::string& path,
-                                               YamlReader& r) {
-  if (!node.IsSequence() || node.size() != 2) {
-    r.Error(node, path, "expected a point [x, y] in metres, got " + Describe(node));
-    return std::nullopt;
-  }
-  const auto x = r.AsReal(node[0], JoinPath(path, "0"), {-1e6, 1e6});
-  const auto y = r.AsReal(node[1], JoinPath(path, "1"), {-1e6, 1e6});
-  if (!x || !y) return std::nullopt;
-  return std::array<double, 2>{*x, *y};
-}
 
 // Copies every key of `from` into `to` (both maps), the later one winning.
 void MergeInto(YAML::Node to, const YAML::Node& from) {
@@ -87,6 +70,7 @@ class Expander {
     for (const auto& c : user_connections_) connections.push_back(c);
     for (const auto& c : connections_) connections.push_back(c);
     out_["connections"] = connections;
+    r_.SetOrigins(std::move(origins_));
     return out_;
   }
 
@@ -101,8 +85,36 @@ class Expander {
     connections_.push_back(c);
   }
 
-  // The master step as written (the system loader checks it); 1 ms if absent.
-  double MasterStepS() const { return Child(Child(root_, "master"), "step_s").as<double>(0.001); }
+  // The master step as written when it is a usable one; 1 ms if absent or
+  // bad (the system loader reports a bad one at master.step_s).
+  double MasterStepS() const {
+    const YAML::Node node = Child(Child(root_, "master"), "step_s");
+    double step_s = 0.0;
+    if (node.IsScalar() && YAML::convert<double>::decode(node, step_s) && step_s >= 1e-9 &&
+        step_s <= 10.0) {
+      return step_s;
+    }
+    return 0.001;
+  }
+
+  // Records that the expansion's `expanded` path holds a value derived from
+  // the robot-level key `key` of `parent` (at `path`), so that a problem
+  // found there is reported where the user can change it.
+  void Derived(const std::string& expanded, const YAML::Node& parent, const std::string& path,
+               const std::string& key) {
+    const YAML::Node node = Child(parent, key);
+    origins_[expanded] = {node.IsDefined() ? node : parent, JoinPath(path, key)};
+  }
+
+  // A chassis parameter as the chassis unit will get it; undefined if
+  // nothing sets it.
+  YAML::Node ChassisValue(const std::string& key) const {
+    for (const YAML::Node& source : {user_chassis_, robot_chassis_, chassis_model_}) {
+      const YAML::Node v = Child(source, key);
+      if (v.IsDefined() && !v.IsNull()) return v;
+    }
+    return YAML::Node(YAML::NodeType::Undefined);
+  }
 
   // A section that must be a map if present; an empty map if absent.
   YAML::Node Section(const YAML::Node& parent, const std::string& path, const std::string& key,
@@ -124,35 +136,47 @@ class Expander {
     yaw_rad_ = r_.Real(pose, "robot.pose", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad;
 
     // The robot model file names the models of each unit and their settings.
-    const fs::path file = fs::path(models::ModelsDir()) / "robots" / (model + ".yaml");
-    YAML::Node robot_model;
-    try {
-      robot_model = YAML::LoadFile(file.string());
-    } catch (const YAML::BadFile&) {
-      std::vector<std::string> names;
-      std::error_code ec;
-      for (const auto& entry :
-           fs::directory_iterator(fs::path(models::ModelsDir()) / "robots", ec)) {
-        if (entry.path().extension() == ".yaml") names.push_back(entry.path().stem().string());
-      }
-      r_.Error(Child(robot, "model"), "robot.model",
-               "no robot model " + file.string() + cosim::ClosestHint(model, names));
-      return;
-    } catch (const std::exception& e) {
-      r_.Error(Child(robot, "model"), "robot.model",
-               "cannot read robot model " + file.string() + ": " + e.what());
-      return;
-    }
+    const YAML::Node robot_model =
+        LoadModel(r_, Child(robot, "model"), "robot.model", "robot model", model, "robots",
+                  r_.file(), &robot_file_);
+    if (!robot_model.IsDefined()) return;
     const YAML::Node units = Child(robot_model, "units");
-    info_.body_length_m = Child(Child(robot_model, "plot"), "body_length_m").as<double>(1.03);
-    info_.body_width_m = Child(Child(robot_model, "plot"), "body_width_m").as<double>(0.57);
-    info_.wheel_count = 4;
+    {
+      const YamlReader::InFile in_model(r_, robot_file_);
+      const YAML::Node plot = Child(robot_model, "plot");
+      info_.body_length_m =
+          r_.Real(plot, "plot", "body_length_m", std::nullopt, {0.0, 100.0, true});
+      info_.body_width_m = r_.Real(plot, "plot", "body_width_m", std::nullopt, {0.0, 100.0, true});
+    }
+
+    // The chassis as it will be built: the file's own units.chassis, the
+    // robot model's chassis settings, the chassis model file they name.
+    user_chassis_ = Child(Child(Child(root_, "units"), kChassis), "parameters");
+    robot_chassis_ = Child(units, kChassis);
+    const YAML::Node chassis_model = ChassisValue("model");
+    if (chassis_model.IsScalar()) {
+      // The chassis unit reports a bad model file itself, once.
+      YamlReader quiet(r_.file());
+      chassis_model_ = LoadModel(quiet, chassis_model, "", "model", chassis_model.Scalar(),
+                                 "chassis", r_.file());
+    }
+    std::int64_t wheels = 4;  // the chassis unit's default
+    if (const YAML::Node n = ChassisValue("wheel_count");
+        n.IsScalar() && YAML::convert<std::int64_t>::decode(n, wheels) && wheels >= 1 &&
+        wheels <= 16) {
+      info_.wheel_count = static_cast<int>(wheels);
+    } else {
+      info_.wheel_count = 4;  // a bad count is the chassis unit's to report
+    }
 
     Unit(kChassis)["type"] = "chassis";
     MergeInto(Params(kChassis), Child(units, kChassis));
     Params(kChassis)["initial_x"] = Num(x_m_);
     Params(kChassis)["initial_y"] = Num(y_m_);
     Params(kChassis)["initial_yaw"] = Num(yaw_rad_);
+    Derived("units.chassis.parameters.initial_x", pose, "robot.pose", "x_m");
+    Derived("units.chassis.parameters.initial_y", pose, "robot.pose", "y_m");
+    Derived("units.chassis.parameters.initial_yaw", pose, "robot.pose", "yaw_deg");
     Motors(robot_model, Child(units, kMotors));
     controller_defaults_ = Child(units, kWheelController);
     follower_defaults_ = Child(units, kPathFollower);
@@ -173,16 +197,11 @@ class Expander {
     const char* keys[2] = {"steer_motor_model", "drive_motor_model"};
     for (int group = 0; group < 2; ++group) {
       const std::string name = Child(robot_model, keys[group]).as<std::string>("");
-      const fs::path file = fs::path(models::ModelsDir()) / "motors" / (name + ".yaml");
-      YAML::Node model;
-      try {
-        model = YAML::LoadFile(file.string());
-      } catch (const std::exception& e) {
-        r_.Error(Child(root_, "robot"), "robot.model",
-                 "the robot model's " + std::string(keys[group]) + " '" + name +
-                     "' cannot be read from " + file.string() + ": " + e.what());
-        return;
-      }
+      std::string file;
+      const YAML::Node model = LoadModel(r_, Child(root_, "robot"), "robot.model",
+                                         "the robot model's " + std::string(keys[group]), name,
+                                         "motors", robot_file_, &file);
+      if (!model.IsDefined()) return;
       for (const auto& kv : model) {
         const std::string key = kv.first.Scalar();
         if (key == "source" || key == "description") continue;
@@ -191,7 +210,7 @@ class Expander {
         double value = 0.0;
         if (!kv.second.IsScalar() || !YAML::convert<double>::decode(kv.second, value)) {
           r_.Error(Child(root_, "robot"), "robot.model",
-                   "motor model " + file.string() + ", key '" + key + "': expected a number, got " +
+                   "motor model " + file + ", key '" + key + "': expected a number, got " +
                        Describe(kv.second));
           return;
         }
@@ -208,6 +227,28 @@ class Expander {
         }
       }
       p[key] = List(values);
+    }
+    // What the chassis and the controller need to know of the motors, from
+    // the same model files: the rotor inertia seen at the joint through the
+    // gear, eta N^2 J_rotor (the dc_motor full mode's J_eff = J_rotor +
+    // J_load / (eta N^2), seen from the load), and the back-EMF at the joint,
+    // k_e N = k_t N (SI units), the voltage that holds a joint rate unloaded.
+    const auto group_value = [&](const char* key, int group) {
+      const auto it = arrays.find(key);
+      return it == arrays.end() ? std::numeric_limits<double>::quiet_NaN()
+                                : it->second[static_cast<std::size_t>(group * w)];
+    };
+    const char* joints[2] = {"steer", "drive"};
+    for (int group = 0; group < 2; ++group) {
+      const double j = group_value("rotor_inertia", group);
+      const double n = group_value("gear_ratio", group);
+      const double eta = group_value("gear_efficiency", group);
+      const double k_t = group_value("torque_constant", group);
+      const std::string joint = joints[group];
+      if (std::isfinite(eta * n * n * j)) {
+        Params(kChassis)[joint + "_rotor_inertia"] = Num(eta * n * n * j);
+      }
+      if (std::isfinite(k_t * n)) feedforward_[joint + "_feedforward"] = Num(k_t * n);
     }
     MergeInto(p, settings);
     for (int k = 0; k < w; ++k) {
@@ -241,6 +282,25 @@ class Expander {
         belt.width_m = r_.Real(b, path, "width_m", std::nullopt, {0.0, 1e3, true});
         belt.direction_rad = r_.Real(b, path, "direction_deg", 0.0, {-360, 360}) * kDegToRad;
         info_.belts.push_back(belt);
+        const std::string index = "." + std::to_string(i);
+        for (const auto& [unit, parameter, key] : std::vector<std::array<std::string, 3>>{
+                 {"belt", "center_x", "center_x_m"},
+                 {"belt", "center_y", "center_y_m"},
+                 {"belt", "length", "length_m"},
+                 {"belt", "width", "width_m"},
+                 {"belt", "direction", "direction_deg"},
+                 {"belt", "nominal_speed", "speed_mps"},
+                 {"belt", "speed_variation", "speed_variation"},
+                 {"belt", "variation_period", "variation_period_s"},
+                 {"belt", "acceleration", "acceleration_mps2"},
+                 {"belt", "initially_on", "schedule"},
+                 {"chassis", "belt_center_x", "center_x_m"},
+                 {"chassis", "belt_center_y", "center_y_m"},
+                 {"chassis", "belt_length", "length_m"},
+                 {"chassis", "belt_width", "width_m"},
+                 {"chassis", "belt_direction", "direction_deg"}}) {
+          Derived("units." + unit + ".parameters." + parameter + index, b, path, key);
+        }
         cx.push_back(belt.center_x_m);
         cy.push_back(belt.center_y_m);
         length.push_back(belt.length_m);
@@ -260,24 +320,25 @@ class Expander {
         const std::string schedule_path = JoinPath(path, "schedule");
         if (schedule.IsDefined() && !schedule.IsNull() &&
             r_.ExpectSequence(schedule, schedule_path)) {
-          double last_s = -1.0;
+          cosim::TimeNs last = -1;
           for (std::size_t k = 0; k < schedule.size(); ++k) {
             const std::string item_path = JoinPath(schedule_path, std::to_string(k));
             if (!r_.ExpectMap(schedule[k], item_path)) continue;
             r_.CheckKeys(schedule[k], item_path, {"time_s", "on"});
-            const double t = r_.Real(schedule[k], item_path, "time_s", std::nullopt, {0.0, 1e7});
+            const cosim::TimeNs t =
+                r_.Time(schedule[k], item_path, "time_s", std::nullopt, {0.0, 1e7});
             const bool on = r_.Boolean(schedule[k], item_path, "on", std::nullopt);
-            if (t <= last_s) {
+            if (t <= last) {
               r_.Error(Child(schedule[k], "time_s"), JoinPath(item_path, "time_s"),
                        "switching times must increase");
             }
-            last_s = t;
-            if (t == 0.0) {
+            last = t;
+            if (t == 0) {
               initially_on = on;
               continue;
             }
             YAML::Node s;
-            s["time_s"] = Num(t);
+            s["time_s"] = Num(cosim::NsToSeconds(t));
             s["on"] = on;
             switches.push_back(s);
           }
@@ -312,18 +373,29 @@ class Expander {
     const YAML::Node control = Section(root_, "", "control", {"compensation", "period_s"});
     const bool compensation = r_.Boolean(control, "control", "compensation", true);
     // FACTS.md: the Rob@Work 3 control cycle is 20 ms.
-    period_s_ = r_.Real(control, "control", "period_s", 0.02, {0.0, 10.0, true});
-    const cosim::TimeNs step = cosim::SecondsToNs(MasterStepS());
-    if (step > 0 && cosim::SecondsToNs(period_s_) % step != 0) {
-      r_.Error(Child(control, "period_s"), "control.period_s",
-               "expected a whole multiple of master.step_s (" + cosim::FormatSeconds(step) +
-                   " s), got " + cosim::FormatSeconds(cosim::SecondsToNs(period_s_)) + " s");
-    }
+    const cosim::TimeNs period = r_.Time(control, "control", "period_s", 0.02, {0.0, 10.0, true});
+    // The master checks the controllers' step against its own; its
+    // problems are reported here, where the step comes from.
     for (const char* name : {kWheelController, kPathFollower}) {
-      Unit(name)["step_s"] = Num(period_s_);
+      Unit(name)["step_s"] = Num(cosim::NsToSeconds(period));
+      Derived(JoinPath(JoinPath("units", name), "step_s"), control, "control", "period_s");
     }
     Unit(kWheelController)["type"] = "wheel_controller";
-    MergeInto(Params(kWheelController), controller_defaults_);
+    YAML::Node controller = Params(kWheelController);
+    controller["wheel_count"] = info_.wheel_count;
+    // The controller's robot is the chassis's: the same geometry, from the
+    // same model file and settings.
+    for (const char* key : {"wheel_x", "wheel_y", "wheel_radius"}) {
+      const YAML::Node value = ChassisValue(key);
+      if (!value.IsDefined()) continue;
+      controller[key] = YAML::Clone(value);
+      if (Child(user_chassis_, key).IsDefined()) {
+        const std::string from = JoinPath("units.chassis.parameters", key);
+        origins_[JoinPath("units.wheel_controller.parameters", key)] = {value, from};
+      }
+    }
+    MergeInto(controller, feedforward_);
+    MergeInto(controller, controller_defaults_);
     Params(kWheelController)["compensation"] = compensation;
     for (int k = 0; k < info_.wheel_count; ++k) {
       const std::string s = "[" + std::to_string(k) + "]";
@@ -369,8 +441,8 @@ class Expander {
           r_.Error(waypoints, "task.waypoints", "expected at least two points [x, y]");
         }
         for (std::size_t i = 0; i < waypoints.size(); ++i) {
-          if (auto pt =
-                  ReadPoint(waypoints[i], JoinPath("task.waypoints", std::to_string(i)), r_)) {
+          if (auto pt = r_.AsPoint(waypoints[i], JoinPath("task.waypoints", std::to_string(i)),
+                                   {-1e6, 1e6})) {
             info_.path.push_back(*pt);
           }
         }
@@ -380,7 +452,7 @@ class Expander {
     } else if (info_.task == "hold") {
       std::array<double, 2> point{x_m_, y_m_};
       if (Child(task, "point").IsDefined()) {
-        if (auto pt = ReadPoint(Child(task, "point"), "task.point", r_)) point = *pt;
+        if (auto pt = r_.AsPoint(Child(task, "point"), "task.point", {-1e6, 1e6})) point = *pt;
       }
       info_.path.push_back(point);
       p["mode"] = "hold";
@@ -410,6 +482,22 @@ class Expander {
       for (const auto& kv : units) {
         const std::string name = kv.first.Scalar();
         const std::string path = JoinPath("units", name);
+        // What the file sets here is no longer derived from robot-level keys.
+        if (kv.second.IsMap()) {
+          for (const auto& item : kv.second) {
+            const std::string key = JoinPath(path, item.first.Scalar());
+            std::vector<std::string> written = {key};
+            if (item.first.Scalar() == "parameters" && item.second.IsMap()) {
+              written.clear();
+              for (const auto& p : item.second) written.push_back(JoinPath(key, p.first.Scalar()));
+            }
+            for (const auto& w : written) {
+              std::erase_if(origins_, [&](const auto& o) {
+                return o.first == w || o.first.starts_with(w + ".");
+              });
+            }
+          }
+        }
         YAML::Node target = out_["units"][name];
         if (!kv.second.IsMap()) {
           r_.ExpectMap(kv.second, path);
@@ -490,7 +578,11 @@ class Expander {
   YAML::Node out_{YAML::NodeType::Map};
   std::vector<YAML::Node> user_connections_, connections_;
   YAML::Node controller_defaults_, follower_defaults_;
-  double x_m_ = 0, y_m_ = 0, yaw_rad_ = 0, period_s_ = 0.02;
+  YAML::Node user_chassis_, robot_chassis_, chassis_model_;
+  YAML::Node feedforward_{YAML::NodeType::Map};
+  double x_m_ = 0, y_m_ = 0, yaw_rad_ = 0;
+  std::string robot_file_;
+  std::map<std::string, Origin> origins_;
 };
 
 }  // namespace

@@ -31,7 +31,8 @@ bool IsRobotScenario(const YAML::Node& root);
 /// Expands a robot scenario into a system-level tree (units, connections,
 /// recording, metrics) that the system loader builds. Problems are reported
 /// through `reader` at the robot-level key paths; `info` receives the plot
-/// geometry. `scenario_file` locates model files given as relative paths.
+/// geometry. A robot.model given as a path is relative to the folder of
+/// `reader`'s file, the scenario.
 YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& reader, RobotInfo& info);
 
 }  // namespace linesim::loader

@@ -7,8 +7,8 @@
 #include "cosim/closest_names.h"
 #include "cosim/seed.h"
 #include "loader/unit_types.h"
+#include "loader/yaml_files.h"
 #include "loader/yaml_reader.h"
-#include "models/models_dir.h"
 
 namespace linesim::loader {
 
@@ -18,72 +18,56 @@ namespace {
 
 // Where a parameter's value came from, to point at it if the unit refuses it.
 struct ParameterOrigin {
-  YamlReader* reader;
+  std::string file;
   YAML::Node node;
   std::string path;
 };
 
-// Converts a YAML value to the declared type of a unit variable and sets it.
+// Converts a YAML value to the declared type of a unit variable and sets it;
+// a value that does not convert is reported at `path`.
 void ApplyParameter(cosim::Unit& unit, const cosim::VariableInfo& info, const YAML::Node& node,
                     const std::string& path, YamlReader& r) {
-  cosim::Value value;
-  bool ok = false;
-  std::string expected;
+  constexpr auto kAny = std::numeric_limits<std::int64_t>::max();
+  std::optional<cosim::Value> value;
   switch (info.type) {
-    case cosim::VarType::kReal: {
-      double v;
-      ok = node.IsScalar() && YAML::convert<double>::decode(node, v);
-      value = v;
-      expected = "a number";
+    case cosim::VarType::kReal:
+      if (const auto v = r.AsReal(node, path)) value = *v;
       break;
-    }
-    case cosim::VarType::kInteger: {
-      std::int64_t v;
-      ok = node.IsScalar() && YAML::convert<std::int64_t>::decode(node, v);
-      value = v;
-      expected = "an integer";
+    case cosim::VarType::kInteger:
+      if (const auto v = r.AsInteger(node, path, -kAny - 1, kAny)) value = *v;
       break;
-    }
-    case cosim::VarType::kBoolean: {
-      bool v;
-      ok = node.IsScalar() && YAML::convert<bool>::decode(node, v);
-      value = v;
-      expected = "true or false";
+    case cosim::VarType::kBoolean:
+      if (const auto v = r.AsBoolean(node, path)) value = *v;
       break;
-    }
     case cosim::VarType::kString:
-      ok = node.IsScalar();
-      if (ok) value = node.Scalar();
-      expected = "a text value";
+      if (const auto v = r.AsString(node, path)) value = *v;
       break;
     case cosim::VarType::kRealArray: {
-      expected =
+      const std::string expected =
           "a number (for every element) or a list of " + std::to_string(info.size) + " numbers";
-      double v;
-      if (node.IsScalar() && YAML::convert<double>::decode(node, v)) {
-        value = v;
-        ok = true;
-      } else if (node.IsSequence() && node.size() == info.size) {
+      if (node.IsSequence() && node.size() == info.size) {
         std::vector<double> list(info.size);
-        ok = true;
-        for (std::size_t i = 0; i < info.size && ok; ++i) {
-          ok = node[i].IsScalar() && YAML::convert<double>::decode(node[i], list[i]);
+        bool ok = true;
+        for (std::size_t i = 0; i < info.size; ++i) {
+          const auto v = r.AsReal(node[i], JoinPath(path, std::to_string(i)));
+          ok = ok && v.has_value();
+          list[i] = v.value_or(0.0);
         }
-        value = std::move(list);
+        if (ok) value = std::move(list);
       } else if (node.IsSequence()) {
         r.Error(node, path,
                 "expected " + expected + ", got a list of " + std::to_string(node.size()));
-        return;
+      } else if (const auto v = YamlReader::DecodeReal(node)) {
+        value = *v;
+      } else {
+        r.Error(node, path, "expected " + expected + " (" + info.unit + "), got " + Describe(node));
       }
       break;
     }
   }
-  if (!ok) {
-    r.Error(node, path, "expected " + expected + " (" + info.unit + "), got " + Describe(node));
-    return;
-  }
+  if (!value) return;
   try {
-    unit.variables().SetValue(info.ref, value);
+    unit.variables().SetValue(info.ref, *value);
   } catch (const std::exception& e) {
     r.Error(node, path, e.what());
   }
@@ -105,37 +89,15 @@ void ApplyParameters(cosim::Unit& unit, const YAML::Node& map, const std::string
     const std::string key_path = JoinPath(path, key);
     const auto ref = unit.variables().Find(key);
     if (!ref || unit.variables().info(*ref).causality != cosim::Causality::kParameter) {
-      std::string hint;
-      for (const auto& c : cosim::ClosestNames(key, allowed)) {
-        hint += (hint.empty() ? "" : ", ") + JoinPath(path, c);
-      }
       r.Error(kv.first, key_path,
               "unknown parameter of a " + unit.type_name() + " unit" +
-                  (hint.empty() ? "" : "; closest: " + hint) + " (linesim inspect " +
-                  unit.type_name() + " lists them)");
+                  ClosestPathsHint(path, key, allowed) + " (linesim inspect " + unit.type_name() +
+                  " lists them)");
       continue;
     }
     ApplyParameter(unit, unit.variables().info(*ref), kv.second, key_path, r);
-    origins[key] = {&r, kv.second, key_path};
+    origins[key] = {r.file(), kv.second, key_path};
   }
-}
-
-fs::path ModelFile(const std::string& value, const std::string& folder,
-                   const std::string& scenario_file) {
-  const bool is_path =
-      value.find('/') != std::string::npos || value.ends_with(".yaml") || value.ends_with(".yml");
-  if (is_path) return fs::path(scenario_file).parent_path() / value;
-  return fs::path(models::ModelsDir()) / folder / (value + ".yaml");
-}
-
-std::vector<std::string> ModelNames(const std::string& folder) {
-  std::vector<std::string> names;
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator(fs::path(models::ModelsDir()) / folder, ec)) {
-    if (e.path().extension() == ".yaml") names.push_back(e.path().stem().string());
-  }
-  std::sort(names.begin(), names.end());
-  return names;
 }
 
 class Builder {
@@ -149,11 +111,13 @@ class Builder {
                   "recording", "metrics"});
     s_.name = r_.String(root, "", "name", fs::path(s_.file).stem().string());
     s_.description = r_.String(root, "", "description", "");
-    s_.duration_s = r_.Real(root, "", "duration_s", std::nullopt, {0.0, 1e7, true});
+    cosim::MasterOptions options;
+    options.start = 0;
+    options.stop = r_.Time(root, "", "duration_s", std::nullopt, {0.0, 1e7, true});
+    s_.duration_s = cosim::NsToSeconds(options.stop);
     s_.seed = static_cast<std::uint64_t>(
         r_.Integer(root, "", "seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
 
-    cosim::MasterOptions options;
     const std::size_t issues_before_master = r_.issues().size();
     const YAML::Node master = Child(root, "master");
     if (master.IsDefined() && !master.IsNull() && r_.ExpectMap(master, "master")) {
@@ -164,15 +128,8 @@ class Builder {
         r_.String(master_map, "master", "algorithm", "gauss_seidel", {"jacobi", "gauss_seidel"});
     options.algorithm =
         algorithm == "jacobi" ? cosim::Algorithm::kJacobi : cosim::Algorithm::kGaussSeidel;
-    const double step_s = r_.Real(master_map, "master", "step_s", 0.001, {0.0, 10.0, true});
-    options.base_step = cosim::SecondsToNs(step_s);
-    if (options.base_step <= 0) {
-      r_.Error(Child(master_map, "step_s"), "master.step_s",
-               "step is below one nanosecond: expected at least 1e-9");
-    }
+    options.base_step = r_.Time(master_map, "master", "step_s", 0.001, {0.0, 10.0, true});
     options.threads = static_cast<int>(r_.Integer(master_map, "master", "threads", 1, 1, 256));
-    options.start = 0;
-    options.stop = cosim::SecondsToNs(s_.duration_s);
     if (options.base_step > 0 && options.stop > 0 && options.stop % options.base_step != 0) {
       r_.Error(Child(root, "duration_s"), "duration_s",
                "duration " + cosim::FormatSeconds(options.stop) +
@@ -243,10 +200,8 @@ class Builder {
       r_.Error(Child(spec, "type"), JoinPath(path, "type"), UnknownTypeMessage(type_name));
       return;
     }
-    cosim::TimeNs step = 0;
-    if (Child(spec, "step_s").IsDefined()) {
-      step = cosim::SecondsToNs(r_.Real(spec, path, "step_s", 0.0, {0.0, 1e6, true}));
-    }
+    // 0: the master step.
+    const cosim::TimeNs step = r_.Time(spec, path, "step_s", 0.0, {0.0, 1e6, true});
     const YAML::Node params = Child(spec, "parameters");
     const std::string params_path = JoinPath(path, "parameters");
     if (params.IsDefined() && !params.IsNull() && !r_.ExpectMap(params, params_path)) return;
@@ -269,35 +224,14 @@ class Builder {
     if (params.IsMap() && Child(params, "model").IsDefined() && !type->model_folder.empty()) {
       const std::string model_path = JoinPath(params_path, "model");
       if (const auto value = r_.AsString(Child(params, "model"), model_path)) {
-        const fs::path file = ModelFile(*value, type->model_folder, s_.file);
-        YAML::Node model;
-        std::error_code ec;
-        try {
-          // yaml-cpp would leak its stream buffer reading a folder: check first.
-          if (fs::is_directory(file, ec)) {
-            throw std::runtime_error("it is a folder, not a YAML file");
-          }
-          model = YAML::LoadFile(file.string());
-        } catch (const YAML::BadFile&) {
-          r_.Error(Child(params, "model"), model_path,
-                   "no model file " + file.string() +
-                       cosim::ClosestHint(*value, ModelNames(type->model_folder)));
-        } catch (const YAML::Exception& e) {
-          r_.Error(Child(params, "model"), model_path,
-                   "model file " + file.string() + " is not valid YAML: " + e.what());
-        } catch (const std::exception& e) {  // a folder, an unreadable file
-          r_.Error(Child(params, "model"), model_path,
-                   "cannot read model file " + file.string() + ": " + e.what());
-        }
+        std::string file;
+        const YAML::Node model = LoadModel(r_, Child(params, "model"), model_path, "model", *value,
+                                           type->model_folder, s_.file, &file);
         if (model.IsDefined()) {
-          // Kept alive: parameter origins point into it for later checks.
-          model_readers_.push_back(std::make_unique<YamlReader>(file.string()));
-          YamlReader& mr = *model_readers_.back();
-          if (mr.ExpectMap(model, "")) {
-            ApplyParameters(*unit, model, "", {"source", "description"}, mr, origins);
+          const YamlReader::InFile in_model(r_, file);
+          if (r_.ExpectMap(model, "")) {
+            ApplyParameters(*unit, model, "", {"source", "description"}, r_, origins);
           }
-          for (auto& issue : mr.mutable_issues()) r_.mutable_issues().push_back(issue);
-          mr.mutable_issues().clear();
         }
       }
     }
@@ -306,13 +240,8 @@ class Builder {
     for (const auto& p : unit->CheckParameters()) {
       const std::string suffix = p.index ? "." + std::to_string(*p.index) : "";
       if (auto it = origins.find(p.variable); it != origins.end()) {
-        YamlReader& where = *it->second.reader;
-        const std::size_t n = where.issues().size();
-        where.Error(it->second.node, it->second.path + suffix, p.message);
-        if (&where != &r_) {
-          r_.mutable_issues().push_back(where.issues()[n]);
-          where.mutable_issues().clear();
-        }
+        const ParameterOrigin& origin = it->second;
+        r_.Error(origin.file, origin.node, origin.path + suffix, p.message);
       } else {
         r_.Error(params.IsDefined() ? params : spec, JoinPath(params_path, p.variable) + suffix,
                  p.message);
@@ -348,15 +277,17 @@ class Builder {
   }
 
   void BuildRecording(const YAML::Node& rec, const cosim::MasterOptions& options) {
-    std::vector<std::string> names;
+    std::vector<cosim::Probe> probes;
     s_.record_interval = options.base_step;
     if (!rec.IsDefined() || rec.IsNull()) {
+      std::vector<std::string> names;
       for (const auto& n : s_.system->UnitNames()) names.push_back(n + ".*");
+      probes = cosim::ResolveProbes(*s_.system, names);
     } else if (r_.ExpectMap(rec, "recording")) {
       r_.CheckKeys(rec, "recording", {"variables", "interval_s"});
       if (Child(rec, "interval_s").IsDefined()) {
-        s_.record_interval =
-            cosim::SecondsToNs(r_.Real(rec, "recording", "interval_s", 0.0, {0.0, 1e7, true}));
+        s_.record_interval = r_.Time(rec, "recording", "interval_s",
+                                     cosim::NsToSeconds(options.base_step), {0.0, 1e7, true});
         if (s_.record_interval % options.base_step != 0) {
           r_.Error(Child(rec, "interval_s"), "recording.interval_s",
                    "expected a whole multiple of master.step_s (" +
@@ -367,9 +298,9 @@ class Builder {
       if (vars.IsDefined() && r_.ExpectSequence(vars, "recording.variables")) {
         for (std::size_t i = 0; i < vars.size(); ++i) {
           if (auto v = r_.AsString(vars[i], "recording.variables." + std::to_string(i))) {
-            names.push_back(*v);
             try {
-              cosim::ResolveProbes(*s_.system, {*v});
+              const auto resolved = cosim::ResolveProbes(*s_.system, {*v});
+              probes.insert(probes.end(), resolved.begin(), resolved.end());
             } catch (const cosim::ConfigError& e) {
               r_.Error(vars[i], "recording.variables." + std::to_string(i), e.what());
             }
@@ -377,7 +308,7 @@ class Builder {
         }
       }
     }
-    if (r_.ok()) s_.recorded = cosim::ResolveProbes(*s_.system, names);
+    if (r_.ok()) s_.recorded = std::move(probes);
   }
 
   void BuildMetrics(const YAML::Node& list) {
@@ -418,7 +349,6 @@ class Builder {
 
   Scenario& s_;
   YamlReader& r_;
-  std::vector<std::unique_ptr<YamlReader>> model_readers_;
   // Name and YAML node of each unit added to the system, in system order.
   std::vector<std::pair<std::string, YAML::Node>> unit_nodes_;
 };
@@ -439,29 +369,25 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
       }
     }
   }
-  std::error_code ec;
-  if (!fs::is_regular_file(file, ec)) {
-    throw ScenarioError(
-        {{file, 0, "",
-          fs::exists(file, ec) ? "is not a file (a folder?): expected a YAML file"
-                               : "cannot read the file (missing or not readable)"}});
+  YamlFile loaded = LoadYamlFile(file);
+  switch (loaded.problem) {
+    case YamlFile::Problem::kNone:
+      break;
+    case YamlFile::Problem::kMissing:
+      throw ScenarioError({{file, 0, "", "cannot read the file (missing or not readable)"}});
+    case YamlFile::Problem::kFolder:
+      throw ScenarioError({{file, 0, "", "is not a file (a folder?): expected a YAML file"}});
+    case YamlFile::Problem::kInvalid:
+      throw ScenarioError({{file, loaded.line, "", "not valid YAML: " + loaded.detail}});
+    case YamlFile::Problem::kUnreadable:
+      throw ScenarioError({{file, 0, "", "cannot read the file: " + loaded.detail}});
   }
-  YAML::Node tree;
-  try {
-    tree = YAML::LoadFile(file);
-  } catch (const YAML::BadFile&) {
-    throw ScenarioError({{file, 0, "", "cannot read the file (missing or not readable)"}});
-  } catch (const YAML::ParserException& e) {
-    throw ScenarioError(
-        {{file, e.mark.is_null() ? 0 : e.mark.line + 1, "", "not valid YAML: " + e.msg}});
-  } catch (const std::exception& e) {
-    throw ScenarioError({{file, 0, "", std::string("cannot read the file: ") + e.what()}});
-  }
+  YAML::Node tree = loaded.root;
   ApplyOverrides(tree, s.overrides, file, issues);
   std::set<std::string> overridden;
   for (const auto& o : s.overrides) overridden.insert(o.path);
   YamlReader reader(file, overridden);
-  for (auto& i : issues) reader.mutable_issues().push_back(i);
+  reader.Add(issues);
   if (IsRobotScenario(tree)) {
     RobotInfo info;
     s.expanded = ExpandRobotScenario(tree, reader, info);

@@ -37,8 +37,7 @@ std::unique_ptr<cosim::Unit> MakeStepSignal(const UnitBuildContext& c) {
       if (!r.ExpectMap(item, item_path)) continue;
       r.CheckKeys(item, item_path, {"time_s", "value"});
       sources::StepSignalUnit::Step step;
-      // Bounded like duration_s, so that the time fits in int64 nanoseconds.
-      step.time = cosim::SecondsToNs(r.Real(item, item_path, "time_s", std::nullopt, {0.0, 1e7}));
+      step.time = r.Time(item, item_path, "time_s", std::nullopt, {0.0, 1e7});
       const YAML::Node value = Child(item, "value");
       const std::string value_path = JoinPath(item_path, "value");
       if (!value.IsDefined()) {
@@ -82,14 +81,9 @@ std::vector<std::array<double, 2>> ReadPoints(const UnitBuildContext& c, const s
     c.reader.Error(list, path, "expected at least " + std::to_string(min_points) + " points");
   }
   for (std::size_t i = 0; i < list.size(); ++i) {
-    const std::string item_path = JoinPath(path, std::to_string(i));
-    if (!list[i].IsSequence() || list[i].size() != 2) {
-      c.reader.Error(list[i], item_path, "expected a point [x, y], got " + Describe(list[i]));
-      continue;
+    if (auto p = c.reader.AsPoint(list[i], JoinPath(path, std::to_string(i)))) {
+      points.push_back(*p);
     }
-    const auto x = c.reader.AsReal(list[i][0], JoinPath(item_path, "0"));
-    const auto y = c.reader.AsReal(list[i][1], JoinPath(item_path, "1"));
-    if (x && y) points.push_back({*x, *y});
   }
   return points;
 }
@@ -143,10 +137,8 @@ std::unique_ptr<cosim::Unit> MakeBelt(const UnitBuildContext& c) {
         const std::string item_path = JoinPath(belt_path, std::to_string(i));
         if (!r.ExpectMap(item, item_path)) continue;
         r.CheckKeys(item, item_path, {"time_s", "on"});
-        // Bounded like duration_s, so that the time fits in int64 nanoseconds.
-        const double t = r.Real(item, item_path, "time_s", std::nullopt, {0.0, 1e7});
-        schedules.back().push_back(
-            {cosim::SecondsToNs(t), r.Boolean(item, item_path, "on", std::nullopt)});
+        const cosim::TimeNs t = r.Time(item, item_path, "time_s", std::nullopt, {0.0, 1e7});
+        schedules.back().push_back({t, r.Boolean(item, item_path, "on", std::nullopt)});
       }
     }
   }
@@ -226,10 +218,8 @@ std::vector<std::string> UnitTypeNames() {
 }
 
 std::string UnknownTypeMessage(const std::string& name) {
-  std::string all;
-  for (const auto& n : UnitTypeNames()) all += (all.empty() ? "" : ", ") + n;
   return "unknown unit type '" + name + "'" + cosim::ClosestHint(name, UnitTypeNames()) +
-         "; known types: " + all;
+         "; known types: " + JoinNames(UnitTypeNames());
 }
 
 }  // namespace linesim::loader

@@ -10,6 +10,19 @@ std::string JoinPath(const std::string& path, const std::string& key) {
   return path.empty() ? key : path + "." + key;
 }
 
+std::string ClosestPathsHint(const std::string& path, const std::string& name,
+                             const std::vector<std::string>& candidates) {
+  std::vector<std::string> paths;
+  for (const auto& c : cosim::ClosestNames(name, candidates)) paths.push_back(JoinPath(path, c));
+  return paths.empty() ? "" : "; closest: " + JoinNames(paths);
+}
+
+std::string JoinNames(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
 YAML::Node Child(const YAML::Node& map, const std::string& key) {
   if (map.IsDefined() && map.IsMap()) {
     for (const auto& kv : map) {
@@ -29,7 +42,7 @@ std::string Describe(const YAML::Node& node) {
 }
 
 YamlReader::YamlReader(std::string file, std::set<std::string> overridden)
-    : file_(std::move(file)), overridden_(std::move(overridden)) {}
+    : file_(file), own_file_(std::move(file)), overridden_(std::move(overridden)) {}
 
 int YamlReader::LineOf(const YAML::Node& node) {
   if (!node.IsDefined() || node.Mark().is_null()) return 0;
@@ -44,12 +57,23 @@ bool YamlReader::FromCommandLine(const std::string& path) const {
 }
 
 void YamlReader::Error(const YAML::Node& at, const std::string& path, std::string message) {
+  Error(file_, at, path, std::move(message));
+}
+
+void YamlReader::Add(const std::vector<Issue>& issues) {
+  issues_.insert(issues_.end(), issues.begin(), issues.end());
+}
+
+void YamlReader::Error(const std::string& file, const YAML::Node& at, const std::string& path,
+                       std::string message) {
+  const auto origin = file == own_file_ ? origins_.find(path) : origins_.end();
+  const bool translated = origin != origins_.end();
   Issue issue;
-  issue.file = file_;
-  issue.key_path = path;
+  issue.file = file;
+  issue.key_path = translated ? origin->second.path : path;
   issue.message = std::move(message);
-  issue.from_command_line = FromCommandLine(path);
-  issue.line = issue.from_command_line ? 0 : LineOf(at);
+  issue.from_command_line = file == own_file_ && FromCommandLine(issue.key_path);
+  issue.line = issue.from_command_line ? 0 : LineOf(translated ? origin->second.node : at);
   issues_.push_back(std::move(issue));
 }
 
@@ -73,14 +97,9 @@ void YamlReader::CheckKeys(const YAML::Node& map, const std::string& path,
     bool known = false;
     for (const auto& a : allowed) known |= (a == key);
     if (known) continue;
-    std::vector<std::string> close = cosim::ClosestNames(key, allowed);
-    std::string hint;
-    for (const auto& c : close) hint += (hint.empty() ? "" : ", ") + JoinPath(path, c);
-    std::string expected;
-    for (const auto& a : allowed) expected += (expected.empty() ? "" : ", ") + a;
     Error(kv.first, JoinPath(path, key),
-          "unknown key" + (hint.empty() ? "" : "; closest: " + hint) +
-              "; expected one of: " + expected);
+          "unknown key" + ClosestPathsHint(path, key, allowed) +
+              "; expected one of: " + JoinNames(allowed));
   }
 }
 
@@ -93,13 +112,22 @@ const YAML::Node YamlReader::Lookup(const YAML::Node& map, const std::string& pa
   return node;
 }
 
-std::optional<double> YamlReader::AsReal(const YAML::Node& node, const std::string& path,
-                                         Range range) {
+std::optional<double> YamlReader::DecodeReal(const YAML::Node& node) {
   double v = 0;
   if (!node.IsScalar() || !YAML::convert<double>::decode(node, v) || std::isnan(v)) {
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::optional<double> YamlReader::AsReal(const YAML::Node& node, const std::string& path,
+                                         Range range) {
+  const std::optional<double> decoded = DecodeReal(node);
+  if (!decoded) {
     Error(node, path, "expected a number, got " + Describe(node));
     return std::nullopt;
   }
+  const double v = *decoded;
   const bool below = range.min_exclusive ? v <= range.min : v < range.min;
   if (below || v > range.max) {
     std::string want;
@@ -123,6 +151,18 @@ std::optional<std::string> YamlReader::AsString(const YAML::Node& node, const st
   return node.Scalar();
 }
 
+std::optional<std::array<double, 2>> YamlReader::AsPoint(const YAML::Node& node,
+                                                         const std::string& path, Range range) {
+  if (!node.IsSequence() || node.size() != 2) {
+    Error(node, path, "expected a point [x, y] (m), got " + Describe(node));
+    return std::nullopt;
+  }
+  const auto x = AsReal(node[0], JoinPath(path, "0"), range);
+  const auto y = AsReal(node[1], JoinPath(path, "1"), range);
+  if (!x || !y) return std::nullopt;
+  return std::array<double, 2>{*x, *y};
+}
+
 double YamlReader::Real(const YAML::Node& map, const std::string& path, const std::string& key,
                         std::optional<double> fallback, Range range) {
   const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
@@ -130,36 +170,71 @@ double YamlReader::Real(const YAML::Node& map, const std::string& path, const st
   return AsReal(node, JoinPath(path, key), range).value_or(fallback.value_or(0.0));
 }
 
+cosim::TimeNs YamlReader::Time(const YAML::Node& map, const std::string& path,
+                               const std::string& key, std::optional<double> fallback,
+                               Range range) {
+  // Fallbacks are the caller's own values, in range by construction.
+  const cosim::TimeNs otherwise = fallback ? cosim::SecondsToNs(*fallback) : 0;
+  const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
+  if (!node.IsDefined() || node.IsNull()) return otherwise;
+  const std::string p = JoinPath(path, key);
+  const auto seconds = AsReal(node, p, range);
+  if (!seconds) return otherwise;
+  // int64 nanoseconds end at 9.22e18 ns; SecondsToNs refuses above 9.2e18.
+  constexpr double kMaxSeconds = 9.2e9;
+  if (std::abs(*seconds) > kMaxSeconds) {
+    Error(node, p,
+          "value " + node.Scalar() + " is out of range: a time must be within +-9.2e9 s " +
+              "(int64 nanoseconds)");
+    return otherwise;
+  }
+  if (*seconds != 0.0 && std::abs(*seconds) < 1e-9) {
+    Error(node, p,
+          "value " + node.Scalar() + " is below one nanosecond, the time resolution: expected " +
+              (range.min_exclusive && range.min == 0.0 ? "" : "0 or ") + "at least 1e-9 s");
+    return otherwise;
+  }
+  return cosim::SecondsToNs(*seconds);
+}
+
+std::optional<std::int64_t> YamlReader::AsInteger(const YAML::Node& node, const std::string& path,
+                                                  std::int64_t min, std::int64_t max) {
+  std::int64_t v = 0;
+  if (!node.IsScalar() || !YAML::convert<std::int64_t>::decode(node, v)) {
+    Error(node, path, "expected an integer, got " + Describe(node));
+    return std::nullopt;
+  }
+  if (v < min || v > max) {
+    Error(node, path,
+          "value " + std::to_string(v) + " is out of range: expected an integer from " +
+              std::to_string(min) + " to " + std::to_string(max));
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::optional<bool> YamlReader::AsBoolean(const YAML::Node& node, const std::string& path) {
+  bool v = false;
+  if (!node.IsScalar() || !YAML::convert<bool>::decode(node, v)) {
+    Error(node, path, "expected true or false, got " + Describe(node));
+    return std::nullopt;
+  }
+  return v;
+}
+
 std::int64_t YamlReader::Integer(const YAML::Node& map, const std::string& path,
                                  const std::string& key, std::optional<std::int64_t> fallback,
                                  std::int64_t min, std::int64_t max) {
   const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
   if (!node.IsDefined() || node.IsNull()) return fallback.value_or(0);
-  std::int64_t v = 0;
-  const std::string p = JoinPath(path, key);
-  if (!node.IsScalar() || !YAML::convert<std::int64_t>::decode(node, v)) {
-    Error(node, p, "expected an integer, got " + Describe(node));
-    return fallback.value_or(0);
-  }
-  if (v < min || v > max) {
-    Error(node, p,
-          "value " + std::to_string(v) + " is out of range: expected an integer from " +
-              std::to_string(min) + " to " + std::to_string(max));
-    return fallback.value_or(0);
-  }
-  return v;
+  return AsInteger(node, JoinPath(path, key), min, max).value_or(fallback.value_or(0));
 }
 
 bool YamlReader::Boolean(const YAML::Node& map, const std::string& path, const std::string& key,
                          std::optional<bool> fallback) {
   const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
   if (!node.IsDefined() || node.IsNull()) return fallback.value_or(false);
-  bool v = false;
-  if (!node.IsScalar() || !YAML::convert<bool>::decode(node, v)) {
-    Error(node, JoinPath(path, key), "expected true or false, got " + Describe(node));
-    return fallback.value_or(false);
-  }
-  return v;
+  return AsBoolean(node, JoinPath(path, key)).value_or(fallback.value_or(false));
 }
 
 std::string YamlReader::String(const YAML::Node& map, const std::string& path,
@@ -174,11 +249,9 @@ std::string YamlReader::String(const YAML::Node& map, const std::string& path,
     bool found = false;
     for (const auto& a : allowed) found |= (a == *s);
     if (!found) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      Error(
-          node, p,
-          "'" + *s + "' is not allowed: expected one of " + list + cosim::ClosestHint(*s, allowed));
+      Error(node, p,
+            "'" + *s + "' is not allowed: expected one of " + JoinNames(allowed) +
+                cosim::ClosestHint(*s, allowed));
       return fallback.value_or(allowed.front());
     }
   }

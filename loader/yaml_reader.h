@@ -2,13 +2,16 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <array>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "cosim/time.h"
 #include "loader/scenario_error.h"
 
 namespace linesim::loader {
@@ -16,11 +19,26 @@ namespace linesim::loader {
 /// "a.b" + "c" -> "a.b.c".
 std::string JoinPath(const std::string& path, const std::string& key);
 
+/// "; closest: path.a, path.b" with the candidates close to `name` as full
+/// paths under `path`, or "" when none is close.
+std::string ClosestPathsHint(const std::string& path, const std::string& name,
+                             const std::vector<std::string>& candidates);
+
+/// "a, b, c".
+std::string JoinNames(const std::vector<std::string>& names);
+
 /// Accepted interval of a number.
 struct Range {
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
   bool min_exclusive = false;
+};
+
+/// Where a value of a generated tree came from: the node and the key path
+/// of what the user wrote.
+struct Origin {
+  YAML::Node node;
+  std::string path;
 };
 
 /// Reads a YAML tree and collects issues with file, line and key path
@@ -32,11 +50,35 @@ class YamlReader {
   YamlReader(std::string file, std::set<std::string> overridden = {});
 
   void Error(const YAML::Node& at, const std::string& path, std::string message);
+  /// An issue of another file than the reader's (a model file it read).
+  void Error(const std::string& file, const YAML::Node& at, const std::string& path,
+             std::string message);
+  void Add(const std::vector<Issue>& issues);
+  /// From now on an issue of the reader's own file at a key path in
+  /// `origins` (a generated tree's path) is reported at its origin instead.
+  void SetOrigins(std::map<std::string, Origin> origins) { origins_ = std::move(origins); }
   bool ok() const { return issues_.empty(); }
   const std::vector<Issue>& issues() const { return issues_; }
-  std::vector<Issue>& mutable_issues() { return issues_; }
+  /// The file the reader's issues are of: its own, or the one an InFile
+  /// guard names.
   const std::string& file() const { return file_; }
+
+  /// While it exists, the reader reads another file (a model file read for
+  /// the scenario): its issues name that file, never the command line.
+  class InFile {
+   public:
+    InFile(YamlReader& r, std::string file) : r_(r), saved_(r.file_) { r_.file_ = std::move(file); }
+    ~InFile() { r_.file_ = std::move(saved_); }
+    InFile(const InFile&) = delete;
+    InFile& operator=(const InFile&) = delete;
+
+   private:
+    YamlReader& r_;
+    std::string saved_;
+  };
   static int LineOf(const YAML::Node& node);
+  /// A scalar that reads as a number other than NaN, without reporting.
+  static std::optional<double> DecodeReal(const YAML::Node& node);
 
   bool ExpectMap(const YAML::Node& node, const std::string& path);
   bool ExpectSequence(const YAML::Node& node, const std::string& path);
@@ -48,6 +90,11 @@ class YamlReader {
   /// A key of `map`; when absent, `fallback` (or an issue if none is given).
   double Real(const YAML::Node& map, const std::string& path, const std::string& key,
               std::optional<double> fallback, Range range = {});
+  /// A time in seconds (`fallback` and `range` too) as integer nanoseconds.
+  /// Besides the range, refuses a nonzero time below 1 ns (it would round
+  /// to 0 or 1 ns silently) and one too large for int64 nanoseconds.
+  cosim::TimeNs Time(const YAML::Node& map, const std::string& path, const std::string& key,
+                     std::optional<double> fallback, Range range = {});
   std::int64_t Integer(const YAML::Node& map, const std::string& path, const std::string& key,
                        std::optional<std::int64_t> fallback, std::int64_t min, std::int64_t max);
   bool Boolean(const YAML::Node& map, const std::string& path, const std::string& key,
@@ -57,9 +104,16 @@ class YamlReader {
                      std::optional<std::string> fallback,
                      const std::vector<std::string>& allowed = {});
 
-  /// Scalar readers for a node already looked up.
+  /// Scalar readers for a node already looked up; each reports a bad value
+  /// at `path` and returns nothing.
   std::optional<double> AsReal(const YAML::Node& node, const std::string& path, Range range = {});
+  std::optional<std::int64_t> AsInteger(const YAML::Node& node, const std::string& path,
+                                        std::int64_t min, std::int64_t max);
+  std::optional<bool> AsBoolean(const YAML::Node& node, const std::string& path);
   std::optional<std::string> AsString(const YAML::Node& node, const std::string& path);
+  /// A point [x, y] in metres, each coordinate in `range`.
+  std::optional<std::array<double, 2>> AsPoint(const YAML::Node& node, const std::string& path,
+                                               Range range = {});
 
  private:
   bool FromCommandLine(const std::string& path) const;
@@ -67,7 +121,9 @@ class YamlReader {
                           bool required);
 
   std::string file_;
+  const std::string own_file_;
   std::set<std::string> overridden_;
+  std::map<std::string, Origin> origins_;
   std::vector<Issue> issues_;
 };
 

@@ -16,6 +16,7 @@
 #include <stdexcept>
 
 #include "cosim/closest_names.h"
+#include "cosim/variable_table.h"
 
 extern char** environ;
 
@@ -30,11 +31,7 @@ constexpr const char* kScript = "plots.gp";
 
 // Shortest text that reads back to the same double: deterministic and
 // independent of the locale.
-std::string Num(double x) {
-  char buf[32];
-  const auto res = std::to_chars(buf, buf + sizeof buf, x);
-  return std::string(buf, res.ptr);
-}
+std::string Num(double x) { return cosim::FormatValue(x); }
 
 // A gnuplot single-quoted string: no escapes inside except '' for a quote.
 std::string Quote(const std::string& text) {
@@ -51,20 +48,22 @@ std::string Quote(const std::string& text) {
   return out + "'";
 }
 
-std::vector<std::string> SplitCsv(std::string_view line) {
+// Views of the first `max_fields` fields of a CSV line (all when 0), into a
+// vector reused from row to row: no allocation per field.
+void SplitCsv(std::string_view line, std::vector<std::string_view>& fields,
+              std::size_t max_fields = 0) {
   if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-  std::vector<std::string> fields;
+  fields.clear();
   std::size_t begin = 0;
-  while (true) {
+  while (max_fields == 0 || fields.size() < max_fields) {
     const std::size_t comma = line.find(',', begin);
-    fields.emplace_back(line.substr(begin, comma - begin));
+    fields.push_back(line.substr(begin, comma - begin));
     if (comma == std::string_view::npos) break;
     begin = comma + 1;
   }
-  return fields;
 }
 
-std::optional<double> ParseNumber(const std::string& field) {
+std::optional<double> ParseNumber(std::string_view field) {
   double x = 0.0;
   const char* end = field.data() + field.size();
   const auto res = std::from_chars(field.data(), end, x);
@@ -72,26 +71,29 @@ std::optional<double> ParseNumber(const std::string& field) {
   return x;
 }
 
-/// signals.csv: the column names and the data lines (unparsed; only a few
-/// are read as numbers).
+// 1-based column `col` of a split row, as a number.
+std::optional<double> Column(const std::vector<std::string_view>& fields, int col) {
+  if (col < 1 || static_cast<std::size_t>(col) > fields.size()) return std::nullopt;
+  return ParseNumber(fields[static_cast<std::size_t>(col - 1)]);
+}
+
+/// signals.csv, open after its header: read row by row, never held whole.
 struct Signals {
+  fs::path file;
+  std::ifstream in;
   std::vector<std::string> header;
-  std::vector<std::string> lines;
 };
 
-Signals ReadSignals(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) {
+Signals OpenSignals(const fs::path& file) {
+  Signals s{file, std::ifstream(file, std::ios::binary), {}};
+  if (!s.in) {
     throw std::runtime_error("cannot read " + file.string() + ": " + std::strerror(errno));
   }
-  Signals s;
   std::string line;
-  if (!std::getline(in, line)) throw std::runtime_error(file.string() + " is empty");
-  s.header = SplitCsv(line);
-  while (std::getline(in, line)) {
-    if (!line.empty() && line != "\r") s.lines.push_back(std::move(line));
-  }
-  if (s.lines.empty()) throw std::runtime_error(file.string() + " has no data rows");
+  if (!std::getline(s.in, line)) throw std::runtime_error(file.string() + " is empty");
+  std::vector<std::string_view> fields;
+  SplitCsv(line, fields);
+  s.header.assign(fields.begin(), fields.end());
   return s;
 }
 
@@ -183,12 +185,11 @@ std::vector<std::size_t> EvenlySpaced(std::size_t rows, int count) {
   return picks;
 }
 
-std::string Script(const RobotPlotSpec& spec, const Signals& signals, const fs::path& csv,
-                   std::vector<std::string>* outputs) {
+std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std::string>* outputs) {
   if (spec.x_column.empty() || spec.y_column.empty()) {
     throw std::runtime_error("robot plots need the x and y columns of the robot position");
   }
-  ColumnFinder column(signals.header, csv);
+  ColumnFinder column(signals.header, signals.file);
   const int ix = column(spec.x_column, "robot x");
   const int iy = column(spec.y_column, "robot y");
   const int iyaw = spec.yaw_column.empty() ? 0 : column(spec.yaw_column, "robot yaw");
@@ -239,13 +240,24 @@ std::string Script(const RobotPlotSpec& spec, const Signals& signals, const fs::
   std::string outlines, contacts, labels;
   Bounds view;
   for (const auto& p : spec.path_m) view.Add(p[0], p[1]);
-  for (const std::string& line : signals.lines) {
-    const auto fields = SplitCsv(line);
-    if (static_cast<std::size_t>(std::max(ix, iy)) > fields.size()) continue;
-    const auto x = ParseNumber(fields[static_cast<std::size_t>(ix - 1)]);
-    const auto y = ParseNumber(fields[static_cast<std::size_t>(iy - 1)]);
-    if (x && y) view.Add(*x, *y);
+  // One pass over the rows: the track's extent, and where each row starts
+  // (to come back to the few rows the outlines are drawn at).
+  std::vector<std::streamoff> row_starts;
+  {
+    std::vector<std::string_view> fields;
+    std::string line;
+    const auto needed = static_cast<std::size_t>(std::max(ix, iy));
+    while (true) {
+      const std::streamoff start = signals.in.tellg();
+      if (!std::getline(signals.in, line)) break;
+      if (line.empty() || line == "\r") continue;
+      row_starts.push_back(start);
+      SplitCsv(line, fields, needed);
+      const auto x = Column(fields, ix), y = Column(fields, iy);
+      if (x && y) view.Add(*x, *y);
+    }
   }
+  if (row_starts.empty()) throw std::runtime_error(signals.file.string() + " has no data rows");
   if (iyaw > 0) {
     // A robot standing still would get its labels printed over each other:
     // an instant closer than a quarter body length to the last label joins
@@ -255,12 +267,17 @@ std::string Script(const RobotPlotSpec& spec, const Signals& signals, const fs::
       std::string times;
     };
     std::vector<Label> placed;
-    for (std::size_t row : EvenlySpaced(signals.lines.size(), spec.footprint_count)) {
-      const auto fields = SplitCsv(signals.lines[row]);
-      const auto get = [&](int col) -> std::optional<double> {
-        if (col < 1 || static_cast<std::size_t>(col) > fields.size()) return std::nullopt;
-        return ParseNumber(fields[static_cast<std::size_t>(col - 1)]);
-      };
+    std::vector<std::string_view> fields;
+    std::string line;
+    for (std::size_t row : EvenlySpaced(row_starts.size(), spec.footprint_count)) {
+      signals.in.clear();
+      signals.in.seekg(row_starts[row]);
+      if (!std::getline(signals.in, line)) {
+        throw std::runtime_error("cannot read " + signals.file.string() + " again at row " +
+                                 std::to_string(row + 1));
+      }
+      SplitCsv(line, fields);
+      const auto get = [&](int col) { return Column(fields, col); };
       const auto t = get(1), x = get(ix), y = get(iy), yaw = get(iyaw);
       if (!x || !y || !yaw || !std::isfinite(*x + *y + *yaw)) continue;
       const auto corners = Rectangle(*x, *y, *yaw, spec.body_length_m, spec.body_width_m);
@@ -446,9 +463,9 @@ std::pair<int, std::string> RunGnuplot(const fs::path& dir) {
 std::vector<std::string> WriteRobotPlots(const std::string& dir, const RobotPlotSpec& spec) {
   const fs::path folder(dir);
   const fs::path csv = folder / kSignals;
-  const Signals signals = ReadSignals(csv);
+  Signals signals = OpenSignals(csv);
   std::vector<std::string> names;
-  const std::string script = Script(spec, signals, csv, &names);
+  const std::string script = Script(spec, signals, &names);
   {
     std::ofstream out(folder / kScript, std::ios::binary | std::ios::trunc);
     out << script;

@@ -53,6 +53,19 @@ std::string WriteScenario(const std::string& name, const std::string& text) {
 
 const std::string kMotorStep = LINESIM_SOURCE_DIR "/scenarios/motor_step.yaml";
 
+// Runs `file` twice with `args`, under the file's master and under Jacobi
+// with 2 threads, and expects the same signals.csv bytes each time.
+void ExpectIdenticalSignals(const std::string& file, const std::string& args) {
+  for (const std::string extra : {"", " --set master.algorithm=jacobi --set master.threads=2"}) {
+    const std::string a = Fresh("det_a"), b = Fresh("det_b");
+    ASSERT_EQ(Linesim("run " + file + " --out " + a + args + extra).status, 0) << extra;
+    ASSERT_EQ(Linesim("run " + file + " --out " + b + args + extra).status, 0) << extra;
+    const std::string ca = ReadFile(fs::path(a) / "signals.csv");
+    EXPECT_GT(ca.size(), 1000u);
+    EXPECT_EQ(ca, ReadFile(fs::path(b) / "signals.csv")) << extra;
+  }
+}
+
 // Guards the documented main job: it runs, prints its headline numbers and
 // writes both outputs with the documented columns.
 TEST(Cli, RunMotorStepWritesSummaryAndSignals) {
@@ -75,16 +88,7 @@ TEST(Cli, RunMotorStepWritesSummaryAndSignals) {
 
 // Guards determinism (same scenario and seed -> same bytes), also with the
 // other master algorithm and Jacobi threads.
-TEST(Cli, SameFileAndSeedGiveIdenticalSignals) {
-  for (const std::string extra : {"", " --set master.algorithm=jacobi --set master.threads=2"}) {
-    const std::string a = Fresh("det_a"), b = Fresh("det_b");
-    ASSERT_EQ(Linesim("run " + kMotorStep + " --out " + a + extra).status, 0);
-    ASSERT_EQ(Linesim("run " + kMotorStep + " --out " + b + extra).status, 0);
-    const std::string ca = ReadFile(fs::path(a) / "signals.csv");
-    EXPECT_GT(ca.size(), 1000u);
-    EXPECT_EQ(ca, ReadFile(fs::path(b) / "signals.csv")) << extra;
-  }
-}
+TEST(Cli, SameFileAndSeedGiveIdenticalSignals) { ExpectIdenticalSignals(kMotorStep, ""); }
 
 // Guards the bad-input contract: exit status 2, the key named, nothing
 // written (the output folder is not even created).
@@ -145,16 +149,27 @@ TEST(Cli, RobotLevelBadInputExitsTwo) {
 
 // Guards determinism of a robot run (ODE, CVODE, the seeded belt): same
 // file and seed give the same bytes, under Jacobi with 2 threads too.
-TEST(Cli, RobotRunIsDeterministic) {
-  for (const std::string extra : {"", " --set master.algorithm=jacobi --set master.threads=2"}) {
-    const std::string a = Fresh("robot_det_a"), b = Fresh("robot_det_b");
-    const std::string args = " --set duration_s=3" + extra;
-    ASSERT_EQ(Linesim("run " + kCrossLine + " --out " + a + args).status, 0);
-    ASSERT_EQ(Linesim("run " + kCrossLine + " --out " + b + args).status, 0);
-    const std::string ca = ReadFile(fs::path(a) / "signals.csv");
-    EXPECT_GT(ca.size(), 1000u);
-    EXPECT_EQ(ca, ReadFile(fs::path(b) / "signals.csv")) << extra;
+TEST(Cli, RobotRunIsDeterministic) { ExpectIdenticalSignals(kCrossLine, " --set duration_s=3"); }
+
+// Guards against a master step that no int64 nanosecond count holds (or no
+// number at all) aborting the program in the robot expansion: it is bad
+// input, reported at master.step_s.
+TEST(Cli, UnusableMasterStepOfARobotScenarioIsBadInput) {
+  for (const char* step : {"1e10", ".nan"}) {
+    const Result r = Linesim("inspect " + kCrossLine + " --set master.step_s=" + step);
+    EXPECT_EQ(r.status, 2) << step << ": " << r.err;
+    EXPECT_NE(r.err.find("master.step_s (set on the command line)"), std::string::npos)
+        << step << ": " << r.err;
   }
+}
+
+// Guards the last resort: an exception no command expects (here the file
+// system refusing a name longer than a path may be) ends with a message and
+// the bad-input status, not an abort.
+TEST(Cli, UnexpectedExceptionIsReportedNotAnAbort) {
+  const Result r = Linesim("inspect " + std::string(5000, 'a'));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("linesim: ", 0), 0u) << r.err;
 }
 
 // Guards the --set path check from the command line.
@@ -194,6 +209,23 @@ connections:
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 11) << csv;
 }
 
+// Guards against a lost signals.csv passing for a good run: when its writes
+// fail (here a full disk: the file is /dev/full) the run fails, exit 1, and
+// the summary and the message name the file.
+TEST(Cli, FailedSignalsWriteFailsTheRun) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const std::string out = Fresh("disk_full");
+  fs::create_directories(out);
+  fs::create_symlink("/dev/full", fs::path(out) / "signals.csv");
+  const Result r = Linesim("run " + kMotorStep + " --out " + out);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("cannot write " + out + "/signals.csv"), std::string::npos) << r.err;
+  const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
+  EXPECT_EQ(summary["status"], "failed");
+  ASSERT_EQ(summary["errors"].size(), 1u) << summary.dump();
+  EXPECT_NE(summary["errors"][0].get<std::string>().find("signals.csv"), std::string::npos);
+}
+
 // Guards `inspect` on a type and on a file, and an unknown type.
 TEST(Cli, InspectTypeAndFile) {
   const Result type = Linesim("inspect dc_motor");
@@ -202,8 +234,12 @@ TEST(Cli, InspectTypeAndFile) {
        {"resistance", "parameter", "Ohm", "voltage", "input", "torque", "output", "N.m"}) {
     EXPECT_NE(type.out.find(part), std::string::npos) << part;
   }
-  const Result file = Linesim("inspect " + kMotorStep + " --set units.motors.parameters.count=2");
+  const Result file =
+      Linesim("inspect " + kMotorStep + " --set units.motors.parameters.gear_ratio.1=5");
   ASSERT_EQ(file.status, 0) << file.err;
+  // The file's gear ratios are [1, 21]: the override shows in the table.
+  EXPECT_NE(file.out.find("[1, 5]"), std::string::npos) << file.out;
+  EXPECT_EQ(file.out.find("[1, 21]"), std::string::npos) << file.out;
   EXPECT_NE(file.out.find("unit 'supply' (step_signal"), std::string::npos) << file.out;
   EXPECT_NE(file.out.find("supply.value -> motors.voltage"), std::string::npos) << file.out;
   const Result unknown = Linesim("inspect dc_motr");

@@ -47,5 +47,18 @@ TEST(ApplyOverrides, ItemOfAnAbsentListSaysToSetTheWholeValue) {
       << issues[0].message;
 }
 
+// Guards against an index too large for any integer type aborting the
+// program: it is reported like any index past the end of the list.
+TEST(ApplyOverrides, HugeListIndexIsNotAnItem) {
+  YAML::Node root = YAML::Load("line: {belts: [{speed_mps: 0.1}]}\n");
+  std::vector<Issue> issues;
+  ApplyOverrides(root, {ParseOverride("line.belts.99999999999999999999999=1")}, "f.yaml", issues);
+  ASSERT_EQ(issues.size(), 1u);
+  EXPECT_NE(issues[0].message.find("'line.belts.99999999999999999999999' is not an item of the "
+                                   "list at 'line.belts', which has 1 items"),
+            std::string::npos)
+      << issues[0].message;
+}
+
 }  // namespace
 }  // namespace linesim::loader

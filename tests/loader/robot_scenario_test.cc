@@ -13,22 +13,11 @@
 namespace linesim::loader {
 namespace {
 
+using testing::Has;
+using testing::Issues;
 using testing::WriteScenario;
 
 const std::string kCross = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
-
-std::string Issues(const std::string& file, const std::vector<std::string>& sets = {}) {
-  try {
-    LoadScenario(file, sets);
-  } catch (const ScenarioError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
-
-bool Has(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 double Param(const Scenario& s, const std::string& unit, const std::string& name,
              std::size_t index = 0) {
@@ -71,6 +60,56 @@ TEST(RobotScenario, CrossLineExpandsIntoTheRobotUnits) {
   EXPECT_EQ(Param(s, "motors", "gear_ratio", 3), 4.0);
   EXPECT_EQ(Param(s, "motors", "gear_ratio", 4), 21.0);
   EXPECT_EQ(Param(s, "motors", "gear_ratio", 7), 21.0);
+}
+
+// Guards the robot as one: the controller's geometry is the chassis's (one
+// --set changes both), and what the chassis and the controller know of the
+// motors comes from the motor model files (raw3_steer: RE 40 rotor 1.42e-5
+// kg.m2, k_t 0.0302 N.m/A, belt 4 at eta 0.9; raw3_drive: gear 21 at eta
+// 0.75): joint inertia eta N^2 J_rotor, back-EMF feed-forward k_t N.
+TEST(RobotScenario, ControllerAndChassisShareGeometryAndMotorData) {
+  const Scenario s = LoadScenario(kCross);
+  EXPECT_DOUBLE_EQ(Param(s, "chassis", "steer_rotor_inertia"), 0.9 * 4 * 4 * 1.42e-5);
+  EXPECT_DOUBLE_EQ(Param(s, "chassis", "drive_rotor_inertia"), 0.75 * 21 * 21 * 1.42e-5);
+  EXPECT_DOUBLE_EQ(Param(s, "wheel_controller", "steer_feedforward"), 0.0302 * 4);
+  EXPECT_DOUBLE_EQ(Param(s, "wheel_controller", "drive_feedforward"), 0.0302 * 21);
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(Param(s, "wheel_controller", "wheel_x", k), Param(s, "chassis", "wheel_x", k));
+    EXPECT_EQ(Param(s, "wheel_controller", "wheel_y", k), Param(s, "chassis", "wheel_y", k));
+  }
+  EXPECT_EQ(Param(s, "wheel_controller", "wheel_radius"), 0.08);  // raw3_chassis.yaml
+  std::ifstream in(kCross);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string f = WriteScenario(
+      "robot_radius.yaml", text + "units:\n  chassis:\n    parameters: {wheel_radius: 0.08}\n");
+  const Scenario t = LoadScenario(f, {"units.chassis.parameters.wheel_radius=0.1"});
+  EXPECT_EQ(Param(t, "chassis", "wheel_radius"), 0.1);
+  EXPECT_EQ(Param(t, "wheel_controller", "wheel_radius"), 0.1);
+}
+
+// Guards the wheel count: taken from the chassis's parameters (default 4),
+// it sets the motor count, the controller's modules, the wiring and the
+// plots' wheels.
+TEST(RobotScenario, WheelCountComesFromTheChassis) {
+  std::ifstream in(kCross);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const int wheels : {4, 2}) {
+    const YAML::Node root = YAML::Load(text + "units:\n  chassis:\n    parameters: {wheel_count: " +
+                                       std::to_string(wheels) + "}\n");
+    YamlReader reader("robot.yaml");
+    RobotInfo info;
+    const YAML::Node expanded = ExpandRobotScenario(root, reader, info);
+    EXPECT_TRUE(reader.ok()) << wheels;
+    EXPECT_EQ(info.wheel_count, wheels);
+    EXPECT_EQ(expanded["units"]["motors"]["parameters"]["count"].as<int>(), 2 * wheels);
+    EXPECT_EQ(expanded["units"]["wheel_controller"]["parameters"]["wheel_count"].as<int>(), wheels);
+    std::size_t to_motors = 0;
+    for (const auto& c : expanded["connections"]) {
+      to_motors += c["to"].as<std::string>().starts_with("motors.voltage[");
+    }
+    EXPECT_EQ(to_motors, static_cast<std::size_t>(2 * wheels));
+  }
+  EXPECT_EQ(LoadScenario(kCross).robot->wheel_count, 4);
 }
 
 // Guards `linesim inspect`'s promise that the expansion is a system-level
@@ -150,7 +189,7 @@ task: {type: wander}
 )");
   const std::string e = Issues(f);
   EXPECT_TRUE(Has(e, "robot.pose.yaw_degs")) << e;
-  EXPECT_TRUE(Has(e, "robot.pose.yaw_deg")) << e;  // the closest key
+  EXPECT_TRUE(Has(e, "closest: robot.pose.yaw_deg")) << e;
   EXPECT_TRUE(Has(e, "line.belts.0.length_m")) << e;
   EXPECT_TRUE(Has(e, "control.compensation")) << e;
   EXPECT_TRUE(Has(e, "task.type")) << e;
@@ -182,11 +221,52 @@ TEST(RobotScenario, ControlPeriodMustBeAMultipleOfTheMasterStep) {
   EXPECT_FALSE(Has(e, "units.wheel_controller")) << e;
 }
 
+// Guards the depth of master problems: a duration the controllers' period
+// does not divide is reported at the key the period comes from (with its
+// line), not at an expanded unit the file does not have; a unit step the
+// file sets itself under units: is reported there.
+TEST(RobotScenario, MasterProblemsOfExpandedUnitsPointAtRobotLevelKeys) {
+  const std::string e = Issues(kCross, {"duration_s=20.01"});
+  EXPECT_TRUE(Has(e, kCross + ":24: control.period_s: unit 'wheel_controller' step 0.02 s does "
+                              "not divide the duration 20.01 s"))
+      << e;
+  EXPECT_FALSE(Has(e, "units.")) << e;
+  std::ifstream in(kCross);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string f = WriteScenario("robot_own_step.yaml",
+                                      text + "units:\n  wheel_controller:\n    step_s: 0.0153\n");
+  const std::string g = Issues(f);
+  EXPECT_TRUE(Has(g, f + ":35: units.wheel_controller.step_s: unit 'wheel_controller' step 0.0153"))
+      << g;
+  EXPECT_FALSE(Has(g, "control.period_s")) << g;
+}
+
+// Guards the robot-level times against the 1 ns resolution: a control
+// period or a switching time below it is refused at its own key.
+TEST(RobotScenario, TimesBelowOneNanosecondAreRefusedAtTheirKeys) {
+  const std::string e =
+      Issues(kCross, {"control.period_s=1.0e-12", "line.belts.0.schedule.0.time_s=1.0e-10"});
+  EXPECT_TRUE(Has(e,
+                  "control.period_s (set on the command line): value 1.0e-12 is below one "
+                  "nanosecond"))
+      << e;
+  EXPECT_TRUE(Has(e,
+                  "line.belts.0.schedule.0.time_s (set on the command line): value 1.0e-10 is "
+                  "below one nanosecond"))
+      << e;
+}
+
 // Guards an unknown robot model: named with the models that exist.
 TEST(RobotScenario, UnknownRobotModelNamesTheKnownOnes) {
   const std::string e = Issues(kCross, {"robot.model=raw4"});
   EXPECT_TRUE(Has(e, "robot.model")) << e;
-  EXPECT_TRUE(Has(e, "raw3")) << e;
+  EXPECT_TRUE(Has(e, "no robot model file")) << e;
+  EXPECT_TRUE(Has(e, "(closest: raw3)")) << e;
+  // Loaded like every model file: a folder is refused before yaml-cpp reads
+  // it (it leaked its buffer on one), at the key.
+  const std::string f = Issues(kCross, {"robot.model=./"});
+  EXPECT_TRUE(Has(f, "robot.model (set on the command line): cannot read robot model file")) << f;
+  EXPECT_TRUE(Has(f, "it is not a file (a folder?)")) << f;
 }
 
 // Guards the pass-through: `units.NAME.parameters` in a robot scenario

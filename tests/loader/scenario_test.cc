@@ -2,28 +2,21 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
 #include "loader/unit_types.h"
 #include "scenario_test.h"
 
 namespace linesim::loader {
 namespace {
 
+using testing::Has;
+using testing::Issues;
 using testing::kValidScenario;
 using testing::WriteScenario;
-
-// Every issue of an error, one per line, for matching in assertions.
-std::string Issues(const std::string& file, const std::vector<std::string>& sets = {}) {
-  try {
-    LoadScenario(file, sets);
-  } catch (const ScenarioError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
-
-bool Has(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
+namespace fs = std::filesystem;
 
 // Guards the shipped example: it must load, with its units, connections and
 // master settings as written in the file.
@@ -52,6 +45,10 @@ TEST(LoadScenario, OverridesChangeValues) {
   EXPECT_EQ(s.master->options().algorithm, cosim::Algorithm::kGaussSeidel);
   const auto& m = s.system->unit(*s.system->FindUnit("motor")).variables();
   EXPECT_EQ(m.GetRealElement(*m.Find("resistance"), 0), 0.5);
+  // The supply's one step (at 2 ms, 12 V in the file) now gives 6 V.
+  ASSERT_TRUE(s.master->Run().ok);
+  const auto& supply = s.system->unit(*s.system->FindUnit("supply")).variables();
+  EXPECT_EQ(supply.GetRealElement(*supply.Find("value"), 0), 6.0);
 }
 
 // Guards against a typo in --set going unnoticed: it names the closest path.
@@ -124,6 +121,44 @@ units:
       << all;
 }
 
+// Guards against times below the 1 ns resolution silently becoming 0 (a
+// unit step of 0 is "the master step"; a step time of 0 is the start): every
+// time key of a system scenario refuses them at its key.
+TEST(LoadScenario, TimesBelowOneNanosecondAreRefusedAtTheirKeys) {
+  const std::string f = WriteScenario("tiny_times.yaml", R"(duration_s: 0.01
+master: {step_s: 1.0e-12}
+units:
+  supply:
+    type: step_signal
+    step_s: 1.0e-10
+    parameters: {steps: [{time_s: 5.0e-10, value: 1}]}
+  belt:
+    type: belt
+    parameters: {schedules: [[{time_s: 1.0e-11, on: false}]]}
+recording: {interval_s: 2.0e-10}
+)");
+  const std::string all = Issues(f);
+  for (const char* key : {":2: master.step_s", ":6: units.supply.step_s",
+                          ":7: units.supply.parameters.steps.0.time_s",
+                          ":10: units.belt.parameters.schedules.0.0.time_s"}) {
+    EXPECT_TRUE(Has(all, f + std::string(key) + ": value ")) << key << "\n" << all;
+  }
+  EXPECT_EQ(std::count(all.begin(), all.end(), '\n') + 1, 4) << all;
+  EXPECT_TRUE(Has(all, "below one nanosecond")) << all;
+  // The recording is checked once the units are built.
+  const std::vector<std::string> good = {"master.step_s=0.001", "units.supply.step_s=0.001",
+                                         "units.supply.parameters.steps.0.time_s=0",
+                                         "units.belt.parameters.schedules.0.0.time_s=0"};
+  const std::string rec = Issues(f, good);
+  EXPECT_TRUE(Has(rec, f + ":11: recording.interval_s: value 2.0e-10 is below one nanosecond"))
+      << rec;
+  std::vector<std::string> sets = good;
+  sets.push_back("duration_s=1.0e-10");
+  const std::string d = Issues(f, sets);
+  EXPECT_TRUE(Has(d, "duration_s (set on the command line): value 1.0e-10 is below one nanosecond"))
+      << d;
+}
+
 // Guards the parameter path: a value of the wrong shape or an unknown name
 // is refused with what was expected.
 TEST(LoadScenario, ParameterValuesAreChecked) {
@@ -144,6 +179,32 @@ units:
       << all;
   EXPECT_TRUE(Has(all, "units.motor.parameters.gear_ratio: expected a number (for every element)"))
       << all;
+}
+
+// Guards parameters against NaN: it is no number, for a Real parameter
+// (the standard message), for a whole array and for one element of it.
+TEST(LoadScenario, NanParameterIsRefused) {
+  const std::string f = WriteScenario("nan.yaml", kValidScenario);
+  const std::string all = Issues(
+      f, {"units.motor.parameters.resistance=.nan", "units.motor.parameters.inductance=[.nan]"});
+  EXPECT_TRUE(Has(all,
+                  "units.motor.parameters.resistance (set on the command line): expected a "
+                  "number (for every element) or a list of 1 numbers (Ohm), got '.nan'"))
+      << all;
+  EXPECT_TRUE(Has(all,
+                  "units.motor.parameters.inductance.0 (set on the command line): expected a "
+                  "number, got '.nan'"))
+      << all;
+  // A Real (not array) parameter: the chassis's friction, in a robot scenario.
+  std::ifstream in(LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string g = WriteScenario(
+      "nan_robot.yaml", text + "units:\n  chassis:\n    parameters: {friction: 0.7}\n");
+  const std::string robot = Issues(g, {"units.chassis.parameters.friction=.nan"});
+  EXPECT_TRUE(Has(robot,
+                  "units.chassis.parameters.friction (set on the command line): expected a "
+                  "number, got '.nan'"))
+      << robot;
 }
 
 // Guards unit names: they are the first part of every connection path, so
@@ -183,7 +244,7 @@ units:
 )");
   const std::string all = Issues(f);
   EXPECT_TRUE(Has(all, f + ":1: duration_s: duration 0.0105 s is not a whole number of master "
-                       "steps (master.step_s = 0.001 s)"))
+                           "steps (master.step_s = 0.001 s)"))
       << all;
 }
 
@@ -244,6 +305,27 @@ units:
     parameters: {model: ./}
 )");
   EXPECT_TRUE(Has(Issues(g), "units.motor.parameters.model: cannot read model file")) << Issues(g);
+}
+
+// Guards model files' own problems: named at the model file's line and key
+// (not the scenario's), also when the unit's check refuses a value.
+TEST(LoadScenario, ModelFileProblemsNameTheModelFile) {
+  const std::string model = WriteScenario("bad_motor.yaml", R"(description: broken motor
+resistance: -1
+inductanse: 1
+gear_ratio: .nan
+)");
+  const std::string f = WriteScenario("uses_bad_motor.yaml", R"(duration_s: 0.01
+units:
+  motor:
+    type: dc_motor
+    parameters: {model: )" + fs::path(model).filename().string() +
+                                                                 "}\n");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all, model + ":3: inductanse: unknown parameter of a dc_motor unit")) << all;
+  EXPECT_TRUE(Has(all, model + ":4: gear_ratio: expected a number")) << all;
+  EXPECT_TRUE(Has(all, model + ":2: resistance.0:")) << all;
+  EXPECT_FALSE(Has(all, "set on the command line")) << all;
 }
 
 // Guards the shipped motor model files: each loads in both motor modes (a

@@ -5,6 +5,9 @@
 
 #include <fstream>
 #include <string>
+#include <vector>
+
+#include "loader/scenario.h"
 
 namespace linesim::loader::testing {
 
@@ -14,6 +17,21 @@ inline std::string WriteScenario(const std::string& name, const std::string& tex
   const std::string path = ::testing::TempDir() + std::to_string(getpid()) + "_" + name;
   std::ofstream(path) << text;
   return path;
+}
+
+/// Every issue of loading `file` with `sets`, one per line, for matching in
+/// assertions; "(no error)" when it loads.
+inline std::string Issues(const std::string& file, const std::vector<std::string>& sets = {}) {
+  try {
+    LoadScenario(file, sets);
+  } catch (const ScenarioError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+inline bool Has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
 }
 
 /// A valid two-unit system: a step source driving one DC motor.

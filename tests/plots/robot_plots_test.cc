@@ -129,6 +129,21 @@ TEST_F(RobotPlotsTest, IsDeterministic) {
   EXPECT_EQ(ReadAll(dir_ / "top_view.png"), png);
 }
 
+// Guards the streaming read: a file with a header and no rows (blank and
+// CR-only lines are no rows) is refused by name, not drawn empty.
+TEST_F(RobotPlotsTest, SignalsWithoutRowsAreRefused) {
+  WriteSignals();
+  const std::string all = ReadAll(dir_ / "signals.csv");
+  std::ofstream(dir_ / "signals.csv") << all.substr(0, all.find('\n') + 1) << "\n\r\n";
+  try {
+    WriteRobotPlots(dir_.string(), Spec());
+    FAIL() << "a file without rows was drawn";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("signals.csv has no data rows"), std::string::npos)
+        << e.what();
+  }
+}
+
 // Guards against an unknown column being plotted as garbage or reported
 // vaguely: every unknown name is in the message with the closest real one.
 TEST_F(RobotPlotsTest, UnknownColumnIsNamed) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iostream>
 #include <map>
@@ -44,6 +45,14 @@ constexpr double kGain = 1.0;
 // constants of the loop, so the nominal deviation nears v/k = 0.10 m (less
 // the part of the time only some wheels are on the belt). Both arrive: the
 // path is 4 m long.
+//
+// The factor between the two: with compensation a wheel's change of surface
+// is seen at most one control period T = 20 ms late, so each of the 4 wheel
+// transitions at an edge (front pair, then rear pair, entering and leaving)
+// lets the belt carry the robot at most v T = 2 mm before the loop (1/k =
+// 1 s) takes it back: at most 4 v T = 8 mm in all. The nominal deviation is
+// at least 0.5 v/k = 50 mm, more than 6 times that; a factor 3 keeps half
+// of the margin for the contact dynamics.
 TEST(Paper1Scenarios, CrossLineCompensatedStaysWithin4cmNominalDoesNot) {
   const auto on = RunScenario("cross_line", {"control.compensation=true"});
   const auto off = RunScenario("cross_line", {"control.compensation=false"});
@@ -79,13 +88,18 @@ TEST(Paper1Scenarios, CrossLineHoldsAcrossAlgorithmStepAndHeading) {
 // speed variation). With Algorithm 1 it stays put: we ask for a tenth of
 // that at worst (the belt starts at 0.5 m/s2 faster than the 20 ms
 // controller sees it) and a return to the point once the line runs
-// steadily.
+// steadily. The last switch is at 15 s, 9 s = 9/k before the end: of a
+// transient within the 0.1 v/k bound, e^-9 of it (under 3 um) is left, plus
+// the lag of the compensation behind the belt's speed variation (+-10 % of
+// 0.20 m/s over 20 s: dv/dt <= 0.1 * 0.20 * 2 pi / 20 = 6.3 mm/s2, seen T =
+// 20 ms late, held by k at 6.3e-3 * 0.02 / k = 0.13 mm). The final bound,
+// 5 mm = 2.5 % of v/k, leaves room for the contact dynamics.
 TEST(Paper1Scenarios, HoldOnBeltHoldsWithCompensation) {
   const auto on = RunScenario("hold_on_belt", {"control.compensation=true"});
   const auto off = RunScenario("hold_on_belt", {"control.compensation=false"});
   const double v_over_k = 0.20 / kGain;
   EXPECT_LT(on.at("max_position_drift_m"), 0.1 * v_over_k);
-  EXPECT_LT(on.at("final_position_drift_m"), 0.005);
+  EXPECT_LT(on.at("final_position_drift_m"), 0.025 * v_over_k);  // 5 mm
   EXPECT_GT(off.at("max_position_drift_m"), 0.85 * v_over_k);
   EXPECT_LT(off.at("max_position_drift_m"), 1.15 * v_over_k);
 }
@@ -93,13 +107,21 @@ TEST(Paper1Scenarios, HoldOnBeltHoldsWithCompensation) {
 // Straddling the edge only two wheels are dragged (the braked robot would
 // yaw, see the chassis tests): the nominal robot both drifts, about half of
 // v/k since half of the wheels push, and turns; the compensated one holds
-// position and heading.
+// position and heading. Headings from the geometry: the belt-side and
+// floor-side wheel rows are 0.32 m apart (raw3_chassis.yaml wheel_y: 0.186
+// + 0.134 m), so a displacement d of one row against the other turns the
+// robot by d / 0.32 m. Compensated: the 5 mm final position bound (as on
+// the belt) at one row alone would be 0.016 rad; we ask 0.01 rad. Nominal:
+// the belt row is dragged by at least the asserted 0.3 v/k = 60 mm more
+// than the robot's centre, so by twice that against the floor row if that
+// row held still: 0.37 rad; the heading loop takes most of it back, and we
+// ask for a seventh, 0.05 rad.
 TEST(Paper1Scenarios, HoldStraddlingHoldsWithCompensation) {
   const auto on = RunScenario("hold_straddle", {"control.compensation=true"});
   const auto off = RunScenario("hold_straddle", {"control.compensation=false"});
   const double v_over_k = 0.20 / kGain;
   EXPECT_LT(on.at("max_position_drift_m"), 0.1 * v_over_k);
-  EXPECT_LT(on.at("final_position_drift_m"), 0.005);
+  EXPECT_LT(on.at("final_position_drift_m"), 0.025 * v_over_k);
   EXPECT_LT(std::abs(on.at("final_yaw_rad")), 0.01);
   EXPECT_GT(off.at("max_position_drift_m"), 0.3 * v_over_k);
   EXPECT_GT(std::abs(off.at("final_yaw_rad")), 0.05);
@@ -111,15 +133,18 @@ class StepChatter : public cosim::Observer {
  public:
   void OnStart(const cosim::Master& master) override {
     probes_ = cosim::ResolveProbes(master.system(), {"chassis.drive_rate"});
-    history_.assign(probes_.size(), {});
+    last_.assign(probes_.size(), {});
+    samples_ = 0;
   }
   void OnSample(cosim::TimeNs, const cosim::System& system) override {
+    ++samples_;
     for (std::size_t w = 0; w < probes_.size(); ++w) {
-      auto& h = history_[w];
-      h.push_back(cosim::ReadProbe(system, probes_[w]));
-      max_rate_ = std::max(max_rate_, std::abs(h.back()));
-      if (h.size() >= 3) {
-        const double a = std::abs(h[h.size() - 1] - 2.0 * h[h.size() - 2] + h[h.size() - 3]) / 4;
+      // The last three samples, newest first.
+      auto& h = last_[w];
+      h = {cosim::ReadProbe(system, probes_[w]), h[0], h[1]};
+      max_rate_ = std::max(max_rate_, std::abs(h[0]));
+      if (samples_ >= 3) {
+        const double a = std::abs(h[0] - 2.0 * h[1] + h[2]) / 4;
         sum_sq_ += a * a;
         ++count_;
       }
@@ -130,7 +155,8 @@ class StepChatter : public cosim::Observer {
 
  private:
   std::vector<cosim::Probe> probes_;
-  std::vector<std::vector<double>> history_;
+  std::vector<std::array<double, 3>> last_;
+  std::size_t samples_ = 0;
   double sum_sq_ = 0, max_rate_ = 0;
   std::size_t count_ = 0;
 };

@@ -1,0 +1,84 @@
+#include "loader/yaml_files.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "cosim/closest_names.h"
+#include "models/models_dir.h"
+
+namespace linesim::loader {
+
+namespace fs = std::filesystem;
+
+YamlFile LoadYamlFile(const std::string& file) {
+  YamlFile out;
+  std::error_code ec;
+  if (!fs::exists(file, ec)) {
+    out.problem = YamlFile::Problem::kMissing;
+    return out;
+  }
+  if (!fs::is_regular_file(file, ec)) {
+    out.problem = YamlFile::Problem::kFolder;
+    return out;
+  }
+  try {
+    out.root = YAML::LoadFile(file);
+  } catch (const YAML::BadFile&) {
+    out.problem = YamlFile::Problem::kUnreadable;
+    out.detail = "not readable";
+  } catch (const YAML::ParserException& e) {
+    out.problem = YamlFile::Problem::kInvalid;
+    out.detail = e.msg;
+    out.line = e.mark.is_null() ? 0 : e.mark.line + 1;
+  } catch (const std::exception& e) {
+    out.problem = YamlFile::Problem::kUnreadable;
+    out.detail = e.what();
+  }
+  return out;
+}
+
+std::vector<std::string> ModelNames(const std::string& folder) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(fs::path(models::ModelsDir()) / folder, ec)) {
+    if (e.path().extension() == ".yaml") names.push_back(e.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+YAML::Node LoadModel(YamlReader& r, const YAML::Node& at, const std::string& path,
+                     const std::string& what, const std::string& value, const std::string& folder,
+                     const std::string& relative_to, std::string* file) {
+  const bool is_path =
+      value.find('/') != std::string::npos || value.ends_with(".yaml") || value.ends_with(".yml");
+  const std::string name = (is_path ? fs::path(relative_to).parent_path() / value
+                                    : fs::path(models::ModelsDir()) / folder / (value + ".yaml"))
+                               .string();
+  if (file) *file = name;
+  const YamlFile loaded = LoadYamlFile(name);
+  switch (loaded.problem) {
+    case YamlFile::Problem::kNone:
+      return loaded.root;
+    case YamlFile::Problem::kMissing:
+      r.Error(at, path,
+              "no " + what + " file " + name +
+                  (is_path ? "" : cosim::ClosestHint(value, ModelNames(folder))));
+      break;
+    case YamlFile::Problem::kFolder:
+      r.Error(at, path, "cannot read " + what + " file " + name + ": it is not a file (a folder?)");
+      break;
+    case YamlFile::Problem::kInvalid:
+      r.Error(at, path,
+              "cannot read " + what + " file " + name + ": not valid YAML" +
+                  (loaded.line > 0 ? " at line " + std::to_string(loaded.line) : "") + ": " +
+                  loaded.detail);
+      break;
+    case YamlFile::Problem::kUnreadable:
+      r.Error(at, path, "cannot read " + what + " file " + name + ": " + loaded.detail);
+      break;
+  }
+  return YAML::Node(YAML::NodeType::Undefined);
+}
+
+}  // namespace linesim::loader

@@ -1,0 +1,37 @@
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <string>
+#include <vector>
+
+#include "loader/yaml_reader.h"
+
+namespace linesim::loader {
+
+/// A YAML file read whole, or why it could not be.
+struct YamlFile {
+  enum class Problem { kNone, kMissing, kFolder, kInvalid, kUnreadable };
+  YAML::Node root;
+  Problem problem = Problem::kNone;
+  std::string detail;  // the parser's or the system's words
+  int line = 0;        // of invalid YAML; 0 when unknown
+};
+
+/// Reads `file` (a folder is refused before yaml-cpp, which would leak its
+/// buffer reading one); never throws.
+YamlFile LoadYamlFile(const std::string& file);
+
+/// Names of the model files in models/`folder`, sorted.
+std::vector<std::string> ModelNames(const std::string& folder);
+
+/// Reads the model `value` names: a name of a file in models/`folder`, or a
+/// path (with '/' or ending in .yaml) relative to `relative_to`'s folder.
+/// Problems are reported at `at`/`path` through `r`, "no <what> file F
+/// (closest: ...)" or "cannot read <what> file F: why"; then the result is
+/// an undefined node. `file` receives the file's path.
+YAML::Node LoadModel(YamlReader& r, const YAML::Node& at, const std::string& path,
+                     const std::string& what, const std::string& value, const std::string& folder,
+                     const std::string& relative_to, std::string* file = nullptr);
+
+}  // namespace linesim::loader

@@ -1,0 +1,40 @@
+#include "loader/yaml_reader.h"
+
+#include <gtest/gtest.h>
+
+namespace linesim::loader {
+namespace {
+
+bool Has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// Guards times: whole nanoseconds, a nonzero time below 1 ns and one beyond
+// int64 nanoseconds (9.22e9 s) refused at their keys instead of silently
+// becoming 0 (or one master step) or throwing.
+TEST(YamlReader, TimeIsWholeNanosecondsAndRefusesWhatTheyCannotHold) {
+  const YAML::Node map = YAML::Load("{ok: 0.002, zero: 0, tiny: 1.0e-10, huge: 1.0e10, nan: .nan}");
+  YamlReader r("f.yaml");
+  EXPECT_EQ(r.Time(map, "m", "ok", std::nullopt), 2'000'000);
+  EXPECT_EQ(r.Time(map, "m", "zero", std::nullopt), 0);
+  EXPECT_EQ(r.Time(map, "m", "absent", 0.5), 500'000'000);
+  EXPECT_TRUE(r.ok());
+  EXPECT_EQ(r.Time(map, "m", "tiny", 0.001), 1'000'000);  // refused: the fallback
+  EXPECT_EQ(r.Time(map, "m", "huge", std::nullopt), 0);
+  EXPECT_EQ(r.Time(map, "m", "nan", std::nullopt), 0);
+  EXPECT_EQ(r.Time(map, "m", "tiny", std::nullopt, {0.0, 1.0, true}), 0);
+  ASSERT_EQ(r.issues().size(), 4u);
+  EXPECT_EQ(r.issues()[0].key_path, "m.tiny");
+  EXPECT_TRUE(Has(r.issues()[0].message, "below one nanosecond")) << r.issues()[0].message;
+  EXPECT_TRUE(Has(r.issues()[0].message, "expected 0 or at least 1e-9 s")) << r.issues()[0].message;
+  EXPECT_EQ(r.issues()[1].key_path, "m.huge");
+  EXPECT_TRUE(Has(r.issues()[1].message, "int64 nanoseconds")) << r.issues()[1].message;
+  EXPECT_EQ(r.issues()[2].key_path, "m.nan");
+  EXPECT_TRUE(Has(r.issues()[2].message, "expected a number")) << r.issues()[2].message;
+  // Where 0 is out of range, the message does not offer it.
+  EXPECT_TRUE(Has(r.issues()[3].message, "expected at least 1e-9 s")) << r.issues()[3].message;
+  EXPECT_FALSE(Has(r.issues()[3].message, "0 or")) << r.issues()[3].message;
+}
+
+}  // namespace
+}  // namespace linesim::loader
