@@ -284,10 +284,6 @@ class Expander {
         info_.belts.push_back(belt);
         const std::string index = "." + std::to_string(i);
         for (const auto& [unit, parameter, key] : std::vector<std::array<std::string, 3>>{
-                 {"belt", "center_x", "center_x_m"},
-                 {"belt", "center_y", "center_y_m"},
-                 {"belt", "length", "length_m"},
-                 {"belt", "width", "width_m"},
                  {"belt", "direction", "direction_deg"},
                  {"belt", "nominal_speed", "speed_mps"},
                  {"belt", "speed_variation", "speed_variation"},
