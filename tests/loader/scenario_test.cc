@@ -7,6 +7,7 @@
 #include <iterator>
 
 #include "loader/unit_types.h"
+#include "models/dc_motor_params.h"
 #include "scenario_test.h"
 
 namespace linesim::loader {
@@ -342,6 +343,28 @@ units:
       EXPECT_NO_THROW(LoadScenario(f)) << model << " " << mode << ": " << Issues(f);
     }
   }
+}
+
+// Guards the bare-motor model file against drifting from the unit's
+// defaults: both transcribe the same datasheet (maxon RE 40 148877).
+TEST(LoadScenario, BareMotorModelFileIsTheDefaultDatasheet) {
+  const std::string f = WriteScenario("re40.yaml", R"(duration_s: 0.01
+units:
+  motor:
+    type: dc_motor
+    parameters: {model: maxon_re40_148877}
+)");
+  const Scenario s = LoadScenario(f);
+  const auto& v = s.system->unit(*s.system->FindUnit("motor")).variables();
+  const auto first = [&](const char* name) { return v.GetRealElement(*v.Find(name), 0); };
+  const models::DcMotorParams p;
+  EXPECT_DOUBLE_EQ(first("resistance"), p.resistance_ohm);
+  EXPECT_DOUBLE_EQ(first("inductance"), p.inductance_h);
+  EXPECT_DOUBLE_EQ(first("torque_constant"), p.torque_constant_nm_per_a);
+  EXPECT_DOUBLE_EQ(first("rotor_inertia"), p.rotor_inertia_kgm2);
+  EXPECT_NEAR(first("viscous_friction"), p.viscous_friction_nms_per_rad,
+              1e-4 * p.viscous_friction_nms_per_rad);
+  EXPECT_EQ(first("gear_ratio"), 1.0);
 }
 
 // Guards file-level failures: a missing file and malformed YAML.

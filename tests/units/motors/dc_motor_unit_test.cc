@@ -1,13 +1,11 @@
 #include "units/motors/dc_motor_unit.h"
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <iostream>
 #include <numbers>
 #include <string>
@@ -17,7 +15,6 @@
 #include "cosim/system.h"
 #include "cosim/time.h"
 #include "models/dc_motor_params.h"
-#include "models/models_dir.h"
 
 namespace linesim::motors {
 namespace {
@@ -814,40 +811,6 @@ TEST(DcMotorUnit, DefaultsAreTheMaxonRe40DataSheet) {
   EXPECT_NEAR(p.viscous_friction_nms_per_rad, 5.2e-6, 0.05e-6);
   // Speed constant 317 rpm/V is the same constant as k_t, to rounding.
   EXPECT_NEAR(1.0 / (317.0 * 2.0 * std::numbers::pi / 60.0), p.torque_constant_nm_per_a, 2e-4);
-}
-
-// Guards against model files with keys the unit does not have (typos a
-// loader would reject) or values it refuses, and the bare-motor file
-// drifting from the defaults.
-TEST(DcMotorUnit, ModelFilesUseParameterNamesAndValidValues) {
-  const std::filesystem::path dir = std::filesystem::path(models::ModelsDir()) / "motors";
-  for (const char* file : {"maxon_re40_148877.yaml", "raw3_drive.yaml", "raw3_steer.yaml"}) {
-    SCOPED_TRACE(file);
-    const YAML::Node root = YAML::LoadFile((dir / file).string());
-    ASSERT_TRUE(root.IsMap());
-    EXPECT_TRUE(root["source"] && root["source"].IsScalar());
-    DcMotorUnit u("m", 1, MotorMode::kFull);
-    for (const auto& kv : root) {
-      const std::string key = kv.first.as<std::string>();
-      if (key == "source" || key == "description") continue;
-      const auto ref = u.variables().Find(key);
-      ASSERT_TRUE(ref) << "unknown key " << key;
-      EXPECT_EQ(u.variables().info(*ref).causality, cosim::Causality::kParameter) << key;
-      u.variables().SetValue(*ref, cosim::Value{kv.second.as<double>()});
-    }
-    EXPECT_NO_THROW(u.Initialize());
-    if (std::string(file) == "maxon_re40_148877.yaml") {
-      const models::DcMotorParams p;
-      const auto first = [&](const char* name) { return Get(u, name)[0]; };
-      EXPECT_DOUBLE_EQ(first("resistance"), p.resistance_ohm);
-      EXPECT_DOUBLE_EQ(first("inductance"), p.inductance_h);
-      EXPECT_DOUBLE_EQ(first("torque_constant"), p.torque_constant_nm_per_a);
-      EXPECT_DOUBLE_EQ(first("rotor_inertia"), p.rotor_inertia_kgm2);
-      EXPECT_NEAR(first("viscous_friction"), p.viscous_friction_nms_per_rad,
-                  1e-4 * p.viscous_friction_nms_per_rad);
-      EXPECT_EQ(first("gear_ratio"), 1.0);
-    }
-  }
 }
 
 }  // namespace
