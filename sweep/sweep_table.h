@@ -1,0 +1,36 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace linesim::sweep {
+
+/// The finished runs of a sweep, as the report (summary.json, the terminal
+/// table and the plots) reads them: one row per run, sorted by run id.
+struct SweepTable {
+  std::string name;
+  /// The varied parameters by dotted path, in the sweep file's order.
+  std::vector<std::string> parameters;
+  /// For each parameter, its distinct values in plan order as the YAML text
+  /// the run was given ("0.05", "true", "jacobi"); empty for a parameter
+  /// drawn at random (every run has its own value).
+  std::vector<std::vector<std::string>> levels;
+  /// Metric names as results.csv writes them; the last one is "wall_s",
+  /// the run's wall-clock time.
+  std::vector<std::string> metrics;
+  /// True for `combine: grid`; false for Monte-Carlo draws.
+  bool grid = true;
+
+  struct Row {
+    std::int64_t id = 0;
+    std::vector<std::string> values;  // one per parameter
+    std::uint64_t seed = 0;
+    bool ok = false;
+    std::vector<double> metrics;  // one per metric; NaN when not ok
+    std::string error;            // empty when ok
+  };
+  std::vector<Row> rows;
+};
+
+}  // namespace linesim::sweep
