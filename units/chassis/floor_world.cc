@@ -44,6 +44,9 @@ void EnsureOdeForThisThread() {
 FloorWorld::FloorWorld() {
   EnsureOdeForThisThread();
   world_ = dWorldCreate();
+  threading_ = dThreadingAllocateSelfThreadedImplementation();
+  dWorldSetStepThreadingImplementation(world_, dThreadingImplementationGetFunctions(threading_),
+                                       threading_);
   dWorldSetGravity(world_, 0.0, 0.0, -kGravityMps2);
   group_ = dJointGroupCreate(0);
   // Not in a space: geoms are collided with the floor one by one.
@@ -55,6 +58,7 @@ FloorWorld::~FloorWorld() {
   dJointGroupDestroy(group_);
   dGeomDestroy(floor_);
   dWorldDestroy(world_);
+  dThreadingFreeImplementation(threading_);
 }
 
 void FloorWorld::SetBelts(std::vector<BeltPatch> belts) {
@@ -224,6 +228,13 @@ bool FloorWorld::Step(double h_s) {
   } catch (const OdeError&) {
     dJointGroupEmpty(group_);
     collided_ = false;
+    // The step was left midway: its threading object still lists its jobs,
+    // and ODE asserts when such an object is freed. It is left allocated
+    // (a few hundred bytes, once per failed run) and the world gets a fresh
+    // one, so that it can be initialised and stepped again.
+    threading_ = dThreadingAllocateSelfThreadedImplementation();
+    dWorldSetStepThreadingImplementation(world_, dThreadingImplementationGetFunctions(threading_),
+                                         threading_);
     throw;
   }
   if (ok == 0) collided_ = false;

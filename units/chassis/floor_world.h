@@ -169,6 +169,10 @@ class FloorWorld {
   void MakeJoints(std::size_t i, double erp, double cfm);
 
   dWorldID world_ = nullptr;
+  // Each world steps with its own threading object: without one, ODE steps
+  // every world through a single process-wide job list, and two worlds
+  // stepped on two threads (a sweep's runs) corrupt it.
+  dThreadingImplementationID threading_ = nullptr;
   dJointGroupID group_ = nullptr;
   dGeomID floor_ = nullptr;
   ContactSurface surface_;
