@@ -54,7 +54,7 @@ void ApplyOverrides(YAML::Node& root, const std::vector<Override>& overrides,
   for (const Override& o : overrides) {
     const auto report = [&](const std::string& message) {
       issues.push_back(
-          {file, 0, o.path, message + " (in --set " + o.path + "=" + o.value + ")", true});
+          {file, 0, o.path, message + " (in --set " + o.path + "=" + o.value + ")", true, true});
     };
     const std::vector<std::string> parts = Split(o.path);
     if (std::any_of(parts.begin(), parts.end(), [](const std::string& p) { return p.empty(); })) {

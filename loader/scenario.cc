@@ -89,7 +89,7 @@ void ApplyParameters(cosim::Unit& unit, const YAML::Node& map, const std::string
     const std::string key_path = JoinPath(path, key);
     const auto ref = unit.variables().Find(key);
     if (!ref || unit.variables().info(*ref).causality != cosim::Causality::kParameter) {
-      r.Error(kv.first, key_path,
+      r.UnknownPath(kv.first, key_path,
               "unknown parameter of a " + unit.type_name() + " unit" +
                   ClosestPathsHint(path, key, allowed) + " (linesim inspect " + unit.type_name() +
                   " lists them)");

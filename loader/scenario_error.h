@@ -14,6 +14,10 @@ struct Issue {
   std::string key_path;  // "units.motors.parameters.resistance"
   std::string message;
   bool from_command_line = false;  // the value came from --set
+  /// The key path itself is wrong (no such key or list item), as opposed to
+  /// a bad value at a right path: a sweep refuses such a parameter path at
+  /// once instead of failing every run.
+  bool unknown_path = false;
 
   std::string ToString() const;
 };

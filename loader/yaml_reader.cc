@@ -77,6 +77,11 @@ void YamlReader::Error(const std::string& file, const YAML::Node& at, const std:
   issues_.push_back(std::move(issue));
 }
 
+void YamlReader::UnknownPath(const YAML::Node& at, const std::string& path, std::string message) {
+  Error(at, path, std::move(message));
+  issues_.back().unknown_path = true;
+}
+
 bool YamlReader::ExpectMap(const YAML::Node& node, const std::string& path) {
   if (node.IsMap()) return true;
   Error(node, path, "expected a map of keys, got " + Describe(node));
@@ -97,9 +102,9 @@ void YamlReader::CheckKeys(const YAML::Node& map, const std::string& path,
     bool known = false;
     for (const auto& a : allowed) known |= (a == key);
     if (known) continue;
-    Error(kv.first, JoinPath(path, key),
-          "unknown key" + ClosestPathsHint(path, key, allowed) +
-              "; expected one of: " + JoinNames(allowed));
+    UnknownPath(kv.first, JoinPath(path, key),
+                "unknown key" + ClosestPathsHint(path, key, allowed) +
+                    "; expected one of: " + JoinNames(allowed));
   }
 }
 

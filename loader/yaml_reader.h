@@ -53,6 +53,8 @@ class YamlReader {
   /// An issue of another file than the reader's (a model file it read).
   void Error(const std::string& file, const YAML::Node& at, const std::string& path,
              std::string message);
+  /// An issue with the key path itself (no such key), not with a value.
+  void UnknownPath(const YAML::Node& at, const std::string& path, std::string message);
   void Add(const std::vector<Issue>& issues);
   /// From now on an issue of the reader's own file at a key path in
   /// `origins` (a generated tree's path) is reported at its origin instead.
