@@ -1,0 +1,153 @@
+#include "sweep/mpi_sweep.h"
+
+#include <mpi.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+#include <thread>
+
+namespace linesim::sweep {
+
+namespace {
+
+enum Tag : int { kReady = 1, kResult = 2, kRun = 3, kStop = 4 };
+
+// A run's outcome as bytes: fixed fields, the metrics, then the error text.
+std::vector<char> Pack(const RunOutcome& o) {
+  const std::int64_t head[4] = {o.id, static_cast<std::int64_t>(o.seed),
+                                static_cast<std::int64_t>(o.status),
+                                static_cast<std::int64_t>(o.metrics.size())};
+  std::vector<char> buf(sizeof head + sizeof(double) * (1 + o.metrics.size()) + o.error.size());
+  char* at = buf.data();
+  std::memcpy(at, head, sizeof head);
+  at += sizeof head;
+  std::memcpy(at, &o.wall_s, sizeof(double));
+  at += sizeof(double);
+  if (!o.metrics.empty()) std::memcpy(at, o.metrics.data(), sizeof(double) * o.metrics.size());
+  at += sizeof(double) * o.metrics.size();
+  if (!o.error.empty()) std::memcpy(at, o.error.data(), o.error.size());
+  return buf;
+}
+
+RunOutcome Unpack(const std::vector<char>& buf) {
+  RunOutcome o;
+  std::int64_t head[4];
+  if (buf.size() < sizeof head + sizeof(double)) throw std::runtime_error("short MPI result");
+  const char* at = buf.data();
+  std::memcpy(head, at, sizeof head);
+  at += sizeof head;
+  o.id = head[0];
+  o.seed = static_cast<std::uint64_t>(head[1]);
+  o.status = static_cast<RunStatus>(head[2]);
+  const auto n = static_cast<std::size_t>(head[3]);
+  std::memcpy(&o.wall_s, at, sizeof(double));
+  at += sizeof(double);
+  const std::size_t fixed = sizeof head + sizeof(double) * (1 + n);
+  if (buf.size() < fixed) throw std::runtime_error("short MPI result");
+  o.metrics.resize(n);
+  if (n) std::memcpy(o.metrics.data(), at, sizeof(double) * n);
+  o.error.assign(buf.data() + fixed, buf.size() - fixed);
+  return o;
+}
+
+void SendRun(std::int64_t id, int rank) {
+  MPI_Send(&id, 1, MPI_INT64_T, rank, kRun, MPI_COMM_WORLD);
+}
+
+void SendStop(int rank) {
+  const std::int64_t none = -1;
+  MPI_Send(&none, 1, MPI_INT64_T, rank, kStop, MPI_COMM_WORLD);
+}
+
+}  // namespace
+
+bool LaunchedByMpi() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK", "MPI_LOCALNRANKS"}) {
+    if (std::getenv(name)) return true;
+  }
+  return false;
+}
+
+MpiSession::MpiSession(int* argc, char*** argv) {
+  // Only the main thread talks MPI.
+  int provided = 0;
+  MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+}
+
+MpiSession::~MpiSession() { MPI_Finalize(); }
+
+int MpiSession::ShareStatus(int status) const {
+  int worst = status;
+  MPI_Allreduce(&status, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  return worst;
+}
+
+void DispatchRuns(const SweepSpec& spec, const std::vector<RunSpec>& runs,
+                  std::atomic<bool>& stop, const OnRunDone& on_done) {
+  int size = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  if (size == 1) {
+    RunOnThreads(spec, runs, 1, stop, on_done);
+    return;
+  }
+  std::size_t next = 0;
+  int active = size - 1;  // workers not yet told to stop
+  std::vector<char> buf;
+  std::exception_ptr failure;
+  while (active > 0) {
+    int arrived = 0;
+    MPI_Status status;
+    MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &arrived, &status);
+    if (!arrived) {
+      // Polling politely: a blocking receive would spin a core that a
+      // worker rank on the same machine needs. 1 ms is nothing next to a run.
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      continue;
+    }
+    int count = 0;
+    MPI_Get_count(&status, MPI_CHAR, &count);
+    buf.resize(static_cast<std::size_t>(count));
+    MPI_Recv(buf.data(), count, MPI_CHAR, status.MPI_SOURCE, status.MPI_TAG, MPI_COMM_WORLD,
+             MPI_STATUS_IGNORE);
+    if (status.MPI_TAG == kResult && !failure) {
+      const RunOutcome outcome = Unpack(buf);
+      if (outcome.status == RunStatus::kInterrupted) {
+        stop = true;
+      } else {
+        try {
+          on_done(PlanRun(spec, outcome.id), outcome);
+        } catch (...) {
+          failure = std::current_exception();
+          stop = true;
+        }
+      }
+    }
+    if (!stop.load() && next < runs.size()) {
+      SendRun(runs[next++].id, status.MPI_SOURCE);
+    } else {
+      SendStop(status.MPI_SOURCE);
+      --active;
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+}
+
+void ServeRuns(const SweepSpec& spec, std::atomic<bool>& stop) {
+  MPI_Send(nullptr, 0, MPI_CHAR, 0, kReady, MPI_COMM_WORLD);
+  while (true) {
+    MPI_Status status;
+    std::int64_t id = 0;
+    MPI_Recv(&id, 1, MPI_INT64_T, 0, MPI_ANY_TAG, MPI_COMM_WORLD, &status);
+    if (status.MPI_TAG == kStop) return;
+    const RunOutcome outcome = ExecuteRun(spec, PlanRun(spec, id), &stop);
+    std::vector<char> buf = Pack(outcome);
+    MPI_Send(buf.data(), static_cast<int>(buf.size()), MPI_CHAR, 0, kResult, MPI_COMM_WORLD);
+  }
+}
+
+}  // namespace linesim::sweep

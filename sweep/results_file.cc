@@ -1,0 +1,251 @@
+#include "sweep/results_file.h"
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "cosim/variable_table.h"
+
+namespace linesim::sweep {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string Quote(const std::string& field) {
+  const bool plain = field.find_first_of(",\"\n\r") == std::string::npos &&
+                     (field.empty() || (field.front() != ' ' && field.back() != ' '));
+  if (plain) return field;
+  std::string out = "\"";
+  for (char c : field) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string Number(double v) { return std::isfinite(v) ? cosim::FormatValue(v) : ""; }
+
+std::uint64_t Fnv1a(std::uint64_t h, std::string_view text) {
+  for (char c : text) {
+    h ^= static_cast<unsigned char>(c);
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+std::string ReadWhole(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::FILE* OpenOrThrow(const std::string& path, const char* mode) {
+  std::FILE* f = std::fopen(path.c_str(), mode);
+  if (!f) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  return f;
+}
+
+std::optional<std::int64_t> ParseId(const std::string& text) {
+  std::int64_t id = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), id);
+  if (ec != std::errc() || end != text.data() + text.size()) return std::nullopt;
+  return id;
+}
+
+double ParseNumber(const std::string& text) {
+  if (text.empty()) return std::numeric_limits<double>::quiet_NaN();
+  double v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  return ec == std::errc() && end == text.data() + text.size()
+             ? v
+             : std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace
+
+std::vector<std::string> ResultsHeader(const SweepSpec& spec) {
+  std::vector<std::string> h{"run_id"};
+  for (const auto& p : spec.parameters) h.push_back(p.path);
+  h.push_back("seed");
+  for (const auto& m : spec.metrics) h.push_back(m);
+  h.insert(h.end(), {"status", "error", "wall_s"});
+  return h;
+}
+
+std::string JoinCsvLine(const std::vector<std::string>& fields) {
+  std::string line;
+  for (std::size_t i = 0; i < fields.size(); ++i) line += (i ? "," : "") + Quote(fields[i]);
+  return line + "\n";
+}
+
+std::optional<std::vector<std::string>> SplitCsvLine(std::string_view line) {
+  std::vector<std::string> fields(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        fields.back() += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        fields.back() += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      fields.emplace_back();
+    } else {
+      fields.back() += c;
+    }
+  }
+  if (quoted) return std::nullopt;
+  return fields;
+}
+
+std::string FormatRow(const SweepSpec& spec, const RunSpec& run, const RunOutcome& outcome) {
+  std::vector<std::string> f{std::to_string(run.id)};
+  f.insert(f.end(), run.values.begin(), run.values.end());
+  f.push_back(std::to_string(outcome.seed));
+  for (double m : outcome.metrics) f.push_back(Number(m));
+  f.push_back(outcome.status == RunStatus::kOk ? "ok" : "failed");
+  f.push_back(outcome.error);
+  f.push_back(cosim::FormatValue(outcome.wall_s));
+  (void)spec;
+  return JoinCsvLine(f);
+}
+
+std::string SweepFingerprint(const SweepSpec& spec) {
+  std::uint64_t h = 1469598103934665603ull;
+  h = Fnv1a(h, ReadWhole(spec.scenario));
+  for (const auto& m : spec.metrics) h = Fnv1a(h, "metric " + m + "\n");
+  for (std::int64_t id = 0; id < RunCount(spec); ++id) {
+    for (const auto& a : RunOverrides(spec, PlanRun(spec, id))) h = Fnv1a(h, a + "\n");
+    h = Fnv1a(h, "\n");
+  }
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+  return text;
+}
+
+ResultsFile::ResultsFile(std::string path, std::string header, std::FILE* file,
+                         std::map<std::int64_t, std::string> rows)
+    : path_(std::move(path)), header_(std::move(header)), file_(file), rows_(std::move(rows)) {}
+
+ResultsFile::ResultsFile(ResultsFile&& other) noexcept
+    : path_(std::move(other.path_)),
+      header_(std::move(other.header_)),
+      file_(other.file_),
+      rows_(std::move(other.rows_)) {
+  other.file_ = nullptr;
+}
+
+ResultsFile::~ResultsFile() {
+  if (file_) std::fclose(file_);
+}
+
+ResultsFile ResultsFile::Create(const std::string& path, const SweepSpec& spec) {
+  ResultsFile f(path, JoinCsvLine(ResultsHeader(spec)), nullptr, {});
+  f.Rewrite();
+  return f;
+}
+
+ResultsFile ResultsFile::Resume(const std::string& path, const SweepSpec& spec) {
+  const std::string header = JoinCsvLine(ResultsHeader(spec));
+  const std::string text = ReadWhole(path);
+  if (text.compare(0, header.size(), header) != 0) {
+    throw std::runtime_error(path + " has other columns than this sweep writes (expected " +
+                             header.substr(0, header.size() - 1) +
+                             "): it is not this sweep's; choose another --out");
+  }
+  const std::size_t columns = ResultsHeader(spec).size();
+  const std::int64_t count = RunCount(spec);
+  std::map<std::int64_t, std::string> rows;
+  std::size_t start = header.size();
+  while (start < text.size()) {
+    const std::size_t end = text.find('\n', start);
+    // A line without its newline was cut off while being written.
+    if (end == std::string::npos) break;
+    const std::string line = text.substr(start, end + 1 - start);
+    start = end + 1;
+    const auto fields = SplitCsvLine(std::string_view(line).substr(0, line.size() - 1));
+    if (!fields || fields->size() != columns) continue;
+    const auto id = ParseId(fields->front());
+    if (!id || *id < 0 || *id >= count) continue;
+    rows.emplace(*id, line);
+  }
+  ResultsFile f(path, header, nullptr, std::move(rows));
+  f.Rewrite();
+  return f;
+}
+
+void ResultsFile::Rewrite() {
+  if (file_) {
+    std::fclose(file_);
+    file_ = nullptr;
+  }
+  const std::string tmp = path_ + ".tmp";
+  std::FILE* out = OpenOrThrow(tmp, "wb");
+  bool ok = std::fputs(header_.c_str(), out) >= 0;
+  for (const auto& [id, line] : rows_) ok = ok && std::fputs(line.c_str(), out) >= 0;
+  ok = std::fclose(out) == 0 && ok;
+  if (!ok) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot write " + tmp + " (disk full?)");
+  }
+  std::error_code ec;
+  fs::rename(tmp, path_, ec);
+  if (ec) throw std::runtime_error("cannot replace " + path_ + ": " + ec.message());
+  file_ = OpenOrThrow(path_, "ab");
+}
+
+void ResultsFile::Append(std::int64_t id, const std::string& line) {
+  // One write and a flush per row: a kill loses at most the line being
+  // written, which a resumed sweep drops and runs again.
+  if (std::fputs(line.c_str(), file_) < 0 || std::fflush(file_) != 0) {
+    throw std::runtime_error("cannot write " + path_ + ": " + std::strerror(errno));
+  }
+  rows_.emplace(id, line);
+}
+
+void ResultsFile::SortByRunId() { Rewrite(); }
+
+SweepTable ResultsFile::Table(const SweepSpec& spec) const {
+  SweepTable t;
+  t.name = spec.name;
+  t.grid = spec.combination == Combination::kGrid;
+  for (const auto& p : spec.parameters) {
+    t.parameters.push_back(p.path);
+    t.levels.push_back(p.kind == ParameterKind::kRandom ? std::vector<std::string>{} : p.values);
+  }
+  t.metrics = spec.metrics;
+  t.metrics.push_back("wall_s");
+  const std::size_t np = spec.parameters.size();
+  const std::size_t nm = spec.metrics.size();
+  for (const auto& [id, line] : rows_) {
+    const auto fields = SplitCsvLine(std::string_view(line).substr(0, line.size() - 1));
+    if (!fields) continue;
+    const auto& f = *fields;
+    SweepTable::Row row;
+    row.id = id;
+    row.values.assign(f.begin() + 1, f.begin() + 1 + static_cast<std::ptrdiff_t>(np));
+    row.seed = std::strtoull(f[1 + np].c_str(), nullptr, 10);
+    for (std::size_t m = 0; m < nm; ++m) row.metrics.push_back(ParseNumber(f[2 + np + m]));
+    row.ok = f[2 + np + nm] == "ok";
+    row.error = f[3 + np + nm];
+    row.metrics.push_back(ParseNumber(f[4 + np + nm]));
+    t.rows.push_back(std::move(row));
+  }
+  return t;
+}
+
+}  // namespace linesim::sweep

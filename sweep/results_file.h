@@ -1,0 +1,74 @@
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sweep/run_one.h"
+#include "sweep/run_plan.h"
+#include "sweep/sweep_spec.h"
+#include "sweep/sweep_table.h"
+
+namespace linesim::sweep {
+
+/// Column names of results.csv: run_id, each parameter path, seed, each
+/// metric, status, error, wall_s.
+std::vector<std::string> ResultsHeader(const SweepSpec& spec);
+
+/// One line of results.csv (with its newline). Numbers are written as the
+/// shortest text that reads back to the same double, so rows are the same
+/// bytes on any machine, thread or rank; only wall_s differs between runs.
+std::string FormatRow(const SweepSpec& spec, const RunSpec& run, const RunOutcome& outcome);
+
+/// CSV fields, RFC 4180 quoting; nothing when a quote is left open (a line
+/// cut off by a killed process).
+std::optional<std::vector<std::string>> SplitCsvLine(std::string_view line);
+std::string JoinCsvLine(const std::vector<std::string>& fields);
+
+/// A fingerprint of everything that decides the rows: the base scenario's
+/// text, every run's overrides and the metrics. A resumed sweep must match.
+std::string SweepFingerprint(const SweepSpec& spec);
+
+/// The results.csv of a sweep folder, written as runs finish: one flushed
+/// line per run (completion order), then sorted by run id at the end.
+class ResultsFile {
+ public:
+  /// Starts `path` afresh with the header; throws std::runtime_error naming
+  /// the file when it cannot be written.
+  static ResultsFile Create(const std::string& path, const SweepSpec& spec);
+  /// Continues `path`: keeps every complete row of a planned run (the first
+  /// of duplicates) and drops a line cut off by a kill, rewriting the file
+  /// through a temporary and a rename. Throws std::runtime_error when the
+  /// header is not this sweep's.
+  static ResultsFile Resume(const std::string& path, const SweepSpec& spec);
+
+  ResultsFile(ResultsFile&& other) noexcept;
+  ResultsFile& operator=(ResultsFile&&) = delete;
+  ~ResultsFile();
+
+  bool HasRow(std::int64_t id) const { return rows_.count(id) != 0; }
+  std::size_t row_count() const { return rows_.size(); }
+  /// Appends and flushes one row; throws std::runtime_error on a write
+  /// failure (disk full).
+  void Append(std::int64_t id, const std::string& line);
+  /// Rewrites the file with its rows sorted by run id (temporary and rename).
+  void SortByRunId();
+  /// The rows parsed for the report, sorted by run id.
+  SweepTable Table(const SweepSpec& spec) const;
+
+ private:
+  ResultsFile(std::string path, std::string header, std::FILE* file,
+              std::map<std::int64_t, std::string> rows);
+  void Rewrite();
+
+  std::string path_;
+  std::string header_;
+  std::FILE* file_ = nullptr;
+  std::map<std::int64_t, std::string> rows_;  // run id -> line with its newline
+};
+
+}  // namespace linesim::sweep

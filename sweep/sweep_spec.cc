@@ -1,0 +1,262 @@
+#include "sweep/sweep_spec.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
+#include "cosim/variable_table.h"
+#include "loader/overrides.h"
+#include "loader/scenario.h"
+#include "loader/yaml_files.h"
+#include "loader/yaml_reader.h"
+
+namespace linesim::sweep {
+
+namespace fs = std::filesystem;
+using loader::Child;
+using loader::Issue;
+using loader::JoinPath;
+using loader::ScenarioError;
+using loader::YamlReader;
+
+namespace {
+
+// A value of the sweep file as the text `--set` would take: scalars as
+// written, lists and maps in YAML flow style.
+std::string YamlText(const YAML::Node& node) {
+  if (node.IsScalar()) return node.Scalar();
+  YAML::Emitter out;
+  out << YAML::Flow << node;
+  return out.c_str();
+}
+
+void ReadRange(const YAML::Node& range, const std::string& path, YamlReader& r,
+               ParameterSpec& p) {
+  if (!r.ExpectMap(range, path)) return;
+  r.CheckKeys(range, path, {"from", "to", "count"});
+  const std::size_t issues_before = r.issues().size();
+  const double from = r.Real(range, path, "from", std::nullopt);
+  const double to = r.Real(range, path, "to", std::nullopt);
+  const std::int64_t count = r.Integer(range, path, "count", std::nullopt, 1, 1000000);
+  if (r.issues().size() != issues_before) return;
+  if (count == 1 && from != to) {
+    r.Error(Child(range, "count"), JoinPath(path, "count"),
+            "a range from " + cosim::FormatValue(from) + " to " + cosim::FormatValue(to) +
+                " needs a count of at least 2 (both ends are included)");
+    return;
+  }
+  for (std::int64_t i = 0; i < count; ++i) {
+    const double v = i + 1 == count ? to
+                                    : from + (to - from) * static_cast<double>(i) /
+                                                 static_cast<double>(count - 1);
+    // 12 significant digits: 0.05 + 2 * 0.05 is the 0.15 the user means,
+    // not 0.15000000000000002, in the rows and the plots alike.
+    char text[32];
+    std::snprintf(text, sizeof text, "%.12g", v);
+    p.values.push_back(cosim::FormatValue(std::strtod(text, nullptr)));
+  }
+}
+
+void ReadRandom(const YAML::Node& random, const std::string& path, YamlReader& r,
+                ParameterSpec& p) {
+  if (!r.ExpectMap(random, path)) return;
+  const std::string d = r.String(random, path, "distribution", std::nullopt,
+                                 {"uniform", "normal", "log_uniform"});
+  if (d == "normal") {
+    r.CheckKeys(random, path, {"distribution", "mean", "std"});
+    p.distribution = Distribution::kNormal;
+    p.a = r.Real(random, path, "mean", std::nullopt);
+    p.b = r.Real(random, path, "std", std::nullopt, {0, INFINITY});
+  } else if (d == "uniform" || d == "log_uniform") {
+    r.CheckKeys(random, path, {"distribution", "min", "max"});
+    p.distribution = d == "uniform" ? Distribution::kUniform : Distribution::kLogUniform;
+    const loader::Range range =
+        d == "uniform" ? loader::Range{} : loader::Range{0, INFINITY, true};
+    p.a = r.Real(random, path, "min", std::nullopt, range);
+    p.b = r.Real(random, path, "max", std::nullopt, range);
+    if (r.ok() && !(p.b >= p.a)) {
+      r.Error(Child(random, "max"), JoinPath(path, "max"),
+              "expected max >= min (" + cosim::FormatValue(p.a) + ")");
+    }
+  }
+}
+
+void ReadParameter(const YAML::Node& node, const std::string& path, YamlReader& r,
+                   SweepSpec& spec) {
+  if (!r.ExpectMap(node, path)) return;
+  r.CheckKeys(node, path, {"path", "values", "range", "random"});
+  ParameterSpec p;
+  p.path = r.String(node, path, "path", std::nullopt);
+  const char* kinds[] = {"values", "range", "random"};
+  int given = 0;
+  for (const char* k : kinds) given += Child(node, k).IsDefined() ? 1 : 0;
+  if (given != 1) {
+    r.Error(node, path,
+            "expected exactly one of values: [...], range: {from, to, count} or "
+            "random: {distribution, ...}");
+    return;
+  }
+  if (const YAML::Node values = Child(node, "values"); values.IsDefined()) {
+    const std::string vpath = JoinPath(path, "values");
+    if (!r.ExpectSequence(values, vpath)) return;
+    if (values.size() == 0) r.Error(values, vpath, "expected at least one value");
+    for (const auto& v : values) p.values.push_back(YamlText(v));
+  } else if (const YAML::Node range = Child(node, "range"); range.IsDefined()) {
+    p.kind = ParameterKind::kRange;
+    ReadRange(range, JoinPath(path, "range"), r, p);
+  } else {
+    p.kind = ParameterKind::kRandom;
+    ReadRandom(Child(node, "random"), JoinPath(path, "random"), r, p);
+  }
+  for (const auto& other : spec.parameters) {
+    if (other.path == p.path && !p.path.empty()) {
+      r.Error(Child(node, "path"), JoinPath(path, "path"),
+              "'" + p.path + "' is varied twice; give all its values in one parameter");
+    }
+  }
+  spec.parameters.push_back(std::move(p));
+}
+
+// Issues about the key path itself, raised by loading the base scenario with
+// one override: those make every run fail the same way, so the sweep file is
+// wrong, not a run.
+void CheckParameterPath(const SweepSpec& spec, const ParameterSpec& p, const YAML::Node& at,
+                        const std::string& key_path, YamlReader& r) {
+  std::vector<std::string> args;
+  for (const auto& [path, value] : spec.fixed) args.push_back(path + "=" + value);
+  const std::string probe = p.kind == ParameterKind::kRandom ? cosim::FormatValue(p.a)
+                                                             : p.values.front();
+  args.push_back(p.path + "=" + probe);
+  try {
+    loader::LoadScenario(spec.scenario, args);
+  } catch (const ScenarioError& e) {
+    for (const Issue& i : e.issues()) {
+      const bool at_parameter =
+          i.key_path == p.path || i.key_path.rfind(p.path + ".", 0) == 0 ||
+          p.path.rfind(i.key_path + ".", 0) == 0;
+      if (i.unknown_path && at_parameter) {
+        r.Error(at, key_path, "not a setting of " + spec.scenario + ": " + i.message);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+SweepSpec LoadSweepSpec(const std::string& file) {
+  SweepSpec spec;
+  spec.file = file;
+  const loader::YamlFile loaded = loader::LoadYamlFile(file);
+  switch (loaded.problem) {
+    case loader::YamlFile::Problem::kNone:
+      break;
+    case loader::YamlFile::Problem::kMissing:
+      throw ScenarioError({{file, 0, "", "cannot read the sweep file (missing or not readable)"}});
+    case loader::YamlFile::Problem::kFolder:
+      throw ScenarioError({{file, 0, "", "is not a file (a folder?): expected a YAML sweep file"}});
+    case loader::YamlFile::Problem::kInvalid:
+      throw ScenarioError({{file, loaded.line, "", "not valid YAML: " + loaded.detail}});
+    case loader::YamlFile::Problem::kUnreadable:
+      throw ScenarioError({{file, 0, "", "cannot read the file: " + loaded.detail}});
+  }
+  const YAML::Node root = loaded.root;
+  YamlReader r(file);
+  if (!r.ExpectMap(root, "")) throw ScenarioError(r.issues());
+  r.CheckKeys(root, "",
+              {"name", "description", "scenario", "set", "parameters", "combine", "samples",
+               "repeats", "seed", "seeds", "metrics"});
+  spec.name = r.String(root, "", "name", fs::path(file).stem().string());
+  spec.description = r.String(root, "", "description", "");
+  const std::string scenario = r.String(root, "", "scenario", std::nullopt);
+  if (!scenario.empty()) {
+    // Relative to the sweep file, so a sweep runs from any folder.
+    const fs::path p(scenario);
+    spec.scenario = p.is_absolute() ? scenario : (fs::path(file).parent_path() / p).string();
+  }
+  if (const YAML::Node set = Child(root, "set"); set.IsDefined()) {
+    if (r.ExpectMap(set, "set")) {
+      for (const auto& kv : set) spec.fixed.emplace_back(kv.first.Scalar(), YamlText(kv.second));
+    }
+  }
+  const YAML::Node parameters = Child(root, "parameters");
+  if (!parameters.IsDefined()) {
+    r.Error(root, "parameters", "missing required key: the list of parameters to vary");
+  } else if (r.ExpectSequence(parameters, "parameters")) {
+    if (parameters.size() == 0) r.Error(parameters, "parameters", "expected at least one");
+    for (std::size_t i = 0; i < parameters.size(); ++i) {
+      ReadParameter(parameters[i], "parameters." + std::to_string(i), r, spec);
+    }
+  }
+  const std::string combine =
+      r.String(root, "", "combine", "grid", {"grid", "monte_carlo"});
+  spec.combination = combine == "monte_carlo" ? Combination::kMonteCarlo : Combination::kGrid;
+  if (spec.combination == Combination::kMonteCarlo) {
+    spec.samples = r.Integer(root, "", "samples", std::nullopt, 1, 100000000);
+  } else {
+    if (Child(root, "samples").IsDefined()) {
+      r.Error(Child(root, "samples"), "samples",
+              "samples are Monte-Carlo draws: set combine: monte_carlo, or leave samples out");
+    }
+    for (std::size_t i = 0; i < spec.parameters.size(); ++i) {
+      if (spec.parameters[i].kind == ParameterKind::kRandom) {
+        r.Error(parameters[i], "parameters." + std::to_string(i) + ".random",
+                "random draws need combine: monte_carlo (a grid takes values or a range)");
+      }
+    }
+  }
+  spec.repeats = r.Integer(root, "", "repeats", 1, 1, 1000000);
+  spec.seed = static_cast<std::uint64_t>(
+      r.Integer(root, "", "seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
+  spec.seeds = r.String(root, "", "seeds", "common", {"common", "per_run"}) == "per_run"
+                   ? SeedPolicy::kPerRun
+                   : SeedPolicy::kCommon;
+  const YAML::Node metrics = Child(root, "metrics");
+  if (metrics.IsDefined() && r.ExpectSequence(metrics, "metrics")) {
+    for (std::size_t i = 0; i < metrics.size(); ++i) {
+      if (auto m = r.AsString(metrics[i], "metrics." + std::to_string(i))) {
+        spec.metrics.push_back(*m);
+      }
+    }
+  }
+  if (!r.ok()) throw ScenarioError(r.issues());
+
+  // The base scenario with the fixed settings must load by itself.
+  std::vector<std::string> args;
+  for (const auto& [path, value] : spec.fixed) args.push_back(path + "=" + value);
+  loader::Scenario base;
+  try {
+    base = loader::LoadScenario(spec.scenario, args);
+  } catch (const ScenarioError& e) {
+    std::vector<Issue> issues{{file, YamlReader::LineOf(Child(root, "scenario")), "scenario",
+                               "the base scenario " + spec.scenario +
+                                   (spec.fixed.empty() ? "" : " with the settings under set:") +
+                                   " is refused:"}};
+    issues.insert(issues.end(), e.issues().begin(), e.issues().end());
+    throw ScenarioError(issues);
+  }
+  std::vector<std::string> defined;
+  for (const auto& m : base.metrics) defined.push_back(m.name);
+  if (spec.metrics.empty()) spec.metrics = defined;
+  for (std::size_t i = 0; i < spec.metrics.size(); ++i) {
+    if (std::find(defined.begin(), defined.end(), spec.metrics[i]) == defined.end()) {
+      r.Error(metrics[i], "metrics." + std::to_string(i),
+              "'" + spec.metrics[i] + "' is not a metric of " + spec.scenario +
+                  (defined.empty() ? " (it defines none)" : "; it defines: " +
+                                                               loader::JoinNames(defined)));
+    }
+  }
+  if (spec.metrics.empty() && r.ok()) {
+    r.Error(root, "metrics", "the base scenario defines no metrics, so a sweep has nothing to collect");
+  }
+  for (std::size_t i = 0; i < spec.parameters.size(); ++i) {
+    const std::string path = "parameters." + std::to_string(i) + ".path";
+    CheckParameterPath(spec, spec.parameters[i], Child(parameters[i], "path"), path, r);
+  }
+  if (!r.ok()) throw ScenarioError(r.issues());
+  return spec;
+}
+
+}  // namespace linesim::sweep

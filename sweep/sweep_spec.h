@@ -1,0 +1,69 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace linesim::sweep {
+
+/// How a parameter's values are chosen.
+enum class ParameterKind {
+  kValues,  // `values: [...]`: the listed YAML values
+  kRange,   // `range: {from, to, count}`: count evenly spaced numbers, both ends included
+  kRandom,  // `random: {distribution, ...}`: one draw per Monte-Carlo sample
+};
+
+enum class Distribution { kUniform, kNormal, kLogUniform };
+
+/// One varied setting of the base scenario, by the dotted path `--set` takes.
+struct ParameterSpec {
+  std::string path;
+  ParameterKind kind = ParameterKind::kValues;
+  /// kValues and kRange: the values as YAML text, in order.
+  std::vector<std::string> values;
+  /// kRandom: uniform and log-uniform draw in [a, b]; normal has mean a and
+  /// standard deviation b.
+  Distribution distribution = Distribution::kUniform;
+  double a = 0, b = 0;
+};
+
+enum class Combination {
+  kGrid,        // every combination of the listed values
+  kMonteCarlo,  // `samples` random draws, crossed with the listed values
+};
+
+/// Which scenario seed each run gets.
+enum class SeedPolicy {
+  /// Runs with the same sample and repeat number share a seed at every grid
+  /// point (common random numbers: differences between points are the
+  /// parameters' doing, not the noise's).
+  kCommon,
+  /// Every run its own seed.
+  kPerRun,
+};
+
+/// A sweep file, read and checked.
+struct SweepSpec {
+  std::string file;           // the sweep file as given
+  std::string name;
+  std::string description;
+  std::string scenario;       // the base scenario, resolved against the sweep file's folder
+  std::vector<std::pair<std::string, std::string>> fixed;  // `set:`, applied to every run
+  std::vector<ParameterSpec> parameters;
+  Combination combination = Combination::kGrid;
+  std::int64_t samples = 1;   // Monte-Carlo draws (1 for a grid)
+  std::int64_t repeats = 1;   // runs per point, each with its own seed
+  std::uint64_t seed = 1;
+  SeedPolicy seeds = SeedPolicy::kCommon;
+  /// Metrics of the base scenario to collect; all of them when the file
+  /// names none.
+  std::vector<std::string> metrics;
+};
+
+/// Reads and checks a sweep file, and that its base scenario loads with the
+/// fixed settings, every parameter path exists in it and every metric is
+/// one it defines. Throws loader::ScenarioError listing every problem (file,
+/// line, key path, what was expected).
+SweepSpec LoadSweepSpec(const std::string& file);
+
+}  // namespace linesim::sweep

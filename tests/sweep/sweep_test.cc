@@ -1,0 +1,393 @@
+// The sweep library with the real loader and units: sweep files, the run
+// plan, results.csv and the threaded executor.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "loader/scenario_error.h"
+#include "sweep/executor.h"
+#include "sweep/results_file.h"
+#include "sweep/run_plan.h"
+#include "sweep/sweep_spec.h"
+
+namespace linesim::sweep {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kCrossLine = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
+
+std::string WriteFile(const std::string& name, const std::string& text) {
+  const std::string path =
+      ::testing::TempDir() + "sweep_" + std::to_string(getpid()) + "_" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The shipped belt-speed x compensation sweep, shortened to 2 s runs.
+std::string BeltSweep(const std::string& extra = "") {
+  return "name: belt\n"
+         "scenario: " +
+         kCrossLine +
+         "\n"
+         "set: {duration_s: 2}\n"
+         "parameters:\n"
+         "  - {path: line.belts.0.speed_mps, range: {from: 0.05, to: 0.25, count: 5}}\n"
+         "  - {path: control.compensation, values: [true, false]}\n" +
+         extra;
+}
+
+std::vector<std::string> IssueTexts(const std::string& file) {
+  try {
+    LoadSweepSpec(file);
+  } catch (const loader::ScenarioError& e) {
+    std::vector<std::string> out;
+    for (const auto& i : e.issues()) out.push_back(i.ToString());
+    return out;
+  }
+  return {};
+}
+
+bool AnyContains(const std::vector<std::string>& texts, const std::string& a,
+                 const std::string& b = "") {
+  return std::any_of(texts.begin(), texts.end(), [&](const std::string& t) {
+    return t.find(a) != std::string::npos && t.find(b) != std::string::npos;
+  });
+}
+
+TEST(SweepSpec, GridCountsRepeatsFastestThenTheLastParameter) {
+  const SweepSpec spec = LoadSweepSpec(WriteFile("grid.yaml", BeltSweep("repeats: 2\n")));
+  ASSERT_EQ(spec.parameters.size(), 2u);
+  // Five evenly spaced speeds, both ends included, as the user means them
+  // (0.15, not 0.15000000000000002).
+  EXPECT_EQ(spec.parameters[0].values,
+            (std::vector<std::string>{"0.05", "0.1", "0.15", "0.2", "0.25"}));
+  EXPECT_EQ(spec.parameters[1].values, (std::vector<std::string>{"true", "false"}));
+  EXPECT_EQ(RunCount(spec), 5 * 2 * 2);
+  // Metrics default to all of the base scenario's.
+  EXPECT_FALSE(spec.metrics.empty());
+  EXPECT_EQ(spec.scenario, kCrossLine);
+
+  const RunSpec r7 = PlanRun(spec, 7);  // point 3 (speed 0.1, false), repeat 1
+  EXPECT_EQ(r7.point, 3);
+  EXPECT_EQ(r7.repeat, 1);
+  EXPECT_EQ(r7.values, (std::vector<std::string>{"0.1", "false"}));
+  const RunSpec last = PlanRun(spec, 19);
+  EXPECT_EQ(last.values, (std::vector<std::string>{"0.25", "false"}));
+  EXPECT_THROW(PlanRun(spec, 20), std::out_of_range);
+
+  // Every combination exactly once per repeat.
+  std::set<std::vector<std::string>> points;
+  for (std::int64_t id = 0; id < RunCount(spec); ++id) points.insert(PlanRun(spec, id).values);
+  EXPECT_EQ(points.size(), 10u);
+}
+
+TEST(SweepSpec, OverridesPutTheSeedFirstAndParametersLast) {
+  const SweepSpec spec = LoadSweepSpec(WriteFile("order.yaml", BeltSweep()));
+  const RunSpec run = PlanRun(spec, 0);
+  EXPECT_EQ(RunOverrides(spec, run),
+            (std::vector<std::string>{"seed=" + std::to_string(run.seed), "duration_s=2",
+                                      "line.belts.0.speed_mps=0.05",
+                                      "control.compensation=true"}));
+}
+
+TEST(SweepSeeds, CommonSeedsAreSharedAcrossPointsAndIndependentOfPlanningOrder) {
+  const SweepSpec spec = LoadSweepSpec(WriteFile("seeds.yaml", BeltSweep("repeats: 3\n")));
+  std::vector<RunSpec> forward;
+  for (std::int64_t id = 0; id < RunCount(spec); ++id) forward.push_back(PlanRun(spec, id));
+  // Planned backwards, one by one, each run is the same.
+  for (std::int64_t id = RunCount(spec); id-- > 0;) {
+    const RunSpec r = PlanRun(spec, id);
+    EXPECT_EQ(r.seed, forward[static_cast<std::size_t>(id)].seed);
+    EXPECT_EQ(r.values, forward[static_cast<std::size_t>(id)].values);
+  }
+  std::set<std::uint64_t> seeds;
+  for (const auto& r : forward) {
+    seeds.insert(r.seed);
+    EXPECT_EQ(r.seed, forward[static_cast<std::size_t>(r.repeat)].seed) << r.id;
+    EXPECT_LE(r.seed, static_cast<std::uint64_t>(INT64_MAX));  // a scenario reads int64
+  }
+  EXPECT_EQ(seeds.size(), 3u);  // one per repeat
+
+  const SweepSpec per_run =
+      LoadSweepSpec(WriteFile("seeds2.yaml", BeltSweep("repeats: 3\nseeds: per_run\n")));
+  std::set<std::uint64_t> distinct;
+  for (std::int64_t id = 0; id < RunCount(per_run); ++id) {
+    distinct.insert(PlanRun(per_run, id).seed);
+  }
+  EXPECT_EQ(distinct.size(), static_cast<std::size_t>(RunCount(per_run)));
+  // The sweep seed changes them all.
+  const SweepSpec other = LoadSweepSpec(WriteFile("seeds3.yaml", BeltSweep("seed: 2\n")));
+  EXPECT_NE(PlanRun(other, 0).seed, PlanRun(spec, 0).seed);
+}
+
+TEST(SweepSpec, MonteCarloDrawsAreReproducibleSharedByPointsAndOrderFree) {
+  const std::string draws =
+      "combine: monte_carlo\nsamples: 400\n"
+      "parameters:\n"
+      "  - {path: control.compensation, values: [true, false]}\n"
+      "  - {path: line.belts.0.speed_mps, random: {distribution: uniform, min: 0.05, max: 0.25}}\n"
+      "  - {path: robot.pose.yaw_deg, random: {distribution: normal, mean: 90, std: 5}}\n";
+  const std::string head = "scenario: " + kCrossLine + "\nset: {duration_s: 1}\n";
+  const SweepSpec spec = LoadSweepSpec(WriteFile("mc.yaml", head + draws));
+  EXPECT_EQ(RunCount(spec), 2 * 400);
+  double sum = 0, sum_sq = 0, lo = 1, hi = 0;
+  for (std::int64_t s = 0; s < 400; ++s) {
+    const RunSpec on = PlanRun(spec, s);          // point 0: compensation true
+    const RunSpec off = PlanRun(spec, 400 + s);   // point 1: the same draw
+    EXPECT_EQ(on.sample, s);
+    EXPECT_EQ(on.values[1], off.values[1]);
+    EXPECT_EQ(on.values[2], off.values[2]);
+    EXPECT_EQ(on.seed, off.seed);  // common random numbers
+    const double speed = std::stod(on.values[1]);
+    lo = std::min(lo, speed);
+    hi = std::max(hi, speed);
+    const double yaw = std::stod(on.values[2]);
+    sum += yaw;
+    sum_sq += yaw * yaw;
+  }
+  EXPECT_GE(lo, 0.05);
+  EXPECT_LT(hi, 0.25);
+  // 400 uniform draws cover [0.05, 0.25]: the expected gap at each end is
+  // 0.2 / 401 = 5e-4; 1e-2 fails with probability (1 - 0.05)^400 ~ 1e-9.
+  EXPECT_LT(lo, 0.06);
+  EXPECT_GT(hi, 0.24);
+  // Normal(90, 5): the sample mean is within 4 standard errors (4 * 5 / 20).
+  const double mean = sum / 400, sd = std::sqrt(sum_sq / 400 - mean * mean);
+  EXPECT_NEAR(mean, 90.0, 4 * 5.0 / 20.0);
+  EXPECT_NEAR(sd, 5.0, 0.75);  // about 4 standard errors of s (5 / sqrt(800))
+
+  // Reordering the parameters moves no draw: draws follow the path.
+  const std::string swapped =
+      "combine: monte_carlo\nsamples: 400\n"
+      "parameters:\n"
+      "  - {path: robot.pose.yaw_deg, random: {distribution: normal, mean: 90, std: 5}}\n"
+      "  - {path: line.belts.0.speed_mps, random: {distribution: uniform, min: 0.05, max: 0.25}}\n"
+      "  - {path: control.compensation, values: [true, false]}\n";
+  const SweepSpec spec2 = LoadSweepSpec(WriteFile("mc2.yaml", head + swapped));
+  EXPECT_EQ(PlanRun(spec2, 17).values[0], PlanRun(spec, 17).values[2]);
+  EXPECT_EQ(PlanRun(spec2, 17).values[1], PlanRun(spec, 17).values[1]);
+}
+
+TEST(SweepSpec, LogUniformDrawsStayInsideTheirBounds) {
+  const SweepSpec spec = LoadSweepSpec(WriteFile(
+      "logu.yaml", "scenario: " + kCrossLine +
+                       "\ncombine: monte_carlo\nsamples: 200\nparameters:\n"
+                       "  - {path: line.belts.0.speed_mps, random: {distribution: log_uniform, "
+                       "min: 0.01, max: 1}}\n"));
+  int below_tenth = 0;
+  for (std::int64_t id = 0; id < 200; ++id) {
+    const double v = std::stod(PlanRun(spec, id).values[0]);
+    EXPECT_GE(v, 0.01);
+    EXPECT_LE(v, 1.0);
+    below_tenth += v < 0.1 ? 1 : 0;
+  }
+  // Half of a log-uniform [0.01, 1] lies below 0.1; binomial sd sqrt(50) ~ 7.
+  EXPECT_NEAR(below_tenth, 100, 30);
+}
+
+TEST(SweepSpec, BadSweepFilesNameFileKeyPathAndWhatWasExpected) {
+  const std::string file = WriteFile(
+      "bad.yaml", "scenario: " + kCrossLine +
+                      "\nrepeatz: 2\n"
+                      "metrics: [max_deviaton]\n"
+                      "parameters:\n"
+                      "  - {path: control.compensaton, values: [true, false]}\n"
+                      "  - {path: line.belts.0.speed_mps, range: {from: 0.1, to: 0.2, count: 1}}\n"
+                      "  - {path: line.belts.7.speed_mps, values: [0.1]}\n"
+                      "  - {path: units.chassis.parameters.muu, values: [0.5]}\n");
+  const auto texts = IssueTexts(file);
+  ASSERT_FALSE(texts.empty());
+  EXPECT_TRUE(AnyContains(texts, file + ":2: repeatz", "unknown key")) << texts[0];
+  EXPECT_TRUE(AnyContains(texts, "parameters.1.range.count", "at least 2"));
+  // Path problems are found against the base scenario, each at its own key.
+  const std::string again = WriteFile(
+      "bad2.yaml", "scenario: " + kCrossLine +
+                       "\nmetrics: [max_deviaton]\n"
+                       "parameters:\n"
+                       "  - {path: control.compensaton, values: [true, false]}\n"
+                       "  - {path: line.belts.7.speed_mps, values: [0.1]}\n"
+                       "  - {path: units.chassis.parameters.muu, values: [0.5]}\n");
+  const auto t2 = IssueTexts(again);
+  EXPECT_TRUE(AnyContains(t2, "parameters.0.path", "control.compensation"));  // closest key
+  EXPECT_TRUE(AnyContains(t2, "parameters.1.path", "not an item of the list"));
+  // A robot file without a units: map takes no unit parameters.
+  EXPECT_TRUE(AnyContains(t2, "parameters.2.path", "no key 'units'"));
+  EXPECT_TRUE(AnyContains(t2, "metrics.0", "not a metric"));
+
+  EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("nofile.yaml", "scenario: nowhere.yaml\n"
+                                                              "parameters: [{path: seed, values: [1]}]\n")),
+                          "scenario", "refused"));
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(WriteFile("gridrandom.yaml",
+                           "scenario: " + kCrossLine +
+                               "\nparameters: [{path: seed, random: {distribution: uniform, "
+                               "min: 1, max: 2}}]\n")),
+      "parameters.0.random", "monte_carlo"));
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(WriteFile("twokinds.yaml", "scenario: " + kCrossLine +
+                                                "\nparameters: [{path: seed, values: [1], "
+                                                "range: {from: 1, to: 2, count: 2}}]\n")),
+      "parameters.0", "exactly one of"));
+  EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("missing.yaml", "parameters: []\n")), "scenario",
+                          "missing required key"));
+  EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("absent_sweep.yaml", "")), "expected a map"));
+  EXPECT_TRUE(AnyContains(IssueTexts("/nonexistent/sweep.yaml"), "cannot read the sweep file"));
+}
+
+TEST(SweepSpec, AnOutOfRangeValueIsARunProblemNotASweepProblem) {
+  // A value the scenario refuses fails its own run only: the others may be
+  // what the user wants to see.
+  EXPECT_NO_THROW(LoadSweepSpec(WriteFile(
+      "range.yaml", "scenario: " + kCrossLine +
+                        "\nparameters: [{path: master.step_s, values: [-1, 0.001]}]\n")));
+}
+
+TEST(ResultsCsv, QuotesRoundTrip) {
+  const std::vector<std::string> fields{"1", "[1, 2]", "say \"hi\"", "", "a\nb", " pad"};
+  const std::string line = JoinCsvLine(fields);
+  EXPECT_EQ(line, "1,\"[1, 2]\",\"say \"\"hi\"\"\",,\"a\nb\",\" pad\"\n");
+  EXPECT_EQ(SplitCsvLine(line.substr(0, line.size() - 1)), fields);
+  EXPECT_FALSE(SplitCsvLine("1,\"open").has_value());
+}
+
+// A folder of its own for each test.
+std::string FreshDir(const std::string& name) {
+  const fs::path p = fs::path(::testing::TempDir()) / ("sweep_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p.string();
+}
+
+// The rows without the wall_s column, the one thing that differs between
+// two runs of the same sweep.
+std::string WithoutWallTime(const std::string& csv) {
+  std::string out;
+  std::istringstream in(csv);
+  for (std::string line; std::getline(in, line);) out += line.substr(0, line.rfind(',')) + "\n";
+  return out;
+}
+
+std::string RunSweep(const SweepSpec& spec, int jobs, const std::string& dir) {
+  ResultsFile results = ResultsFile::Create(dir + "/results.csv", spec);
+  std::vector<RunSpec> runs;
+  for (std::int64_t id = 0; id < RunCount(spec); ++id) runs.push_back(PlanRun(spec, id));
+  std::atomic<bool> stop{false};
+  RunOnThreads(spec, runs, jobs, stop, [&](const RunSpec& run, const RunOutcome& outcome) {
+    results.Append(run.id, FormatRow(spec, run, outcome));
+  });
+  results.SortByRunId();
+  return ReadFile(dir + "/results.csv");
+}
+
+TEST(SweepExecutor, OneAndTwoJobsWriteTheSameRowsAndAFailingRunIsIsolated) {
+  // A step of 0.003 s does not divide the 20 ms control period: the loader
+  // refuses that run; 0.002 s runs. By 6 s the robot is well onto the belt.
+  const SweepSpec spec = LoadSweepSpec(WriteFile(
+      "exec.yaml", "scenario: " + kCrossLine +
+                       "\nset: {duration_s: 6}\n"
+                       "metrics: [max_path_deviation_m]\n"
+                       "parameters:\n"
+                       "  - {path: master.step_s, values: [0.001, 0.003, 0.002]}\n"
+                       "  - {path: control.compensation, values: [true, false]}\n"));
+  const std::string one = RunSweep(spec, 1, FreshDir("one"));
+  const std::string two = RunSweep(spec, 2, FreshDir("two"));
+  EXPECT_EQ(WithoutWallTime(one), WithoutWallTime(two));
+
+  std::istringstream in(one);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header,
+            "run_id,master.step_s,control.compensation,seed,max_path_deviation_m,status,error,wall_s");
+  std::vector<std::vector<std::string>> rows;
+  for (std::string line; std::getline(in, line);) rows.push_back(*SplitCsvLine(line));
+  ASSERT_EQ(rows.size(), 6u);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i][0], std::to_string(i));  // sorted by run id
+    const bool bad = rows[i][1] == "0.003";
+    EXPECT_EQ(rows[i][5], bad ? "failed" : "ok") << i;
+    EXPECT_EQ(rows[i][4].empty(), bad) << i;
+    if (bad) {
+      EXPECT_NE(rows[i][6].find("not an integer multiple of the master step 0.003 s"), std::string::npos) << rows[i][6];
+    }
+  }
+  // Compensation on beats off at both good steps (paper 1, Sec. VI-B).
+  EXPECT_LT(std::stod(rows[0][4]), std::stod(rows[1][4]));
+  EXPECT_LT(std::stod(rows[4][4]), std::stod(rows[5][4]));
+}
+
+TEST(SweepExecutor, AStopLeavesNoRowForTheInterruptedRun) {
+  const SweepSpec spec = LoadSweepSpec(WriteFile("stop.yaml", BeltSweep()));
+  std::vector<RunSpec> runs;
+  for (std::int64_t id = 0; id < RunCount(spec); ++id) runs.push_back(PlanRun(spec, id));
+  std::atomic<bool> stop{false};
+  std::vector<std::int64_t> done;
+  RunOnThreads(spec, runs, 2, stop, [&](const RunSpec& run, const RunOutcome&) {
+    done.push_back(run.id);
+    if (done.size() == 3) stop = true;
+  });
+  // Three rows; a run finishing on the other thread may add a fourth.
+  EXPECT_GE(done.size(), 3u);
+  EXPECT_LE(done.size(), 4u);
+  const RunOutcome o = ExecuteRun(spec, runs[0], &stop);
+  EXPECT_EQ(o.status, RunStatus::kInterrupted);
+}
+
+TEST(ResultsFile, ResumeKeepsCompleteRowsAndDropsACutOffLine) {
+  const SweepSpec spec = LoadSweepSpec(WriteFile("resume.yaml", BeltSweep()));
+  const std::string dir = FreshDir("resume");
+  const std::string full = RunSweep(spec, 2, dir);
+  // Keep the header and rows 0, 3 and a duplicate of 3; cut row 5 short.
+  std::istringstream in(full);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line + "\n");
+  const std::string path = dir + "/results.csv";
+  std::ofstream(path, std::ios::trunc) << lines[0] << lines[4] << lines[1] << lines[4]
+                                       << lines[6].substr(0, 12);
+  ResultsFile resumed = ResultsFile::Resume(path, spec);
+  EXPECT_EQ(resumed.row_count(), 2u);
+  EXPECT_TRUE(resumed.HasRow(0));
+  EXPECT_TRUE(resumed.HasRow(3));
+  EXPECT_FALSE(resumed.HasRow(5));
+  EXPECT_EQ(ReadFile(path), lines[0] + lines[1] + lines[4]);
+
+  // Another sweep's file is refused, not mixed.
+  const SweepSpec other = LoadSweepSpec(WriteFile("other.yaml", BeltSweep("metrics: [max_path_deviation_m]\n")));
+  std::ofstream(path, std::ios::trunc) << "run_id,x,seed\n";
+  EXPECT_THROW(ResultsFile::Resume(path, other), std::runtime_error);
+}
+
+TEST(ResultsFile, TableParsesRowsBack) {
+  const SweepSpec spec = LoadSweepSpec(WriteFile("table.yaml", BeltSweep()));
+  const std::string dir = FreshDir("table");
+  RunSweep(spec, 2, dir);
+  const SweepTable t = ResultsFile::Resume(dir + "/results.csv", spec).Table(spec);
+  ASSERT_EQ(t.rows.size(), 10u);
+  EXPECT_EQ(t.parameters, (std::vector<std::string>{"line.belts.0.speed_mps",
+                                                    "control.compensation"}));
+  EXPECT_EQ(t.metrics.back(), "wall_s");
+  EXPECT_EQ(t.levels[1], (std::vector<std::string>{"true", "false"}));
+  EXPECT_TRUE(t.grid);
+  for (const auto& row : t.rows) {
+    EXPECT_TRUE(row.ok) << row.error;
+    EXPECT_EQ(row.metrics.size(), t.metrics.size());
+    EXPECT_GT(row.metrics.back(), 0.0);
+    EXPECT_EQ(row.seed, PlanRun(spec, row.id).seed);
+  }
+}
+
+}  // namespace
+}  // namespace linesim::sweep
