@@ -1,10 +1,5 @@
 #include "plots/robot_plots.h"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -17,8 +12,7 @@
 
 #include "cosim/closest_names.h"
 #include "cosim/variable_table.h"
-
-extern char** environ;
+#include "plots/gnuplot.h"
 
 namespace linesim::plots {
 
@@ -32,21 +26,6 @@ constexpr const char* kScript = "plots.gp";
 // Shortest text that reads back to the same double: deterministic and
 // independent of the locale.
 std::string Num(double x) { return cosim::FormatValue(x); }
-
-// A gnuplot single-quoted string: no escapes inside except '' for a quote.
-std::string Quote(const std::string& text) {
-  std::string out = "'";
-  for (char c : text) {
-    if (c == '\'') {
-      out += "''";
-    } else if (c == '\n' || c == '\r') {
-      out += ' ';
-    } else {
-      out += c;
-    }
-  }
-  return out + "'";
-}
 
 // Views of the first `max_fields` fields of a CSV line (all when 0), into a
 // vector reused from row to row: no allocation per field.
@@ -205,16 +184,8 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
 
   std::string s =
       "# Written by linesim (plots/robot_plots.cc). Run `gnuplot plots.gp` in this folder\n"
-      "# to redraw; data come from signals.csv (columns by number, header skipped).\n"
-      "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {\n"
-      "  set terminal pngcairo size " +
-      std::to_string(kCanvasWidthPx) + "," + std::to_string(kCanvasHeightPx) +
-      " noenhanced font ',10'\n"
-      "} else {\n"
-      "  set terminal png size " +
-      std::to_string(kCanvasWidthPx) + "," + std::to_string(kCanvasHeightPx) +
-      " noenhanced\n"
-      "}\n"
+      "# to redraw; data come from signals.csv (columns by number, header skipped).\n" +
+      GnuplotPngTerminal(kCanvasWidthPx, kCanvasHeightPx) +
       "set datafile separator comma\n"
       "set grid\n";
 
@@ -316,14 +287,14 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   if (!labels.empty()) AppendBlock(s, "labels", labels);
 
   const std::string title_prefix = spec.title.empty() ? "" : spec.title + ": ";
-  const std::string signals_file = Quote(kSignals);
+  const std::string signals_file = GnuplotQuote(kSignals);
 
   // Top view of the robot's neighbourhood (path, track, outlines), not of
   // the whole line: belts are clipped to it.
   outputs->push_back("top_view.png");
   s += "\nset output 'top_view.png'\n"
        "set title " +
-       Quote(title_prefix + "top view (map frame)") +
+       GnuplotQuote(title_prefix + "top view (map frame)") +
        "\n"
        "set xlabel 'x (m)'\nset ylabel 'y (m)'\n"
        "set lmargin at screen " +
@@ -381,15 +352,15 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
 
   if (ierr > 0) {
     outputs->push_back("error.png");
-    s += "\nset output 'error.png'\nset title " + Quote(title_prefix + spec.error_label) +
-         "\nset xlabel 'time (s)'\nset ylabel " + Quote(spec.error_label) + "\nplot " +
+    s += "\nset output 'error.png'\nset title " + GnuplotQuote(title_prefix + spec.error_label) +
+         "\nset xlabel 'time (s)'\nset ylabel " + GnuplotQuote(spec.error_label) + "\nplot " +
          signals_file + " skip 1 using 1:" + std::to_string(ierr) + " with lines lw 1.5 title " +
-         Quote(spec.error_column) + "\n";
+         GnuplotQuote(spec.error_column) + "\n";
   }
 
   if (!speeds.empty() || !ons.empty()) {
     outputs->push_back("belt.png");
-    s += "\nset output 'belt.png'\nset title " + Quote(title_prefix + "belts") +
+    s += "\nset output 'belt.png'\nset title " + GnuplotQuote(title_prefix + "belts") +
          "\nset xlabel 'time (s)'\nset ylabel 'belt speed (m/s)'\n"
          "set y2label 'scheduled on (1) / off (0)'\n"
          "set yrange [0:*]\nset offsets 0, 0, graph 0.08, 0\n"
@@ -397,65 +368,18 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     items.clear();
     for (std::size_t i = 0; i < speeds.size(); ++i) {
       items.push_back(signals_file + " skip 1 using 1:" + std::to_string(speeds[i]) +
-                      " with lines lw 2 title " + Quote(spec.belt_speed_columns[i]));
+                      " with lines lw 2 title " + GnuplotQuote(spec.belt_speed_columns[i]));
     }
     for (std::size_t i = 0; i < ons.size(); ++i) {
       items.push_back(signals_file + " skip 1 using 1:" + std::to_string(ons[i]) +
-                      " axes x1y2 with steps dt 2 lw 1.5 title " + Quote(spec.belt_on_columns[i]));
+                      " axes x1y2 with steps dt 2 lw 1.5 title " +
+                      GnuplotQuote(spec.belt_on_columns[i]));
     }
     for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
     s += "\n";
   }
   s += "unset output\n";
   return s;
-}
-
-/// Runs `gnuplot plots.gp` in `dir` without a shell (paths with spaces or
-/// quotes need no escaping); returns gnuplot's exit status and stderr text.
-std::pair<int, std::string> RunGnuplot(const fs::path& dir) {
-  int err_pipe[2];
-  if (pipe(err_pipe) != 0) {
-    throw std::runtime_error(std::string("cannot create a pipe for gnuplot: ") +
-                             std::strerror(errno));
-  }
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_adddup2(&actions, err_pipe[1], 2);
-  posix_spawn_file_actions_addclose(&actions, err_pipe[0]);
-  posix_spawn_file_actions_addclose(&actions, err_pipe[1]);
-  const std::string dir_text = dir.string();
-  posix_spawn_file_actions_addchdir_np(&actions, dir_text.c_str());
-  char arg0[] = "gnuplot";
-  char arg1[] = "plots.gp";
-  char* argv[] = {arg0, arg1, nullptr};
-  pid_t pid = 0;
-  const int spawn_error = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
-  posix_spawn_file_actions_destroy(&actions);
-  close(err_pipe[1]);
-  if (spawn_error != 0) {
-    close(err_pipe[0]);
-    throw std::runtime_error("cannot run gnuplot (is it installed and on PATH?): " +
-                             std::string(std::strerror(spawn_error)));
-  }
-  std::string text;
-  char buf[4096];
-  while (true) {
-    const ssize_t n = read(err_pipe[0], buf, sizeof buf);
-    if (n > 0) {
-      text.append(buf, static_cast<std::size_t>(n));
-    } else if (n == 0 || errno != EINTR) {
-      break;
-    }
-  }
-  close(err_pipe[0]);
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) throw std::runtime_error("waiting for gnuplot failed");
-  }
-  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  return {code, text};
 }
 
 }  // namespace
@@ -466,27 +390,7 @@ std::vector<std::string> WriteRobotPlots(const std::string& dir, const RobotPlot
   Signals signals = OpenSignals(csv);
   std::vector<std::string> names;
   const std::string script = Script(spec, signals, &names);
-  {
-    std::ofstream out(folder / kScript, std::ios::binary | std::ios::trunc);
-    out << script;
-    if (!out.flush()) throw std::runtime_error("cannot write " + (folder / kScript).string());
-  }
-  // Stale plots from an earlier run must not pass for new ones.
-  for (const auto& name : names) fs::remove(folder / name);
-  const auto [code, errors] = RunGnuplot(folder);
-  std::vector<std::string> written;
-  for (const auto& name : names) {
-    const fs::path png = folder / name;
-    if (code == 0 && !fs::exists(png)) {
-      throw std::runtime_error("gnuplot did not write " + png.string() + ": " + errors);
-    }
-    written.push_back(png.string());
-  }
-  if (code != 0) {
-    throw std::runtime_error("gnuplot failed on " + (folder / kScript).string() + " (exit status " +
-                             std::to_string(code) + "): " + errors);
-  }
-  return written;
+  return DrawWithGnuplot(dir, kScript, script, names);
 }
 
 }  // namespace linesim::plots

@@ -1,0 +1,208 @@
+#include "plots/sweep_plots.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <optional>
+#include <set>
+#include <stdexcept>
+
+#include "cosim/variable_table.h"
+#include "plots/gnuplot.h"
+
+namespace linesim::plots {
+
+namespace {
+
+constexpr const char* kScript = "sweep_plots.gp";
+constexpr int kWidthPx = 800, kHeightPx = 500;
+
+// Shortest text that reads back to the same double, independent of the
+// locale.
+std::string Num(double x) { return cosim::FormatValue(x); }
+
+std::optional<double> ParseNumber(std::string_view text) {
+  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+  double x = 0.0;
+  const char* end = text.data() + text.size();
+  const auto res = std::from_chars(text.data(), end, x);
+  if (text.empty() || res.ec != std::errc() || res.ptr != end || !std::isfinite(x)) {
+    return std::nullopt;
+  }
+  return x;
+}
+
+bool IsSafeFileName(const std::string& name) {
+  return !name.empty() && name != "." && name != ".." && SafeFileName(name) == name;
+}
+
+[[noreturn]] void Refuse(const SweepChart& chart, const std::string& why) {
+  throw std::runtime_error("sweep plot '" + chart.file + "': " + why);
+}
+
+void CheckChart(const SweepChart& chart) {
+  if (!IsSafeFileName(chart.file) || !chart.file.ends_with(".png")) {
+    Refuse(chart, "the file name must be made of [A-Za-z0-9._-] and end in .png");
+  }
+  for (const SweepSeries& s : chart.series) {
+    const std::size_t n = s.x.size();
+    const bool bars_ok =
+        chart.scatter ? (s.min.empty() || s.min.size() == n) && (s.max.empty() || s.max.size() == n)
+                      : s.min.size() == n && s.max.size() == n;
+    if (s.mean.size() != n || !bars_ok) {
+      Refuse(chart, "series '" + s.label + "' has " + std::to_string(n) + " x values but " +
+                        std::to_string(s.mean.size()) + " means, " + std::to_string(s.min.size()) +
+                        " minima and " + std::to_string(s.max.size()) + " maxima");
+    }
+    if (chart.categorical_x) continue;
+    for (const std::string& x : s.x) {
+      if (!ParseNumber(x)) Refuse(chart, "x value '" + x + "' is not a number on a numeric axis");
+    }
+  }
+}
+
+// Tic order of a categorical axis: the chart's categories, then any others
+// in first-seen order.
+std::vector<std::string> Categories(const SweepChart& chart) {
+  std::vector<std::string> order = chart.categories;
+  for (const SweepSeries& s : chart.series) {
+    for (const std::string& x : s.x) {
+      if (std::find(order.begin(), order.end(), x) == order.end()) order.push_back(x);
+    }
+  }
+  return order;
+}
+
+struct Point {
+  double x, mean, min, max;
+};
+
+// The drawable points of a series: finite, sorted along a numeric axis (the
+// line joins them in x order); categories moved sideways by `shift` so that
+// the error bars of several series stay apart.
+std::vector<Point> Points(const SweepChart& chart, const SweepSeries& s,
+                          const std::vector<std::string>& categories, double shift) {
+  std::vector<Point> points;
+  for (std::size_t i = 0; i < s.x.size(); ++i) {
+    double x = 0.0;
+    if (chart.categorical_x) {
+      x = static_cast<double>(std::find(categories.begin(), categories.end(), s.x[i]) -
+                              categories.begin()) +
+          shift;
+    } else {
+      x = *ParseNumber(s.x[i]);
+    }
+    const double lo = i < s.min.size() ? s.min[i] : s.mean[i];
+    const double hi = i < s.max.size() ? s.max[i] : s.mean[i];
+    if (!std::isfinite(s.mean[i]) || (!chart.scatter && !std::isfinite(lo + hi))) continue;
+    points.push_back({x, s.mean[i], lo, hi});
+  }
+  if (!chart.categorical_x) {
+    std::stable_sort(points.begin(), points.end(),
+                     [](const Point& a, const Point& b) { return a.x < b.x; });
+  }
+  return points;
+}
+
+// The script lines of one chart; empty when it has nothing to draw.
+std::string ChartScript(const SweepChart& chart, std::size_t index) {
+  const std::vector<std::string> categories =
+      chart.categorical_x ? Categories(chart) : std::vector<std::string>{};
+  const std::size_t count = chart.series.size();
+  // Sideways spread of the series at one category: at most 0.6 of the gap.
+  const double step = std::min(0.1, 0.6 / static_cast<double>(count));
+  std::string blocks, items;
+  bool any_label = false;
+  for (std::size_t k = 0; k < count; ++k) {
+    const SweepSeries& s = chart.series[k];
+    const double shift =
+        chart.categorical_x && !chart.scatter
+            ? (static_cast<double>(k) - 0.5 * static_cast<double>(count - 1)) * step
+            : 0.0;
+    const std::vector<Point> points = Points(chart, s, categories, shift);
+    if (points.empty()) continue;
+    const std::string block = "$chart" + std::to_string(index) + "_" + std::to_string(k);
+    blocks += block + " << EOD\n";
+    for (const Point& p : points) {
+      blocks += Num(p.x) + " " + Num(p.mean);
+      if (!chart.scatter) blocks += " " + Num(p.min) + " " + Num(p.max);
+      blocks += "\n";
+    }
+    blocks += "EOD\n";
+    any_label = any_label || !s.label.empty();
+    std::string style;
+    if (chart.scatter) {
+      style = "using 1:2 with points pt 7 ps 0.8";
+    } else if (chart.categorical_x) {
+      style = "using 1:2:3:4 with yerrorbars pt 7 ps 1.2 lw 2";
+    } else {
+      style = "using 1:2:3:4 with yerrorlines pt 7 ps 1.2 lw 2";
+    }
+    const std::string default_title =
+        chart.scatter ? "one point per run" : "mean, bars: min to max";
+    items += std::string(items.empty() ? "plot " : ", \\\n     ") + block + " " + style + " lt " +
+             std::to_string(k + 1) + " title " +
+             GnuplotQuote(s.label.empty() ? default_title : s.label);
+  }
+  if (items.empty()) return {};
+
+  std::string s = "\n" + blocks + "set output " + GnuplotQuote(chart.file) + "\nset title " +
+                  GnuplotQuote(chart.title) + "\nset xlabel " + GnuplotQuote(chart.x_label) +
+                  "\nset ylabel " + GnuplotQuote(chart.y_label) + "\n";
+  if (chart.categorical_x) {
+    s += "set xrange [-0.5:" + Num(static_cast<double>(categories.size()) - 0.5) + "]\nset xtics (";
+    for (std::size_t i = 0; i < categories.size(); ++i) {
+      s += (i ? ", " : "") + GnuplotQuote(categories[i]) + " " + std::to_string(i);
+    }
+    s += ")\n";
+  } else {
+    s += "set autoscale x\nset xtics autofreq\n";
+  }
+  if (any_label) {
+    s += "set key title " +
+         GnuplotQuote(chart.scatter ? "one point per run" : "mean, bars: min to max") + "\n";
+  } else {
+    s += "set key title ''\n";
+  }
+  return s + items + "\n";
+}
+
+}  // namespace
+
+std::string SafeFileName(std::string_view name) {
+  std::string out(name);
+  for (char& c : out) {
+    const bool safe = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      c == '.' || c == '_' || c == '-';
+    if (!safe) c = '_';
+  }
+  return out;
+}
+
+std::vector<std::string> WriteSweepPlots(const std::string& dir,
+                                         const std::vector<SweepChart>& charts) {
+  std::set<std::string> files;
+  for (const SweepChart& chart : charts) {
+    CheckChart(chart);
+    if (!files.insert(chart.file).second) Refuse(chart, "two charts have this file name");
+  }
+  std::string script =
+      "# Written by linesim (plots/sweep_plots.cc). Run `gnuplot sweep_plots.gp` in this\n"
+      "# folder to redraw; the data are inline.\n" +
+      GnuplotPngTerminal(kWidthPx, kHeightPx) +
+      "set grid\n"
+      "set key below\n"
+      "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n";
+  std::vector<std::string> outputs;
+  for (std::size_t i = 0; i < charts.size(); ++i) {
+    const std::string chart = ChartScript(charts[i], i);
+    if (chart.empty()) continue;
+    script += chart;
+    outputs.push_back(charts[i].file);
+  }
+  if (outputs.empty()) return {};
+  script += "unset output\n";
+  return DrawWithGnuplot(dir, kScript, script, outputs);
+}
+
+}  // namespace linesim::plots
