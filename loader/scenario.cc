@@ -90,9 +90,9 @@ void ApplyParameters(cosim::Unit& unit, const YAML::Node& map, const std::string
     const auto ref = unit.variables().Find(key);
     if (!ref || unit.variables().info(*ref).causality != cosim::Causality::kParameter) {
       r.UnknownPath(kv.first, key_path,
-              "unknown parameter of a " + unit.type_name() + " unit" +
-                  ClosestPathsHint(path, key, allowed) + " (linesim inspect " + unit.type_name() +
-                  " lists them)");
+                    "unknown parameter of a " + unit.type_name() + " unit" +
+                        ClosestPathsHint(path, key, allowed) + " (linesim inspect " +
+                        unit.type_name() + " lists them)");
       continue;
     }
     ApplyParameter(unit, unit.variables().info(*ref), kv.second, key_path, r);

@@ -87,8 +87,8 @@ int MpiSession::ShareStatus(int status) const {
   return worst;
 }
 
-void DispatchRuns(const SweepSpec& spec, const std::vector<RunSpec>& runs,
-                  std::atomic<bool>& stop, const OnRunDone& on_done) {
+void DispatchRuns(const SweepSpec& spec, const std::vector<RunSpec>& runs, std::atomic<bool>& stop,
+                  const OnRunDone& on_done) {
   int size = 1;
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   if (size == 1) {

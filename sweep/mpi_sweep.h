@@ -34,8 +34,8 @@ class MpiSession {
 /// (dynamic balance), and calls `on_done` for each result, in arrival
 /// order. Once `stop` is set it hands out nothing more and waits for the
 /// running ones. With one rank only, rank 0 runs them itself.
-void DispatchRuns(const SweepSpec& spec, const std::vector<RunSpec>& runs,
-                  std::atomic<bool>& stop, const OnRunDone& on_done);
+void DispatchRuns(const SweepSpec& spec, const std::vector<RunSpec>& runs, std::atomic<bool>& stop,
+                  const OnRunDone& on_done);
 
 /// Ranks other than 0: run what rank 0 sends until it says stop. `stop`
 /// interrupts the running run (it then sends no row).

@@ -18,8 +18,8 @@ std::string FormatDuration(double seconds) {
   return text;
 }
 
-ProgressBar::ProgressBar(std::ostream& out, bool enabled, std::int64_t total,
-                         std::int64_t already, std::int64_t already_failed)
+ProgressBar::ProgressBar(std::ostream& out, bool enabled, std::int64_t total, std::int64_t already,
+                         std::int64_t already_failed)
     : out_(out),
       enabled_(enabled),
       total_(total),
@@ -39,9 +39,8 @@ std::string ProgressBar::Text() const {
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   const std::int64_t fresh = done_ - already_;
-  const double eta = fresh > 0 ? elapsed / static_cast<double>(fresh) *
-                                     static_cast<double>(total_ - done_)
-                               : NAN;
+  const double eta =
+      fresh > 0 ? elapsed / static_cast<double>(fresh) * static_cast<double>(total_ - done_) : NAN;
   return bar + std::to_string(done_) + "/" + std::to_string(total_) + " done, " +
          std::to_string(failed_) + " failed, " + FormatDuration(elapsed) + " elapsed, ETA " +
          (done_ == total_ ? "0:00" : FormatDuration(eta));

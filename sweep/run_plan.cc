@@ -42,8 +42,8 @@ double Draw(const SweepSpec& spec, const ParameterSpec& p, std::int64_t sample) 
     case Distribution::kNormal: {
       // Box-Muller with a second independent draw; 1 - u is in (0, 1].
       const double u2 = UniformDraw(Mix(seed));
-      return p.a + p.b * std::sqrt(-2.0 * std::log(1.0 - u)) *
-                       std::cos(2.0 * std::numbers::pi * u2);
+      return p.a +
+             p.b * std::sqrt(-2.0 * std::log(1.0 - u)) * std::cos(2.0 * std::numbers::pi * u2);
     }
   }
   return p.a;
@@ -51,9 +51,7 @@ double Draw(const SweepSpec& spec, const ParameterSpec& p, std::int64_t sample) 
 
 }  // namespace
 
-double UniformDraw(std::uint64_t seed) {
-  return static_cast<double>(Mix(seed) >> 11) * 0x1.0p-53;
-}
+double UniformDraw(std::uint64_t seed) { return static_cast<double>(Mix(seed) >> 11) * 0x1.0p-53; }
 
 std::int64_t RunCount(const SweepSpec& spec) {
   return PointCount(spec) * spec.samples * spec.repeats;

@@ -33,8 +33,7 @@ std::string YamlText(const YAML::Node& node) {
   return out.c_str();
 }
 
-void ReadRange(const YAML::Node& range, const std::string& path, YamlReader& r,
-               ParameterSpec& p) {
+void ReadRange(const YAML::Node& range, const std::string& path, YamlReader& r, ParameterSpec& p) {
   if (!r.ExpectMap(range, path)) return;
   r.CheckKeys(range, path, {"from", "to", "count"});
   const std::size_t issues_before = r.issues().size();
@@ -63,8 +62,8 @@ void ReadRange(const YAML::Node& range, const std::string& path, YamlReader& r,
 void ReadRandom(const YAML::Node& random, const std::string& path, YamlReader& r,
                 ParameterSpec& p) {
   if (!r.ExpectMap(random, path)) return;
-  const std::string d = r.String(random, path, "distribution", std::nullopt,
-                                 {"uniform", "normal", "log_uniform"});
+  const std::string d =
+      r.String(random, path, "distribution", std::nullopt, {"uniform", "normal", "log_uniform"});
   if (d == "normal") {
     r.CheckKeys(random, path, {"distribution", "mean", "std"});
     p.distribution = Distribution::kNormal;
@@ -73,8 +72,7 @@ void ReadRandom(const YAML::Node& random, const std::string& path, YamlReader& r
   } else if (d == "uniform" || d == "log_uniform") {
     r.CheckKeys(random, path, {"distribution", "min", "max"});
     p.distribution = d == "uniform" ? Distribution::kUniform : Distribution::kLogUniform;
-    const loader::Range range =
-        d == "uniform" ? loader::Range{} : loader::Range{0, INFINITY, true};
+    const loader::Range range = d == "uniform" ? loader::Range{} : loader::Range{0, INFINITY, true};
     p.a = r.Real(random, path, "min", std::nullopt, range);
     p.b = r.Real(random, path, "max", std::nullopt, range);
     if (r.ok() && !(p.b >= p.a)) {
@@ -127,16 +125,15 @@ void CheckParameterPath(const SweepSpec& spec, const ParameterSpec& p, const YAM
                         const std::string& key_path, YamlReader& r) {
   std::vector<std::string> args;
   for (const auto& [path, value] : spec.fixed) args.push_back(path + "=" + value);
-  const std::string probe = p.kind == ParameterKind::kRandom ? cosim::FormatValue(p.a)
-                                                             : p.values.front();
+  const std::string probe =
+      p.kind == ParameterKind::kRandom ? cosim::FormatValue(p.a) : p.values.front();
   args.push_back(p.path + "=" + probe);
   try {
     loader::LoadScenario(spec.scenario, args);
   } catch (const ScenarioError& e) {
     for (const Issue& i : e.issues()) {
-      const bool at_parameter =
-          i.key_path == p.path || i.key_path.rfind(p.path + ".", 0) == 0 ||
-          p.path.rfind(i.key_path + ".", 0) == 0;
+      const bool at_parameter = i.key_path == p.path || i.key_path.rfind(p.path + ".", 0) == 0 ||
+                                p.path.rfind(i.key_path + ".", 0) == 0;
       if (i.unknown_path && at_parameter) {
         r.Error(at, key_path, "not a setting of " + spec.scenario + ": " + i.message);
       }
@@ -190,8 +187,7 @@ SweepSpec LoadSweepSpec(const std::string& file) {
       ReadParameter(parameters[i], "parameters." + std::to_string(i), r, spec);
     }
   }
-  const std::string combine =
-      r.String(root, "", "combine", "grid", {"grid", "monte_carlo"});
+  const std::string combine = r.String(root, "", "combine", "grid", {"grid", "monte_carlo"});
   spec.combination = combine == "monte_carlo" ? Combination::kMonteCarlo : Combination::kGrid;
   if (spec.combination == Combination::kMonteCarlo) {
     spec.samples = r.Integer(root, "", "samples", std::nullopt, 1, 100000000);
@@ -244,12 +240,13 @@ SweepSpec LoadSweepSpec(const std::string& file) {
     if (std::find(defined.begin(), defined.end(), spec.metrics[i]) == defined.end()) {
       r.Error(metrics[i], "metrics." + std::to_string(i),
               "'" + spec.metrics[i] + "' is not a metric of " + spec.scenario +
-                  (defined.empty() ? " (it defines none)" : "; it defines: " +
-                                                               loader::JoinNames(defined)));
+                  (defined.empty() ? " (it defines none)"
+                                   : "; it defines: " + loader::JoinNames(defined)));
     }
   }
   if (spec.metrics.empty() && r.ok()) {
-    r.Error(root, "metrics", "the base scenario defines no metrics, so a sweep has nothing to collect");
+    r.Error(root, "metrics",
+            "the base scenario defines no metrics, so a sweep has nothing to collect");
   }
   for (std::size_t i = 0; i < spec.parameters.size(); ++i) {
     const std::string path = "parameters." + std::to_string(i) + ".path";

@@ -44,15 +44,15 @@ enum class SeedPolicy {
 
 /// A sweep file, read and checked.
 struct SweepSpec {
-  std::string file;           // the sweep file as given
+  std::string file;  // the sweep file as given
   std::string name;
   std::string description;
-  std::string scenario;       // the base scenario, resolved against the sweep file's folder
+  std::string scenario;  // the base scenario, resolved against the sweep file's folder
   std::vector<std::pair<std::string, std::string>> fixed;  // `set:`, applied to every run
   std::vector<ParameterSpec> parameters;
   Combination combination = Combination::kGrid;
-  std::int64_t samples = 1;   // Monte-Carlo draws (1 for a grid)
-  std::int64_t repeats = 1;   // runs per point, each with its own seed
+  std::int64_t samples = 1;  // Monte-Carlo draws (1 for a grid)
+  std::int64_t repeats = 1;  // runs per point, each with its own seed
   std::uint64_t seed = 1;
   SeedPolicy seeds = SeedPolicy::kCommon;
   /// Metrics of the base scenario to collect; all of them when the file

@@ -24,8 +24,7 @@ namespace fs = std::filesystem;
 const std::string kCrossLine = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
 
 std::string WriteFile(const std::string& name, const std::string& text) {
-  const std::string path =
-      ::testing::TempDir() + "sweep_" + std::to_string(getpid()) + "_" + name;
+  const std::string path = ::testing::TempDir() + "sweep_" + std::to_string(getpid()) + "_" + name;
   std::ofstream(path) << text;
   return path;
 }
@@ -100,8 +99,7 @@ TEST(SweepSpec, OverridesPutTheSeedFirstAndParametersLast) {
   const RunSpec run = PlanRun(spec, 0);
   EXPECT_EQ(RunOverrides(spec, run),
             (std::vector<std::string>{"seed=" + std::to_string(run.seed), "duration_s=2",
-                                      "line.belts.0.speed_mps=0.05",
-                                      "control.compensation=true"}));
+                                      "line.belts.0.speed_mps=0.05", "control.compensation=true"}));
 }
 
 TEST(SweepSeeds, CommonSeedsAreSharedAcrossPointsAndIndependentOfPlanningOrder) {
@@ -146,8 +144,8 @@ TEST(SweepSpec, MonteCarloDrawsAreReproducibleSharedByPointsAndOrderFree) {
   EXPECT_EQ(RunCount(spec), 2 * 400);
   double sum = 0, sum_sq = 0, lo = 1, hi = 0;
   for (std::int64_t s = 0; s < 400; ++s) {
-    const RunSpec on = PlanRun(spec, s);          // point 0: compensation true
-    const RunSpec off = PlanRun(spec, 400 + s);   // point 1: the same draw
+    const RunSpec on = PlanRun(spec, s);         // point 0: compensation true
+    const RunSpec off = PlanRun(spec, 400 + s);  // point 1: the same draw
     EXPECT_EQ(on.sample, s);
     EXPECT_EQ(on.values[1], off.values[1]);
     EXPECT_EQ(on.values[2], off.values[2]);
@@ -214,13 +212,13 @@ TEST(SweepSpec, BadSweepFilesNameFileKeyPathAndWhatWasExpected) {
   EXPECT_TRUE(AnyContains(texts, file + ":2: repeatz", "unknown key")) << texts[0];
   EXPECT_TRUE(AnyContains(texts, "parameters.1.range.count", "at least 2"));
   // Path problems are found against the base scenario, each at its own key.
-  const std::string again = WriteFile(
-      "bad2.yaml", "scenario: " + kCrossLine +
-                       "\nmetrics: [max_deviaton]\n"
-                       "parameters:\n"
-                       "  - {path: control.compensaton, values: [true, false]}\n"
-                       "  - {path: line.belts.7.speed_mps, values: [0.1]}\n"
-                       "  - {path: units.chassis.parameters.muu, values: [0.5]}\n");
+  const std::string again =
+      WriteFile("bad2.yaml", "scenario: " + kCrossLine +
+                                 "\nmetrics: [max_deviaton]\n"
+                                 "parameters:\n"
+                                 "  - {path: control.compensaton, values: [true, false]}\n"
+                                 "  - {path: line.belts.7.speed_mps, values: [0.1]}\n"
+                                 "  - {path: units.chassis.parameters.muu, values: [0.5]}\n");
   const auto t2 = IssueTexts(again);
   EXPECT_TRUE(AnyContains(t2, "parameters.0.path", "control.compensation"));  // closest key
   EXPECT_TRUE(AnyContains(t2, "parameters.1.path", "not an item of the list"));
@@ -228,8 +226,9 @@ TEST(SweepSpec, BadSweepFilesNameFileKeyPathAndWhatWasExpected) {
   EXPECT_TRUE(AnyContains(t2, "parameters.2.path", "no key 'units'"));
   EXPECT_TRUE(AnyContains(t2, "metrics.0", "not a metric"));
 
-  EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("nofile.yaml", "scenario: nowhere.yaml\n"
-                                                              "parameters: [{path: seed, values: [1]}]\n")),
+  EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("nofile.yaml",
+                                               "scenario: nowhere.yaml\n"
+                                               "parameters: [{path: seed, values: [1]}]\n")),
                           "scenario", "refused"));
   EXPECT_TRUE(AnyContains(
       IssueTexts(WriteFile("gridrandom.yaml",
@@ -252,8 +251,8 @@ TEST(SweepSpec, AnOutOfRangeValueIsARunProblemNotASweepProblem) {
   // A value the scenario refuses fails its own run only: the others may be
   // what the user wants to see.
   EXPECT_NO_THROW(LoadSweepSpec(WriteFile(
-      "range.yaml", "scenario: " + kCrossLine +
-                        "\nparameters: [{path: master.step_s, values: [-1, 0.001]}]\n")));
+      "range.yaml",
+      "scenario: " + kCrossLine + "\nparameters: [{path: master.step_s, values: [-1, 0.001]}]\n")));
 }
 
 TEST(ResultsCsv, QuotesRoundTrip) {
@@ -266,7 +265,8 @@ TEST(ResultsCsv, QuotesRoundTrip) {
 
 // A folder of its own for each test.
 std::string FreshDir(const std::string& name) {
-  const fs::path p = fs::path(::testing::TempDir()) / ("sweep_" + name + "_" + std::to_string(getpid()));
+  const fs::path p =
+      fs::path(::testing::TempDir()) / ("sweep_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(p);
   fs::create_directories(p);
   return p.string();
@@ -296,13 +296,13 @@ std::string RunSweep(const SweepSpec& spec, int jobs, const std::string& dir) {
 TEST(SweepExecutor, OneAndTwoJobsWriteTheSameRowsAndAFailingRunIsIsolated) {
   // A step of 0.003 s does not divide the 20 ms control period: the loader
   // refuses that run; 0.002 s runs. By 6 s the robot is well onto the belt.
-  const SweepSpec spec = LoadSweepSpec(WriteFile(
-      "exec.yaml", "scenario: " + kCrossLine +
-                       "\nset: {duration_s: 6}\n"
-                       "metrics: [max_path_deviation_m]\n"
-                       "parameters:\n"
-                       "  - {path: master.step_s, values: [0.001, 0.003, 0.002]}\n"
-                       "  - {path: control.compensation, values: [true, false]}\n"));
+  const SweepSpec spec = LoadSweepSpec(
+      WriteFile("exec.yaml", "scenario: " + kCrossLine +
+                                 "\nset: {duration_s: 6}\n"
+                                 "metrics: [max_path_deviation_m]\n"
+                                 "parameters:\n"
+                                 "  - {path: master.step_s, values: [0.001, 0.003, 0.002]}\n"
+                                 "  - {path: control.compensation, values: [true, false]}\n"));
   const std::string one = RunSweep(spec, 1, FreshDir("one"));
   const std::string two = RunSweep(spec, 2, FreshDir("two"));
   EXPECT_EQ(WithoutWallTime(one), WithoutWallTime(two));
@@ -310,8 +310,9 @@ TEST(SweepExecutor, OneAndTwoJobsWriteTheSameRowsAndAFailingRunIsIsolated) {
   std::istringstream in(one);
   std::string header;
   std::getline(in, header);
-  EXPECT_EQ(header,
-            "run_id,master.step_s,control.compensation,seed,max_path_deviation_m,status,error,wall_s");
+  EXPECT_EQ(
+      header,
+      "run_id,master.step_s,control.compensation,seed,max_path_deviation_m,status,error,wall_s");
   std::vector<std::vector<std::string>> rows;
   for (std::string line; std::getline(in, line);) rows.push_back(*SplitCsvLine(line));
   ASSERT_EQ(rows.size(), 6u);
@@ -321,7 +322,9 @@ TEST(SweepExecutor, OneAndTwoJobsWriteTheSameRowsAndAFailingRunIsIsolated) {
     EXPECT_EQ(rows[i][5], bad ? "failed" : "ok") << i;
     EXPECT_EQ(rows[i][4].empty(), bad) << i;
     if (bad) {
-      EXPECT_NE(rows[i][6].find("not an integer multiple of the master step 0.003 s"), std::string::npos) << rows[i][6];
+      EXPECT_NE(rows[i][6].find("not an integer multiple of the master step 0.003 s"),
+                std::string::npos)
+          << rows[i][6];
     }
   }
   // Compensation on beats off at both good steps (paper 1, Sec. VI-B).
@@ -355,8 +358,8 @@ TEST(ResultsFile, ResumeKeepsCompleteRowsAndDropsACutOffLine) {
   std::vector<std::string> lines;
   for (std::string line; std::getline(in, line);) lines.push_back(line + "\n");
   const std::string path = dir + "/results.csv";
-  std::ofstream(path, std::ios::trunc) << lines[0] << lines[4] << lines[1] << lines[4]
-                                       << lines[6].substr(0, 12);
+  std::ofstream(path, std::ios::trunc)
+      << lines[0] << lines[4] << lines[1] << lines[4] << lines[6].substr(0, 12);
   ResultsFile resumed = ResultsFile::Resume(path, spec);
   EXPECT_EQ(resumed.row_count(), 2u);
   EXPECT_TRUE(resumed.HasRow(0));
@@ -365,7 +368,8 @@ TEST(ResultsFile, ResumeKeepsCompleteRowsAndDropsACutOffLine) {
   EXPECT_EQ(ReadFile(path), lines[0] + lines[1] + lines[4]);
 
   // Another sweep's file is refused, not mixed.
-  const SweepSpec other = LoadSweepSpec(WriteFile("other.yaml", BeltSweep("metrics: [max_path_deviation_m]\n")));
+  const SweepSpec other =
+      LoadSweepSpec(WriteFile("other.yaml", BeltSweep("metrics: [max_path_deviation_m]\n")));
   std::ofstream(path, std::ios::trunc) << "run_id,x,seed\n";
   EXPECT_THROW(ResultsFile::Resume(path, other), std::runtime_error);
 }
@@ -376,8 +380,8 @@ TEST(ResultsFile, TableParsesRowsBack) {
   RunSweep(spec, 2, dir);
   const SweepTable t = ResultsFile::Resume(dir + "/results.csv", spec).Table(spec);
   ASSERT_EQ(t.rows.size(), 10u);
-  EXPECT_EQ(t.parameters, (std::vector<std::string>{"line.belts.0.speed_mps",
-                                                    "control.compensation"}));
+  EXPECT_EQ(t.parameters,
+            (std::vector<std::string>{"line.belts.0.speed_mps", "control.compensation"}));
   EXPECT_EQ(t.metrics.back(), "wall_s");
   EXPECT_EQ(t.levels[1], (std::vector<std::string>{"true", "false"}));
   EXPECT_TRUE(t.grid);
