@@ -3,6 +3,10 @@
 #include <string>
 #include <vector>
 
+namespace linesim::sweep {
+class MpiSession;
+}
+
 namespace linesim::app {
 
 /// Exit statuses of the `linesim` command.
@@ -16,5 +20,20 @@ int RunCommand(const std::string& file, const std::string& out_dir,
 
 /// `linesim inspect TYPE|FILE [--set path=value ...]`.
 int InspectCommand(const std::string& what, const std::vector<std::string>& set_args);
+
+struct SweepArgs {
+  std::string file;
+  std::string out_dir;
+  int jobs = 1;
+  bool resume = false;
+  bool force = false;
+};
+
+/// `linesim sweep FILE --out DIR [--jobs N] [--resume|--force]`; under
+/// mpirun `mpi` is the MPI session (rank 0 dispatches and writes, the other
+/// ranks run), otherwise null and the runs go on `jobs` threads. Exits 0
+/// when every run is ok, 1 when a run failed (it has a row with its error),
+/// 2 on bad input with nothing written, 130 when interrupted.
+int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi);
 
 }  // namespace linesim::app

@@ -1,7 +1,10 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <memory>
+#include <thread>
 
 #include "app/commands.h"
+#include "sweep/mpi_sweep.h"
 
 int main(int argc, char** argv) {
   using namespace linesim::app;
@@ -25,6 +28,23 @@ int main(int argc, char** argv) {
   inspect->add_option("--set", inspect_sets, "override a value: dotted.path=value (repeatable)")
       ->take_all();
 
+  SweepArgs sweep_args;
+  sweep_args.jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  CLI::App* sweep = cli.add_subcommand(
+      "sweep", "run a sweep file's runs (threads, or MPI ranks under mpirun) into results.csv");
+  sweep->add_option("file", sweep_args.file, "sweep YAML file")->required();
+  sweep->add_option("--out,-o", sweep_args.out_dir, "output folder (created if missing)")
+      ->required();
+  sweep
+      ->add_option("--jobs,-j", sweep_args.jobs,
+                   "runs at a time on this machine (default: its cores); under mpirun the "
+                   "ranks other than 0 are the jobs")
+      ->check(CLI::Range(1, 4096));
+  CLI::Option* resume =
+      sweep->add_flag("--resume", sweep_args.resume, "run only the runs without a row in DIR");
+  sweep->add_flag("--force", sweep_args.force, "start afresh, replacing DIR's results")
+      ->excludes(resume);
+
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -36,6 +56,14 @@ int main(int argc, char** argv) {
   // answered with a message and an exit status, never an abort.
   try {
     if (run->parsed()) return RunCommand(run_file, out_dir, run_sets);
+    if (sweep->parsed()) {
+      // MPI only under mpirun: a plain sweep needs no MPI runtime.
+      std::unique_ptr<linesim::sweep::MpiSession> mpi;
+      if (linesim::sweep::LaunchedByMpi()) {
+        mpi = std::make_unique<linesim::sweep::MpiSession>(&argc, &argv);
+      }
+      return SweepCommand(sweep_args, mpi.get());
+    }
     return InspectCommand(what, inspect_sets);
   } catch (const std::exception& e) {
     std::cerr << "linesim: " << e.what() << "\n";

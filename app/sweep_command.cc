@@ -1,0 +1,220 @@
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+
+#include "app/commands.h"
+#include "loader/scenario_error.h"
+#include "sweep/executor.h"
+#include "sweep/mpi_sweep.h"
+#include "sweep/progress.h"
+#include "sweep/results_file.h"
+#include "sweep/run_plan.h"
+#include "sweep/summary.h"
+#include "sweep/sweep_spec.h"
+
+namespace linesim::app {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+namespace {
+
+constexpr int kExitInterrupted = 130;  // the shell's code for Ctrl-C
+
+// Set by Ctrl-C (SIGINT) or SIGTERM: no new run starts, running ones stop at
+// their next step and leave no row. A second signal ends the process at once.
+std::atomic<bool> g_stop{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "used from a signal handler");
+
+extern "C" void OnSignal(int sig) {
+  if (g_stop.exchange(true)) {
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+    return;
+  }
+  const char text[] = "\nlinesim: interrupted: stopping the running runs (again to quit at once)\n";
+  [[maybe_unused]] const auto n = write(STDERR_FILENO, text, sizeof text - 1);
+}
+
+void PrintIssues(const loader::ScenarioError& e) {
+  std::cerr << "linesim: the sweep is refused (" << e.issues().size()
+            << (e.issues().size() == 1 ? " problem" : " problems") << "):\n";
+  for (const auto& i : e.issues()) std::cerr << "  " << i.ToString() << "\n";
+}
+
+std::string ReadFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The sweep folder made ready on rank 0: results.csv started or resumed and
+// sweep.json saying which sweep it holds. Prints why not and returns nothing
+// when the folder cannot take this sweep.
+std::optional<sweep::ResultsFile> PrepareFolder(const sweep::SweepSpec& spec, const fs::path& dir,
+                                                bool resume, bool force) {
+  const fs::path results = dir / "results.csv";
+  const fs::path identity = dir / "sweep.json";
+  const std::string fingerprint = sweep::SweepFingerprint(spec);
+  const bool exists = fs::exists(results);
+  if (exists && !resume && !force) {
+    std::cerr << "linesim: " << results.string()
+              << " exists: --resume continues that sweep, --force starts it afresh, or choose "
+                 "another --out\n";
+    return std::nullopt;
+  }
+  if (exists && resume) {
+    std::string held;
+    try {
+      held = Json::parse(ReadFile(identity)).value("fingerprint", "");
+    } catch (const std::exception&) {
+    }
+    if (held != fingerprint) {
+      std::cerr << "linesim: cannot resume in " << dir.string() << ": "
+                << (held.empty() ? identity.string() + " is missing or unreadable"
+                                 : "it holds another sweep, or the sweep file or its base "
+                                   "scenario changed since")
+                << "; --force starts afresh\n";
+      return std::nullopt;
+    }
+  }
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) {
+    std::cerr << "linesim: cannot create the output folder " << dir.string() << ": "
+              << (ec ? ec.message() : "a file of that name exists") << "\n";
+    return std::nullopt;
+  }
+  try {
+    Json id;
+    id["name"] = spec.name;
+    id["sweep_file"] = spec.file;
+    id["scenario"] = spec.scenario;
+    id["runs"] = sweep::RunCount(spec);
+    id["fingerprint"] = fingerprint;
+    {
+      std::ofstream out(identity.string() + ".tmp", std::ios::binary | std::ios::trunc);
+      out << id.dump(2) << "\n";
+      if (!out.flush()) throw std::runtime_error("cannot write " + identity.string());
+    }
+    fs::rename(identity.string() + ".tmp", identity);
+    if (exists && resume) return sweep::ResultsFile::Resume(results.string(), spec);
+    return sweep::ResultsFile::Create(results.string(), spec);
+  } catch (const std::exception& e) {
+    std::cerr << "linesim: " << e.what() << "\n";
+    return std::nullopt;
+  }
+}
+
+}  // namespace
+
+int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
+  const bool leader = !mpi || mpi->rank() == 0;
+  const auto share = [&](int status) { return mpi ? mpi->ShareStatus(status) : status; };
+
+  // Every rank reads the sweep the same way; rank 0 speaks for all.
+  sweep::SweepSpec spec;
+  int status = kExitOk;
+  try {
+    spec = sweep::LoadSweepSpec(args.file);
+  } catch (const loader::ScenarioError& e) {
+    if (leader) PrintIssues(e);
+    status = kExitBadInput;
+  }
+  if (share(status) != kExitOk) return kExitBadInput;
+
+  std::optional<sweep::ResultsFile> results =
+      leader ? PrepareFolder(spec, args.out_dir, args.resume, args.force) : std::nullopt;
+  if (leader && !results) status = kExitBadInput;
+  if (share(status) != kExitOk) return kExitBadInput;
+
+  std::signal(SIGINT, OnSignal);
+  std::signal(SIGTERM, OnSignal);
+  if (!leader) {
+    sweep::ServeRuns(spec, g_stop);
+    return kExitOk;
+  }
+
+  const std::int64_t total = sweep::RunCount(spec);
+  std::vector<sweep::RunSpec> pending;
+  for (std::int64_t id = 0; id < total; ++id) {
+    if (!results->HasRow(id)) pending.push_back(sweep::PlanRun(spec, id));
+  }
+  std::int64_t failed_before = 0;
+  for (const auto& row : results->Table(spec).rows) failed_before += row.ok ? 0 : 1;
+  const int jobs = mpi ? mpi->size() - 1 : args.jobs;
+  std::cout << "sweep " << spec.name << ": " << total << " runs";
+  if (static_cast<std::int64_t>(pending.size()) < total) {
+    std::cout << " (" << total - static_cast<std::int64_t>(pending.size()) << " already have rows)";
+  }
+  std::cout << " of " << spec.scenario << ", "
+            << (mpi ? std::to_string(std::max(1, jobs)) + " MPI worker rank(s)"
+                    : std::to_string(jobs) + " job(s)")
+            << "\n"
+            << std::flush;
+
+  sweep::ProgressBar bar(std::cerr, isatty(STDERR_FILENO) != 0, total,
+                         total - static_cast<std::int64_t>(pending.size()), failed_before);
+  const auto on_done = [&](const sweep::RunSpec& run, const sweep::RunOutcome& outcome) {
+    results->Append(run.id, sweep::FormatRow(spec, run, outcome));
+    bar.RunDone(outcome.status == sweep::RunStatus::kOk);
+  };
+  const auto wall0 = std::chrono::steady_clock::now();
+  try {
+    if (mpi) {
+      sweep::DispatchRuns(spec, pending, g_stop, on_done);
+    } else {
+      sweep::RunOnThreads(spec, pending, args.jobs, g_stop, on_done);
+    }
+  } catch (const std::exception& e) {
+    bar.Finish();
+    std::cerr << "linesim: the sweep stopped: " << e.what() << "\n";
+    return kExitRunFailed;
+  }
+  bar.Finish();
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  const fs::path dir(args.out_dir);
+  if (static_cast<std::int64_t>(results->row_count()) < total) {
+    std::cerr << "linesim: interrupted: " << results->row_count() << " of " << total
+              << " runs have rows in " << (dir / "results.csv").string()
+              << "; the same command with --resume runs the rest\n";
+    return kExitInterrupted;
+  }
+  try {
+    results->SortByRunId();
+  } catch (const std::exception& e) {
+    std::cerr << "linesim: " << e.what() << "\n";
+    return kExitRunFailed;
+  }
+  const sweep::SweepTable table = results->Table(spec);
+  std::int64_t failed = 0;
+  for (const auto& row : table.rows) failed += row.ok ? 0 : 1;
+  std::cout << "sweep " << spec.name << ": finished in " << std::setprecision(3) << wall_s
+            << " s wall\n";
+  sweep::PrintSummary(table, std::cout);
+  std::vector<std::string> written;
+  try {
+    written = sweep::WriteSweepReport(dir.string(), table);
+  } catch (const std::exception& e) {
+    std::cerr << "linesim: " << e.what() << "\n";
+    return kExitRunFailed;
+  }
+  std::cout << "  wrote " << (dir / "results.csv").string();
+  for (const auto& f : written) std::cout << ", " << fs::path(f).filename().string();
+  std::cout << "\n";
+  return failed == 0 ? kExitOk : kExitRunFailed;
+}
+
+}  // namespace linesim::app
