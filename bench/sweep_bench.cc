@@ -29,12 +29,12 @@ void BM_Sweep(benchmark::State& state) {
   std::int64_t finished = 0, failed = 0;
   for (auto _ : state) {
     std::atomic<bool> stop{false};
-    linesim::sweep::RunOnThreads(spec, runs, jobs, stop,
-                                 [&](const linesim::sweep::RunSpec&,
-                                     const linesim::sweep::RunOutcome& outcome) {
-                                   ++finished;
-                                   if (outcome.status != linesim::sweep::RunStatus::kOk) ++failed;
-                                 });
+    linesim::sweep::RunOnThreads(
+        spec, runs, jobs, stop,
+        [&](const linesim::sweep::RunSpec&, const linesim::sweep::RunOutcome& outcome) {
+          ++finished;
+          if (outcome.status != linesim::sweep::RunStatus::kOk) ++failed;
+        });
   }
   if (failed > 0) state.SkipWithError("a run of the sweep failed");
   state.counters["runs_per_s"] =

@@ -239,6 +239,35 @@ void PrintLevels(const SweepTable& t, std::size_t p, const Rows& all, std::ostre
   PrintColumns(rows, {false, true, true, false, true, false, false}, out);
 }
 
+// One line per grid point with each metric's mean over its ok runs: the
+// view the marginals above hide (belt speed against compensation, say).
+constexpr std::size_t kMaxPointsPrinted = 60;
+void PrintPoints(const SweepTable& t, const Rows& all, std::ostream& out) {
+  const std::vector<Group> points = GroupBy(AllParameters(t), all);
+  if (points.size() > kMaxPointsPrinted) {
+    out << "\nper point: " << points.size() << " points, see summary.json (by_point)\n";
+    return;
+  }
+  out << "\nper point (mean over ok runs)\n";
+  std::vector<std::vector<std::string>> rows{t.parameters};
+  rows[0].push_back("runs");
+  rows[0].push_back("failed");
+  rows[0].insert(rows[0].end(), t.metrics.begin(), t.metrics.end());
+  for (const Group& g : points) {
+    std::vector<std::string> row = g.values;
+    row.push_back(std::to_string(g.rows.size()));
+    row.push_back(std::to_string(CountFailed(g.rows)));
+    for (std::size_t m = 0; m < t.metrics.size(); ++m) {
+      const Stats st = StatsOf(OkValues(g.rows, m));
+      row.push_back(st.n == 0 ? "-" : Sig4(st.mean));
+    }
+    rows.push_back(std::move(row));
+  }
+  std::vector<bool> right(rows[0].size(), true);
+  for (std::size_t p = 0; p < t.parameters.size(); ++p) right[p] = false;
+  PrintColumns(rows, right, out);
+}
+
 void PrintRandom(const SweepTable& t, std::size_t p, std::ostream& out) {
   const RandomParameter r = DescribeRandom(t, p);
   out << "\n"
@@ -419,6 +448,7 @@ void PrintSummary(const SweepTable& t, std::ostream& out) {
       PrintLevels(t, p, all, out);
     }
   }
+  if (t.grid && t.parameters.size() > 1) PrintPoints(t, all, out);
   if (failed == 0) return;
   out << "\nfailed runs:\n";
   std::size_t printed = 0;

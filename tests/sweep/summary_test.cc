@@ -240,7 +240,7 @@ TEST(Summarize, RowOfTheWrongShapeIsRefused) {
 // Numbers by hand: speed 0.05 wall times {10, 10, 12, 12}: mean 11, std
 // sqrt(4/3) = 1.155; compensation=true deviations {1, 4, 3, 5}: mean 3.25,
 // squared deviations 8.75, std sqrt(8.75/3) = 1.708.
-TEST(PrintSummary, AlignedTablePerParameterThenFailures) {
+TEST(PrintSummary, AlignedTablePerParameterThenPerPointThenFailures) {
   std::ostringstream out;
   PrintSummary(Grid(), out);
   const std::string expected =
@@ -259,6 +259,15 @@ TEST(PrintSummary, AlignedTablePerParameterThenFailures) {
       "                       wall_s             11  ± 1.155  [10, 12]\n"
       "  false     4       2  max_deviation_m     3  ± 1.414  [2, 4]\n"
       "                       wall_s             11  ± 1.414  [10, 12]\n"
+      "\n"
+      // Per point, mean over repeats: (0.05, true) from 1 and 3, and so on;
+      // the point whose runs all failed has none.
+      "per point (mean over ok runs)\n"
+      "  line.belts.0.speed_mps  control.compensation  runs  failed  max_deviation_m  wall_s\n"
+      "  0.05                    true                     2       0                2      11\n"
+      "  0.05                    false                    2       0                3      11\n"
+      "  0.1                     true                     2       0              4.5      11\n"
+      "  0.1                     false                    2       2                -       -\n"
       "\n"
       "failed runs:\n"
       "  run 3 (line.belts.0.speed_mps=0.1, control.compensation=false): chassis: output "

@@ -12,6 +12,7 @@
 
 #include "loader/scenario_error.h"
 #include "sweep/executor.h"
+#include "sweep/progress.h"
 #include "sweep/results_file.h"
 #include "sweep/run_plan.h"
 #include "sweep/sweep_spec.h"
@@ -391,6 +392,35 @@ TEST(ResultsFile, TableParsesRowsBack) {
     EXPECT_GT(row.metrics.back(), 0.0);
     EXPECT_EQ(row.seed, PlanRun(spec, row.id).seed);
   }
+}
+
+TEST(ProgressBar, DrawsInPlaceOnATerminalAndStaysQuietOtherwise) {
+  std::ostringstream tty;
+  {
+    ProgressBar bar(tty, true, 10, 2, 1);  // a resumed sweep: 2 rows, 1 failed
+    bar.RunDone(true);
+    bar.RunDone(false);
+    EXPECT_NE(bar.Text().find("4/10 done, 2 failed"), std::string::npos) << bar.Text();
+    EXPECT_NE(bar.Text().find("ETA"), std::string::npos);
+    bar.Finish();
+    bar.Finish();
+  }
+  const std::string text = tty.str();
+  EXPECT_EQ(text.front(), '\r');  // redrawn in place
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\r'), 3);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1);  // one line ended once
+  EXPECT_NE(text.find("[############"), std::string::npos);  // 40 % of 30 columns
+
+  std::ostringstream pipe;
+  ProgressBar quiet(pipe, false, 10, 0, 0);
+  quiet.RunDone(true);
+  quiet.Finish();
+  EXPECT_TRUE(pipe.str().empty());
+
+  EXPECT_EQ(FormatDuration(0), "0:00");
+  EXPECT_EQ(FormatDuration(75.4), "1:15");
+  EXPECT_EQ(FormatDuration(3725), "1:02:05");
+  EXPECT_EQ(FormatDuration(NAN), "?");
 }
 
 }  // namespace
