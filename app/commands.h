@@ -25,6 +25,7 @@ struct SweepArgs {
   std::string file;
   std::string out_dir;
   int jobs = 1;
+  bool jobs_given = false;  // --jobs on the command line (it means nothing under mpirun)
   bool resume = false;
   bool force = false;
 };

@@ -35,11 +35,11 @@ int main(int argc, char** argv) {
   sweep->add_option("file", sweep_args.file, "sweep YAML file")->required();
   sweep->add_option("--out,-o", sweep_args.out_dir, "output folder (created if missing)")
       ->required();
-  sweep
-      ->add_option("--jobs,-j", sweep_args.jobs,
-                   "runs at a time on this machine (default: its cores); under mpirun the "
-                   "ranks other than 0 are the jobs")
-      ->check(CLI::Range(1, 4096));
+  CLI::Option* jobs =
+      sweep->add_option("--jobs,-j", sweep_args.jobs,
+                        "runs at a time on this machine (default: its cores); under mpirun the "
+                        "ranks other than 0 are the jobs");
+  jobs->check(CLI::Range(1, 4096));
   CLI::Option* resume =
       sweep->add_flag("--resume", sweep_args.resume, "run only the runs without a row in DIR");
   sweep->add_flag("--force", sweep_args.force, "start afresh, replacing DIR's results")
@@ -62,6 +62,7 @@ int main(int argc, char** argv) {
       if (linesim::sweep::LaunchedByMpi()) {
         mpi = std::make_unique<linesim::sweep::MpiSession>(&argc, &argv);
       }
+      sweep_args.jobs_given = jobs->count() > 0;
       return SweepCommand(sweep_args, mpi.get());
     }
     return InspectCommand(what, inspect_sets);

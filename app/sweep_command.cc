@@ -153,6 +153,10 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
   }
   std::int64_t failed_before = 0;
   for (const auto& row : results->Table(spec).rows) failed_before += row.ok ? 0 : 1;
+  if (mpi && args.jobs_given) {
+    std::cerr << "linesim: --jobs does not apply under mpirun: ranks 1 to " << mpi->size() - 1
+              << " run the runs, one at a time each\n";
+  }
   const int jobs = mpi ? mpi->size() - 1 : args.jobs;
   std::cout << "sweep " << spec.name << ": " << total << " runs";
   if (static_cast<std::int64_t>(pending.size()) < total) {

@@ -171,7 +171,8 @@ SweepSpec LoadSweepSpec(const std::string& file) {
   if (!scenario.empty()) {
     // Relative to the sweep file, so a sweep runs from any folder.
     const fs::path p(scenario);
-    spec.scenario = p.is_absolute() ? scenario : (fs::path(file).parent_path() / p).string();
+    spec.scenario =
+        p.is_absolute() ? scenario : (fs::path(file).parent_path() / p).lexically_normal().string();
   }
   if (const YAML::Node set = Child(root, "set"); set.IsDefined()) {
     if (r.ExpectMap(set, "set")) {
