@@ -52,13 +52,13 @@ int main(int argc, char** argv) {
     const int status = cli.exit(e);
     return status == 0 ? kExitOk : kExitBadInput;
   }
+  // MPI only for a sweep under mpirun: a plain sweep needs no MPI runtime.
+  std::unique_ptr<linesim::sweep::MpiSession> mpi;
   // The commands report what they expect; anything else escaping is still
   // answered with a message and an exit status, never an abort.
   try {
     if (run->parsed()) return RunCommand(run_file, out_dir, run_sets);
     if (sweep->parsed()) {
-      // MPI only under mpirun: a plain sweep needs no MPI runtime.
-      std::unique_ptr<linesim::sweep::MpiSession> mpi;
       if (linesim::sweep::LaunchedByMpi()) {
         mpi = std::make_unique<linesim::sweep::MpiSession>(&argc, &argv);
       }
@@ -68,6 +68,8 @@ int main(int argc, char** argv) {
     return InspectCommand(what, inspect_sets);
   } catch (const std::exception& e) {
     std::cerr << "linesim: " << e.what() << "\n";
+    // The other ranks may be waiting on this one: end them all.
+    if (mpi) mpi->Abort(kExitRunFailed);
     return kExitBadInput;
   }
 }

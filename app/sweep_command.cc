@@ -3,14 +3,18 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
+#include <stop_token>
+#include <thread>
 
 #include "app/commands.h"
 #include "loader/scenario_error.h"
@@ -46,10 +50,10 @@ extern "C" void OnSignal(int sig) {
   [[maybe_unused]] const auto n = write(STDERR_FILENO, text, sizeof text - 1);
 }
 
-void PrintIssues(const loader::ScenarioError& e) {
-  std::cerr << "linesim: the sweep is refused (" << e.issues().size()
-            << (e.issues().size() == 1 ? " problem" : " problems") << "):\n";
-  for (const auto& i : e.issues()) std::cerr << "  " << i.ToString() << "\n";
+void PrintIssues(const loader::ScenarioError& e, std::ostream& out) {
+  out << "linesim: the sweep is refused (" << e.issues().size()
+      << (e.issues().size() == 1 ? " problem" : " problems") << "):\n";
+  for (const auto& i : e.issues()) out << "  " << i.ToString() << "\n";
 }
 
 std::string ReadFile(const fs::path& path) {
@@ -63,10 +67,10 @@ std::string ReadFile(const fs::path& path) {
 // sweep.json saying which sweep it holds. Prints why not and returns nothing
 // when the folder cannot take this sweep.
 std::optional<sweep::ResultsFile> PrepareFolder(const sweep::SweepSpec& spec, const fs::path& dir,
-                                                bool resume, bool force) {
+                                                const std::string& fingerprint, bool resume,
+                                                bool force) {
   const fs::path results = dir / "results.csv";
   const fs::path identity = dir / "sweep.json";
-  const std::string fingerprint = sweep::SweepFingerprint(spec);
   const bool exists = fs::exists(results);
   if (exists && !resume && !force) {
     std::cerr << "linesim: " << results.string()
@@ -83,8 +87,8 @@ std::optional<sweep::ResultsFile> PrepareFolder(const sweep::SweepSpec& spec, co
     if (held != fingerprint) {
       std::cerr << "linesim: cannot resume in " << dir.string() << ": "
                 << (held.empty() ? identity.string() + " is missing or unreadable"
-                                 : "it holds another sweep, or the sweep file or its base "
-                                   "scenario changed since")
+                                 : "it holds another sweep, or the sweep file, its base "
+                                   "scenario or a model file changed since")
                 << "; --force starts afresh\n";
       return std::nullopt;
     }
@@ -97,6 +101,11 @@ std::optional<sweep::ResultsFile> PrepareFolder(const sweep::SweepSpec& spec, co
     return std::nullopt;
   }
   try {
+    if (exists && resume) return sweep::ResultsFile::Resume(results.string(), spec);
+    // The old identity goes first: a folder is never left saying it holds
+    // this sweep while it holds another's rows.
+    fs::remove(identity);
+    sweep::ResultsFile created = sweep::ResultsFile::Create(results.string(), spec);
     Json id;
     id["name"] = spec.name;
     id["sweep_file"] = spec.file;
@@ -109,8 +118,7 @@ std::optional<sweep::ResultsFile> PrepareFolder(const sweep::SweepSpec& spec, co
       if (!out.flush()) throw std::runtime_error("cannot write " + identity.string());
     }
     fs::rename(identity.string() + ".tmp", identity);
-    if (exists && resume) return sweep::ResultsFile::Resume(results.string(), spec);
-    return sweep::ResultsFile::Create(results.string(), spec);
+    return created;
   } catch (const std::exception& e) {
     std::cerr << "linesim: " << e.what() << "\n";
     return std::nullopt;
@@ -121,21 +129,49 @@ std::optional<sweep::ResultsFile> PrepareFolder(const sweep::SweepSpec& spec, co
 
 int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
   const bool leader = !mpi || mpi->rank() == 0;
-  const auto share = [&](int status) { return mpi ? mpi->ShareStatus(status) : status; };
+  // Every rank checks for itself; all go on or all stop. Rank 0 speaks for
+  // all, and a rank that alone finds a problem speaks for itself.
+  std::ostringstream problems;
+  const auto share = [&](int status) {
+    if (!mpi) {
+      std::cerr << problems.str();
+      return status;
+    }
+    const int leader_status = mpi->LeaderStatus(status);
+    if (leader || leader_status == kExitOk) {
+      std::istringstream text(problems.str());
+      for (std::string line; std::getline(text, line);) {
+        std::cerr << (leader ? "" : "rank " + std::to_string(mpi->rank()) + ": ") << line << "\n";
+      }
+    }
+    problems.str("");
+    return mpi->ShareStatus(status);
+  };
 
-  // Every rank reads the sweep the same way; rank 0 speaks for all.
   sweep::SweepSpec spec;
+  std::string fingerprint;
   int status = kExitOk;
   try {
     spec = sweep::LoadSweepSpec(args.file);
+    fingerprint = sweep::SweepFingerprint(spec);
   } catch (const loader::ScenarioError& e) {
-    if (leader) PrintIssues(e);
+    PrintIssues(e, problems);
+    status = kExitBadInput;
+  }
+  if (share(status) != kExitOk) return kExitBadInput;
+  // Ranks on other machines must run the same sweep from the same files.
+  if (const std::string held = mpi ? mpi->LeaderText(fingerprint) : fingerprint;
+      held != fingerprint) {
+    problems << "linesim: the sweep file, its base scenario or a model file differs from rank "
+                "0's (fingerprint "
+             << fingerprint << " against " << held << ")\n";
     status = kExitBadInput;
   }
   if (share(status) != kExitOk) return kExitBadInput;
 
   std::optional<sweep::ResultsFile> results =
-      leader ? PrepareFolder(spec, args.out_dir, args.resume, args.force) : std::nullopt;
+      leader ? PrepareFolder(spec, args.out_dir, fingerprint, args.resume, args.force)
+             : std::nullopt;
   if (leader && !results) status = kExitBadInput;
   if (share(status) != kExitOk) return kExitBadInput;
 
@@ -147,33 +183,50 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
   }
 
   const std::int64_t total = sweep::RunCount(spec);
-  std::vector<sweep::RunSpec> pending;
+  std::vector<std::int64_t> pending;
   for (std::int64_t id = 0; id < total; ++id) {
-    if (!results->HasRow(id)) pending.push_back(sweep::PlanRun(spec, id));
+    if (!results->HasRow(id)) pending.push_back(id);
   }
+  const auto done_before = total - static_cast<std::int64_t>(pending.size());
   std::int64_t failed_before = 0;
   for (const auto& row : results->Table(spec).rows) failed_before += row.ok ? 0 : 1;
   if (mpi && args.jobs_given) {
-    std::cerr << "linesim: --jobs does not apply under mpirun: ranks 1 to " << mpi->size() - 1
-              << " run the runs, one at a time each\n";
+    std::cerr << "linesim: --jobs does not apply under mpirun: each rank but 0 runs one run at "
+                 "a time\n";
   }
-  const int jobs = mpi ? mpi->size() - 1 : args.jobs;
   std::cout << "sweep " << spec.name << ": " << total << " runs";
-  if (static_cast<std::int64_t>(pending.size()) < total) {
-    std::cout << " (" << total - static_cast<std::int64_t>(pending.size()) << " already have rows)";
+  if (done_before > 0) std::cout << " (" << done_before << " already have rows)";
+  std::cout << " of " << spec.scenario << ", ";
+  if (!mpi) {
+    std::cout << args.jobs << " job(s)\n";
+  } else if (mpi->size() == 1) {
+    std::cout << "on rank 0 alone (mpirun -n 1)\n";
+  } else {
+    std::cout << mpi->size() - 1 << " MPI worker rank(s)\n";
   }
-  std::cout << " of " << spec.scenario << ", "
-            << (mpi ? std::to_string(std::max(1, jobs)) + " MPI worker rank(s)"
-                    : std::to_string(jobs) + " job(s)")
-            << "\n"
-            << std::flush;
+  std::cout << std::flush;
 
-  sweep::ProgressBar bar(std::cerr, isatty(STDERR_FILENO) != 0, total,
-                         total - static_cast<std::int64_t>(pending.size()), failed_before);
+  sweep::ProgressBar bar(std::cerr, isatty(STDERR_FILENO) != 0, total, done_before, failed_before);
+  std::mutex bar_mutex;
   const auto on_done = [&](const sweep::RunSpec& run, const sweep::RunOutcome& outcome) {
     results->Append(run.id, sweep::FormatRow(spec, run, outcome));
+    const std::lock_guard lock(bar_mutex);
     bar.RunDone(outcome.status == sweep::RunStatus::kOk);
   };
+  // Elapsed time and ETA move on between runs too.
+  std::jthread ticker;
+  if (bar.enabled()) {
+    ticker = std::jthread([&](std::stop_token token) {
+      std::mutex sleep_mutex;
+      std::condition_variable_any wake;
+      std::unique_lock sleep_lock(sleep_mutex);
+      while (!wake.wait_for(sleep_lock, token, std::chrono::seconds(1), [] { return false; })) {
+        if (token.stop_requested()) return;
+        const std::lock_guard lock(bar_mutex);
+        bar.Redraw();
+      }
+    });
+  }
   const auto wall0 = std::chrono::steady_clock::now();
   try {
     if (mpi) {
@@ -182,10 +235,12 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
       sweep::RunOnThreads(spec, pending, args.jobs, g_stop, on_done);
     }
   } catch (const std::exception& e) {
+    ticker = {};
     bar.Finish();
     std::cerr << "linesim: the sweep stopped: " << e.what() << "\n";
     return kExitRunFailed;
   }
+  ticker = {};  // joined: the bar is finished once, with nothing drawing after
   bar.Finish();
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -21,16 +21,16 @@ namespace {
 void BM_Sweep(benchmark::State& state) {
   const linesim::sweep::SweepSpec spec = linesim::sweep::LoadSweepSpec(
       LINESIM_SOURCE_DIR "/scenarios/sweeps/belt_speed_compensation.yaml");
-  std::vector<linesim::sweep::RunSpec> runs;
+  std::vector<std::int64_t> ids;
   for (std::int64_t id = 0; id < linesim::sweep::RunCount(spec); ++id) {
-    runs.push_back(linesim::sweep::PlanRun(spec, id));
+    ids.push_back(id);
   }
   const int jobs = static_cast<int>(state.range(0));
   std::int64_t finished = 0, failed = 0;
   for (auto _ : state) {
     std::atomic<bool> stop{false};
     linesim::sweep::RunOnThreads(
-        spec, runs, jobs, stop,
+        spec, ids, jobs, stop,
         [&](const linesim::sweep::RunSpec&, const linesim::sweep::RunOutcome& outcome) {
           ++finished;
           if (outcome.status != linesim::sweep::RunStatus::kOk) ++failed;

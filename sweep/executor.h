@@ -1,6 +1,7 @@
 #pragma once
 
 #include <atomic>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -14,12 +15,14 @@ namespace linesim::sweep {
 /// a time, in completion order.
 using OnRunDone = std::function<void(const RunSpec&, const RunOutcome&)>;
 
-/// Runs `runs` on `jobs` threads, each taking the next run when it is free.
+/// Runs the runs `ids` (planned one by one as they start, so a sweep of
+/// millions holds only their ids) on `jobs` threads, each taking the next
+/// run when it is free.
 /// Runs share nothing mutable: each builds its own system from the files.
 /// Once `stop` is set no run starts and running ones stop at their next
 /// master step. If `on_done` throws, the remaining runs are stopped and the
 /// exception is rethrown here.
-void RunOnThreads(const SweepSpec& spec, const std::vector<RunSpec>& runs, int jobs,
+void RunOnThreads(const SweepSpec& spec, const std::vector<std::int64_t>& ids, int jobs,
                   std::atomic<bool>& stop, const OnRunDone& on_done);
 
 }  // namespace linesim::sweep

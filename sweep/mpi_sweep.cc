@@ -87,12 +87,30 @@ int MpiSession::ShareStatus(int status) const {
   return worst;
 }
 
-void DispatchRuns(const SweepSpec& spec, const std::vector<RunSpec>& runs, std::atomic<bool>& stop,
-                  const OnRunDone& on_done) {
+int MpiSession::LeaderStatus(int status) const {
+  MPI_Bcast(&status, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return status;
+}
+
+std::string MpiSession::LeaderText(const std::string& text) const {
+  int size = static_cast<int>(text.size());
+  MPI_Bcast(&size, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  std::string out = rank_ == 0 ? text : std::string(static_cast<std::size_t>(size), '\0');
+  MPI_Bcast(out.data(), size, MPI_CHAR, 0, MPI_COMM_WORLD);
+  return out;
+}
+
+void MpiSession::Abort(int status) const {
+  MPI_Abort(MPI_COMM_WORLD, status);
+  std::abort();  // MPI_Abort does not return
+}
+
+void DispatchRuns(const SweepSpec& spec, const std::vector<std::int64_t>& ids,
+                  std::atomic<bool>& stop, const OnRunDone& on_done) {
   int size = 1;
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   if (size == 1) {
-    RunOnThreads(spec, runs, 1, stop, on_done);
+    RunOnThreads(spec, ids, 1, stop, on_done);
     return;
   }
   std::size_t next = 0;
@@ -115,20 +133,22 @@ void DispatchRuns(const SweepSpec& spec, const std::vector<RunSpec>& runs, std::
     MPI_Recv(buf.data(), count, MPI_CHAR, status.MPI_SOURCE, status.MPI_TAG, MPI_COMM_WORLD,
              MPI_STATUS_IGNORE);
     if (status.MPI_TAG == kResult && !failure) {
-      const RunOutcome outcome = Unpack(buf);
-      if (outcome.status == RunStatus::kInterrupted) {
-        stop = true;
-      } else {
-        try {
-          on_done(PlanRun(spec, outcome.id), outcome);
-        } catch (...) {
-          failure = std::current_exception();
+      // Whatever goes wrong here, every worker is still answered (told to
+      // stop), so that no rank is left waiting in a receive.
+      try {
+        const RunOutcome outcome = Unpack(buf);
+        if (outcome.status == RunStatus::kInterrupted) {
           stop = true;
+        } else {
+          on_done(PlanRun(spec, outcome.id), outcome);
         }
+      } catch (...) {
+        failure = std::current_exception();
+        stop = true;
       }
     }
-    if (!stop.load() && next < runs.size()) {
-      SendRun(runs[next++].id, status.MPI_SOURCE);
+    if (!stop.load() && next < ids.size()) {
+      SendRun(ids[next++], status.MPI_SOURCE);
     } else {
       SendStop(status.MPI_SOURCE);
       --active;

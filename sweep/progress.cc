@@ -53,6 +53,10 @@ void ProgressBar::RunDone(bool ok) {
   if (enabled_) out_ << "\r" << Text() << "   " << std::flush;
 }
 
+void ProgressBar::Redraw() {
+  if (enabled_ && !finished_) out_ << "\r" << Text() << "   " << std::flush;
+}
+
 void ProgressBar::Finish() {
   if (enabled_ && !finished_) out_ << "\n" << std::flush;
   finished_ = true;

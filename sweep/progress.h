@@ -16,6 +16,9 @@ class ProgressBar {
   ProgressBar(std::ostream& out, bool enabled, std::int64_t total, std::int64_t already,
               std::int64_t already_failed);
   void RunDone(bool ok);
+  /// Draws again (elapsed time and ETA move on between runs).
+  void Redraw();
+  bool enabled() const { return enabled_; }
   /// Ends the line (once).
   void Finish();
   /// "12/40 done, 1 failed, 0:12 elapsed, ETA 0:28": what the bar shows.

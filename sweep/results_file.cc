@@ -1,5 +1,8 @@
 #include "sweep/results_file.h"
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -11,6 +14,7 @@
 #include <stdexcept>
 
 #include "cosim/variable_table.h"
+#include "models/models_dir.h"
 
 namespace linesim::sweep {
 
@@ -126,12 +130,33 @@ std::string FormatRow(const SweepSpec& spec, const RunSpec& run, const RunOutcom
 
 std::string SweepFingerprint(const SweepSpec& spec) {
   std::uint64_t h = 1469598103934665603ull;
-  h = Fnv1a(h, ReadWhole(spec.scenario));
-  for (const auto& m : spec.metrics) h = Fnv1a(h, "metric " + m + "\n");
-  for (std::int64_t id = 0; id < RunCount(spec); ++id) {
-    for (const auto& a : RunOverrides(spec, PlanRun(spec, id))) h = Fnv1a(h, a + "\n");
-    h = Fnv1a(h, "\n");
+  const auto add = [&h](std::string_view text) { h = Fnv1a(Fnv1a(h, text), "\n"); };
+  // The files the runs are built from: the base scenario and every model
+  // file (a robot model names the others), sorted for a stable order.
+  add(ReadWhole(spec.scenario));
+  std::vector<fs::path> models;
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(models::ModelsDir(), ec), end; !ec && it != end;
+       it.increment(ec)) {
+    if (it->is_regular_file(ec)) models.push_back(it->path());
   }
+  std::sort(models.begin(), models.end());
+  for (const auto& m : models) {
+    add(fs::relative(m, models::ModelsDir(), ec).string());
+    add(ReadWhole(m.string()));
+  }
+  // What decides each run's overrides, seed and columns.
+  for (const auto& [path, value] : spec.fixed) add("set " + path + "=" + value);
+  for (const auto& p : spec.parameters) {
+    add("parameter " + p.path + " kind " + std::to_string(static_cast<int>(p.kind)));
+    for (const auto& v : p.values) add(v);
+    add("distribution " + std::to_string(static_cast<int>(p.distribution)) + " " +
+        cosim::FormatValue(p.a) + " " + cosim::FormatValue(p.b));
+  }
+  add("combination " + std::to_string(static_cast<int>(spec.combination)) + " samples " +
+      std::to_string(spec.samples) + " repeats " + std::to_string(spec.repeats) + " seed " +
+      std::to_string(spec.seed) + " seeds " + std::to_string(static_cast<int>(spec.seeds)));
+  for (const auto& m : spec.metrics) add("metric " + m);
   char text[17];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
   return text;
@@ -197,6 +222,8 @@ void ResultsFile::Rewrite() {
   std::FILE* out = OpenOrThrow(tmp, "wb");
   bool ok = std::fputs(header_.c_str(), out) >= 0;
   for (const auto& [id, line] : rows_) ok = ok && std::fputs(line.c_str(), out) >= 0;
+  // On disk before the rename replaces the old file, also across a power cut.
+  ok = ok && std::fflush(out) == 0 && fsync(fileno(out)) == 0;
   ok = std::fclose(out) == 0 && ok;
   if (!ok) {
     std::remove(tmp.c_str());

@@ -30,7 +30,8 @@ std::optional<std::vector<std::string>> SplitCsvLine(std::string_view line);
 std::string JoinCsvLine(const std::vector<std::string>& fields);
 
 /// A fingerprint of everything that decides the rows: the base scenario's
-/// text, every run's overrides and the metrics. A resumed sweep must match.
+/// text, every model file, the sweep's settings and metrics. A resumed
+/// sweep, and every MPI rank, must match it.
 std::string SweepFingerprint(const SweepSpec& spec);
 
 /// The results.csv of a sweep folder, written as runs finish: one flushed

@@ -68,6 +68,8 @@ RunOutcome ExecuteRun(const SweepSpec& spec, const RunSpec& run, const std::atom
     return finish(RunStatus::kOk, "");
   } catch (const std::exception& e) {
     return finish(RunStatus::kFailed, e.what());
+  } catch (...) {
+    return finish(RunStatus::kFailed, "an exception that is not a std::exception");
   }
 }
 

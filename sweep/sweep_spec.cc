@@ -2,10 +2,12 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 
 #include "cosim/variable_table.h"
 #include "loader/overrides.h"
@@ -17,6 +19,7 @@ namespace linesim::sweep {
 
 namespace fs = std::filesystem;
 using loader::Child;
+using loader::Describe;
 using loader::Issue;
 using loader::JoinPath;
 using loader::ScenarioError;
@@ -33,6 +36,23 @@ std::string YamlText(const YAML::Node& node) {
   return out.c_str();
 }
 
+// A dotted path as --set takes it: non-empty keys between the dots.
+bool IsDottedPath(const std::string& path) {
+  if (path.empty() || path.front() == '.' || path.back() == '.') return false;
+  return path.find("..") == std::string::npos && path.find('=') == std::string::npos;
+}
+
+// The first repeated text of `items`, if any.
+std::optional<std::size_t> FirstRepeat(const std::vector<std::string>& items) {
+  for (std::size_t i = 1; i < items.size(); ++i) {
+    if (std::find(items.begin(), items.begin() + static_cast<std::ptrdiff_t>(i), items[i]) !=
+        items.begin() + static_cast<std::ptrdiff_t>(i)) {
+      return i;
+    }
+  }
+  return std::nullopt;
+}
+
 void ReadRange(const YAML::Node& range, const std::string& path, YamlReader& r, ParameterSpec& p) {
   if (!r.ExpectMap(range, path)) return;
   r.CheckKeys(range, path, {"from", "to", "count"});
@@ -41,6 +61,11 @@ void ReadRange(const YAML::Node& range, const std::string& path, YamlReader& r, 
   const double to = r.Real(range, path, "to", std::nullopt);
   const std::int64_t count = r.Integer(range, path, "count", std::nullopt, 1, 1000000);
   if (r.issues().size() != issues_before) return;
+  if (count > 1 && from == to) {
+    r.Error(Child(range, "to"), JoinPath(path, "to"),
+            "a range of " + std::to_string(count) + " values needs to != from");
+    return;
+  }
   if (count == 1 && from != to) {
     r.Error(Child(range, "count"), JoinPath(path, "count"),
             "a range from " + cosim::FormatValue(from) + " to " + cosim::FormatValue(to) +
@@ -88,6 +113,14 @@ void ReadParameter(const YAML::Node& node, const std::string& path, YamlReader& 
   r.CheckKeys(node, path, {"path", "values", "range", "random"});
   ParameterSpec p;
   p.path = r.String(node, path, "path", std::nullopt);
+  if (Child(node, "path").IsScalar() && !IsDottedPath(p.path)) {
+    r.Error(Child(node, "path"), JoinPath(path, "path"),
+            "expected a dotted path of keys, e.g. line.belts.0.speed_mps");
+  } else if (p.path == "seed") {
+    r.Error(Child(node, "path"), JoinPath(path, "path"),
+            "each run's seed comes from the sweep (repeats:, seeds: and seed:), which results.csv "
+            "reports in its seed column; for N seeds per point set repeats: N");
+  }
   const char* kinds[] = {"values", "range", "random"};
   int given = 0;
   for (const char* k : kinds) given += Child(node, k).IsDefined() ? 1 : 0;
@@ -102,6 +135,10 @@ void ReadParameter(const YAML::Node& node, const std::string& path, YamlReader& 
     if (!r.ExpectSequence(values, vpath)) return;
     if (values.size() == 0) r.Error(values, vpath, "expected at least one value");
     for (const auto& v : values) p.values.push_back(YamlText(v));
+    if (const auto i = FirstRepeat(p.values)) {
+      r.Error(values[*i], vpath + "." + std::to_string(*i),
+              "'" + p.values[*i] + "' is listed twice (each value is one point)");
+    }
   } else if (const YAML::Node range = Child(node, "range"); range.IsDefined()) {
     p.kind = ParameterKind::kRange;
     ReadRange(range, JoinPath(path, "range"), r, p);
@@ -132,8 +169,9 @@ void CheckParameterPath(const SweepSpec& spec, const ParameterSpec& p, const YAM
     loader::LoadScenario(spec.scenario, args);
   } catch (const ScenarioError& e) {
     for (const Issue& i : e.issues()) {
-      const bool at_parameter = i.key_path == p.path || i.key_path.rfind(p.path + ".", 0) == 0 ||
-                                p.path.rfind(i.key_path + ".", 0) == 0;
+      // At the path or on the way to it; an unknown key deeper down is in a
+      // value (a map given as the value), which fails only its own run.
+      const bool at_parameter = i.key_path == p.path || p.path.rfind(i.key_path + ".", 0) == 0;
       if (i.unknown_path && at_parameter) {
         r.Error(at, key_path, "not a setting of " + spec.scenario + ": " + i.message);
       }
@@ -176,7 +214,15 @@ SweepSpec LoadSweepSpec(const std::string& file) {
   }
   if (const YAML::Node set = Child(root, "set"); set.IsDefined()) {
     if (r.ExpectMap(set, "set")) {
-      for (const auto& kv : set) spec.fixed.emplace_back(kv.first.Scalar(), YamlText(kv.second));
+      for (const auto& kv : set) {
+        const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "";
+        if (!IsDottedPath(key)) {
+          r.Error(kv.first, "set",
+                  "expected dotted paths as keys, e.g. duration_s: 5, got " + Describe(kv.first));
+          continue;
+        }
+        spec.fixed.emplace_back(key, YamlText(kv.second));
+      }
     }
   }
   const YAML::Node parameters = Child(root, "parameters");
@@ -205,6 +251,19 @@ SweepSpec LoadSweepSpec(const std::string& file) {
     }
   }
   spec.repeats = r.Integer(root, "", "repeats", 1, 1, 1000000);
+  // Points x samples x repeats, refused above kMaxRuns before it could
+  // overflow: each run is a row, and the ids of the runs to do are held.
+  double runs = static_cast<double>(spec.samples) * static_cast<double>(spec.repeats);
+  for (const auto& p : spec.parameters) {
+    if (p.kind != ParameterKind::kRandom)
+      runs *= static_cast<double>(std::max<std::size_t>(1, p.values.size()));
+  }
+  if (runs > static_cast<double>(kMaxRuns)) {
+    r.Error(parameters, "parameters",
+            "the sweep has " + cosim::FormatValue(runs) +
+                " runs (points x samples x repeats); at most " + std::to_string(kMaxRuns) +
+                " are allowed: split it into several sweeps");
+  }
   spec.seed = static_cast<std::uint64_t>(
       r.Integer(root, "", "seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
   spec.seeds = r.String(root, "", "seeds", "common", {"common", "per_run"}) == "per_run"
@@ -243,6 +302,23 @@ SweepSpec LoadSweepSpec(const std::string& file) {
               "'" + spec.metrics[i] + "' is not a metric of " + spec.scenario +
                   (defined.empty() ? " (it defines none)"
                                    : "; it defines: " + loader::JoinNames(defined)));
+    }
+  }
+  if (const auto i = FirstRepeat(spec.metrics); i && metrics.IsDefined()) {
+    r.Error(metrics[*i], "metrics." + std::to_string(*i),
+            "'" + spec.metrics[*i] + "' is listed twice");
+  }
+  for (std::size_t i = 0; i < spec.metrics.size(); ++i) {
+    const std::string& m = spec.metrics[i];
+    const bool taken = m == "run_id" || m == "seed" || m == "status" || m == "error" ||
+                       m == "wall_s" ||
+                       std::any_of(spec.parameters.begin(), spec.parameters.end(),
+                                   [&](const ParameterSpec& p) { return p.path == m; });
+    if (taken) {
+      r.Error(metrics.IsDefined() ? metrics[i] : root, "metrics." + std::to_string(i),
+              "'" + m +
+                  "' is also the name of another column of results.csv; rename the metric "
+                  "in the scenario");
     }
   }
   if (spec.metrics.empty() && r.ok()) {

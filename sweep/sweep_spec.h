@@ -42,6 +42,9 @@ enum class SeedPolicy {
   kPerRun,
 };
 
+/// The most runs one sweep may have (each is a row of results.csv).
+inline constexpr std::int64_t kMaxRuns = 10'000'000;
+
 /// A sweep file, read and checked.
 struct SweepSpec {
   std::string file;  // the sweep file as given

@@ -158,6 +158,50 @@ TEST(SweepCli, TwoAndThreeMpiRanksGiveTheThreadedRows) {
   }
 }
 
+TEST(SweepCli, OneMpiRankRunsAloneAndRanksWithOtherModelFilesAreRefused) {
+  const std::string file = SmallSweep("mpi1.yaml", 1);
+  const std::string alone = Fresh("mpi_alone");
+  const Result r = Exec({"mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "1", LINESIM_CLI,
+                         "sweep", file, "--out", alone});
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("on rank 0 alone"), std::string::npos) << r.out;
+  EXPECT_EQ(LineCount(fs::path(alone) / "results.csv"), 7u);
+
+  // Rank 1 reads a copy of the model files with one line added: its rows
+  // could differ, so no rank starts and nothing is written.
+  const fs::path models = Temp("models_copy");
+  fs::remove_all(models);
+  fs::copy(LINESIM_SOURCE_DIR "/models", models, fs::copy_options::recursive);
+  std::ofstream(models / "chassis" / "raw3_chassis.yaml", std::ios::app) << "\n# edited\n";
+  const std::string dir = Fresh("mpi_mismatch");
+  const Result m = Exec({"mpirun",
+                         "--allow-run-as-root",
+                         "--oversubscribe",
+                         "-n",
+                         "1",
+                         LINESIM_CLI,
+                         "sweep",
+                         file,
+                         "--out",
+                         dir,
+                         ":",
+                         "-n",
+                         "1",
+                         "env",
+                         "LINESIM_MODELS_DIR=" + models.string(),
+                         LINESIM_CLI,
+                         "sweep",
+                         file,
+                         "--out",
+                         dir});
+  EXPECT_NE(m.status, 0);
+  EXPECT_NE(m.err.find("rank 1: linesim: the sweep file, its base scenario or a model file "
+                       "differs from rank 0's"),
+            std::string::npos)
+      << m.err;
+  EXPECT_FALSE(fs::exists(dir));
+}
+
 // Polls until results.csv has `rows` rows (or the process has ended).
 void WaitForRows(const std::string& dir, std::size_t rows, pid_t pid) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
@@ -230,6 +274,34 @@ TEST(SweepCli, CtrlCStopsCleanlyAndResumeFinishes) {
   ASSERT_EQ(resumed.status, 0) << resumed.err;
   const std::string whole = Fresh("int_whole");
   ASSERT_EQ(Sweep(file, whole).status, 0);
+  EXPECT_EQ(Rows(dir), Rows(whole));
+}
+
+TEST(SweepCli, AnInterruptedMpiSweepResumesToTheSameFile) {
+  const std::string file = WriteSweep(
+      "mpiint.yaml", "scenario: " + kCrossLine +
+                         "\nset: {duration_s: 6}\n"
+                         "parameters:\n"
+                         "  - {path: line.belts.0.speed_mps, range: {from: 0.05, to: 0.25, count: "
+                         "12}}\n"
+                         "  - {path: control.compensation, values: [true, false]}\n");
+  const std::string dir = Fresh("mpi_interrupted");
+  const pid_t pid = Spawn({"mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "3",
+                           LINESIM_CLI, "sweep", file, "--out", dir},
+                          Temp("mpi_int_log"));
+  WaitForRows(dir, 2, pid);
+  // mpirun passes Ctrl-C on to the ranks (when it does so is mpirun's
+  // business: the sweep may be further along, or done).
+  kill(pid, SIGINT);
+  Wait(pid);
+  const std::string csv = ReadFile(fs::path(dir) / "results.csv");
+  ASSERT_FALSE(csv.empty());
+  EXPECT_EQ(csv.back(), '\n');
+  const Result resumed = Exec({"mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "3",
+                               LINESIM_CLI, "sweep", file, "--out", dir, "--resume"});
+  ASSERT_EQ(resumed.status, 0) << resumed.out << resumed.err;
+  const std::string whole = Fresh("mpi_int_whole");
+  ASSERT_EQ(Sweep(file, whole, {"--jobs", "2"}).status, 0);
   EXPECT_EQ(Rows(dir), Rows(whole));
 }
 

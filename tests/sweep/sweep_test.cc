@@ -229,23 +229,101 @@ TEST(SweepSpec, BadSweepFilesNameFileKeyPathAndWhatWasExpected) {
 
   EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("nofile.yaml",
                                                "scenario: nowhere.yaml\n"
-                                               "parameters: [{path: seed, values: [1]}]\n")),
+                                               "parameters: [{path: duration_s, values: [1]}]\n")),
                           "scenario", "refused"));
   EXPECT_TRUE(AnyContains(
       IssueTexts(WriteFile("gridrandom.yaml",
                            "scenario: " + kCrossLine +
-                               "\nparameters: [{path: seed, random: {distribution: uniform, "
+                               "\nparameters: [{path: duration_s, random: {distribution: uniform, "
                                "min: 1, max: 2}}]\n")),
       "parameters.0.random", "monte_carlo"));
   EXPECT_TRUE(AnyContains(
       IssueTexts(WriteFile("twokinds.yaml", "scenario: " + kCrossLine +
-                                                "\nparameters: [{path: seed, values: [1], "
+                                                "\nparameters: [{path: duration_s, values: [1], "
                                                 "range: {from: 1, to: 2, count: 2}}]\n")),
       "parameters.0", "exactly one of"));
   EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("missing.yaml", "parameters: []\n")), "scenario",
                           "missing required key"));
   EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("absent_sweep.yaml", "")), "expected a map"));
   EXPECT_TRUE(AnyContains(IssueTexts("/nonexistent/sweep.yaml"), "cannot read the sweep file"));
+}
+
+TEST(SweepSpec, MalformedPathsDuplicatesAndHugeSweepsAreRefused) {
+  const std::string head = "scenario: " + kCrossLine + "\n";
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(WriteFile("empty.yaml", head + "parameters: [{path: '', values: [1]}]\n")),
+      "parameters.0.path", "dotted path"));
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(WriteFile("dots.yaml", head + "parameters: [{path: 'a..b', values: [1]}]\n")),
+      "parameters.0.path", "dotted path"));
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(WriteFile("setkey.yaml", head + "set: {[a]: 1}\n"
+                                                 "parameters: [{path: duration_s, values: "
+                                                 "[1]}]\n")),
+      ": set:", "dotted paths as keys"));
+  // The seed column is the sweep's: the seed is varied by repeats.
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(WriteFile("seed.yaml", head + "parameters: [{path: seed, values: [1, 2]}]\n")),
+      "parameters.0.path", "repeats: N"));
+  EXPECT_TRUE(
+      AnyContains(IssueTexts(WriteFile("twice.yaml", head + "parameters: [{path: duration_s, "
+                                                            "values: [1, 2, 1]}]\n")),
+                  "parameters.0.values.2", "listed twice"));
+  EXPECT_TRUE(
+      AnyContains(IssueTexts(WriteFile("flat.yaml", head + "parameters: [{path: duration_s, "
+                                                           "range: {from: 1, to: 1, count: "
+                                                           "3}}]\n")),
+                  "parameters.0.range.to", "!= from"));
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(
+          WriteFile("metric2.yaml", head + "metrics: [max_path_deviation_m, max_path_deviation_m]\n"
+                                           "parameters: [{path: duration_s, values: [1]}]\n")),
+      "metrics.1", "listed twice"));
+  // 1000^3 points x 20 repeats: refused before it could overflow or fill
+  // the memory with run ids.
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(WriteFile(
+          "huge.yaml",
+          head + "repeats: 20\nparameters:\n"
+                 "  - {path: duration_s, range: {from: 1, to: 2, count: 1000}}\n"
+                 "  - {path: line.belts.0.speed_mps, range: {from: 0, to: 1, count: 1000}}\n"
+                 "  - {path: robot.pose.yaw_deg, range: {from: 0, to: 90, count: 1000}}\n")),
+      "parameters", "at most 10000000"));
+}
+
+TEST(SweepSpec, AWrongKeyInsideAValueFailsOnlyThatRun) {
+  // Whole maps as values: the second has a misspelled key. The path exists,
+  // so the sweep is accepted whatever the order of the values.
+  for (const std::string values :
+       {"[{x_m: 0, y_m: -2, yaw_deg: 90}, {x_m: 0, y_m: -2, yaw: 90}]",
+        "[{x_m: 0, y_m: -2, yaw: 90}, {x_m: 0, y_m: -2, yaw_deg: 90}]"}) {
+    EXPECT_NO_THROW(LoadSweepSpec(
+        WriteFile("map.yaml", "scenario: " + kCrossLine +
+                                  "\nparameters: [{path: robot.pose, values: " + values + "}]\n")))
+        << values;
+  }
+}
+
+TEST(SweepFingerprint, ChangesWithTheSweepTheScenarioAndTheModelFiles) {
+  const SweepSpec spec = LoadSweepSpec(WriteFile("fp.yaml", BeltSweep()));
+  const std::string base = SweepFingerprint(spec);
+  EXPECT_EQ(SweepFingerprint(LoadSweepSpec(WriteFile("fp_same.yaml", BeltSweep()))), base);
+  EXPECT_NE(SweepFingerprint(LoadSweepSpec(WriteFile("fp_rep.yaml", BeltSweep("repeats: 2\n")))),
+            base);
+  EXPECT_NE(SweepFingerprint(LoadSweepSpec(WriteFile("fp_seed.yaml", BeltSweep("seed: 3\n")))),
+            base);
+  // A copy of the model files with one mass changed: the rows would differ.
+  const fs::path models =
+      fs::path(::testing::TempDir()) / ("sweep_models_" + std::to_string(getpid()));
+  fs::remove_all(models);
+  fs::copy(LINESIM_SOURCE_DIR "/models", models, fs::copy_options::recursive);
+  setenv("LINESIM_MODELS_DIR", models.c_str(), 1);
+  const std::string copied = SweepFingerprint(spec);
+  { std::ofstream(models / "chassis" / "raw3_chassis.yaml", std::ios::app) << "\n# edited\n"; }
+  const std::string edited = SweepFingerprint(spec);
+  unsetenv("LINESIM_MODELS_DIR");
+  EXPECT_EQ(copied, base);
+  EXPECT_NE(edited, base);
 }
 
 TEST(SweepSpec, AnOutOfRangeValueIsARunProblemNotASweepProblem) {
@@ -284,10 +362,10 @@ std::string WithoutWallTime(const std::string& csv) {
 
 std::string RunSweep(const SweepSpec& spec, int jobs, const std::string& dir) {
   ResultsFile results = ResultsFile::Create(dir + "/results.csv", spec);
-  std::vector<RunSpec> runs;
-  for (std::int64_t id = 0; id < RunCount(spec); ++id) runs.push_back(PlanRun(spec, id));
+  std::vector<std::int64_t> ids;
+  for (std::int64_t id = 0; id < RunCount(spec); ++id) ids.push_back(id);
   std::atomic<bool> stop{false};
-  RunOnThreads(spec, runs, jobs, stop, [&](const RunSpec& run, const RunOutcome& outcome) {
+  RunOnThreads(spec, ids, jobs, stop, [&](const RunSpec& run, const RunOutcome& outcome) {
     results.Append(run.id, FormatRow(spec, run, outcome));
   });
   results.SortByRunId();
@@ -335,18 +413,21 @@ TEST(SweepExecutor, OneAndTwoJobsWriteTheSameRowsAndAFailingRunIsIsolated) {
 
 TEST(SweepExecutor, AStopLeavesNoRowForTheInterruptedRun) {
   const SweepSpec spec = LoadSweepSpec(WriteFile("stop.yaml", BeltSweep()));
-  std::vector<RunSpec> runs;
-  for (std::int64_t id = 0; id < RunCount(spec); ++id) runs.push_back(PlanRun(spec, id));
+  std::vector<std::int64_t> ids;
+  for (std::int64_t id = 0; id < RunCount(spec); ++id) ids.push_back(id);
   std::atomic<bool> stop{false};
   std::vector<std::int64_t> done;
-  RunOnThreads(spec, runs, 2, stop, [&](const RunSpec& run, const RunOutcome&) {
+  RunOnThreads(spec, ids, 2, stop, [&](const RunSpec& run, const RunOutcome& outcome) {
+    // The run stopped on the other thread is never reported.
+    EXPECT_NE(outcome.status, RunStatus::kInterrupted) << run.id;
     done.push_back(run.id);
     if (done.size() == 3) stop = true;
   });
-  // Three rows; a run finishing on the other thread may add a fourth.
+  // Three rows; a run that finished on the other thread just before the
+  // stop may add a fourth; the stopped one adds none.
   EXPECT_GE(done.size(), 3u);
   EXPECT_LE(done.size(), 4u);
-  const RunOutcome o = ExecuteRun(spec, runs[0], &stop);
+  const RunOutcome o = ExecuteRun(spec, PlanRun(spec, 0), &stop);
   EXPECT_EQ(o.status, RunStatus::kInterrupted);
 }
 
@@ -368,11 +449,13 @@ TEST(ResultsFile, ResumeKeepsCompleteRowsAndDropsACutOffLine) {
   EXPECT_FALSE(resumed.HasRow(5));
   EXPECT_EQ(ReadFile(path), lines[0] + lines[1] + lines[4]);
 
-  // Another sweep's file is refused, not mixed.
+  // The file of a sweep with other metrics (all four against one) is
+  // refused, not mixed.
   const SweepSpec other =
       LoadSweepSpec(WriteFile("other.yaml", BeltSweep("metrics: [max_path_deviation_m]\n")));
-  std::ofstream(path, std::ios::trunc) << "run_id,x,seed\n";
+  std::ofstream(path, std::ios::trunc) << full;
   EXPECT_THROW(ResultsFile::Resume(path, other), std::runtime_error);
+  EXPECT_EQ(ReadFile(path), full);  // and left as it was
 }
 
 TEST(ResultsFile, TableParsesRowsBack) {
