@@ -297,9 +297,12 @@ plots::SweepSeries LevelSeries(const SweepTable& t, std::size_t p, std::size_t m
 }
 
 // Every ok run with a finite metric `m` as a point at its value of `p`.
-plots::SweepSeries ScatterSeries(const SweepTable& t, std::size_t p, std::size_t m) {
+plots::SweepSeries ScatterSeries(std::size_t p, std::size_t m, const Rows& rows,
+                                 std::string label) {
   plots::SweepSeries series;
-  for (const Row& r : t.rows) {
+  series.label = std::move(label);
+  for (const Row* row : rows) {
+    const Row& r = *row;
     if (!r.ok || !std::isfinite(r.metrics[m])) continue;
     series.x.push_back(r.values[p]);
     series.mean.push_back(r.metrics[m]);
@@ -480,8 +483,27 @@ std::vector<plots::SweepChart> SweepCharts(const SweepTable& t) {
       std::vector<plots::SweepSeries> series;
       if (t.levels[p].empty()) {
         chart.scatter = true;
-        series.push_back(ScatterSeries(t, p, m));
-        chart.categorical_x = !AllNumbers(series.back().x);
+        // One colour per combination of the listed values (compensation on
+        // and off, say), as long as that stays readable.
+        std::vector<std::size_t> listed;
+        for (std::size_t q = 0; q < t.parameters.size(); ++q) {
+          if (!t.levels[q].empty()) listed.push_back(q);
+        }
+        const std::vector<Group> combinations = GroupBy(listed, all);
+        if (listed.empty() || combinations.size() > kMaxSeries) {
+          series.push_back(ScatterSeries(p, m, all, ""));
+        } else {
+          for (const Group& g : combinations) {
+            std::string label;
+            for (std::size_t i = 0; i < listed.size(); ++i) {
+              label += (i ? ", " : "") + t.parameters[listed[i]] + "=" + g.values[i];
+            }
+            series.push_back(ScatterSeries(p, m, g.rows, std::move(label)));
+          }
+        }
+        std::vector<std::string> xs;
+        for (const auto& one : series) xs.insert(xs.end(), one.x.begin(), one.x.end());
+        chart.categorical_x = !AllNumbers(xs);
       } else {
         chart.categorical_x = !AllNumbers(t.levels[p]);
         chart.categories = t.levels[p];

@@ -385,6 +385,27 @@ TEST(SweepCharts, RandomParameterIsAScatterOfOkRuns) {
   EXPECT_TRUE(SweepCharts(failed).empty());
 }
 
+// Monte-Carlo draws crossed with listed values: one colour per listed
+// value, so compensation on and off are told apart in the scatter.
+TEST(SweepCharts, ScatterSplitsByTheListedParameters) {
+  SweepTable t;
+  t.name = "mc";
+  t.parameters = {"line.belts.0.speed_mps", "control.compensation"};
+  t.levels = {{}, {"true", "false"}};
+  t.metrics = {"max_deviation_m"};
+  t.grid = false;
+  t.rows = {Ok(0, {"0.1", "true"}, {0.01}), Ok(1, {"0.2", "true"}, {0.02}),
+            Ok(2, {"0.1", "false"}, {0.1}), Ok(3, {"0.2", "false"}, {0.2})};
+  const auto charts = SweepCharts(t);
+  ASSERT_EQ(charts.size(), 2u);  // against each parameter
+  ASSERT_TRUE(charts[0].scatter);
+  ASSERT_EQ(charts[0].series.size(), 2u);
+  EXPECT_EQ(charts[0].series[0].label, "control.compensation=true");
+  EXPECT_EQ(charts[0].series[0].mean, (std::vector<double>{0.01, 0.02}));
+  EXPECT_EQ(charts[0].series[1].label, "control.compensation=false");
+  EXPECT_EQ(charts[0].series[1].x, (std::vector<std::string>{"0.1", "0.2"}));
+}
+
 // Guards file names made from parameter paths: only [A-Za-z0-9._-], and two
 // paths that map to the same name do not overwrite each other's chart.
 TEST(SweepCharts, FileNamesAreSafeAndDistinct) {

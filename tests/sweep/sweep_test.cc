@@ -326,6 +326,14 @@ TEST(SweepFingerprint, ChangesWithTheSweepTheScenarioAndTheModelFiles) {
   EXPECT_NE(edited, base);
 }
 
+TEST(SweepSpec, ShippedSweepsLoad) {
+  for (const std::string name : {"belt_speed_compensation", "master_step", "heading_monte_carlo"}) {
+    const SweepSpec spec = LoadSweepSpec(LINESIM_SOURCE_DIR "/scenarios/sweeps/" + name + ".yaml");
+    EXPECT_EQ(spec.name, name);
+    EXPECT_EQ(spec.scenario, LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml");
+  }
+}
+
 TEST(SweepSpec, AnOutOfRangeValueIsARunProblemNotASweepProblem) {
   // A value the scenario refuses fails its own run only: the others may be
   // what the user wants to see.
