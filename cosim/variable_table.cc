@@ -1,6 +1,7 @@
 #include "cosim/variable_table.h"
 
 #include <charconv>
+#include <cmath>
 #include <stdexcept>
 
 namespace linesim::cosim {
@@ -55,6 +56,17 @@ std::string FormatValue(double x) {
   char buf[32];
   auto res = std::to_chars(buf, buf + sizeof buf, x);
   return std::string(buf, res.ptr);
+}
+
+std::optional<double> ParseFiniteValue(std::string_view text) {
+  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+  double x = 0.0;
+  const char* end = text.data() + text.size();
+  const auto res = std::from_chars(text.data(), end, x);
+  if (text.empty() || res.ec != std::errc() || res.ptr != end || !std::isfinite(x)) {
+    return std::nullopt;
+  }
+  return x;
 }
 
 std::string FormatValue(const Value& v) {

@@ -35,6 +35,9 @@ std::string FormatValue(const Value& v);
 /// A number as the shortest text that reads back to it ("0.1", "1e-05",
 /// "nan"): for messages, files and the YAML the loader writes.
 std::string FormatValue(double x);
+/// The inverse for files: a finite number written as text (an optional
+/// leading '+'), whatever the locale; nothing for anything else.
+std::optional<double> ParseFiniteValue(std::string_view text);
 
 struct VariableInfo {
   ValueRef ref = 0;

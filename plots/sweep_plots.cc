@@ -21,17 +21,6 @@ constexpr int kWidthPx = 800, kHeightPx = 500;
 // locale.
 std::string Num(double x) { return cosim::FormatValue(x); }
 
-std::optional<double> ParseNumber(std::string_view text) {
-  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-  double x = 0.0;
-  const char* end = text.data() + text.size();
-  const auto res = std::from_chars(text.data(), end, x);
-  if (text.empty() || res.ec != std::errc() || res.ptr != end || !std::isfinite(x)) {
-    return std::nullopt;
-  }
-  return x;
-}
-
 bool IsSafeFileName(const std::string& name) {
   return !name.empty() && name != "." && name != ".." && SafeFileName(name) == name;
 }
@@ -56,7 +45,8 @@ void CheckChart(const SweepChart& chart) {
     }
     if (chart.categorical_x) continue;
     for (const std::string& x : s.x) {
-      if (!ParseNumber(x)) Refuse(chart, "x value '" + x + "' is not a number on a numeric axis");
+      if (!cosim::ParseFiniteValue(x))
+        Refuse(chart, "x value '" + x + "' is not a number on a numeric axis");
     }
   }
 }
@@ -90,7 +80,7 @@ std::vector<Point> Points(const SweepChart& chart, const SweepSeries& s,
                               categories.begin()) +
           shift;
     } else {
-      x = *ParseNumber(s.x[i]);
+      x = *cosim::ParseFiniteValue(s.x[i]);
     }
     const double lo = i < s.min.size() ? s.min[i] : s.mean[i];
     const double hi = i < s.max.size() ? s.max[i] : s.mean[i];

@@ -65,12 +65,7 @@ std::optional<std::int64_t> ParseId(const std::string& text) {
 }
 
 double ParseNumber(const std::string& text) {
-  if (text.empty()) return std::numeric_limits<double>::quiet_NaN();
-  double v = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  return ec == std::errc() && end == text.data() + text.size()
-             ? v
-             : std::numeric_limits<double>::quiet_NaN();
+  return cosim::ParseFiniteValue(text).value_or(std::numeric_limits<double>::quiet_NaN());
 }
 
 }  // namespace

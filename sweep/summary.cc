@@ -15,6 +15,8 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "cosim/variable_table.h"
+
 namespace linesim::sweep {
 
 namespace {
@@ -30,17 +32,6 @@ constexpr std::size_t kMaxSeries = 8;
 constexpr std::size_t kMaxFailuresPrinted = 10;
 
 Json Number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
-
-std::optional<double> ParseNumber(std::string_view text) {
-  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-  double x = 0.0;
-  const char* end = text.data() + text.size();
-  const auto res = std::from_chars(text.data(), end, x);
-  if (text.empty() || res.ec != std::errc() || res.ptr != end || !std::isfinite(x)) {
-    return std::nullopt;
-  }
-  return x;
-}
 
 // A number with 4 significant digits, as printf's %.4g but independent of
 // the locale; "-" when not finite.
@@ -168,7 +159,7 @@ struct RandomParameter {
 RandomParameter DescribeRandom(const SweepTable& t, std::size_t p) {
   RandomParameter out;
   for (const Row& r : t.rows) {
-    const auto x = ParseNumber(r.values[p]);
+    const auto x = cosim::ParseFiniteValue(r.values[p]);
     if (!x) continue;
     out.min = std::isnan(out.min) ? *x : std::min(out.min, *x);
     out.max = std::isnan(out.max) ? *x : std::max(out.max, *x);
@@ -176,7 +167,7 @@ RandomParameter DescribeRandom(const SweepTable& t, std::size_t p) {
   for (std::size_t m = 0; m < t.metrics.size(); ++m) {
     std::vector<double> xs, ys;
     for (const Row& r : t.rows) {
-      const auto x = ParseNumber(r.values[p]);
+      const auto x = cosim::ParseFiniteValue(r.values[p]);
       if (!r.ok || !x || !std::isfinite(r.metrics[m])) continue;
       xs.push_back(*x);
       ys.push_back(r.metrics[m]);
@@ -312,7 +303,7 @@ plots::SweepSeries ScatterSeries(std::size_t p, std::size_t m, const Rows& rows,
 
 bool AllNumbers(const std::vector<std::string>& texts) {
   return std::all_of(texts.begin(), texts.end(),
-                     [](const std::string& x) { return ParseNumber(x).has_value(); });
+                     [](const std::string& x) { return cosim::ParseFiniteValue(x).has_value(); });
 }
 
 // `name`, or with "_2", "_3", ... before ".png" when it is taken.
