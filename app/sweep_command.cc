@@ -209,7 +209,7 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
   sweep::ProgressBar bar(std::cerr, isatty(STDERR_FILENO) != 0, total, done_before, failed_before);
   std::mutex bar_mutex;
   const auto on_done = [&](const sweep::RunSpec& run, const sweep::RunOutcome& outcome) {
-    results->Append(run.id, sweep::FormatRow(spec, run, outcome));
+    results->Append(run.id, sweep::FormatRow(run, outcome));
     const std::lock_guard lock(bar_mutex);
     bar.RunDone(outcome.status == sweep::RunStatus::kOk);
   };

@@ -111,7 +111,7 @@ std::optional<std::vector<std::string>> SplitCsvLine(std::string_view line) {
   return fields;
 }
 
-std::string FormatRow(const SweepSpec& spec, const RunSpec& run, const RunOutcome& outcome) {
+std::string FormatRow(const RunSpec& run, const RunOutcome& outcome) {
   std::vector<std::string> f{std::to_string(run.id)};
   f.insert(f.end(), run.values.begin(), run.values.end());
   f.push_back(std::to_string(outcome.seed));
@@ -119,7 +119,6 @@ std::string FormatRow(const SweepSpec& spec, const RunSpec& run, const RunOutcom
   f.push_back(outcome.status == RunStatus::kOk ? "ok" : "failed");
   f.push_back(outcome.error);
   f.push_back(cosim::FormatValue(outcome.wall_s));
-  (void)spec;
   return JoinCsvLine(f);
 }
 

@@ -22,7 +22,7 @@ std::vector<std::string> ResultsHeader(const SweepSpec& spec);
 /// One line of results.csv (with its newline). Numbers are written as the
 /// shortest text that reads back to the same double, so rows are the same
 /// bytes on any machine, thread or rank; only wall_s differs between runs.
-std::string FormatRow(const SweepSpec& spec, const RunSpec& run, const RunOutcome& outcome);
+std::string FormatRow(const RunSpec& run, const RunOutcome& outcome);
 
 /// CSV fields, RFC 4180 quoting; nothing when a quote is left open (a line
 /// cut off by a killed process).

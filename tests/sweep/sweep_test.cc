@@ -374,7 +374,7 @@ std::string RunSweep(const SweepSpec& spec, int jobs, const std::string& dir) {
   for (std::int64_t id = 0; id < RunCount(spec); ++id) ids.push_back(id);
   std::atomic<bool> stop{false};
   RunOnThreads(spec, ids, jobs, stop, [&](const RunSpec& run, const RunOutcome& outcome) {
-    results.Append(run.id, FormatRow(spec, run, outcome));
+    results.Append(run.id, FormatRow(run, outcome));
   });
   results.SortByRunId();
   return ReadFile(dir + "/results.csv");
