@@ -15,6 +15,7 @@
 #include "cosim/system.h"
 #include "cosim/time.h"
 #include "models/dc_motor_params.h"
+#include "tests/cosim/test_units.h"
 
 namespace linesim::motors {
 namespace {
@@ -45,10 +46,9 @@ std::vector<double> Get(const DcMotorUnit& u, const std::string& name) {
 // Closed-form reference for one motor in full mode. State x = (i, w_rotor):
 //   x' = A x + c,  A = [[-R/L, -k_t/L], [k_t/J, -b/J]],
 //   c = (V/L, tau_load/(eta N J)),  J = J_rotor + J_load/(eta N^2).
-// With constant inputs x(t) = x_ss + Phi(t) (x0 - x_ss), x_ss = -A^-1 c, and
-// for the distinct real eigenvalues l1, l2 of A (Sylvester's formula):
-//   Phi(t) = (e^(l1 t) (A - l2 I) - e^(l2 t) (A - l1 I)) / (l1 - l2).
-// Eigen is used for the 2x2 linear algebra only, not for the exponential.
+// With constant inputs the exact solution is the matrix exponential of the
+// augmented system (cosim::test_units::ExactZohStep, shared with the cosim
+// tests), not a numerical integration.
 struct Motor {
   // The unit's defaults (maxon RE 40 148877 datasheet, checked against the
   // datasheet in DefaultsAreTheMaxonRe40DataSheet).
@@ -70,28 +70,14 @@ struct Motor {
 
 class Reference {
  public:
-  explicit Reference(const Motor& m) : m_(m), a_(m.A()) {
-    const double half_tr = 0.5 * a_.trace();
-    const double disc = half_tr * half_tr - a_.determinant();
-    EXPECT_GT(disc, 0.0) << "the formula below needs distinct real eigenvalues";
-    // Stable quadratic roots: the large one first, the small one from det.
-    l1_ = half_tr - std::sqrt(disc);
-    l2_ = a_.determinant() / l1_;
-  }
+  explicit Reference(const Motor& m) : m_(m) {}
   /// State (i, w_rotor) after `t_s` seconds from x0 with constant inputs.
   Vec2 Advance(const Vec2& x0, double volt, double tau_load, double t_s) const {
-    const Vec2 x_ss = -a_.partialPivLu().solve(m_.C(volt, tau_load));
-    const Mat2 id = Mat2::Identity();
-    const Mat2 phi =
-        (std::exp(l1_ * t_s) * (a_ - l2_ * id) - std::exp(l2_ * t_s) * (a_ - l1_ * id)) /
-        (l1_ - l2_);
-    return x_ss + phi * (x0 - x_ss);
+    return cosim::test_units::ExactZohStep<2>(m_.A(), m_.C(volt, tau_load), x0, t_s);
   }
 
  private:
   Motor m_;
-  Mat2 a_;
-  double l1_ = 0, l2_ = 0;
 };
 
 void ApplyParams(DcMotorUnit& u, const std::vector<Motor>& ms) {
@@ -552,6 +538,22 @@ TEST(DcMotorUnit, RestoreRejectsStateOfAnotherLayout) {
   a.Initialize();
   DcMotorUnit b("a", 2, MotorMode::kFull);
   EXPECT_ANY_THROW(b.RestoreState(a.SaveState()));
+}
+
+// Guards the unit's own check of its internal state (same layout, one real
+// short): the variable-table check above does not reach it.
+TEST(DcMotorUnit, RestoreRefusesTruncatedInternalState) {
+  DcMotorUnit a("a", 2, MotorMode::kFull);
+  a.Initialize();
+  cosim::UnitState state = a.SaveState();
+  state.reals.pop_back();
+  DcMotorUnit b("a", 2, MotorMode::kFull);
+  try {
+    b.RestoreState(state);
+    FAIL() << "a truncated state was restored";
+  } catch (const cosim::UnitError& e) {
+    EXPECT_NE(std::string(e.what()).find("saved state has"), std::string::npos) << e.what();
+  }
 }
 
 // ---------------------------------------------------------------------------
