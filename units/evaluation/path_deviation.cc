@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include "cosim/parameter_checks.h"
+#include "cosim/variable_table.h"
+
 namespace linesim::evaluation {
 
 PathDistance DistanceToPath(const std::vector<std::array<double, 2>>& path, double x_m,
@@ -37,14 +40,16 @@ PathDeviationUnit::PathDeviationUnit(std::string name, std::vector<std::array<do
 }
 
 std::vector<cosim::ParameterProblem> PathDeviationUnit::CheckParameters() const {
-  std::vector<cosim::ParameterProblem> problems;
-  if (path_.empty()) problems.push_back({"path", std::nullopt, "needs at least one point"});
+  cosim::ParameterChecks c;
+  if (path_.empty()) c.Add({"path", std::nullopt, "needs at least one point"});
   for (std::size_t i = 0; i < path_.size(); ++i) {
     if (!std::isfinite(path_[i][0]) || !std::isfinite(path_[i][1])) {
-      problems.push_back({"path", i, "coordinates must be finite"});
+      c.Add({"path", i,
+             "must be finite, got (" + cosim::FormatValue(path_[i][0]) + ", " +
+                 cosim::FormatValue(path_[i][1]) + ")"});
     }
   }
-  return problems;
+  return c.Take();
 }
 
 void PathDeviationUnit::Evaluate() {

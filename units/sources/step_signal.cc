@@ -1,6 +1,9 @@
 #include "units/sources/step_signal.h"
 
+#include <cmath>
 #include <string>
+
+#include "cosim/parameter_checks.h"
 
 namespace linesim::sources {
 
@@ -25,15 +28,23 @@ StepSignalUnit::StepSignalUnit(std::string name, int count, std::string unit,
 }
 
 std::vector<cosim::ParameterProblem> StepSignalUnit::CheckParameters() const {
-  std::vector<cosim::ParameterProblem> problems;
-  for (std::size_t i = 1; i < steps_.size(); ++i) {
-    if (steps_[i].time <= steps_[i - 1].time) {
-      problems.push_back({"steps", i,
-                          "step times must increase, got " + cosim::FormatSeconds(steps_[i].time) +
-                              " s after " + cosim::FormatSeconds(steps_[i - 1].time) + " s"});
+  cosim::ParameterChecks c;
+  // A non-finite value is named here, not later as a NaN output.
+  c.Finite("initial", initial_);
+  for (std::size_t i = 0; i < steps_.size(); ++i) {
+    for (double v : steps_[i].value) {
+      if (!std::isfinite(v)) {
+        c.Add({"steps", i, "values must be finite, got " + cosim::FormatValue(v)});
+        break;
+      }
+    }
+    if (i > 0 && steps_[i].time <= steps_[i - 1].time) {
+      c.Add({"steps", i,
+             "step times must increase, got " + cosim::FormatSeconds(steps_[i].time) + " s after " +
+                 cosim::FormatSeconds(steps_[i - 1].time) + " s"});
     }
   }
-  return problems;
+  return c.Take();
 }
 
 void StepSignalUnit::Evaluate(cosim::TimeNs t) {

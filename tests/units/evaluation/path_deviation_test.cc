@@ -58,5 +58,15 @@ TEST(PathDeviationUnit, RefusesAnEmptyPath) {
   EXPECT_THROW(u.Initialize(), cosim::UnitError);
 }
 
+// Guards against a non-finite point (every distance would be NaN): refused
+// at its index, with the value.
+TEST(PathDeviationUnit, RefusesANonFinitePointWithItsValue) {
+  PathDeviationUnit u("monitor", {{0, 0}, {1, std::nan("")}});
+  const auto problems = u.CheckParameters();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].index, 1u);
+  EXPECT_EQ(problems[0].message, "must be finite, got (1, nan)");
+}
+
 }  // namespace
 }  // namespace linesim::evaluation

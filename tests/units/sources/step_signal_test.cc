@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 namespace linesim::sources {
 namespace {
 
@@ -36,6 +39,22 @@ TEST(StepSignalUnit, RefusesDecreasingStepTimes) {
   EXPECT_EQ(problems[0].index, 1u);
   EXPECT_NE(problems[0].message.find("increase"), std::string::npos);
   // Also without the loader: Initialize refuses them.
+  EXPECT_THROW(u.Initialize(), cosim::UnitError);
+}
+
+// Guards against a non-finite value reaching the output: it is refused at
+// the parameter that holds it, not found later as a NaN output.
+TEST(StepSignalUnit, RefusesNonFiniteValuesNamingTheStep) {
+  StepSignalUnit u("s", 2, "V", {{10 * kMs, {1, 2}}, {20 * kMs, {3, std::nan("")}}});
+  u.variables().SetRealArray(*u.variables().Find("initial"),
+                             std::vector<double>{0, std::numeric_limits<double>::infinity()});
+  const auto problems = u.CheckParameters();
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_EQ(problems[0].variable, "initial");
+  EXPECT_EQ(problems[0].index, 1u);
+  EXPECT_EQ(problems[1].variable, "steps");
+  EXPECT_EQ(problems[1].index, 1u);
+  EXPECT_NE(problems[1].message.find("got nan"), std::string::npos) << problems[1].message;
   EXPECT_THROW(u.Initialize(), cosim::UnitError);
 }
 
