@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "app/console.h"
+#include "cosim/files.h"
 #include "cosim/observers.h"
 #include "loader/scenario.h"
 #include "loader/unit_types.h"
@@ -22,12 +24,6 @@ namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
 namespace {
-
-void PrintIssues(const loader::ScenarioError& e) {
-  std::cerr << "linesim: the scenario is refused (" << e.issues().size()
-            << (e.issues().size() == 1 ? " problem" : " problems") << "):\n";
-  for (const auto& i : e.issues()) std::cerr << "  " << i.ToString() << "\n";
-}
 
 Json Number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
@@ -67,18 +63,6 @@ void PrintTable(const cosim::Unit& unit, std::ostream& out) {
   }
 }
 
-// Writes through a temporary file and a rename, so a reader never sees half
-// a file.
-void WriteAtomically(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    f << text;
-    if (!f) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  fs::rename(tmp, path);
-}
-
 // What the plots of a robot run draw, by the column names the recorder
 // gives the expanded units' variables.
 plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
@@ -116,19 +100,13 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   try {
     s = loader::LoadScenario(file, set_args);
   } catch (const loader::ScenarioError& e) {
-    PrintIssues(e);
+    PrintIssues(e, "scenario", std::cerr);
     return kExitBadInput;
   }
 
   // Everything is checked: only now is anything written.
   const fs::path dir(out_dir);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) {
-    std::cerr << "linesim: cannot create the output folder " << out_dir << ": "
-              << (ec ? ec.message() : "a file of that name exists") << "\n";
-    return kExitBadInput;
-  }
+  if (!CreateOutputFolder(out_dir)) return kExitBadInput;
   const fs::path csv_path = dir / "signals.csv";
   std::ofstream csv(csv_path, std::ios::binary | std::ios::trunc);
   if (!csv) {
@@ -222,7 +200,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
     }
   }
   try {
-    WriteAtomically(dir / "summary.json", summary.dump(2) + "\n");
+    cosim::WriteFileAtomically((dir / "summary.json").string(), summary.dump(2) + "\n");
   } catch (const std::exception& e) {
     std::cerr << "linesim: " << e.what() << "\n";
     return kExitRunFailed;
@@ -279,7 +257,7 @@ int InspectCommand(const std::string& what, const std::vector<std::string>& set_
   try {
     s = loader::LoadScenario(what, set_args);
   } catch (const loader::ScenarioError& e) {
-    PrintIssues(e);
+    PrintIssues(e, "scenario", std::cerr);
     return kExitBadInput;
   }
   const auto& o = s.master->options();

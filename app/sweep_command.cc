@@ -1,22 +1,20 @@
 #include <unistd.h>
 
-#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <mutex>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <stop_token>
 #include <thread>
 
 #include "app/commands.h"
+#include "app/console.h"
 #include "loader/scenario_error.h"
 #include "sweep/executor.h"
 #include "sweep/mpi_sweep.h"
@@ -29,7 +27,6 @@
 namespace linesim::app {
 
 namespace fs = std::filesystem;
-using Json = nlohmann::ordered_json;
 
 namespace {
 
@@ -50,19 +47,6 @@ extern "C" void OnSignal(int sig) {
   [[maybe_unused]] const auto n = write(STDERR_FILENO, text, sizeof text - 1);
 }
 
-void PrintIssues(const loader::ScenarioError& e, std::ostream& out) {
-  out << "linesim: the sweep is refused (" << e.issues().size()
-      << (e.issues().size() == 1 ? " problem" : " problems") << "):\n";
-  for (const auto& i : e.issues()) out << "  " << i.ToString() << "\n";
-}
-
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // The sweep folder made ready on rank 0: results.csv started or resumed and
 // sweep.json saying which sweep it holds. Prints why not and returns nothing
 // when the folder cannot take this sweep.
@@ -79,45 +63,24 @@ std::optional<sweep::ResultsFile> PrepareFolder(const sweep::SweepSpec& spec, co
     return std::nullopt;
   }
   if (exists && resume) {
-    std::string held;
-    try {
-      held = Json::parse(ReadFile(identity)).value("fingerprint", "");
-    } catch (const std::exception&) {
-    }
+    const auto held = sweep::ReadSweepFingerprint(identity.string());
     if (held != fingerprint) {
       std::cerr << "linesim: cannot resume in " << dir.string() << ": "
-                << (held.empty() ? identity.string() + " is missing or unreadable"
-                                 : "it holds another sweep, or the sweep file, its base "
-                                   "scenario or a model file changed since")
+                << (!held ? identity.string() + " is missing or unreadable"
+                          : "it holds another sweep, or the sweep file, its base "
+                            "scenario or a model file changed since")
                 << "; --force starts afresh\n";
       return std::nullopt;
     }
   }
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) {
-    std::cerr << "linesim: cannot create the output folder " << dir.string() << ": "
-              << (ec ? ec.message() : "a file of that name exists") << "\n";
-    return std::nullopt;
-  }
+  if (!CreateOutputFolder(dir.string())) return std::nullopt;
   try {
     if (exists && resume) return sweep::ResultsFile::Resume(results.string(), spec);
     // The old identity goes first: a folder is never left saying it holds
     // this sweep while it holds another's rows.
     fs::remove(identity);
     sweep::ResultsFile created = sweep::ResultsFile::Create(results.string(), spec);
-    Json id;
-    id["name"] = spec.name;
-    id["sweep_file"] = spec.file;
-    id["scenario"] = spec.scenario;
-    id["runs"] = sweep::RunCount(spec);
-    id["fingerprint"] = fingerprint;
-    {
-      std::ofstream out(identity.string() + ".tmp", std::ios::binary | std::ios::trunc);
-      out << id.dump(2) << "\n";
-      if (!out.flush()) throw std::runtime_error("cannot write " + identity.string());
-    }
-    fs::rename(identity.string() + ".tmp", identity);
+    sweep::WriteSweepIdentity(identity.string(), spec, fingerprint);
     return created;
   } catch (const std::exception& e) {
     std::cerr << "linesim: " << e.what() << "\n";
@@ -155,7 +118,7 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
     spec = sweep::LoadSweepSpec(args.file);
     fingerprint = sweep::SweepFingerprint(spec);
   } catch (const loader::ScenarioError& e) {
-    PrintIssues(e, problems);
+    PrintIssues(e, "sweep", problems);
     status = kExitBadInput;
   }
   if (share(status) != kExitOk) return kExitBadInput;

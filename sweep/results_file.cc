@@ -1,7 +1,5 @@
 #include "sweep/results_file.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -10,9 +8,11 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
 
+#include "cosim/files.h"
 #include "cosim/variable_table.h"
 #include "models/models_dir.h"
 
@@ -44,12 +44,9 @@ std::uint64_t Fnv1a(std::uint64_t h, std::string_view text) {
   return h;
 }
 
-std::string ReadWhole(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+// A missing file reads as empty: the fingerprint then differs from any
+// file's, and Resume finds no header.
+std::string ReadWhole(const std::string& path) { return cosim::ReadWholeFile(path).value_or(""); }
 
 std::FILE* OpenOrThrow(const std::string& path, const char* mode) {
   std::FILE* f = std::fopen(path.c_str(), mode);
@@ -156,6 +153,27 @@ std::string SweepFingerprint(const SweepSpec& spec) {
   return text;
 }
 
+void WriteSweepIdentity(const std::string& path, const SweepSpec& spec,
+                        const std::string& fingerprint) {
+  nlohmann::ordered_json id;
+  id["name"] = spec.name;
+  id["sweep_file"] = spec.file;
+  id["scenario"] = spec.scenario;
+  id["runs"] = RunCount(spec);
+  id["fingerprint"] = fingerprint;
+  cosim::WriteFileAtomically(path, id.dump(2) + "\n");
+}
+
+std::optional<std::string> ReadSweepFingerprint(const std::string& path) {
+  const auto text = cosim::ReadWholeFile(path);
+  if (!text) return std::nullopt;
+  const auto id = nlohmann::json::parse(*text, nullptr, /*allow_exceptions=*/false);
+  if (!id.is_object() || !id.contains("fingerprint") || !id["fingerprint"].is_string()) {
+    return std::nullopt;
+  }
+  return id["fingerprint"].get<std::string>();
+}
+
 ResultsFile::ResultsFile(std::string path, std::string header, std::FILE* file,
                          std::map<std::int64_t, std::string> rows)
     : path_(std::move(path)), header_(std::move(header)), file_(file), rows_(std::move(rows)) {}
@@ -212,20 +230,9 @@ void ResultsFile::Rewrite() {
     std::fclose(file_);
     file_ = nullptr;
   }
-  const std::string tmp = path_ + ".tmp";
-  std::FILE* out = OpenOrThrow(tmp, "wb");
-  bool ok = std::fputs(header_.c_str(), out) >= 0;
-  for (const auto& [id, line] : rows_) ok = ok && std::fputs(line.c_str(), out) >= 0;
-  // On disk before the rename replaces the old file, also across a power cut.
-  ok = ok && std::fflush(out) == 0 && fsync(fileno(out)) == 0;
-  ok = std::fclose(out) == 0 && ok;
-  if (!ok) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot write " + tmp + " (disk full?)");
-  }
-  std::error_code ec;
-  fs::rename(tmp, path_, ec);
-  if (ec) throw std::runtime_error("cannot replace " + path_ + ": " + ec.message());
+  std::string text = header_;
+  for (const auto& [id, line] : rows_) text += line;
+  cosim::WriteFileAtomically(path_, text);
   file_ = OpenOrThrow(path_, "ab");
 }
 

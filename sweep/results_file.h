@@ -34,6 +34,14 @@ std::string JoinCsvLine(const std::vector<std::string>& fields);
 /// sweep, and every MPI rank, must match it.
 std::string SweepFingerprint(const SweepSpec& spec);
 
+/// sweep.json, which says what sweep a folder holds: name, files, run count
+/// and SweepFingerprint. Written atomically; throws std::runtime_error.
+void WriteSweepIdentity(const std::string& path, const SweepSpec& spec,
+                        const std::string& fingerprint);
+/// The fingerprint a sweep.json holds; nothing when it is missing or
+/// unreadable.
+std::optional<std::string> ReadSweepFingerprint(const std::string& path);
+
 /// The results.csv of a sweep folder, written as runs finish: one flushed
 /// line per run (completion order), then sorted by run id at the end.
 class ResultsFile {

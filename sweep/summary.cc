@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "cosim/files.h"
 #include "cosim/variable_table.h"
 
 namespace linesim::sweep {
@@ -315,16 +316,6 @@ std::string UniqueFile(const std::string& name, std::set<std::string>& taken) {
   return file;
 }
 
-void WriteAtomically(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    f << text;
-    if (!f.flush()) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  fs::rename(tmp, path);
-}
-
 }  // namespace
 
 Stats StatsOf(std::span<const double> values) {
@@ -547,7 +538,8 @@ std::vector<std::string> WriteSweepReport(const std::string& dir, const SweepTab
     summary["plots"] = {{"error", e.what()}};
   }
   // Run errors and gnuplot's text may hold bytes that are not UTF-8.
-  WriteAtomically(summary_path, summary.dump(2, ' ', false, Json::error_handler_t::replace) + "\n");
+  cosim::WriteFileAtomically(summary_path.string(),
+                             summary.dump(2, ' ', false, Json::error_handler_t::replace) + "\n");
   return written;
 }
 
