@@ -137,7 +137,7 @@ std::string SweepFingerprint(const SweepSpec& spec) {
     add(ReadWhole(m.string()));
   }
   // What decides each run's overrides, seed and columns.
-  for (const auto& [path, value] : spec.fixed) add("set " + path + "=" + value);
+  for (const auto& a : FixedOverrides(spec)) add("set " + a);
   for (const auto& p : spec.parameters) {
     add("parameter " + p.path + " kind " + std::to_string(static_cast<int>(p.kind)));
     for (const auto& v : p.values) add(v);

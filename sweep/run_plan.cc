@@ -90,7 +90,7 @@ RunSpec PlanRun(const SweepSpec& spec, std::int64_t id) {
 
 std::vector<std::string> RunOverrides(const SweepSpec& spec, const RunSpec& run) {
   std::vector<std::string> args{"seed=" + std::to_string(run.seed)};
-  for (const auto& [path, value] : spec.fixed) args.push_back(path + "=" + value);
+  for (const auto& a : FixedOverrides(spec)) args.push_back(a);
   for (std::size_t i = 0; i < spec.parameters.size(); ++i) {
     args.push_back(spec.parameters[i].path + "=" + run.values[i]);
   }

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <optional>
 
 #include "cosim/variable_table.h"
@@ -14,6 +15,7 @@
 #include "loader/scenario.h"
 #include "loader/yaml_files.h"
 #include "loader/yaml_reader.h"
+#include "sweep/results_file.h"
 
 namespace linesim::sweep {
 
@@ -53,12 +55,16 @@ std::optional<std::size_t> FirstRepeat(const std::vector<std::string>& items) {
   return std::nullopt;
 }
 
+// Finite numbers only: an infinite bound would make NaN or inf values.
+const loader::Range kFinite{std::numeric_limits<double>::lowest(),
+                            std::numeric_limits<double>::max()};
+
 void ReadRange(const YAML::Node& range, const std::string& path, YamlReader& r, ParameterSpec& p) {
   if (!r.ExpectMap(range, path)) return;
   r.CheckKeys(range, path, {"from", "to", "count"});
   const std::size_t issues_before = r.issues().size();
-  const double from = r.Real(range, path, "from", std::nullopt);
-  const double to = r.Real(range, path, "to", std::nullopt);
+  const double from = r.Real(range, path, "from", std::nullopt, kFinite);
+  const double to = r.Real(range, path, "to", std::nullopt, kFinite);
   const std::int64_t count = r.Integer(range, path, "count", std::nullopt, 1, 1000000);
   if (r.issues().size() != issues_before) return;
   if (count > 1 && from == to) {
@@ -73,9 +79,10 @@ void ReadRange(const YAML::Node& range, const std::string& path, YamlReader& r, 
     return;
   }
   for (std::int64_t i = 0; i < count; ++i) {
-    const double v = i + 1 == count ? to
-                                    : from + (to - from) * static_cast<double>(i) /
-                                                 static_cast<double>(count - 1);
+    // Weighted ends, not from + (to - from) * f, whose difference can
+    // overflow; the last value is `to` itself.
+    const double f = static_cast<double>(i) / static_cast<double>(count - 1);
+    const double v = i + 1 == count ? to : from * (1.0 - f) + to * f;
     // 12 significant digits: 0.05 + 2 * 0.05 is the 0.15 the user means,
     // not 0.15000000000000002, in the rows and the plots alike.
     char text[32];
@@ -92,12 +99,12 @@ void ReadRandom(const YAML::Node& random, const std::string& path, YamlReader& r
   if (d == "normal") {
     r.CheckKeys(random, path, {"distribution", "mean", "std"});
     p.distribution = Distribution::kNormal;
-    p.a = r.Real(random, path, "mean", std::nullopt);
-    p.b = r.Real(random, path, "std", std::nullopt, {0, INFINITY});
+    p.a = r.Real(random, path, "mean", std::nullopt, kFinite);
+    p.b = r.Real(random, path, "std", std::nullopt, {0, kFinite.max});
   } else if (d == "uniform" || d == "log_uniform") {
     r.CheckKeys(random, path, {"distribution", "min", "max"});
     p.distribution = d == "uniform" ? Distribution::kUniform : Distribution::kLogUniform;
-    const loader::Range range = d == "uniform" ? loader::Range{} : loader::Range{0, INFINITY, true};
+    const loader::Range range = d == "uniform" ? kFinite : loader::Range{0, kFinite.max, true};
     p.a = r.Real(random, path, "min", std::nullopt, range);
     p.b = r.Real(random, path, "max", std::nullopt, range);
     if (r.ok() && !(p.b >= p.a)) {
@@ -134,7 +141,13 @@ void ReadParameter(const YAML::Node& node, const std::string& path, YamlReader& 
     const std::string vpath = JoinPath(path, "values");
     if (!r.ExpectSequence(values, vpath)) return;
     if (values.size() == 0) r.Error(values, vpath, "expected at least one value");
-    for (const auto& v : values) p.values.push_back(YamlText(v));
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      p.values.push_back(YamlText(values[i]));
+      // A row of results.csv is one line.
+      if (p.values.back().find_first_of("\r\n") != std::string::npos) {
+        r.Error(values[i], vpath + "." + std::to_string(i), "a value may not contain a line break");
+      }
+    }
     if (const auto i = FirstRepeat(p.values)) {
       r.Error(values[*i], vpath + "." + std::to_string(*i),
               "'" + p.values[*i] + "' is listed twice (each value is one point)");
@@ -142,6 +155,12 @@ void ReadParameter(const YAML::Node& node, const std::string& path, YamlReader& 
   } else if (const YAML::Node range = Child(node, "range"); range.IsDefined()) {
     p.kind = ParameterKind::kRange;
     ReadRange(range, JoinPath(path, "range"), r, p);
+    if (const auto i = FirstRepeat(p.values)) {
+      r.Error(range, JoinPath(path, "range"),
+              "values " + std::to_string(*i - 1) + " and " + std::to_string(*i) +
+                  " round to the same " + p.values[*i] +
+                  " (12 significant digits): a smaller count or a wider range");
+    }
   } else {
     p.kind = ParameterKind::kRandom;
     ReadRandom(Child(node, "random"), JoinPath(path, "random"), r, p);
@@ -160,8 +179,7 @@ void ReadParameter(const YAML::Node& node, const std::string& path, YamlReader& 
 // wrong, not a run.
 void CheckParameterPath(const SweepSpec& spec, const ParameterSpec& p, const YAML::Node& at,
                         const std::string& key_path, YamlReader& r) {
-  std::vector<std::string> args;
-  for (const auto& [path, value] : spec.fixed) args.push_back(path + "=" + value);
+  std::vector<std::string> args = FixedOverrides(spec);
   const std::string probe =
       p.kind == ParameterKind::kRandom ? cosim::FormatValue(p.a) : p.values.front();
   args.push_back(p.path + "=" + probe);
@@ -180,6 +198,12 @@ void CheckParameterPath(const SweepSpec& spec, const ParameterSpec& p, const YAM
 }
 
 }  // namespace
+
+std::vector<std::string> FixedOverrides(const SweepSpec& spec) {
+  std::vector<std::string> args;
+  for (const auto& [path, value] : spec.fixed) args.push_back(path + "=" + value);
+  return args;
+}
 
 SweepSpec LoadSweepSpec(const std::string& file) {
   SweepSpec spec;
@@ -280,11 +304,9 @@ SweepSpec LoadSweepSpec(const std::string& file) {
   if (!r.ok()) throw ScenarioError(r.issues());
 
   // The base scenario with the fixed settings must load by itself.
-  std::vector<std::string> args;
-  for (const auto& [path, value] : spec.fixed) args.push_back(path + "=" + value);
   loader::Scenario base;
   try {
-    base = loader::LoadScenario(spec.scenario, args);
+    base = loader::LoadScenario(spec.scenario, FixedOverrides(spec));
   } catch (const ScenarioError& e) {
     std::vector<Issue> issues{{file, YamlReader::LineOf(Child(root, "scenario")), "scenario",
                                "the base scenario " + spec.scenario +
@@ -308,13 +330,10 @@ SweepSpec LoadSweepSpec(const std::string& file) {
     r.Error(metrics[*i], "metrics." + std::to_string(*i),
             "'" + spec.metrics[*i] + "' is listed twice");
   }
+  const std::vector<std::string> header = ResultsHeader(spec);
   for (std::size_t i = 0; i < spec.metrics.size(); ++i) {
     const std::string& m = spec.metrics[i];
-    const bool taken = m == "run_id" || m == "seed" || m == "status" || m == "error" ||
-                       m == "wall_s" ||
-                       std::any_of(spec.parameters.begin(), spec.parameters.end(),
-                                   [&](const ParameterSpec& p) { return p.path == m; });
-    if (taken) {
+    if (std::count(header.begin(), header.end(), m) > 1) {
       r.Error(metrics.IsDefined() ? metrics[i] : root, "metrics." + std::to_string(i),
               "'" + m +
                   "' is also the name of another column of results.csv; rename the metric "

@@ -63,6 +63,9 @@ struct SweepSpec {
   std::vector<std::string> metrics;
 };
 
+/// The `set:` entries as `--set` arguments ("path=value"), in file order.
+std::vector<std::string> FixedOverrides(const SweepSpec& spec);
+
 /// Reads and checks a sweep file, and that its base scenario loads with the
 /// fixed settings, every parameter path exists in it and every metric is
 /// one it defines. Throws loader::ScenarioError listing every problem (file,

@@ -279,6 +279,27 @@ TEST(SweepSpec, MalformedPathsDuplicatesAndHugeSweepsAreRefused) {
           WriteFile("metric2.yaml", head + "metrics: [max_path_deviation_m, max_path_deviation_m]\n"
                                            "parameters: [{path: duration_s, values: [1]}]\n")),
       "metrics.1", "listed twice"));
+  // Bounds that would make NaN or inf values, a value that would break a
+  // row in two, and range values that round to the same point.
+  EXPECT_TRUE(
+      AnyContains(IssueTexts(WriteFile("inf.yaml", head + "parameters: [{path: duration_s, "
+                                                          "range: {from: 0, to: .inf, count: "
+                                                          "3}}]\n")),
+                  "parameters.0.range.to", "expected"));
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(WriteFile("infmc.yaml", head + "combine: monte_carlo\nsamples: 2\n"
+                                                "parameters: [{path: duration_s, random: "
+                                                "{distribution: uniform, min: 0, max: .inf}}]\n")),
+      "parameters.0.random.max", "expected"));
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(WriteFile("newline.yaml", head + "parameters: [{path: master.algorithm, "
+                                                  "values: [jacobi, \"gauss\\nseidel\"]}]\n")),
+      "parameters.0.values.1", "line break"));
+  EXPECT_TRUE(
+      AnyContains(IssueTexts(WriteFile("round.yaml", head + "parameters: [{path: duration_s, "
+                                                            "range: {from: 0.1, to: "
+                                                            "0.1000000000001, count: 3}}]\n")),
+                  "parameters.0.range", "round to the same"));
   // 1000^3 points x 20 repeats: refused before it could overflow or fill
   // the memory with run ids.
   EXPECT_TRUE(AnyContains(
