@@ -151,8 +151,6 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
     if (!results->HasRow(id)) pending.push_back(id);
   }
   const auto done_before = total - static_cast<std::int64_t>(pending.size());
-  std::int64_t failed_before = 0;
-  for (const auto& row : results->Table(spec).rows) failed_before += row.ok ? 0 : 1;
   if (mpi && args.jobs_given) {
     std::cerr << "linesim: --jobs does not apply under mpirun: each rank but 0 runs one run at "
                  "a time\n";
@@ -169,10 +167,12 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
   }
   std::cout << std::flush;
 
-  sweep::ProgressBar bar(std::cerr, isatty(STDERR_FILENO) != 0, total, done_before, failed_before);
+  sweep::ProgressBar bar(std::cerr, isatty(STDERR_FILENO) != 0, total, done_before,
+                         results->failed_count());
   std::mutex bar_mutex;
   const auto on_done = [&](const sweep::RunSpec& run, const sweep::RunOutcome& outcome) {
-    results->Append(run.id, sweep::FormatRow(run, outcome));
+    results->Append(run.id, sweep::FormatRow(run, outcome),
+                    outcome.status == sweep::RunStatus::kOk);
     const std::lock_guard lock(bar_mutex);
     bar.RunDone(outcome.status == sweep::RunStatus::kOk);
   };
@@ -221,8 +221,6 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
     return kExitRunFailed;
   }
   const sweep::SweepTable table = results->Table(spec);
-  std::int64_t failed = 0;
-  for (const auto& row : table.rows) failed += row.ok ? 0 : 1;
   std::cout << "sweep " << spec.name << ": finished in " << std::setprecision(3) << wall_s
             << " s wall\n";
   sweep::PrintSummary(table, std::cout);
@@ -236,7 +234,7 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
   std::cout << "  wrote " << (dir / "results.csv").string();
   for (const auto& f : written) std::cout << ", " << fs::path(f).filename().string();
   std::cout << "\n";
-  return failed == 0 ? kExitOk : kExitRunFailed;
+  return results->failed_count() == 0 ? kExitOk : kExitRunFailed;
 }
 
 }  // namespace linesim::app

@@ -182,7 +182,8 @@ ResultsFile::ResultsFile(ResultsFile&& other) noexcept
     : path_(std::move(other.path_)),
       header_(std::move(other.header_)),
       file_(other.file_),
-      rows_(std::move(other.rows_)) {
+      rows_(std::move(other.rows_)),
+      failed_(other.failed_) {
   other.file_ = nullptr;
 }
 
@@ -207,6 +208,7 @@ ResultsFile ResultsFile::Resume(const std::string& path, const SweepSpec& spec) 
   const std::size_t columns = ResultsHeader(spec).size();
   const std::int64_t count = RunCount(spec);
   std::map<std::int64_t, std::string> rows;
+  std::int64_t failed = 0;
   std::size_t start = header.size();
   while (start < text.size()) {
     const std::size_t end = text.find('\n', start);
@@ -218,9 +220,10 @@ ResultsFile ResultsFile::Resume(const std::string& path, const SweepSpec& spec) 
     if (!fields || fields->size() != columns) continue;
     const auto id = ParseId(fields->front());
     if (!id || *id < 0 || *id >= count) continue;
-    rows.emplace(*id, line);
+    if (rows.emplace(*id, line).second && (*fields)[columns - 3] != "ok") ++failed;
   }
   ResultsFile f(path, header, nullptr, std::move(rows));
+  f.failed_ = failed;
   f.Rewrite();
   return f;
 }
@@ -236,13 +239,13 @@ void ResultsFile::Rewrite() {
   file_ = OpenOrThrow(path_, "ab");
 }
 
-void ResultsFile::Append(std::int64_t id, const std::string& line) {
+void ResultsFile::Append(std::int64_t id, const std::string& line, bool ok) {
   // One write and a flush per row: a kill loses at most the line being
   // written, which a resumed sweep drops and runs again.
   if (std::fputs(line.c_str(), file_) < 0 || std::fflush(file_) != 0) {
     throw std::runtime_error("cannot write " + path_ + ": " + std::strerror(errno));
   }
-  rows_.emplace(id, line);
+  if (rows_.emplace(id, line).second && !ok) ++failed_;
 }
 
 void ResultsFile::SortByRunId() { Rewrite(); }

@@ -63,7 +63,9 @@ class ResultsFile {
   std::size_t row_count() const { return rows_.size(); }
   /// Appends and flushes one row; throws std::runtime_error on a write
   /// failure (disk full).
-  void Append(std::int64_t id, const std::string& line);
+  void Append(std::int64_t id, const std::string& line, bool ok);
+  /// Rows whose run failed.
+  std::int64_t failed_count() const { return failed_; }
   /// Rewrites the file with its rows sorted by run id (temporary and rename).
   void SortByRunId();
   /// The rows parsed for the report, sorted by run id.
@@ -78,6 +80,7 @@ class ResultsFile {
   std::string header_;
   std::FILE* file_ = nullptr;
   std::map<std::int64_t, std::string> rows_;  // run id -> line with its newline
+  std::int64_t failed_ = 0;
 };
 
 }  // namespace linesim::sweep

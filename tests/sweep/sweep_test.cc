@@ -395,7 +395,7 @@ std::string RunSweep(const SweepSpec& spec, int jobs, const std::string& dir) {
   for (std::int64_t id = 0; id < RunCount(spec); ++id) ids.push_back(id);
   std::atomic<bool> stop{false};
   RunOnThreads(spec, ids, jobs, stop, [&](const RunSpec& run, const RunOutcome& outcome) {
-    results.Append(run.id, FormatRow(run, outcome));
+    results.Append(run.id, FormatRow(run, outcome), outcome.status == RunStatus::kOk);
   });
   results.SortByRunId();
   return ReadFile(dir + "/results.csv");
@@ -411,7 +411,8 @@ TEST(SweepExecutor, OneAndTwoJobsWriteTheSameRowsAndAFailingRunIsIsolated) {
                                  "parameters:\n"
                                  "  - {path: master.step_s, values: [0.001, 0.003, 0.002]}\n"
                                  "  - {path: control.compensation, values: [true, false]}\n"));
-  const std::string one = RunSweep(spec, 1, FreshDir("one"));
+  const std::string one_dir = FreshDir("one");
+  const std::string one = RunSweep(spec, 1, one_dir);
   const std::string two = RunSweep(spec, 2, FreshDir("two"));
   EXPECT_EQ(WithoutWallTime(one), WithoutWallTime(two));
 
@@ -435,6 +436,8 @@ TEST(SweepExecutor, OneAndTwoJobsWriteTheSameRowsAndAFailingRunIsIsolated) {
           << rows[i][6];
     }
   }
+  // A resumed file counts its failed rows (the two at 0.003 s).
+  EXPECT_EQ(ResultsFile::Resume(one_dir + "/results.csv", spec).failed_count(), 2);
   // Compensation on beats off at both good steps (paper 1, Sec. VI-B).
   EXPECT_LT(std::stod(rows[0][4]), std::stod(rows[1][4]));
   EXPECT_LT(std::stod(rows[4][4]), std::stod(rows[5][4]));
@@ -473,6 +476,7 @@ TEST(ResultsFile, ResumeKeepsCompleteRowsAndDropsACutOffLine) {
       << lines[0] << lines[4] << lines[1] << lines[4] << lines[6].substr(0, 12);
   ResultsFile resumed = ResultsFile::Resume(path, spec);
   EXPECT_EQ(resumed.row_count(), 2u);
+  EXPECT_EQ(resumed.failed_count(), 0);
   EXPECT_TRUE(resumed.HasRow(0));
   EXPECT_TRUE(resumed.HasRow(3));
   EXPECT_FALSE(resumed.HasRow(5));
