@@ -178,12 +178,42 @@ RandomParameter DescribeRandom(const SweepTable& t, std::size_t p) {
   return out;
 }
 
-std::string ValuesText(const SweepTable& t, const Row& r) {
+// "p=v, q=w" for the parameters `which` and their `values`.
+std::string Label(const SweepTable& t, const std::vector<std::size_t>& which,
+                  const std::vector<std::string>& values) {
   std::string text;
-  for (std::size_t p = 0; p < t.parameters.size(); ++p) {
-    text += (p ? ", " : "") + t.parameters[p] + "=" + r.values[p];
+  for (std::size_t i = 0; i < which.size(); ++i) {
+    text += (i ? ", " : "") + t.parameters[which[i]] + "=" + values[i];
   }
   return text;
+}
+
+std::string ValuesText(const SweepTable& t, const Row& r) {
+  return Label(t, AllParameters(t), r.values);
+}
+
+// The runs that the charts against parameter `p` draw as one series each,
+// with the series' label: one per combination of the other parameters'
+// values (of the listed ones, for a random `p`) while that stays readable,
+// otherwise all runs together. The same for every metric.
+struct SeriesRows {
+  std::string label;
+  Rows rows;
+};
+std::vector<SeriesRows> SeriesOf(const SweepTable& t, std::size_t p, const Rows& all) {
+  const bool random = t.levels[p].empty();
+  std::vector<std::size_t> others;
+  for (std::size_t q = 0; q < t.parameters.size(); ++q) {
+    if (q != p && (!random || !t.levels[q].empty())) others.push_back(q);
+  }
+  if (others.empty() || (!random && !t.grid)) return {{"", all}};
+  const std::vector<Group> groups = GroupBy(others, all);
+  if (groups.size() > kMaxSeries) {
+    return {{random ? "" : "all runs (other parameters pooled)", all}};
+  }
+  std::vector<SeriesRows> out;
+  for (const Group& g : groups) out.push_back({Label(t, others, g.values), g.rows});
+  return out;
 }
 
 // Columns two spaces apart, padded to their widest cell.
@@ -453,6 +483,8 @@ void PrintSummary(const SweepTable& t, std::ostream& out) {
 std::vector<plots::SweepChart> SweepCharts(const SweepTable& t) {
   CheckShape(t);
   const Rows all = AllRows(t);
+  std::vector<std::vector<SeriesRows>> series_rows;
+  for (std::size_t p = 0; p < t.parameters.size(); ++p) series_rows.push_back(SeriesOf(t, p, all));
   std::vector<plots::SweepChart> charts;
   std::set<std::string> taken;
   for (std::size_t m = 0; m < t.metrics.size(); ++m) {
@@ -465,23 +497,8 @@ std::vector<plots::SweepChart> SweepCharts(const SweepTable& t) {
       std::vector<plots::SweepSeries> series;
       if (t.levels[p].empty()) {
         chart.scatter = true;
-        // One colour per combination of the listed values (compensation on
-        // and off, say), as long as that stays readable.
-        std::vector<std::size_t> listed;
-        for (std::size_t q = 0; q < t.parameters.size(); ++q) {
-          if (!t.levels[q].empty()) listed.push_back(q);
-        }
-        const std::vector<Group> combinations = GroupBy(listed, all);
-        if (listed.empty() || combinations.size() > kMaxSeries) {
-          series.push_back(ScatterSeries(p, m, all, ""));
-        } else {
-          for (const Group& g : combinations) {
-            std::string label;
-            for (std::size_t i = 0; i < listed.size(); ++i) {
-              label += (i ? ", " : "") + t.parameters[listed[i]] + "=" + g.values[i];
-            }
-            series.push_back(ScatterSeries(p, m, g.rows, std::move(label)));
-          }
+        for (const SeriesRows& g : series_rows[p]) {
+          series.push_back(ScatterSeries(p, m, g.rows, g.label));
         }
         std::vector<std::string> xs;
         for (const auto& one : series) xs.insert(xs.end(), one.x.begin(), one.x.end());
@@ -489,23 +506,8 @@ std::vector<plots::SweepChart> SweepCharts(const SweepTable& t) {
       } else {
         chart.categorical_x = !AllNumbers(t.levels[p]);
         chart.categories = t.levels[p];
-        std::vector<std::size_t> others;
-        for (std::size_t q = 0; q < t.parameters.size(); ++q) {
-          if (q != p) others.push_back(q);
-        }
-        const std::vector<Group> combinations = GroupBy(others, all);
-        if (!t.grid || others.empty()) {
-          series.push_back(LevelSeries(t, p, m, all, ""));
-        } else if (combinations.size() > kMaxSeries) {
-          series.push_back(LevelSeries(t, p, m, all, "all runs (other parameters pooled)"));
-        } else {
-          for (const Group& g : combinations) {
-            std::string label;
-            for (std::size_t i = 0; i < others.size(); ++i) {
-              label += (i ? ", " : "") + t.parameters[others[i]] + "=" + g.values[i];
-            }
-            series.push_back(LevelSeries(t, p, m, g.rows, std::move(label)));
-          }
+        for (const SeriesRows& g : series_rows[p]) {
+          series.push_back(LevelSeries(t, p, m, g.rows, g.label));
         }
       }
       for (auto& s : series) {
