@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -42,18 +41,11 @@ void SplitCsv(std::string_view line, std::vector<std::string_view>& fields,
   }
 }
 
-std::optional<double> ParseNumber(std::string_view field) {
-  double x = 0.0;
-  const char* end = field.data() + field.size();
-  const auto res = std::from_chars(field.data(), end, x);
-  if (res.ec != std::errc() || res.ptr != end) return std::nullopt;
-  return x;
-}
-
 // 1-based column `col` of a split row, as a number.
 std::optional<double> Column(const std::vector<std::string_view>& fields, int col) {
   if (col < 1 || static_cast<std::size_t>(col) > fields.size()) return std::nullopt;
-  return ParseNumber(fields[static_cast<std::size_t>(col - 1)]);
+  // Non-finite values are left out of the plots like missing ones.
+  return cosim::ParseFiniteValue(fields[static_cast<std::size_t>(col - 1)]);
 }
 
 /// signals.csv, open after its header: read row by row, never held whole.

@@ -1,7 +1,6 @@
 #include "plots/sweep_plots.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <optional>
 #include <set>
@@ -102,6 +101,8 @@ std::string ChartScript(const SweepChart& chart, std::size_t index) {
   // Sideways spread of the series at one category: at most 0.6 of the gap.
   const double step = std::min(0.1, 0.6 / static_cast<double>(count));
   std::string blocks, items;
+  // What a point is: the series' title, or the legend's when series have labels.
+  const std::string what = chart.scatter ? "one point per run" : "mean, bars: min to max";
   bool any_label = false;
   for (std::size_t k = 0; k < count; ++k) {
     const SweepSeries& s = chart.series[k];
@@ -128,11 +129,9 @@ std::string ChartScript(const SweepChart& chart, std::size_t index) {
     } else {
       style = "using 1:2:3:4 with yerrorlines pt 7 ps 1.2 lw 2";
     }
-    const std::string default_title =
-        chart.scatter ? "one point per run" : "mean, bars: min to max";
     items += std::string(items.empty() ? "plot " : ", \\\n     ") + block + " " + style + " lt " +
              std::to_string(k + 1) + " title " +
-             GnuplotQuote(s.label.empty() ? default_title : s.label);
+             GnuplotQuote(s.label.empty() ? what : s.label);
   }
   if (items.empty()) return {};
 
@@ -149,8 +148,7 @@ std::string ChartScript(const SweepChart& chart, std::size_t index) {
     s += "set autoscale x\nset xtics autofreq\n";
   }
   if (any_label) {
-    s += "set key title " +
-         GnuplotQuote(chart.scatter ? "one point per run" : "mean, bars: min to max") + "\n";
+    s += "set key title " + GnuplotQuote(what) + "\n";
   } else {
     s += "set key title ''\n";
   }

@@ -1,7 +1,6 @@
 #include "sweep/run_one.h"
 
 #include <chrono>
-#include <cmath>
 #include <limits>
 
 #include "cosim/observers.h"

@@ -1,7 +1,6 @@
 #include "sweep/summary.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -9,11 +8,9 @@
 #include <limits>
 #include <locale>
 #include <map>
-#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
-#include <string_view>
 
 #include "cosim/files.h"
 #include "cosim/variable_table.h"

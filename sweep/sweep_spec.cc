@@ -11,7 +11,6 @@
 #include <optional>
 
 #include "cosim/variable_table.h"
-#include "loader/overrides.h"
 #include "loader/scenario.h"
 #include "loader/yaml_files.h"
 #include "loader/yaml_reader.h"
