@@ -369,20 +369,7 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
       }
     }
   }
-  YamlFile loaded = LoadYamlFile(file);
-  switch (loaded.problem) {
-    case YamlFile::Problem::kNone:
-      break;
-    case YamlFile::Problem::kMissing:
-      throw ScenarioError({{file, 0, "", "cannot read the file (missing or not readable)"}});
-    case YamlFile::Problem::kFolder:
-      throw ScenarioError({{file, 0, "", "is not a file (a folder?): expected a YAML file"}});
-    case YamlFile::Problem::kInvalid:
-      throw ScenarioError({{file, loaded.line, "", "not valid YAML: " + loaded.detail}});
-    case YamlFile::Problem::kUnreadable:
-      throw ScenarioError({{file, 0, "", "cannot read the file: " + loaded.detail}});
-  }
-  YAML::Node tree = loaded.root;
+  YAML::Node tree = LoadYamlOrThrow(file);
   ApplyOverrides(tree, s.overrides, file, issues);
   std::set<std::string> overridden;
   for (const auto& o : s.overrides) overridden.insert(o.path);

@@ -37,6 +37,25 @@ YamlFile LoadYamlFile(const std::string& file) {
   return out;
 }
 
+YAML::Node LoadYamlOrThrow(const std::string& file, const std::string& kind) {
+  const std::string what = kind.empty() ? "file" : kind + " file";
+  YamlFile loaded = LoadYamlFile(file);
+  switch (loaded.problem) {
+    case YamlFile::Problem::kNone:
+      break;
+    case YamlFile::Problem::kMissing:
+      throw ScenarioError(
+          {{file, 0, "", "cannot read the " + what + " (missing or not readable)"}});
+    case YamlFile::Problem::kFolder:
+      throw ScenarioError({{file, 0, "", "is not a file (a folder?): expected a YAML " + what}});
+    case YamlFile::Problem::kInvalid:
+      throw ScenarioError({{file, loaded.line, "", "not valid YAML: " + loaded.detail}});
+    case YamlFile::Problem::kUnreadable:
+      throw ScenarioError({{file, 0, "", "cannot read the file: " + loaded.detail}});
+  }
+  return loaded.root;
+}
+
 std::vector<std::string> ModelNames(const std::string& folder) {
   std::vector<std::string> names;
   std::error_code ec;

@@ -22,6 +22,11 @@ struct YamlFile {
 /// buffer reading one); never throws.
 YamlFile LoadYamlFile(const std::string& file);
 
+/// The tree of `file`, or ScenarioError naming the file (and the line of
+/// invalid YAML). `kind` words the messages: "sweep" gives "cannot read the
+/// sweep file"; empty gives "cannot read the file".
+YAML::Node LoadYamlOrThrow(const std::string& file, const std::string& kind = "");
+
 /// Names of the model files in models/`folder`, sorted.
 std::vector<std::string> ModelNames(const std::string& folder);
 

@@ -207,20 +207,7 @@ std::vector<std::string> FixedOverrides(const SweepSpec& spec) {
 SweepSpec LoadSweepSpec(const std::string& file) {
   SweepSpec spec;
   spec.file = file;
-  const loader::YamlFile loaded = loader::LoadYamlFile(file);
-  switch (loaded.problem) {
-    case loader::YamlFile::Problem::kNone:
-      break;
-    case loader::YamlFile::Problem::kMissing:
-      throw ScenarioError({{file, 0, "", "cannot read the sweep file (missing or not readable)"}});
-    case loader::YamlFile::Problem::kFolder:
-      throw ScenarioError({{file, 0, "", "is not a file (a folder?): expected a YAML sweep file"}});
-    case loader::YamlFile::Problem::kInvalid:
-      throw ScenarioError({{file, loaded.line, "", "not valid YAML: " + loaded.detail}});
-    case loader::YamlFile::Problem::kUnreadable:
-      throw ScenarioError({{file, 0, "", "cannot read the file: " + loaded.detail}});
-  }
-  const YAML::Node root = loaded.root;
+  const YAML::Node root = loader::LoadYamlOrThrow(file, "sweep");
   YamlReader r(file);
   if (!r.ExpectMap(root, "")) throw ScenarioError(r.issues());
   r.CheckKeys(root, "",
