@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "loader/scenario.h"
 #include "sweep/executor.h"
 #include "sweep/run_plan.h"
 #include "sweep/sweep_spec.h"
@@ -25,6 +26,9 @@ void BM_Sweep(benchmark::State& state) {
   for (std::int64_t id = 0; id < linesim::sweep::RunCount(spec); ++id) {
     ids.push_back(id);
   }
+  // Every run simulates the base scenario's duration (no parameter changes it).
+  const double duration_s =
+      linesim::loader::LoadScenario(spec.scenario, linesim::sweep::FixedOverrides(spec)).duration_s;
   const int jobs = static_cast<int>(state.range(0));
   std::int64_t finished = 0, failed = 0;
   for (auto _ : state) {
@@ -39,9 +43,8 @@ void BM_Sweep(benchmark::State& state) {
   if (failed > 0) state.SkipWithError("a run of the sweep failed");
   state.counters["runs_per_s"] =
       benchmark::Counter(static_cast<double>(finished), benchmark::Counter::kIsRate);
-  // Every run of this sweep simulates the scenario's 20 s.
   state.counters["rtf"] =
-      benchmark::Counter(20.0 * static_cast<double>(finished), benchmark::Counter::kIsRate);
+      benchmark::Counter(duration_s * static_cast<double>(finished), benchmark::Counter::kIsRate);
 }
 
 BENCHMARK(BM_Sweep)

@@ -351,9 +351,12 @@ TEST(SweepCli, ShippedSweepsRunAndShowTheCompensationsBenefit) {
   const Result r = Sweep(LINESIM_SOURCE_DIR "/scenarios/sweeps/belt_speed_compensation.yaml", belt,
                          {"--jobs", "2"});
   ASSERT_EQ(r.status, 0) << r.out << r.err;
-  // Paper 1, Sec. VI-B: without compensation the robot is pushed off its path
-  // by about v / k_cross (k_cross = 1/s in the path follower, so 1 s times the
-  // belt speed); with it, by far less (< 4 cm at 0.10 m/s in the paper).
+  // Without compensation the cross-track loop e' = -k_cross e + v settles at
+  // v / k_cross (k_cross = 1/s in the path follower): 1 s times the belt
+  // speed, within the belt's +-10 % speed variation (speed_variation: 0.1 in
+  // cross_line.yaml) plus 5 % allowed for the lag of the wheel loops.
+  // With it: paper 1, Sec. VI-B, < 4 cm at 0.10 m/s, taken as 0.4 s times
+  // the belt speed at the other speeds.
   const auto summary = nlohmann::json::parse(ReadFile(fs::path(belt) / "summary.json"));
   ASSERT_EQ(summary["by_point"].size(), 10u);
   for (const auto& point : summary["by_point"]) {
@@ -361,9 +364,9 @@ TEST(SweepCli, ShippedSweepsRunAndShowTheCompensationsBenefit) {
     const bool on = point["values"]["control.compensation"] == "true";
     const double mean = point["metrics"]["max_path_deviation_m"]["mean"];
     if (on) {
-      EXPECT_LT(mean, 0.2 * v) << v;
+      EXPECT_LT(mean, 0.4 * v) << v;
     } else {
-      EXPECT_NEAR(mean, v, 0.15 * v) << v;
+      EXPECT_NEAR(mean, v, (0.10 + 0.05) * v) << v;
     }
   }
   const std::string step = Fresh("master_step");
