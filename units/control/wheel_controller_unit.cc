@@ -7,28 +7,28 @@
 
 #include "cosim/parameter_checks.h"
 #include "models/dc_motor_params.h"
+#include "models/raw3.h"
 #include "units/control/wheel_kinematics.h"
 
 namespace linesim::control {
 
 namespace {
 
-// Default plant, Rob@Work 3 (FACTS.md) with the maxon RE 40 stand-in motor
-// of models::DcMotorParams and the gears of models/motors/raw3_drive.yaml
-// (21, efficiency 0.75) and raw3_steer.yaml (belt 4, efficiency 0.9); the
-// efficiencies are the assumptions of those files.
+// Default plant, Rob@Work 3 (models/raw3.h) with the maxon RE 40 stand-in
+// motor of models::DcMotorParams.
 constexpr models::DcMotorParams kMotor{};
 constexpr double kMotorConstant = kMotor.torque_constant_nm_per_a;  // k_t = k_e, V.s/rad
 constexpr double kResistanceOhm = kMotor.resistance_ohm;
 constexpr double kRotorInertiaKgm2 = kMotor.rotor_inertia_kgm2;
-constexpr double kDriveGear = 21.0;
-constexpr double kDriveEfficiency = 0.75;
-constexpr double kSteerGear = 4.0;
-constexpr double kSteerEfficiency = 0.9;
+constexpr double kDriveGear = models::raw3::kDriveGearRatio;
+constexpr double kDriveEfficiency = models::raw3::kDriveGearEfficiency;
+constexpr double kSteerGear = models::raw3::kSteerGearRatio;
+constexpr double kSteerEfficiency = models::raw3::kSteerGearEfficiency;
+constexpr double kWheelRadiusM = models::raw3::kWheelRadiusM;
 // A quarter of the 120 kg robot on an 80 mm wheel, m r^2 = 0.192 kg.m^2,
 // plus the rotor seen through the gear (eta N^2 J_rotor = 0.0047).
-constexpr double kDriveInertiaKgm2 =
-    30.0 * 0.08 * 0.08 + kDriveEfficiency * kDriveGear * kDriveGear * kRotorInertiaKgm2;
+constexpr double kDriveInertiaKgm2 = 0.25 * models::raw3::kMassKg * kWheelRadiusM * kWheelRadiusM +
+                                     kDriveEfficiency * kDriveGear * kDriveGear * kRotorInertiaKgm2;
 // Steering module about its vertical axis: an estimate of 0.01 kg.m^2 (a
 // few kg within about 5 cm of the axis), plus the rotor through the belt
 // (eta N^2 J_rotor = 2.0e-4).
@@ -52,9 +52,9 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
   }
   const auto n = static_cast<std::size_t>(wheel_count);
   if (wheel_count == 4) {
-    // Steering axes W1..W4 from raw3-1 Platform.ini (FACTS.md).
-    wheel_x_ = {0.368, -0.368, -0.368, 0.368};
-    wheel_y_ = {0.186, 0.134, -0.186, -0.134};
+    // Rob@Work 3's steering axes.
+    wheel_x_.assign(models::raw3::kWheelXM.begin(), models::raw3::kWheelXM.end());
+    wheel_y_.assign(models::raw3::kWheelYM.begin(), models::raw3::kWheelYM.end());
   } else {
     wheel_x_.assign(n, 0.0);
     wheel_y_.assign(n, 0.0);

@@ -5,6 +5,7 @@
 
 #include "cosim/time.h"
 #include "cosim/unit.h"
+#include "models/raw3.h"
 
 namespace linesim::control {
 
@@ -36,8 +37,8 @@ class WheelControllerUnit : public cosim::Unit {
   static constexpr const char* kTypeName = "wheel_controller";
 
   /// Throws cosim::UnitError if wheel_count < 1. With 4 wheels the wheel
-  /// positions default to Rob@Work 3 (FACTS.md); otherwise they are zero and
-  /// must be set.
+  /// positions default to Rob@Work 3 (models/raw3.h); otherwise they are
+  /// zero and must be set.
   explicit WheelControllerUnit(std::string name, int wheel_count = 4);
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
@@ -70,7 +71,7 @@ class WheelControllerUnit : public cosim::Unit {
 
   // Parameters.
   std::vector<double> wheel_x_, wheel_y_;
-  double wheel_radius_ = 0.08;
+  double wheel_radius_ = models::raw3::kWheelRadiusM;
   bool compensation_ = true;
   double zero_speed_threshold_ = 1e-3;
   double steer_kp_ = 10.0;
