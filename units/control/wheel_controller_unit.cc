@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
 
 #include "cosim/parameter_checks.h"
@@ -150,6 +151,27 @@ std::vector<cosim::ParameterProblem> WheelControllerUnit::CheckParameters() cons
   cosim::ParameterChecks c;
   c.Finite("wheel_x", wheel_x_);
   c.Finite("wheel_y", wheel_y_);
+  // Two steering axes at one point are no robot, and the zero default for
+  // any count but 4 would quietly turn a yaw command into no wheel motion.
+  const std::size_t n = wheel_x_.size();
+  std::vector<bool> reported(n, false);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::vector<std::size_t> same = {i};
+    for (std::size_t j = i + 1; j < n; ++j) {
+      if (!reported[j] && wheel_x_[j] == wheel_x_[i] && wheel_y_[j] == wheel_y_[i]) {
+        same.push_back(j);
+        reported[j] = true;
+      }
+    }
+    if (same.size() < 2) continue;
+    std::string wheels = std::to_string(same[0]);
+    for (std::size_t k = 1; k < same.size(); ++k) {
+      wheels += (k + 1 == same.size() ? " and " : ", ") + std::to_string(same[k]);
+    }
+    c.Add({"wheel_x", std::nullopt,
+           "with wheel_y puts wheels " + wheels + " at the same point (set the positions of all " +
+               std::to_string(n) + " wheels)"});
+  }
   c.Positive("wheel_radius", wheel_radius_);
   c.NonNegative("zero_speed_threshold", zero_speed_threshold_);
   c.NonNegative("steer_kp", steer_kp_);

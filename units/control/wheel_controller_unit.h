@@ -38,7 +38,7 @@ class WheelControllerUnit : public cosim::Unit {
 
   /// Throws cosim::UnitError if wheel_count < 1. With 4 wheels the wheel
   /// positions default to Rob@Work 3 (models/raw3.h); otherwise they are
-  /// zero and must be set.
+  /// zero and must be set (CheckParameters reports wheels at one point).
   explicit WheelControllerUnit(std::string name, int wheel_count = 4);
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;

@@ -559,6 +559,36 @@ TEST(WheelControllerUnit, CheckParametersListsEveryProblem) {
   EXPECT_THROW(WheelControllerUnit("none", 0), cosim::UnitError);
 }
 
+// Guards against wheel positions left at their zero default (any count but
+// 4): every wheel at the centre turns a yaw command into no wheel motion,
+// silently. Wheels at one point are refused, every group of them named.
+TEST(WheelControllerUnit, CheckParametersRefusesWheelsAtOnePoint) {
+  WheelControllerUnit six("six", 6);
+  auto problems = six.CheckParameters();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].variable, "wheel_x");
+  EXPECT_EQ(problems[0].message,
+            "with wheel_y puts wheels 0, 1, 2, 3, 4 and 5 at the same point (set the positions "
+            "of all 6 wheels)");
+  EXPECT_THROW(six.Initialize(), cosim::UnitError);
+
+  Set(six, "wheel_x", {0.4, 0.0, -0.4, 0.0, 0.4, -0.4});
+  Set(six, "wheel_y", {0.3, 0.3, 0.3, 0.3, -0.3, 0.3});
+  problems = six.CheckParameters();
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_NE(problems[0].message.find("wheels 1 and 3 "), std::string::npos) << problems[0].message;
+  EXPECT_NE(problems[1].message.find("wheels 2 and 5 "), std::string::npos) << problems[1].message;
+
+  Set(six, "wheel_y", {0.3, 0.3, 0.3, -0.3, -0.3, -0.3});
+  EXPECT_TRUE(six.CheckParameters().empty());
+  six.Initialize();
+  Set(six, "twist_command", {0.0, 0.0, 0.5});
+  for (int k = 0; k < 30; ++k) Sample(six, k * kPeriod);
+  for (double w : Get(six, "drive_rate_target")) EXPECT_GT(std::abs(w), 1.0);
+
+  EXPECT_TRUE(WheelControllerUnit("one", 1).CheckParameters().empty());
+}
+
 // Guards against a NaN measurement silently poisoning the integrators.
 TEST(WheelControllerUnit, NonFiniteInputFailsTheStep) {
   WheelControllerUnit u("ctl");
