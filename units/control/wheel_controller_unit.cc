@@ -46,7 +46,17 @@ double SignedMin(double x, double limit) { return std::clamp(x, -limit, limit); 
 }  // namespace
 
 WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
-    : cosim::Unit(kTypeName, std::move(name)), wheel_count_(wheel_count) {
+    : cosim::Unit(kTypeName, std::move(name)),
+      wheel_count_(wheel_count),
+      // Back-EMF at the joint (k_e N): the voltage that holds a rate without
+      // load.
+      steer_feedforward_(kMotorConstant * kSteerGear),
+      // J / (eta N k_t / R): the voltage that accelerates the nominal load.
+      steer_acceleration_feedforward_(kSteerInertiaKgm2 /
+                                      TorquePerVolt(kSteerGear, kSteerEfficiency)),
+      drive_feedforward_(kMotorConstant * kDriveGear),
+      drive_acceleration_feedforward_(kDriveInertiaKgm2 /
+                                      TorquePerVolt(kDriveGear, kDriveEfficiency)) {
   if (wheel_count < 1) {
     throw cosim::UnitError(Where() + ": wheel_count must be at least 1, got " +
                            std::to_string(wheel_count));
@@ -60,15 +70,6 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
     wheel_x_.assign(n, 0.0);
     wheel_y_.assign(n, 0.0);
   }
-  // Back-EMF at the joint (k_e N): the voltage that holds a rate without load.
-  steer_feedforward_ = kMotorConstant * kSteerGear;
-  drive_feedforward_ = kMotorConstant * kDriveGear;
-  // J / (eta N k_t / R): the voltage that accelerates the nominal load.
-  steer_acceleration_feedforward_ = kSteerInertiaKgm2 / TorquePerVolt(kSteerGear, kSteerEfficiency);
-  drive_acceleration_feedforward_ = kDriveInertiaKgm2 / TorquePerVolt(kDriveGear, kDriveEfficiency);
-  // 1 m/s^2 at the wheel rim.
-  drive_max_acceleration_ = 1.0 / wheel_radius_;
-
   twist_command_.assign(3, 0.0);
   surface_velocity_.assign(2 * n, 0.0);
   steer_angle_.assign(n, 0.0);
@@ -203,10 +204,14 @@ void WheelControllerUnit::Initialize() {
   ComputeOutputs();
 }
 
+double WheelControllerUnit::SteerRateReference(std::size_t i) const {
+  return period_s_ > 0.0 ? WrapAngle(steer_next_[i] - steer_ref_[i]) / period_s_ : 0.0;
+}
+
 WheelControllerUnit::Voltages WheelControllerUnit::Compute(std::size_t i) const {
-  double steer_rate_ref = 0.0, steer_accel_ref = 0.0, drive_accel_ref = 0.0;
+  const double steer_rate_ref = SteerRateReference(i);
+  double steer_accel_ref = 0.0, drive_accel_ref = 0.0;
   if (period_s_ > 0.0) {
-    steer_rate_ref = WrapAngle(steer_next_[i] - steer_ref_[i]) / period_s_;
     steer_accel_ref = (steer_rate_ref - steer_prev_rate_[i]) / period_s_;
     drive_accel_ref = (drive_next_[i] - drive_ref_[i]) / period_s_;
   }
@@ -275,8 +280,7 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
     // at the largest rate from which the acceleration limit still stops the
     // discrete profile exactly at the target: rates (m + f) dv, (m - 1 + f)
     // dv, ..., f dv cover dv dt ((m + 1) f + m (m + 1) / 2).
-    const double rate_now =
-        period_s_ > 0.0 ? WrapAngle(steer_next_[i] - steer_ref_[i]) / period_s_ : 0.0;
+    const double rate_now = SteerRateReference(i);
     steer_prev_rate_[i] = rate_now;
     steer_ref_[i] = steer_next_[i];
     const double gap = WrapAngle(flip_angle_[i] - steer_ref_[i]);
