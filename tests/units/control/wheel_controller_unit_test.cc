@@ -421,13 +421,34 @@ TEST(WheelControllerUnit, ClosedLoopSteeringReachesFortyFiveDegrees) {
 // constant is shorter than the period) and a light steering module
 // (0.002 kg.m^2) must still converge without sustained oscillation. The
 // acceleration feedforward is then too large, so some overshoot is allowed.
+//
+// The drive bounds, from the sampled model of this loop (inductance and
+// friction left out: they move its numbers by under 0.05 % of goal). The
+// airborne wheel (J = 0.0064 + eta N^2 J_rotor = 0.0111 kg.m^2) lags its
+// voltage with tau = J R / (eta N^2 k_t k_e) = 11 ms: a = exp(-T / tau) =
+// 0.162 per T = 20 ms. The acceleration feedforward k_acc = 0.124 V.s^2/rad is sized
+// for the wheel on the floor (0.197 kg.m^2), so along the ramp (alpha =
+// 12.5 rad/s^2, 0.25 rad/s per sample) it over-drives the wheel. With
+// k_e N = 0.634 V.s/rad, the wheel's lead l over its reference and the
+// integral I go from sample to sample as
+//   l' = p l + g I + q,  I' = I - T l,  p = a - (1 - a) kp / (k_e N) = -0.498,
+//   g = (1 - a) ki / (k_e N) = 6.60 /s, q = (1 - a) k_acc alpha / (k_e N)
+//   - 0.25 (1 + a) / 2 = 1.90 rad/s,
+// so from rest l_k = q (z1^k - z2^k) / (z1 - z2) = 1.45 (z1^k - z2^k) rad/s,
+// with the poles z1 = 0.906, z2 = -0.404 of z^2 - (1 + p) z + p + g T. The
+// peak is the lead at the end of the 25-sample ramp: 1.45 z1^25 = 0.122
+// rad/s, 1.96 % of goal (simulated 1.65 %: the integrator takes its error
+// 1 ms after the sample, once the motors have stepped, when the wheel leads
+// by more). After the ramp the integral left over, 1.45 (1 - z1^25) = 1.33
+// rad/s, decays with z1: 0.74 % of goal at 1.2 s, where the 1 % band checked
+// below starts (simulated 0.77 %; the model reaches 1 % at 1.14 s).
 TEST(WheelControllerUnit, ClosedLoopStaysStableWithLightLoads) {
   const double goal = 0.5 / kRadiusM;
   const Trace drive = RunClosedLoop({0.5, 0.0, 0.0}, 1500 * kMs, 0.5 * 2.0 * kRadiusM * kRadiusM);
   double peak = 0;
   for (double w : drive.drive_rate) peak = std::max(peak, w);
   std::cout << "airborne drive wheel: overshoot " << 100 * (peak / goal - 1) << " %\n";
-  EXPECT_LE(peak, 1.2 * goal);
+  EXPECT_LE(peak, 1.02 * goal);
   for (std::size_t k = drive.time_s.size() - 300; k < drive.time_s.size(); ++k) {
     EXPECT_NEAR(drive.drive_rate[k], goal, 0.01 * goal) << drive.time_s[k];
   }
