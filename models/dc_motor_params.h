@@ -20,7 +20,8 @@ struct DcMotorParams {
   /// Not on the data sheet: derived from the no-load point (7580 rpm at
   /// 137 mA, 24 V) as b = k_t * I0 / omega0, about 5.2e-6 N.m.s/rad.
   /// It lumps brush and bearing friction into a viscous term.
-  double viscous_friction_nms_per_rad = 30.2e-3 * 0.137 / (7580.0 * 2.0 * std::numbers::pi / 60.0);
+  double viscous_friction_nms_per_rad =
+      torque_constant_nm_per_a * 0.137 / (7580.0 * 2.0 * std::numbers::pi / 60.0);
   /// Motor revolutions per output revolution; 1 = no gearbox.
   double gear_ratio = 1.0;
   /// Fraction of the motor torque that reaches the output (0 < eta <= 1).

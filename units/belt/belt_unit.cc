@@ -48,6 +48,8 @@ BeltUnit::BeltUnit(std::string name, int belt_count, std::vector<std::vector<Swi
   // assumptions (no source gives them): a line drive ramps up within a
   // fraction of a second.
   direction_.assign(n, 0.0);
+  direction_x_.assign(n, 1.0);
+  direction_y_.assign(n, 0.0);
   nominal_speed_.assign(n, 0.1);
   initially_on_.assign(n, 1.0);
   speed_variation_.assign(n, 0.1);
@@ -133,8 +135,15 @@ double BeltUnit::TargetSpeed(std::size_t b, bool on, cosim::TimeNs t) const {
 void BeltUnit::ComputeOutputs(cosim::TimeNs t) {
   for (std::size_t b = 0; b < nominal_speed_.size(); ++b) {
     on_[b] = ScheduledOn(static_cast<int>(b), t) ? 1.0 : 0.0;
-    velocity_[2 * b] = belt_speed_[b] * std::cos(direction_[b]);
-    velocity_[2 * b + 1] = belt_speed_[b] * std::sin(direction_[b]);
+    velocity_[2 * b] = belt_speed_[b] * direction_x_[b];
+    velocity_[2 * b + 1] = belt_speed_[b] * direction_y_[b];
+  }
+}
+
+void BeltUnit::CacheDirections() {
+  for (std::size_t b = 0; b < direction_.size(); ++b) {
+    direction_x_[b] = std::cos(direction_[b]);
+    direction_y_[b] = std::sin(direction_[b]);
   }
 }
 
@@ -142,6 +151,7 @@ void BeltUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }
 
 void BeltUnit::Initialize() {
   ThrowIfBadParameters();
+  CacheDirections();
   for (std::size_t b = 0; b < nominal_speed_.size(); ++b) {
     belt_speed_[b] = TargetSpeed(b, ScheduledOn(static_cast<int>(b), start_), start_);
   }
@@ -197,6 +207,8 @@ void BeltUnit::RestoreInternal(const cosim::UnitState& state) {
   period_factors_.assign(state.reals.begin(), middle);
   phases_rad_.assign(middle, state.reals.end());
   start_ = state.integers[0];
+  // The parameters came back with the variables.
+  CacheDirections();
 }
 
 }  // namespace linesim::belt

@@ -72,6 +72,9 @@ class BeltUnit : public cosim::Unit {
   /// Speed the belt tends to at time t in the given scheduled state.
   double TargetSpeed(std::size_t b, bool on, cosim::TimeNs t) const;
   void ComputeOutputs(cosim::TimeNs t);
+  /// The unit vectors of direction_, once per parameter set instead of per
+  /// step.
+  void CacheDirections();
 
   int belt_count_;
   std::vector<std::vector<Switch>> schedules_;
@@ -81,6 +84,9 @@ class BeltUnit : public cosim::Unit {
   // Parameters, one element per belt.
   std::vector<double> direction_, nominal_speed_, initially_on_, speed_variation_,
       variation_period_, acceleration_;
+
+  // cos and sin of direction_ (CacheDirections).
+  std::vector<double> direction_x_, direction_y_;
 
   // Outputs.
   std::vector<double> velocity_, belt_speed_, on_;

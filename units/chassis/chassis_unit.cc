@@ -96,9 +96,9 @@ ChassisUnit::ChassisUnit(std::string name, int wheel_count, int belt_count)
   const auto w = static_cast<std::size_t>(wheel_count);
   const auto b = static_cast<std::size_t>(belt_count);
   if (wheel_count == 4) {
-    // Rob@Work 3 steering-axis positions (raw3-1 Platform.ini, FACTS.md).
-    wheel_x_ = {0.368, -0.368, -0.368, 0.368};
-    wheel_y_ = {0.186, 0.134, -0.186, -0.134};
+    // Rob@Work 3's steering axes.
+    wheel_x_.assign(models::raw3::kWheelXM.begin(), models::raw3::kWheelXM.end());
+    wheel_y_.assign(models::raw3::kWheelYM.begin(), models::raw3::kWheelYM.end());
   } else {
     // No robot to copy: evenly on a circle of 0.3 m, a placeholder.
     for (std::size_t k = 0; k < w; ++k) {

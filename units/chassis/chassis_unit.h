@@ -8,6 +8,7 @@
 #include "cosim/time.h"
 #include "cosim/unit.h"
 #include "models/dc_motor_params.h"
+#include "models/raw3.h"
 
 namespace linesim::chassis {
 
@@ -85,18 +86,21 @@ class ChassisUnit : public cosim::Unit {
   double body_length_ = 1.03;
   double body_width_ = 0.57;
   double body_height_ = 0.40;
-  double mass_ = 120.0;
+  double mass_ = models::raw3::kMassKg;
   double module_mass_ = 5.0;
   double com_height_ = 0.13;
-  double wheel_radius_ = 0.080;
+  double wheel_radius_ = models::raw3::kWheelRadiusM;
   std::vector<double> wheel_x_, wheel_y_;
-  // The RE 40 rotor (models::DcMotorParams) through the steer belt 4 and the
-  // drive gear 21 (models/motors/raw3_steer.yaml, raw3_drive.yaml).
-  // eta N^2 J_rotor: the rotor as the dc_motor unit's full-mode equations
-  // see it from the output (J_eff = J + J_load / (eta N^2)); steer belt 4 at
-  // 0.9, drive gear 21 at 0.75 (models/motors/raw3_*.yaml).
-  double steer_rotor_inertia_ = 0.9 * 4.0 * 4.0 * models::DcMotorParams{}.rotor_inertia_kgm2;
-  double drive_rotor_inertia_ = 0.75 * 21.0 * 21.0 * models::DcMotorParams{}.rotor_inertia_kgm2;
+  // The RE 40 rotor (models::DcMotorParams) through the Rob@Work 3 steer
+  // belt and drive gear, as eta N^2 J_rotor: the rotor as the dc_motor
+  // unit's full-mode equations see it from the output (J_eff = J + J_load /
+  // (eta N^2)).
+  double steer_rotor_inertia_ = models::raw3::kSteerGearEfficiency * models::raw3::kSteerGearRatio *
+                                models::raw3::kSteerGearRatio *
+                                models::DcMotorParams{}.rotor_inertia_kgm2;
+  double drive_rotor_inertia_ = models::raw3::kDriveGearEfficiency * models::raw3::kDriveGearRatio *
+                                models::raw3::kDriveGearRatio *
+                                models::DcMotorParams{}.rotor_inertia_kgm2;
   double steer_friction_ = 0.01;
   double drive_friction_ = 0.01;
   double friction_ = 0.8;

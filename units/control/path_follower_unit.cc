@@ -16,14 +16,7 @@ PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
       waypoints_m_(std::move(waypoints_m)),
       pose_(3, 0.0),
       twist_command_(3, 0.0) {
-  if (mode_ == Mode::kPath) {
-    cumulative_m_.push_back(0.0);
-    for (std::size_t k = 1; k < waypoints_m_.size(); ++k) {
-      const double dx = waypoints_m_[k][0] - waypoints_m_[k - 1][0];
-      const double dy = waypoints_m_[k][1] - waypoints_m_[k - 1][1];
-      cumulative_m_.push_back(cumulative_m_.back() + std::hypot(dx, dy));
-    }
-  }
+  if (mode_ == Mode::kPath) cumulative_m_ = models::CumulativeLengths(waypoints_m_);
   auto& v = variables();
   v.Parameter("speed", "m/s", &speed_, "cruise speed along the path");
   v.Parameter("acceleration", "m/s2", &acceleration_,
@@ -48,9 +41,10 @@ PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
 }
 
 bool PathFollowerUnit::ZeroSegment(std::size_t k) const {
-  // Evaluate divides by the growth of cumulative_m_, so a segment too short
-  // to grow the sum is as bad as a zero one. After a non-finite waypoint the
-  // sum is NaN, and only the segment itself can be judged.
+  // The search takes a segment's direction from the growth of cumulative_m_
+  // (none: no tangent to follow), so a segment too short to grow the sum is
+  // as bad as a zero one. After a non-finite waypoint the sum is NaN, and
+  // only the segment itself can be judged.
   if (std::isfinite(cumulative_m_[k - 1])) return !(cumulative_m_[k] > cumulative_m_[k - 1]);
   return !(std::hypot(waypoints_m_[k][0] - waypoints_m_[k - 1][0],
                       waypoints_m_[k][1] - waypoints_m_[k - 1][1]) > 0.0);
@@ -96,35 +90,15 @@ void PathFollowerUnit::Initialize() {
   ComputeOutputs(FindNearest());
 }
 
-PathFollowerUnit::Nearest PathFollowerUnit::FindNearest() const {
-  Nearest n;
-  if (mode_ != Mode::kPath) return n;
-  // Nearest point over all segments (the first on a tie); the first and
-  // last segments extend beyond the ends, so that progress runs below 0
+models::PolylinePoint PathFollowerUnit::FindNearest() const {
+  if (mode_ != Mode::kPath) return {};
+  // The end segments extend beyond the ends, so that progress runs below 0
   // before the start and past the length after the goal.
-  const double x = pose_[0], y = pose_[1];
-  const std::size_t segments = waypoints_m_.size() - 1;
-  double best_dist2 = INFINITY;
-  for (std::size_t k = 0; k < segments; ++k) {
-    const auto& a = waypoints_m_[k];
-    const double len = cumulative_m_[k + 1] - cumulative_m_[k];
-    const double tx = (waypoints_m_[k + 1][0] - a[0]) / len;
-    const double ty = (waypoints_m_[k + 1][1] - a[1]) / len;
-    const double along = (x - a[0]) * tx + (y - a[1]) * ty;
-    const double lo = k == 0 ? -INFINITY : 0.0;
-    const double hi = k + 1 == segments ? INFINITY : len;
-    const double u = std::clamp(along, lo, hi);
-    const double cross = -(x - a[0]) * ty + (y - a[1]) * tx;
-    const double dist2 = (along - u) * (along - u) + cross * cross;
-    if (dist2 < best_dist2) {
-      best_dist2 = dist2;
-      n = {true, tx, ty, cumulative_m_[k] + u, cross};
-    }
-  }
-  return n;
+  return models::NearestOnPolyline(waypoints_m_, cumulative_m_, pose_[0], pose_[1],
+                                   models::PolylineEnds::kExtend);
 }
 
-PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const Nearest& n) const {
+PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const models::PolylinePoint& n) const {
   Sample s;
   const double x = pose_[0], y = pose_[1];
   if (mode_ == Mode::kHold) {
@@ -142,8 +116,8 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const Nearest& n) const {
           std::min({ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * std::abs(remaining)),
                     k_position_ * std::abs(remaining)});
       s.along_mps = std::copysign(magnitude, remaining);
-      s.vx_map_mps = n.tx * s.along_mps + n.ty * k_cross_ * n.cross_track_m;
-      s.vy_map_mps = n.ty * s.along_mps - n.tx * k_cross_ * n.cross_track_m;
+      s.vx_map_mps = n.tangent_x * s.along_mps + n.tangent_y * k_cross_ * n.cross_track_m;
+      s.vy_map_mps = n.tangent_y * s.along_mps - n.tangent_x * k_cross_ * n.cross_track_m;
     }
     const auto& goal = waypoints_m_.back();
     s.at_goal = done_latched_ || std::hypot(x - goal[0], y - goal[1]) <= goal_tolerance_;
@@ -163,7 +137,7 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const Nearest& n) const {
   return s;
 }
 
-void PathFollowerUnit::ComputeOutputs(const Nearest& n) {
+void PathFollowerUnit::ComputeOutputs(const models::PolylinePoint& n) {
   const Sample s = Evaluate(n);
   const double c = std::cos(pose_[2]), sn = std::sin(pose_[2]);
   twist_command_[0] = c * s.vx_map_mps + sn * s.vy_map_mps;
@@ -178,7 +152,7 @@ cosim::StepResult PathFollowerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
   if (!InputsFinite(t)) return cosim::StepResult::kError;
   // The pose is the same before and after the commit: one search.
-  const Nearest n = FindNearest();
+  const models::PolylinePoint n = FindNearest();
   const Sample s = Evaluate(n);
   // The ramp continues from the speed actually commanded, so that it also
   // restarts gently after a slow-down.

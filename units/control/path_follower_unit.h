@@ -6,6 +6,7 @@
 
 #include "cosim/time.h"
 #include "cosim/unit.h"
+#include "models/polyline.h"
 
 namespace linesim::control {
 
@@ -66,21 +67,18 @@ class PathFollowerUnit : public cosim::Unit {
   /// Whether the segment into waypoint k (> 0, both ends finite) has no
   /// length.
   bool ZeroSegment(std::size_t k) const;
-  // Path mode: the nearest path point to the pose (found is false in hold
-  // mode, or when no distance compares below infinity).
-  struct Nearest {
-    bool found = false;
-    double tx = 0.0, ty = 0.0;  // unit tangent of its segment
-    double progress_m = 0.0, cross_track_m = 0.0;
-  };
-  Nearest FindNearest() const;
+  // Path mode: the nearest path point to the pose, the end segments
+  // extended (found is false in hold mode, or when no distance compares
+  // below infinity).
+  models::PolylinePoint FindNearest() const;
   /// The command for the pose whose nearest path point is n, from the state.
-  Sample Evaluate(const Nearest& n) const;
-  void ComputeOutputs(const Nearest& n);
+  Sample Evaluate(const models::PolylinePoint& n) const;
+  void ComputeOutputs(const models::PolylinePoint& n);
 
   Mode mode_;
   std::vector<std::array<double, 2>> waypoints_m_;
-  std::vector<double> cumulative_m_;  // path length at each waypoint
+  // Path length at each waypoint (path mode), once for the search.
+  std::vector<double> cumulative_m_;
 
   // Parameters.
   double speed_ = 0.3;

@@ -3,32 +3,33 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
 
 #include "cosim/parameter_checks.h"
 #include "models/dc_motor_params.h"
+#include "models/raw3.h"
 #include "units/control/wheel_kinematics.h"
 
 namespace linesim::control {
 
 namespace {
 
-// Default plant, Rob@Work 3 (FACTS.md) with the maxon RE 40 stand-in motor
-// of models::DcMotorParams and the gears of models/motors/raw3_drive.yaml
-// (21, efficiency 0.75) and raw3_steer.yaml (belt 4, efficiency 0.9); the
-// efficiencies are the assumptions of those files.
+// Default plant, Rob@Work 3 (models/raw3.h) with the maxon RE 40 stand-in
+// motor of models::DcMotorParams.
 constexpr models::DcMotorParams kMotor{};
 constexpr double kMotorConstant = kMotor.torque_constant_nm_per_a;  // k_t = k_e, V.s/rad
 constexpr double kResistanceOhm = kMotor.resistance_ohm;
 constexpr double kRotorInertiaKgm2 = kMotor.rotor_inertia_kgm2;
-constexpr double kDriveGear = 21.0;
-constexpr double kDriveEfficiency = 0.75;
-constexpr double kSteerGear = 4.0;
-constexpr double kSteerEfficiency = 0.9;
+constexpr double kDriveGear = models::raw3::kDriveGearRatio;
+constexpr double kDriveEfficiency = models::raw3::kDriveGearEfficiency;
+constexpr double kSteerGear = models::raw3::kSteerGearRatio;
+constexpr double kSteerEfficiency = models::raw3::kSteerGearEfficiency;
+constexpr double kWheelRadiusM = models::raw3::kWheelRadiusM;
 // A quarter of the 120 kg robot on an 80 mm wheel, m r^2 = 0.192 kg.m^2,
 // plus the rotor seen through the gear (eta N^2 J_rotor = 0.0047).
-constexpr double kDriveInertiaKgm2 =
-    30.0 * 0.08 * 0.08 + kDriveEfficiency * kDriveGear * kDriveGear * kRotorInertiaKgm2;
+constexpr double kDriveInertiaKgm2 = 0.25 * models::raw3::kMassKg * kWheelRadiusM * kWheelRadiusM +
+                                     kDriveEfficiency * kDriveGear * kDriveGear * kRotorInertiaKgm2;
 // Steering module about its vertical axis: an estimate of 0.01 kg.m^2 (a
 // few kg within about 5 cm of the axis), plus the rotor through the belt
 // (eta N^2 J_rotor = 2.0e-4).
@@ -45,29 +46,30 @@ double SignedMin(double x, double limit) { return std::clamp(x, -limit, limit); 
 }  // namespace
 
 WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
-    : cosim::Unit(kTypeName, std::move(name)), wheel_count_(wheel_count) {
+    : cosim::Unit(kTypeName, std::move(name)),
+      wheel_count_(wheel_count),
+      // Back-EMF at the joint (k_e N): the voltage that holds a rate without
+      // load.
+      steer_feedforward_(kMotorConstant * kSteerGear),
+      // J / (eta N k_t / R): the voltage that accelerates the nominal load.
+      steer_acceleration_feedforward_(kSteerInertiaKgm2 /
+                                      TorquePerVolt(kSteerGear, kSteerEfficiency)),
+      drive_feedforward_(kMotorConstant * kDriveGear),
+      drive_acceleration_feedforward_(kDriveInertiaKgm2 /
+                                      TorquePerVolt(kDriveGear, kDriveEfficiency)) {
   if (wheel_count < 1) {
     throw cosim::UnitError(Where() + ": wheel_count must be at least 1, got " +
                            std::to_string(wheel_count));
   }
   const auto n = static_cast<std::size_t>(wheel_count);
   if (wheel_count == 4) {
-    // Steering axes W1..W4 from raw3-1 Platform.ini (FACTS.md).
-    wheel_x_ = {0.368, -0.368, -0.368, 0.368};
-    wheel_y_ = {0.186, 0.134, -0.186, -0.134};
+    // Rob@Work 3's steering axes.
+    wheel_x_.assign(models::raw3::kWheelXM.begin(), models::raw3::kWheelXM.end());
+    wheel_y_.assign(models::raw3::kWheelYM.begin(), models::raw3::kWheelYM.end());
   } else {
     wheel_x_.assign(n, 0.0);
     wheel_y_.assign(n, 0.0);
   }
-  // Back-EMF at the joint (k_e N): the voltage that holds a rate without load.
-  steer_feedforward_ = kMotorConstant * kSteerGear;
-  drive_feedforward_ = kMotorConstant * kDriveGear;
-  // J / (eta N k_t / R): the voltage that accelerates the nominal load.
-  steer_acceleration_feedforward_ = kSteerInertiaKgm2 / TorquePerVolt(kSteerGear, kSteerEfficiency);
-  drive_acceleration_feedforward_ = kDriveInertiaKgm2 / TorquePerVolt(kDriveGear, kDriveEfficiency);
-  // 1 m/s^2 at the wheel rim.
-  drive_max_acceleration_ = 1.0 / wheel_radius_;
-
   twist_command_.assign(3, 0.0);
   surface_velocity_.assign(2 * n, 0.0);
   steer_angle_.assign(n, 0.0);
@@ -150,6 +152,27 @@ std::vector<cosim::ParameterProblem> WheelControllerUnit::CheckParameters() cons
   cosim::ParameterChecks c;
   c.Finite("wheel_x", wheel_x_);
   c.Finite("wheel_y", wheel_y_);
+  // Two steering axes at one point are no robot, and the zero default for
+  // any count but 4 would quietly turn a yaw command into no wheel motion.
+  const std::size_t n = wheel_x_.size();
+  std::vector<bool> reported(n, false);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::vector<std::size_t> same = {i};
+    for (std::size_t j = i + 1; j < n; ++j) {
+      if (!reported[j] && wheel_x_[j] == wheel_x_[i] && wheel_y_[j] == wheel_y_[i]) {
+        same.push_back(j);
+        reported[j] = true;
+      }
+    }
+    if (same.size() < 2) continue;
+    std::string wheels = std::to_string(same[0]);
+    for (std::size_t k = 1; k < same.size(); ++k) {
+      wheels += (k + 1 == same.size() ? " and " : ", ") + std::to_string(same[k]);
+    }
+    c.Add({"wheel_x", std::nullopt,
+           "with wheel_y puts wheels " + wheels + " at the same point (set the positions of all " +
+               std::to_string(n) + " wheels)"});
+  }
   c.Positive("wheel_radius", wheel_radius_);
   c.NonNegative("zero_speed_threshold", zero_speed_threshold_);
   c.NonNegative("steer_kp", steer_kp_);
@@ -181,10 +204,14 @@ void WheelControllerUnit::Initialize() {
   ComputeOutputs();
 }
 
+double WheelControllerUnit::SteerRateReference(std::size_t i) const {
+  return period_s_ > 0.0 ? WrapAngle(steer_next_[i] - steer_ref_[i]) / period_s_ : 0.0;
+}
+
 WheelControllerUnit::Voltages WheelControllerUnit::Compute(std::size_t i) const {
-  double steer_rate_ref = 0.0, steer_accel_ref = 0.0, drive_accel_ref = 0.0;
+  const double steer_rate_ref = SteerRateReference(i);
+  double steer_accel_ref = 0.0, drive_accel_ref = 0.0;
   if (period_s_ > 0.0) {
-    steer_rate_ref = WrapAngle(steer_next_[i] - steer_ref_[i]) / period_s_;
     steer_accel_ref = (steer_rate_ref - steer_prev_rate_[i]) / period_s_;
     drive_accel_ref = (drive_next_[i] - drive_ref_[i]) / period_s_;
   }
@@ -253,8 +280,7 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
     // at the largest rate from which the acceleration limit still stops the
     // discrete profile exactly at the target: rates (m + f) dv, (m - 1 + f)
     // dv, ..., f dv cover dv dt ((m + 1) f + m (m + 1) / 2).
-    const double rate_now =
-        period_s_ > 0.0 ? WrapAngle(steer_next_[i] - steer_ref_[i]) / period_s_ : 0.0;
+    const double rate_now = SteerRateReference(i);
     steer_prev_rate_[i] = rate_now;
     steer_ref_[i] = steer_next_[i];
     const double gap = WrapAngle(flip_angle_[i] - steer_ref_[i]);

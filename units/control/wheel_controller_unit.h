@@ -5,6 +5,7 @@
 
 #include "cosim/time.h"
 #include "cosim/unit.h"
+#include "models/raw3.h"
 
 namespace linesim::control {
 
@@ -36,8 +37,8 @@ class WheelControllerUnit : public cosim::Unit {
   static constexpr const char* kTypeName = "wheel_controller";
 
   /// Throws cosim::UnitError if wheel_count < 1. With 4 wheels the wheel
-  /// positions default to Rob@Work 3 (FACTS.md); otherwise they are zero and
-  /// must be set.
+  /// positions default to Rob@Work 3 (models/raw3.h); otherwise they are
+  /// zero and must be set (CheckParameters reports wheels at one point).
   explicit WheelControllerUnit(std::string name, int wheel_count = 4);
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
@@ -64,27 +65,30 @@ class WheelControllerUnit : public cosim::Unit {
     double drive_v;  // before saturation
   };
   Voltages Compute(std::size_t i) const;
+  /// Reference steering rate of wheel i over the coming period (0 before
+  /// the first step).
+  double SteerRateReference(std::size_t i) const;
   void ComputeOutputs();
 
   int wheel_count_;
 
   // Parameters.
   std::vector<double> wheel_x_, wheel_y_;
-  double wheel_radius_ = 0.08;
+  double wheel_radius_ = models::raw3::kWheelRadiusM;
   bool compensation_ = true;
   double zero_speed_threshold_ = 1e-3;
   double steer_kp_ = 10.0;
   double steer_kd_ = 0.5;
-  double steer_feedforward_ = 0.0;
-  double steer_acceleration_feedforward_ = 0.0;
+  double steer_feedforward_;  // the feedforwards: the constructor derives them from the plant
+  double steer_acceleration_feedforward_;
   double steer_max_rate_ = 10.0;
   double steer_max_acceleration_ = 40.0;
-  double drive_feedforward_ = 0.0;
-  double drive_acceleration_feedforward_ = 0.0;
+  double drive_feedforward_;
+  double drive_acceleration_feedforward_;
   double drive_kp_ = 0.5;
   double drive_ki_ = 5.0;
   double drive_max_rate_ = 12.267;
-  double drive_max_acceleration_ = 12.5;
+  double drive_max_acceleration_ = 1.0 / models::raw3::kWheelRadiusM;  // 1 m/s^2 at the rim
   double max_voltage_ = 24.0;
 
   // Inputs.

@@ -15,6 +15,10 @@ struct PathDistance {
   double distance_m;
   double progress_m;
 };
+/// `cumulative_m`: the path's models::CumulativeLengths.
+PathDistance DistanceToPath(const std::vector<std::array<double, 2>>& path,
+                            const std::vector<double>& cumulative_m, double x_m, double y_m);
+/// For one query: computes the path's lengths first.
 PathDistance DistanceToPath(const std::vector<std::array<double, 2>>& path, double x_m, double y_m);
 
 /// Ground-truth evaluation of a robot task: how far the robot's centre is
@@ -42,6 +46,7 @@ class PathDeviationUnit : public cosim::Unit {
   void Evaluate();
 
   std::vector<std::array<double, 2>> path_;
+  std::vector<double> cumulative_m_;  // path length at each point, once
   std::vector<double> pose_ = std::vector<double>(3, 0.0);
   double deviation_ = 0.0;
   double progress_ = 0.0;

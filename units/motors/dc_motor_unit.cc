@@ -184,8 +184,11 @@ DcMotorUnit::DcMotorUnit(std::string name, int count, MotorMode mode)
         "CVodeSetErrHandlerFn", 0);
   Check(CVodeInit(sun_->cvode, &Sundials::Rhs, 0.0, sun_->y), "CVodeInit", 0);
   Check(CVodeSetUserData(sun_->cvode, this), "CVodeSetUserData", 0);
-  Check(CVodeSetLinearSolver(sun_->cvode, sun_->solver, sun_->matrix), "CVodeSetLinearSolver", 0);
-  Check(CVodeSetJacFn(sun_->cvode, &Sundials::Jacobian), "CVodeSetJacFn", 0);
+  // The CVLS functions have their own flag names.
+  Check(CVodeSetLinearSolver(sun_->cvode, sun_->solver, sun_->matrix), "CVodeSetLinearSolver", 0,
+        &CVodeGetLinReturnFlagName);
+  Check(CVodeSetJacFn(sun_->cvode, &Sundials::Jacobian), "CVodeSetJacFn", 0,
+        &CVodeGetLinReturnFlagName);
   // The default of 500 steps per call is too few for long communication
   // steps right after a restart at tight tolerances.
   Check(CVodeSetMaxNumSteps(sun_->cvode, 100000), "CVodeSetMaxNumSteps", 0);
@@ -193,16 +196,12 @@ DcMotorUnit::DcMotorUnit(std::string name, int count, MotorMode mode)
 
 DcMotorUnit::~DcMotorUnit() = default;
 
-void DcMotorUnit::Check(int flag, const char* function, cosim::TimeNs t) const {
+void DcMotorUnit::Check(int flag, const char* function, cosim::TimeNs t, FlagName flag_name) const {
   if (flag >= 0) return;
-  // The CVLS functions have their own flag names. Both return a malloc'ed
-  // string.
-  const bool linear = std::strcmp(function, "CVodeSetLinearSolver") == 0 ||
-                      std::strcmp(function, "CVodeSetJacFn") == 0;
-  char* flag_name = linear ? CVodeGetLinReturnFlagName(flag) : CVodeGetReturnFlagName(flag);
+  char* name = (flag_name ? flag_name : &CVodeGetReturnFlagName)(flag);
   std::string text = Where() + ": " + function + " failed at t = " + cosim::FormatSeconds(t) +
-                     " s with " + (flag_name ? flag_name : std::to_string(flag));
-  std::free(flag_name);
+                     " s with " + (name ? name : std::to_string(flag));
+  std::free(name);
   if (sun_ && !sun_->message.empty()) {
     text += " (" + sun_->message + ")";
     sun_->message.clear();

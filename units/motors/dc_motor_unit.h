@@ -92,9 +92,13 @@ class DcMotorUnit : public cosim::Unit {
   /// Advances CVODE from t0_s to t1_s (the step starting at t), restarting it
   /// from y_ first if asked; returns CVode's flag.
   int Integrate(cosim::TimeNs t, double t0_s, double t1_s, bool restart);
+  /// SUNDIALS's lookup of a flag's name (a malloc'ed string).
+  using FlagName = char* (*)(long int);
   /// Throws cosim::UnitError naming the unit, the SUNDIALS function, the time
-  /// and the flag when `flag` is negative.
-  void Check(int flag, const char* function, cosim::TimeNs t) const;
+  /// and the flag when `flag` is negative. `flag_name` names the flag: null
+  /// is CVodeGetReturnFlagName (kept out of this header with SUNDIALS); the
+  /// linear-solver functions pass CVodeGetLinReturnFlagName.
+  void Check(int flag, const char* function, cosim::TimeNs t, FlagName flag_name = nullptr) const;
   std::string WorstState() const;
   void SetTolerances();
 

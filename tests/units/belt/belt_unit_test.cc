@@ -9,30 +9,22 @@
 #include <string>
 #include <vector>
 
+#include "tests/units/test_helpers.h"
+
 namespace linesim::belt {
 namespace {
 
 using cosim::TimeNs;
 using Switch = BeltUnit::Switch;
+using test_helpers::Get;
+using test_helpers::SetAll;
+using test_helpers::SetArray;
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kS = 1'000'000'000;
 
 // ---------------------------------------------------------------------------
-// Helpers to drive a unit through its variable table, as the master does.
-
-void SetAll(BeltUnit& u, const std::string& name, double v) {
-  u.variables().SetValue(*u.variables().Find(name), cosim::Value{v});
-}
-
-void SetArray(BeltUnit& u, const std::string& name, const std::vector<double>& v) {
-  u.variables().SetRealArray(*u.variables().Find(name), v);
-}
-
-std::vector<double> Get(const BeltUnit& u, const std::string& name) {
-  const auto s = u.variables().GetRealArray(*u.variables().Find(name));
-  return {s.begin(), s.end()};
-}
+// Helpers to drive a unit as the master does.
 
 void Start(BeltUnit& u) {
   u.Setup(0, 10'000 * kS);

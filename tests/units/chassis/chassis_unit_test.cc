@@ -6,7 +6,6 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <numbers>
 #include <string>
@@ -15,12 +14,17 @@
 
 #include "cosim/time.h"
 #include "models/models_dir.h"
+#include "tests/units/test_helpers.h"
 #include "units/chassis/floor_world.h"
 
 namespace linesim::chassis {
 namespace {
 
 using cosim::TimeNs;
+using test_helpers::Get;
+using test_helpers::Outputs;
+using test_helpers::SameBits;
+using test_helpers::SetArray;
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr double kPi = std::numbers::pi;
@@ -40,17 +44,8 @@ constexpr double kWheelYM[4] = {0.186, 0.134, -0.186, -0.134};
 // ---------------------------------------------------------------------------
 // Access through the variable table, as the master does.
 
-std::vector<double> Get(const ChassisUnit& u, const std::string& name) {
-  const auto s = u.variables().GetRealArray(*u.variables().Find(name));
-  return {s.begin(), s.end()};
-}
-
 void Set(ChassisUnit& u, const std::string& name, const cosim::Value& v) {
   u.variables().SetValue(*u.variables().Find(name), v);
-}
-
-void SetArray(ChassisUnit& u, const std::string& name, const std::vector<double>& v) {
-  u.variables().SetRealArray(*u.variables().Find(name), v);
 }
 
 void SetBrake(ChassisUnit& u, bool on) {
@@ -360,20 +355,6 @@ TEST(ChassisUnit, BrakeHoldsAgainstDriveTorque) {
 
 // ---------------------------------------------------------------------------
 // Save/restore and idempotence, compared bit for bit.
-
-std::vector<double> Outputs(const ChassisUnit& u) {
-  std::vector<double> out;
-  for (const auto& info : u.variables().infos()) {
-    if (info.causality != cosim::Causality::kOutput) continue;
-    const auto a = u.variables().GetRealArray(info.ref);
-    out.insert(out.end(), a.begin(), a.end());
-  }
-  return out;
-}
-
-bool SameBits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
 
 // Straddling a running belt with torques that change every step.
 std::vector<std::vector<double>> Drive(ChassisUnit& u, int from, int to) {

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <iostream>
 #include <memory>
 #include <numbers>
@@ -15,12 +14,18 @@
 #include "cosim/system.h"
 #include "cosim/time.h"
 #include "models/dc_motor_params.h"
+#include "tests/units/test_helpers.h"
 #include "units/motors/dc_motor_unit.h"
 
 namespace linesim::control {
 namespace {
 
 using cosim::TimeNs;
+using test_helpers::Get;
+using test_helpers::Outputs;
+using test_helpers::SameBits;
+using test_helpers::SetAll;
+using test_helpers::SetArray;
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kPeriod = 20 * kMs;  // control cycle (FACTS.md)
@@ -30,16 +35,6 @@ constexpr double kRadiusM = 0.08;
 
 double Deg(double d) { return d * kPi / 180.0; }
 
-void Set(cosim::Unit& u, const std::string& name, const std::vector<double>& v) {
-  u.variables().SetRealArray(*u.variables().Find(name), v);
-}
-void SetAll(cosim::Unit& u, const std::string& name, double v) {
-  u.variables().SetValue(*u.variables().Find(name), cosim::Value{v});
-}
-std::vector<double> Get(const cosim::Unit& u, const std::string& name) {
-  const auto s = u.variables().GetRealArray(*u.variables().Find(name));
-  return {s.begin(), s.end()};
-}
 double GetScalar(const cosim::Unit& u, const std::string& name) {
   return u.variables().GetReal(*u.variables().Find(name));
 }
@@ -150,7 +145,7 @@ TEST(WheelControllerUnit, AlgorithmOneDrivesOnlyTheWheelsOnTheBelt) {
     WheelControllerUnit u("ctl");
     u.variables().SetBoolean(*u.variables().Find("compensation"), on);
     u.Initialize();
-    Set(u, "surface_velocity", {0.2, 0, 0.2, 0, 0, 0, 0, 0});
+    SetArray(u, "surface_velocity", {0.2, 0, 0.2, 0, 0, 0, 0, 0});
     // 2.5 rad/s at 12.5 rad/s^2 is 10 periods, plus one of delay.
     for (int k = 0; k < 15; ++k) Sample(u, k * kPeriod);
     const auto rate = Get(u, "drive_rate_target");
@@ -173,7 +168,7 @@ TEST(WheelControllerUnit, AlgorithmOneDrivesOnlyTheWheelsOnTheBelt) {
 TEST(WheelControllerUnit, ReferenceRespectsSlewLimitsAndArrives) {
   WheelControllerUnit u("ctl");
   u.Initialize();
-  Set(u, "twist_command", {0.1, 0.1, 0.0});
+  SetArray(u, "twist_command", {0.1, 0.1, 0.0});
   const double goal = Deg(45), max_rate = GetScalar(u, "steer_max_rate"),
                max_acc = GetScalar(u, "steer_max_acceleration");
   const double drive_goal = std::sqrt(0.02) / kRadiusM;
@@ -216,7 +211,7 @@ TEST(WheelControllerUnit, TooFastCommandScalesAllWheelsAlike) {
   WheelControllerUnit u("ctl");
   u.Initialize();
   // 1.5 m/s forward while turning at 1 rad/s: W3/W4-side wheels differ.
-  Set(u, "twist_command", {1.5, 0.0, 1.0});
+  SetArray(u, "twist_command", {1.5, 0.0, 1.0});
   for (int k = 0; k < 100; ++k) Sample(u, k * kPeriod);
   const auto rate = Get(u, "drive_rate_target");
   const auto x = Get(u, "wheel_x"), y = Get(u, "wheel_y");
@@ -238,15 +233,15 @@ TEST(WheelControllerUnit, TooFastCommandScalesAllWheelsAlike) {
 TEST(WheelControllerUnit, UpdateOutputsIsPureAndInitializeIdempotent) {
   WheelControllerUnit a("ctl"), b("ctl");
   for (auto* u : {&a, &b}) {
-    Set(*u, "steer_angle", {0.1, 0.0, 0.0, 0.0});
+    SetArray(*u, "steer_angle", {0.1, 0.0, 0.0, 0.0});
     u->Initialize();
   }
   b.Initialize();
   EXPECT_EQ(a.SaveState().reals, b.SaveState().reals);
   for (auto* u : {&a, &b}) {
-    Set(*u, "steer_angle", {0.1 + 0.05, 0.0, 0.0, 0.0});
-    Set(*u, "drive_rate", {0.0, 2.0, 0.0, 0.0});
-    Set(*u, "twist_command", {0.3, 0.0, 0.0});
+    SetArray(*u, "steer_angle", {0.1 + 0.05, 0.0, 0.0, 0.0});
+    SetArray(*u, "drive_rate", {0.0, 2.0, 0.0, 0.0});
+    SetArray(*u, "twist_command", {0.3, 0.0, 0.0});
   }
   b.UpdateOutputs();
   b.UpdateOutputs();
@@ -267,7 +262,7 @@ TEST(WheelControllerUnit, UpdateOutputsIsPureAndInitializeIdempotent) {
 TEST(WheelControllerUnit, VoltagesSaturateAtMaxVoltage) {
   WheelControllerUnit u("ctl");
   u.Initialize();
-  Set(u, "steer_angle", {3.0, -3.0, 0.0, 0.0});
+  SetArray(u, "steer_angle", {3.0, -3.0, 0.0, 0.0});
   u.UpdateOutputs();
   EXPECT_EQ(Get(u, "steer_voltage")[0], -24.0);
   EXPECT_EQ(Get(u, "steer_voltage")[1], 24.0);
@@ -282,7 +277,7 @@ TEST(WheelControllerUnit, VoltagesSaturateAtMaxVoltage) {
 TEST(WheelControllerUnit, AntiWindupOnABlockedWheel) {
   WheelControllerUnit u("ctl");
   u.Initialize();
-  Set(u, "twist_command", {0.5, 0.0, 0.0});
+  SetArray(u, "twist_command", {0.5, 0.0, 0.0});
   for (int k = 0; k < 150; ++k) Sample(u, k * kPeriod);  // 3 s blocked
   EXPECT_EQ(Get(u, "drive_voltage")[0], 24.0);
   SetAll(u, "drive_rate", 0.5 / kRadiusM);
@@ -330,7 +325,7 @@ Trace RunClosedLoop(const std::vector<double>& twist, TimeNs duration,
                     double steer_load_kgm2 = 0.01) {
   cosim::System system;
   auto ctl = std::make_unique<WheelControllerUnit>("ctl");
-  Set(*ctl, "twist_command", twist);
+  SetArray(*ctl, "twist_command", twist);
   system.Add(std::move(ctl), kPeriod);
   auto steer = std::make_unique<motors::DcMotorUnit>("steer", 4, motors::MotorMode::kFull);
   SetAll(*steer, "gear_ratio", 4.0);
@@ -421,13 +416,34 @@ TEST(WheelControllerUnit, ClosedLoopSteeringReachesFortyFiveDegrees) {
 // constant is shorter than the period) and a light steering module
 // (0.002 kg.m^2) must still converge without sustained oscillation. The
 // acceleration feedforward is then too large, so some overshoot is allowed.
+//
+// The drive bounds, from the sampled model of this loop (inductance and
+// friction left out: they move its numbers by under 0.05 % of goal). The
+// airborne wheel (J = 0.0064 + eta N^2 J_rotor = 0.0111 kg.m^2) lags its
+// voltage with tau = J R / (eta N^2 k_t k_e) = 11 ms: a = exp(-T / tau) =
+// 0.162 per T = 20 ms. The acceleration feedforward k_acc = 0.124 V.s^2/rad is sized
+// for the wheel on the floor (0.197 kg.m^2), so along the ramp (alpha =
+// 12.5 rad/s^2, 0.25 rad/s per sample) it over-drives the wheel. With
+// k_e N = 0.634 V.s/rad, the wheel's lead l over its reference and the
+// integral I go from sample to sample as
+//   l' = p l + g I + q,  I' = I - T l,  p = a - (1 - a) kp / (k_e N) = -0.498,
+//   g = (1 - a) ki / (k_e N) = 6.60 /s, q = (1 - a) k_acc alpha / (k_e N)
+//   - 0.25 (1 + a) / 2 = 1.90 rad/s,
+// so from rest l_k = q (z1^k - z2^k) / (z1 - z2) = 1.45 (z1^k - z2^k) rad/s,
+// with the poles z1 = 0.906, z2 = -0.404 of z^2 - (1 + p) z + p + g T. The
+// peak is the lead at the end of the 25-sample ramp: 1.45 z1^25 = 0.122
+// rad/s, 1.96 % of goal (simulated 1.65 %: the integrator takes its error
+// 1 ms after the sample, once the motors have stepped, when the wheel leads
+// by more). After the ramp the integral left over, 1.45 (1 - z1^25) = 1.33
+// rad/s, decays with z1: 0.74 % of goal at 1.2 s, where the 1 % band checked
+// below starts (simulated 0.77 %; the model reaches 1 % at 1.14 s).
 TEST(WheelControllerUnit, ClosedLoopStaysStableWithLightLoads) {
   const double goal = 0.5 / kRadiusM;
   const Trace drive = RunClosedLoop({0.5, 0.0, 0.0}, 1500 * kMs, 0.5 * 2.0 * kRadiusM * kRadiusM);
   double peak = 0;
   for (double w : drive.drive_rate) peak = std::max(peak, w);
   std::cout << "airborne drive wheel: overshoot " << 100 * (peak / goal - 1) << " %\n";
-  EXPECT_LE(peak, 1.2 * goal);
+  EXPECT_LE(peak, 1.02 * goal);
   for (std::size_t k = drive.time_s.size() - 300; k < drive.time_s.size(); ++k) {
     EXPECT_NEAR(drive.drive_rate[k], goal, 0.01 * goal) << drive.time_s[k];
   }
@@ -446,33 +462,16 @@ TEST(WheelControllerUnit, ClosedLoopStaysStableWithLightLoads) {
 // Guards against a restored unit drifting from the original (a state
 // member missing from the save). Inputs follow a scripted cycle with
 // flips, zero commands and surface changes; outputs compared bit for bit.
-struct Snapshot {
-  std::vector<double> values;
-  bool operator==(const Snapshot& o) const {
-    return values.size() == o.values.size() &&
-           std::memcmp(values.data(), o.values.data(), values.size() * sizeof(double)) == 0;
-  }
-};
-
-Snapshot Outputs(const WheelControllerUnit& u) {
-  Snapshot s;
-  for (const char* name : {"steer_voltage", "drive_voltage", "steer_target", "drive_rate_target"}) {
-    const auto v = Get(u, name);
-    s.values.insert(s.values.end(), v.begin(), v.end());
-  }
-  return s;
-}
-
-std::vector<Snapshot> Script(WheelControllerUnit& u, int from, int to) {
-  std::vector<Snapshot> out;
+std::vector<std::vector<double>> Script(WheelControllerUnit& u, int from, int to) {
+  std::vector<std::vector<double>> out;
   for (int k = from; k < to; ++k) {
     const int p = k % 9;
     const double vx = p < 3 ? 0.4 : (p < 6 ? -0.3 : 0.0);
-    Set(u, "twist_command", {vx, 0.1 * (p % 2), 0.2 * (p % 3 - 1)});
-    Set(u, "surface_velocity", {0.1 * (p > 4), 0, 0.1 * (p > 4), 0, 0, 0, 0, 0});
-    Set(u, "steer_angle", {0.01 * k, -0.02 * k, 0.5, 3.1});
-    Set(u, "steer_rate", {0.5, -0.5, 0.0, 1.0 * p});
-    Set(u, "drive_rate", {0.3 * p, -0.2 * p, 1.0, 0.0});
+    SetArray(u, "twist_command", {vx, 0.1 * (p % 2), 0.2 * (p % 3 - 1)});
+    SetArray(u, "surface_velocity", {0.1 * (p > 4), 0, 0.1 * (p > 4), 0, 0, 0, 0, 0});
+    SetArray(u, "steer_angle", {0.01 * k, -0.02 * k, 0.5, 3.1});
+    SetArray(u, "steer_rate", {0.5, -0.5, 0.0, 1.0 * p});
+    SetArray(u, "drive_rate", {0.3 * p, -0.2 * p, 1.0, 0.0});
     u.UpdateOutputs();
     out.push_back(Outputs(u));
     EXPECT_EQ(u.DoStep(k * kPeriod, kPeriod), cosim::StepResult::kOk) << u.last_error();
@@ -494,8 +493,8 @@ TEST(WheelControllerUnit, SaveStepRestoreStepIsBitForBit) {
   const auto third = Script(fresh, 7, 30);
   ASSERT_EQ(first.size(), second.size());
   for (std::size_t k = 0; k < first.size(); ++k) {
-    EXPECT_TRUE(first[k] == second[k]) << k;
-    EXPECT_TRUE(first[k] == third[k]) << k;
+    EXPECT_TRUE(SameBits(first[k], second[k])) << k;
+    EXPECT_TRUE(SameBits(first[k], third[k])) << k;
   }
   WheelControllerUnit six("ctl", 6);
   EXPECT_THROW(six.RestoreState(saved), std::exception);
@@ -534,7 +533,7 @@ TEST(WheelControllerUnit, RestoreRefusesTruncatedInternalState) {
 TEST(WheelControllerUnit, CheckParametersListsEveryProblem) {
   WheelControllerUnit u("left");
   EXPECT_TRUE(u.CheckParameters().empty());
-  Set(u, "wheel_x", {0.368, NAN, -0.368, 0.368});
+  SetArray(u, "wheel_x", {0.368, NAN, -0.368, 0.368});
   SetAll(u, "wheel_radius", 0.0);
   SetAll(u, "steer_kp", -1.0);
   SetAll(u, "drive_max_acceleration", 0.0);
@@ -559,11 +558,41 @@ TEST(WheelControllerUnit, CheckParametersListsEveryProblem) {
   EXPECT_THROW(WheelControllerUnit("none", 0), cosim::UnitError);
 }
 
+// Guards against wheel positions left at their zero default (any count but
+// 4): every wheel at the centre turns a yaw command into no wheel motion,
+// silently. Wheels at one point are refused, every group of them named.
+TEST(WheelControllerUnit, CheckParametersRefusesWheelsAtOnePoint) {
+  WheelControllerUnit six("six", 6);
+  auto problems = six.CheckParameters();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].variable, "wheel_x");
+  EXPECT_EQ(problems[0].message,
+            "with wheel_y puts wheels 0, 1, 2, 3, 4 and 5 at the same point (set the positions "
+            "of all 6 wheels)");
+  EXPECT_THROW(six.Initialize(), cosim::UnitError);
+
+  SetArray(six, "wheel_x", {0.4, 0.0, -0.4, 0.0, 0.4, -0.4});
+  SetArray(six, "wheel_y", {0.3, 0.3, 0.3, 0.3, -0.3, 0.3});
+  problems = six.CheckParameters();
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_NE(problems[0].message.find("wheels 1 and 3 "), std::string::npos) << problems[0].message;
+  EXPECT_NE(problems[1].message.find("wheels 2 and 5 "), std::string::npos) << problems[1].message;
+
+  SetArray(six, "wheel_y", {0.3, 0.3, 0.3, -0.3, -0.3, -0.3});
+  EXPECT_TRUE(six.CheckParameters().empty());
+  six.Initialize();
+  SetArray(six, "twist_command", {0.0, 0.0, 0.5});
+  for (int k = 0; k < 30; ++k) Sample(six, k * kPeriod);
+  for (double w : Get(six, "drive_rate_target")) EXPECT_GT(std::abs(w), 1.0);
+
+  EXPECT_TRUE(WheelControllerUnit("one", 1).CheckParameters().empty());
+}
+
 // Guards against a NaN measurement silently poisoning the integrators.
 TEST(WheelControllerUnit, NonFiniteInputFailsTheStep) {
   WheelControllerUnit u("ctl");
   u.Initialize();
-  Set(u, "drive_rate", {0, 0, NAN, 0});
+  SetArray(u, "drive_rate", {0, 0, NAN, 0});
   EXPECT_EQ(u.DoStep(0, kPeriod), cosim::StepResult::kError);
   EXPECT_NE(u.last_error().find("drive_rate[2]"), std::string::npos) << u.last_error();
 }

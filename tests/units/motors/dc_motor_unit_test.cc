@@ -16,6 +16,7 @@
 #include "cosim/time.h"
 #include "models/dc_motor_params.h"
 #include "tests/cosim/test_units.h"
+#include "tests/units/test_helpers.h"
 
 namespace linesim::motors {
 namespace {
@@ -23,24 +24,13 @@ namespace {
 using cosim::TimeNs;
 using Vec2 = Eigen::Vector2d;
 using Mat2 = Eigen::Matrix2d;
+using test_helpers::Get;
+using test_helpers::Outputs;
+using test_helpers::SameBits;
+using test_helpers::SetAll;
+using test_helpers::SetArray;
 
 constexpr TimeNs kMs = 1'000'000;
-
-// ---------------------------------------------------------------------------
-// Helpers to drive a unit through its variable table, as the master does.
-
-void SetArray(DcMotorUnit& u, const std::string& name, const std::vector<double>& v) {
-  u.variables().SetRealArray(*u.variables().Find(name), v);
-}
-
-void SetAll(DcMotorUnit& u, const std::string& name, double v) {
-  u.variables().SetValue(*u.variables().Find(name), cosim::Value{v});
-}
-
-std::vector<double> Get(const DcMotorUnit& u, const std::string& name) {
-  const auto s = u.variables().GetRealArray(*u.variables().Find(name));
-  return {s.begin(), s.end()};
-}
 
 // ---------------------------------------------------------------------------
 // Closed-form reference for one motor in full mode. State x = (i, w_rotor):
@@ -354,31 +344,13 @@ TEST(DcMotorUnit, SeveralMotorsEachMatchTheirOwnClosedForm) {
 // (e) Guards against a restored unit drifting from the original (CVODE
 // history not reset, held inputs or counters leaking across a restore).
 // Compared bit for bit.
-struct Snapshot {
-  std::vector<double> values;
-  bool operator==(const Snapshot& o) const {
-    return values.size() == o.values.size() &&
-           std::memcmp(values.data(), o.values.data(), values.size() * sizeof(double)) == 0;
-  }
-};
-
-Snapshot Outputs(const DcMotorUnit& u) {
-  Snapshot s;
-  for (const auto& info : u.variables().infos()) {
-    if (info.causality != cosim::Causality::kOutput) continue;
-    const auto a = u.variables().GetRealArray(info.ref);
-    s.values.insert(s.values.end(), a.begin(), a.end());
-  }
-  return s;
-}
-
 // Steps k = from..to-1. Inputs follow a 7-step cycle: each input jumps at
 // some steps and holds at others, so both paths (restart, continue) occur.
 // Steps 5, 6, 20 have the same inputs, so neither the step after the save
 // (6) nor the step after the restore (6 again, after 20) sees an input
 // change: only the save/restore logic itself can force their restarts.
-std::vector<Snapshot> Drive(DcMotorUnit& u, int from, int to, TimeNs dt) {
-  std::vector<Snapshot> out;
+std::vector<std::vector<double>> Drive(DcMotorUnit& u, int from, int to, TimeNs dt) {
+  std::vector<std::vector<double>> out;
   for (int k = from; k < to; ++k) {
     const int p = k % 7;
     const double volt = p < 3 ? 24.0 : -6.0;
@@ -410,20 +382,20 @@ void CheckSaveRestoreBitForBit(MotorMode mode, const std::string& hold = "zero_o
   const auto second = Drive(u, 6, 21, dt);
   ASSERT_EQ(first.size(), second.size());
   for (std::size_t k = 0; k < first.size(); ++k) {
-    EXPECT_TRUE(first[k] == second[k]) << "step " << 6 + k;
+    EXPECT_TRUE(SameBits(first[k], second[k])) << "step " << 6 + k;
   }
   // A fresh unit restored from the same state continues identically too.
   DcMotorUnit fresh("m", 2, mode);
   fresh.RestoreState(saved);  // parameters, the hold among them, come back too
   const auto third = Drive(fresh, 6, 21, dt);
   for (std::size_t k = 0; k < first.size(); ++k) {
-    EXPECT_TRUE(first[k] == third[k]) << "step " << 6 + k;
+    EXPECT_TRUE(SameBits(first[k], third[k])) << "step " << 6 + k;
   }
   // Outputs come back as they were saved, before any step.
   u.RestoreState(saved);
   DcMotorUnit probe("m", 2, mode);
   probe.RestoreState(saved);
-  EXPECT_TRUE(Outputs(u) == Outputs(probe));
+  EXPECT_TRUE(SameBits(Outputs(u), Outputs(probe)));
 }
 
 TEST(DcMotorUnit, SaveStepRestoreStepIsBitForBitFullMode) {

@@ -1,0 +1,44 @@
+#pragma once
+
+// What the unit tests share: access to a unit's variables by name, as the
+// master does, and bit-for-bit comparison of its outputs.
+
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "cosim/unit.h"
+
+namespace linesim::test_helpers {
+
+inline void SetArray(cosim::Unit& u, const std::string& name, const std::vector<double>& v) {
+  u.variables().SetRealArray(*u.variables().Find(name), v);
+}
+
+/// Every element of `name` to v.
+inline void SetAll(cosim::Unit& u, const std::string& name, double v) {
+  u.variables().SetValue(*u.variables().Find(name), cosim::Value{v});
+}
+
+inline std::vector<double> Get(const cosim::Unit& u, const std::string& name) {
+  const auto s = u.variables().GetRealArray(*u.variables().Find(name));
+  return {s.begin(), s.end()};
+}
+
+/// Every output (all real), one after the other in table order.
+inline std::vector<double> Outputs(const cosim::Unit& u) {
+  std::vector<double> out;
+  for (const auto& info : u.variables().infos()) {
+    if (info.causality != cosim::Causality::kOutput) continue;
+    const auto a = u.variables().GetRealArray(info.ref);
+    out.insert(out.end(), a.begin(), a.end());
+  }
+  return out;
+}
+
+/// Equal bit for bit (== would take -0 for 0 and refuse NaN for NaN).
+inline bool SameBits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+}  // namespace linesim::test_helpers
