@@ -104,7 +104,6 @@ class Master {
   std::vector<bool> has_feedthrough_;                 // some output depends on an input
   struct Arena;                                       // TBB arena of `threads` threads
   std::unique_ptr<Arena> arena_;
-  std::vector<std::vector<ValueRef>> real_outputs_;  // per unit, for the NaN guard
   std::vector<std::size_t> due_;
   std::vector<double> unit_wall_seconds_;
   std::vector<std::string> errors_;
