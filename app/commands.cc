@@ -248,25 +248,33 @@ int RunCommand(const std::string& file, const std::string& out_dir,
 }
 
 int InspectCommand(const std::string& what, const std::vector<std::string>& set_args) {
-  const bool is_file = fs::exists(what) || what.ends_with(".yaml") || what.ends_with(".yml");
+  // A type name first: a file or folder of that name where linesim runs
+  // (inspect chassis from inside units/) does not hide the type.
+  const loader::UnitType* type = loader::FindUnitType(what);
+  std::error_code ec;
+  const bool is_file =
+      !type && (fs::exists(what, ec) || what.ends_with(".yaml") || what.ends_with(".yml"));
   if (!is_file) {
     if (!set_args.empty()) {
       std::cerr << "linesim: --set applies to a scenario file, not to a unit type\n";
       return kExitBadInput;
     }
+    if (!type) {
+      std::cerr << "linesim: " << loader::UnknownTypeMessage(what) << "\n";
+      return kExitBadInput;
+    }
     std::unique_ptr<cosim::Unit> unit;
     try {
-      unit = loader::CreateDefaultUnit(what);
+      unit = loader::CreateDefaultUnit(*type);
     } catch (const loader::ScenarioError& e) {
       std::cerr << "linesim: " << e.what() << "\n";
       return kExitBadInput;
     }
-    const loader::UnitType& type = *loader::FindUnitType(what);
-    std::cout << "unit type '" << type.name << "': " << type.description << "\n";
+    std::cout << "unit type '" << type->name << "': " << type->description << "\n";
     std::cout << "keys under parameters: that shape the unit:\n";
     std::size_t key_width = 0;
-    for (const auto& k : type.structural_keys) key_width = std::max(key_width, k.name.size());
-    for (const auto& k : type.structural_keys) {
+    for (const auto& k : type->structural_keys) key_width = std::max(key_width, k.name.size());
+    for (const auto& k : type->structural_keys) {
       std::cout << "  " << std::left << std::setw(static_cast<int>(key_width)) << k.name << "  "
                 << k.description << "\n";
     }

@@ -404,10 +404,14 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
 std::unique_ptr<cosim::Unit> CreateDefaultUnit(const std::string& type_name) {
   const UnitType* type = FindUnitType(type_name);
   if (!type) throw ScenarioError({{"", 0, "", UnknownTypeMessage(type_name)}});
+  return CreateDefaultUnit(*type);
+}
+
+std::unique_ptr<cosim::Unit> CreateDefaultUnit(const UnitType& type) {
   YamlReader reader("(defaults)");
   const YAML::Node none;
   const std::string path = "parameters";
-  auto unit = type->create({type_name, 1, reader, none, path});
+  auto unit = type.create({type.name, 1, reader, none, path});
   if (!reader.ok() || !unit) throw ScenarioError(reader.issues());
   return unit;
 }

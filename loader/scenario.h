@@ -50,5 +50,8 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
 /// after its type (for `linesim inspect TYPE`); throws ScenarioError with the
 /// closest type names when the type is unknown.
 std::unique_ptr<cosim::Unit> CreateDefaultUnit(const std::string& type);
+struct UnitType;
+/// The same for a type already looked up (FindUnitType).
+std::unique_ptr<cosim::Unit> CreateDefaultUnit(const UnitType& type);
 
 }  // namespace linesim::loader
