@@ -166,10 +166,9 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   Json settings;
   settings["duration_s"] = s.duration_s;
   settings["seed"] = s.seed;
-  settings["master"] = {
-      {"algorithm", options.algorithm == cosim::Algorithm::kJacobi ? "jacobi" : "gauss_seidel"},
-      {"step_s", cosim::NsToSeconds(options.base_step)},
-      {"threads", options.threads}};
+  settings["master"] = {{"algorithm", cosim::ToString(options.algorithm)},
+                        {"step_s", cosim::NsToSeconds(options.base_step)},
+                        {"threads", options.threads}};
   Json overrides = Json::array();
   for (const auto& o : s.overrides) overrides.push_back(o.path + "=" + o.value);
   settings["overrides"] = overrides;
@@ -294,8 +293,8 @@ int InspectCommand(const std::string& what, const std::vector<std::string>& set_
   std::cout << "scenario '" << s.name << "' (" << what << ")";
   if (!s.description.empty()) std::cout << ": " << s.description;
   std::cout << "\n  duration " << cosim::FormatSeconds(o.stop - o.start) << " s, seed " << s.seed
-            << ", master " << (o.algorithm == cosim::Algorithm::kJacobi ? "jacobi" : "gauss_seidel")
-            << " step " << cosim::FormatSeconds(o.base_step) << " s\n";
+            << ", master " << cosim::ToString(o.algorithm) << " step "
+            << cosim::FormatSeconds(o.base_step) << " s\n";
   if (s.robot) {
     // The robot-level file and what it stands for, in the system-level
     // format (a file of its own could be run as is).

@@ -37,6 +37,31 @@ bool SameBits(double a, double b) {
 
 }  // namespace
 
+std::string_view ToString(Algorithm a) {
+  switch (a) {
+    case Algorithm::kJacobi:
+      return "jacobi";
+    case Algorithm::kGaussSeidel:
+      return "gauss_seidel";
+  }
+  return "?";
+}
+
+bool ParseAlgorithm(std::string_view text, Algorithm* out) {
+  for (const Algorithm a : {Algorithm::kJacobi, Algorithm::kGaussSeidel}) {
+    if (text == ToString(a)) {
+      *out = a;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::vector<std::string> AlgorithmNames() {
+  return {std::string(ToString(Algorithm::kJacobi)),
+          std::string(ToString(Algorithm::kGaussSeidel))};
+}
+
 // Keeps TBB out of the public header; limits Jacobi to `threads` threads.
 struct Master::Arena {
   explicit Arena(int threads) : arena(threads) {}

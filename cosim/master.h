@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cosim/system.h"
@@ -11,6 +12,11 @@
 namespace linesim::cosim {
 
 enum class Algorithm { kJacobi, kGaussSeidel };
+/// "jacobi" or "gauss_seidel": the names scenarios, summaries and messages use.
+std::string_view ToString(Algorithm a);
+/// The inverse of ToString; false, leaving *out alone, for any other text.
+bool ParseAlgorithm(std::string_view text, Algorithm* out);
+std::vector<std::string> AlgorithmNames();
 
 struct MasterOptions {
   Algorithm algorithm = Algorithm::kGaussSeidel;

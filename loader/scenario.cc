@@ -124,10 +124,10 @@ class Builder {
       r_.CheckKeys(master, "master", {"algorithm", "step_s", "threads"});
     }
     const YAML::Node master_map = master.IsMap() ? master : YAML::Node(YAML::NodeType::Map);
-    const std::string algorithm =
-        r_.String(master_map, "master", "algorithm", "gauss_seidel", {"jacobi", "gauss_seidel"});
-    options.algorithm =
-        algorithm == "jacobi" ? cosim::Algorithm::kJacobi : cosim::Algorithm::kGaussSeidel;
+    const std::string algorithm = r_.String(
+        master_map, "master", "algorithm",
+        std::string(cosim::ToString(cosim::Algorithm::kGaussSeidel)), cosim::AlgorithmNames());
+    cosim::ParseAlgorithm(algorithm, &options.algorithm);
     options.base_step = r_.Time(master_map, "master", "step_s", 0.001, {0.0, 10.0, true});
     options.threads = static_cast<int>(r_.Integer(master_map, "master", "threads", 1, 1, 256));
     if (options.base_step > 0 && options.stop > 0 && options.stop % options.base_step != 0) {
