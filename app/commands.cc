@@ -79,8 +79,8 @@ void WriteAtomically(const fs::path& path, const std::string& text) {
   fs::rename(tmp, path);
 }
 
-// What the plots of a robot run draw, by the column names the recorder
-// gives the expanded units' variables.
+// What the plots of a robot run draw, by the columns the robot expansion
+// names.
 plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
   const loader::RobotInfo& robot = *s.robot;
   plots::RobotPlotSpec spec;
@@ -89,22 +89,17 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
     spec.belts.push_back({b.center_x_m, b.center_y_m, b.length_m, b.width_m, b.direction_rad});
   }
   spec.path_m = robot.path;
-  spec.x_column = "chassis.pose[0]";
-  spec.y_column = "chassis.pose[1]";
-  spec.yaw_column = "chassis.pose[2]";
-  for (int w = 0; w < robot.wheel_count; ++w) {
-    spec.wheel_columns.emplace_back("chassis.wheel_contact[" + std::to_string(2 * w) + "]",
-                                    "chassis.wheel_contact[" + std::to_string(2 * w + 1) + "]");
-  }
-  spec.error_column = "deviation.deviation";
+  spec.x_column = robot.x_column;
+  spec.y_column = robot.y_column;
+  spec.yaw_column = robot.yaw_column;
+  spec.wheel_columns = robot.wheel_columns;
+  spec.error_column = robot.error_column;
   spec.error_label =
       robot.task == "path" ? "deviation from the path (m)" : "drift from the held position (m)";
-  for (std::size_t b = 0; b < robot.belts.size(); ++b) {
-    spec.belt_speed_columns.push_back("belt.speed[" + std::to_string(b) + "]");
-    spec.belt_on_columns.push_back("belt.on[" + std::to_string(b) + "]");
-  }
-  spec.body_length_m = robot.body_length_m;
-  spec.body_width_m = robot.body_width_m;
+  spec.belt_speed_columns = robot.belt_speed_columns;
+  spec.belt_on_columns = robot.belt_on_columns;
+  if (robot.body_length_m) spec.body_length_m = *robot.body_length_m;
+  if (robot.body_width_m) spec.body_width_m = *robot.body_width_m;
   return spec;
 }
 

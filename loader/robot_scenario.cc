@@ -64,6 +64,7 @@ class Expander {
     Passthrough();
     Recording();
     Metrics();
+    PlotColumns();
     // The file's own connections and metrics come first, so that a problem
     // found in them later carries the index they have in the file.
     YAML::Node connections(YAML::NodeType::Sequence);
@@ -116,6 +117,17 @@ class Expander {
     return YAML::Node(YAML::NodeType::Undefined);
   }
 
+  // A chassis parameter that is a positive finite number; nothing otherwise.
+  std::optional<double> PositiveChassisValue(const std::string& key) const {
+    const YAML::Node n = ChassisValue(key);
+    double value = 0.0;
+    if (n.IsScalar() && YAML::convert<double>::decode(n, value) && std::isfinite(value) &&
+        value > 0.0) {
+      return value;
+    }
+    return std::nullopt;
+  }
+
   // A section that must be a map if present; an empty map if absent.
   YAML::Node Section(const YAML::Node& parent, const std::string& path, const std::string& key,
                      const std::vector<std::string>& keys) {
@@ -141,13 +153,6 @@ class Expander {
                   r_.file(), &robot_file_);
     if (!robot_model.IsDefined()) return;
     const YAML::Node units = Child(robot_model, "units");
-    {
-      const YamlReader::InFile in_model(r_, robot_file_);
-      const YAML::Node plot = Child(robot_model, "plot");
-      info_.body_length_m =
-          r_.Real(plot, "plot", "body_length_m", std::nullopt, {0.0, 100.0, true});
-      info_.body_width_m = r_.Real(plot, "plot", "body_width_m", std::nullopt, {0.0, 100.0, true});
-    }
 
     // The chassis as it will be built: the file's own units.chassis, the
     // robot model's chassis settings, the chassis model file they name.
@@ -168,6 +173,10 @@ class Expander {
     } else {
       info_.wheel_count = 4;  // a bad count is the chassis unit's to report
     }
+    // The plots draw the body the chassis simulates; a bad size is the
+    // chassis unit's to report.
+    info_.body_length_m = PositiveChassisValue("body_length");
+    info_.body_width_m = PositiveChassisValue("body_width");
 
     Unit(kChassis)["type"] = "chassis";
     MergeInto(Params(kChassis), Child(units, kChassis));
@@ -566,6 +575,28 @@ class Expander {
     }
     add("final_yaw_rad", "chassis.pose[2]", "final");
     out_["metrics"] = metrics;
+  }
+
+  // The columns the recorder gives the variables the plots read.
+  void PlotColumns() {
+    const auto column = [](const char* unit, const std::string& variable) {
+      return std::string(unit) + "." + variable;
+    };
+    const auto element = [&](const char* unit, const std::string& variable, std::size_t k) {
+      return column(unit, variable + "[" + std::to_string(k) + "]");
+    };
+    info_.x_column = element(kChassis, "pose", 0);
+    info_.y_column = element(kChassis, "pose", 1);
+    info_.yaw_column = element(kChassis, "pose", 2);
+    for (std::size_t w = 0; w < static_cast<std::size_t>(info_.wheel_count); ++w) {
+      info_.wheel_columns.emplace_back(element(kChassis, "wheel_contact", 2 * w),
+                                       element(kChassis, "wheel_contact", 2 * w + 1));
+    }
+    info_.error_column = column(kDeviation, "deviation");
+    for (std::size_t b = 0; b < info_.belts.size(); ++b) {
+      info_.belt_speed_columns.push_back(element(kBelt, "speed", b));
+      info_.belt_on_columns.push_back(element(kBelt, "on", b));
+    }
   }
 
   const YAML::Node& root_;

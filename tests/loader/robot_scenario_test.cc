@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -110,6 +111,38 @@ TEST(RobotScenario, WheelCountComesFromTheChassis) {
     EXPECT_EQ(to_motors, static_cast<std::size_t>(2 * wheels));
   }
   EXPECT_EQ(LoadScenario(kCross).robot->wheel_count, 4);
+}
+
+// Guards the plots' view of a robot run: every column they read is one the
+// expansion records, one wheel per chassis wheel and one belt per belt, and
+// the body they draw is the chassis's, so setting the chassis resizes it.
+TEST(RobotScenario, PlotColumnsAndBodyComeFromTheExpansion) {
+  const Scenario s = LoadScenario(kCross);
+  ASSERT_TRUE(s.robot);
+  const RobotInfo& info = *s.robot;
+  std::vector<std::string> read = {info.x_column, info.y_column, info.yaw_column,
+                                   info.error_column};
+  for (const auto& [x, y] : info.wheel_columns) read.insert(read.end(), {x, y});
+  read.insert(read.end(), info.belt_speed_columns.begin(), info.belt_speed_columns.end());
+  read.insert(read.end(), info.belt_on_columns.begin(), info.belt_on_columns.end());
+  std::vector<std::string> recorded;
+  for (const auto& p : s.recorded) recorded.push_back(p.label);
+  for (const auto& column : read) {
+    EXPECT_NE(std::find(recorded.begin(), recorded.end(), column), recorded.end()) << column;
+  }
+  EXPECT_EQ(info.x_column, "chassis.pose[0]");
+  EXPECT_EQ(info.wheel_columns.size(), static_cast<std::size_t>(info.wheel_count));
+  ASSERT_FALSE(info.belts.empty());
+  EXPECT_EQ(info.belt_speed_columns.size(), info.belts.size());
+  EXPECT_EQ(info.belt_on_columns.size(), info.belts.size());
+  // models/chassis/raw3_chassis.yaml
+  EXPECT_EQ(info.body_length_m, 1.03);
+  EXPECT_EQ(info.body_width_m, 0.57);
+  const Scenario longer =
+      LoadScenario(kCross, {"units={chassis: {parameters: {body_length: 1.5}}}"});
+  EXPECT_EQ(longer.robot->body_length_m, 1.5);
+  EXPECT_EQ(Param(longer, "chassis", "body_length"), 1.5);
+  EXPECT_EQ(longer.robot->body_width_m, 0.57);
 }
 
 // Guards `linesim inspect`'s promise that the expansion is a system-level
