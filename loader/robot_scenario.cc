@@ -7,6 +7,7 @@
 
 #include "cosim/time.h"
 #include "cosim/variable_table.h"
+#include "loader/scenario.h"
 #include "loader/yaml_files.h"
 
 namespace linesim::loader {
@@ -86,16 +87,11 @@ class Expander {
     connections_.push_back(c);
   }
 
-  // The master step as written when it is a usable one; 1 ms if absent or
-  // bad (the system loader reports a bad one at master.step_s).
-  double MasterStepS() const {
-    const YAML::Node node = Child(Child(root_, "master"), "step_s");
-    double step_s = 0.0;
-    if (node.IsScalar() && YAML::convert<double>::decode(node, step_s) && step_s >= 1e-9 &&
-        step_s <= 10.0) {
-      return step_s;
-    }
-    return 0.001;
+  // The master step as the system loader reads it; its default if absent
+  // or bad (the system loader reports a bad one at master.step_s).
+  cosim::TimeNs MasterStep() const {
+    YamlReader quiet(r_.file());
+    return ReadMasterStep(quiet, Child(root_, "master"));
   }
 
   // Records that the expansion's `expanded` path holds a value derived from
@@ -546,10 +542,10 @@ class Expander {
     out_["recording"]["variables"] = vars;
     // About 100 Hz is enough for the plots and keeps signals.csv small; it
     // must be a whole number of master steps (the master refuses bad steps).
-    const double step_s = MasterStepS();
-    const double interval_s =
-        step_s > 0.0 && step_s < 0.01 ? std::ceil(0.01 / step_s - 1e-9) * step_s : step_s;
-    out_["recording"]["interval_s"] = Num(interval_s);
+    constexpr cosim::TimeNs kInterval = cosim::kNsPerSecond / 100;
+    const cosim::TimeNs step = MasterStep();
+    const cosim::TimeNs interval = step < kInterval ? (kInterval + step - 1) / step * step : step;
+    out_["recording"]["interval_s"] = Num(cosim::NsToSeconds(interval));
   }
 
   void Metrics() {

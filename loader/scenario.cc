@@ -128,7 +128,7 @@ class Builder {
         master_map, "master", "algorithm",
         std::string(cosim::ToString(cosim::Algorithm::kGaussSeidel)), cosim::AlgorithmNames());
     cosim::ParseAlgorithm(algorithm, &options.algorithm);
-    options.base_step = r_.Time(master_map, "master", "step_s", 0.001, {0.0, 10.0, true});
+    options.base_step = ReadMasterStep(r_, master_map);
     options.threads = static_cast<int>(r_.Integer(master_map, "master", "threads", 1, 1, 256));
     if (options.base_step > 0 && options.stop > 0 && options.stop % options.base_step != 0) {
       r_.Error(Child(root, "duration_s"), "duration_s",
@@ -399,6 +399,10 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
   Builder(s, reader).Build(tree);
   if (!reader.ok()) throw ScenarioError(reader.issues());
   return s;
+}
+
+cosim::TimeNs ReadMasterStep(YamlReader& r, const YAML::Node& master) {
+  return r.Time(master, "master", "step_s", 0.001, {0.0, 10.0, true});
 }
 
 std::unique_ptr<cosim::Unit> CreateDefaultUnit(const std::string& type_name) {

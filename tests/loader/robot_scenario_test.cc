@@ -145,6 +145,36 @@ TEST(RobotScenario, PlotColumnsAndBodyComeFromTheExpansion) {
   EXPECT_EQ(longer.robot->body_width_m, 0.57);
 }
 
+// Guards the default recording interval: the first whole number of master
+// steps from 10 ms on, exact in decimal (no 0.010199999999999999 for a
+// 0.3 ms step), and 10 ms for a missing or bad step (reported elsewhere).
+TEST(RobotScenario, RecordingIntervalIsAWholeNumberOfMasterSteps) {
+  std::ifstream in(kCross);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const auto& [step, interval] :
+       std::vector<std::pair<std::string, std::string>>{{"0.001", "0.01"},
+                                                        {"0.003", "0.012"},
+                                                        {"0.0003", "0.0102"},
+                                                        {"0.01", "0.01"},
+                                                        {"0.02", "0.02"},
+                                                        {"1e-9", "0.01"},
+                                                        {"0", "0.01"},
+                                                        {"11", "0.01"},
+                                                        {"x", "0.01"}}) {
+    YAML::Node root = YAML::Load(text);
+    root["master"]["step_s"] = step;
+    YamlReader reader("robot.yaml");
+    RobotInfo info;
+    const YAML::Node expanded = ExpandRobotScenario(root, reader, info);
+    EXPECT_EQ(expanded["recording"]["interval_s"].Scalar(), interval) << step;
+  }
+  YAML::Node root = YAML::Load(text);
+  root.remove("master");
+  YamlReader reader("robot.yaml");
+  RobotInfo info;
+  EXPECT_EQ(ExpandRobotScenario(root, reader, info)["recording"]["interval_s"].Scalar(), "0.01");
+}
+
 // Guards `linesim inspect`'s promise that the expansion is a system-level
 // scenario of its own: written out and loaded again, it builds the same
 // units, connections and metrics.
