@@ -16,7 +16,7 @@ bool IsFinite(double x) { return std::isfinite(x); }
 
 void ParameterChecks::Add(const char* name, std::optional<std::size_t> index, const char* expected,
                           double value) {
-  problems_.push_back({name, index, std::string(expected) + ", got " + FormatValue(Value{value})});
+  problems_.push_back({name, index, std::string(expected) + ", got " + FormatValue(value)});
 }
 
 void ParameterChecks::Positive(const char* name, double value) {

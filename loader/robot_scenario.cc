@@ -27,7 +27,7 @@ constexpr const char* kDeviation = "deviation";
 
 // A number as the shortest text that reads back to it, so that the
 // expansion `linesim inspect` prints shows 0.9 rather than 0.90000000000000002.
-YAML::Node Num(double x) { return YAML::Node(cosim::FormatValue(cosim::Value{x})); }
+YAML::Node Num(double x) { return YAML::Node(cosim::FormatValue(x)); }
 
 YAML::Node List(const std::vector<double>& values) {
   YAML::Node list(YAML::NodeType::Sequence);
