@@ -60,7 +60,11 @@ void ApplyParameter(cosim::Unit& unit, const cosim::VariableInfo& info, const YA
       } else if (const auto v = YamlReader::DecodeReal(node)) {
         value = *v;
       } else {
-        r.Error(node, path, "expected " + expected + " (" + info.unit + "), got " + Describe(node));
+        // A dimensionless value ("1") has no unit to name.
+        const bool has_unit = !info.unit.empty() && info.unit != "1";
+        r.Error(node, path,
+                "expected " + expected + (has_unit ? " (" + info.unit + ")" : "") + ", got " +
+                    Describe(node));
       }
       break;
     }
