@@ -9,7 +9,6 @@
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "cosim/observers.h"
 #include "loader/scenario.h"

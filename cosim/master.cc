@@ -121,7 +121,6 @@ Master::Master(System& system, MasterOptions options) : system_(system), options
     }
   }
   if (options_.threads > 1) arena_ = std::make_unique<Arena>(options_.threads);
-  unit_wall_seconds_.assign(n, 0.0);
   time_ = options_.start;
 }
 

@@ -83,7 +83,8 @@ class Master {
   /// Communication step of unit i as a multiple of the base step.
   std::int64_t decimation(std::size_t unit) const { return decimation_[unit]; }
   /// Wall time spent in each unit (Setup, Initialize, DoStep, UpdateOutputs),
-  /// in seconds; zero without `profile`.
+  /// in seconds, one entry per unit from Start() on (which zeroes them);
+  /// zero without `profile`.
   const std::vector<double>& unit_wall_seconds() const { return unit_wall_seconds_; }
   /// Wall time of Start, every Step and Finish together (units included);
   /// zero without `profile`.

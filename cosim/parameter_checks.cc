@@ -1,5 +1,7 @@
 #include "cosim/parameter_checks.h"
 
+#include <cmath>
+
 namespace linesim::cosim {
 
 namespace {
