@@ -9,7 +9,6 @@
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "app/console.h"
 #include "cosim/files.h"
@@ -63,8 +62,8 @@ void PrintTable(const cosim::Unit& unit, std::ostream& out) {
   }
 }
 
-// What the plots of a robot run draw, by the column names the recorder
-// gives the expanded units' variables.
+// What the plots of a robot run draw, by the columns the robot expansion
+// names.
 plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
   const loader::RobotInfo& robot = *s.robot;
   plots::RobotPlotSpec spec;
@@ -73,22 +72,17 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
     spec.belts.push_back({b.center_x_m, b.center_y_m, b.length_m, b.width_m, b.direction_rad});
   }
   spec.path_m = robot.path;
-  spec.x_column = "chassis.pose[0]";
-  spec.y_column = "chassis.pose[1]";
-  spec.yaw_column = "chassis.pose[2]";
-  for (int w = 0; w < robot.wheel_count; ++w) {
-    spec.wheel_columns.emplace_back("chassis.wheel_contact[" + std::to_string(2 * w) + "]",
-                                    "chassis.wheel_contact[" + std::to_string(2 * w + 1) + "]");
-  }
-  spec.error_column = "deviation.deviation";
+  spec.x_column = robot.x_column;
+  spec.y_column = robot.y_column;
+  spec.yaw_column = robot.yaw_column;
+  spec.wheel_columns = robot.wheel_columns;
+  spec.error_column = robot.error_column;
   spec.error_label =
       robot.task == "path" ? "deviation from the path (m)" : "drift from the held position (m)";
-  for (std::size_t b = 0; b < robot.belts.size(); ++b) {
-    spec.belt_speed_columns.push_back("belt.speed[" + std::to_string(b) + "]");
-    spec.belt_on_columns.push_back("belt.on[" + std::to_string(b) + "]");
-  }
-  spec.body_length_m = robot.body_length_m;
-  spec.body_width_m = robot.body_width_m;
+  spec.belt_speed_columns = robot.belt_speed_columns;
+  spec.belt_on_columns = robot.belt_on_columns;
+  if (robot.body_length_m) spec.body_length_m = *robot.body_length_m;
+  if (robot.body_width_m) spec.body_width_m = *robot.body_width_m;
   return spec;
 }
 
@@ -144,10 +138,9 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   Json settings;
   settings["duration_s"] = s.duration_s;
   settings["seed"] = s.seed;
-  settings["master"] = {
-      {"algorithm", options.algorithm == cosim::Algorithm::kJacobi ? "jacobi" : "gauss_seidel"},
-      {"step_s", cosim::NsToSeconds(options.base_step)},
-      {"threads", options.threads}};
+  settings["master"] = {{"algorithm", cosim::ToString(options.algorithm)},
+                        {"step_s", cosim::NsToSeconds(options.base_step)},
+                        {"threads", options.threads}};
   Json overrides = Json::array();
   for (const auto& o : s.overrides) overrides.push_back(o.path + "=" + o.value);
   settings["overrides"] = overrides;
@@ -226,25 +219,33 @@ int RunCommand(const std::string& file, const std::string& out_dir,
 }
 
 int InspectCommand(const std::string& what, const std::vector<std::string>& set_args) {
-  const bool is_file = fs::exists(what) || what.ends_with(".yaml") || what.ends_with(".yml");
+  // A type name first: a file or folder of that name where linesim runs
+  // (inspect chassis from inside units/) does not hide the type.
+  const loader::UnitType* type = loader::FindUnitType(what);
+  std::error_code ec;
+  const bool is_file =
+      !type && (fs::exists(what, ec) || what.ends_with(".yaml") || what.ends_with(".yml"));
   if (!is_file) {
     if (!set_args.empty()) {
       std::cerr << "linesim: --set applies to a scenario file, not to a unit type\n";
       return kExitBadInput;
     }
+    if (!type) {
+      std::cerr << "linesim: " << loader::UnknownTypeMessage(what) << "\n";
+      return kExitBadInput;
+    }
     std::unique_ptr<cosim::Unit> unit;
     try {
-      unit = loader::CreateDefaultUnit(what);
+      unit = loader::CreateDefaultUnit(*type);
     } catch (const loader::ScenarioError& e) {
       std::cerr << "linesim: " << e.what() << "\n";
       return kExitBadInput;
     }
-    const loader::UnitType& type = *loader::FindUnitType(what);
-    std::cout << "unit type '" << type.name << "': " << type.description << "\n";
+    std::cout << "unit type '" << type->name << "': " << type->description << "\n";
     std::cout << "keys under parameters: that shape the unit:\n";
     std::size_t key_width = 0;
-    for (const auto& k : type.structural_keys) key_width = std::max(key_width, k.name.size());
-    for (const auto& k : type.structural_keys) {
+    for (const auto& k : type->structural_keys) key_width = std::max(key_width, k.name.size());
+    for (const auto& k : type->structural_keys) {
       std::cout << "  " << std::left << std::setw(static_cast<int>(key_width)) << k.name << "  "
                 << k.description << "\n";
     }
@@ -264,8 +265,8 @@ int InspectCommand(const std::string& what, const std::vector<std::string>& set_
   std::cout << "scenario '" << s.name << "' (" << what << ")";
   if (!s.description.empty()) std::cout << ": " << s.description;
   std::cout << "\n  duration " << cosim::FormatSeconds(o.stop - o.start) << " s, seed " << s.seed
-            << ", master " << (o.algorithm == cosim::Algorithm::kJacobi ? "jacobi" : "gauss_seidel")
-            << " step " << cosim::FormatSeconds(o.base_step) << " s\n";
+            << ", master " << cosim::ToString(o.algorithm) << " step "
+            << cosim::FormatSeconds(o.base_step) << " s\n";
   if (s.robot) {
     // The robot-level file and what it stands for, in the system-level
     // format (a file of its own could be run as is).

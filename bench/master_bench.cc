@@ -74,8 +74,8 @@ void BM_MasterStep(benchmark::State& state) {
   state.counters["unit_step"] =
       benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate |
                                                      benchmark::Counter::kInvert);
-  state.SetLabel(std::string(o.algorithm == Algorithm::kJacobi ? "jacobi" : "gauss_seidel") +
-                 (o.profile ? " profile" : " no_profile") + (state.range(3) ? " feedthrough" : ""));
+  state.SetLabel(std::string(ToString(o.algorithm)) + (o.profile ? " profile" : " no_profile") +
+                 (state.range(3) ? " feedthrough" : ""));
   master.Finish();
 }
 

@@ -5,7 +5,6 @@
 
 #include <bit>
 #include <chrono>
-#include <cmath>
 #include <cstring>
 
 namespace linesim::cosim {
@@ -37,6 +36,31 @@ bool SameBits(double a, double b) {
 }
 
 }  // namespace
+
+std::string_view ToString(Algorithm a) {
+  switch (a) {
+    case Algorithm::kJacobi:
+      return "jacobi";
+    case Algorithm::kGaussSeidel:
+      return "gauss_seidel";
+  }
+  return "?";
+}
+
+bool ParseAlgorithm(std::string_view text, Algorithm* out) {
+  for (const Algorithm a : {Algorithm::kJacobi, Algorithm::kGaussSeidel}) {
+    if (text == ToString(a)) {
+      *out = a;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::vector<std::string> AlgorithmNames() {
+  return {std::string(ToString(Algorithm::kJacobi)),
+          std::string(ToString(Algorithm::kGaussSeidel))};
+}
 
 // Keeps TBB out of the public header; limits Jacobi to `threads` threads.
 struct Master::Arena {
@@ -97,16 +121,6 @@ Master::Master(System& system, MasterOptions options) : system_(system), options
     }
   }
   if (options_.threads > 1) arena_ = std::make_unique<Arena>(options_.threads);
-  real_outputs_.assign(n, {});
-  for (std::size_t u = 0; u < n; ++u) {
-    for (const auto& info : system_.unit(u).variables().infos()) {
-      if (info.causality == Causality::kOutput &&
-          (info.type == VarType::kReal || info.type == VarType::kRealArray)) {
-        real_outputs_[u].push_back(info.ref);
-      }
-    }
-  }
-  unit_wall_seconds_.assign(n, 0.0);
   time_ = options_.start;
 }
 
@@ -180,27 +194,10 @@ bool Master::InitializeUnit(std::size_t u) {
 
 bool Master::CheckOutputs(std::size_t u, TimeNs t) {
   const VariableTable& table = system_.unit(u).variables();
-  for (ValueRef ref : real_outputs_[u]) {
-    const VariableInfo& info = table.info(ref);
-    if (info.type == VarType::kReal) {
-      const double v = table.GetReal(ref);
-      if (!std::isfinite(v)) {
-        RecordError(u, t, "", "output '" + info.name + "' is " + FormatValue(v));
-        return false;
-      }
-    } else {
-      const auto values = table.GetRealArray(ref);
-      for (std::size_t i = 0; i < values.size(); ++i) {
-        if (!std::isfinite(values[i])) {
-          RecordError(
-              u, t, "",
-              "output '" + info.name + "[" + std::to_string(i) + "]' is " + FormatValue(values[i]));
-          return false;
-        }
-      }
-    }
-  }
-  return true;
+  const auto problem = FirstNonFinite(table, table.real_outputs());
+  if (!problem) return true;
+  RecordError(u, t, "", *problem);
+  return false;
 }
 
 // Steps one unit; returns false with the cause in the unit's error slot.

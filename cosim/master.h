@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cosim/system.h"
@@ -11,6 +12,11 @@
 namespace linesim::cosim {
 
 enum class Algorithm { kJacobi, kGaussSeidel };
+/// "jacobi" or "gauss_seidel": the names scenarios, summaries and messages use.
+std::string_view ToString(Algorithm a);
+/// The inverse of ToString; false, leaving *out alone, for any other text.
+bool ParseAlgorithm(std::string_view text, Algorithm* out);
+std::vector<std::string> AlgorithmNames();
 
 struct MasterOptions {
   Algorithm algorithm = Algorithm::kGaussSeidel;
@@ -77,7 +83,8 @@ class Master {
   /// Communication step of unit i as a multiple of the base step.
   std::int64_t decimation(std::size_t unit) const { return decimation_[unit]; }
   /// Wall time spent in each unit (Setup, Initialize, DoStep, UpdateOutputs),
-  /// in seconds; zero without `profile`.
+  /// in seconds, one entry per unit from Start() on (which zeroes them);
+  /// zero without `profile`.
   const std::vector<double>& unit_wall_seconds() const { return unit_wall_seconds_; }
   /// Wall time of Start, every Step and Finish together (units included);
   /// zero without `profile`.
@@ -104,7 +111,6 @@ class Master {
   std::vector<bool> has_feedthrough_;                 // some output depends on an input
   struct Arena;                                       // TBB arena of `threads` threads
   std::unique_ptr<Arena> arena_;
-  std::vector<std::vector<ValueRef>> real_outputs_;  // per unit, for the NaN guard
   std::vector<std::size_t> due_;
   std::vector<double> unit_wall_seconds_;
   std::vector<std::string> errors_;

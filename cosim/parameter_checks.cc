@@ -1,5 +1,7 @@
 #include "cosim/parameter_checks.h"
 
+#include <cmath>
+
 namespace linesim::cosim {
 
 namespace {
@@ -16,7 +18,7 @@ bool IsFinite(double x) { return std::isfinite(x); }
 
 void ParameterChecks::Add(const char* name, std::optional<std::size_t> index, const char* expected,
                           double value) {
-  problems_.push_back({name, index, std::string(expected) + ", got " + FormatValue(Value{value})});
+  problems_.push_back({name, index, std::string(expected) + ", got " + FormatValue(value)});
 }
 
 void ParameterChecks::Positive(const char* name, double value) {

@@ -1,7 +1,5 @@
 #include "cosim/unit.h"
 
-#include <cmath>
-
 namespace linesim::cosim {
 
 UnitState Unit::SaveState() const {
@@ -29,27 +27,10 @@ void Unit::RestoreState(const UnitState& state) {
 }
 
 bool Unit::InputsFinite(TimeNs t) {
-  for (const VariableInfo& info : variables_.infos()) {
-    if (info.causality != Causality::kInput) continue;
-    if (info.type == VarType::kReal) {
-      const double v = variables_.GetReal(info.ref);
-      if (!std::isfinite(v)) {
-        Fail(Where() + ": input '" + info.name + "' is " + FormatValue(v) +
-             " at t = " + FormatSeconds(t) + " s");
-        return false;
-      }
-    } else if (info.type == VarType::kRealArray) {
-      const auto values = variables_.GetRealArray(info.ref);
-      for (std::size_t k = 0; k < values.size(); ++k) {
-        if (!std::isfinite(values[k])) {
-          Fail(Where() + ": input '" + info.name + "[" + std::to_string(k) + "]' is " +
-               FormatValue(values[k]) + " at t = " + FormatSeconds(t) + " s");
-          return false;
-        }
-      }
-    }
-  }
-  return true;
+  const auto problem = FirstNonFinite(variables_, variables_.real_inputs());
+  if (!problem) return true;
+  Fail(Where() + ": " + *problem + " at t = " + FormatSeconds(t) + " s");
+  return false;
 }
 
 void Unit::ThrowIfBadParameters() const {

@@ -135,6 +135,10 @@ ValueRef VariableTable::Bind(std::string name, Causality causality, Variability 
   }
   info.ref = static_cast<ValueRef>(infos_.size());
   by_name_.emplace(info.name, info.ref);
+  if (info.type == VarType::kReal || info.type == VarType::kRealArray) {
+    if (causality == Causality::kInput) real_inputs_.push_back(info.ref);
+    if (causality == Causality::kOutput) real_outputs_.push_back(info.ref);
+  }
   infos_.push_back(std::move(info));
   storage_.push_back(storage);
   return infos_.back().ref;
@@ -333,6 +337,29 @@ void VariableTable::SetValue(ValueRef ref, const Value& v) {
     }
   }
   throw std::invalid_argument("expected " + expected() + ", got " + FormatValue(v));
+}
+
+std::optional<std::string> FirstNonFinite(const VariableTable& table,
+                                          std::span<const ValueRef> refs) {
+  const auto describe = [&](const VariableInfo& info, std::string element, double v) {
+    return std::string(ToString(info.causality)) + " '" + info.name + element + "' is " +
+           FormatValue(v);
+  };
+  for (ValueRef ref : refs) {
+    const VariableInfo& info = table.info(ref);
+    if (info.type == VarType::kReal) {
+      const double v = table.GetReal(ref);
+      if (!std::isfinite(v)) return describe(info, "", v);
+    } else {
+      const auto values = table.GetRealArray(ref);
+      for (std::size_t k = 0; k < values.size(); ++k) {
+        if (!std::isfinite(values[k])) {
+          return describe(info, "[" + std::to_string(k) + "]", values[k]);
+        }
+      }
+    }
+  }
+  return std::nullopt;
 }
 
 }  // namespace linesim::cosim

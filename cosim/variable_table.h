@@ -101,6 +101,10 @@ class VariableTable {
   const VariableInfo& info(ValueRef ref) const { return infos_.at(ref); }
   std::optional<ValueRef> Find(std::string_view name) const;
   std::vector<std::string> Names() const;
+  /// The Real and Real[] inputs, and outputs, in declaration order: what the
+  /// finite checks scan, listed once as variables are declared.
+  const std::vector<ValueRef>& real_inputs() const { return real_inputs_; }
+  const std::vector<ValueRef>& real_outputs() const { return real_outputs_; }
 
   // Typed access. Each checks the type and throws std::logic_error on misuse;
   // array setters check the element count.
@@ -150,6 +154,14 @@ class VariableTable {
   std::vector<VariableInfo> infos_;
   std::vector<void*> storage_;
   std::unordered_map<std::string, ValueRef> by_name_;
+  std::vector<ValueRef> real_inputs_;
+  std::vector<ValueRef> real_outputs_;
 };
+
+/// The first non-finite value among `refs` (Real or Real[] variables of
+/// `table`), as "input 'x[k]' is nan" (the variable's causality, its name
+/// and the element of an array); nothing when all are finite.
+std::optional<std::string> FirstNonFinite(const VariableTable& table,
+                                          std::span<const ValueRef> refs);
 
 }  // namespace linesim::cosim

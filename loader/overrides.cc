@@ -4,6 +4,7 @@
 #include <cctype>
 #include <charconv>
 #include <optional>
+#include <string_view>
 
 #include "loader/yaml_reader.h"
 
@@ -38,6 +39,13 @@ std::optional<std::size_t> IndexBelow(const std::string& s, std::size_t size) {
   return index;
 }
 
+// A value meant as a YAML list, map or quoted string.
+bool LooksStructured(const std::string& value) {
+  const auto first = value.find_first_not_of(" \t");
+  return first != std::string::npos &&
+         std::string_view("[{\"'").find(value[first]) != std::string_view::npos;
+}
+
 }  // namespace
 
 Override ParseOverride(const std::string& text) {
@@ -64,7 +72,17 @@ void ApplyOverrides(YAML::Node& root, const std::vector<Override>& overrides,
     YAML::Node value;
     try {
       value = o.value.empty() ? YAML::Node(YAML::NodeType::Null) : YAML::Load(o.value);
-    } catch (const YAML::Exception&) {
+    } catch (const YAML::Exception& e) {
+      // Plain text that YAML refuses ("a: b: c") is meant as a string; a
+      // list, map or quoted string that does not parse is a typo.
+      if (LooksStructured(o.value)) {
+        // A bad value at a path that may well be right.
+        issues.push_back(
+            {file, 0, o.path,
+             "value is not valid YAML: " + e.msg + " (in --set " + o.path + "=" + o.value + ")",
+             true, false});
+        continue;
+      }
       value = YAML::Node(o.value);
     }
 

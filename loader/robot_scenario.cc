@@ -7,6 +7,7 @@
 
 #include "cosim/time.h"
 #include "cosim/variable_table.h"
+#include "loader/scenario.h"
 #include "loader/yaml_files.h"
 
 namespace linesim::loader {
@@ -26,7 +27,7 @@ constexpr const char* kDeviation = "deviation";
 
 // A number as the shortest text that reads back to it, so that the
 // expansion `linesim inspect` prints shows 0.9 rather than 0.90000000000000002.
-YAML::Node Num(double x) { return YAML::Node(cosim::FormatValue(cosim::Value{x})); }
+YAML::Node Num(double x) { return YAML::Node(cosim::FormatValue(x)); }
 
 YAML::Node List(const std::vector<double>& values) {
   YAML::Node list(YAML::NodeType::Sequence);
@@ -64,6 +65,7 @@ class Expander {
     Passthrough();
     Recording();
     Metrics();
+    PlotColumns();
     // The file's own connections and metrics come first, so that a problem
     // found in them later carries the index they have in the file.
     YAML::Node connections(YAML::NodeType::Sequence);
@@ -85,16 +87,11 @@ class Expander {
     connections_.push_back(c);
   }
 
-  // The master step as written when it is a usable one; 1 ms if absent or
-  // bad (the system loader reports a bad one at master.step_s).
-  double MasterStepS() const {
-    const YAML::Node node = Child(Child(root_, "master"), "step_s");
-    double step_s = 0.0;
-    if (node.IsScalar() && YAML::convert<double>::decode(node, step_s) && step_s >= 1e-9 &&
-        step_s <= 10.0) {
-      return step_s;
-    }
-    return 0.001;
+  // The master step as the system loader reads it; its default if absent
+  // or bad (the system loader reports a bad one at master.step_s).
+  cosim::TimeNs MasterStep() const {
+    YamlReader quiet(r_.file());
+    return ReadMasterStep(quiet, Child(root_, "master"));
   }
 
   // Records that the expansion's `expanded` path holds a value derived from
@@ -114,6 +111,17 @@ class Expander {
       if (v.IsDefined() && !v.IsNull()) return v;
     }
     return YAML::Node(YAML::NodeType::Undefined);
+  }
+
+  // A chassis parameter that is a positive finite number; nothing otherwise.
+  std::optional<double> PositiveChassisValue(const std::string& key) const {
+    const YAML::Node n = ChassisValue(key);
+    double value = 0.0;
+    if (n.IsScalar() && YAML::convert<double>::decode(n, value) && std::isfinite(value) &&
+        value > 0.0) {
+      return value;
+    }
+    return std::nullopt;
   }
 
   // A section that must be a map if present; an empty map if absent.
@@ -141,13 +149,6 @@ class Expander {
                   r_.file(), &robot_file_);
     if (!robot_model.IsDefined()) return;
     const YAML::Node units = Child(robot_model, "units");
-    {
-      const YamlReader::InFile in_model(r_, robot_file_);
-      const YAML::Node plot = Child(robot_model, "plot");
-      info_.body_length_m =
-          r_.Real(plot, "plot", "body_length_m", std::nullopt, {0.0, 100.0, true});
-      info_.body_width_m = r_.Real(plot, "plot", "body_width_m", std::nullopt, {0.0, 100.0, true});
-    }
 
     // The chassis as it will be built: the file's own units.chassis, the
     // robot model's chassis settings, the chassis model file they name.
@@ -168,6 +169,10 @@ class Expander {
     } else {
       info_.wheel_count = 4;  // a bad count is the chassis unit's to report
     }
+    // The plots draw the body the chassis simulates; a bad size is the
+    // chassis unit's to report.
+    info_.body_length_m = PositiveChassisValue("body_length");
+    info_.body_width_m = PositiveChassisValue("body_width");
 
     Unit(kChassis)["type"] = "chassis";
     MergeInto(Params(kChassis), Child(units, kChassis));
@@ -537,10 +542,10 @@ class Expander {
     out_["recording"]["variables"] = vars;
     // About 100 Hz is enough for the plots and keeps signals.csv small; it
     // must be a whole number of master steps (the master refuses bad steps).
-    const double step_s = MasterStepS();
-    const double interval_s =
-        step_s > 0.0 && step_s < 0.01 ? std::ceil(0.01 / step_s - 1e-9) * step_s : step_s;
-    out_["recording"]["interval_s"] = Num(interval_s);
+    constexpr cosim::TimeNs kInterval = cosim::kNsPerSecond / 100;
+    const cosim::TimeNs step = MasterStep();
+    const cosim::TimeNs interval = step < kInterval ? (kInterval + step - 1) / step * step : step;
+    out_["recording"]["interval_s"] = Num(cosim::NsToSeconds(interval));
   }
 
   void Metrics() {
@@ -566,6 +571,28 @@ class Expander {
     }
     add("final_yaw_rad", "chassis.pose[2]", "final");
     out_["metrics"] = metrics;
+  }
+
+  // The columns the recorder gives the variables the plots read.
+  void PlotColumns() {
+    const auto column = [](const char* unit, const std::string& variable) {
+      return std::string(unit) + "." + variable;
+    };
+    const auto element = [&](const char* unit, const std::string& variable, std::size_t k) {
+      return column(unit, variable + "[" + std::to_string(k) + "]");
+    };
+    info_.x_column = element(kChassis, "pose", 0);
+    info_.y_column = element(kChassis, "pose", 1);
+    info_.yaw_column = element(kChassis, "pose", 2);
+    for (std::size_t w = 0; w < static_cast<std::size_t>(info_.wheel_count); ++w) {
+      info_.wheel_columns.emplace_back(element(kChassis, "wheel_contact", 2 * w),
+                                       element(kChassis, "wheel_contact", 2 * w + 1));
+    }
+    info_.error_column = column(kDeviation, "deviation");
+    for (std::size_t b = 0; b < info_.belts.size(); ++b) {
+      info_.belt_speed_columns.push_back(element(kBelt, "speed", b));
+      info_.belt_on_columns.push_back(element(kBelt, "on", b));
+    }
   }
 
   const YAML::Node& root_;

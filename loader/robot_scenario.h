@@ -3,7 +3,9 @@
 #include <yaml-cpp/yaml.h>
 
 #include <array>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "loader/yaml_reader.h"
@@ -19,8 +21,18 @@ struct RobotInfo {
   std::string task;                         // "path" or "hold"
   std::vector<std::array<double, 2>> path;  // desired path; one point for a hold
   std::vector<Belt> belts;
-  double body_length_m = 0, body_width_m = 0;
+  /// The chassis body as the chassis unit gets it; nothing when no file or
+  /// setting gives a usable value (the unit then uses its own default).
+  std::optional<double> body_length_m, body_width_m;
   int wheel_count = 0;
+
+  /// Recorded columns (signals.csv headers) of the expanded units that the
+  /// plots read: the robot's position and yaw, each wheel's contact point
+  /// (x, y), the deviation or drift, and each belt's speed and on state.
+  std::string x_column, y_column, yaw_column;
+  std::vector<std::pair<std::string, std::string>> wheel_columns;
+  std::string error_column;
+  std::vector<std::string> belt_speed_columns, belt_on_columns;
 };
 
 /// A robot scenario is written at the level of robot, line, control, task,

@@ -60,7 +60,11 @@ void ApplyParameter(cosim::Unit& unit, const cosim::VariableInfo& info, const YA
       } else if (const auto v = YamlReader::DecodeReal(node)) {
         value = *v;
       } else {
-        r.Error(node, path, "expected " + expected + " (" + info.unit + "), got " + Describe(node));
+        // A dimensionless value ("1") has no unit to name.
+        const bool has_unit = !info.unit.empty() && info.unit != "1";
+        r.Error(node, path,
+                "expected " + expected + (has_unit ? " (" + info.unit + ")" : "") + ", got " +
+                    Describe(node));
       }
       break;
     }
@@ -124,11 +128,11 @@ class Builder {
       r_.CheckKeys(master, "master", {"algorithm", "step_s", "threads"});
     }
     const YAML::Node master_map = master.IsMap() ? master : YAML::Node(YAML::NodeType::Map);
-    const std::string algorithm =
-        r_.String(master_map, "master", "algorithm", "gauss_seidel", {"jacobi", "gauss_seidel"});
-    options.algorithm =
-        algorithm == "jacobi" ? cosim::Algorithm::kJacobi : cosim::Algorithm::kGaussSeidel;
-    options.base_step = r_.Time(master_map, "master", "step_s", 0.001, {0.0, 10.0, true});
+    const std::string algorithm = r_.String(
+        master_map, "master", "algorithm",
+        std::string(cosim::ToString(cosim::Algorithm::kGaussSeidel)), cosim::AlgorithmNames());
+    cosim::ParseAlgorithm(algorithm, &options.algorithm);
+    options.base_step = ReadMasterStep(r_, master_map);
     options.threads = static_cast<int>(r_.Integer(master_map, "master", "threads", 1, 1, 256));
     if (options.base_step > 0 && options.stop > 0 && options.stop % options.base_step != 0) {
       r_.Error(Child(root, "duration_s"), "duration_s",
@@ -388,13 +392,21 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
   return s;
 }
 
+cosim::TimeNs ReadMasterStep(YamlReader& r, const YAML::Node& master) {
+  return r.Time(master, "master", "step_s", 0.001, {0.0, 10.0, true});
+}
+
 std::unique_ptr<cosim::Unit> CreateDefaultUnit(const std::string& type_name) {
   const UnitType* type = FindUnitType(type_name);
   if (!type) throw ScenarioError({{"", 0, "", UnknownTypeMessage(type_name)}});
+  return CreateDefaultUnit(*type);
+}
+
+std::unique_ptr<cosim::Unit> CreateDefaultUnit(const UnitType& type) {
   YamlReader reader("(defaults)");
   const YAML::Node none;
   const std::string path = "parameters";
-  auto unit = type->create({type_name, 1, reader, none, path});
+  auto unit = type.create({type.name, 1, reader, none, path});
   if (!reader.ok() || !unit) throw ScenarioError(reader.issues());
   return unit;
 }

@@ -46,9 +46,17 @@ struct Scenario {
 /// problem (file, line, key path, bad value, what was expected).
 Scenario LoadScenario(const std::string& file, const std::vector<std::string>& set_args = {});
 
+/// `master.step_s` of the map `master` as every loader reads it: within
+/// (0, 10] s, 1 ms when absent. A bad value is reported through `r` and
+/// reads as 1 ms.
+cosim::TimeNs ReadMasterStep(YamlReader& r, const YAML::Node& master);
+
 /// A unit of a registered type with default structural parameters, named
 /// after its type (for `linesim inspect TYPE`); throws ScenarioError with the
 /// closest type names when the type is unknown.
 std::unique_ptr<cosim::Unit> CreateDefaultUnit(const std::string& type);
+struct UnitType;
+/// The same for a type already looked up (FindUnitType).
+std::unique_ptr<cosim::Unit> CreateDefaultUnit(const UnitType& type);
 
 }  // namespace linesim::loader

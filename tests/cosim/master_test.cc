@@ -485,5 +485,20 @@ TEST(MasterFeedthrough, OutputsFollowInputsSetAtTheSameCommunicationPoint) {
   }
 }
 
+// Guards against: the algorithm names of scenarios and summaries drifting
+// apart, or a typo being read as an algorithm.
+TEST(ParseAlgorithm, NamesReadBackAndOthersAreRefused) {
+  EXPECT_EQ(AlgorithmNames(), (std::vector<std::string>{"jacobi", "gauss_seidel"}));
+  for (const Algorithm a : {Algorithm::kJacobi, Algorithm::kGaussSeidel}) {
+    Algorithm parsed = a == Algorithm::kJacobi ? Algorithm::kGaussSeidel : Algorithm::kJacobi;
+    EXPECT_TRUE(ParseAlgorithm(ToString(a), &parsed)) << ToString(a);
+    EXPECT_EQ(parsed, a);
+  }
+  Algorithm a = Algorithm::kJacobi;
+  EXPECT_FALSE(ParseAlgorithm("gauss-seidel", &a));
+  EXPECT_FALSE(ParseAlgorithm("Jacobi", &a));
+  EXPECT_EQ(a, Algorithm::kJacobi);
+}
+
 }  // namespace
 }  // namespace linesim::cosim

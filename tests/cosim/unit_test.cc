@@ -131,7 +131,8 @@ TEST(UnitState, RestoringAStateOfTheWrongSizeThrows) {
     EXPECT_THAT(e.what(), HasSubstr("state of " + std::to_string(truncated.variables.size()) +
                                     " variables restored into unit 'mass1'"));
   }
-  UnitState empty;
+  UnitState empty;  // of the right type, so that the size rule refuses it
+  empty.type_name = coupling.type_name();
   EXPECT_THROW(coupling.RestoreState(empty), std::invalid_argument);
   // Same variable count (8), other type: refused before anything is written.
   const UnitState before = mass1.SaveState();

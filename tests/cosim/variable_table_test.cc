@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -209,6 +211,22 @@ TEST(VariableTable, DependsOnMustNameAnEarlierInput) {
   EXPECT_THROW(t.Output("w", "1", &w, "depends on a later input", {"late"}), std::logic_error);
   t.Input("late", "1", &late, "declared after w was refused");
   EXPECT_EQ(t.size(), 4u);  // p, u, y, late: refused outputs were not added
+}
+
+// Guards against: the finite checks scanning parameters, locals or
+// non-real signals, or naming the wrong element of an array.
+TEST(VariableTable, FirstNonFiniteScansTheListedRealSignals) {
+  Holder h;
+  EXPECT_EQ(h.t.real_inputs(), (std::vector<ValueRef>{h.speed_ref, h.scan_ref}));
+  EXPECT_EQ(h.t.real_outputs(), (std::vector<ValueRef>{h.force_ref}));
+  EXPECT_EQ(FirstNonFinite(h.t, h.t.real_inputs()), std::nullopt);
+  h.gain = std::numeric_limits<double>::quiet_NaN();  // a parameter: not scanned
+  h.state = std::numeric_limits<double>::infinity();  // a local: not scanned
+  EXPECT_EQ(FirstNonFinite(h.t, h.t.real_inputs()), std::nullopt);
+  h.scan[2] = -std::numeric_limits<double>::infinity();
+  EXPECT_EQ(FirstNonFinite(h.t, h.t.real_inputs()), "input 'scan[2]' is -inf");
+  h.force = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(FirstNonFinite(h.t, h.t.real_outputs()), "output 'force' is nan");
 }
 
 // Guards against: unreadable values in messages (a list without brackets,

@@ -60,5 +60,29 @@ TEST(ApplyOverrides, HugeListIndexIsNotAnItem) {
       << issues[0].message;
 }
 
+// Guards against a list, map or quoted string with a typo being taken as a
+// plain string (and refused later with a confusing message): it is reported
+// at its key with the parser's message, and the tree is left alone. Plain
+// text that YAML refuses is still a string.
+TEST(ApplyOverrides, UnparsableStructuredValueIsAnIssue) {
+  YAML::Node root = YAML::Load("a: {b: 1}\n");
+  std::vector<Issue> issues;
+  ApplyOverrides(root,
+                 {ParseOverride("a.b=[1, 2"), ParseOverride("a.c= {x: 1"),
+                  ParseOverride("a.d=\"open"), ParseOverride("a.e=x: y: z")},
+                 "f.yaml", issues);
+  ASSERT_EQ(issues.size(), 3u);
+  EXPECT_EQ(issues[0].key_path, "a.b");
+  EXPECT_EQ(issues[0].message.rfind("value is not valid YAML: ", 0), 0u) << issues[0].message;
+  EXPECT_NE(issues[0].message.find("(in --set a.b=[1, 2)"), std::string::npos) << issues[0].message;
+  EXPECT_TRUE(issues[0].from_command_line);
+  EXPECT_FALSE(issues[0].unknown_path);
+  EXPECT_EQ(issues[1].key_path, "a.c");
+  EXPECT_EQ(issues[2].key_path, "a.d");
+  EXPECT_EQ(root["a"]["b"].as<int>(), 1);
+  EXPECT_FALSE(root["a"]["c"].IsDefined());
+  EXPECT_EQ(root["a"]["e"].as<std::string>(), "x: y: z");
+}
+
 }  // namespace
 }  // namespace linesim::loader

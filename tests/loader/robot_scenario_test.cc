@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -110,6 +111,68 @@ TEST(RobotScenario, WheelCountComesFromTheChassis) {
     EXPECT_EQ(to_motors, static_cast<std::size_t>(2 * wheels));
   }
   EXPECT_EQ(LoadScenario(kCross).robot->wheel_count, 4);
+}
+
+// Guards the plots' view of a robot run: every column they read is one the
+// expansion records, one wheel per chassis wheel and one belt per belt, and
+// the body they draw is the chassis's, so setting the chassis resizes it.
+TEST(RobotScenario, PlotColumnsAndBodyComeFromTheExpansion) {
+  const Scenario s = LoadScenario(kCross);
+  ASSERT_TRUE(s.robot);
+  const RobotInfo& info = *s.robot;
+  std::vector<std::string> read = {info.x_column, info.y_column, info.yaw_column,
+                                   info.error_column};
+  for (const auto& [x, y] : info.wheel_columns) read.insert(read.end(), {x, y});
+  read.insert(read.end(), info.belt_speed_columns.begin(), info.belt_speed_columns.end());
+  read.insert(read.end(), info.belt_on_columns.begin(), info.belt_on_columns.end());
+  std::vector<std::string> recorded;
+  for (const auto& p : s.recorded) recorded.push_back(p.label);
+  for (const auto& column : read) {
+    EXPECT_NE(std::find(recorded.begin(), recorded.end(), column), recorded.end()) << column;
+  }
+  EXPECT_EQ(info.x_column, "chassis.pose[0]");
+  EXPECT_EQ(info.wheel_columns.size(), static_cast<std::size_t>(info.wheel_count));
+  ASSERT_FALSE(info.belts.empty());
+  EXPECT_EQ(info.belt_speed_columns.size(), info.belts.size());
+  EXPECT_EQ(info.belt_on_columns.size(), info.belts.size());
+  // models/chassis/raw3_chassis.yaml
+  EXPECT_EQ(info.body_length_m, 1.03);
+  EXPECT_EQ(info.body_width_m, 0.57);
+  const Scenario longer =
+      LoadScenario(kCross, {"units={chassis: {parameters: {body_length: 1.5}}}"});
+  EXPECT_EQ(longer.robot->body_length_m, 1.5);
+  EXPECT_EQ(Param(longer, "chassis", "body_length"), 1.5);
+  EXPECT_EQ(longer.robot->body_width_m, 0.57);
+}
+
+// Guards the default recording interval: the first whole number of master
+// steps from 10 ms on, exact in decimal (no 0.010199999999999999 for a
+// 0.3 ms step), and 10 ms for a missing or bad step (reported elsewhere).
+TEST(RobotScenario, RecordingIntervalIsAWholeNumberOfMasterSteps) {
+  std::ifstream in(kCross);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const auto& [step, interval] :
+       std::vector<std::pair<std::string, std::string>>{{"0.001", "0.01"},
+                                                        {"0.003", "0.012"},
+                                                        {"0.0003", "0.0102"},
+                                                        {"0.01", "0.01"},
+                                                        {"0.02", "0.02"},
+                                                        {"1e-9", "0.01"},
+                                                        {"0", "0.01"},
+                                                        {"11", "0.01"},
+                                                        {"x", "0.01"}}) {
+    YAML::Node root = YAML::Load(text);
+    root["master"]["step_s"] = step;
+    YamlReader reader("robot.yaml");
+    RobotInfo info;
+    const YAML::Node expanded = ExpandRobotScenario(root, reader, info);
+    EXPECT_EQ(expanded["recording"]["interval_s"].Scalar(), interval) << step;
+  }
+  YAML::Node root = YAML::Load(text);
+  root.remove("master");
+  YamlReader reader("robot.yaml");
+  RobotInfo info;
+  EXPECT_EQ(ExpandRobotScenario(root, reader, info)["recording"]["interval_s"].Scalar(), "0.01");
 }
 
 // Guards `linesim inspect`'s promise that the expansion is a system-level

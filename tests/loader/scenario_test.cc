@@ -182,6 +182,26 @@ units:
       << all;
 }
 
+// Guards the unit named in a refused array value: a dimensionless one ("1")
+// is not shown as "(1)"; one with a unit still shows it.
+TEST(LoadScenario, DimensionlessArrayParameterNamesNoUnit) {
+  const std::string f = WriteScenario("dimensionless.yaml", R"(duration_s: 0.01
+units:
+  motor:
+    type: dc_motor
+    parameters: {count: 2, gear_ratio: fast, resistance: slow}
+)");
+  const std::string all = Issues(f);
+  EXPECT_TRUE(Has(all,
+                  "units.motor.parameters.gear_ratio: expected a number (for every element) or a "
+                  "list of 2 numbers, got 'fast'"))
+      << all;
+  EXPECT_TRUE(Has(all,
+                  "units.motor.parameters.resistance: expected a number (for every element) or a "
+                  "list of 2 numbers (Ohm), got 'slow'"))
+      << all;
+}
+
 // Guards parameters against NaN: it is no number, for a Real parameter
 // (the standard message), for a whole array and for one element of it.
 TEST(LoadScenario, NanParameterIsRefused) {
