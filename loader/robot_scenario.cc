@@ -148,6 +148,12 @@ class Expander {
         LoadModel(r_, Child(robot, "model"), "robot.model", "robot model", model, "robots",
                   r_.file(), &robot_file_);
     if (!robot_model.IsDefined()) return;
+    {
+      // A misspelled key in the model file would otherwise go unread.
+      YamlReader::InFile in_model(r_, robot_file_);
+      r_.CheckKeys(robot_model, "",
+                   {"description", "source", "steer_motor_model", "drive_motor_model", "units"});
+    }
     const YAML::Node units = Child(robot_model, "units");
 
     // The chassis as it will be built: the file's own units.chassis, the

@@ -332,6 +332,17 @@ TEST(RobotScenario, UnknownRobotModelNamesTheKnownOnes) {
   EXPECT_TRUE(Has(f, "it is not a file (a folder?)")) << f;
 }
 
+// Guards against a misspelled key in a robot model file going unread: it is
+// reported in that file, at its line.
+TEST(RobotScenario, UnknownKeyInTheRobotModelFileIsNamedThere) {
+  std::ifstream in(LINESIM_SOURCE_DIR "/models/robots/raw3.yaml");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string model = WriteScenario("raw3_typo.yaml", text + "steer_motor_modell: x\n");
+  const std::string e = Issues(kCross, {"robot.model=" + model});
+  EXPECT_TRUE(Has(e, model + ":")) << e;
+  EXPECT_TRUE(Has(e, "steer_motor_modell: unknown key; closest: steer_motor_model")) << e;
+}
+
 // Guards the pass-through: `units.NAME.parameters` in a robot scenario
 // overrides the expansion (so every unit parameter is sweepable), and an
 // unknown parameter there is reported at that path.
