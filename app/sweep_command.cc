@@ -55,7 +55,8 @@ std::optional<sweep::ResultsFile> PrepareFolder(const sweep::SweepSpec& spec, co
                                                 bool force) {
   const fs::path results = dir / "results.csv";
   const fs::path identity = dir / "sweep.json";
-  const bool exists = fs::exists(results);
+  std::error_code ec;  // a bad name is reported when the folder is made
+  const bool exists = fs::exists(results, ec);
   if (exists && !resume && !force) {
     std::cerr << "linesim: " << results.string()
               << " exists: --resume continues that sweep, --force starts it afresh, or choose "
@@ -78,7 +79,7 @@ std::optional<sweep::ResultsFile> PrepareFolder(const sweep::SweepSpec& spec, co
     if (exists && resume) return sweep::ResultsFile::Resume(results.string(), spec);
     // The old identity goes first: a folder is never left saying it holds
     // this sweep while it holds another's rows.
-    fs::remove(identity);
+    fs::remove(identity, ec);
     sweep::ResultsFile created = sweep::ResultsFile::Create(results.string(), spec);
     sweep::WriteSweepIdentity(identity.string(), spec, fingerprint);
     return created;

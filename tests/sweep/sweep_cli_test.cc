@@ -333,6 +333,11 @@ TEST(SweepCli, BadInputExitsTwoAndWritesNothing) {
   EXPECT_FALSE(fs::exists(dir));
 
   EXPECT_EQ(Sweep(Temp("absent.yaml"), dir).status, 2);
+  // A folder name the system refuses (over NAME_MAX, 255 bytes on Linux).
+  const Result long_name = Sweep(SmallSweep("long.yaml"), Temp(std::string(300, 'a')));
+  EXPECT_EQ(long_name.status, 2);
+  EXPECT_NE(long_name.err.find("cannot create the output folder"), std::string::npos)
+      << long_name.err;
   EXPECT_EQ(Sweep(SmallSweep("jobs.yaml"), dir, {"--jobs", "0"}).status, 2);
   EXPECT_FALSE(fs::exists(dir));
 
