@@ -213,7 +213,8 @@ class Builder {
     const std::size_t issues_before = r_.issues().size();
     std::unique_ptr<cosim::Unit> unit;
     try {
-      unit = type->create({name, cosim::DeriveSeed(s_.seed, name), r_, params, params_path});
+      unit = type->create(
+          {name, cosim::DeriveSeed(s_.seed, name), r_, params, params_path, s_.scene});
     } catch (const std::exception& e) {
       r_.Error(spec, path, std::string("cannot create the unit: ") + e.what());
       return;
@@ -406,7 +407,8 @@ std::unique_ptr<cosim::Unit> CreateDefaultUnit(const UnitType& type) {
   YamlReader reader("(defaults)");
   const YAML::Node none;
   const std::string path = "parameters";
-  auto unit = type.create({type.name, 1, reader, none, path});
+  const models::Scene no_scene;
+  auto unit = type.create({type.name, 1, reader, none, path, no_scene});
   if (!reader.ok() || !unit) throw ScenarioError(reader.issues());
   return unit;
 }

@@ -14,6 +14,7 @@
 #include "loader/overrides.h"
 #include "loader/robot_scenario.h"
 #include "loader/scenario_error.h"
+#include "models/scene.h"
 
 namespace linesim::loader {
 
@@ -27,6 +28,9 @@ struct Scenario {
   std::uint64_t seed = 1;
   double duration_s = 0;
   std::vector<Override> overrides;
+  /// The scene every unit that needs geometry builds from (`scene:`);
+  /// empty when the scenario names none.
+  models::Scene scene;
 
   std::unique_ptr<cosim::System> system;  // declared before master: outlives it
   std::unique_ptr<cosim::Master> master;

@@ -11,6 +11,7 @@
 
 #include "cosim/unit.h"
 #include "loader/yaml_reader.h"
+#include "models/scene.h"
 
 namespace linesim::loader {
 
@@ -24,6 +25,9 @@ struct UnitBuildContext {
   YamlReader& reader;
   const YAML::Node& parameters;  // may be undefined
   const std::string& path;       // "units.NAME.parameters"
+  /// The scenario's scene (models/scene.h), read once by the loader; an
+  /// empty scene when the scenario names none.
+  const models::Scene& scene;
 };
 
 struct UnitType {

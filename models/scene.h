@@ -1,0 +1,137 @@
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+/// The typed description of a scene (models/scenes/*.yaml): the floor and
+/// its surfaces, the belts of the line, static obstacles, objects the belts
+/// carry, and 3D terrain pieces. Read once by the loader (loader/scene_file.h)
+/// and handed to every unit that needs geometry (chassis, belt, sensors,
+/// plots), which builds its own structures from it. All in the map frame
+/// (x, y on the floor, z up), SI units.
+namespace linesim::models {
+
+/// A floor covering. The optical numbers are what an optic-flow sensor
+/// looking down at it sees.
+struct Surface {
+  std::string name;
+  /// Coulomb coefficient of a robot wheel's tread on it (dimensionless).
+  double friction = 0.0;
+  /// Texture contrast (dimensionless, 0..1): the standard deviation of the
+  /// surface's reflectance over its mean, at the scale of a few millimetres
+  /// that a downward camera 0.1-0.2 m above it resolves. 0 is a featureless
+  /// surface (no flow can be measured); 0.3 a strongly textured one.
+  double texture_contrast = 0.0;
+  /// Ambient illumination on the surface (lux), before any light the robot
+  /// adds. Factory halls are lit at 300-750 lx (EN 12464-1 gives 300 lx
+  /// for rough assembly, 500 lx for medium work).
+  double illumination_lux = 0.0;
+};
+
+/// A rectangle on the floor: centre, size, and the direction of its length
+/// axis (counter-clockwise from map x).
+struct Rect {
+  double center_x_m = 0.0;
+  double center_y_m = 0.0;
+  double length_m = 0.0;  // along direction_rad
+  double width_m = 0.0;   // across it
+  double direction_rad = 0.0;
+};
+
+/// A switch of a belt's drive at a time.
+struct BeltSwitch {
+  std::int64_t time_ns = 0;
+  bool on = false;
+};
+
+/// A conveyor belt of the line: a moving patch of the floor, flush with it.
+struct Belt {
+  std::string name;
+  Rect area;
+  /// Index into Scene::surfaces of its top (its friction and optics).
+  int surface = 0;
+  double nominal_speed_mps = 0.0;
+  /// Relative amplitude of the slow speed variation (0.1: +-10 %).
+  double speed_variation = 0.0;
+  double variation_period_s = 1.0;
+  /// Acceleration when it starts or stops.
+  double acceleration_mps2 = 1.0;
+  bool initially_on = true;
+  /// Later switches, in increasing time, all after time zero.
+  std::vector<BeltSwitch> schedule;
+};
+
+/// A solid shape standing on something: a box or a vertical cylinder.
+struct Solid {
+  enum class Kind { kBox, kCylinder };
+  Kind kind = Kind::kBox;
+  /// Centre of the footprint in map, and its heading (boxes).
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double yaw_rad = 0.0;
+  /// Box: size along its heading and across it. Cylinder: radius.
+  double length_m = 0.0;
+  double width_m = 0.0;
+  double radius_m = 0.0;
+  /// Bottom and top above the floor (a car body on skids starts above it).
+  double bottom_m = 0.0;
+  double height_m = 0.0;  // top = bottom + height
+};
+
+/// A static obstacle: a wall, a pillar, a part cart, a rack.
+struct Obstacle {
+  std::string name;
+  std::string kind;  // wall, pillar, cart, rack: for plots and reports
+  Solid solid;
+};
+
+/// An object a belt carries (a car body): at time zero where `solid` says;
+/// later moved along the belt's direction by the belt's travelled distance.
+struct CarriedObject {
+  std::string name;
+  int belt = 0;  // index into Scene::belts
+  Solid solid;
+};
+
+/// A rigid 3D terrain piece: a box placed and tilted (a ramp, a raised
+/// floor). Its top face is what a wheel drives on.
+struct TerrainPiece {
+  std::string name;
+  double center_x_m = 0.0, center_y_m = 0.0, center_z_m = 0.0;
+  double length_m = 0.0, width_m = 0.0, thickness_m = 0.0;
+  /// Heading of its length axis, then the tilt about its own width axis
+  /// (+ raises the far end) and about its length axis.
+  double yaw_rad = 0.0, pitch_rad = 0.0, roll_rad = 0.0;
+  int surface = 0;  // index into Scene::surfaces
+};
+
+/// The hall: the floor's extent and its covering.
+struct Floor {
+  double min_x_m = 0.0, max_x_m = 0.0, min_y_m = 0.0, max_y_m = 0.0;
+  int surface = 0;  // index into Scene::surfaces
+};
+
+struct Scene {
+  std::string name;
+  std::string description;
+  /// The file it was read from (for messages); empty for a scene built in code.
+  std::string file;
+  std::vector<Surface> surfaces;
+  Floor floor;
+  std::vector<Belt> belts;
+  std::vector<Obstacle> obstacles;
+  std::vector<CarriedObject> carried;
+  std::vector<TerrainPiece> terrain;
+
+  /// Index of the surface called `name`, if any.
+  std::optional<int> FindSurface(const std::string& name) const {
+    for (std::size_t i = 0; i < surfaces.size(); ++i) {
+      if (surfaces[i].name == name) return static_cast<int>(i);
+    }
+    return std::nullopt;
+  }
+};
+
+}  // namespace linesim::models
