@@ -407,8 +407,8 @@ std::unique_ptr<cosim::Unit> CreateDefaultUnit(const UnitType& type) {
   YamlReader reader("(defaults)");
   const YAML::Node none;
   const std::string path = "parameters";
-  const models::Scene no_scene;
-  auto unit = type.create({type.name, 1, reader, none, path, no_scene});
+  const models::Scene open_floor = models::OpenFloor();
+  auto unit = type.create({type.name, 1, reader, none, path, open_floor});
   if (!reader.ok() || !unit) throw ScenarioError(reader.issues());
   return unit;
 }

@@ -29,8 +29,8 @@ struct Scenario {
   double duration_s = 0;
   std::vector<Override> overrides;
   /// The scene every unit that needs geometry builds from (`scene:`);
-  /// empty when the scenario names none.
-  models::Scene scene;
+  /// models::OpenFloor() when the scenario names none.
+  models::Scene scene = models::OpenFloor();
 
   std::unique_ptr<cosim::System> system;  // declared before master: outlives it
   std::unique_ptr<cosim::Master> master;

@@ -25,8 +25,8 @@ struct UnitBuildContext {
   YamlReader& reader;
   const YAML::Node& parameters;  // may be undefined
   const std::string& path;       // "units.NAME.parameters"
-  /// The scenario's scene (models/scene.h), read once by the loader; an
-  /// empty scene when the scenario names none.
+  /// The scenario's scene (models/scene.h), read once by the loader;
+  /// models::OpenFloor() when the scenario names none.
   const models::Scene& scene;
 };
 

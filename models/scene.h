@@ -134,4 +134,18 @@ struct Scene {
   }
 };
 
+/// The scene of a scenario that names none: an unbounded floor of one
+/// surface, sealed concrete under a polyurethane tread (friction 0.8, the
+/// middle of the 0.6-0.9 usual for such a pair), moderately textured, in a
+/// hall lit at 500 lx (EN 12464-1, medium assembly work). No belts, no
+/// obstacles.
+inline Scene OpenFloor() {
+  Scene s;
+  s.name = "open_floor";
+  s.description = "an unbounded concrete floor";
+  s.surfaces.push_back({"concrete", 0.8, 0.2, 500.0});
+  s.floor = {-1e6, 1e6, -1e6, 1e6, 0};
+  return s;
+}
+
 }  // namespace linesim::models
