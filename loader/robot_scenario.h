@@ -12,39 +12,37 @@
 
 namespace linesim::loader {
 
-/// What a robot scenario adds to a run beyond its system: the geometry the
-/// plots draw and the columns they read.
+/// What a robot scenario adds to a run beyond its system: what the plots
+/// draw besides the scene, and the columns they read.
 struct RobotInfo {
-  struct Belt {
-    double center_x_m, center_y_m, length_m, width_m, direction_rad;
-  };
   std::string task;                         // "path" or "hold"
   std::vector<std::array<double, 2>> path;  // desired path; one point for a hold
-  std::vector<Belt> belts;
-  /// The chassis body as the chassis unit gets it; nothing when no file or
-  /// setting gives a usable value (the unit then uses its own default).
+  /// The chassis body as the chassis unit gets it; nothing when the value
+  /// there is not a positive number (the chassis unit reports it).
   std::optional<double> body_length_m, body_width_m;
   int wheel_count = 0;
 
   /// Recorded columns (signals.csv headers) of the expanded units that the
   /// plots read: the robot's position and yaw, each wheel's contact point
-  /// (x, y), the deviation or drift, and each belt's speed and on state.
+  /// (x, y), the deviation or drift, and each belt's speed, on state and
+  /// travel (which moves the objects it carries).
   std::string x_column, y_column, yaw_column;
   std::vector<std::pair<std::string, std::string>> wheel_columns;
   std::string error_column;
-  std::vector<std::string> belt_speed_columns, belt_on_columns;
+  std::vector<std::string> belt_speed_columns, belt_on_columns, belt_travel_columns;
 };
 
-/// A robot scenario is written at the level of robot, line, control, task,
-/// sensing and localization (see README "Scenario files"); it is recognised
-/// by its top-level `robot` key.
+/// A robot scenario is written at the level of robot, scene, line, control,
+/// task, sensing and localization (see README "Scenario files"); it is
+/// recognised by its top-level `robot` key.
 bool IsRobotScenario(const YAML::Node& root);
 
-/// Expands a robot scenario into a system-level tree (units, connections,
-/// recording, metrics) that the system loader builds. Problems are reported
-/// through `reader` at the robot-level key paths; `info` receives the plot
-/// geometry. A robot.model given as a path is relative to the folder of
-/// `reader`'s file, the scenario.
+/// Expands a robot scenario into a system-level tree (scene, units,
+/// connections, recording, metrics) that the system loader builds, one
+/// concern after another (loader/assembly/concerns.h). Problems are
+/// reported through `reader` at the robot-level key paths; `info` receives
+/// what the plots need. A robot.model given as a path is relative to the
+/// folder of `reader`'s file, the scenario.
 YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& reader, RobotInfo& info);
 
 }  // namespace linesim::loader

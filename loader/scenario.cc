@@ -407,8 +407,19 @@ std::unique_ptr<cosim::Unit> CreateDefaultUnit(const UnitType& type) {
   YamlReader reader("(defaults)");
   const YAML::Node none;
   const std::string path = "parameters";
-  const models::Scene open_floor = models::OpenFloor();
-  auto unit = type.create({type.name, 1, reader, none, path, open_floor});
+  // Units that take geometry from the scene show their variables for an
+  // open floor with one belt: 10 m x 2 m along x at paper 1's typical
+  // 0.1 m/s, +-10 %.
+  models::Scene scene = models::OpenFloor();
+  models::Belt belt;
+  belt.name = "line";
+  belt.area = {0.0, 0.0, 10.0, 2.0, 0.0};
+  belt.nominal_speed_mps = 0.1;
+  belt.speed_variation = 0.1;
+  belt.variation_period_s = 20.0;
+  belt.acceleration_mps2 = 0.5;
+  scene.belts.push_back(belt);
+  auto unit = type.create({type.name, 1, reader, none, path, scene});
   if (!reader.ok() || !unit) throw ScenarioError(reader.issues());
   return unit;
 }

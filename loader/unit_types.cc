@@ -116,34 +116,13 @@ std::unique_ptr<cosim::Unit> MakePathDeviation(const UnitBuildContext& c) {
 }
 
 std::unique_ptr<cosim::Unit> MakeBelt(const UnitBuildContext& c) {
-  YamlReader& r = c.reader;
-  const auto count = r.Integer(c.parameters, c.path, "count", 1, 1, 64);
-  std::vector<std::vector<belt::BeltUnit::Switch>> schedules;
-  const YAML::Node list = Child(c.parameters, "schedules");
-  const std::string list_path = JoinPath(c.path, "schedules");
-  if (list.IsDefined() && !list.IsNull() && r.ExpectSequence(list, list_path)) {
-    if (list.size() != static_cast<std::size_t>(count)) {
-      r.Error(list, list_path,
-              "expected one schedule per belt (" + std::to_string(count) + "), got " +
-                  std::to_string(list.size()));
-      return nullptr;
-    }
-    for (std::size_t b = 0; b < list.size(); ++b) {
-      const std::string belt_path = JoinPath(list_path, std::to_string(b));
-      schedules.emplace_back();
-      if (list[b].IsNull() || !r.ExpectSequence(list[b], belt_path)) continue;
-      for (std::size_t i = 0; i < list[b].size(); ++i) {
-        const YAML::Node item = list[b][i];
-        const std::string item_path = JoinPath(belt_path, std::to_string(i));
-        if (!r.ExpectMap(item, item_path)) continue;
-        r.CheckKeys(item, item_path, {"time_s", "on"});
-        const cosim::TimeNs t = r.Time(item, item_path, "time_s", std::nullopt, {0.0, 1e7});
-        schedules.back().push_back({t, r.Boolean(item, item_path, "on", std::nullopt)});
-      }
-    }
+  if (c.scene.belts.empty()) {
+    c.reader.Error(c.parameters, c.path,
+                   "the scene has no belts: a belt unit drives the belts of the scenario's scene "
+                   "(scene.belts)");
+    return nullptr;
   }
-  return std::make_unique<belt::BeltUnit>(c.name, static_cast<int>(count), std::move(schedules),
-                                          c.seed);
+  return std::make_unique<belt::BeltUnit>(c.name, c.scene.belts, c.seed);
 }
 
 }  // namespace
@@ -168,11 +147,10 @@ const std::vector<UnitType>& UnitTypes() {
          "list of {time_s, value}: value (one number, or one per channel) from time_s on"}},
        MakeStepSignal},
       {belt::BeltUnit::kTypeName,
-       "assembly-line belts: on/off schedule, finite acceleration, seeded +-variation of speed",
+       "the belts of the scene (scene.belts): on/off schedule, finite acceleration, seeded "
+       "+-variation of speed, travelled distance",
        "",
-       {{"count", "number of belts (default 1)"},
-        {"schedules",
-         "one list per belt of {time_s, on}: switching times of the line (default: none)"}},
+       {},
        MakeBelt},
       {chassis::ChassisUnit::kTypeName,
        "robot body, steer+drive modules and wheel/floor/belt contact in ODE: each wheel "

@@ -58,6 +58,7 @@ BeltUnit::BeltUnit(std::string name, int belt_count, std::vector<std::vector<Swi
   velocity_.assign(2 * n, 0.0);
   belt_speed_.assign(n, 0.0);
   on_.assign(n, 0.0);
+  travel_.assign(n, 0.0);
 
   auto& v = variables();
   v.Parameter("direction", "rad", &direction_,
@@ -77,6 +78,35 @@ BeltUnit::BeltUnit(std::string name, int belt_count, std::vector<std::vector<Swi
            "surface velocity in the map frame: vx, vy of belt 0, then of belt 1, ...", {});
   v.Output("speed", "m/s", &belt_speed_, "surface speed along the direction of motion", {});
   v.Output("on", "1", &on_, "scheduled state: 1 on, 0 off (the speed ramps after a switch)", {});
+  v.Output("travel", "m", &travel_,
+           "distance the belt's surface has moved along its direction since the start (what "
+           "carries the objects on it)",
+           {});
+}
+
+namespace {
+
+std::vector<std::vector<BeltUnit::Switch>> Schedules(const std::vector<models::Belt>& belts) {
+  std::vector<std::vector<BeltUnit::Switch>> schedules;
+  for (const models::Belt& b : belts) {
+    schedules.emplace_back();
+    for (const models::BeltSwitch& s : b.schedule) schedules.back().push_back({s.time_ns, s.on});
+  }
+  return schedules;
+}
+
+}  // namespace
+
+BeltUnit::BeltUnit(std::string name, const std::vector<models::Belt>& belts, std::uint64_t seed)
+    : BeltUnit(std::move(name), static_cast<int>(belts.size()), Schedules(belts), seed) {
+  for (std::size_t b = 0; b < belts.size(); ++b) {
+    direction_[b] = belts[b].area.direction_rad;
+    nominal_speed_[b] = belts[b].nominal_speed_mps;
+    initially_on_[b] = belts[b].initially_on ? 1.0 : 0.0;
+    speed_variation_[b] = belts[b].speed_variation;
+    variation_period_[b] = belts[b].variation_period_s;
+    acceleration_[b] = belts[b].acceleration_mps2;
+  }
 }
 
 std::vector<cosim::ParameterProblem> BeltUnit::CheckParameters() const {
@@ -154,6 +184,7 @@ void BeltUnit::Initialize() {
   CacheDirections();
   for (std::size_t b = 0; b < nominal_speed_.size(); ++b) {
     belt_speed_[b] = TargetSpeed(b, ScheduledOn(static_cast<int>(b), start_), start_);
+    travel_[b] = 0.0;
   }
   ComputeOutputs(start_);
 }
@@ -166,12 +197,18 @@ cosim::StepResult BeltUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     // exactly at its switching time whatever the step size. Within a
     // sub-step the scheduled state is the one at its start and the target
     // is taken at its end.
+    // The travel takes the speed as linear over each sub-step (the
+    // trapezoid of its ends), as the slew limit makes it while ramping.
     double s = belt_speed_[b];
+    double travel = travel_[b];
     const auto slew = [&](cosim::TimeNs from, cosim::TimeNs to) {
       const bool on = ScheduledOn(static_cast<int>(b), from);
       const double target = TargetSpeed(b, on, to);
-      const double max_change = acceleration_[b] * cosim::NsToSeconds(to - from);
+      const double h_s = cosim::NsToSeconds(to - from);
+      const double max_change = acceleration_[b] * h_s;
+      const double before = s;
       s += std::clamp(target - s, -max_change, max_change);
+      travel += 0.5 * (before + s) * h_s;
     };
     cosim::TimeNs from = t;
     for (const Switch& sw : schedules_[b]) {
@@ -182,6 +219,7 @@ cosim::StepResult BeltUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     }
     slew(from, t_end);
     belt_speed_[b] = s;
+    travel_[b] = travel;
   }
   ComputeOutputs(t_end);
   return cosim::StepResult::kOk;

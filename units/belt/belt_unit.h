@@ -6,6 +6,7 @@
 
 #include "cosim/time.h"
 #include "cosim/unit.h"
+#include "models/scene.h"
 
 namespace linesim::belt {
 
@@ -46,6 +47,10 @@ class BeltUnit : public cosim::Unit {
   /// another size.
   BeltUnit(std::string name, int belt_count, std::vector<std::vector<Switch>> schedules,
            std::uint64_t seed);
+  /// The belts of a scene: one per scene belt, its parameters starting at
+  /// the scene's values (still settable as parameters) and its schedule the
+  /// scene's. Throws cosim::UnitError if `belts` is empty.
+  BeltUnit(std::string name, const std::vector<models::Belt>& belts, std::uint64_t seed);
 
   /// Every parameter value out of range, with the belt index; a schedule
   /// whose times do not increase is reported as variable "schedules.<belt>"
@@ -89,7 +94,7 @@ class BeltUnit : public cosim::Unit {
   std::vector<double> direction_x_, direction_y_;
 
   // Outputs.
-  std::vector<double> velocity_, belt_speed_, on_;
+  std::vector<double> velocity_, belt_speed_, on_, travel_;
 
   cosim::TimeNs start_ = 0;
 };

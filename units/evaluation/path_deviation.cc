@@ -15,7 +15,7 @@ PathDistance DistanceToPath(const std::vector<std::array<double, 2>>& path,
   if (path.size() == 1) return {std::hypot(x_m - path[0][0], y_m - path[0][1]), 0.0};
   const models::PolylinePoint p =
       models::NearestOnPolyline(path, cumulative_m, x_m, y_m, models::PolylineEnds::kClamp);
-  // No distance compares (a NaN pose): infinitely far.
+  // No distance compares (a NaN position): infinitely far.
   if (!p.found) return {std::numeric_limits<double>::infinity(), 0.0};
   return {p.distance_m, p.progress_m};
 }
@@ -30,10 +30,10 @@ PathDeviationUnit::PathDeviationUnit(std::string name, std::vector<std::array<do
       path_(std::move(path)),
       cumulative_m_(models::CumulativeLengths(path_)) {
   auto& v = variables();
-  v.Input("pose", "m", &pose_, "true pose x, y (m), yaw (rad) in the map frame");
+  v.Input("position", "m", &position_, "true position x, y of base_link in the map frame");
   v.Output("deviation", "m", &deviation_,
-           "distance of the robot centre from the desired path or held point", {"pose"});
-  v.Output("progress", "m", &progress_, "arc length of the nearest point along the path", {"pose"});
+           "distance of the robot centre from the desired path or held point", {"position"});
+  v.Output("progress", "m", &progress_, "arc length of the nearest point along the path", {"position"});
 }
 
 std::vector<cosim::ParameterProblem> PathDeviationUnit::CheckParameters() const {
@@ -50,7 +50,7 @@ std::vector<cosim::ParameterProblem> PathDeviationUnit::CheckParameters() const 
 }
 
 void PathDeviationUnit::Evaluate() {
-  const PathDistance d = DistanceToPath(path_, cumulative_m_, pose_[0], pose_[1]);
+  const PathDistance d = DistanceToPath(path_, cumulative_m_, position_[0], position_[1]);
   deviation_ = d.distance_m;
   progress_ = d.progress_m;
 }

@@ -23,7 +23,7 @@ PathDistance DistanceToPath(const std::vector<std::array<double, 2>>& path, doub
 
 /// Ground-truth evaluation of a robot task: how far the robot's centre is
 /// from the desired path (a crossing) or from the held point (a position
-/// hold). It reads the true pose, never an estimate, so that the scenario's
+/// hold). It reads the true position, never an estimate, so that the scenario's
 /// metrics judge the controller and the estimators together.
 class PathDeviationUnit : public cosim::Unit {
  public:
@@ -37,7 +37,7 @@ class PathDeviationUnit : public cosim::Unit {
     ThrowIfBadParameters();
     Evaluate();
   }
-  /// The deviation follows the pose at each communication point; the step
+  /// The deviation follows the position at each communication point; the step
   /// itself has nothing to advance.
   void UpdateOutputs() override { Evaluate(); }
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
@@ -47,7 +47,7 @@ class PathDeviationUnit : public cosim::Unit {
 
   std::vector<std::array<double, 2>> path_;
   std::vector<double> cumulative_m_;  // path length at each point, once
-  std::vector<double> pose_ = std::vector<double>(3, 0.0);
+  std::vector<double> position_ = std::vector<double>(2, 0.0);
   double deviation_ = 0.0;
   double progress_ = 0.0;
 };

@@ -100,6 +100,34 @@ TEST(BeltUnit, StartsAndStopsRampAtTheGivenAcceleration) {
   }
 }
 
+// Guards the belt built from a scene (its parameters and schedule are the
+// scene's) and the travelled distance that carries objects on the line.
+// Analytic: switched on at T = 1.003 s at a = 0.5 m/s^2 to v = 0.1 m/s, the
+// belt travels v^2 / (2 a) = 0.01 m while ramping and v (t - T - v / a)
+// after, 0.2897 m at t = 4 s. The travel takes the speed as linear over each
+// 10 ms step; the ramp ends inside one, which costs at most
+// (v / 2) x 10 ms x (1 - 0.3) x 0.015 = 5.3e-6 m of area there.
+TEST(BeltUnit, SceneBeltTravelsTheIntegralOfItsSpeed) {
+  models::Belt belt;
+  belt.area = {0.0, 0.0, 20.0, 2.0, 0.5};
+  belt.nominal_speed_mps = 0.1;
+  belt.speed_variation = 0.0;
+  belt.variation_period_s = 20.0;
+  belt.acceleration_mps2 = 0.5;
+  belt.initially_on = false;
+  belt.schedule = {{1003 * kMs, true}};
+  BeltUnit u("belt", std::vector<models::Belt>{belt}, 1);
+  EXPECT_EQ(Get(u, "nominal_speed")[0], 0.1);
+  EXPECT_EQ(Get(u, "direction")[0], 0.5);
+  EXPECT_EQ(Get(u, "initially_on")[0], 0.0);
+  Start(u);
+  EXPECT_EQ(Get(u, "travel")[0], 0.0);
+  const TimeNs dt = 10 * kMs;
+  for (TimeNs t = 0; t < 4 * kS; t += dt) ASSERT_EQ(u.DoStep(t, dt), cosim::StepResult::kOk);
+  EXPECT_NEAR(Get(u, "travel")[0], 0.01 + 0.1 * (4.0 - 1.003 - 0.2), 1e-5);
+  EXPECT_THROW(BeltUnit("belt", std::vector<models::Belt>{}, 1), cosim::UnitError);
+}
+
 // Guards against the on output or the speed ignoring the schedule, against
 // belts sharing one schedule, and against an off-by-one at a switching time
 // (a switch at time T is in force from T on). With variation 0 a belt that

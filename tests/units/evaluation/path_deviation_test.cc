@@ -33,16 +33,16 @@ TEST(DistanceToPath, SinglePointIsAHoldTarget) {
   EXPECT_DOUBLE_EQ(DistanceToPath({{1, 1}}, 4, 5).distance_m, 5.0);
 }
 
-// Guards the unit wiring: the deviation follows the pose input at once
+// Guards the unit wiring: the deviation follows the position input at once
 // (feedthrough) and after a step.
 TEST(PathDeviationUnit, OutputsFollowThePose) {
   PathDeviationUnit u("monitor", {{0, -2}, {0, 2}});
   ASSERT_TRUE(u.CheckParameters().empty());
   auto& v = u.variables();
-  v.SetRealArray(*v.Find("pose"), std::vector<double>{0.1, 0.0, 0.3});
+  v.SetRealArray(*v.Find("position"), std::vector<double>{0.1, 0.0});
   u.Initialize();
   EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("deviation")), 0.1);
-  v.SetRealArray(*v.Find("pose"), std::vector<double>{-0.04, 1.0, 0.0});
+  v.SetRealArray(*v.Find("position"), std::vector<double>{-0.04, 1.0});
   u.UpdateOutputs();
   EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("deviation")), 0.04);
   EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("progress")), 3.0);

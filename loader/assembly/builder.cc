@@ -1,0 +1,89 @@
+#include "loader/assembly/builder.h"
+
+#include "cosim/variable_table.h"
+#include "loader/scenario.h"
+
+namespace linesim::loader::assembly {
+
+std::string Signal(const std::string& unit, const std::string& variable) {
+  return unit + "." + variable;
+}
+
+std::string Element(const std::string& unit, const std::string& variable, std::size_t k) {
+  return Signal(unit, variable) + "[" + std::to_string(k) + "]";
+}
+
+YAML::Node Num(double x) { return YAML::Node(cosim::FormatValue(x)); }
+
+YAML::Node List(const std::vector<double>& values) {
+  YAML::Node list(YAML::NodeType::Sequence);
+  list.SetStyle(YAML::EmitterStyle::Flow);
+  for (double v : values) list.push_back(Num(v));
+  return list;
+}
+
+YAML::Node IntList(const std::vector<int>& values) {
+  YAML::Node list(YAML::NodeType::Sequence);
+  list.SetStyle(YAML::EmitterStyle::Flow);
+  for (int v : values) list.push_back(v);
+  return list;
+}
+
+void MergeInto(YAML::Node to, const YAML::Node& from) {
+  if (!from.IsMap()) return;
+  for (const auto& kv : from) to[kv.first.Scalar()] = kv.second;
+}
+
+YAML::Node SystemBuilder::Unit(const std::string& name, const std::string& type) {
+  YAML::Node unit = out_["units"][name];
+  unit["type"] = type;
+  return unit;
+}
+
+bool SystemBuilder::HasUnit(const std::string& name) const {
+  const YAML::Node units = Child(out_, "units");
+  return Child(units, name).IsDefined();
+}
+
+YAML::Node SystemBuilder::Params(const std::string& name) {
+  return out_["units"][name]["parameters"];
+}
+
+void SystemBuilder::SetStep(const std::string& name, cosim::TimeNs step) {
+  out_["units"][name]["step_s"] = Num(cosim::NsToSeconds(step));
+}
+
+void SystemBuilder::Connect(const std::string& from, const std::string& to) {
+  YAML::Node c;
+  c.SetStyle(YAML::EmitterStyle::Flow);
+  c["from"] = from;
+  c["to"] = to;
+  connections_.push_back(c);
+}
+
+void SystemBuilder::Derived(const std::string& expanded, const YAML::Node& parent,
+                            const std::string& path, const std::string& key) {
+  const YAML::Node node = Child(parent, key);
+  origins_[expanded] = {node.IsDefined() ? node : parent, JoinPath(path, key)};
+}
+
+void SystemBuilder::Origin(const std::string& expanded, loader::Origin origin) {
+  origins_[expanded] = std::move(origin);
+}
+
+YAML::Node SystemBuilder::Section(const YAML::Node& parent, const std::string& path,
+                                  const std::string& key, const std::vector<std::string>& keys) {
+  const YAML::Node node = Child(parent, key);
+  const std::string full = JoinPath(path, key);
+  if (!node.IsDefined() || node.IsNull()) return YAML::Node(YAML::NodeType::Map);
+  if (!r_.ExpectMap(node, full)) return YAML::Node(YAML::NodeType::Map);
+  r_.CheckKeys(node, full, keys);
+  return node;
+}
+
+cosim::TimeNs SystemBuilder::MasterStep() const {
+  YamlReader quiet(r_.file());
+  return ReadMasterStep(quiet, Child(root_, "master"));
+}
+
+}  // namespace linesim::loader::assembly

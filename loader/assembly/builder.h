@@ -1,0 +1,81 @@
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cosim/time.h"
+#include "loader/yaml_reader.h"
+
+/// The assembly of a robot scenario into a system-level tree: a builder the
+/// concerns add units and connections to, and the names of the units the
+/// expansion makes (recording, metrics, plots and --set refer to these).
+namespace linesim::loader::assembly {
+
+inline constexpr const char* kBelt = "belt";
+inline constexpr const char* kChassis = "chassis";
+inline constexpr const char* kMotors = "motors";
+inline constexpr const char* kWheelController = "wheel_controller";
+inline constexpr const char* kPathFollower = "path_follower";
+inline constexpr const char* kDeviation = "deviation";
+
+/// "unit.variable".
+std::string Signal(const std::string& unit, const std::string& variable);
+/// "unit.variable[k]".
+std::string Element(const std::string& unit, const std::string& variable, std::size_t k);
+
+/// A number as the shortest text that reads back to it, so that the
+/// expansion `linesim inspect` prints shows 0.9 rather than 0.90000000000000002.
+YAML::Node Num(double x);
+YAML::Node List(const std::vector<double>& values);
+YAML::Node IntList(const std::vector<int>& values);
+/// Copies every key of `from` into `to` (both maps), the later one winning.
+void MergeInto(YAML::Node to, const YAML::Node& from);
+
+/// The system-level tree under construction. Every concern adds its units
+/// and connections here; what a unit's value was derived from is recorded
+/// so that a problem found in the expansion is reported at the robot-level
+/// key the user wrote.
+class SystemBuilder {
+ public:
+  SystemBuilder(const YAML::Node& root, YamlReader& reader) : root_(root), r_(reader) {}
+
+  const YAML::Node& root() const { return root_; }
+  YamlReader& reader() { return r_; }
+
+  /// Adds (or returns) unit `name` of `type`.
+  YAML::Node Unit(const std::string& name, const std::string& type);
+  bool HasUnit(const std::string& name) const;
+  YAML::Node Params(const std::string& name);
+  void SetStep(const std::string& name, cosim::TimeNs step);
+  void Connect(const std::string& from, const std::string& to);
+
+  /// Records that the expansion's `expanded` path holds a value derived
+  /// from the robot-level key `key` of `parent` (at `path`).
+  void Derived(const std::string& expanded, const YAML::Node& parent, const std::string& path,
+               const std::string& key);
+  void Origin(const std::string& expanded, loader::Origin origin);
+  /// A map section of the robot scenario (empty when absent), its keys
+  /// checked.
+  YAML::Node Section(const YAML::Node& parent, const std::string& path, const std::string& key,
+                     const std::vector<std::string>& keys);
+
+  /// The master step as the system loader reads it (its default if absent
+  /// or bad: the system loader reports a bad one at master.step_s).
+  cosim::TimeNs MasterStep() const;
+
+  YAML::Node& out() { return out_; }
+  std::vector<YAML::Node>& connections() { return connections_; }
+  std::map<std::string, loader::Origin>& origins() { return origins_; }
+
+ private:
+  const YAML::Node& root_;
+  YamlReader& r_;
+  YAML::Node out_{YAML::NodeType::Map};
+  std::vector<YAML::Node> connections_;
+  std::map<std::string, loader::Origin> origins_;
+};
+
+}  // namespace linesim::loader::assembly

@@ -1,0 +1,80 @@
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "loader/assembly/builder.h"
+#include "loader/robot_file.h"
+#include "loader/robot_scenario.h"
+#include "models/scene.h"
+
+/// The concerns a robot scenario is assembled from, in the order
+/// ExpandRobotScenario applies them. Each adds its units and connections to
+/// the builder and records in Signals what it provides; the next concern
+/// connects to whatever provides a pose, a twist or a surface velocity,
+/// never to a literal unit of another concern.
+namespace linesim::loader::assembly {
+
+/// What the assembled units provide, by role, as "unit.variable" names.
+struct Signals {
+  /// Ground truth of the robot: evaluation reads these, never estimates.
+  std::string true_position, true_yaw, true_surface_velocity;
+  /// What the controllers use: localization's and sensing's choice.
+  std::string position, yaw, surface_velocity;
+
+  /// Joints of the drive train: the chassis's index of each wheel's
+  /// steering joint (-1: fixed wheel) and drive joint, and the dc_motor
+  /// element of each chassis steering and drive joint.
+  std::vector<int> wheel_steer_joint, wheel_drive_joint;
+  std::vector<std::size_t> steer_motor_element, drive_motor_element;
+
+  /// The wheel controller's command inputs, which the task drives.
+  std::string velocity_command_input, yaw_rate_command_input;
+
+  /// Belts of the scene: how many, and the belt unit's outputs.
+  std::size_t belt_count = 0;
+
+  /// What each concern wants recorded, in order.
+  std::vector<std::string> recorded;
+};
+
+/// The robot's pose at time zero (robot.pose).
+struct StartPose {
+  double x_m = 0.0, y_m = 0.0, yaw_rad = 0.0;
+};
+
+/// scene + line: the scenario's scene (`scene:`, with `line.belts` as the
+/// overrides of its belts by index) into the expansion's `scene:`; returns
+/// the scene as the system loader will read it.
+models::Scene AddScene(SystemBuilder& b);
+
+/// robot: the chassis (ODE) and the motors (one CVODE unit for every motor
+/// group), wired torque to joint and joint rate to shaft.
+Signals AddDriveTrain(SystemBuilder& b, const RobotFile& robot, const StartPose& start,
+                      RobotInfo& info);
+
+/// The line's belt unit, driving the scene's belts under the chassis.
+void AddLine(SystemBuilder& b, const models::Scene& scene, Signals& s);
+
+/// sensing.surface_velocity and localization.source: who tells the
+/// controllers the surface velocity under each wheel and the pose.
+void AddSensing(SystemBuilder& b, Signals& s);
+
+/// control: the wheel controller of the robot's kind (swerve: Eq. 1 and
+/// Algorithm 1; differential), wired to the motors and the joints.
+void AddControl(SystemBuilder& b, const RobotFile& robot, Signals& s);
+
+/// task: the path follower (a path, or a point to hold) driving the wheel
+/// controller's command inputs from the pose.
+void AddTask(SystemBuilder& b, const RobotFile& robot, const StartPose& start, Signals& s,
+             RobotInfo& info);
+
+/// Evaluation: the ground-truth deviation from the task and the metrics.
+void AddEvaluation(SystemBuilder& b, Signals& s, RobotInfo& info);
+
+/// recording: what signals.csv holds (unless the scenario says), at about
+/// 100 Hz; and the columns the plots read.
+void AddRecording(SystemBuilder& b, const Signals& s, RobotInfo& info);
+
+}  // namespace linesim::loader::assembly

@@ -1,0 +1,160 @@
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "loader/assembly/concerns.h"
+#include "models/drive_train.h"
+
+namespace linesim::loader::assembly {
+
+namespace {
+
+// The motors of every group as one dc_motor unit: one CVODE system
+// restarted once per controller cycle instead of once per group. Each
+// element takes its group's motor model (the gear included) as element
+// arrays.
+void AddMotors(SystemBuilder& b, const RobotFile& file) {
+  const models::RobotDescription& robot = file.robot;
+  const auto motors = robot.Motors();
+  b.Unit(kMotors, "dc_motor");
+  YAML::Node p = b.Params(kMotors);
+  p["count"] = motors.size();
+  // The chassis owns the mechanics; the motors get its joint rates.
+  p["mode"] = "current_only";
+  std::map<std::string, std::vector<double>> arrays;
+  for (std::size_t e = 0; e < motors.size(); ++e) {
+    for (const auto& [key, value] : robot.motor_groups[motors[e].first].motor) {
+      auto& values = arrays[key];
+      values.resize(motors.size(), std::numeric_limits<double>::quiet_NaN());
+      values[e] = value;
+    }
+  }
+  for (const auto& [key, values] : arrays) {
+    for (std::size_t e = 0; e < values.size(); ++e) {
+      if (std::isnan(values[e])) {
+        const auto& group = robot.motor_groups[motors[e].first];
+        b.reader().Error(robot.file, YAML::Node(), "motor_groups",
+                         "every motor model must set the same keys; '" + key + "' is not in " +
+                             group.model_file + " (group '" + group.name + "')");
+        return;
+      }
+    }
+    p[key] = List(values);
+  }
+  MergeInto(p, file.motor_settings);
+}
+
+// The joint view of a motor group (the drive-train algebra of models/).
+models::JointDrive Drive(const models::MotorGroup& g) {
+  const auto get = [&](const char* key) {
+    const auto it = g.motor.find(key);
+    return it == g.motor.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
+  };
+  return models::ReflectThroughGear(get("rotor_inertia"), get("torque_constant"), g.gear_ratio,
+                                    g.gear_efficiency);
+}
+
+}  // namespace
+
+Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& start,
+                      RobotInfo& info) {
+  const models::RobotDescription& robot = file.robot;
+  Signals s;
+  const auto motors = robot.Motors();
+  std::map<std::string, std::size_t> element;
+  for (std::size_t e = 0; e < motors.size(); ++e) element[motors[e].second] = e;
+
+  // The chassis's joints in motor order: steering joint k is the k-th motor
+  // that steers a wheel, drive joint k the k-th that drives one.
+  std::map<std::string, int> steer_joint, drive_joint;
+  for (const auto& [group, name] : motors) {
+    for (const auto& w : robot.wheels) {
+      if (w.steer_motor == name && !steer_joint.contains(name)) {
+        steer_joint[name] = static_cast<int>(s.steer_motor_element.size());
+        s.steer_motor_element.push_back(element.at(name));
+      }
+      if (w.drive_motor == name && !drive_joint.contains(name)) {
+        drive_joint[name] = static_cast<int>(s.drive_motor_element.size());
+        s.drive_motor_element.push_back(element.at(name));
+      }
+    }
+  }
+  std::vector<double> x, y, radius;
+  for (const auto& w : robot.wheels) {
+    s.wheel_steer_joint.push_back(w.steer_motor ? steer_joint.at(*w.steer_motor) : -1);
+    s.wheel_drive_joint.push_back(drive_joint.at(w.drive_motor));
+    x.push_back(w.x_m);
+    y.push_back(w.y_m);
+    radius.push_back(w.radius_m);
+  }
+
+  b.Unit(kChassis, "chassis");
+  YAML::Node c = b.Params(kChassis);
+  c["wheel_count"] = robot.wheels.size();
+  c["steer_motor"] = IntList(s.wheel_steer_joint);
+  c["drive_motor"] = IntList(s.wheel_drive_joint);
+  MergeInto(c, file.chassis_settings);
+  c["body_length"] = Num(robot.body.length_m);
+  c["body_width"] = Num(robot.body.width_m);
+  c["body_height"] = Num(robot.body.height_m);
+  c["mass"] = Num(robot.body.mass_kg);
+  c["com_height"] = Num(robot.body.com_height_m);
+  // One mass for every wheel module: the chassis lumps it into each wheel.
+  c["module_mass"] = Num(robot.wheels.front().mass_kg);
+  for (const auto& w : robot.wheels) {
+    if (w.mass_kg != robot.wheels.front().mass_kg) {
+      b.reader().Error(robot.file, YAML::Node(), "wheels",
+                       "every wheel must have the same mass_kg (the chassis lumps one module "
+                       "mass into each wheel); '" + w.name + "' differs");
+      break;
+    }
+  }
+  c["wheel_x"] = List(x);
+  c["wheel_y"] = List(y);
+  c["wheel_radius"] = List(radius);
+  // The rotor inertia each joint sees through its gear (eta N^2 J).
+  for (const auto& [joint, joints] :
+       {std::pair{"steer", &s.steer_motor_element}, std::pair{"drive", &s.drive_motor_element}}) {
+    if (joints->empty()) continue;
+    const auto& group = robot.motor_groups[motors[joints->front()].first];
+    c[std::string(joint) + "_rotor_inertia"] = Num(Drive(group).reflected_inertia_kgm2);
+  }
+  c["initial_x"] = Num(start.x_m);
+  c["initial_y"] = Num(start.y_m);
+  c["initial_yaw"] = Num(start.yaw_rad);
+  const YAML::Node pose = Child(Child(b.root(), "robot"), "pose");
+  b.Derived("units.chassis.parameters.initial_x", pose, "robot.pose", "x_m");
+  b.Derived("units.chassis.parameters.initial_y", pose, "robot.pose", "y_m");
+  b.Derived("units.chassis.parameters.initial_yaw", pose, "robot.pose", "yaw_deg");
+
+  AddMotors(b, file);
+  const auto wire = [&](const char* joint, const std::vector<std::size_t>& elements) {
+    for (std::size_t k = 0; k < elements.size(); ++k) {
+      b.Connect(Element(kMotors, "torque", elements[k]),
+                Element(kChassis, std::string(joint) + "_torque", k));
+      b.Connect(Element(kChassis, std::string(joint) + "_rate", k),
+                Element(kMotors, "shaft_speed", elements[k]));
+    }
+  };
+  wire("steer", s.steer_motor_element);
+  wire("drive", s.drive_motor_element);
+
+  s.true_position = Signal(kChassis, "position");
+  s.true_yaw = Signal(kChassis, "yaw");
+  s.true_surface_velocity = Signal(kChassis, "wheel_surface_velocity");
+  for (const char* v : {"position", "yaw", "linear_velocity", "yaw_rate"}) {
+    s.recorded.push_back(Signal(kChassis, v));
+  }
+  if (!s.steer_motor_element.empty()) s.recorded.push_back(Signal(kChassis, "steer_angle"));
+  for (const char* v : {"drive_rate", "wheel_surface", "wheel_contact"}) {
+    s.recorded.push_back(Signal(kChassis, v));
+  }
+  s.recorded.push_back(Signal(kMotors, "current"));
+
+  info.wheel_count = static_cast<int>(robot.wheels.size());
+  info.body_length_m = robot.body.length_m;
+  info.body_width_m = robot.body.width_m;
+  return s;
+}
+
+}  // namespace linesim::loader::assembly

@@ -1,0 +1,78 @@
+#include <numbers>
+
+#include "loader/assembly/concerns.h"
+
+namespace linesim::loader::assembly {
+
+namespace {
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+}  // namespace
+
+void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Signals& s,
+             RobotInfo& info) {
+  YamlReader& r = b.reader();
+  const YAML::Node task =
+      b.Section(b.root(), "", "task",
+                {"type", "waypoints", "point", "speed_mps", "acceleration_mps2", "yaw_deg"});
+  info.task = r.String(task, "task", "type", std::nullopt, {"path", "hold"});
+  b.Unit(kPathFollower, "path_follower");
+  YAML::Node p = b.Params(kPathFollower);
+  const bool differential = file.robot.controller == models::ControllerKind::kDifferential;
+  if (info.task == "path") {
+    const YAML::Node waypoints = Child(task, "waypoints");
+    if (!waypoints.IsDefined()) {
+      r.Error(task, "task.waypoints", "missing required key: a list of points [x, y] (m)");
+    } else if (r.ExpectSequence(waypoints, "task.waypoints")) {
+      if (waypoints.size() < 2) {
+        r.Error(waypoints, "task.waypoints", "expected at least two points [x, y]");
+      }
+      for (std::size_t i = 0; i < waypoints.size(); ++i) {
+        if (auto pt = r.AsPoint(waypoints[i], JoinPath("task.waypoints", std::to_string(i)),
+                                {-1e6, 1e6})) {
+          info.path.push_back(*pt);
+        }
+      }
+    }
+    p["mode"] = "path";
+    // Paper 1, Table I: the Rob@Work 3's top speed is 1.2 m/s.
+    p["speed"] = Num(r.Real(task, "task", "speed_mps", 0.3, {0.0, 1.2, true}));
+  } else if (info.task == "hold") {
+    std::array<double, 2> point{start.x_m, start.y_m};
+    if (Child(task, "point").IsDefined()) {
+      if (auto pt = r.AsPoint(Child(task, "point"), "task.point", {-1e6, 1e6})) point = *pt;
+    }
+    info.path.push_back(point);
+    p["mode"] = "hold";
+  }
+  if (Child(task, "acceleration_mps2").IsDefined()) {
+    p["acceleration"] = Num(r.Real(task, "task", "acceleration_mps2", 0.3, {0.0, 10.0, true}));
+  }
+  if (differential) {
+    // A differential base heads along its motion; it holds no heading.
+    p["base"] = "differential";
+    if (Child(task, "yaw_deg").IsDefined()) {
+      r.Error(Child(task, "yaw_deg"), "task.yaw_deg",
+              "robot '" + file.robot.name + "' is a differential base: it cannot hold a heading "
+              "while it moves; leave task.yaw_deg out");
+    }
+  } else {
+    // An omnidirectional base keeps this heading while it moves.
+    p["yaw"] = Num(Child(task, "yaw_deg").IsDefined()
+                       ? r.Real(task, "task", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad
+                       : start.yaw_rad);
+  }
+  YAML::Node waypoints(YAML::NodeType::Sequence);
+  waypoints.SetStyle(YAML::EmitterStyle::Flow);
+  for (const auto& pt : info.path) waypoints.push_back(List({pt[0], pt[1]}));
+  p["waypoints"] = waypoints;
+
+  b.Connect(s.position, Signal(kPathFollower, "position"));
+  b.Connect(s.yaw, Signal(kPathFollower, "yaw"));
+  b.Connect(Signal(kPathFollower, "velocity_command"), s.velocity_command_input);
+  b.Connect(Signal(kPathFollower, "yaw_rate_command"), s.yaw_rate_command_input);
+  for (const char* v : {"velocity_command", "yaw_rate_command"}) {
+    s.recorded.push_back(Signal(kPathFollower, v));
+  }
+}
+
+}  // namespace linesim::loader::assembly

@@ -1,0 +1,305 @@
+#include "loader/robot_file.h"
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <set>
+
+#include "loader/yaml_files.h"
+
+namespace linesim::loader {
+
+namespace {
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+// Sizes of anything that rolls on a factory floor: a wheel of 1 mm to 2 m,
+// a robot up to 10 m long and 10 t heavy.
+constexpr Range kPositionM{-10.0, 10.0};
+constexpr Range kSizeM{0.0, 10.0, true};
+constexpr Range kWheelRadiusM{0.001, 2.0};
+constexpr Range kMassKg{0.0, 1e4, true};
+
+class Reader {
+ public:
+  Reader(YamlReader& r, std::string file) : r_(r), file_(std::move(file)) {}
+
+  std::optional<RobotFile> Read(const YAML::Node& root) {
+    RobotFile out;
+    models::RobotDescription& robot = out.robot;
+    robot.file = file_;
+    if (!r_.ExpectMap(root, "")) return std::nullopt;
+    root_ = root;
+    r_.CheckKeys(root, "",
+                 {"description", "source", "body", "wheels", "motor_groups", "controller",
+                  "chassis", "motors", "sensor_mounts"});
+    robot.description = r_.String(root, "", "description", "");
+    Body(Child(root, "body"), robot.body);
+    MotorGroups(Child(root, "motor_groups"), robot);
+    Wheels(Child(root, "wheels"), robot);
+    Controller(Child(root, "controller"), out);
+    SensorMounts(Child(root, "sensor_mounts"), robot);
+    out.chassis_settings = Settings(root, "chassis");
+    out.motor_settings = Settings(root, "motors");
+    return out;
+  }
+
+ private:
+  YAML::Node Map(const YAML::Node& parent, const std::string& path, const std::string& key,
+                 bool required) {
+    const YAML::Node node = Child(parent, key);
+    const std::string full = JoinPath(path, key);
+    if (!node.IsDefined() || node.IsNull()) {
+      if (required) r_.Error(parent, full, "missing required key: a map");
+      return YAML::Node(YAML::NodeType::Undefined);
+    }
+    return r_.ExpectMap(node, full) ? node : YAML::Node(YAML::NodeType::Undefined);
+  }
+
+  YAML::Node Settings(const YAML::Node& root, const std::string& key) {
+    const YAML::Node node = Map(root, "", key, false);
+    return node.IsDefined() ? node : YAML::Node(YAML::NodeType::Map);
+  }
+
+  void Body(const YAML::Node& parent_node, models::BodyDescription& b) {
+    const YAML::Node root = parent_node;
+    if (!root.IsDefined()) {
+      r_.Error(root_, "body", "missing required key: a map of the body's size and mass");
+      return;
+    }
+    if (!r_.ExpectMap(root, "body")) return;
+    r_.CheckKeys(root, "body", {"length_m", "width_m", "height_m", "mass_kg", "com_height_m"});
+    b.length_m = r_.Real(root, "body", "length_m", std::nullopt, kSizeM);
+    b.width_m = r_.Real(root, "body", "width_m", std::nullopt, kSizeM);
+    b.height_m = r_.Real(root, "body", "height_m", std::nullopt, kSizeM);
+    b.mass_kg = r_.Real(root, "body", "mass_kg", std::nullopt, kMassKg);
+    b.com_height_m = r_.Real(root, "body", "com_height_m", std::nullopt, kSizeM);
+  }
+
+  void MotorGroups(const YAML::Node& list, models::RobotDescription& robot) {
+    const std::string path = "motor_groups";
+    if (!list.IsDefined()) {
+      r_.Error(root_, path, "missing required key: a list of motor groups");
+      return;
+    }
+    if (!r_.ExpectSequence(list, path)) return;
+    std::set<std::string> names;
+    for (std::size_t g = 0; g < list.size(); ++g) {
+      const std::string gp = JoinPath(path, std::to_string(g));
+      const YAML::Node node = list[g];
+      if (!r_.ExpectMap(node, gp)) continue;
+      r_.CheckKeys(node, gp, {"name", "model", "gear_ratio", "gear_efficiency", "motors"});
+      models::MotorGroup group;
+      group.name = r_.String(node, gp, "name", std::nullopt);
+      // A gear turns the motor at most 1000 times per output turn; its
+      // efficiency is a fraction.
+      group.gear_ratio = r_.Real(node, gp, "gear_ratio", std::nullopt, {0.0, 1000.0, true});
+      group.gear_efficiency = r_.Real(node, gp, "gear_efficiency", std::nullopt, {0.0, 1.0, true});
+      const std::string model = r_.String(node, gp, "model", std::nullopt);
+      if (!model.empty()) {
+        const YAML::Node motor = LoadModel(r_, Child(node, "model"), JoinPath(gp, "model"),
+                                           "motor model", model, "motors", file_,
+                                           &group.model_file);
+        if (motor.IsDefined()) Motor(motor, group);
+      }
+      group.motor["gear_ratio"] = group.gear_ratio;
+      group.motor["gear_efficiency"] = group.gear_efficiency;
+      const YAML::Node motors = Child(node, "motors");
+      const std::string mp = JoinPath(gp, "motors");
+      if (!motors.IsDefined()) {
+        r_.Error(node, mp, "missing required key: a list of motor names");
+      } else if (r_.ExpectSequence(motors, mp)) {
+        for (std::size_t k = 0; k < motors.size(); ++k) {
+          const std::string kp = JoinPath(mp, std::to_string(k));
+          const auto name = r_.AsString(motors[k], kp);
+          if (!name) continue;
+          if (!motor_names_.insert(*name).second) {
+            r_.Error(motors[k], kp, "motor '" + *name + "' is named twice");
+          }
+          motor_at_[*name] = {motors[k], kp};
+          group.motors.push_back(*name);
+        }
+        if (motors.size() == 0) r_.Error(motors, mp, "expected at least one motor");
+      }
+      if (!group.name.empty() && !names.insert(group.name).second) {
+        r_.Error(Child(node, "name"), JoinPath(gp, "name"),
+                 "motor group '" + group.name + "' is named twice");
+      }
+      robot.motor_groups.push_back(std::move(group));
+    }
+  }
+
+  // The motor model file's numbers (dc_motor parameter names); a gear in it
+  // is the bare motor's (1) and is replaced by the group's.
+  void Motor(const YAML::Node& motor, models::MotorGroup& group) {
+    YamlReader::InFile in(r_, group.model_file);
+    if (!r_.ExpectMap(motor, "")) return;
+    for (const auto& kv : motor) {
+      const std::string key = kv.first.Scalar();
+      if (key == "source" || key == "description") continue;
+      if (const auto v = r_.AsReal(kv.second, key)) group.motor[key] = *v;
+    }
+  }
+
+  void Wheels(const YAML::Node& list, models::RobotDescription& robot) {
+    const std::string path = "wheels";
+    if (!list.IsDefined()) {
+      r_.Error(root_, path, "missing required key: a list of wheels");
+      return;
+    }
+    if (!r_.ExpectSequence(list, path)) return;
+    if (list.size() == 0) r_.Error(list, path, "expected at least one wheel");
+    std::set<std::string> used;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string wp = JoinPath(path, std::to_string(i));
+      const YAML::Node node = list[i];
+      if (!r_.ExpectMap(node, wp)) continue;
+      r_.CheckKeys(node, wp,
+                   {"name", "x_m", "y_m", "radius_m", "width_m", "mass_kg", "steer_inertia_kgm2",
+                    "steer_motor", "drive_motor"});
+      models::WheelDescription w;
+      w.name = r_.String(node, wp, "name", std::nullopt);
+      w.x_m = r_.Real(node, wp, "x_m", std::nullopt, kPositionM);
+      w.y_m = r_.Real(node, wp, "y_m", std::nullopt, kPositionM);
+      w.radius_m = r_.Real(node, wp, "radius_m", std::nullopt, kWheelRadiusM);
+      w.width_m = r_.Real(node, wp, "width_m", std::nullopt, kSizeM);
+      w.mass_kg = r_.Real(node, wp, "mass_kg", std::nullopt, kMassKg);
+      w.drive_motor = MotorName(node, wp, "drive_motor", true).value_or("");
+      w.steer_motor = MotorName(node, wp, "steer_motor", false);
+      w.steer_inertia_kgm2 =
+          r_.Real(node, wp, "steer_inertia_kgm2", w.steer_motor ? std::nullopt : std::optional(0.0),
+                  {0.0, 100.0});
+      for (const auto& m : {std::optional(w.drive_motor), w.steer_motor}) {
+        if (m && !m->empty()) used.insert(*m);
+      }
+      if (w.steer_motor && *w.steer_motor == w.drive_motor) {
+        r_.Error(Child(node, "steer_motor"), JoinPath(wp, "steer_motor"),
+                 "a wheel cannot be steered and driven by the same motor '" + w.drive_motor + "'");
+      }
+      robot.wheels.push_back(std::move(w));
+    }
+    // A motor that moves no wheel is a description error, not a spare.
+    for (const auto& group : robot.motor_groups) {
+      for (const auto& m : group.motors) {
+        if (!used.contains(m)) {
+          const Origin& at = motor_at_.at(m);
+          r_.Error(at.node, at.path, "motor '" + m + "' moves no wheel");
+        }
+      }
+    }
+  }
+
+  std::optional<std::string> MotorName(const YAML::Node& wheel, const std::string& path,
+                                       const std::string& key, bool required) {
+    const YAML::Node node = Child(wheel, key);
+    const std::string full = JoinPath(path, key);
+    if (!node.IsDefined() || node.IsNull()) {
+      if (required) r_.Error(wheel, full, "missing required key: the name of a motor");
+      return std::nullopt;
+    }
+    const auto name = r_.AsString(node, full);
+    if (name && !motor_names_.contains(*name)) {
+      r_.Error(node, full,
+               "no motor '" + *name + "' in motor_groups; motors: " +
+                   JoinNames({motor_names_.begin(), motor_names_.end()}));
+    }
+    return name;
+  }
+
+  void Controller(const YAML::Node& node, RobotFile& out) {
+    const std::string path = "controller";
+    models::RobotDescription& robot = out.robot;
+    out.controller_settings = YAML::Node(YAML::NodeType::Map);
+    if (!node.IsDefined()) {
+      r_.Error(root_, path, "missing required key: a map with kind (swerve or differential)");
+      return;
+    }
+    if (!r_.ExpectMap(node, path)) return;
+    const std::string kind = r_.String(node, path, "kind", std::nullopt, {"swerve", "differential"});
+    for (const auto& kv : node) {
+      if (kv.first.Scalar() != "kind") out.controller_settings[kv.first.Scalar()] = kv.second;
+    }
+    const auto error = [&](const std::string& message) {
+      r_.Error(Child(node, "kind"), JoinPath(path, "kind"), message);
+    };
+    if (kind == "swerve") {
+      robot.controller = models::ControllerKind::kSwerve;
+      // Each wheel its own steering and drive motor: a swerve base.
+      std::set<std::string> drive, steer;
+      for (const auto& w : robot.wheels) {
+        if (!w.steer_motor) {
+          error("a swerve controller steers every wheel; wheel '" + w.name + "' has no steer_motor");
+        }
+        if (!drive.insert(w.drive_motor).second ||
+            (w.steer_motor && !steer.insert(*w.steer_motor).second)) {
+          error("a swerve controller needs a steer and a drive motor of its own for each wheel; "
+                "wheel '" + w.name + "' shares one");
+        }
+      }
+    } else if (kind == "differential") {
+      robot.controller = models::ControllerKind::kDifferential;
+      // Fixed wheels, one drive motor per side: left (y > 0), right (y < 0).
+      std::set<std::string> left, right;
+      for (const auto& w : robot.wheels) {
+        if (w.steer_motor) error("a differential base has no steered wheel; '" + w.name + "' is");
+        (w.y_m > 0.0 ? left : right).insert(w.drive_motor);
+        if (w.y_m == 0.0) error("wheel '" + w.name + "' is on neither side (y_m = 0)");
+      }
+      if (left.size() != 1 || right.size() != 1 || left == right) {
+        error("a differential base has one drive motor for the left wheels (y > 0) and another "
+              "for the right ones");
+      }
+    }
+  }
+
+  void SensorMounts(const YAML::Node& list, models::RobotDescription& robot) {
+    const std::string path = "sensor_mounts";
+    if (!list.IsDefined() || list.IsNull() || !r_.ExpectSequence(list, path)) return;
+    std::set<std::string> names;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string sp = JoinPath(path, std::to_string(i));
+      const YAML::Node node = list[i];
+      if (!r_.ExpectMap(node, sp)) continue;
+      r_.CheckKeys(node, sp,
+                   {"name", "kind", "x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg",
+                    "source"});
+      models::SensorMount m;
+      m.name = r_.String(node, sp, "name", std::nullopt);
+      m.kind = r_.String(node, sp, "kind", std::nullopt);
+      m.x_m = r_.Real(node, sp, "x_m", std::nullopt, kPositionM);
+      m.y_m = r_.Real(node, sp, "y_m", std::nullopt, kPositionM);
+      m.z_m = r_.Real(node, sp, "z_m", std::nullopt, {0.0, 10.0});
+      m.roll_rad = r_.Real(node, sp, "roll_deg", 0.0, {-360.0, 360.0}) * kDegToRad;
+      m.pitch_rad = r_.Real(node, sp, "pitch_deg", 0.0, {-360.0, 360.0}) * kDegToRad;
+      m.yaw_rad = r_.Real(node, sp, "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad;
+      if (!m.name.empty() && !names.insert(m.name).second) {
+        r_.Error(Child(node, "name"), JoinPath(sp, "name"), "mount '" + m.name + "' is named twice");
+      }
+      robot.sensor_mounts.push_back(std::move(m));
+    }
+  }
+
+  YamlReader& r_;
+  std::string file_;
+  std::set<std::string> motor_names_;
+  std::map<std::string, Origin> motor_at_;
+  YAML::Node root_;
+};
+
+}  // namespace
+
+std::optional<RobotFile> ReadRobotFile(YamlReader& r, const YAML::Node& at,
+                                       const std::string& path, const std::string& model,
+                                       const std::string& relative_to) {
+  std::string file;
+  const YAML::Node root = LoadModel(r, at, path, "robot model", model, "robots", relative_to, &file);
+  if (!root.IsDefined()) return std::nullopt;
+  YamlReader::InFile in(r, file);
+  const std::size_t before = r.issues().size();
+  Reader reader(r, file);
+  auto out = reader.Read(root);
+  if (r.issues().size() != before) return std::nullopt;
+  if (out) out->robot.name = model;
+  return out;
+}
+
+}  // namespace linesim::loader

@@ -1,0 +1,40 @@
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <optional>
+#include <string>
+
+#include "loader/yaml_reader.h"
+#include "models/robot_description.h"
+
+namespace linesim::loader {
+
+/// A robot description file (models/robots/*.yaml) as read: the typed
+/// description, and the settings it gives the units built from it, in the
+/// units' own parameter names (passed on as they are).
+struct RobotFile {
+  models::RobotDescription robot;
+  /// Map of chassis unit parameters that are not geometry: contact,
+  /// suspension, joint friction, brake, substeps.
+  YAML::Node chassis_settings;
+  /// Map of dc_motor unit settings shared by every motor (tolerances, how
+  /// the shaft speed is held).
+  YAML::Node motor_settings;
+  /// Map of the wheel controller's parameters that the description gives
+  /// directly (rate and acceleration limits, gains, an effective track).
+  YAML::Node controller_settings;
+};
+
+/// Reads the robot description `model` names (a file in models/robots, or a
+/// path relative to `relative_to`'s folder) and the motor model files its
+/// groups name. Every problem is reported through `r` in the file it is in,
+/// with its line and key path: a missing required value names its key, a
+/// wheel that names an unknown motor, a motor no wheel uses, a topology the
+/// controller kind cannot drive. Problems of the name itself are reported
+/// at `at`/`path`. Nothing when the file cannot be used.
+std::optional<RobotFile> ReadRobotFile(YamlReader& r, const YAML::Node& at,
+                                       const std::string& path, const std::string& model,
+                                       const std::string& relative_to);
+
+}  // namespace linesim::loader

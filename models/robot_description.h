@@ -1,0 +1,91 @@
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+/// The typed description of a robot (models/robots/*.yaml): its body, its
+/// wheels and which motors steer and drive them, the motor groups, the kind
+/// of wheel controller, and the frames where sensors are mounted. Read by
+/// the loader (loader/robot_file.h); the robot scenario's assembly turns it
+/// into the parameters of the chassis, motor and controller units, which
+/// take no robot-specific default of their own. base_link: x forward, y
+/// left, z up, origin at the planform centre on the floor.
+namespace linesim::models {
+
+struct BodyDescription {
+  double length_m = 0.0;  // along base_link x
+  double width_m = 0.0;
+  double height_m = 0.0;
+  /// The whole robot, wheels included.
+  double mass_kg = 0.0;
+  /// Height of the body's centre of mass (wheels excluded) above the floor.
+  double com_height_m = 0.0;
+};
+
+struct WheelDescription {
+  std::string name;
+  /// Contact point below the wheel centre (the steering axis of a
+  /// steerable wheel) in base_link.
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double radius_m = 0.0;
+  double width_m = 0.0;
+  /// Everything that turns with the wheel or its steering module, lumped
+  /// into the wheel.
+  double mass_kg = 0.0;
+  /// A steerable wheel's module inertia about its steering axis (the
+  /// controller's steering feedforward); 0 for a fixed wheel.
+  double steer_inertia_kgm2 = 0.0;
+  /// Names of motors in the motor groups; no steer motor: a fixed wheel.
+  /// Wheels naming the same drive motor share it (belt or chain).
+  std::optional<std::string> steer_motor;
+  std::string drive_motor;
+};
+
+/// Motors of one model behind one kind of gear.
+struct MotorGroup {
+  std::string name;
+  /// The motor's model file (models/motors) as read: dc_motor parameter
+  /// name to value, the gear of this group included.
+  std::map<std::string, double> motor;
+  std::string model_file;
+  double gear_ratio = 1.0;
+  double gear_efficiency = 1.0;
+  std::vector<std::string> motors;
+};
+
+/// A frame on the robot where a sensor is mounted (its type is the
+/// sensor's own description).
+struct SensorMount {
+  std::string name;
+  std::string kind;  // px4flow, laser_scanner, imu, ...
+  double x_m = 0.0, y_m = 0.0, z_m = 0.0;
+  double roll_rad = 0.0, pitch_rad = 0.0, yaw_rad = 0.0;
+};
+
+enum class ControllerKind { kSwerve, kDifferential };
+
+struct RobotDescription {
+  std::string name;
+  std::string description;
+  std::string file;
+  BodyDescription body;
+  std::vector<WheelDescription> wheels;
+  std::vector<MotorGroup> motor_groups;
+  ControllerKind controller = ControllerKind::kSwerve;
+  std::vector<SensorMount> sensor_mounts;
+
+  /// Every motor of every group, in group order: the elements of the one
+  /// dc_motor unit that simulates them. Each entry: group index, motor name.
+  std::vector<std::pair<std::size_t, std::string>> Motors() const {
+    std::vector<std::pair<std::size_t, std::string>> all;
+    for (std::size_t g = 0; g < motor_groups.size(); ++g) {
+      for (const auto& m : motor_groups[g].motors) all.emplace_back(g, m);
+    }
+    return all;
+  }
+};
+
+}  // namespace linesim::models

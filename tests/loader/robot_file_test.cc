@@ -1,0 +1,122 @@
+#include "loader/robot_file.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "scenario_test.h"
+
+namespace linesim::loader {
+namespace {
+
+using testing::Has;
+using testing::WriteScenario;
+
+// Reads a robot file, as a robot scenario in the same folder names it.
+struct Read {
+  std::optional<RobotFile> file;
+  std::string issues;
+};
+
+Read ReadModel(const std::string& model, const std::string& relative_to = "scenario.yaml") {
+  YamlReader r(relative_to);
+  Read out;
+  out.file = ReadRobotFile(r, YAML::Node(), "robot.model", model, relative_to);
+  for (const auto& issue : r.issues()) out.issues += issue.ToString() + "\n";
+  return out;
+}
+
+// A complete differential robot with one line left out or changed by the
+// test, to check what is refused and where.
+std::string Robot(const std::string& wheel0) {
+  return "body: {length_m: 1, width_m: 0.6, height_m: 0.3, mass_kg: 40, com_height_m: 0.2}\n"
+         "wheels:\n"
+         "  - " + wheel0 + "\n"
+         "  - {name: r, x_m: 0, y_m: -0.3, radius_m: 0.1, width_m: 0.05, mass_kg: 2, "
+         "drive_motor: right}\n"
+         "motor_groups:\n"
+         "  - {name: drive, model: maxon_re40_148877, gear_ratio: 20, gear_efficiency: 0.8,\n"
+         "     motors: [left, right]}\n"
+         "controller: {kind: differential, effective_track: 0.8}\n";
+}
+
+const char* kLeft =
+    "{name: l, x_m: 0, y_m: 0.3, radius_m: 0.1, width_m: 0.05, mass_kg: 2, drive_motor: left}";
+
+// Guards the shipped descriptions: both robots of the papers read, with the
+// numbers of their sources (paper 1 Table I and the raw3-1 Platform.ini; the
+// Husky URDF and manual) and the motor groups' gears.
+TEST(RobotFile, ShippedRobotsRead) {
+  const Read raw3 = ReadModel("raw3");
+  ASSERT_TRUE(raw3.file) << raw3.issues;
+  const models::RobotDescription& r = raw3.file->robot;
+  EXPECT_EQ(r.controller, models::ControllerKind::kSwerve);
+  ASSERT_EQ(r.wheels.size(), 4u);
+  EXPECT_EQ(r.wheels[1].x_m, -0.368);
+  EXPECT_EQ(r.wheels[1].y_m, 0.134);
+  EXPECT_EQ(r.body.mass_kg, 120.0);
+  ASSERT_EQ(r.Motors().size(), 8u);
+  EXPECT_EQ(r.motor_groups[1].gear_ratio, 21.0);
+  EXPECT_EQ(r.motor_groups[1].motor.at("gear_ratio"), 21.0);
+  EXPECT_EQ(r.motor_groups[1].motor.at("torque_constant"), 0.0302);  // maxon RE 40 sheet
+  EXPECT_EQ(r.sensor_mounts.size(), 6u);
+
+  const Read husky = ReadModel("husky");
+  ASSERT_TRUE(husky.file) << husky.issues;
+  const models::RobotDescription& h = husky.file->robot;
+  EXPECT_EQ(h.controller, models::ControllerKind::kDifferential);
+  ASSERT_EQ(h.wheels.size(), 4u);
+  EXPECT_FALSE(h.wheels[0].steer_motor);
+  EXPECT_EQ(h.wheels[0].drive_motor, h.wheels[1].drive_motor);  // belt-coupled side
+  EXPECT_EQ(h.wheels[0].radius_m, 0.1651);
+  EXPECT_EQ(h.Motors().size(), 2u);
+}
+
+// Guards "no silent default": a description that leaves out a required
+// value is refused naming the file, the line of the item and the key.
+TEST(RobotFile, MissingRequiredValueNamesFileLineAndKey) {
+  const std::string file = WriteScenario(
+      "robot_missing.yaml",
+      Robot("{name: l, x_m: 0, y_m: 0.3, width_m: 0.05, mass_kg: 2, drive_motor: left}"));
+  const Read read = ReadModel(file);
+  EXPECT_FALSE(read.file);
+  EXPECT_TRUE(Has(read.issues, file + ":3")) << read.issues;
+  EXPECT_TRUE(Has(read.issues, "wheels.0.radius_m")) << read.issues;
+  EXPECT_TRUE(Has(read.issues, "missing required key")) << read.issues;
+}
+
+// Guards the topology checks: a wheel naming no motor of the groups, a
+// motor that moves nothing, a differential base with a steered wheel, and
+// an unknown key in the file.
+TEST(RobotFile, TopologyProblemsAreNamed) {
+  const std::string unknown_motor = WriteScenario(
+      "robot_unknown_motor.yaml",
+      Robot("{name: l, x_m: 0, y_m: 0.3, radius_m: 0.1, width_m: 0.05, mass_kg: 2, "
+            "drive_motor: lft}"));
+  const Read a = ReadModel(unknown_motor);
+  EXPECT_TRUE(Has(a.issues, "wheels.0.drive_motor: no motor 'lft' in motor_groups")) << a.issues;
+  EXPECT_TRUE(Has(a.issues, "motor 'left' moves no wheel")) << a.issues;
+
+  const std::string steered = WriteScenario(
+      "robot_steered.yaml",
+      Robot("{name: l, x_m: 0, y_m: 0.3, radius_m: 0.1, width_m: 0.05, mass_kg: 2, "
+            "steer_inertia_kgm2: 0.01, steer_motor: right, drive_motor: left}"));
+  EXPECT_TRUE(Has(ReadModel(steered).issues, "a differential base has no steered wheel"))
+      << ReadModel(steered).issues;
+
+  const std::string typo = WriteScenario("robot_typo.yaml", Robot(kLeft) + "wheel: []\n");
+  EXPECT_TRUE(Has(ReadModel(typo).issues, "wheel")) << ReadModel(typo).issues;
+  EXPECT_FALSE(ReadModel(typo).file);
+
+  EXPECT_TRUE(ReadModel(WriteScenario("robot_ok.yaml", Robot(kLeft))).file);
+}
+
+// Guards the name: an unknown robot lists the shipped ones.
+TEST(RobotFile, UnknownRobotNamesTheClosest) {
+  const Read read = ReadModel("huskey");
+  EXPECT_FALSE(read.file);
+  EXPECT_TRUE(Has(read.issues, "husky")) << read.issues;
+}
+
+}  // namespace
+}  // namespace linesim::loader
