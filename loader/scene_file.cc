@@ -29,7 +29,7 @@ constexpr Range kLength{0.0, 1e4, true};
 constexpr Range kHeight{0.0, 100.0, true};
 constexpr Range kBottom{0.0, 100.0};
 
-const std::vector<std::string> kSceneKeys = {"name",  "description", "source", "surfaces", "floor",
+const std::vector<std::string> kSceneKeys = {"name",  "description", "source",  "surfaces", "floor",
                                              "belts", "obstacles",   "carried", "terrain"};
 
 // Reads the lists of named items with the names each list defines, so that
@@ -90,20 +90,22 @@ class SceneParser {
     if (it != names.end()) return static_cast<int>(it - names.begin());
     r_.Error(Child(item, key), JoinPath(path, key),
              "no " + what + " '" + name + "' in this scene" +
-                 (names.empty() ? " (it defines none)"
-                                : ": expected one of " + JoinNames(names) +
-                                      cosim::ClosestHint(name, names)));
+                 (names.empty()
+                      ? " (it defines none)"
+                      : ": expected one of " + JoinNames(names) + cosim::ClosestHint(name, names)));
     return 0;
   }
 
   void Surfaces(const YAML::Node& list, const std::string& path, const YAML::Node& root) {
     if (!list.IsDefined() || list.IsNull()) {
-      r_.Error(root, path, "missing required key: a list of surfaces {name, friction, "
-                           "texture_contrast, illumination_lux}");
+      r_.Error(root, path,
+               "missing required key: a list of surfaces {name, friction, "
+               "texture_contrast, illumination_lux}");
       return;
     }
     const auto items = Items(list, path);
-    if (list.IsSequence() && list.size() == 0) r_.Error(list, path, "expected at least one surface");
+    if (list.IsSequence() && list.size() == 0)
+      r_.Error(list, path, "expected at least one surface");
     for (const auto& [p, item] : items) {
       r_.CheckKeys(item, p, {"name", "friction", "texture_contrast", "illumination_lux"});
       models::Surface surface;
@@ -136,9 +138,9 @@ class SceneParser {
       const double hi = axis[0] == 'x' ? f.max_x_m : f.max_y_m;
       const std::string key = std::string("max_") + axis + "_m";
       if (Child(floor, key).IsDefined() && hi <= lo) {
-        r_.Error(Child(floor, key), JoinPath(path, key),
-                 "expected more than min_" + std::string(axis) + "_m (" +
-                     YAML::Node(lo).Scalar() + ")");
+        r_.Error(
+            Child(floor, key), JoinPath(path, key),
+            "expected more than min_" + std::string(axis) + "_m (" + YAML::Node(lo).Scalar() + ")");
       }
     }
     f.surface = Reference(floor, path, "surface", surface_names_, "surface");
@@ -146,10 +148,10 @@ class SceneParser {
 
   void Belts(const YAML::Node& list, const std::string& path) {
     for (const auto& [p, b] : Items(list, path)) {
-      r_.CheckKeys(b, p,
-                   {"name", "surface", "center_x_m", "center_y_m", "length_m", "width_m",
-                    "direction_deg", "speed_mps", "speed_variation", "variation_period_s",
-                    "acceleration_mps2", "schedule"});
+      r_.CheckKeys(
+          b, p,
+          {"name", "surface", "center_x_m", "center_y_m", "length_m", "width_m", "direction_deg",
+           "speed_mps", "speed_variation", "variation_period_s", "acceleration_mps2", "schedule"});
       models::Belt belt;
       belt.name = Name(b, p, belt_names_);
       belt.surface = Reference(b, p, "surface", surface_names_, "surface");
@@ -263,8 +265,9 @@ class SceneParser {
     if (!node.IsDefined() || node.IsNull()) {
       r_.Error(item, p, "missing required key: " + meaning);
     } else if (!node.IsSequence() || node.size() != 3) {
-      r_.Error(node, p, "expected " + meaning + ", got " + Describe(node) +
-                            (node.IsSequence() ? " of " + std::to_string(node.size()) : ""));
+      r_.Error(node, p,
+               "expected " + meaning + ", got " + Describe(node) +
+                   (node.IsSequence() ? " of " + std::to_string(node.size()) : ""));
     } else {
       for (std::size_t i = 0; i < 3; ++i) {
         out[i] = r_.AsReal(node[i], JoinPath(p, std::to_string(i)), ranges[i]).value_or(0.0);
@@ -395,6 +398,7 @@ models::Scene ReadScenarioScene(YamlReader& r, const YAML::Node& scene,
   if (!model_node.IsDefined()) {
     models::Scene out;
     out.name = fs::path(scenario_file).stem().string();
+    out.file = scenario_file;
     SceneParser(r, out).Parse(scene, "scene", true);
     return out;
   }
@@ -403,7 +407,14 @@ models::Scene ReadScenarioScene(YamlReader& r, const YAML::Node& scene,
   std::string file;
   const YAML::Node model =
       LoadModel(r, model_node, "scene.model", "scene", *model_name, "scenes", scenario_file, &file);
-  if (!model.IsDefined()) return models::OpenFloor();
+  if (!model.IsDefined()) {
+    // Without the file there is nothing to merge onto; its keys can still
+    // be checked.
+    std::vector<std::string> keys = kSceneKeys;
+    keys.insert(keys.begin(), "model");
+    r.CheckKeys(scene, "scene", keys);
+    return models::OpenFloor();
+  }
   const std::string name = fs::path(file).stem().string();
 
   // The scene file alone first: its problems are its own, at its lines.

@@ -207,8 +207,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   column.ThrowIfUnknown();
   if (!travels.empty() && travels.size() != spec.scene.belts.size()) {
     throw std::runtime_error("robot plots: " + std::to_string(travels.size()) +
-                             " belt travel columns for " +
-                             std::to_string(spec.scene.belts.size()) +
+                             " belt travel columns for " + std::to_string(spec.scene.belts.size()) +
                              " belts of the scene: expected one per belt");
   }
 
@@ -352,8 +351,8 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
       for (const Point& c : corners) view.Add(c.x, c.y);
     }
   } else if (!view.empty()) {
-    const Bounds near{view.x_min - spec.near_m, view.x_max + spec.near_m,
-                      view.y_min - spec.near_m, view.y_max + spec.near_m};
+    const Bounds near{view.x_min - spec.near_m, view.x_max + spec.near_m, view.y_min - spec.near_m,
+                      view.y_max + spec.near_m};
     for (const auto& corners : footprints) {
       Bounds box;
       for (const Point& c : corners) box.Add(c.x, c.y);
@@ -427,15 +426,13 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
                       " noautoscale title " + GnuplotQuote(title));
     }
     if (!layer.circles.empty()) {
-      items.push_back("$" + name + "_circles using 1:2:3 with circles " + style +
-                      " noautoscale " +
+      items.push_back("$" + name + "_circles using 1:2:3 with circles " + style + " noautoscale " +
                       (layer.polygons.empty() ? "title " + GnuplotQuote(title) : "notitle"));
     }
   };
   solids(obstacles, "obstacles",
          "fillcolor rgb '#b8b8b8' fillstyle solid 1.0 border lc rgb '#606060'", "obstacle");
-  solids(carried, "carried",
-         "fillcolor rgb '#f6d3a8' fillstyle solid 1.0 border lc rgb '#c07020'",
+  solids(carried, "carried", "fillcolor rgb '#f6d3a8' fillstyle solid 1.0 border lc rgb '#c07020'",
          "carried object (t = 0)");
   if (!carried_end.polygons.empty()) {
     items.push_back(

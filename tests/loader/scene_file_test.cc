@@ -139,8 +139,8 @@ TEST(SceneFile, RangesAndTypesAreChecked) {
 TEST(ScenarioScene, AbsentIsOpenFloorAndWrittenIsRead) {
   const std::string plain = WriteScenario("plain.yaml", kValidScenario);
   EXPECT_EQ(LoadScenario(plain).scene.name, "open_floor");
-  const std::string written =
-      WriteScenario("written.yaml", std::string(kValidScenario) + "scene:\n" + [] {
+  const std::string written = WriteScenario(
+      "written.yaml", std::string(kValidScenario) + "scene:\n" + [] {
         std::string indented;
         std::string text = kSmallScene;
         for (std::size_t at = 0, next; at < text.size(); at = next + 1) {
@@ -158,8 +158,7 @@ TEST(ScenarioScene, AbsentIsOpenFloorAndWrittenIsRead) {
 // Guards the merge rules: maps by key, list items by index, an item past
 // the model's list added; the rest of the model kept.
 TEST(ScenarioScene, OverridesByIndexAndAddedItems) {
-  const std::string f = WriteScenario(
-      "merge.yaml", std::string(kValidScenario) + R"(scene:
+  const std::string f = WriteScenario("merge.yaml", std::string(kValidScenario) + R"(scene:
   model: factory_line
   description: the hall with a faster line
   surfaces:
@@ -194,8 +193,7 @@ TEST(ScenarioScene, OverridesByIndexAndAddedItems) {
 // own line and key path under scene; an added item missing a required value
 // at the item; a scene file's own problem in the scene file.
 TEST(ScenarioScene, ProblemsAreReportedWhereTheyAreWritten) {
-  const std::string f = WriteScenario(
-      "bad_merge.yaml", std::string(kValidScenario) + R"(scene:
+  const std::string f = WriteScenario("bad_merge.yaml", std::string(kValidScenario) + R"(scene:
   model: factory_line
   belts:
     - speed_mps: 5
@@ -213,12 +211,18 @@ TEST(ScenarioScene, ProblemsAreReportedWhereTheyAreWritten) {
   EXPECT_TRUE(Has(issues, f + ":21: scene.carried.2.box: missing required key")) << issues;
   EXPECT_FALSE(Has(issues, "factory_line.yaml")) << issues;
 
+  const std::string typos = Issues(WriteScenario(
+      "scene_typos.yaml", std::string(kValidScenario) + "scene: {model: factory_lin, belt: []}\n"));
+  EXPECT_TRUE(Has(typos, "scene.model: no scene file ")) << typos;
+  EXPECT_TRUE(Has(typos, "(closest: factory_line)")) << typos;
+  EXPECT_TRUE(Has(typos, "scene.belt: unknown key; closest: scene.belts")) << typos;
+
   std::string bad = kSmallScene;
   bad.replace(bad.find("width_m: 2"), 10, "width_m: -2");
   const std::string scene_file = WriteScenario("bad_scene.yaml", bad);
-  const std::string g = WriteScenario(
-      "uses_bad_scene.yaml", std::string(kValidScenario) + "scene: {model: " +
-                                 scene_file.substr(scene_file.rfind('/') + 1) + "}\n");
+  const std::string g = WriteScenario("uses_bad_scene.yaml",
+                                      std::string(kValidScenario) + "scene: {model: " +
+                                          scene_file.substr(scene_file.rfind('/') + 1) + "}\n");
   const std::string from_file = Issues(g);
   EXPECT_TRUE(Has(from_file, scene_file + ":7: belts.0.width_m: value -2 is out of range"))
       << from_file;
@@ -227,15 +231,13 @@ TEST(ScenarioScene, ProblemsAreReportedWhereTheyAreWritten) {
 // Guards --set of a scene value the scenario writes: it applies, and a bad
 // one is reported as from the command line, not at a line of either file.
 TEST(ScenarioScene, SetOnTheCommandLine) {
-  const std::string f = WriteScenario(
-      "set_scene.yaml", std::string(kValidScenario) + R"(scene:
+  const std::string f = WriteScenario("set_scene.yaml", std::string(kValidScenario) + R"(scene:
   model: factory_line
   belts:
     - {speed_mps: 0.2}
 )");
-  EXPECT_DOUBLE_EQ(LoadScenario(f, {"scene.belts.0.speed_mps=0.15"}).scene.belts[0]
-                       .nominal_speed_mps,
-                   0.15);
+  EXPECT_DOUBLE_EQ(
+      LoadScenario(f, {"scene.belts.0.speed_mps=0.15"}).scene.belts[0].nominal_speed_mps, 0.15);
   const std::string issues = Issues(f, {"scene.belts.0.speed_mps=3"});
   EXPECT_TRUE(Has(issues, f + ": scene.belts.0.speed_mps (set on the command line): value 3 is "
                               "out of range"))

@@ -208,7 +208,8 @@ TEST_F(RobotPlotsTest, DrawsObstaclesAndCarriedObjects) {
     std::string line, out;
     std::getline(in, line);
     out = line + ",belt.travel[0]\n";
-    for (int k = 0; std::getline(in, line); ++k) out += line + "," + std::to_string(0.001 * k) + "\n";
+    for (int k = 0; std::getline(in, line); ++k)
+      out += line + "," + std::to_string(0.001 * k) + "\n";
     in.close();
     std::ofstream(dir_ / "signals.csv") << out;
   }
