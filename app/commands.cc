@@ -68,8 +68,15 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
   const loader::RobotInfo& robot = *s.robot;
   plots::RobotPlotSpec spec;
   spec.title = s.name;
-  for (const auto& b : robot.belts) {
-    spec.belts.push_back({b.center_x_m, b.center_y_m, b.length_m, b.width_m, b.direction_rad});
+  spec.scene = s.scene;
+  // Until robot scenarios expand into a `scene:`, their belts come from the
+  // robot expansion.
+  if (spec.scene.belts.empty()) {
+    for (const auto& b : robot.belts) {
+      models::Belt belt;
+      belt.area = {b.center_x_m, b.center_y_m, b.length_m, b.width_m, b.direction_rad};
+      spec.scene.belts.push_back(belt);
+    }
   }
   spec.path_m = robot.path;
   spec.x_column = robot.x_column;

@@ -6,6 +6,7 @@
 
 #include "cosim/closest_names.h"
 #include "cosim/seed.h"
+#include "loader/scene_file.h"
 #include "loader/unit_types.h"
 #include "loader/yaml_files.h"
 #include "loader/yaml_reader.h"
@@ -112,7 +113,7 @@ class Builder {
     if (!r_.ExpectMap(root, "(top)")) return;
     r_.CheckKeys(root, "",
                  {"name", "description", "duration_s", "seed", "master", "units", "connections",
-                  "recording", "metrics"});
+                  "recording", "metrics", "scene"});
     s_.name = r_.String(root, "", "name", fs::path(s_.file).stem().string());
     s_.description = r_.String(root, "", "description", "");
     cosim::MasterOptions options;
@@ -141,6 +142,12 @@ class Builder {
                    cosim::FormatSeconds(options.base_step) + " s)");
     }
     const bool master_ok = r_.issues().size() == issues_before_master;
+
+    // The scene first: units that need geometry build from it.
+    const std::size_t issues_before_scene = r_.issues().size();
+    s_.scene = ReadScenarioScene(r_, Child(root, "scene"), s_.file);
+    // A scene problem would only echo as problems of the units built on it.
+    if (r_.issues().size() != issues_before_scene) return;
 
     s_.system = std::make_unique<cosim::System>();
     const std::size_t issues_before_units = r_.issues().size();

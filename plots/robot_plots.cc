@@ -142,6 +142,36 @@ void AppendBlock(std::string& script, const std::string& name, const std::string
   script += "$" + name + " << EOD\n" + data + "EOD\n";
 }
 
+// Solids of the scene as gnuplot data: boxes as closed polygons, cylinders
+// as "x,y,radius" rows for `with circles`.
+struct SolidLayer {
+  std::string polygons, circles;
+};
+
+// Footprint corners of `solid` moved by (dx, dy): a box's four, or the
+// bounding square of a cylinder.
+std::array<Point, 4> Footprint(const models::Solid& solid, double dx, double dy) {
+  if (solid.kind == models::Solid::Kind::kCylinder) {
+    return Rectangle(solid.x_m + dx, solid.y_m + dy, 0.0, 2.0 * solid.radius_m,
+                     2.0 * solid.radius_m);
+  }
+  return Rectangle(solid.x_m + dx, solid.y_m + dy, solid.yaw_rad, solid.length_m, solid.width_m);
+}
+
+void AppendSolid(SolidLayer& layer, const models::Solid& solid, double dx, double dy) {
+  if (solid.kind == models::Solid::Kind::kCylinder) {
+    layer.circles +=
+        Num(solid.x_m + dx) + "," + Num(solid.y_m + dy) + "," + Num(solid.radius_m) + "\n";
+  } else {
+    AppendPolygon(layer.polygons, Footprint(solid, dx, dy));
+  }
+}
+
+std::array<Point, 4> BeltCorners(const models::Belt& b) {
+  return Rectangle(b.area.center_x_m, b.area.center_y_m, b.area.direction_rad, b.area.length_m,
+                   b.area.width_m);
+}
+
 // Row indices of `count` instants evenly spaced from the first row to the
 // last (rounded to the nearest row).
 std::vector<std::size_t> EvenlySpaced(std::size_t rows, int count) {
@@ -172,7 +202,14 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   std::vector<int> speeds, ons;
   for (const auto& name : spec.belt_speed_columns) speeds.push_back(column(name, "belt speed"));
   for (const auto& name : spec.belt_on_columns) ons.push_back(column(name, "belt on"));
+  std::vector<int> travels;
+  for (const auto& name : spec.belt_travel_columns) travels.push_back(column(name, "belt travel"));
   column.ThrowIfUnknown();
+  if (!travels.empty() && travels.size() != spec.scene.belts.size()) {
+    throw std::runtime_error("robot plots: " + std::to_string(travels.size()) +
+                             " belt travel columns for " + std::to_string(spec.scene.belts.size()) +
+                             " belts of the scene: expected one per belt");
+  }
 
   std::string s =
       "# Written by linesim (plots/robot_plots.cc). Run `gnuplot plots.gp` in this folder\n"
@@ -184,9 +221,9 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   // Belt rectangles, and arrows about every metre along each centre line showing
   // the direction of motion (only those in view are drawn).
   std::string belts, arrows;
-  for (const BeltRect& b : spec.belts) {
-    AppendPolygon(belts,
-                  Rectangle(b.center_x_m, b.center_y_m, b.direction_rad, b.length_m, b.width_m));
+  for (const models::Belt& belt : spec.scene.belts) {
+    const models::Rect& b = belt.area;
+    AppendPolygon(belts, BeltCorners(belt));
     const double c = std::cos(b.direction_rad), sn = std::sin(b.direction_rad);
     const int n = std::clamp(static_cast<int>(b.length_m), 1, 200);
     for (int k = 0; k < n; ++k) {
@@ -206,10 +243,14 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   // One pass over the rows: the track's extent, and where each row starts
   // (to come back to the few rows the outlines are drawn at).
   std::vector<std::streamoff> row_starts;
+  // Each belt's travel at the last row that gives one.
+  std::vector<std::optional<double>> travel(travels.size());
   {
     std::vector<std::string_view> fields;
     std::string line;
-    const auto needed = static_cast<std::size_t>(std::max(ix, iy));
+    int last_column = std::max(ix, iy);
+    for (int col : travels) last_column = std::max(last_column, col);
+    const auto needed = static_cast<std::size_t>(last_column);
     while (true) {
       const std::streamoff start = signals.in.tellg();
       if (!std::getline(signals.in, line)) break;
@@ -218,6 +259,9 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
       SplitCsv(line, fields, needed);
       const auto x = Column(fields, ix), y = Column(fields, iy);
       if (x && y) view.Add(*x, *y);
+      for (std::size_t b = 0; b < travels.size(); ++b) {
+        if (const auto d = Column(fields, travels[b])) travel[b] = d;
+      }
     }
   }
   if (row_starts.empty()) throw std::runtime_error(signals.file.string() + " has no data rows");
@@ -271,7 +315,62 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
       labels += Num(at.x) + "," + Num(at.y) + ",t = " + times + " s\n";
     }
   }
+  // The scene's solids: obstacles, and carried objects at time zero and
+  // (with travel columns) at the end, moved along their belt.
+  SolidLayer obstacles, carried, carried_end;
+  std::vector<std::array<Point, 4>> footprints;  // for framing
+  for (const models::Obstacle& o : spec.scene.obstacles) {
+    AppendSolid(obstacles, o.solid, 0.0, 0.0);
+    footprints.push_back(Footprint(o.solid, 0.0, 0.0));
+  }
+  for (const models::CarriedObject& c : spec.scene.carried) {
+    AppendSolid(carried, c.solid, 0.0, 0.0);
+    footprints.push_back(Footprint(c.solid, 0.0, 0.0));
+    const auto b = static_cast<std::size_t>(c.belt);
+    if (b < travel.size() && travel[b] && b < spec.scene.belts.size()) {
+      const double heading = spec.scene.belts[b].area.direction_rad;
+      const double dx = *travel[b] * std::cos(heading), dy = *travel[b] * std::sin(heading);
+      AppendSolid(carried_end, c.solid, dx, dy);
+      footprints.push_back(Footprint(c.solid, dx, dy));
+    }
+  }
+  for (const models::Belt& b : spec.scene.belts) footprints.push_back(BeltCorners(b));
+
+  // Frame: the robot's neighbourhood and the parts of the scene within
+  // near_m of it (a wall along the path shows, not the whole hall); or,
+  // when asked, the whole scene.
+  if (spec.whole_scene) {
+    const models::Floor& f = spec.scene.floor;
+    // A floor as large as models::OpenFloor()'s is unbounded: not framed.
+    if (std::max({std::abs(f.min_x_m), std::abs(f.max_x_m), std::abs(f.min_y_m),
+                  std::abs(f.max_y_m)}) < 1e5) {
+      view.Add(f.min_x_m, f.min_y_m);
+      view.Add(f.max_x_m, f.max_y_m);
+    }
+    for (const auto& corners : footprints) {
+      for (const Point& c : corners) view.Add(c.x, c.y);
+    }
+  } else if (!view.empty()) {
+    const Bounds near{view.x_min - spec.near_m, view.x_max + spec.near_m, view.y_min - spec.near_m,
+                      view.y_max + spec.near_m};
+    for (const auto& corners : footprints) {
+      Bounds box;
+      for (const Point& c : corners) box.Add(c.x, c.y);
+      const double x0 = std::max(box.x_min, near.x_min), x1 = std::min(box.x_max, near.x_max);
+      const double y0 = std::max(box.y_min, near.y_min), y1 = std::min(box.y_max, near.y_max);
+      if (x0 > x1 || y0 > y1) continue;
+      view.Add(x0, y0);
+      view.Add(x1, y1);
+    }
+  }
+
   if (!belts.empty()) AppendBlock(s, "belts", belts);
+  if (!obstacles.polygons.empty()) AppendBlock(s, "obstacles", obstacles.polygons);
+  if (!obstacles.circles.empty()) AppendBlock(s, "obstacles_circles", obstacles.circles);
+  if (!carried.polygons.empty()) AppendBlock(s, "carried", carried.polygons);
+  if (!carried.circles.empty()) AppendBlock(s, "carried_circles", carried.circles);
+  if (!carried_end.polygons.empty()) AppendBlock(s, "carried_end", carried_end.polygons);
+  if (!carried_end.circles.empty()) AppendBlock(s, "carried_end_circles", carried_end.circles);
   if (!arrows.empty()) AppendBlock(s, "belt_direction", arrows);
   if (!path.empty()) AppendBlock(s, "path", path);
   if (!outlines.empty()) AppendBlock(s, "outlines", outlines);
@@ -318,6 +417,33 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     items.push_back(
         "$belt_direction using 1:2:3:4 with vectors lc rgb '#8fa9cc' noautoscale "
         "title 'belt motion'");
+  }
+  // One legend entry per kind of thing, whether boxes or circles draw it.
+  const auto solids = [&](const SolidLayer& layer, const std::string& name,
+                          const std::string& style, const std::string& title) {
+    if (!layer.polygons.empty()) {
+      items.push_back("$" + name + " using 1:2 with filledcurves closed " + style +
+                      " noautoscale title " + GnuplotQuote(title));
+    }
+    if (!layer.circles.empty()) {
+      items.push_back("$" + name + "_circles using 1:2:3 with circles " + style + " noautoscale " +
+                      (layer.polygons.empty() ? "title " + GnuplotQuote(title) : "notitle"));
+    }
+  };
+  solids(obstacles, "obstacles",
+         "fillcolor rgb '#b8b8b8' fillstyle solid 1.0 border lc rgb '#606060'", "obstacle");
+  solids(carried, "carried", "fillcolor rgb '#f6d3a8' fillstyle solid 1.0 border lc rgb '#c07020'",
+         "carried object (t = 0)");
+  if (!carried_end.polygons.empty()) {
+    items.push_back(
+        "$carried_end using 1:2 with lines dt 2 lw 1.5 lc rgb '#c07020' noautoscale "
+        "title 'carried object (end)'");
+  }
+  if (!carried_end.circles.empty()) {
+    items.push_back(
+        "$carried_end_circles using 1:2:3 with circles fillstyle empty border lc rgb '#c07020' "
+        "noautoscale " +
+        std::string(carried_end.polygons.empty() ? "title 'carried object (end)'" : "notitle"));
   }
   if (spec.path_m.size() == 1) {
     items.push_back(

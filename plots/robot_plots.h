@@ -5,23 +5,28 @@
 #include <utility>
 #include <vector>
 
-namespace linesim::plots {
+#include "models/scene.h"
 
-/// A belt as a rectangle in the map frame.
-struct BeltRect {
-  double center_x_m = 0.0;
-  double center_y_m = 0.0;
-  double length_m = 1.0;  // along the direction of motion
-  double width_m = 1.0;   // across it
-  double direction_rad = 0.0;
-};
+namespace linesim::plots {
 
 /// What to draw for one robot run. Column names are header names of
 /// signals.csv as the recorder writes them ("chassis.pose[0]"); an empty name
 /// leaves out what it would draw.
 struct RobotPlotSpec {
   std::string title;
-  std::vector<BeltRect> belts;
+  /// What the top view draws around the robot: belts (rectangles with
+  /// arrows along their motion), obstacles (filled outlines; cylinders as
+  /// circles), carried objects at their time-zero pose.
+  models::Scene scene;
+  /// Distance travelled by each scene belt's surface (m; one column per
+  /// belt, in scene order, or none): when given, carried objects are drawn
+  /// again at the last row, moved along their belt by its travel.
+  std::vector<std::string> belt_travel_columns;
+  /// The top view frames the robot's path, track and outlines, and what of
+  /// the scene lies within `near_m` of them; with `whole_scene`, the whole
+  /// floor (when bounded) and everything on it.
+  double near_m = 1.5;
+  bool whole_scene = false;
   /// Desired path polyline in the map frame; a single point is a hold target.
   std::vector<std::array<double, 2>> path_m;
   /// Robot position (m) and yaw (rad) in the map frame. x and y are

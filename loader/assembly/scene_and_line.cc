@@ -37,7 +37,7 @@ models::Scene AddScene(SystemBuilder& b) {
   // The scene as the system loader will read it (its problems are
   // reported once, there).
   YamlReader quiet(r.file());
-  return ReadScene(quiet, scene, "scene", r.file());
+  return ReadScenarioScene(quiet, scene, r.file());
 }
 
 void AddLine(SystemBuilder& b, const models::Scene& scene, Signals& s) {

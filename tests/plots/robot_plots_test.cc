@@ -60,7 +60,10 @@ class RobotPlotsTest : public ::testing::Test {
   static RobotPlotSpec Spec() {
     RobotPlotSpec spec;
     spec.title = "crossing 'test'";
-    spec.belts = {{0.0, 0.0, 10.0, 1.0, 0.0}};
+    models::Belt belt;
+    belt.name = "line";
+    belt.area = {0.0, 0.0, 10.0, 1.0, 0.0};
+    spec.scene.belts = {belt};
     spec.path_m = {{0.0, -1.5}, {0.0, 1.5}};
     spec.x_column = "chassis.pose[0]";
     spec.y_column = "chassis.pose[1]";
@@ -191,6 +194,65 @@ TEST_F(RobotPlotsTest, StandingRobotGetsOneJoinedTimeLabel) {
   WriteRobotPlots(dir_.string(), Spec());
   const std::string script = ReadAll(dir_ / "plots.gp");
   EXPECT_NE(script.find(",t = 0 / 7.5 / 15 / 22.5 / 30 s\n"), std::string::npos) << script;
+}
+
+// Guards the scene in the top view: obstacles near the path are drawn and
+// framed (boxes as filled outlines, cylinders as circles), one far away does
+// not stretch the view, and a carried object appears at time zero and at
+// the end, moved along its belt by the travel column's last value.
+TEST_F(RobotPlotsTest, DrawsObstaclesAndCarriedObjects) {
+  WriteSignals();
+  {
+    // A travel column: the belt surface at 0.1 m/s for 30 s travels 3 m.
+    std::ifstream in(dir_ / "signals.csv");
+    std::string line, out;
+    std::getline(in, line);
+    out = line + ",belt.travel[0]\n";
+    for (int k = 0; std::getline(in, line); ++k)
+      out += line + "," + std::to_string(0.001 * k) + "\n";
+    in.close();
+    std::ofstream(dir_ / "signals.csv") << out;
+  }
+  RobotPlotSpec spec = Spec();
+  models::Obstacle cart{"cart", "cart", {}};
+  cart.solid.x_m = 1.0;  // 1 m beside the path at x = 0
+  cart.solid.length_m = 1.2;
+  cart.solid.width_m = 0.8;
+  cart.solid.height_m = 1.0;
+  models::Obstacle pillar{"pillar", "pillar", {}};
+  pillar.solid.kind = models::Solid::Kind::kCylinder;
+  pillar.solid.x_m = -1.0;
+  pillar.solid.radius_m = 0.25;
+  pillar.solid.height_m = 4.0;
+  models::Obstacle far_wall{"wall", "wall", {}};
+  far_wall.solid.x_m = 50.0;
+  far_wall.solid.length_m = 0.2;
+  far_wall.solid.width_m = 20.0;
+  far_wall.solid.height_m = 4.0;
+  spec.scene.obstacles = {cart, pillar, far_wall};
+  models::CarriedObject body{"body", 0, {}};
+  body.solid.x_m = -3.0;
+  body.solid.length_m = 2.0;
+  body.solid.width_m = 0.8;
+  body.solid.height_m = 1.2;
+  spec.scene.carried = {body};
+  spec.belt_travel_columns = {"belt.travel[0]"};
+  const auto files = WriteRobotPlots(dir_.string(), spec);
+  ASSERT_FALSE(files.empty());
+  EXPECT_TRUE(IsPng(files[0]));
+  const std::string script = ReadAll(dir_ / "plots.gp");
+  // The cart's polygon starts at its front-left corner (1.6, 0.4).
+  EXPECT_NE(script.find("$obstacles << EOD\n1.6,0.4\n"), std::string::npos) << script;
+  EXPECT_NE(script.find("$obstacles_circles << EOD\n-1,0,0.25\n"), std::string::npos) << script;
+  EXPECT_NE(script.find("with circles"), std::string::npos);
+  // Time zero: front-left corner at (-2, 0.4); end: moved 3 m along +x.
+  EXPECT_NE(script.find("$carried << EOD\n-2,0.4\n"), std::string::npos) << script;
+  EXPECT_NE(script.find("$carried_end << EOD\n1,0.4\n"), std::string::npos) << script;
+  // The wall at x = 50 is not near the path: the view stays within 10 m.
+  const auto at = script.find("set xrange [");
+  ASSERT_NE(at, std::string::npos);
+  const double x_max = std::stod(script.substr(script.find(':', at) + 1));
+  EXPECT_LT(x_max, 10.0);
 }
 
 // Guards against a missing signals.csv or gnuplot being reported as

@@ -1,0 +1,457 @@
+#include "loader/scene_file.h"
+
+#include <algorithm>
+#include <array>
+#include <filesystem>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <vector>
+
+#include "cosim/closest_names.h"
+#include "loader/yaml_files.h"
+
+namespace linesim::loader {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+
+// Positions on the floor: the same bound as robot scenarios' belts.
+constexpr Range kCoordinate{-1e6, 1e6};
+// Horizontal sizes: a hall is at most a few hundred metres; 1e4 m as for
+// belts in robot scenarios.
+constexpr Range kLength{0.0, 1e4, true};
+// Heights of things standing in a hall, and how far above the floor they
+// start (a car body on skids, a mezzanine).
+constexpr Range kHeight{0.0, 100.0, true};
+constexpr Range kBottom{0.0, 100.0};
+
+const std::vector<std::string> kSceneKeys = {"name",  "description", "source",  "surfaces", "floor",
+                                             "belts", "obstacles",   "carried", "terrain"};
+
+// Reads the lists of named items with the names each list defines, so that
+// references to them can be checked.
+class SceneParser {
+ public:
+  SceneParser(YamlReader& r, models::Scene& scene) : r_(r), s_(scene) {}
+
+  void Parse(const YAML::Node& root, const std::string& path, bool allow_model) {
+    if (!r_.ExpectMap(root, path.empty() ? "(top)" : path)) return;
+    std::vector<std::string> keys = kSceneKeys;
+    if (allow_model) keys.insert(keys.begin(), "model");
+    r_.CheckKeys(root, path, keys);
+    s_.name = r_.String(root, path, "name", s_.name);
+    s_.description = r_.String(root, path, "description", "");
+    r_.String(root, path, "source", "");  // documentation only; must be text
+    Surfaces(Child(root, "surfaces"), JoinPath(path, "surfaces"), root);
+    FloorOf(Child(root, "floor"), JoinPath(path, "floor"), root);
+    Belts(Child(root, "belts"), JoinPath(path, "belts"));
+    Obstacles(Child(root, "obstacles"), JoinPath(path, "obstacles"));
+    Carried(Child(root, "carried"), JoinPath(path, "carried"));
+    Terrain(Child(root, "terrain"), JoinPath(path, "terrain"));
+  }
+
+ private:
+  // The items of an optional list (none when absent or null).
+  std::vector<std::pair<std::string, YAML::Node>> Items(const YAML::Node& list,
+                                                        const std::string& path) {
+    std::vector<std::pair<std::string, YAML::Node>> items;
+    if (!list.IsDefined() || list.IsNull() || !r_.ExpectSequence(list, path)) return items;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string item_path = JoinPath(path, std::to_string(i));
+      if (r_.ExpectMap(list[i], item_path)) items.emplace_back(item_path, list[i]);
+    }
+    return items;
+  }
+
+  // The item's `name`, which must be new in `names`.
+  std::string Name(const YAML::Node& item, const std::string& path,
+                   std::vector<std::string>& names) {
+    const std::string name = r_.String(item, path, "name", std::nullopt);
+    if (name.empty()) return name;
+    if (std::find(names.begin(), names.end(), name) != names.end()) {
+      r_.Error(Child(item, "name"), JoinPath(path, "name"),
+               "'" + name + "' is defined twice in this list: names must differ");
+    }
+    names.push_back(name);
+    return name;
+  }
+
+  // Index of the item `key` names in `names`; an unknown name is reported
+  // with the closest ones.
+  int Reference(const YAML::Node& item, const std::string& path, const std::string& key,
+                const std::vector<std::string>& names, const std::string& what) {
+    const std::string name = r_.String(item, path, key, std::nullopt);
+    if (name.empty()) return 0;
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it != names.end()) return static_cast<int>(it - names.begin());
+    r_.Error(Child(item, key), JoinPath(path, key),
+             "no " + what + " '" + name + "' in this scene" +
+                 (names.empty()
+                      ? " (it defines none)"
+                      : ": expected one of " + JoinNames(names) + cosim::ClosestHint(name, names)));
+    return 0;
+  }
+
+  void Surfaces(const YAML::Node& list, const std::string& path, const YAML::Node& root) {
+    if (!list.IsDefined() || list.IsNull()) {
+      r_.Error(root, path,
+               "missing required key: a list of surfaces {name, friction, "
+               "texture_contrast, illumination_lux}");
+      return;
+    }
+    const auto items = Items(list, path);
+    if (list.IsSequence() && list.size() == 0)
+      r_.Error(list, path, "expected at least one surface");
+    for (const auto& [p, item] : items) {
+      r_.CheckKeys(item, p, {"name", "friction", "texture_contrast", "illumination_lux"});
+      models::Surface surface;
+      surface.name = Name(item, p, surface_names_);
+      // Rubber or polyurethane on floors and belts is 0.5-1.0; 3 leaves
+      // room for studies without admitting nonsense.
+      surface.friction = r_.Real(item, p, "friction", std::nullopt, {0.0, 3.0});
+      surface.texture_contrast = r_.Real(item, p, "texture_contrast", std::nullopt, {0.0, 1.0});
+      // Direct sunlight is about 1e5 lx.
+      surface.illumination_lux = r_.Real(item, p, "illumination_lux", std::nullopt, {0.0, 1e5});
+      s_.surfaces.push_back(surface);
+    }
+  }
+
+  void FloorOf(const YAML::Node& floor, const std::string& path, const YAML::Node& root) {
+    if (!floor.IsDefined() || floor.IsNull()) {
+      r_.Error(root, path,
+               "missing required key: a map {min_x_m, max_x_m, min_y_m, max_y_m, surface}");
+      return;
+    }
+    if (!r_.ExpectMap(floor, path)) return;
+    r_.CheckKeys(floor, path, {"min_x_m", "max_x_m", "min_y_m", "max_y_m", "surface"});
+    models::Floor& f = s_.floor;
+    f.min_x_m = r_.Real(floor, path, "min_x_m", std::nullopt, kCoordinate);
+    f.max_x_m = r_.Real(floor, path, "max_x_m", std::nullopt, kCoordinate);
+    f.min_y_m = r_.Real(floor, path, "min_y_m", std::nullopt, kCoordinate);
+    f.max_y_m = r_.Real(floor, path, "max_y_m", std::nullopt, kCoordinate);
+    for (const char* axis : {"x", "y"}) {
+      const double lo = axis[0] == 'x' ? f.min_x_m : f.min_y_m;
+      const double hi = axis[0] == 'x' ? f.max_x_m : f.max_y_m;
+      const std::string key = std::string("max_") + axis + "_m";
+      if (Child(floor, key).IsDefined() && hi <= lo) {
+        r_.Error(
+            Child(floor, key), JoinPath(path, key),
+            "expected more than min_" + std::string(axis) + "_m (" + YAML::Node(lo).Scalar() + ")");
+      }
+    }
+    f.surface = Reference(floor, path, "surface", surface_names_, "surface");
+  }
+
+  void Belts(const YAML::Node& list, const std::string& path) {
+    for (const auto& [p, b] : Items(list, path)) {
+      r_.CheckKeys(
+          b, p,
+          {"name", "surface", "center_x_m", "center_y_m", "length_m", "width_m", "direction_deg",
+           "speed_mps", "speed_variation", "variation_period_s", "acceleration_mps2", "schedule"});
+      models::Belt belt;
+      belt.name = Name(b, p, belt_names_);
+      belt.surface = Reference(b, p, "surface", surface_names_, "surface");
+      // Keys, defaults and ranges as robot scenarios' line.belts items.
+      belt.area.center_x_m = r_.Real(b, p, "center_x_m", std::nullopt, kCoordinate);
+      belt.area.center_y_m = r_.Real(b, p, "center_y_m", std::nullopt, kCoordinate);
+      belt.area.length_m = r_.Real(b, p, "length_m", std::nullopt, kLength);
+      belt.area.width_m = r_.Real(b, p, "width_m", std::nullopt, {0.0, 1e3, true});
+      belt.area.direction_rad = r_.Real(b, p, "direction_deg", 0.0, {-360, 360}) * kDegToRad;
+      // Paper 1: lines run below 0.2 m/s; 2 m/s leaves room for studies.
+      belt.nominal_speed_mps = r_.Real(b, p, "speed_mps", std::nullopt, {0.0, 2.0, true});
+      // Paper 1: "almost constant velocity (+-10 % variation)".
+      belt.speed_variation = r_.Real(b, p, "speed_variation", 0.1, {0.0, 0.5});
+      belt.variation_period_s = r_.Real(b, p, "variation_period_s", 20.0, {0.0, 1e6, true});
+      belt.acceleration_mps2 = r_.Real(b, p, "acceleration_mps2", 0.5, {0.0, 100.0, true});
+      Schedule(Child(b, "schedule"), JoinPath(p, "schedule"), belt);
+      s_.belts.push_back(belt);
+    }
+  }
+
+  // [{time_s, on}] in increasing time; on at t = 0 unless an entry at 0
+  // says otherwise.
+  void Schedule(const YAML::Node& list, const std::string& path, models::Belt& belt) {
+    belt.initially_on = true;
+    cosim::TimeNs last = -1;
+    for (const auto& [p, item] : Items(list, path)) {
+      r_.CheckKeys(item, p, {"time_s", "on"});
+      const cosim::TimeNs t = r_.Time(item, p, "time_s", std::nullopt, {0.0, 1e7});
+      const bool on = r_.Boolean(item, p, "on", std::nullopt);
+      if (t <= last) {
+        r_.Error(Child(item, "time_s"), JoinPath(p, "time_s"), "switching times must increase");
+      }
+      last = t;
+      if (t == 0) {
+        belt.initially_on = on;
+      } else {
+        belt.schedule.push_back({t, on});
+      }
+    }
+  }
+
+  // A `box` or a `cylinder` (exactly one of them) of `item`.
+  std::optional<models::Solid> Shape(const YAML::Node& item, const std::string& path,
+                                     bool cylinder_allowed) {
+    const YAML::Node box = Child(item, "box");
+    const YAML::Node cylinder = cylinder_allowed ? Child(item, "cylinder") : YAML::Node();
+    const bool has_box = box.IsDefined() && !box.IsNull();
+    const bool has_cylinder = cylinder.IsDefined() && !cylinder.IsNull();
+    const std::string wanted = cylinder_allowed ? "box or cylinder" : "box";
+    if (has_box == has_cylinder) {
+      if (has_box) {
+        r_.Error(cylinder, JoinPath(path, "cylinder"), "expected either box or cylinder, not both");
+      } else {
+        r_.Error(item, JoinPath(path, "box"), "missing required key: the shape (" + wanted + ")");
+      }
+      return std::nullopt;
+    }
+    models::Solid solid;
+    const std::string p = JoinPath(path, has_box ? "box" : "cylinder");
+    const YAML::Node m = has_box ? box : cylinder;
+    if (!r_.ExpectMap(m, p)) return std::nullopt;
+    if (has_box) {
+      r_.CheckKeys(m, p, {"x_m", "y_m", "yaw_deg", "length_m", "width_m", "height_m", "bottom_m"});
+      solid.kind = models::Solid::Kind::kBox;
+      solid.yaw_rad = r_.Real(m, p, "yaw_deg", 0.0, {-360, 360}) * kDegToRad;
+      solid.length_m = r_.Real(m, p, "length_m", std::nullopt, kLength);
+      solid.width_m = r_.Real(m, p, "width_m", std::nullopt, kLength);
+    } else {
+      r_.CheckKeys(m, p, {"x_m", "y_m", "radius_m", "height_m", "bottom_m"});
+      solid.kind = models::Solid::Kind::kCylinder;
+      solid.radius_m = r_.Real(m, p, "radius_m", std::nullopt, {0.0, 1e3, true});
+    }
+    solid.x_m = r_.Real(m, p, "x_m", std::nullopt, kCoordinate);
+    solid.y_m = r_.Real(m, p, "y_m", std::nullopt, kCoordinate);
+    solid.height_m = r_.Real(m, p, "height_m", std::nullopt, kHeight);
+    solid.bottom_m = r_.Real(m, p, "bottom_m", 0.0, kBottom);
+    return solid;
+  }
+
+  void Obstacles(const YAML::Node& list, const std::string& path) {
+    std::vector<std::string> names;
+    for (const auto& [p, item] : Items(list, path)) {
+      r_.CheckKeys(item, p, {"name", "kind", "box", "cylinder"});
+      models::Obstacle o;
+      o.name = Name(item, p, names);
+      o.kind = r_.String(item, p, "kind", std::nullopt, {"wall", "pillar", "cart", "rack"});
+      if (auto solid = Shape(item, p, true)) o.solid = *solid;
+      s_.obstacles.push_back(o);
+    }
+  }
+
+  void Carried(const YAML::Node& list, const std::string& path) {
+    std::vector<std::string> names;
+    for (const auto& [p, item] : Items(list, path)) {
+      r_.CheckKeys(item, p, {"name", "belt", "box"});
+      models::CarriedObject c;
+      c.name = Name(item, p, names);
+      c.belt = Reference(item, p, "belt", belt_names_, "belt");
+      if (auto solid = Shape(item, p, false)) c.solid = *solid;
+      s_.carried.push_back(c);
+    }
+  }
+
+  // A list of exactly three numbers, each in its range.
+  std::array<double, 3> Triple(const YAML::Node& item, const std::string& path,
+                               const std::string& key, const std::string& meaning,
+                               const std::array<Range, 3>& ranges) {
+    std::array<double, 3> out{};
+    const YAML::Node node = Child(item, key);
+    const std::string p = JoinPath(path, key);
+    if (!node.IsDefined() || node.IsNull()) {
+      r_.Error(item, p, "missing required key: " + meaning);
+    } else if (!node.IsSequence() || node.size() != 3) {
+      r_.Error(node, p,
+               "expected " + meaning + ", got " + Describe(node) +
+                   (node.IsSequence() ? " of " + std::to_string(node.size()) : ""));
+    } else {
+      for (std::size_t i = 0; i < 3; ++i) {
+        out[i] = r_.AsReal(node[i], JoinPath(p, std::to_string(i)), ranges[i]).value_or(0.0);
+      }
+    }
+    return out;
+  }
+
+  void Terrain(const YAML::Node& list, const std::string& path) {
+    std::vector<std::string> names;
+    for (const auto& [p, item] : Items(list, path)) {
+      r_.CheckKeys(item, p,
+                   {"name", "center_m", "size_m", "yaw_deg", "pitch_deg", "roll_deg", "surface"});
+      models::TerrainPiece t;
+      t.name = Name(item, p, names);
+      const auto c = Triple(item, p, "center_m", "[x, y, z] (m)",
+                            {kCoordinate, kCoordinate, Range{-100.0, 100.0}});
+      t.center_x_m = c[0];
+      t.center_y_m = c[1];
+      t.center_z_m = c[2];
+      const auto size = Triple(item, p, "size_m", "[length, width, thickness] (m)",
+                               {kLength, kLength, Range{0.0, 100.0, true}});
+      t.length_m = size[0];
+      t.width_m = size[1];
+      t.thickness_m = size[2];
+      t.yaw_rad = r_.Real(item, p, "yaw_deg", 0.0, {-360, 360}) * kDegToRad;
+      // A tilt of 90 degrees or more is a wall, not something driven on.
+      t.pitch_rad = r_.Real(item, p, "pitch_deg", 0.0, {-89.0, 89.0}) * kDegToRad;
+      t.roll_rad = r_.Real(item, p, "roll_deg", 0.0, {-89.0, 89.0}) * kDegToRad;
+      t.surface = Reference(item, p, "surface", surface_names_, "surface");
+      s_.terrain.push_back(t);
+    }
+  }
+
+  YamlReader& r_;
+  models::Scene& s_;
+  std::vector<std::string> surface_names_, belt_names_;
+};
+
+// Where a key path of the merged tree came from in the scenario: the
+// scenario's key node (for unknown keys) and value node.
+struct ScenarioSource {
+  YAML::Node key, value;
+};
+
+YAML::Node Record(const YAML::Node& node, const std::string& path,
+                  std::map<std::string, ScenarioSource>& sources);
+
+// `over` merged onto `base` (the scene file's tree, which is never
+// modified): maps by key, lists by index; anything else replaces. Every
+// path `over` writes is recorded in `sources` (relative to the scene).
+YAML::Node Merge(const YAML::Node& base, const YAML::Node& over, const std::string& path,
+                 std::map<std::string, ScenarioSource>& sources) {
+  if (base.IsMap() && over.IsMap()) {
+    YAML::Node out(YAML::NodeType::Map);
+    for (const auto& kv : base) out[kv.first.Scalar()] = kv.second;
+    for (const auto& kv : over) {
+      const std::string key = kv.first.Scalar();
+      if (path == "scene" && key == "model") continue;
+      const std::string p = JoinPath(path, key);
+      sources[p] = {kv.first, kv.second};
+      const YAML::Node b = Child(base, key);
+      out[key] = b.IsDefined() ? Merge(b, kv.second, p, sources) : Record(kv.second, p, sources);
+    }
+    return out;
+  }
+  if (base.IsSequence() && over.IsSequence()) {
+    YAML::Node out(YAML::NodeType::Sequence);
+    for (std::size_t i = 0; i < std::max(base.size(), over.size()); ++i) {
+      const std::string p = JoinPath(path, std::to_string(i));
+      if (i < over.size()) sources[p] = {over[i], over[i]};
+      if (i < base.size() && i < over.size()) {
+        out.push_back(Merge(base[i], over[i], p, sources));
+      } else if (i < base.size()) {
+        out.push_back(base[i]);
+      } else {
+        out.push_back(Record(over[i], p, sources));
+      }
+    }
+    return out;
+  }
+  return Record(over, path, sources);
+}
+
+// Records every path under `node` as the scenario's; returns `node`.
+YAML::Node Record(const YAML::Node& node, const std::string& path,
+                  std::map<std::string, ScenarioSource>& sources) {
+  if (node.IsMap()) {
+    for (const auto& kv : node) {
+      const std::string p = JoinPath(path, kv.first.Scalar());
+      sources[p] = {kv.first, kv.second};
+      Record(kv.second, p, sources);
+    }
+  } else if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      const std::string p = JoinPath(path, std::to_string(i));
+      sources[p] = {node[i], node[i]};
+      Record(node[i], p, sources);
+    }
+  }
+  return node;
+}
+
+}  // namespace
+
+models::Scene ReadScene(YamlReader& r, const YAML::Node& root, const std::string& path,
+                        const std::string& name, const std::string& file) {
+  models::Scene scene;
+  scene.name = name;
+  scene.file = file;
+  SceneParser(r, scene).Parse(root, path, false);
+  return scene;
+}
+
+models::Scene LoadSceneFile(const std::string& file) {
+  const YAML::Node root = LoadYamlOrThrow(file, "scene");
+  YamlReader r(file);
+  models::Scene scene = ReadScene(r, root, "", fs::path(file).stem().string(), file);
+  if (!r.ok()) throw ScenarioError(r.issues());
+  return scene;
+}
+
+models::Scene ReadScenarioScene(YamlReader& r, const YAML::Node& scene,
+                                const std::string& scenario_file) {
+  if (!scene.IsDefined() || scene.IsNull()) return models::OpenFloor();
+  if (!r.ExpectMap(scene, "scene")) return models::OpenFloor();
+  const YAML::Node model_node = Child(scene, "model");
+  if (!model_node.IsDefined()) {
+    models::Scene out;
+    out.name = fs::path(scenario_file).stem().string();
+    out.file = scenario_file;
+    SceneParser(r, out).Parse(scene, "scene", true);
+    return out;
+  }
+  const auto model_name = r.AsString(model_node, "scene.model");
+  if (!model_name) return models::OpenFloor();
+  std::string file;
+  const YAML::Node model =
+      LoadModel(r, model_node, "scene.model", "scene", *model_name, "scenes", scenario_file, &file);
+  if (!model.IsDefined()) {
+    // Without the file there is nothing to merge onto; its keys can still
+    // be checked.
+    std::vector<std::string> keys = kSceneKeys;
+    keys.insert(keys.begin(), "model");
+    r.CheckKeys(scene, "scene", keys);
+    return models::OpenFloor();
+  }
+  const std::string name = fs::path(file).stem().string();
+
+  // The scene file alone first: its problems are its own, at its lines.
+  {
+    const std::size_t before = r.issues().size();
+    const YamlReader::InFile in_scene(r, file);
+    models::Scene alone = ReadScene(r, model, "", name, file);
+    if (r.issues().size() != before) return models::OpenFloor();
+    if (scene.size() == 1) return alone;  // only `model`
+  }
+
+  // Then the scenario's keys on top. What goes wrong now is the scenario's
+  // doing: each problem is reported at the scenario's key path under
+  // `scene`, at the line of the nearest node the scenario writes.
+  std::map<std::string, ScenarioSource> sources;
+  const YAML::Node merged = Merge(model, scene, "scene", sources);
+  YamlReader merged_reader(file);
+  models::Scene out = ReadScene(merged_reader, merged, "scene", name, file);
+  for (const Issue& issue : merged_reader.issues()) {
+    std::string p = issue.key_path;
+    auto it = sources.find(p);
+    while (it == sources.end() && p.find('.') != std::string::npos) {
+      p = p.substr(0, p.rfind('.'));
+      it = sources.find(p);
+    }
+    const bool exact = it != sources.end() && p == issue.key_path;
+    const YAML::Node at = it == sources.end()
+                              ? scene
+                              : (exact && issue.unknown_path ? it->second.key : it->second.value);
+    const std::string& key_path = issue.key_path;
+    if (issue.unknown_path) {
+      r.UnknownPath(at, key_path, issue.message);
+    } else {
+      r.Error(at, key_path, issue.message);
+    }
+  }
+  return out;
+}
+
+}  // namespace linesim::loader

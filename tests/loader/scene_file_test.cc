@@ -1,0 +1,248 @@
+#include "loader/scene_file.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "loader/scenario.h"
+#include "models/models_dir.h"
+#include "scenario_test.h"
+
+namespace linesim::loader {
+namespace {
+
+using testing::Has;
+using testing::Issues;
+using testing::kValidScenario;
+using testing::WriteScenario;
+
+std::string FactoryLine() { return models::ModelsDir() + "/scenes/factory_line.yaml"; }
+
+// Every issue of reading the scene file `file`, one per line.
+std::string SceneIssues(const std::string& file) {
+  try {
+    LoadSceneFile(file);
+  } catch (const ScenarioError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// A small valid scene file: one surface, a floor, one belt with a body on it.
+constexpr const char* kSmallScene = R"(description: test scene
+surfaces:
+  - {name: concrete, friction: 0.8, texture_contrast: 0.2, illumination_lux: 500}
+floor: {min_x_m: -5, max_x_m: 5, min_y_m: -5, max_y_m: 5, surface: concrete}
+belts:
+  - {name: line, surface: concrete, center_x_m: 0, center_y_m: 0, length_m: 6,
+     width_m: 2, speed_mps: 0.1}
+carried:
+  - {name: body, belt: line, box: {x_m: -1, y_m: 0, length_m: 4.6, width_m: 1.8, height_m: 1.2}}
+)";
+
+// Guards the shipped hall against silent edits: the counts of the layout and
+// the values the brief fixes (paper 1: 0.10 m/s line, +-10 %, 20 x 2 m;
+// friction 0.8 as the chassis used; bodies at -7 and +5 m).
+TEST(SceneFile, FactoryLineLoads) {
+  const models::Scene s = LoadSceneFile(FactoryLine());
+  EXPECT_EQ(s.name, "factory_line");
+  ASSERT_EQ(s.surfaces.size(), 2u);
+  EXPECT_EQ(s.surfaces[0].name, "concrete");
+  EXPECT_DOUBLE_EQ(s.surfaces[0].friction, 0.8);
+  EXPECT_DOUBLE_EQ(s.surfaces[1].friction, 0.8);
+  EXPECT_DOUBLE_EQ(s.surfaces[0].illumination_lux, 500.0);
+  EXPECT_DOUBLE_EQ(s.floor.min_x_m, -15.0);
+  EXPECT_DOUBLE_EQ(s.floor.max_y_m, 10.0);
+  EXPECT_EQ(s.floor.surface, 0);
+  ASSERT_EQ(s.belts.size(), 1u);
+  EXPECT_EQ(s.belts[0].surface, 1);
+  EXPECT_DOUBLE_EQ(s.belts[0].nominal_speed_mps, 0.10);
+  EXPECT_DOUBLE_EQ(s.belts[0].speed_variation, 0.1);
+  EXPECT_DOUBLE_EQ(s.belts[0].area.length_m, 20.0);
+  EXPECT_DOUBLE_EQ(s.belts[0].area.width_m, 2.0);
+  EXPECT_TRUE(s.belts[0].initially_on);
+  EXPECT_TRUE(s.belts[0].schedule.empty());
+  // 4 walls, 10 pillars, 3 carts, 1 rack.
+  EXPECT_EQ(s.obstacles.size(), 18u);
+  int pillars = 0;
+  for (const auto& o : s.obstacles) {
+    if (o.kind == "pillar") {
+      ++pillars;
+      EXPECT_EQ(o.solid.kind, models::Solid::Kind::kCylinder);
+      EXPECT_DOUBLE_EQ(o.solid.radius_m, 0.25);
+    }
+  }
+  EXPECT_EQ(pillars, 10);
+  EXPECT_NEAR(s.obstacles[2].solid.yaw_rad, 0.5 * std::numbers::pi, 1e-15);  // west wall
+  ASSERT_EQ(s.carried.size(), 2u);
+  EXPECT_EQ(s.carried[0].belt, 0);
+  EXPECT_DOUBLE_EQ(s.carried[0].solid.x_m, -7.0);
+  EXPECT_DOUBLE_EQ(s.carried[1].solid.x_m, 5.0);
+  EXPECT_DOUBLE_EQ(s.carried[1].solid.bottom_m, 0.3);
+  EXPECT_TRUE(s.terrain.empty());
+}
+
+// Guards against a required value silently defaulting: a belt without its
+// speed is refused at the belt's line, naming the key.
+TEST(SceneFile, MissingRequiredValueIsNamed) {
+  std::string text = kSmallScene;
+  text.replace(text.find(", speed_mps: 0.1"), 16, "");
+  const std::string f = WriteScenario("no_speed_scene.yaml", text);
+  const std::string issues = SceneIssues(f);
+  EXPECT_TRUE(Has(issues, f + ":6: belts.0.speed_mps: missing required key")) << issues;
+}
+
+// Guards the typo hint: an unknown key names the closest known key path.
+TEST(SceneFile, UnknownKeyNamesClosest) {
+  std::string text = kSmallScene;
+  text.replace(text.find("friction"), 8, "frictoin");
+  const std::string f = WriteScenario("typo_scene.yaml", text);
+  const std::string issues = SceneIssues(f);
+  EXPECT_TRUE(Has(issues, f + ":3: surfaces.0.frictoin: unknown key; closest: surfaces.0.friction"))
+      << issues;
+  EXPECT_TRUE(Has(issues, "surfaces.0.friction: missing required key")) << issues;
+}
+
+// Guards references: a floor naming no defined surface, and a carried object
+// naming no defined belt, are refused with the names there are.
+TEST(SceneFile, UnknownSurfaceOrBeltIsRefused) {
+  std::string text = kSmallScene;
+  text.replace(text.find("surface: concrete}"), 17, "surface: concret");
+  text.replace(text.find("belt: line"), 10, "belt: lin");
+  const std::string f = WriteScenario("bad_ref_scene.yaml", text);
+  const std::string issues = SceneIssues(f);
+  EXPECT_TRUE(Has(issues, f + ":4: floor.surface: no surface 'concret' in this scene: expected "
+                              "one of concrete (closest: concrete)"))
+      << issues;
+  EXPECT_TRUE(Has(issues, f + ":9: carried.0.belt: no belt 'lin' in this scene")) << issues;
+}
+
+// Guards ranges: out-of-range numbers and a wrong type are reported, all at
+// once.
+TEST(SceneFile, RangesAndTypesAreChecked) {
+  std::string text = kSmallScene;
+  text.replace(text.find("friction: 0.8"), 13, "friction: 4");
+  text.replace(text.find("speed_mps: 0.1"), 14, "speed_mps: 0");
+  text.replace(text.find("height_m: 1.2"), 13, "height_m: tall");
+  const std::string f = WriteScenario("range_scene.yaml", text);
+  const std::string issues = SceneIssues(f);
+  EXPECT_TRUE(Has(issues, "surfaces.0.friction: value 4 is out of range")) << issues;
+  EXPECT_TRUE(Has(issues, "belts.0.speed_mps: value 0 is out of range: expected a number > 0"))
+      << issues;
+  EXPECT_TRUE(Has(issues, "carried.0.box.height_m: expected a number, got 'tall'")) << issues;
+}
+
+// Guards the default: a scenario without `scene` gets the open floor, and
+// one that writes a scene without a model gets what it writes.
+TEST(ScenarioScene, AbsentIsOpenFloorAndWrittenIsRead) {
+  const std::string plain = WriteScenario("plain.yaml", kValidScenario);
+  EXPECT_EQ(LoadScenario(plain).scene.name, "open_floor");
+  const std::string written = WriteScenario(
+      "written.yaml", std::string(kValidScenario) + "scene:\n" + [] {
+        std::string indented;
+        std::string text = kSmallScene;
+        for (std::size_t at = 0, next; at < text.size(); at = next + 1) {
+          next = text.find('\n', at);
+          indented += "  " + text.substr(at, next - at) + "\n";
+        }
+        return indented;
+      }());
+  const Scenario s = LoadScenario(written);
+  ASSERT_EQ(s.scene.belts.size(), 1u);
+  EXPECT_EQ(s.scene.carried.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.scene.belts[0].area.length_m, 6.0);
+}
+
+// Guards the merge rules: maps by key, list items by index, an item past
+// the model's list added; the rest of the model kept.
+TEST(ScenarioScene, OverridesByIndexAndAddedItems) {
+  const std::string f = WriteScenario("merge.yaml", std::string(kValidScenario) + R"(scene:
+  model: factory_line
+  description: the hall with a faster line
+  surfaces:
+    - {}
+    - {friction: 0.6}
+    - {name: oil, friction: 0.1, texture_contrast: 0.05, illumination_lux: 500}
+  belts:
+    - {speed_mps: 0.2, schedule: [{time_s: 0, on: false}, {time_s: 2, on: true}]}
+  carried:
+    - {box: {x_m: -8.0}}
+)");
+  const Scenario s = LoadScenario(f);
+  EXPECT_EQ(s.scene.name, "factory_line");
+  EXPECT_EQ(s.scene.description, "the hall with a faster line");
+  ASSERT_EQ(s.scene.surfaces.size(), 3u);
+  EXPECT_DOUBLE_EQ(s.scene.surfaces[0].friction, 0.8);
+  EXPECT_DOUBLE_EQ(s.scene.surfaces[1].friction, 0.6);
+  EXPECT_EQ(s.scene.surfaces[1].name, "belt");
+  EXPECT_EQ(s.scene.surfaces[2].name, "oil");
+  ASSERT_EQ(s.scene.belts.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.scene.belts[0].nominal_speed_mps, 0.2);
+  EXPECT_DOUBLE_EQ(s.scene.belts[0].area.length_m, 20.0);
+  EXPECT_FALSE(s.scene.belts[0].initially_on);
+  ASSERT_EQ(s.scene.belts[0].schedule.size(), 1u);
+  EXPECT_EQ(s.scene.belts[0].schedule[0].time_ns, 2'000'000'000);
+  EXPECT_DOUBLE_EQ(s.scene.carried[0].solid.x_m, -8.0);
+  EXPECT_DOUBLE_EQ(s.scene.carried[0].solid.length_m, 4.6);
+  EXPECT_EQ(s.scene.obstacles.size(), 18u);
+}
+
+// Guards where problems are reported: the scenario's bad override at its
+// own line and key path under scene; an added item missing a required value
+// at the item; a scene file's own problem in the scene file.
+TEST(ScenarioScene, ProblemsAreReportedWhereTheyAreWritten) {
+  const std::string f = WriteScenario("bad_merge.yaml", std::string(kValidScenario) + R"(scene:
+  model: factory_line
+  belts:
+    - speed_mps: 5
+      speed_mp: 1
+  carried:
+    - {}
+    - {}
+    - {name: body_3, belt: line}
+)");
+  const std::string issues = Issues(f);
+  EXPECT_TRUE(Has(issues, f + ":16: scene.belts.0.speed_mps: value 5 is out of range")) << issues;
+  EXPECT_TRUE(Has(issues, f + ":17: scene.belts.0.speed_mp: unknown key; closest: "
+                              "scene.belts.0.speed_mps"))
+      << issues;
+  EXPECT_TRUE(Has(issues, f + ":21: scene.carried.2.box: missing required key")) << issues;
+  EXPECT_FALSE(Has(issues, "factory_line.yaml")) << issues;
+
+  const std::string typos = Issues(WriteScenario(
+      "scene_typos.yaml", std::string(kValidScenario) + "scene: {model: factory_lin, belt: []}\n"));
+  EXPECT_TRUE(Has(typos, "scene.model: no scene file ")) << typos;
+  EXPECT_TRUE(Has(typos, "(closest: factory_line)")) << typos;
+  EXPECT_TRUE(Has(typos, "scene.belt: unknown key; closest: scene.belts")) << typos;
+
+  std::string bad = kSmallScene;
+  bad.replace(bad.find("width_m: 2"), 10, "width_m: -2");
+  const std::string scene_file = WriteScenario("bad_scene.yaml", bad);
+  const std::string g = WriteScenario("uses_bad_scene.yaml",
+                                      std::string(kValidScenario) + "scene: {model: " +
+                                          scene_file.substr(scene_file.rfind('/') + 1) + "}\n");
+  const std::string from_file = Issues(g);
+  EXPECT_TRUE(Has(from_file, scene_file + ":7: belts.0.width_m: value -2 is out of range"))
+      << from_file;
+}
+
+// Guards --set of a scene value the scenario writes: it applies, and a bad
+// one is reported as from the command line, not at a line of either file.
+TEST(ScenarioScene, SetOnTheCommandLine) {
+  const std::string f = WriteScenario("set_scene.yaml", std::string(kValidScenario) + R"(scene:
+  model: factory_line
+  belts:
+    - {speed_mps: 0.2}
+)");
+  EXPECT_DOUBLE_EQ(
+      LoadScenario(f, {"scene.belts.0.speed_mps=0.15"}).scene.belts[0].nominal_speed_mps, 0.15);
+  const std::string issues = Issues(f, {"scene.belts.0.speed_mps=3"});
+  EXPECT_TRUE(Has(issues, f + ": scene.belts.0.speed_mps (set on the command line): value 3 is "
+                              "out of range"))
+      << issues;
+}
+
+}  // namespace
+}  // namespace linesim::loader
