@@ -69,15 +69,6 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
   plots::RobotPlotSpec spec;
   spec.title = s.name;
   spec.scene = s.scene;
-  // Until robot scenarios expand into a `scene:`, their belts come from the
-  // robot expansion.
-  if (spec.scene.belts.empty()) {
-    for (const auto& b : robot.belts) {
-      models::Belt belt;
-      belt.area = {b.center_x_m, b.center_y_m, b.length_m, b.width_m, b.direction_rad};
-      spec.scene.belts.push_back(belt);
-    }
-  }
   spec.path_m = robot.path;
   spec.x_column = robot.x_column;
   spec.y_column = robot.y_column;
@@ -88,6 +79,7 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
       robot.task == "path" ? "deviation from the path (m)" : "drift from the held position (m)";
   spec.belt_speed_columns = robot.belt_speed_columns;
   spec.belt_on_columns = robot.belt_on_columns;
+  spec.belt_travel_columns = robot.belt_travel_columns;
   if (robot.body_length_m) spec.body_length_m = *robot.body_length_m;
   if (robot.body_width_m) spec.body_width_m = *robot.body_width_m;
   return spec;

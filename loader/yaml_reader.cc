@@ -66,14 +66,28 @@ void YamlReader::Add(const std::vector<Issue>& issues) {
 
 void YamlReader::Error(const std::string& file, const YAML::Node& at, const std::string& path,
                        std::string message) {
-  const auto origin = file == own_file_ ? origins_.find(path) : origins_.end();
+  // The origin of the path, or of the longest of its ancestors that has one
+  // (a value below a derived map keeps its place under the user's key).
+  auto origin = origins_.end();
+  std::string rest;
+  if (file == own_file_) {
+    for (std::string prefix = path;;) {
+      origin = origins_.find(prefix);
+      if (origin != origins_.end()) break;
+      const auto dot = prefix.rfind('.');
+      if (dot == std::string::npos) break;
+      rest = path.substr(dot);
+      prefix.resize(dot);
+    }
+  }
   const bool translated = origin != origins_.end();
+  const bool exact = translated && rest.empty();
   Issue issue;
   issue.file = file;
-  issue.key_path = translated ? origin->second.path : path;
+  issue.key_path = translated ? origin->second.path + rest : path;
   issue.message = std::move(message);
   issue.from_command_line = file == own_file_ && FromCommandLine(issue.key_path);
-  issue.line = issue.from_command_line ? 0 : LineOf(translated ? origin->second.node : at);
+  issue.line = issue.from_command_line ? 0 : LineOf(exact ? origin->second.node : at);
   issues_.push_back(std::move(issue));
 }
 

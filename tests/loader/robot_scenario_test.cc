@@ -19,6 +19,7 @@ using testing::Issues;
 using testing::WriteScenario;
 
 const std::string kCross = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
+const std::string kHusky = LINESIM_SOURCE_DIR "/scenarios/husky_floor_path.yaml";
 
 double Param(const Scenario& s, const std::string& unit, const std::string& name,
              std::size_t index = 0) {
@@ -33,9 +34,10 @@ bool BoolParam(const Scenario& s, const std::string& unit, const std::string& na
   return v.GetBoolean(*v.Find(name));
 }
 
-// Guards the expansion: a robot scenario becomes belt, chassis, two motor
-// groups, the two controllers and the ground-truth monitor, wired as in
-// DESIGN.md's signal flow, with the controllers at the 20 ms cycle.
+// Guards the expansion: a robot scenario becomes belt, chassis, the motors
+// of both groups, the two controllers and the ground-truth monitor, wired as
+// in docs/architecture.md's signal flow, with the controllers at the 20 ms
+// cycle, on the scene it names.
 TEST(RobotScenario, CrossLineExpandsIntoTheRobotUnits) {
   const Scenario s = LoadScenario(kCross);
   ASSERT_TRUE(s.robot);
@@ -47,16 +49,17 @@ TEST(RobotScenario, CrossLineExpandsIntoTheRobotUnits) {
   EXPECT_EQ(s.master->decimation(*s.system->FindUnit("chassis")), 1);
   EXPECT_EQ(s.robot->task, "path");
   ASSERT_EQ(s.robot->path.size(), 2u);
-  ASSERT_EQ(s.robot->belts.size(), 1u);
-  EXPECT_EQ(s.robot->belts[0].width_m, 2.0);
+  ASSERT_EQ(s.scene.belts.size(), 1u);
+  EXPECT_EQ(s.scene.belts[0].area.width_m, 2.0);
+  EXPECT_FALSE(s.scene.obstacles.empty());  // models/scenes/factory_line.yaml
   std::vector<std::string> metrics;
   for (const auto& m : s.metrics) metrics.push_back(m.name);
   EXPECT_NE(std::find(metrics.begin(), metrics.end(), "max_path_deviation_m"), metrics.end());
-  // The belt geometry reaches both the belt and the chassis's contact patches.
-  EXPECT_EQ(Param(s, "chassis", "belt_width"), 2.0);
+  // The belt unit drives the scene's belt (line.belts overrides it).
   EXPECT_EQ(Param(s, "belt", "nominal_speed"), 0.10);
   // One motor unit: steering motors 0-3 (belt ratio 4), drive motors 4-7
-  // (gear 21), each group from its model file (FACTS.md ratios).
+  // (gear 21), each group with its gear from the robot description
+  // (Rob@Work 3 ratios, docs/references.md).
   EXPECT_EQ(Param(s, "motors", "gear_ratio", 0), 4.0);
   EXPECT_EQ(Param(s, "motors", "gear_ratio", 3), 4.0);
   EXPECT_EQ(Param(s, "motors", "gear_ratio", 4), 21.0);
@@ -65,9 +68,9 @@ TEST(RobotScenario, CrossLineExpandsIntoTheRobotUnits) {
 
 // Guards the robot as one: the controller's geometry is the chassis's (one
 // --set changes both), and what the chassis and the controller know of the
-// motors comes from the motor model files (raw3_steer: RE 40 rotor 1.42e-5
-// kg.m2, k_t 0.0302 N.m/A, belt 4 at eta 0.9; raw3_drive: gear 21 at eta
-// 0.75): joint inertia eta N^2 J_rotor, back-EMF feed-forward k_t N.
+// motors comes from the motor model file and the groups' gears (RE 40 rotor
+// 1.42e-5 kg.m2, k_t 0.0302 N.m/A; steer belt 4 at eta 0.9, drive gear 21
+// at eta 0.75): joint inertia eta N^2 J_rotor, back-EMF feed-forward k_t N.
 TEST(RobotScenario, ControllerAndChassisShareGeometryAndMotorData) {
   const Scenario s = LoadScenario(kCross);
   EXPECT_DOUBLE_EQ(Param(s, "chassis", "steer_rotor_inertia"), 0.9 * 4 * 4 * 1.42e-5);
@@ -88,29 +91,32 @@ TEST(RobotScenario, ControllerAndChassisShareGeometryAndMotorData) {
   EXPECT_EQ(Param(t, "wheel_controller", "wheel_radius"), 0.1);
 }
 
-// Guards the wheel count: taken from the chassis's parameters (default 4),
-// it sets the motor count, the controller's modules, the wiring and the
-// plots' wheels.
-TEST(RobotScenario, WheelCountComesFromTheChassis) {
-  std::ifstream in(kCross);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  for (const int wheels : {4, 2}) {
-    const YAML::Node root = YAML::Load(text + "units:\n  chassis:\n    parameters: {wheel_count: " +
-                                       std::to_string(wheels) + "}\n");
-    YamlReader reader("robot.yaml");
-    RobotInfo info;
-    const YAML::Node expanded = ExpandRobotScenario(root, reader, info);
-    EXPECT_TRUE(reader.ok()) << wheels;
-    EXPECT_EQ(info.wheel_count, wheels);
-    EXPECT_EQ(expanded["units"]["motors"]["parameters"]["count"].as<int>(), 2 * wheels);
-    EXPECT_EQ(expanded["units"]["wheel_controller"]["parameters"]["wheel_count"].as<int>(), wheels);
-    std::size_t to_motors = 0;
-    for (const auto& c : expanded["connections"]) {
-      to_motors += c["to"].as<std::string>().starts_with("motors.voltage[");
-    }
-    EXPECT_EQ(to_motors, static_cast<std::size_t>(2 * wheels));
+// Guards robots as data: the Husky (models/robots/husky.yaml) is built on
+// the same chassis and motor units as the Rob@Work 3, with four fixed
+// wheels, one drive motor per side (the two wheels of a side share it), the
+// differential controller and the differential path follower; nothing
+// steers, so no steering joint is wired.
+TEST(RobotScenario, HuskyIsBuiltFromItsDescriptionOnTheSameUnits) {
+  const Scenario s = LoadScenario(kHusky);
+  ASSERT_TRUE(s.robot);
+  EXPECT_EQ(s.robot->wheel_count, 4);
+  const auto& types = s.expanded["units"];
+  EXPECT_EQ(types["chassis"]["type"].as<std::string>(), "chassis");
+  EXPECT_EQ(types["motors"]["type"].as<std::string>(), "dc_motor");
+  EXPECT_EQ(types["wheel_controller"]["type"].as<std::string>(), "diff_drive_controller");
+  EXPECT_EQ(types["motors"]["parameters"]["count"].as<int>(), 2);
+  const YAML::Node chassis = types["chassis"]["parameters"];
+  EXPECT_EQ(chassis["drive_motor"].as<std::vector<int>>(), (std::vector<int>{0, 0, 1, 1}));
+  EXPECT_EQ(chassis["steer_motor"].as<std::vector<int>>(), (std::vector<int>{-1, -1, -1, -1}));
+  EXPECT_EQ(Param(s, "chassis", "wheel_radius", 3), 0.1651);  // Husky URDF
+  EXPECT_EQ(Param(s, "motors", "gear_ratio", 1), 79.0);
+  for (const auto& c : s.expanded["connections"]) {
+    EXPECT_FALSE(Has(c["to"].as<std::string>(), "steer")) << c["to"].as<std::string>();
   }
-  EXPECT_EQ(LoadScenario(kCross).robot->wheel_count, 4);
+  // A differential base cannot run Algorithm 1, nor hold a heading.
+  const std::string e = Issues(kHusky, {"control.compensation=true"});
+  EXPECT_TRUE(Has(e, "control.compensation")) << e;
+  EXPECT_TRUE(Has(e, "differential base")) << e;
 }
 
 // Guards the plots' view of a robot run: every column they read is one the
@@ -125,17 +131,19 @@ TEST(RobotScenario, PlotColumnsAndBodyComeFromTheExpansion) {
   for (const auto& [x, y] : info.wheel_columns) read.insert(read.end(), {x, y});
   read.insert(read.end(), info.belt_speed_columns.begin(), info.belt_speed_columns.end());
   read.insert(read.end(), info.belt_on_columns.begin(), info.belt_on_columns.end());
+  read.insert(read.end(), info.belt_travel_columns.begin(), info.belt_travel_columns.end());
   std::vector<std::string> recorded;
   for (const auto& p : s.recorded) recorded.push_back(p.label);
   for (const auto& column : read) {
     EXPECT_NE(std::find(recorded.begin(), recorded.end(), column), recorded.end()) << column;
   }
-  EXPECT_EQ(info.x_column, "chassis.pose[0]");
+  EXPECT_EQ(info.x_column, "chassis.position[0]");
+  EXPECT_EQ(info.yaw_column, "chassis.yaw");
   EXPECT_EQ(info.wheel_columns.size(), static_cast<std::size_t>(info.wheel_count));
-  ASSERT_FALSE(info.belts.empty());
-  EXPECT_EQ(info.belt_speed_columns.size(), info.belts.size());
-  EXPECT_EQ(info.belt_on_columns.size(), info.belts.size());
-  // models/chassis/raw3_chassis.yaml
+  ASSERT_FALSE(s.scene.belts.empty());
+  EXPECT_EQ(info.belt_speed_columns.size(), s.scene.belts.size());
+  EXPECT_EQ(info.belt_on_columns.size(), s.scene.belts.size());
+  // models/robots/raw3.yaml (paper 1, Table I)
   EXPECT_EQ(info.body_length_m, 1.03);
   EXPECT_EQ(info.body_width_m, 0.57);
   const Scenario longer =
@@ -176,20 +184,38 @@ TEST(RobotScenario, RecordingIntervalIsAWholeNumberOfMasterSteps) {
 }
 
 // Guards `linesim inspect`'s promise that the expansion is a system-level
-// scenario of its own: written out and loaded again, it builds the same
-// units, connections and metrics.
+// scenario of its own: for every shipped robot scenario (both robots),
+// written out and loaded again, it builds the same units with the same
+// parameters, the same connections, metrics and scene.
 TEST(RobotScenario, ExpansionLoadsAsASystemScenario) {
-  const Scenario robot = LoadScenario(kCross);
-  YAML::Emitter out;
-  out << robot.expanded;
-  const std::string f = WriteScenario("expanded.yaml", out.c_str());
-  const Scenario system = LoadScenario(f);
-  EXPECT_FALSE(system.robot);
-  EXPECT_EQ(system.system->UnitNames(), robot.system->UnitNames());
-  EXPECT_EQ(system.system->connections().size(), robot.system->connections().size());
-  EXPECT_EQ(system.metrics.size(), robot.metrics.size());
-  EXPECT_EQ(Param(system, "motors", "gear_ratio", 4), 21.0);
-  EXPECT_EQ(Param(system, "chassis", "initial_yaw"), Param(robot, "chassis", "initial_yaw"));
+  for (const char* name :
+       {"cross_line.yaml", "hold_on_belt.yaml", "hold_straddle.yaml", "husky_floor_path.yaml"}) {
+    const Scenario robot = LoadScenario(std::string(LINESIM_SOURCE_DIR "/scenarios/") + name);
+    YAML::Emitter out;
+    out << robot.expanded;
+    const std::string f = WriteScenario(std::string("expanded_") + name, out.c_str());
+    const Scenario system = LoadScenario(f);
+    EXPECT_FALSE(system.robot) << name;
+    ASSERT_EQ(system.system->UnitNames(), robot.system->UnitNames()) << name;
+    for (const auto& unit : robot.system->UnitNames()) {
+      const auto a = robot.system->unit(*robot.system->FindUnit(unit)).SaveState();
+      const auto b = system.system->unit(*system.system->FindUnit(unit)).SaveState();
+      EXPECT_EQ(a.variables, b.variables) << name << " " << unit;
+    }
+    ASSERT_EQ(system.system->connections().size(), robot.system->connections().size()) << name;
+    for (std::size_t i = 0; i < system.system->connections().size(); ++i) {
+      const auto& a = system.system->connections()[i];
+      const auto& b = robot.system->connections()[i];
+      EXPECT_EQ(a.from.ToString() + " -> " + a.to.ToString(),
+                b.from.ToString() + " -> " + b.to.ToString());
+    }
+    ASSERT_EQ(system.metrics.size(), robot.metrics.size()) << name;
+    for (std::size_t i = 0; i < system.metrics.size(); ++i) {
+      EXPECT_EQ(system.metrics[i].name, robot.metrics[i].name) << name;
+    }
+    EXPECT_EQ(system.scene.belts.size(), robot.scene.belts.size()) << name;
+    EXPECT_EQ(system.scene.obstacles.size(), robot.scene.obstacles.size()) << name;
+  }
 }
 
 // Guards the dotted paths the issue reserves for --set and sweeps: each one
@@ -266,9 +292,10 @@ TEST(RobotScenario, OwnConnectionsAndMetricsKeepTheirKeyPaths) {
   std::ifstream in(kCross);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string a = Issues(WriteScenario(
-      "robot_conn.yaml", text + "connections:\n  - {from: chassis.pose, to: deviation.poses}\n"));
+      "robot_conn.yaml",
+      text + "connections:\n  - {from: chassis.position, to: deviation.positions}\n"));
   EXPECT_TRUE(Has(a, "connections.0: ")) << a;
-  EXPECT_TRUE(Has(a, "poses")) << a;
+  EXPECT_TRUE(Has(a, "positions")) << a;
   const std::string b = Issues(
       WriteScenario("robot_metric.yaml",
                     text + "metrics:\n  - {name: top_speed, of: chassis.speed, reduce: max}\n"));
@@ -290,7 +317,7 @@ TEST(RobotScenario, ControlPeriodMustBeAMultipleOfTheMasterStep) {
 // file sets itself under units: is reported there.
 TEST(RobotScenario, MasterProblemsOfExpandedUnitsPointAtRobotLevelKeys) {
   const std::string e = Issues(kCross, {"duration_s=20.01"});
-  EXPECT_TRUE(Has(e, kCross + ":24: control.period_s: unit 'wheel_controller' step 0.02 s does "
+  EXPECT_TRUE(Has(e, kCross + ":27: control.period_s: unit 'wheel_controller' step 0.02 s does "
                               "not divide the duration 20.01 s"))
       << e;
   EXPECT_FALSE(Has(e, "units.")) << e;
@@ -299,7 +326,7 @@ TEST(RobotScenario, MasterProblemsOfExpandedUnitsPointAtRobotLevelKeys) {
   const std::string f = WriteScenario("robot_own_step.yaml",
                                       text + "units:\n  wheel_controller:\n    step_s: 0.0153\n");
   const std::string g = Issues(f);
-  EXPECT_TRUE(Has(g, f + ":35: units.wheel_controller.step_s: unit 'wheel_controller' step 0.0153"))
+  EXPECT_TRUE(Has(g, f + ":38: units.wheel_controller.step_s: unit 'wheel_controller' step 0.0153"))
       << g;
   EXPECT_FALSE(Has(g, "control.period_s")) << g;
 }
@@ -337,10 +364,10 @@ TEST(RobotScenario, UnknownRobotModelNamesTheKnownOnes) {
 TEST(RobotScenario, UnknownKeyInTheRobotModelFileIsNamedThere) {
   std::ifstream in(LINESIM_SOURCE_DIR "/models/robots/raw3.yaml");
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string model = WriteScenario("raw3_typo.yaml", text + "steer_motor_modell: x\n");
+  const std::string model = WriteScenario("raw3_typo.yaml", text + "motor_group: x\n");
   const std::string e = Issues(kCross, {"robot.model=" + model});
   EXPECT_TRUE(Has(e, model + ":")) << e;
-  EXPECT_TRUE(Has(e, "steer_motor_modell: unknown key; closest: steer_motor_model")) << e;
+  EXPECT_TRUE(Has(e, "motor_group: unknown key; closest: motor_groups")) << e;
 }
 
 // Guards the pass-through: `units.NAME.parameters` in a robot scenario
@@ -350,11 +377,11 @@ TEST(RobotScenario, UnitsSectionOverridesExpandedParameters) {
   std::ifstream in(kCross);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string f = WriteScenario(
-      "robot_units.yaml", text + "units:\n  chassis:\n    parameters: {friction: 0.7}\n");
-  const Scenario s = LoadScenario(f, {"units.chassis.parameters.friction=0.5"});
-  EXPECT_EQ(Param(s, "chassis", "friction"), 0.5);
-  const std::string e = Issues(f, {"units.chassis.parameters.fricton=0.5"});
-  EXPECT_TRUE(Has(e, "units.chassis.parameters.fricton")) << e;
+      "robot_units.yaml", text + "units:\n  chassis:\n    parameters: {brake_torque: 20}\n");
+  const Scenario s = LoadScenario(f, {"units.chassis.parameters.brake_torque=25"});
+  EXPECT_EQ(Param(s, "chassis", "brake_torque"), 25.0);
+  const std::string e = Issues(f, {"units.chassis.parameters.brake_torqe=25"});
+  EXPECT_TRUE(Has(e, "units.chassis.parameters.brake_torqe")) << e;
 }
 
 }  // namespace
