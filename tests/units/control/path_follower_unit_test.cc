@@ -22,14 +22,16 @@ constexpr double kPeriodS = 0.02;
 constexpr double kPi = std::numbers::pi;
 
 void SetPose(PathFollowerUnit& u, double x, double y, double yaw) {
-  u.variables().SetRealArray(*u.variables().Find("pose"), std::vector<double>{x, y, yaw});
+  u.variables().SetRealArray(*u.variables().Find("position"), std::vector<double>{x, y});
+  u.variables().SetReal(*u.variables().Find("yaw"), yaw);
 }
 void SetParam(PathFollowerUnit& u, const std::string& name, double v) {
   u.variables().SetReal(*u.variables().Find(name), v);
 }
+// The commands as one twist: velocity_command (vx, vy), yaw_rate_command.
 std::vector<double> Twist(const PathFollowerUnit& u) {
-  const auto s = u.variables().GetRealArray(*u.variables().Find("twist_command"));
-  return {s.begin(), s.end()};
+  const auto s = u.variables().GetRealArray(*u.variables().Find("velocity_command"));
+  return {s[0], s[1], u.variables().GetReal(*u.variables().Find("yaw_rate_command"))};
 }
 double Real(const PathFollowerUnit& u, const std::string& name) {
   return u.variables().GetReal(*u.variables().Find(name));
@@ -60,26 +62,37 @@ std::vector<double> Sample(PathFollowerUnit& u, const Robot& r, int k) {
   return twist;
 }
 
-// Guards against the interface drifting (names, units, feedthrough on pose).
+// Guards against the interface drifting (names, units, feedthrough on the
+// position and heading: the commands depend on both, the path measures on
+// the position only).
 TEST(PathFollowerUnit, VariableTable) {
   PathFollowerUnit u("follow", Mode::kPath, {{0, 0}, {1, 0}});
   EXPECT_EQ(u.type_name(), "path_follower");
   const auto& v = u.variables();
-  for (const char* p : {"speed", "acceleration", "yaw", "k_cross", "k_position", "k_yaw",
+  for (const char* p : {"speed", "acceleration", "heading", "k_cross", "k_position", "k_yaw",
                         "max_speed", "max_yaw_rate", "goal_tolerance"}) {
     ASSERT_TRUE(v.Find(p)) << p;
     EXPECT_EQ(v.info(*v.Find(p)).causality, cosim::Causality::kParameter) << p;
   }
-  EXPECT_EQ(v.info(*v.Find("pose")).size, 3u);
-  EXPECT_EQ(v.info(*v.Find("pose")).causality, cosim::Causality::kInput);
-  for (const char* o : {"twist_command", "cross_track_error", "progress", "done"}) {
+  EXPECT_EQ(v.info(*v.Find("position")).size, 2u);
+  EXPECT_EQ(v.info(*v.Find("position")).unit, "m");
+  EXPECT_EQ(v.info(*v.Find("position")).causality, cosim::Causality::kInput);
+  EXPECT_EQ(v.info(*v.Find("yaw")).unit, "rad");
+  EXPECT_EQ(v.info(*v.Find("yaw")).causality, cosim::Causality::kInput);
+  for (const char* o :
+       {"velocity_command", "yaw_rate_command", "cross_track_error", "progress", "done"}) {
     const auto& info = v.info(*v.Find(o));
     EXPECT_EQ(info.causality, cosim::Causality::kOutput) << o;
-    ASSERT_EQ(info.depends_on.size(), 1u) << o;
-    EXPECT_EQ(v.info(info.depends_on[0]).name, "pose") << o;
+    std::vector<std::string> deps;
+    for (auto d : info.depends_on) deps.push_back(v.info(d).name);
+    const bool command = std::string(o).find("command") != std::string::npos;
+    const std::vector<std::string> expected = command ? std::vector<std::string>{"position", "yaw"}
+                                                      : std::vector<std::string>{"position"};
+    EXPECT_EQ(deps, expected) << o;
   }
-  EXPECT_EQ(v.info(*v.Find("twist_command")).size, 3u);
-  EXPECT_EQ(v.info(*v.Find("twist_command")).unit, "m/s");
+  EXPECT_EQ(v.info(*v.Find("velocity_command")).size, 2u);
+  EXPECT_EQ(v.info(*v.Find("velocity_command")).unit, "m/s");
+  EXPECT_EQ(v.info(*v.Find("yaw_rate_command")).unit, "rad/s");
   EXPECT_EQ(v.info(*v.Find("cross_track_error")).unit, "m");
 }
 
@@ -92,7 +105,7 @@ TEST(PathFollowerUnit, CrossTrackCommandIsMinusGainTimesOffsetInBaseLink) {
   for (const double yaw : {0.0, kPi / 2}) {
     PathFollowerUnit u("follow", Mode::kPath, {{0, 0}, {10, 0}});
     SetParam(u, "k_cross", 1.5);
-    SetParam(u, "yaw", yaw);
+    SetParam(u, "heading", yaw);
     SetPose(u, 2.0, 0.1, yaw);
     u.Initialize();
     EXPECT_NEAR(Real(u, "cross_track_error"), 0.1, 1e-15);
@@ -117,17 +130,17 @@ TEST(PathFollowerUnit, YawRateSignAndWrap) {
   PathFollowerUnit u("hold", Mode::kHold, {{0, 0}});
   SetParam(u, "k_yaw", 2.0);
   SetParam(u, "max_yaw_rate", 10.0);
-  SetParam(u, "yaw", 0.3);
+  SetParam(u, "heading", 0.3);
   SetPose(u, 0, 0, 0.1);
   u.Initialize();
   EXPECT_NEAR(Twist(u)[2], 2.0 * 0.2, 1e-15);  // counter-clockwise
-  SetParam(u, "yaw", -3.0);
+  SetParam(u, "heading", -3.0);
   SetPose(u, 0, 0, 3.0);  // 2 pi - 6 = 0.283 rad counter-clockwise
   u.UpdateOutputs();
   EXPECT_NEAR(Twist(u)[2], 2.0 * (2 * kPi - 6.0), 1e-12);
   SetParam(u, "max_yaw_rate", 0.5);
   SetPose(u, 0, 0, 0.0);
-  SetParam(u, "yaw", -1.0);
+  SetParam(u, "heading", -1.0);
   u.UpdateOutputs();
   EXPECT_EQ(Twist(u)[2], -0.5);
 }
@@ -190,7 +203,7 @@ TEST(PathFollowerUnit, HoldReturnsToThePointGeometrically) {
   PathFollowerUnit u("hold", Mode::kHold, {{2.0, -1.0}});
   SetParam(u, "k_position", 2.0);
   Robot r{2.1, -1.05, 0.7};
-  SetParam(u, "yaw", 0.7);
+  SetParam(u, "heading", 0.7);
   SetPose(u, r.x, r.y, r.yaw);
   u.Initialize();
   const double e0 = std::hypot(0.1, 0.05);
@@ -306,7 +319,7 @@ TEST(PathFollowerUnit, NonFinitePoseFailsTheStep) {
   u.Initialize();
   SetPose(u, 0, NAN, 0);
   EXPECT_EQ(u.DoStep(0, kPeriod), cosim::StepResult::kError);
-  EXPECT_NE(u.last_error().find("pose[1]"), std::string::npos) << u.last_error();
+  EXPECT_NE(u.last_error().find("position[1]"), std::string::npos) << u.last_error();
 }
 
 }  // namespace
