@@ -140,6 +140,8 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const models::PolylinePoint&
           std::min({ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * std::abs(remaining)),
                     k_position_ * std::abs(remaining)});
       s.along_mps = std::copysign(magnitude, remaining);
+      s.toward_goal_x = std::copysign(1.0, remaining) * n.tangent_x;
+      s.toward_goal_y = std::copysign(1.0, remaining) * n.tangent_y;
       s.vx_map_mps = n.tangent_x * s.along_mps + n.tangent_y * k_cross_ * n.cross_track_m;
       s.vy_map_mps = n.tangent_y * s.along_mps - n.tangent_x * k_cross_ * n.cross_track_m;
     }
@@ -169,11 +171,16 @@ void PathFollowerUnit::SteerDifferential(Sample& s) const {
   const double speed = std::hypot(s.vx_map_mps, s.vy_map_mps);
   s.forward_mps = 0.0;
   s.yaw_rate_rad_s = 0.0;
-  if (s.at_goal || !(speed > 0.0)) {
+  double aim_x = s.vx_map_mps, aim_y = s.vy_map_mps;
+  if (!(speed > 0.0)) {
+    aim_x = s.toward_goal_x;
+    aim_y = s.toward_goal_y;
+  }
+  if (s.at_goal || (aim_x == 0.0 && aim_y == 0.0)) {
     s.along_mps = 0.0;
     return;
   }
-  double h = models::WrapAngle(std::atan2(s.vy_map_mps, s.vx_map_mps) - yaw_measured_);
+  double h = models::WrapAngle(std::atan2(aim_y, aim_x) - yaw_measured_);
   double direction = 1.0;
   // Hold: backing up is as good as driving forward, and needs less turning
   // when the point is behind.

@@ -39,7 +39,9 @@ namespace linesim::control {
 /// Differential base: velocity_command = [v, 0], and the yaw rate steers
 /// the heading psi onto the direction of a desired map velocity d:
 ///   path: d = t * v_along - n * k_cross e (as above, before clamping),
-///         always driven forward;
+///         always driven forward; where d = 0 short of the goal (the ramp
+///         at 0 at the start, on the path) the direction of t towards the
+///         goal is aimed at instead, so the robot turns before it starts;
 ///   hold: d = -k_position (p - p_ref), driven forward or backward,
 ///         whichever heading is nearer (so a small correction never turns
 ///         the robot round); zero within goal_tolerance.
@@ -92,6 +94,9 @@ class PathFollowerUnit : public cosim::Unit {
     // Differential base: the forward speed command (the body velocity is
     // [forward, 0]); the omnidirectional base rotates the map velocity.
     double forward_mps = 0.0;
+    // Path mode: the path direction towards the goal, the heading to aim
+    // for when the desired velocity is zero (at the start: ramp at 0).
+    double toward_goal_x = 0.0, toward_goal_y = 0.0;
     double along_mps = 0.0;  // path mode: the along-track speed used
     double cross_track_m = 0.0, progress_m = 0.0;
     bool at_goal = false;

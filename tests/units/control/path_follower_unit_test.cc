@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <iostream>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -320,6 +321,147 @@ TEST(PathFollowerUnit, NonFinitePoseFailsTheStep) {
   SetPose(u, 0, NAN, 0);
   EXPECT_EQ(u.DoStep(0, kPeriod), cosim::StepResult::kError);
   EXPECT_NE(u.last_error().find("position[1]"), std::string::npos) << u.last_error();
+}
+
+}  // namespace
+}  // namespace linesim::control
+
+namespace linesim::control {
+namespace {
+
+using Base = PathFollowerUnit::Base;
+
+// A differential-drive (unicycle) robot moved exactly by a forward speed v
+// and yaw rate w held over dt: along the arc of radius v / w.
+struct Unicycle {
+  double x = 0, y = 0, yaw = 0;
+  void Move(double v, double w, double dt_s) {
+    if (w == 0.0) {
+      x += v * std::cos(yaw) * dt_s;
+      y += v * std::sin(yaw) * dt_s;
+    } else {
+      x += v / w * (std::sin(yaw + w * dt_s) - std::sin(yaw));
+      y -= v / w * (std::cos(yaw + w * dt_s) - std::cos(yaw));
+    }
+    yaw = std::remainder(yaw + w * dt_s, 2.0 * kPi);
+  }
+};
+
+std::vector<double> Sample(PathFollowerUnit& u, const Unicycle& r, int k) {
+  SetPose(u, r.x, r.y, r.yaw);
+  u.UpdateOutputs();
+  const std::vector<double> twist = Twist(u);
+  EXPECT_EQ(u.DoStep(k * kPeriod, kPeriod), cosim::StepResult::kOk) << u.last_error();
+  return twist;
+}
+
+// Guards the interface of the differential base: its extra parameter, and
+// a command that never asks for sideways motion.
+TEST(PathFollowerUnitDifferential, VariableTableAndRange) {
+  PathFollowerUnit omni("f", Mode::kPath, {{0, 0}, {1, 0}});
+  EXPECT_FALSE(omni.variables().Find("turn_in_place_angle"));
+  EXPECT_EQ(omni.base(), Base::kOmnidirectional);
+  PathFollowerUnit u("f", Mode::kPath, {{0, 0}, {1, 0}}, Base::kDifferential);
+  ASSERT_TRUE(u.variables().Find("turn_in_place_angle"));
+  EXPECT_EQ(Real(u, "turn_in_place_angle"), 0.5);
+  EXPECT_TRUE(u.CheckParameters().empty());
+  SetParam(u, "turn_in_place_angle", kPi / 2);
+  const auto problems = u.CheckParameters();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].variable, "turn_in_place_angle");
+}
+
+// Guards the differential law on an L-shaped path (0,0) -> (2,0) -> (2,2),
+// the robot starting on the path but facing +90 deg (across it), defaults
+// (speed 0.3 m/s, ramp 0.3 m/s^2, k_yaw 1/s, max_yaw_rate 0.5 rad/s,
+// turn_in_place_angle 0.5 rad):
+//  - it first turns in place: not a millimetre of motion while the heading
+//    error exceeds 0.5 rad, and at once the command is [0, 0], -0.5 rad/s;
+//  - the 90 deg corner is turned in place: the heading passes 45 deg within
+//    2 cm of the corner (the robot passes it by at most one sample's travel,
+//    0.3 m/s * 20 ms = 6 mm, before the heading error exceeds 0.5 rad);
+//  - the cross-track error stays below the bound of the worst lateral drift
+//    after a turn in place, without the cross-track feedback (which only
+//    reduces it): the heading error decays from 0.5 rad as 0.5 exp(-t)
+//    (k_yaw h, below the rate limit) while the speed ramps as 0.3 t up to
+//    0.3 m/s at 1 s, so e <= int 0.3 min(t, 1) 0.5 exp(-t) dt
+//    = 0.15 (1 - 1/e) = 0.095 m, plus the 6 mm corner overshoot: 0.101 m;
+//  - it reaches the goal (done latches within goal_tolerance) and stops.
+TEST(PathFollowerUnitDifferential, FollowsAnLShapedPathTurningInPlaceAtTheCorner) {
+  PathFollowerUnit u("f", Mode::kPath, {{0, 0}, {2, 0}, {2, 2}}, Base::kDifferential);
+  Unicycle r;
+  r.yaw = kPi / 2;
+  SetPose(u, r.x, r.y, r.yaw);
+  u.Initialize();
+  const auto first = Twist(u);
+  EXPECT_EQ(first, (std::vector<double>{0.0, 0.0, -0.5}));
+  double worst_cross = 0.0, corner_distance = -1.0, start_drift = 0.0;
+  bool corner_turned_in_place = false, turned_at_start = false;
+  int k = 0;
+  for (; k < 3000 && !Done(u); ++k) {
+    const auto cmd = Sample(u, r, k);
+    ASSERT_EQ(cmd[1], 0.0) << k;  // never sideways
+    worst_cross = std::max(worst_cross, std::abs(Real(u, "cross_track_error")));
+    if (!turned_at_start) {
+      if (std::abs(r.yaw) > 0.5) start_drift = std::max(start_drift, std::hypot(r.x, r.y));
+      turned_at_start = std::abs(r.yaw) <= 0.5;
+    }
+    const double yaw_before = r.yaw;
+    r.Move(cmd[0], cmd[2], kPeriodS);
+    if (corner_distance < 0 && r.x > 1.0 && yaw_before < kPi / 4 && r.yaw >= kPi / 4) {
+      corner_distance = std::hypot(r.x - 2.0, r.y);
+      corner_turned_in_place = cmd[0] == 0.0;
+    }
+  }
+  std::cout << "differential L path: done after " << k * kPeriodS << " s, worst cross-track "
+            << worst_cross << " m, heading 45 deg at " << corner_distance << " m from the corner\n";
+  EXPECT_EQ(start_drift, 0.0);
+  EXPECT_TRUE(Done(u));
+  EXPECT_LE(std::hypot(r.x - 2.0, r.y - 2.0), Real(u, "goal_tolerance"));
+  EXPECT_GE(corner_distance, 0.0);
+  EXPECT_LT(corner_distance, 0.02);
+  EXPECT_TRUE(corner_turned_in_place);
+  EXPECT_LT(worst_cross, 0.101);
+  // 4 m at 0.3 m/s is 13.3 s; two turns at most 0.5 rad/s (pi/2 each) 6.3 s,
+  // ramps and the final approach add a few seconds: well inside 30 s.
+  EXPECT_LT(k * kPeriodS, 30.0);
+  const auto stop = Sample(u, r, k);
+  EXPECT_EQ(stop, (std::vector<double>{0.0, 0.0, 0.0}));
+}
+
+// Guards the hold law of the differential base: a point behind is reached
+// backing up without turning (the nearer heading), a point to the side by
+// a turn in place and a drive; inside goal_tolerance the robot stops.
+TEST(PathFollowerUnitDifferential, HoldBacksUpOrTurnsThenStops) {
+  {
+    PathFollowerUnit u("h", Mode::kHold, {{-0.5, 0.0}}, Base::kDifferential);
+    Unicycle r;
+    SetPose(u, r.x, r.y, r.yaw);
+    u.Initialize();
+    // -k_position * 0.5 m: straight back at 0.5 m/s (max_speed 0.5).
+    EXPECT_EQ(Twist(u), (std::vector<double>{-0.5, 0.0, 0.0}));
+    int k = 0;
+    for (; k < 500 && !Done(u); ++k) {
+      const auto cmd = Sample(u, r, k);
+      r.Move(cmd[0], cmd[2], kPeriodS);
+    }
+    EXPECT_TRUE(Done(u));
+    EXPECT_EQ(r.yaw, 0.0);
+    EXPECT_NEAR(r.x, -0.5, Real(u, "goal_tolerance"));
+  }
+  PathFollowerUnit u("h", Mode::kHold, {{0.0, 0.5}}, Base::kDifferential);
+  Unicycle r;
+  SetPose(u, r.x, r.y, r.yaw);
+  u.Initialize();
+  EXPECT_EQ(Twist(u), (std::vector<double>{0.0, 0.0, 0.5}));  // turn in place, 90 deg left
+  int k = 0;
+  for (; k < 1000 && !Done(u); ++k) {
+    const auto cmd = Sample(u, r, k);
+    r.Move(cmd[0], cmd[2], kPeriodS);
+  }
+  ASSERT_TRUE(Done(u));
+  EXPECT_LE(std::hypot(r.x, r.y - 0.5), Real(u, "goal_tolerance"));
+  EXPECT_EQ(Sample(u, r, k), (std::vector<double>{0.0, 0.0, 0.0}));
 }
 
 }  // namespace
