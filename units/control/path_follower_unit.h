@@ -31,9 +31,9 @@ namespace linesim::control {
 /// kHold holds the first waypoint: velocity -k_position (p - p_ref); done
 /// says whether it is within goal_tolerance (it never latches).
 ///
-/// In both modes the velocity is clamped to max_speed, the yaw rate is
-/// k_yaw wrap(heading - yaw) clamped to max_yaw_rate, and the
-/// velocity is rotated into base_link by -yaw (the
+/// Omnidirectional base, in both modes: the velocity is clamped to
+/// max_speed, the yaw rate is k_yaw wrap(heading - yaw) clamped to
+/// max_yaw_rate, and the velocity is rotated into base_link by -yaw (the
 /// measured heading input).
 ///
 /// Differential base: velocity_command = [v, 0], and the yaw rate steers

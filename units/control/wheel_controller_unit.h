@@ -15,8 +15,8 @@ namespace linesim::control {
 ///  - feedback (UpdateOutputs, direct feedthrough): the motor voltages from
 ///    the reference of this sample and the measured joint angles and rates;
 ///  - reference (DoStep(t, dt)): the body velocity and yaw rate commands
-///    become a contact
-///    velocity per wheel (paper 1 Eq. 1), less the surface velocity under
+///    become a contact velocity per wheel (paper 1 Eq. 1), less the surface
+///    velocity under
 ///    the wheel when compensation is on (Algorithm 1), then a steering
 ///    angle and drive rate by the flip rule; both are slew-limited into the
 ///    reference that the next samples track.
