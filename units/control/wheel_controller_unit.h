@@ -16,10 +16,9 @@ namespace linesim::control {
 ///    the reference of this sample and the measured joint angles and rates;
 ///  - reference (DoStep(t, dt)): the body velocity and yaw rate commands
 ///    become a contact velocity per wheel (paper 1 Eq. 1), less the surface
-///    velocity under
-///    the wheel when compensation is on (Algorithm 1), then a steering
-///    angle and drive rate by the flip rule; both are slew-limited into the
-///    reference that the next samples track.
+///    velocity under the wheel when compensation is on (Algorithm 1), then
+///    a steering angle and drive rate by the flip rule; both are
+///    slew-limited into the reference that the next samples track.
 /// So a new command reaches the voltages one sample later, while the
 /// measured joint states act at once. Outputs are meant to be held by the
 /// master over the period.
