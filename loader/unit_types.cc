@@ -3,6 +3,7 @@
 #include "cosim/closest_names.h"
 #include "units/belt/belt_unit.h"
 #include "units/chassis/chassis_unit.h"
+#include "units/control/diff_drive_controller_unit.h"
 #include "units/control/path_follower_unit.h"
 #include "units/control/wheel_controller_unit.h"
 #include "units/evaluation/path_deviation.h"
@@ -100,15 +101,23 @@ std::unique_ptr<cosim::Unit> MakeWheelController(const UnitBuildContext& c) {
   return std::make_unique<control::WheelControllerUnit>(c.name, static_cast<int>(wheels));
 }
 
+std::unique_ptr<cosim::Unit> MakeDiffDriveController(const UnitBuildContext& c) {
+  return std::make_unique<control::DiffDriveControllerUnit>(c.name);
+}
+
 std::unique_ptr<cosim::Unit> MakePathFollower(const UnitBuildContext& c) {
   const std::string mode = c.reader.String(c.parameters, c.path, "mode", "path", {"path", "hold"});
+  const std::string base = c.reader.String(c.parameters, c.path, "base", "omnidirectional",
+                                           {"omnidirectional", "differential"});
   std::vector<std::array<double, 2>> waypoints = ReadPoints(c, "waypoints", 1);
   if (!c.parameters.IsDefined() || c.parameters.IsNull()) waypoints = {{0.0, 0.0}, {1.0, 0.0}};
-  return std::make_unique<control::PathFollowerUnit>(c.name,
-                                                     mode == "hold"
-                                                         ? control::PathFollowerUnit::Mode::kHold
-                                                         : control::PathFollowerUnit::Mode::kPath,
-                                                     std::move(waypoints));
+  return std::make_unique<control::PathFollowerUnit>(
+      c.name,
+      mode == "hold" ? control::PathFollowerUnit::Mode::kHold
+                     : control::PathFollowerUnit::Mode::kPath,
+      std::move(waypoints),
+      base == "differential" ? control::PathFollowerUnit::Base::kDifferential
+                             : control::PathFollowerUnit::Base::kOmnidirectional);
 }
 
 std::unique_ptr<cosim::Unit> MakePathDeviation(const UnitBuildContext& c) {
@@ -161,16 +170,28 @@ const std::vector<UnitType>& UnitTypes() {
         {"model", "model file from models/chassis/ (name) or a path relative to the scenario"}},
        MakeChassis},
       {control::WheelControllerUnit::kTypeName,
-       "Rob@Work 3 wheel controller: Eq. 1, Algorithm 1 (surface compensation), flip rule, "
-       "steering and drive PD to motor voltages (paper 1, Sec. III)",
+       "swerve wheel controller (Rob@Work 3, paper 1 Sec. III): Eq. 1, Algorithm 1 (surface "
+       "compensation), flip rule, steering and drive PD to motor voltages; robot-specific "
+       "parameters have no default",
        "",
        {{"wheel_count", "number of steer+drive modules (default 4)"}},
        MakeWheelController},
+      {control::DiffDriveControllerUnit::kTypeName,
+       "differential / skid-steer drive controller: body command to left and right wheel rates "
+       "with an effective track, PI with back-EMF and acceleration feedforward to the 2 drive "
+       "motor voltages; every parameter robot-specific (no default)",
+       "",
+       {},
+       MakeDiffDriveController},
       {control::PathFollowerUnit::kTypeName,
-       "follows a polyline at a cruise speed, or holds a point, keeping a heading; outputs a "
-       "body twist",
+       "follows a polyline at a cruise speed, or holds a point; outputs a body velocity and yaw "
+       "rate command (omnidirectional: keeping a heading; differential: steering the heading "
+       "onto the path, turning in place at sharp corners)",
        "",
        {{"mode", "path (follow the waypoints, stop at the last) or hold (hold the first)"},
+        {"base",
+         "omnidirectional (default: translates keeping `heading`) or differential "
+         "(drives along its heading only)"},
         {"waypoints", "list of points [x, y] (m) in the map frame"}},
        MakePathFollower},
       {evaluation::PathDeviationUnit::kTypeName,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <utility>
 
 #include "cosim/parameter_checks.h"
@@ -10,18 +11,21 @@
 namespace linesim::control {
 
 PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
-                                   std::vector<std::array<double, 2>> waypoints_m)
+                                   std::vector<std::array<double, 2>> waypoints_m, Base base)
     : cosim::Unit(kTypeName, std::move(name)),
       mode_(mode),
+      base_(base),
       waypoints_m_(std::move(waypoints_m)),
-      pose_(3, 0.0),
-      twist_command_(3, 0.0) {
+      position_(2, 0.0),
+      velocity_command_(2, 0.0) {
   if (mode_ == Mode::kPath) cumulative_m_ = models::CumulativeLengths(waypoints_m_);
   auto& v = variables();
   v.Parameter("speed", "m/s", &speed_, "cruise speed along the path");
   v.Parameter("acceleration", "m/s2", &acceleration_,
               "along-path ramp up from the start and down before the goal");
-  v.Parameter("yaw", "rad", &yaw_, "heading to hold in map while translating");
+  // Named heading, not yaw: `yaw` is the measured heading input.
+  v.Parameter("heading", "rad", &yaw_,
+              "heading to hold in map while translating (omnidirectional base only)");
   v.Parameter("k_cross", "1/s", &k_cross_, "cross-track gain");
   v.Parameter("k_position", "1/s", &k_position_,
               "position gain: along-track near the goal, and in hold mode");
@@ -30,14 +34,28 @@ PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
   v.Parameter("max_yaw_rate", "rad/s", &max_yaw_rate_, "limit on the commanded yaw rate");
   v.Parameter("goal_tolerance", "m", &goal_tolerance_,
               "distance from the goal (hold: the point) counted as arrived");
-  v.Input("pose", "m", &pose_, "robot pose in map: x (m), y (m), yaw (rad)");
-  v.Output("twist_command", "m/s", &twist_command_,
-           "body twist command in base_link: vx (m/s), vy (m/s), yaw rate (rad/s)", {"pose"});
+  if (base_ == Base::kDifferential) {
+    v.Parameter("turn_in_place_angle", "rad", &turn_in_place_angle_,
+                "heading error beyond which the robot stops and turns in place");
+  }
+  v.Input("position", "m", &position_, "x, y of base_link in map");
+  v.Input("yaw", "rad", &yaw_measured_, "heading of base_link in map");
+  // The velocity is rotated by the measured heading, and both commands
+  // stop once the goal (a position) is reached: both depend on both.
+  v.Output("velocity_command", "m/s", &velocity_command_,
+           base_ == Base::kDifferential
+               ? "body velocity command in base_link: vx, vy (always 0: differential base)"
+               : "body velocity command in base_link: vx, vy",
+           {"position", "yaw"});
+  v.Output("yaw_rate_command", "rad/s", &yaw_rate_command_, "body yaw rate command",
+           {"position", "yaw"});
   v.Output("cross_track_error", "m", &cross_track_error_,
-           "signed distance from the path, + left of it; hold: distance from the point", {"pose"});
-  v.Output("progress", "m", &progress_, "arc length of the nearest path point (hold: 0)", {"pose"});
+           "signed distance from the path, + left of it; hold: distance from the point",
+           {"position"});
+  v.Output("progress", "m", &progress_, "arc length of the nearest path point (hold: 0)",
+           {"position"});
   v.Output("done", &done_, "path: the goal was reached (latched); hold: within tolerance",
-           {"pose"});
+           {"position"});
 }
 
 bool PathFollowerUnit::ZeroSegment(std::size_t k) const {
@@ -73,13 +91,19 @@ std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
   }
   c.Positive("speed", speed_);
   c.Positive("acceleration", acceleration_);
-  c.Finite("yaw", yaw_);
+  c.Finite("heading", yaw_);
   c.NonNegative("k_cross", k_cross_);
   c.Positive("k_position", k_position_);
   c.NonNegative("k_yaw", k_yaw_);
   c.Positive("max_speed", max_speed_);
   c.NonNegative("max_yaw_rate", max_yaw_rate_);
   c.Positive("goal_tolerance", goal_tolerance_);
+  if (base_ == Base::kDifferential) {
+    c.Check(
+        "turn_in_place_angle", turn_in_place_angle_,
+        [](double a) { return a >= 0.0 && a < 0.5 * std::numbers::pi; },
+        "must be in [0, pi/2) rad (at pi/2 the robot would drive across its path)");
+  }
   return c.Take();
 }
 
@@ -94,13 +118,13 @@ models::PolylinePoint PathFollowerUnit::FindNearest() const {
   if (mode_ != Mode::kPath) return {};
   // The end segments extend beyond the ends, so that progress runs below 0
   // before the start and past the length after the goal.
-  return models::NearestOnPolyline(waypoints_m_, cumulative_m_, pose_[0], pose_[1],
+  return models::NearestOnPolyline(waypoints_m_, cumulative_m_, position_[0], position_[1],
                                    models::PolylineEnds::kExtend);
 }
 
 PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const models::PolylinePoint& n) const {
   Sample s;
-  const double x = pose_[0], y = pose_[1];
+  const double x = position_[0], y = position_[1];
   if (mode_ == Mode::kHold) {
     const double ex = x - waypoints_m_[0][0], ey = y - waypoints_m_[0][1];
     s.vx_map_mps = -k_position_ * ex;
@@ -116,6 +140,8 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const models::PolylinePoint&
           std::min({ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * std::abs(remaining)),
                     k_position_ * std::abs(remaining)});
       s.along_mps = std::copysign(magnitude, remaining);
+      s.toward_goal_x = std::copysign(1.0, remaining) * n.tangent_x;
+      s.toward_goal_y = std::copysign(1.0, remaining) * n.tangent_y;
       s.vx_map_mps = n.tangent_x * s.along_mps + n.tangent_y * k_cross_ * n.cross_track_m;
       s.vy_map_mps = n.tangent_y * s.along_mps - n.tangent_x * k_cross_ * n.cross_track_m;
     }
@@ -125,6 +151,10 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const models::PolylinePoint&
       s.vx_map_mps = s.vy_map_mps = s.along_mps = 0.0;
     }
   }
+  if (base_ == Base::kDifferential) {
+    SteerDifferential(s);
+    return s;
+  }
   const double speed = std::hypot(s.vx_map_mps, s.vy_map_mps);
   if (speed > max_speed_) {
     s.vx_map_mps *= max_speed_ / speed;
@@ -132,17 +162,53 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const models::PolylinePoint&
   }
   if (!(mode_ == Mode::kPath && s.at_goal)) {
     s.yaw_rate_rad_s =
-        std::clamp(k_yaw_ * models::WrapAngle(yaw_ - pose_[2]), -max_yaw_rate_, max_yaw_rate_);
+        std::clamp(k_yaw_ * models::WrapAngle(yaw_ - yaw_measured_), -max_yaw_rate_, max_yaw_rate_);
   }
   return s;
 }
 
+void PathFollowerUnit::SteerDifferential(Sample& s) const {
+  const double speed = std::hypot(s.vx_map_mps, s.vy_map_mps);
+  s.forward_mps = 0.0;
+  s.yaw_rate_rad_s = 0.0;
+  double aim_x = s.vx_map_mps, aim_y = s.vy_map_mps;
+  if (!(speed > 0.0)) {
+    aim_x = s.toward_goal_x;
+    aim_y = s.toward_goal_y;
+  }
+  if (s.at_goal || (aim_x == 0.0 && aim_y == 0.0)) {
+    s.along_mps = 0.0;
+    return;
+  }
+  double h = models::WrapAngle(std::atan2(aim_y, aim_x) - yaw_measured_);
+  double direction = 1.0;
+  // Hold: backing up is as good as driving forward, and needs less turning
+  // when the point is behind.
+  if (mode_ == Mode::kHold && std::abs(h) > 0.5 * std::numbers::pi) {
+    h = models::WrapAngle(h - std::numbers::pi);
+    direction = -1.0;
+  }
+  s.yaw_rate_rad_s = std::clamp(k_yaw_ * h, -max_yaw_rate_, max_yaw_rate_);
+  if (std::abs(h) > turn_in_place_angle_) {
+    s.along_mps = 0.0;  // the ramp starts again after the turn
+    return;
+  }
+  const double cos_h = std::cos(h);
+  s.forward_mps = direction * std::min(speed * cos_h, max_speed_);
+  s.along_mps *= cos_h;
+}
+
 void PathFollowerUnit::ComputeOutputs(const models::PolylinePoint& n) {
   const Sample s = Evaluate(n);
-  const double c = std::cos(pose_[2]), sn = std::sin(pose_[2]);
-  twist_command_[0] = c * s.vx_map_mps + sn * s.vy_map_mps;
-  twist_command_[1] = -sn * s.vx_map_mps + c * s.vy_map_mps;
-  twist_command_[2] = s.yaw_rate_rad_s;
+  if (base_ == Base::kDifferential) {
+    velocity_command_[0] = s.forward_mps;
+    velocity_command_[1] = 0.0;
+  } else {
+    const double c = std::cos(yaw_measured_), sn = std::sin(yaw_measured_);
+    velocity_command_[0] = c * s.vx_map_mps + sn * s.vy_map_mps;
+    velocity_command_[1] = -sn * s.vx_map_mps + c * s.vy_map_mps;
+  }
+  yaw_rate_command_ = s.yaw_rate_rad_s;
   cross_track_error_ = s.cross_track_m;
   progress_ = s.progress_m;
   done_ = s.at_goal;
@@ -151,7 +217,7 @@ void PathFollowerUnit::ComputeOutputs(const models::PolylinePoint& n) {
 cosim::StepResult PathFollowerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
   if (!InputsFinite(t)) return cosim::StepResult::kError;
-  // The pose is the same before and after the commit: one search.
+  // The position is the same before and after the commit: one search.
   const models::PolylinePoint n = FindNearest();
   const Sample s = Evaluate(n);
   // The ramp continues from the speed actually commanded, so that it also

@@ -7,70 +7,26 @@
 #include <utility>
 
 #include "cosim/parameter_checks.h"
-#include "models/dc_motor_params.h"
-#include "models/raw3.h"
 #include "units/control/wheel_kinematics.h"
 
 namespace linesim::control {
 
 namespace {
 
-// Default plant, Rob@Work 3 (models/raw3.h) with the maxon RE 40 stand-in
-// motor of models::DcMotorParams.
-constexpr models::DcMotorParams kMotor{};
-constexpr double kMotorConstant = kMotor.torque_constant_nm_per_a;  // k_t = k_e, V.s/rad
-constexpr double kResistanceOhm = kMotor.resistance_ohm;
-constexpr double kRotorInertiaKgm2 = kMotor.rotor_inertia_kgm2;
-constexpr double kDriveGear = models::raw3::kDriveGearRatio;
-constexpr double kDriveEfficiency = models::raw3::kDriveGearEfficiency;
-constexpr double kSteerGear = models::raw3::kSteerGearRatio;
-constexpr double kSteerEfficiency = models::raw3::kSteerGearEfficiency;
-constexpr double kWheelRadiusM = models::raw3::kWheelRadiusM;
-// A quarter of the 120 kg robot on an 80 mm wheel, m r^2 = 0.192 kg.m^2,
-// plus the rotor seen through the gear (eta N^2 J_rotor = 0.0047).
-constexpr double kDriveInertiaKgm2 = 0.25 * models::raw3::kMassKg * kWheelRadiusM * kWheelRadiusM +
-                                     kDriveEfficiency * kDriveGear * kDriveGear * kRotorInertiaKgm2;
-// Steering module about its vertical axis: an estimate of 0.01 kg.m^2 (a
-// few kg within about 5 cm of the axis), plus the rotor through the belt
-// (eta N^2 J_rotor = 2.0e-4).
-constexpr double kSteerInertiaKgm2 =
-    0.01 + kSteerEfficiency * kSteerGear * kSteerGear * kRotorInertiaKgm2;
-
-// Torque at the joint per volt at standstill: eta N k_t / R.
-constexpr double TorquePerVolt(double gear, double efficiency) {
-  return efficiency * gear * kMotorConstant / kResistanceOhm;
-}
-
 double SignedMin(double x, double limit) { return std::clamp(x, -limit, limit); }
 
 }  // namespace
 
 WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
-    : cosim::Unit(kTypeName, std::move(name)),
-      wheel_count_(wheel_count),
-      // Back-EMF at the joint (k_e N): the voltage that holds a rate without
-      // load.
-      steer_feedforward_(kMotorConstant * kSteerGear),
-      // J / (eta N k_t / R): the voltage that accelerates the nominal load.
-      steer_acceleration_feedforward_(kSteerInertiaKgm2 /
-                                      TorquePerVolt(kSteerGear, kSteerEfficiency)),
-      drive_feedforward_(kMotorConstant * kDriveGear),
-      drive_acceleration_feedforward_(kDriveInertiaKgm2 /
-                                      TorquePerVolt(kDriveGear, kDriveEfficiency)) {
+    : cosim::Unit(kTypeName, std::move(name)), wheel_count_(wheel_count) {
   if (wheel_count < 1) {
     throw cosim::UnitError(Where() + ": wheel_count must be at least 1, got " +
                            std::to_string(wheel_count));
   }
   const auto n = static_cast<std::size_t>(wheel_count);
-  if (wheel_count == 4) {
-    // Rob@Work 3's steering axes.
-    wheel_x_.assign(models::raw3::kWheelXM.begin(), models::raw3::kWheelXM.end());
-    wheel_y_.assign(models::raw3::kWheelYM.begin(), models::raw3::kWheelYM.end());
-  } else {
-    wheel_x_.assign(n, 0.0);
-    wheel_y_.assign(n, 0.0);
-  }
-  twist_command_.assign(3, 0.0);
+  wheel_x_.assign(n, kUnset);
+  wheel_y_.assign(n, kUnset);
+  velocity_command_.assign(2, 0.0);
   surface_velocity_.assign(2 * n, 0.0);
   steer_angle_.assign(n, 0.0);
   steer_rate_.assign(n, 0.0);
@@ -85,7 +41,9 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
   }
 
   // Default gains, for the 20 ms period (sampled plant with zero-order
-  // hold, checked by simulation over the inertia ranges below):
+  // hold, checked by simulation over the inertia ranges below, for
+  // Rob@Work 3 with its maxon RE 40 stand-in motors: they are design
+  // values for that plant, to be retuned for another):
   //  - drive: back-EMF damping at the wheel eta N^2 k_t k_e / R = 1.01
   //    N.m.s, so the loaded wheel (0.197 kg.m^2) has a 0.195 s time
   //    constant, but a wheel off the ground (about 0.01 kg.m^2) has 10 ms,
@@ -126,8 +84,9 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
               "wheel rate reference acceleration limit");
   v.Parameter("max_voltage", "V", &max_voltage_, "supply voltage: outputs saturate at +-this");
 
-  v.Input("twist_command", "m/s", &twist_command_,
-          "body twist command in base_link: vx (m/s), vy (m/s), yaw rate (rad/s)");
+  v.Input("velocity_command", "m/s", &velocity_command_,
+          "body velocity command of base_link in base_link: vx, vy");
+  v.Input("yaw_rate_command", "rad/s", &yaw_rate_command_, "body yaw rate command");
   v.Input("surface_velocity", "m/s", &surface_velocity_,
           "absolute velocity of the floor under each wheel in base_link, interleaved "
           "(vx0, vy0, vx1, vy1, ...)");
@@ -150,8 +109,8 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
 
 std::vector<cosim::ParameterProblem> WheelControllerUnit::CheckParameters() const {
   cosim::ParameterChecks c;
-  c.Finite("wheel_x", wheel_x_);
-  c.Finite("wheel_y", wheel_y_);
+  if (CheckSet(c, "wheel_x", wheel_x_)) c.Finite("wheel_x", wheel_x_);
+  if (CheckSet(c, "wheel_y", wheel_y_)) c.Finite("wheel_y", wheel_y_);
   // Two steering axes at one point are no robot, and the zero default for
   // any count but 4 would quietly turn a yaw command into no wheel motion.
   const std::size_t n = wheel_x_.size();
@@ -173,20 +132,25 @@ std::vector<cosim::ParameterProblem> WheelControllerUnit::CheckParameters() cons
            "with wheel_y puts wheels " + wheels + " at the same point (set the positions of all " +
                std::to_string(n) + " wheels)"});
   }
-  c.Positive("wheel_radius", wheel_radius_);
+  if (CheckSet(c, "wheel_radius", wheel_radius_)) c.Positive("wheel_radius", wheel_radius_);
   c.NonNegative("zero_speed_threshold", zero_speed_threshold_);
   c.NonNegative("steer_kp", steer_kp_);
   c.NonNegative("steer_kd", steer_kd_);
-  c.NonNegative("steer_feedforward", steer_feedforward_);
-  c.NonNegative("steer_acceleration_feedforward", steer_acceleration_feedforward_);
+  if (CheckSet(c, "steer_feedforward", steer_feedforward_))
+    c.NonNegative("steer_feedforward", steer_feedforward_);
+  if (CheckSet(c, "steer_acceleration_feedforward", steer_acceleration_feedforward_))
+    c.NonNegative("steer_acceleration_feedforward", steer_acceleration_feedforward_);
   c.Positive("steer_max_rate", steer_max_rate_);
   c.Positive("steer_max_acceleration", steer_max_acceleration_);
-  c.NonNegative("drive_feedforward", drive_feedforward_);
-  c.NonNegative("drive_acceleration_feedforward", drive_acceleration_feedforward_);
+  if (CheckSet(c, "drive_feedforward", drive_feedforward_))
+    c.NonNegative("drive_feedforward", drive_feedforward_);
+  if (CheckSet(c, "drive_acceleration_feedforward", drive_acceleration_feedforward_))
+    c.NonNegative("drive_acceleration_feedforward", drive_acceleration_feedforward_);
   c.NonNegative("drive_kp", drive_kp_);
   c.NonNegative("drive_ki", drive_ki_);
-  c.Positive("drive_max_rate", drive_max_rate_);
-  c.Positive("drive_max_acceleration", drive_max_acceleration_);
+  if (CheckSet(c, "drive_max_rate", drive_max_rate_)) c.Positive("drive_max_rate", drive_max_rate_);
+  if (CheckSet(c, "drive_max_acceleration", drive_max_acceleration_))
+    c.Positive("drive_max_acceleration", drive_max_acceleration_);
   c.Positive("max_voltage", max_voltage_);
   return c.Take();
 }
@@ -245,7 +209,7 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
 
   // Set points of this sample: Eq. 1, Algorithm 1, flip rule (from the
   // last flip-rule heading, which the set point then replaces).
-  const Eigen::Vector3d twist(twist_command_[0], twist_command_[1], twist_command_[2]);
+  const Eigen::Vector3d twist(velocity_command_[0], velocity_command_[1], yaw_rate_command_);
   double fastest_rad_s = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     Eigen::Vector2d v = WheelVelocity(twist, {wheel_x_[i], wheel_y_[i]});

@@ -5,7 +5,7 @@
 
 #include "cosim/time.h"
 #include "cosim/unit.h"
-#include "models/raw3.h"
+#include "units/control/required_parameters.h"
 
 namespace linesim::control {
 
@@ -14,12 +14,12 @@ namespace linesim::control {
 /// paper 1's robot). Per sample at time t:
 ///  - feedback (UpdateOutputs, direct feedthrough): the motor voltages from
 ///    the reference of this sample and the measured joint angles and rates;
-///  - reference (DoStep(t, dt)): the body twist command becomes a contact
-///    velocity per wheel (paper 1 Eq. 1), less the surface velocity under
-///    the wheel when compensation is on (Algorithm 1), then a steering
-///    angle and drive rate by the flip rule; both are slew-limited into the
-///    reference that the next samples track.
-/// So a new twist command reaches the voltages one sample later, while the
+///  - reference (DoStep(t, dt)): the body velocity and yaw rate commands
+///    become a contact velocity per wheel (paper 1 Eq. 1), less the surface
+///    velocity under the wheel when compensation is on (Algorithm 1), then
+///    a steering angle and drive rate by the flip rule; both are
+///    slew-limited into the reference that the next samples track.
+/// So a new command reaches the voltages one sample later, while the
 /// measured joint states act at once. Outputs are meant to be held by the
 /// master over the period.
 ///
@@ -32,13 +32,16 @@ namespace linesim::control {
 /// The feedforward gains are the back-EMF constant and the load inertia
 /// seen through the gearbox, so a well-modelled wheel follows its reference
 /// without error and the feedback only corrects what the model misses.
+///
+/// Robot-specific parameters have no default (NaN until set; Initialize
+/// refuses them): wheel_x, wheel_y, wheel_radius, the four feedforwards,
+/// drive_max_rate and drive_max_acceleration.
 class WheelControllerUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "wheel_controller";
 
-  /// Throws cosim::UnitError if wheel_count < 1. With 4 wheels the wheel
-  /// positions default to Rob@Work 3 (models/raw3.h); otherwise they are
-  /// zero and must be set (CheckParameters reports wheels at one point).
+  /// Throws cosim::UnitError if wheel_count < 1. The robot-specific
+  /// parameters start unset (NaN) and must be set before Initialize.
   explicit WheelControllerUnit(std::string name, int wheel_count = 4);
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
@@ -74,25 +77,26 @@ class WheelControllerUnit : public cosim::Unit {
 
   // Parameters.
   std::vector<double> wheel_x_, wheel_y_;
-  double wheel_radius_ = models::raw3::kWheelRadiusM;
+  double wheel_radius_ = kUnset;
   bool compensation_ = true;
   double zero_speed_threshold_ = 1e-3;
   double steer_kp_ = 10.0;
   double steer_kd_ = 0.5;
-  double steer_feedforward_;  // the feedforwards: the constructor derives them from the plant
-  double steer_acceleration_feedforward_;
+  double steer_feedforward_ = kUnset;
+  double steer_acceleration_feedforward_ = kUnset;
   double steer_max_rate_ = 10.0;
   double steer_max_acceleration_ = 40.0;
-  double drive_feedforward_;
-  double drive_acceleration_feedforward_;
+  double drive_feedforward_ = kUnset;
+  double drive_acceleration_feedforward_ = kUnset;
   double drive_kp_ = 0.5;
   double drive_ki_ = 5.0;
-  double drive_max_rate_ = 12.267;
-  double drive_max_acceleration_ = 1.0 / models::raw3::kWheelRadiusM;  // 1 m/s^2 at the rim
+  double drive_max_rate_ = kUnset;
+  double drive_max_acceleration_ = kUnset;
   double max_voltage_ = 24.0;
 
   // Inputs.
-  std::vector<double> twist_command_;
+  std::vector<double> velocity_command_;
+  double yaw_rate_command_ = 0.0;
   std::vector<double> surface_velocity_;
   std::vector<double> steer_angle_, steer_rate_, drive_rate_;
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <iostream>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -22,14 +23,16 @@ constexpr double kPeriodS = 0.02;
 constexpr double kPi = std::numbers::pi;
 
 void SetPose(PathFollowerUnit& u, double x, double y, double yaw) {
-  u.variables().SetRealArray(*u.variables().Find("pose"), std::vector<double>{x, y, yaw});
+  u.variables().SetRealArray(*u.variables().Find("position"), std::vector<double>{x, y});
+  u.variables().SetReal(*u.variables().Find("yaw"), yaw);
 }
 void SetParam(PathFollowerUnit& u, const std::string& name, double v) {
   u.variables().SetReal(*u.variables().Find(name), v);
 }
+// The commands as one twist: velocity_command (vx, vy), yaw_rate_command.
 std::vector<double> Twist(const PathFollowerUnit& u) {
-  const auto s = u.variables().GetRealArray(*u.variables().Find("twist_command"));
-  return {s.begin(), s.end()};
+  const auto s = u.variables().GetRealArray(*u.variables().Find("velocity_command"));
+  return {s[0], s[1], u.variables().GetReal(*u.variables().Find("yaw_rate_command"))};
 }
 double Real(const PathFollowerUnit& u, const std::string& name) {
   return u.variables().GetReal(*u.variables().Find(name));
@@ -60,26 +63,37 @@ std::vector<double> Sample(PathFollowerUnit& u, const Robot& r, int k) {
   return twist;
 }
 
-// Guards against the interface drifting (names, units, feedthrough on pose).
+// Guards against the interface drifting (names, units, feedthrough on the
+// position and heading: the commands depend on both, the path measures on
+// the position only).
 TEST(PathFollowerUnit, VariableTable) {
   PathFollowerUnit u("follow", Mode::kPath, {{0, 0}, {1, 0}});
   EXPECT_EQ(u.type_name(), "path_follower");
   const auto& v = u.variables();
-  for (const char* p : {"speed", "acceleration", "yaw", "k_cross", "k_position", "k_yaw",
+  for (const char* p : {"speed", "acceleration", "heading", "k_cross", "k_position", "k_yaw",
                         "max_speed", "max_yaw_rate", "goal_tolerance"}) {
     ASSERT_TRUE(v.Find(p)) << p;
     EXPECT_EQ(v.info(*v.Find(p)).causality, cosim::Causality::kParameter) << p;
   }
-  EXPECT_EQ(v.info(*v.Find("pose")).size, 3u);
-  EXPECT_EQ(v.info(*v.Find("pose")).causality, cosim::Causality::kInput);
-  for (const char* o : {"twist_command", "cross_track_error", "progress", "done"}) {
+  EXPECT_EQ(v.info(*v.Find("position")).size, 2u);
+  EXPECT_EQ(v.info(*v.Find("position")).unit, "m");
+  EXPECT_EQ(v.info(*v.Find("position")).causality, cosim::Causality::kInput);
+  EXPECT_EQ(v.info(*v.Find("yaw")).unit, "rad");
+  EXPECT_EQ(v.info(*v.Find("yaw")).causality, cosim::Causality::kInput);
+  for (const char* o :
+       {"velocity_command", "yaw_rate_command", "cross_track_error", "progress", "done"}) {
     const auto& info = v.info(*v.Find(o));
     EXPECT_EQ(info.causality, cosim::Causality::kOutput) << o;
-    ASSERT_EQ(info.depends_on.size(), 1u) << o;
-    EXPECT_EQ(v.info(info.depends_on[0]).name, "pose") << o;
+    std::vector<std::string> deps;
+    for (auto d : info.depends_on) deps.push_back(v.info(d).name);
+    const bool command = std::string(o).find("command") != std::string::npos;
+    const std::vector<std::string> expected = command ? std::vector<std::string>{"position", "yaw"}
+                                                      : std::vector<std::string>{"position"};
+    EXPECT_EQ(deps, expected) << o;
   }
-  EXPECT_EQ(v.info(*v.Find("twist_command")).size, 3u);
-  EXPECT_EQ(v.info(*v.Find("twist_command")).unit, "m/s");
+  EXPECT_EQ(v.info(*v.Find("velocity_command")).size, 2u);
+  EXPECT_EQ(v.info(*v.Find("velocity_command")).unit, "m/s");
+  EXPECT_EQ(v.info(*v.Find("yaw_rate_command")).unit, "rad/s");
   EXPECT_EQ(v.info(*v.Find("cross_track_error")).unit, "m");
 }
 
@@ -92,7 +106,7 @@ TEST(PathFollowerUnit, CrossTrackCommandIsMinusGainTimesOffsetInBaseLink) {
   for (const double yaw : {0.0, kPi / 2}) {
     PathFollowerUnit u("follow", Mode::kPath, {{0, 0}, {10, 0}});
     SetParam(u, "k_cross", 1.5);
-    SetParam(u, "yaw", yaw);
+    SetParam(u, "heading", yaw);
     SetPose(u, 2.0, 0.1, yaw);
     u.Initialize();
     EXPECT_NEAR(Real(u, "cross_track_error"), 0.1, 1e-15);
@@ -117,17 +131,17 @@ TEST(PathFollowerUnit, YawRateSignAndWrap) {
   PathFollowerUnit u("hold", Mode::kHold, {{0, 0}});
   SetParam(u, "k_yaw", 2.0);
   SetParam(u, "max_yaw_rate", 10.0);
-  SetParam(u, "yaw", 0.3);
+  SetParam(u, "heading", 0.3);
   SetPose(u, 0, 0, 0.1);
   u.Initialize();
   EXPECT_NEAR(Twist(u)[2], 2.0 * 0.2, 1e-15);  // counter-clockwise
-  SetParam(u, "yaw", -3.0);
+  SetParam(u, "heading", -3.0);
   SetPose(u, 0, 0, 3.0);  // 2 pi - 6 = 0.283 rad counter-clockwise
   u.UpdateOutputs();
   EXPECT_NEAR(Twist(u)[2], 2.0 * (2 * kPi - 6.0), 1e-12);
   SetParam(u, "max_yaw_rate", 0.5);
   SetPose(u, 0, 0, 0.0);
-  SetParam(u, "yaw", -1.0);
+  SetParam(u, "heading", -1.0);
   u.UpdateOutputs();
   EXPECT_EQ(Twist(u)[2], -0.5);
 }
@@ -190,7 +204,7 @@ TEST(PathFollowerUnit, HoldReturnsToThePointGeometrically) {
   PathFollowerUnit u("hold", Mode::kHold, {{2.0, -1.0}});
   SetParam(u, "k_position", 2.0);
   Robot r{2.1, -1.05, 0.7};
-  SetParam(u, "yaw", 0.7);
+  SetParam(u, "heading", 0.7);
   SetPose(u, r.x, r.y, r.yaw);
   u.Initialize();
   const double e0 = std::hypot(0.1, 0.05);
@@ -306,7 +320,148 @@ TEST(PathFollowerUnit, NonFinitePoseFailsTheStep) {
   u.Initialize();
   SetPose(u, 0, NAN, 0);
   EXPECT_EQ(u.DoStep(0, kPeriod), cosim::StepResult::kError);
-  EXPECT_NE(u.last_error().find("pose[1]"), std::string::npos) << u.last_error();
+  EXPECT_NE(u.last_error().find("position[1]"), std::string::npos) << u.last_error();
+}
+
+}  // namespace
+}  // namespace linesim::control
+
+namespace linesim::control {
+namespace {
+
+using Base = PathFollowerUnit::Base;
+
+// A differential-drive (unicycle) robot moved exactly by a forward speed v
+// and yaw rate w held over dt: along the arc of radius v / w.
+struct Unicycle {
+  double x = 0, y = 0, yaw = 0;
+  void Move(double v, double w, double dt_s) {
+    if (w == 0.0) {
+      x += v * std::cos(yaw) * dt_s;
+      y += v * std::sin(yaw) * dt_s;
+    } else {
+      x += v / w * (std::sin(yaw + w * dt_s) - std::sin(yaw));
+      y -= v / w * (std::cos(yaw + w * dt_s) - std::cos(yaw));
+    }
+    yaw = std::remainder(yaw + w * dt_s, 2.0 * kPi);
+  }
+};
+
+std::vector<double> Sample(PathFollowerUnit& u, const Unicycle& r, int k) {
+  SetPose(u, r.x, r.y, r.yaw);
+  u.UpdateOutputs();
+  const std::vector<double> twist = Twist(u);
+  EXPECT_EQ(u.DoStep(k * kPeriod, kPeriod), cosim::StepResult::kOk) << u.last_error();
+  return twist;
+}
+
+// Guards the interface of the differential base: its extra parameter, and
+// a command that never asks for sideways motion.
+TEST(PathFollowerUnitDifferential, VariableTableAndRange) {
+  PathFollowerUnit omni("f", Mode::kPath, {{0, 0}, {1, 0}});
+  EXPECT_FALSE(omni.variables().Find("turn_in_place_angle"));
+  EXPECT_EQ(omni.base(), Base::kOmnidirectional);
+  PathFollowerUnit u("f", Mode::kPath, {{0, 0}, {1, 0}}, Base::kDifferential);
+  ASSERT_TRUE(u.variables().Find("turn_in_place_angle"));
+  EXPECT_EQ(Real(u, "turn_in_place_angle"), 0.5);
+  EXPECT_TRUE(u.CheckParameters().empty());
+  SetParam(u, "turn_in_place_angle", kPi / 2);
+  const auto problems = u.CheckParameters();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].variable, "turn_in_place_angle");
+}
+
+// Guards the differential law on an L-shaped path (0,0) -> (2,0) -> (2,2),
+// the robot starting on the path but facing +90 deg (across it), defaults
+// (speed 0.3 m/s, ramp 0.3 m/s^2, k_yaw 1/s, max_yaw_rate 0.5 rad/s,
+// turn_in_place_angle 0.5 rad):
+//  - it first turns in place: not a millimetre of motion while the heading
+//    error exceeds 0.5 rad, and at once the command is [0, 0], -0.5 rad/s;
+//  - the 90 deg corner is turned in place: the heading passes 45 deg within
+//    2 cm of the corner (the robot passes it by at most one sample's travel,
+//    0.3 m/s * 20 ms = 6 mm, before the heading error exceeds 0.5 rad);
+//  - the cross-track error stays below the bound of the worst lateral drift
+//    after a turn in place, without the cross-track feedback (which only
+//    reduces it): the heading error decays from 0.5 rad as 0.5 exp(-t)
+//    (k_yaw h, below the rate limit) while the speed ramps as 0.3 t up to
+//    0.3 m/s at 1 s, so e <= int 0.3 min(t, 1) 0.5 exp(-t) dt
+//    = 0.15 (1 - 1/e) = 0.095 m, plus the 6 mm corner overshoot: 0.101 m;
+//  - it reaches the goal (done latches within goal_tolerance) and stops.
+TEST(PathFollowerUnitDifferential, FollowsAnLShapedPathTurningInPlaceAtTheCorner) {
+  PathFollowerUnit u("f", Mode::kPath, {{0, 0}, {2, 0}, {2, 2}}, Base::kDifferential);
+  Unicycle r;
+  r.yaw = kPi / 2;
+  SetPose(u, r.x, r.y, r.yaw);
+  u.Initialize();
+  const auto first = Twist(u);
+  EXPECT_EQ(first, (std::vector<double>{0.0, 0.0, -0.5}));
+  double worst_cross = 0.0, corner_distance = -1.0, start_drift = 0.0;
+  bool corner_turned_in_place = false, turned_at_start = false;
+  int k = 0;
+  for (; k < 3000 && !Done(u); ++k) {
+    const auto cmd = Sample(u, r, k);
+    ASSERT_EQ(cmd[1], 0.0) << k;  // never sideways
+    worst_cross = std::max(worst_cross, std::abs(Real(u, "cross_track_error")));
+    if (!turned_at_start) {
+      if (std::abs(r.yaw) > 0.5) start_drift = std::max(start_drift, std::hypot(r.x, r.y));
+      turned_at_start = std::abs(r.yaw) <= 0.5;
+    }
+    const double yaw_before = r.yaw;
+    r.Move(cmd[0], cmd[2], kPeriodS);
+    if (corner_distance < 0 && r.x > 1.0 && yaw_before < kPi / 4 && r.yaw >= kPi / 4) {
+      corner_distance = std::hypot(r.x - 2.0, r.y);
+      corner_turned_in_place = cmd[0] == 0.0;
+    }
+  }
+  std::cout << "differential L path: done after " << k * kPeriodS << " s, worst cross-track "
+            << worst_cross << " m, heading 45 deg at " << corner_distance << " m from the corner\n";
+  EXPECT_EQ(start_drift, 0.0);
+  EXPECT_TRUE(Done(u));
+  EXPECT_LE(std::hypot(r.x - 2.0, r.y - 2.0), Real(u, "goal_tolerance"));
+  EXPECT_GE(corner_distance, 0.0);
+  EXPECT_LT(corner_distance, 0.02);
+  EXPECT_TRUE(corner_turned_in_place);
+  EXPECT_LT(worst_cross, 0.101);
+  // 4 m at 0.3 m/s is 13.3 s; two turns at most 0.5 rad/s (pi/2 each) 6.3 s,
+  // ramps and the final approach add a few seconds: well inside 30 s.
+  EXPECT_LT(k * kPeriodS, 30.0);
+  const auto stop = Sample(u, r, k);
+  EXPECT_EQ(stop, (std::vector<double>{0.0, 0.0, 0.0}));
+}
+
+// Guards the hold law of the differential base: a point behind is reached
+// backing up without turning (the nearer heading), a point to the side by
+// a turn in place and a drive; inside goal_tolerance the robot stops.
+TEST(PathFollowerUnitDifferential, HoldBacksUpOrTurnsThenStops) {
+  {
+    PathFollowerUnit u("h", Mode::kHold, {{-0.5, 0.0}}, Base::kDifferential);
+    Unicycle r;
+    SetPose(u, r.x, r.y, r.yaw);
+    u.Initialize();
+    // -k_position * 0.5 m: straight back at 0.5 m/s (max_speed 0.5).
+    EXPECT_EQ(Twist(u), (std::vector<double>{-0.5, 0.0, 0.0}));
+    int k = 0;
+    for (; k < 500 && !Done(u); ++k) {
+      const auto cmd = Sample(u, r, k);
+      r.Move(cmd[0], cmd[2], kPeriodS);
+    }
+    EXPECT_TRUE(Done(u));
+    EXPECT_EQ(r.yaw, 0.0);
+    EXPECT_NEAR(r.x, -0.5, Real(u, "goal_tolerance"));
+  }
+  PathFollowerUnit u("h", Mode::kHold, {{0.0, 0.5}}, Base::kDifferential);
+  Unicycle r;
+  SetPose(u, r.x, r.y, r.yaw);
+  u.Initialize();
+  EXPECT_EQ(Twist(u), (std::vector<double>{0.0, 0.0, 0.5}));  // turn in place, 90 deg left
+  int k = 0;
+  for (; k < 1000 && !Done(u); ++k) {
+    const auto cmd = Sample(u, r, k);
+    r.Move(cmd[0], cmd[2], kPeriodS);
+  }
+  ASSERT_TRUE(Done(u));
+  EXPECT_LE(std::hypot(r.x, r.y - 0.5), Real(u, "goal_tolerance"));
+  EXPECT_EQ(Sample(u, r, k), (std::vector<double>{0.0, 0.0, 0.0}));
 }
 
 }  // namespace

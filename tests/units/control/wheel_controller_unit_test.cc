@@ -13,7 +13,6 @@
 #include "cosim/master.h"
 #include "cosim/system.h"
 #include "cosim/time.h"
-#include "models/dc_motor_params.h"
 #include "tests/units/test_helpers.h"
 #include "units/motors/dc_motor_unit.h"
 
@@ -39,6 +38,59 @@ double GetScalar(const cosim::Unit& u, const std::string& name) {
   return u.variables().GetReal(*u.variables().Find(name));
 }
 
+// Rob@Work 3 with the maxon RE 40 148877 stand-in motor (24 V: k_t = k_e =
+// 30.2 mNm/A, R 0.299 Ohm, rotor 142 g.cm^2, maxon catalogue data sheet),
+// drive gear 21 and steering belt 4 (ipa320 cob_robots / cob_control
+// configs), gear efficiencies 0.75 / 0.9 (ASSUMPTIONS of
+// models/motors/raw3_{drive,steer}.yaml).
+constexpr double kKe = 30.2e-3, kOhm = 0.299, kRotor = 142e-7;
+constexpr double kDriveGear = 21.0, kDriveEta = 0.75, kSteerGear = 4.0, kSteerEta = 0.9;
+// Joint inertias, as the drive-train model computes them (reflected rotor
+// eta N^2 J_rotor added to the load): drive wheel, a quarter of the 120 kg
+// robot (paper 1, Table I) on the 80 mm wheel, m r^2 = 0.192 kg.m^2;
+// steering module an estimate of 0.01 kg.m^2 (a few kg within about 5 cm of
+// its axis).
+constexpr double kDriveJ =
+    0.25 * 120.0 * kRadiusM * kRadiusM + kDriveEta * kDriveGear * kDriveGear * kRotor;
+constexpr double kSteerJ = 0.01 + kSteerEta * kSteerGear * kSteerGear * kRotor;
+// Joint torque per volt at standstill, eta N k_t / R: the acceleration
+// feedforward is J divided by it.
+constexpr double TorquePerVolt(double gear, double eta) { return eta * gear * kKe / kOhm; }
+
+// The robot-specific parameters but the wheel positions (any wheel count):
+// wheel radius 0.080 m, drive limit 12.267 rad/s (IPA config), 1 m/s^2 at
+// the rim.
+void SetRaw3Drives(cosim::Unit& u) {
+  SetAll(u, "wheel_radius", kRadiusM);
+  SetAll(u, "steer_feedforward", kKe * kSteerGear);
+  SetAll(u, "steer_acceleration_feedforward", kSteerJ / TorquePerVolt(kSteerGear, kSteerEta));
+  SetAll(u, "drive_feedforward", kKe * kDriveGear);
+  SetAll(u, "drive_acceleration_feedforward", kDriveJ / TorquePerVolt(kDriveGear, kDriveEta));
+  SetAll(u, "drive_max_rate", 12.267);
+  SetAll(u, "drive_max_acceleration", 1.0 / kRadiusM);
+}
+
+// Every robot-specific parameter to Rob@Work 3's; the steering axes from
+// raw3-1 Platform.ini.
+void SetRobAtWork3(cosim::Unit& u) {
+  SetArray(u, "wheel_x", {0.368, -0.368, -0.368, 0.368});
+  SetArray(u, "wheel_y", {0.186, 0.134, -0.186, -0.134});
+  SetRaw3Drives(u);
+}
+
+// A Rob@Work 3 wheel controller.
+struct Raw3Controller : WheelControllerUnit {
+  explicit Raw3Controller(std::string name) : WheelControllerUnit(std::move(name)) {
+    SetRobAtWork3(*this);
+  }
+};
+
+// The body command: velocity_command (vx, vy) and yaw_rate_command.
+void SetCommand(cosim::Unit& u, const std::vector<double>& twist) {
+  SetArray(u, "velocity_command", {twist[0], twist[1]});
+  SetAll(u, "yaw_rate_command", twist[2]);
+}
+
 // Controller without a plant: inputs set by hand, sampled every 20 ms as
 // the master does it (inputs, UpdateOutputs, DoStep).
 void Sample(WheelControllerUnit& u, TimeNs t) {
@@ -50,7 +102,7 @@ void Sample(WheelControllerUnit& u, TimeNs t) {
 // Guards against the variable table drifting from the interface the loader
 // and the other units are written against (names, units, sizes, feedthrough).
 TEST(WheelControllerUnit, VariableTable) {
-  WheelControllerUnit u("ctl");
+  Raw3Controller u("ctl");
   EXPECT_EQ(u.type_name(), "wheel_controller");
   struct Expected {
     std::string name;
@@ -79,7 +131,8 @@ TEST(WheelControllerUnit, VariableTable) {
       {"drive_max_rate", C::kParameter, "rad/s", 1, {}},
       {"drive_max_acceleration", C::kParameter, "rad/s2", 1, {}},
       {"max_voltage", C::kParameter, "V", 1, {}},
-      {"twist_command", C::kInput, "m/s", 3, {}},
+      {"velocity_command", C::kInput, "m/s", 2, {}},
+      {"yaw_rate_command", C::kInput, "rad/s", 1, {}},
       {"surface_velocity", C::kInput, "m/s", 8, {}},
       {"steer_angle", C::kInput, "rad", 4, {}},
       {"steer_rate", C::kInput, "rad/s", 4, {}},
@@ -108,31 +161,47 @@ TEST(WheelControllerUnit, VariableTable) {
   EXPECT_EQ(six.variables().info(*six.variables().Find("drive_voltage")).size, 6u);
 }
 
-// Guards against the defaults drifting from the robot they are derived
-// from (FACTS.md; maxon RE 40: k_e = 0.0302 V.s/rad; drive gear 21, steer
-// belt 4; R 0.299 Ohm; efficiencies 0.75 / 0.9 of models/motors).
-TEST(WheelControllerUnit, DefaultsComeFromRobAtWork3) {
+// Guards against another robot's numbers used silently: every
+// robot-specific parameter starts unset, Initialize refuses the unit naming
+// each, and the generic ones keep their defaults.
+TEST(WheelControllerUnit, RobotSpecificParametersHaveNoDefault) {
   WheelControllerUnit u("ctl");
-  EXPECT_EQ(Get(u, "wheel_x"), (std::vector<double>{0.368, -0.368, -0.368, 0.368}));
-  EXPECT_EQ(Get(u, "wheel_y"), (std::vector<double>{0.186, 0.134, -0.186, -0.134}));
-  EXPECT_EQ(GetScalar(u, "wheel_radius"), 0.08);
+  const std::vector<std::string> required = {"wheel_x",
+                                             "wheel_y",
+                                             "wheel_radius",
+                                             "steer_feedforward",
+                                             "steer_acceleration_feedforward",
+                                             "drive_feedforward",
+                                             "drive_acceleration_feedforward",
+                                             "drive_max_rate",
+                                             "drive_max_acceleration"};
+  const auto problems = u.CheckParameters();
+  ASSERT_EQ(problems.size(), required.size());
+  for (std::size_t k = 0; k < required.size(); ++k) {
+    EXPECT_EQ(problems[k].variable, required[k]);
+    EXPECT_FALSE(problems[k].index.has_value()) << required[k];
+    EXPECT_EQ(problems[k].message, "must be set (robot-specific: no default)");
+  }
+  try {
+    u.Initialize();
+    FAIL() << "unset parameters accepted";
+  } catch (const cosim::UnitError& e) {
+    const std::string what = e.what();
+    for (const auto& name : required) EXPECT_NE(what.find(name), std::string::npos) << name;
+  }
+  // One wheel position left out is named by its index.
+  SetRobAtWork3(u);
+  SetArray(u, "wheel_y", {0.186, NAN, -0.186, -0.134});
+  const auto one = u.CheckParameters();
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_EQ(one[0].variable, "wheel_y");
+  EXPECT_EQ(one[0].index, 1u);
+  SetRobAtWork3(u);
+  EXPECT_TRUE(u.CheckParameters().empty());
+  // Generic defaults (design values with their reason in the unit).
   EXPECT_EQ(GetScalar(u, "max_voltage"), 24.0);
-  EXPECT_EQ(GetScalar(u, "drive_max_rate"), 12.267);
-  EXPECT_NEAR(GetScalar(u, "drive_feedforward"), 0.0302 * 21, 1e-15);
-  EXPECT_NEAR(GetScalar(u, "steer_feedforward"), 0.0302 * 4, 1e-15);
-  EXPECT_NEAR(GetScalar(u, "drive_max_acceleration"), 1.0 / 0.08, 1e-12);  // 1 m/s^2
-  EXPECT_GE(GetScalar(u, "steer_max_rate"), 10.0);
-  EXPECT_LE(GetScalar(u, "steer_max_rate"), 12.0);
   EXPECT_EQ(GetScalar(u, "steer_max_acceleration"), 40.0);
-  // J R / (eta N k_t): 30 kg * 0.08^2 + 0.75 * 21^2 * 142e-7 at the wheel.
-  const double j_drive = 30 * 0.0064 + 0.75 * 441 * 142e-7;
-  EXPECT_NEAR(GetScalar(u, "drive_acceleration_feedforward"),
-              j_drive * 0.299 / (0.75 * 21 * 0.0302), 1e-12);
   EXPECT_TRUE(u.variables().GetBoolean(*u.variables().Find("compensation")));
-  // Taken from the motor model, so the two cannot drift apart.
-  const models::DcMotorParams re40;
-  EXPECT_EQ(GetScalar(u, "drive_feedforward"), re40.torque_constant_nm_per_a * 21.0);
-  EXPECT_EQ(GetScalar(u, "steer_feedforward"), re40.torque_constant_nm_per_a * 4.0);
 }
 
 // ---------------------------------------------------------------------------
@@ -142,7 +211,7 @@ TEST(WheelControllerUnit, DefaultsComeFromRobAtWork3) {
 // -2.5 rad/s, keeping heading 0; W3, W4 stay at zero. Off: all zero.
 TEST(WheelControllerUnit, AlgorithmOneDrivesOnlyTheWheelsOnTheBelt) {
   for (const bool on : {true, false}) {
-    WheelControllerUnit u("ctl");
+    Raw3Controller u("ctl");
     u.variables().SetBoolean(*u.variables().Find("compensation"), on);
     u.Initialize();
     SetArray(u, "surface_velocity", {0.2, 0, 0.2, 0, 0, 0, 0, 0});
@@ -166,9 +235,9 @@ TEST(WheelControllerUnit, AlgorithmOneDrivesOnlyTheWheelsOnTheBelt) {
 // Limits 10 rad/s and 40 rad/s^2 (FACTS.md); 45 deg takes at least
 // 2 sqrt(0.785 / 40) = 0.28 s with this acceleration.
 TEST(WheelControllerUnit, ReferenceRespectsSlewLimitsAndArrives) {
-  WheelControllerUnit u("ctl");
+  Raw3Controller u("ctl");
   u.Initialize();
-  SetArray(u, "twist_command", {0.1, 0.1, 0.0});
+  SetCommand(u, {0.1, 0.1, 0.0});
   const double goal = Deg(45), max_rate = GetScalar(u, "steer_max_rate"),
                max_acc = GetScalar(u, "steer_max_acceleration");
   const double drive_goal = std::sqrt(0.02) / kRadiusM;
@@ -208,10 +277,10 @@ TEST(WheelControllerUnit, ReferenceRespectsSlewLimitsAndArrives) {
 // limit: all wheels are scaled by one factor, so the ratios of Eq. 1 hold
 // and the fastest wheel runs at exactly 12.267 rad/s.
 TEST(WheelControllerUnit, TooFastCommandScalesAllWheelsAlike) {
-  WheelControllerUnit u("ctl");
+  Raw3Controller u("ctl");
   u.Initialize();
   // 1.5 m/s forward while turning at 1 rad/s: W3/W4-side wheels differ.
-  SetArray(u, "twist_command", {1.5, 0.0, 1.0});
+  SetCommand(u, {1.5, 0.0, 1.0});
   for (int k = 0; k < 100; ++k) Sample(u, k * kPeriod);
   const auto rate = Get(u, "drive_rate_target");
   const auto x = Get(u, "wheel_x"), y = Get(u, "wheel_y");
@@ -231,7 +300,7 @@ TEST(WheelControllerUnit, TooFastCommandScalesAllWheelsAlike) {
 // a zero reference) and changes no state, so calling it any number of
 // times does not change what DoStep does; Initialize is idempotent.
 TEST(WheelControllerUnit, UpdateOutputsIsPureAndInitializeIdempotent) {
-  WheelControllerUnit a("ctl"), b("ctl");
+  Raw3Controller a("ctl"), b("ctl");
   for (auto* u : {&a, &b}) {
     SetArray(*u, "steer_angle", {0.1, 0.0, 0.0, 0.0});
     u->Initialize();
@@ -241,7 +310,7 @@ TEST(WheelControllerUnit, UpdateOutputsIsPureAndInitializeIdempotent) {
   for (auto* u : {&a, &b}) {
     SetArray(*u, "steer_angle", {0.1 + 0.05, 0.0, 0.0, 0.0});
     SetArray(*u, "drive_rate", {0.0, 2.0, 0.0, 0.0});
-    SetArray(*u, "twist_command", {0.3, 0.0, 0.0});
+    SetCommand(*u, {0.3, 0.0, 0.0});
   }
   b.UpdateOutputs();
   b.UpdateOutputs();
@@ -260,7 +329,7 @@ TEST(WheelControllerUnit, UpdateOutputsIsPureAndInitializeIdempotent) {
 // Guards against outputs beyond the supply (kp 10 V/rad times 3 rad would
 // ask for 30 V).
 TEST(WheelControllerUnit, VoltagesSaturateAtMaxVoltage) {
-  WheelControllerUnit u("ctl");
+  Raw3Controller u("ctl");
   u.Initialize();
   SetArray(u, "steer_angle", {3.0, -3.0, 0.0, 0.0});
   u.UpdateOutputs();
@@ -275,9 +344,9 @@ TEST(WheelControllerUnit, VoltagesSaturateAtMaxVoltage) {
 //   24 - kp e + ki e dt = 24 - 0.5 * 6.25 + 5 * 6.25 * 0.02 = 21.5 V
 // (e <= 6.25 rad/s, the target), where a wound-up integrator gives 24 V.
 TEST(WheelControllerUnit, AntiWindupOnABlockedWheel) {
-  WheelControllerUnit u("ctl");
+  Raw3Controller u("ctl");
   u.Initialize();
-  SetArray(u, "twist_command", {0.5, 0.0, 0.0});
+  SetCommand(u, {0.5, 0.0, 0.0});
   for (int k = 0; k < 150; ++k) Sample(u, k * kPeriod);  // 3 s blocked
   EXPECT_EQ(Get(u, "drive_voltage")[0], 24.0);
   SetAll(u, "drive_rate", 0.5 / kRadiusM);
@@ -324,8 +393,8 @@ Trace RunClosedLoop(const std::vector<double>& twist, TimeNs duration,
                     double drive_load_kgm2 = 30.0 * kRadiusM * kRadiusM,
                     double steer_load_kgm2 = 0.01) {
   cosim::System system;
-  auto ctl = std::make_unique<WheelControllerUnit>("ctl");
-  SetArray(*ctl, "twist_command", twist);
+  auto ctl = std::make_unique<Raw3Controller>("ctl");
+  SetCommand(*ctl, twist);
   system.Add(std::move(ctl), kPeriod);
   auto steer = std::make_unique<motors::DcMotorUnit>("steer", 4, motors::MotorMode::kFull);
   SetAll(*steer, "gear_ratio", 4.0);
@@ -467,7 +536,7 @@ std::vector<std::vector<double>> Script(WheelControllerUnit& u, int from, int to
   for (int k = from; k < to; ++k) {
     const int p = k % 9;
     const double vx = p < 3 ? 0.4 : (p < 6 ? -0.3 : 0.0);
-    SetArray(u, "twist_command", {vx, 0.1 * (p % 2), 0.2 * (p % 3 - 1)});
+    SetCommand(u, {vx, 0.1 * (p % 2), 0.2 * (p % 3 - 1)});
     SetArray(u, "surface_velocity", {0.1 * (p > 4), 0, 0.1 * (p > 4), 0, 0, 0, 0, 0});
     SetArray(u, "steer_angle", {0.01 * k, -0.02 * k, 0.5, 3.1});
     SetArray(u, "steer_rate", {0.5, -0.5, 0.0, 1.0 * p});
@@ -481,14 +550,14 @@ std::vector<std::vector<double>> Script(WheelControllerUnit& u, int from, int to
 }
 
 TEST(WheelControllerUnit, SaveStepRestoreStepIsBitForBit) {
-  WheelControllerUnit u("ctl");
+  Raw3Controller u("ctl");
   u.Initialize();
   Script(u, 0, 7);
   const cosim::UnitState saved = u.SaveState();
   const auto first = Script(u, 7, 30);
   u.RestoreState(saved);
   const auto second = Script(u, 7, 30);
-  WheelControllerUnit fresh("ctl");
+  Raw3Controller fresh("ctl");
   fresh.RestoreState(saved);
   const auto third = Script(fresh, 7, 30);
   ASSERT_EQ(first.size(), second.size());
@@ -504,7 +573,7 @@ TEST(WheelControllerUnit, SaveStepRestoreStepIsBitForBit) {
 // matches, so only RestoreInternal can refuse): 7 reals per wheel and the
 // period, no integers.
 TEST(WheelControllerUnit, RestoreRefusesTruncatedInternalState) {
-  WheelControllerUnit u("ctl");
+  Raw3Controller u("ctl");
   u.Initialize();
   const cosim::UnitState saved = u.SaveState();
   ASSERT_EQ(saved.reals.size(), 7u * 4u + 1u);
@@ -531,7 +600,7 @@ TEST(WheelControllerUnit, RestoreRefusesTruncatedInternalState) {
 // Guards against bad parameters reaching the loop (division by zero in the
 // slew, a negative limit) and against reporting only the first one.
 TEST(WheelControllerUnit, CheckParametersListsEveryProblem) {
-  WheelControllerUnit u("left");
+  Raw3Controller u("left");
   EXPECT_TRUE(u.CheckParameters().empty());
   SetArray(u, "wheel_x", {0.368, NAN, -0.368, 0.368});
   SetAll(u, "wheel_radius", 0.0);
@@ -558,11 +627,14 @@ TEST(WheelControllerUnit, CheckParametersListsEveryProblem) {
   EXPECT_THROW(WheelControllerUnit("none", 0), cosim::UnitError);
 }
 
-// Guards against wheel positions left at their zero default (any count but
-// 4): every wheel at the centre turns a yaw command into no wheel motion,
-// silently. Wheels at one point are refused, every group of them named.
+// Guards against wheel positions all set to one point: every wheel at the
+// centre turns a yaw command into no wheel motion, silently. Wheels at one
+// point are refused, every group of them named.
 TEST(WheelControllerUnit, CheckParametersRefusesWheelsAtOnePoint) {
   WheelControllerUnit six("six", 6);
+  SetRaw3Drives(six);
+  SetAll(six, "wheel_x", 0.0);
+  SetAll(six, "wheel_y", 0.0);
   auto problems = six.CheckParameters();
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_EQ(problems[0].variable, "wheel_x");
@@ -581,16 +653,20 @@ TEST(WheelControllerUnit, CheckParametersRefusesWheelsAtOnePoint) {
   SetArray(six, "wheel_y", {0.3, 0.3, 0.3, -0.3, -0.3, -0.3});
   EXPECT_TRUE(six.CheckParameters().empty());
   six.Initialize();
-  SetArray(six, "twist_command", {0.0, 0.0, 0.5});
+  SetCommand(six, {0.0, 0.0, 0.5});
   for (int k = 0; k < 30; ++k) Sample(six, k * kPeriod);
   for (double w : Get(six, "drive_rate_target")) EXPECT_GT(std::abs(w), 1.0);
 
-  EXPECT_TRUE(WheelControllerUnit("one", 1).CheckParameters().empty());
+  WheelControllerUnit one("one", 1);
+  SetRaw3Drives(one);
+  SetAll(one, "wheel_x", 0.0);
+  SetAll(one, "wheel_y", 0.0);
+  EXPECT_TRUE(one.CheckParameters().empty());
 }
 
 // Guards against a NaN measurement silently poisoning the integrators.
 TEST(WheelControllerUnit, NonFiniteInputFailsTheStep) {
-  WheelControllerUnit u("ctl");
+  Raw3Controller u("ctl");
   u.Initialize();
   SetArray(u, "drive_rate", {0, 0, NAN, 0});
   EXPECT_EQ(u.DoStep(0, kPeriod), cosim::StepResult::kError);
