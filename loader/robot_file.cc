@@ -31,7 +31,7 @@ class Reader {
     root_ = root;
     r_.CheckKeys(root, "",
                  {"description", "source", "body", "wheels", "motor_groups", "controller",
-                  "chassis", "motors", "sensor_mounts"});
+                  "chassis", "motors", "path_follower", "sensor_mounts"});
     robot.description = r_.String(root, "", "description", "");
     Body(Child(root, "body"), robot.body);
     MotorGroups(Child(root, "motor_groups"), robot);
@@ -40,6 +40,7 @@ class Reader {
     SensorMounts(Child(root, "sensor_mounts"), robot);
     out.chassis_settings = Settings(root, "chassis");
     out.motor_settings = Settings(root, "motors");
+    out.follower_settings = Settings(root, "path_follower");
     return out;
   }
 

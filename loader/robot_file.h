@@ -24,6 +24,9 @@ struct RobotFile {
   /// Map of the wheel controller's parameters that the description gives
   /// directly (rate and acceleration limits, gains, an effective track).
   YAML::Node controller_settings;
+  /// Map of path_follower parameters the robot sets (its speed and yaw
+  /// rate limits).
+  YAML::Node follower_settings;
 };
 
 /// Reads the robot description `model` names (a file in models/robots, or a

@@ -17,6 +17,7 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
   info.task = r.String(task, "task", "type", std::nullopt, {"path", "hold"});
   b.Unit(kPathFollower, "path_follower");
   YAML::Node p = b.Params(kPathFollower);
+  MergeInto(p, file.follower_settings);
   const bool differential = file.robot.controller == models::ControllerKind::kDifferential;
   if (info.task == "path") {
     const YAML::Node waypoints = Child(task, "waypoints");
@@ -57,7 +58,7 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
     }
   } else {
     // An omnidirectional base keeps this heading while it moves.
-    p["yaw"] = Num(Child(task, "yaw_deg").IsDefined()
+    p["heading"] = Num(Child(task, "yaw_deg").IsDefined()
                        ? r.Real(task, "task", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad
                        : start.yaw_rad);
   }

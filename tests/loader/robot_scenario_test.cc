@@ -228,7 +228,7 @@ TEST(RobotScenario, ReservedOverridePathsReachTheUnits) {
   EXPECT_EQ(Param(s, "belt", "nominal_speed"), 0.15);
   EXPECT_FALSE(BoolParam(s, "wheel_controller", "compensation"));
   EXPECT_NEAR(Param(s, "chassis", "initial_yaw"), 30.0 * std::numbers::pi / 180.0, 1e-15);
-  EXPECT_NEAR(Param(s, "path_follower", "yaw"), 30.0 * std::numbers::pi / 180.0, 1e-15);
+  EXPECT_NEAR(Param(s, "path_follower", "heading"), 30.0 * std::numbers::pi / 180.0, 1e-15);
   EXPECT_EQ(s.seed, 7u);
   EXPECT_EQ(s.master->options().algorithm, cosim::Algorithm::kJacobi);
   EXPECT_EQ(s.master->options().base_step, 2'000'000);
