@@ -133,25 +133,20 @@ units:
     type: step_signal
     step_s: 1.0e-10
     parameters: {steps: [{time_s: 5.0e-10, value: 1}]}
-  belt:
-    type: belt
-    parameters: {schedules: [[{time_s: 1.0e-11, on: false}]]}
 recording: {interval_s: 2.0e-10}
 )");
   const std::string all = Issues(f);
   for (const char* key : {":2: master.step_s", ":6: units.supply.step_s",
-                          ":7: units.supply.parameters.steps.0.time_s",
-                          ":10: units.belt.parameters.schedules.0.0.time_s"}) {
+                          ":7: units.supply.parameters.steps.0.time_s"}) {
     EXPECT_TRUE(Has(all, f + std::string(key) + ": value ")) << key << "\n" << all;
   }
-  EXPECT_EQ(std::count(all.begin(), all.end(), '\n') + 1, 4) << all;
+  EXPECT_EQ(std::count(all.begin(), all.end(), '\n') + 1, 3) << all;
   EXPECT_TRUE(Has(all, "below one nanosecond")) << all;
   // The recording is checked once the units are built.
   const std::vector<std::string> good = {"master.step_s=0.001", "units.supply.step_s=0.001",
-                                         "units.supply.parameters.steps.0.time_s=0",
-                                         "units.belt.parameters.schedules.0.0.time_s=0"};
+                                         "units.supply.parameters.steps.0.time_s=0"};
   const std::string rec = Issues(f, good);
-  EXPECT_TRUE(Has(rec, f + ":11: recording.interval_s: value 2.0e-10 is below one nanosecond"))
+  EXPECT_TRUE(Has(rec, f + ":8: recording.interval_s: value 2.0e-10 is below one nanosecond"))
       << rec;
   std::vector<std::string> sets = good;
   sets.push_back("duration_s=1.0e-10");
@@ -313,11 +308,11 @@ TEST(LoadScenario, UnknownModelFileNamesClosest) {
 units:
   motor:
     type: dc_motor
-    parameters: {model: raw3_driv}
+    parameters: {model: maxon_re40_14887}
 )");
   const std::string all = Issues(f);
   EXPECT_TRUE(Has(all, "units.motor.parameters.model: no model file")) << all;
-  EXPECT_TRUE(Has(all, "closest: raw3_drive")) << all;
+  EXPECT_TRUE(Has(all, "closest: maxon_re40_148877")) << all;
   // A path that is a folder is an issue at the key, not a crash.
   const std::string g = WriteScenario("model_dir.yaml", R"(duration_s: 0.01
 units:
@@ -353,7 +348,7 @@ units:
 // model file describes motor and gearbox, never the load, so it has no
 // full-mode-only keys).
 TEST(LoadScenario, ModelFilesLoadInBothModes) {
-  for (const char* model : {"maxon_re40_148877", "raw3_drive", "raw3_steer"}) {
+  for (const char* model : {"maxon_re40_148877", "husky_drive"}) {
     for (const char* mode : {"full", "current_only"}) {
       const std::string f = WriteScenario("models.yaml", std::string(R"(duration_s: 0.01
 units:
