@@ -36,7 +36,8 @@ class UnitError : public std::runtime_error {
 ///   propagates initial values) -> repeated {set inputs, DoStep, get outputs}
 ///   -> Terminate().
 /// Outputs are valid after Initialize() and after each DoStep(t, dt), for the
-/// time t + dt.
+/// time t + dt. Once the master has initialized every unit it locks the
+/// tables: a fixed parameter then refuses a new value (VariableTable::Lock).
 class Unit {
  public:
   Unit(std::string type_name, std::string instance_name)

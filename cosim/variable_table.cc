@@ -227,8 +227,8 @@ std::optional<std::string> Rule::Violation(const std::string& x) const {
 
 void Rule::CheckApplies(const std::string& variable, VarType type) const {
   const auto refuse = [&](const std::string& what) {
-    throw std::logic_error("parameter '" + variable + "' is " + std::string(ToString(type)) +
-                           ": " + what);
+    throw std::logic_error("parameter '" + variable + "' is " + std::string(ToString(type)) + ": " +
+                           what);
   };
   switch (type) {
     case VarType::kReal:
@@ -368,8 +368,7 @@ void VariableTable::SetRule(ValueRef ref, Rule rule) {
   if (rule.required()) {
     // No default means no default: a start value would hide a missing one.
     const auto& start = i.start;
-    const bool unset =
-        std::visit([](const auto& x) { return IsUnset(x); }, start);
+    const bool unset = std::visit([](const auto& x) { return IsUnset(x); }, start);
     if (!unset) {
       throw std::logic_error("parameter '" + i.name + "' is required (no default) but starts at " +
                              FormatValue(start) + ": start it at NaN (or \"\")");

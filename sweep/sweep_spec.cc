@@ -215,8 +215,8 @@ std::optional<RuledParameter> FindRuledParameter(const loader::Scenario& base,
     if (dot == std::string::npos) break;
     start = dot + 1;
   }
-  if ((parts.size() != 4 && parts.size() != 5) || parts[0] != "units" ||
-      parts[2] != "parameters" || !base.system) {
+  if ((parts.size() != 4 && parts.size() != 5) || parts[0] != "units" || parts[2] != "parameters" ||
+      !base.system) {
     return std::nullopt;
   }
   const auto u = base.system->FindUnit(parts[1]);
@@ -227,8 +227,8 @@ std::optional<RuledParameter> FindRuledParameter(const loader::Scenario& base,
   const cosim::VariableInfo& info = unit.variables().info(*ref);
   if (info.causality != cosim::Causality::kParameter || info.rule.empty()) return std::nullopt;
   if (parts.size() == 5) {
-    const bool digits = !parts[4].empty() && parts[4].find_first_not_of("0123456789") ==
-                                                 std::string::npos;
+    const bool digits =
+        !parts[4].empty() && parts[4].find_first_not_of("0123456789") == std::string::npos;
     if (info.type != cosim::VarType::kRealArray || !digits) return std::nullopt;
   }
   return RuledParameter{&unit, &info, parts.size() == 5};
@@ -312,9 +312,9 @@ void CheckParameterRule(const loader::Scenario& base, const ParameterSpec& p,
     }
     case ParameterKind::kRandom: {
       const YAML::Node random = Child(node, "random");
-      const std::vector<const char*> keys =
-          p.distribution == Distribution::kNormal ? std::vector<const char*>{"mean"}
-                                                  : std::vector<const char*>{"min", "max"};
+      const std::vector<const char*> keys = p.distribution == Distribution::kNormal
+                                                ? std::vector<const char*>{"mean"}
+                                                : std::vector<const char*>{"min", "max"};
       for (const char* key : keys) {
         check(Child(random, key), JoinPath(path, std::string("random.") + key));
       }

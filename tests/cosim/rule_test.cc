@@ -185,9 +185,9 @@ TEST(Variability, FixedParametersAreReadOnlyOnceLockedAndRestoreStillWorks) {
   EXPECT_THROW(t.SetString(*t.Find("mode"), "full"), std::logic_error);
   EXPECT_THROW(t.SetInteger(*t.Find("count"), 1), std::logic_error);
   EXPECT_EQ(t.GetReal(mass), 3.0);
-  t.SetReal(gain, 0.7);  // tunable
+  t.SetReal(gain, 0.7);          // tunable
   t.SetReal(*t.Find("y"), 1.0);  // the unit's own output
-  u.mass_ = 9.0;  // the unit may still do what it likes with its members
+  u.mass_ = 9.0;                 // the unit may still do what it likes with its members
   u.RestoreState(saved);
   EXPECT_EQ(t.GetReal(mass), 3.0);
   EXPECT_EQ(t.GetReal(gain), 0.5);

@@ -334,15 +334,17 @@ TEST(SweepCli, BadInputExitsTwoAndWritesNothing) {
 
   // A value the unit's declared rule refuses (dc_motor: resistance > 0):
   // the sweep file is refused at that value, no run is made.
-  const std::string ruled = WriteSweep(
-      "ruled.yaml", "scenario: " LINESIM_SOURCE_DIR
-                    "/scenarios/motor_step.yaml\n"
-                    "parameters: [{path: units.motors.parameters.resistance, values: [0.3, -1]}]\n");
+  const std::string ruled =
+      WriteSweep("ruled.yaml",
+                 "scenario: " LINESIM_SOURCE_DIR
+                 "/scenarios/motor_step.yaml\n"
+                 "parameters: [{path: units.motors.parameters.resistance, values: [0.3, -1]}]\n");
   const Result refused_value = Sweep(ruled, dir);
   EXPECT_EQ(refused_value.status, 2);
-  EXPECT_NE(refused_value.err.find(ruled + ":2: parameters.0.values.1: "
-                                           "units.motors.parameters.resistance: must be > 0, got -1"),
-            std::string::npos)
+  EXPECT_NE(
+      refused_value.err.find(ruled + ":2: parameters.0.values.1: "
+                                     "units.motors.parameters.resistance: must be > 0, got -1"),
+      std::string::npos)
       << refused_value.err;
   EXPECT_FALSE(fs::exists(dir));
 

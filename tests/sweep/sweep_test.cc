@@ -376,13 +376,14 @@ TEST(SweepSpec, AUnitParameterValueBreakingItsDeclaredRuleIsRefusedAtItsKey) {
           "  - {path: units.supply.parameters.initial, values: [0, 1]}\n");
   const auto texts = IssueTexts(file);
   ASSERT_EQ(texts.size(), 4u) << (texts.empty() ? "" : texts[0]);
-  EXPECT_TRUE(AnyContains(texts,
-                          file + ":5: parameters.0.values.1: units.motors.parameters.resistance: "
-                                 "must be > 0, got -1 (the rule of unit 'motors' (dc_motor): > 0)"))
+  EXPECT_TRUE(
+      AnyContains(texts, file + ":5: parameters.0.values.1: units.motors.parameters.resistance: "
+                                "must be > 0, got -1 (the rule of unit 'motors' (dc_motor): > 0)"))
       << texts[0];
   EXPECT_TRUE(AnyContains(texts, "parameters.0.values.2.1: units.motors.parameters.resistance.1: ",
                           "must be > 0, got 0"));
-  EXPECT_TRUE(AnyContains(texts, file + ":6: parameters.1.range.to: ", "must be in (0, 1], got 1.5"));
+  EXPECT_TRUE(
+      AnyContains(texts, file + ":6: parameters.1.range.to: ", "must be in (0, 1], got 1.5"));
   EXPECT_TRUE(AnyContains(texts, "parameters.2.random.min: units.motors.parameters.inductance: ",
                           "must be > 0, got 0"));
   // Within the rules (and a unit parameter with no rule): accepted.

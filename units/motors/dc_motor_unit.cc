@@ -12,7 +12,6 @@
 #include <cstring>
 #include <utility>
 
-
 namespace linesim::motors {
 
 namespace {
@@ -107,8 +106,7 @@ DcMotorUnit::DcMotorUnit(std::string name, int count, MotorMode mode)
   v.Parameter("torque_constant", "N.m/A", &torque_constant_,
               "torque constant k_t, equal to the back-EMF constant in V.s/rad",
               cosim::Rule::Positive());
-  v.Parameter("rotor_inertia", "kg.m2", &rotor_inertia_, "rotor inertia",
-              cosim::Rule::Positive());
+  v.Parameter("rotor_inertia", "kg.m2", &rotor_inertia_, "rotor inertia", cosim::Rule::Positive());
   v.Parameter("viscous_friction", "N.m.s/rad", &viscous_friction_,
               "viscous friction on the rotor, b (friction torque b * rotor speed)",
               cosim::Rule::NonNegative());

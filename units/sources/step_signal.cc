@@ -3,7 +3,6 @@
 #include <cmath>
 #include <string>
 
-
 namespace linesim::sources {
 
 StepSignalUnit::StepSignalUnit(std::string name, int count, std::string unit,

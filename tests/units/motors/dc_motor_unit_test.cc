@@ -589,11 +589,18 @@ TEST(DcMotorUnit, CheckParametersListsEveryProblem) {
 // quantities of the model equations that divide or scale must be > 0, the
 // efficiency is a fraction in (0, 1], the hold one of its two algorithms.
 TEST(DcMotorUnit, DeclaresTheRangeOfEveryParameter) {
-  const std::vector<std::pair<std::string, std::string>> full = {
-      {"resistance", "> 0"},       {"inductance", "> 0"},       {"torque_constant", "> 0"},
-      {"rotor_inertia", "> 0"},    {"viscous_friction", ">= 0"}, {"gear_ratio", "> 0"},
-      {"gear_efficiency", "(0, 1]"}, {"initial_current", "finite"}, {"load_inertia", ">= 0"},
-      {"initial_speed", "finite"}, {"rel_tol", "> 0"},         {"abs_tol", "> 0"}};
+  const std::vector<std::pair<std::string, std::string>> full = {{"resistance", "> 0"},
+                                                                 {"inductance", "> 0"},
+                                                                 {"torque_constant", "> 0"},
+                                                                 {"rotor_inertia", "> 0"},
+                                                                 {"viscous_friction", ">= 0"},
+                                                                 {"gear_ratio", "> 0"},
+                                                                 {"gear_efficiency", "(0, 1]"},
+                                                                 {"initial_current", "finite"},
+                                                                 {"load_inertia", ">= 0"},
+                                                                 {"initial_speed", "finite"},
+                                                                 {"rel_tol", "> 0"},
+                                                                 {"abs_tol", "> 0"}};
   DcMotorUnit u("m", 2, MotorMode::kFull);
   for (const auto& [name, rule] : full) {
     EXPECT_EQ(u.variables().info(*u.variables().Find(name)).rule.Text(), rule) << name;
