@@ -32,12 +32,15 @@ std::string TypeLabel(const cosim::VariableInfo& v) {
 }
 
 // The variable table as aligned columns; "start" is the value the unit
-// starts with: its declared start value, or what the scenario set.
+// starts with: its declared start value, or what the scenario set; "rule"
+// the values a parameter accepts ("> 0", "(0, 1]", "one of: a, b",
+// "required"), "-" for none.
 void PrintTable(const cosim::Unit& unit, std::ostream& out) {
+  constexpr int kColumns = 7;
   struct Row {
-    std::string cells[6];
+    std::string cells[kColumns];
   };
-  std::vector<Row> rows{{{"name", "causality", "type", "unit", "start", "description"}}};
+  std::vector<Row> rows{{{"name", "causality", "type", "unit", "start", "rule", "description"}}};
   const auto& table = unit.variables();
   for (const auto& v : table.infos()) {
     std::string description = v.description;
@@ -46,19 +49,19 @@ void PrintTable(const cosim::Unit& unit, std::ostream& out) {
       for (auto ref : v.depends_on) description += " " + table.info(ref).name;
       description += "]";
     }
-    rows.push_back(
-        {{v.name, std::string(cosim::ToString(v.causality)), TypeLabel(v),
-          v.unit.empty() ? "-" : v.unit, cosim::FormatValue(table.GetValue(v.ref)), description}});
+    rows.push_back({{v.name, std::string(cosim::ToString(v.causality)), TypeLabel(v),
+                     v.unit.empty() ? "-" : v.unit, cosim::FormatValue(table.GetValue(v.ref)),
+                     v.rule.empty() ? "-" : v.rule.Text(), description}});
   }
-  std::size_t width[5] = {};
+  std::size_t width[kColumns - 1] = {};
   for (const auto& r : rows) {
-    for (int c = 0; c < 5; ++c) width[c] = std::max(width[c], r.cells[c].size());
+    for (int c = 0; c + 1 < kColumns; ++c) width[c] = std::max(width[c], r.cells[c].size());
   }
   for (const auto& r : rows) {
     out << "  ";
-    for (int c = 0; c < 5; ++c)
+    for (int c = 0; c + 1 < kColumns; ++c)
       out << std::left << std::setw(static_cast<int>(width[c]) + 2) << r.cells[c];
-    out << r.cells[5] << "\n";
+    out << r.cells[kColumns - 1] << "\n";
   }
 }
 

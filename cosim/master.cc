@@ -291,6 +291,9 @@ void Master::Start() {
     }
   }
   for (std::size_t u = 0; u < n && !failed_; ++u) CheckOutputs(u, time_);
+  // Initialization is over: fixed parameters keep their values from here on
+  // (FMI: they may change only before exiting initialization mode).
+  for (std::size_t u = 0; u < n; ++u) system_.unit(u).variables().Lock();
   started_ = true;
   // An observer that refuses the run (say, a recording interval off the
   // master's steps) fails it like a unit would: the units still terminate.

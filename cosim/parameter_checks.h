@@ -11,7 +11,9 @@ namespace linesim::cosim {
 /// Collects a unit's parameter problems for CheckParameters, with the
 /// common rules and one wording for them ("must be positive and finite,
 /// got -1"). Arrays are checked element by element, each bad element a
-/// problem with its index.
+/// problem with its index. A rule on one parameter is better declared with
+/// it (cosim::Rule, which inspect prints and sweeps check before running);
+/// this is for what a declaration cannot say.
 class ParameterChecks {
  public:
   void Positive(const char* name, double value);

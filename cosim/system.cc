@@ -157,6 +157,14 @@ std::optional<Link> System::CheckConnection(std::size_t c, std::vector<Problem>&
       return std::nullopt;
     }
     const VariableInfo& info = table.info(*ref);
+    if (info.causality == Causality::kParameter && wanted == Causality::kInput) {
+      // A parameter keeps its value over the run (fixed, or tunable between
+      // steps by the master, never by a signal): it cannot be a target.
+      report(e.unit + "." + e.variable +
+             " is a parameter: parameters are set before the run (under parameters:), "
+             "not connected; a connection must go from an output to an input");
+      return std::nullopt;
+    }
     if (info.causality != wanted) {
       report(e.unit + "." + e.variable + " is " + std::string(ToString(info.causality)) +
              ", a connection must go from an output to an input");

@@ -22,9 +22,13 @@ void Unit::RestoreState(const UnitState& state) {
                                 " variables restored into " + Where() + " with " +
                                 std::to_string(variables_.size()));
   }
-  for (ValueRef r = 0; r < variables_.size(); ++r) variables_.SetValue(r, state.variables[r]);
+  // Read-only variables too: a restored unit is the saved one, whatever
+  // the lock says.
+  for (ValueRef r = 0; r < variables_.size(); ++r) variables_.RestoreValue(r, state.variables[r]);
   RestoreInternal(state);
 }
+
+std::vector<ParameterProblem> Unit::CheckParameters() const { return CheckRules(variables_); }
 
 bool Unit::InputsFinite(TimeNs t) {
   const auto problem = FirstNonFinite(variables_, variables_.real_inputs());

@@ -23,13 +23,6 @@ struct UnitState {
   std::vector<std::string> strings;
 };
 
-/// A parameter value a unit refuses, found before time zero.
-struct ParameterProblem {
-  std::string variable;
-  std::optional<std::size_t> index;  // element of an array parameter
-  std::string message;               // what was expected
-};
-
 /// Thrown by a unit for a failure it cannot recover from; the master adds the
 /// unit name and time.
 class UnitError : public std::runtime_error {
@@ -43,7 +36,8 @@ class UnitError : public std::runtime_error {
 ///   propagates initial values) -> repeated {set inputs, DoStep, get outputs}
 ///   -> Terminate().
 /// Outputs are valid after Initialize() and after each DoStep(t, dt), for the
-/// time t + dt.
+/// time t + dt. Once the master has initialized every unit it locks the
+/// tables: a fixed parameter then refuses a new value (VariableTable::Lock).
 class Unit {
  public:
   Unit(std::string type_name, std::string instance_name)
@@ -58,8 +52,18 @@ class Unit {
   const VariableTable& variables() const { return variables_; }
 
   /// Checks parameter values after they are set and before Setup, so that a
-  /// scenario is refused before time zero. The default accepts everything.
-  virtual std::vector<ParameterProblem> CheckParameters() const { return {}; }
+  /// scenario is refused before time zero. The default reports every
+  /// parameter value that breaks the rule declared with it (see Rule), each
+  /// element of an array on its own. Declare single-parameter rules with the
+  /// parameter; override only for rules between parameters (a < b, list
+  /// lengths that must agree), and start from the base:
+  ///
+  ///   std::vector<ParameterProblem> CheckParameters() const override {
+  ///     auto problems = Unit::CheckParameters();
+  ///     if (min_ >= max_) problems.push_back({"max", std::nullopt, "must be > min"});
+  ///     return problems;
+  ///   }
+  virtual std::vector<ParameterProblem> CheckParameters() const;
 
   virtual void Setup(TimeNs start, TimeNs stop) {
     (void)start;

@@ -1,5 +1,6 @@
 #include "cosim/variable_table.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
@@ -89,6 +90,166 @@ std::string FormatValue(const Value& v) {
 
 namespace {
 
+std::string JoinTexts(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& i : items) out += (out.empty() ? "" : ", ") + i;
+  return out;
+}
+
+}  // namespace
+
+Rule Rule::Finite() {
+  Rule r;
+  r.numeric_ = true;
+  return r;
+}
+Rule Rule::Positive() { return AtLeast(0.0, false); }
+Rule Rule::NonNegative() { return AtLeast(0.0, true); }
+
+Rule Rule::AtLeast(double min, bool inclusive) {
+  if (!std::isfinite(min)) throw std::logic_error("Rule::AtLeast: the bound must be finite");
+  Rule r = Finite();
+  r.min_ = Bound{min, inclusive};
+  return r;
+}
+
+Rule Rule::AtMost(double max, bool inclusive) {
+  if (!std::isfinite(max)) throw std::logic_error("Rule::AtMost: the bound must be finite");
+  Rule r = Finite();
+  r.max_ = Bound{max, inclusive};
+  return r;
+}
+
+Rule Rule::Range(double min, bool min_inclusive, double max, bool max_inclusive) {
+  if (!(min < max) && !(min == max && min_inclusive && max_inclusive)) {
+    throw std::logic_error("Rule::Range: no value lies between " + FormatValue(min) + " and " +
+                           FormatValue(max));
+  }
+  Rule r = AtLeast(min, min_inclusive);
+  r.max_ = AtMost(max, max_inclusive).max_;
+  return r;
+}
+
+Rule Rule::OneOf(std::vector<std::string> allowed) {
+  if (allowed.empty()) throw std::logic_error("Rule::OneOf: no allowed value");
+  Rule r;
+  r.strings_ = std::move(allowed);
+  return r;
+}
+Rule Rule::OneOf(std::initializer_list<const char*> allowed) {
+  return OneOf(std::vector<std::string>(allowed.begin(), allowed.end()));
+}
+Rule Rule::OneOf(std::vector<std::int64_t> allowed) {
+  if (allowed.empty()) throw std::logic_error("Rule::OneOf: no allowed value");
+  Rule r;
+  r.integers_ = std::move(allowed);
+  return r;
+}
+Rule Rule::OneOf(std::initializer_list<int> allowed) {
+  return OneOf(std::vector<std::int64_t>(allowed.begin(), allowed.end()));
+}
+
+Rule Rule::NoDefault() const {
+  Rule r = *this;
+  r.required_ = true;
+  return r;
+}
+
+bool Rule::empty() const { return !numeric_ && !strings_ && !integers_ && !required_; }
+
+std::string Rule::Bounds() const {
+  if (min_ && max_) {
+    return std::string(min_->inclusive ? "[" : "(") + FormatValue(min_->value) + ", " +
+           FormatValue(max_->value) + (max_->inclusive ? "]" : ")");
+  }
+  if (min_) return (min_->inclusive ? ">= " : "> ") + FormatValue(min_->value);
+  if (max_) return (max_->inclusive ? "<= " : "< ") + FormatValue(max_->value);
+  return "";
+}
+
+std::string Rule::Text() const {
+  std::vector<std::string> parts;
+  if (required_) parts.push_back("required");
+  if (!Bounds().empty()) {
+    parts.push_back(Bounds());
+  } else if (numeric_ && !required_) {
+    parts.push_back("finite");
+  }
+  if (strings_) parts.push_back("one of: " + JoinTexts(*strings_));
+  if (integers_) {
+    std::vector<std::string> texts;
+    for (auto n : *integers_) texts.push_back(std::to_string(n));
+    parts.push_back("one of: " + JoinTexts(texts));
+  }
+  return JoinTexts(parts);
+}
+
+namespace {
+
+constexpr const char* kNotSet = "must be set (robot-specific: no default)";
+
+}  // namespace
+
+std::optional<std::string> Rule::Violation(double x) const {
+  if (required_ && std::isnan(x)) return kNotSet;
+  if (!numeric_ && !required_) return std::nullopt;
+  // "in [0, 1]" reads better than "[0, 1]" in a sentence; "> 0" as is.
+  const std::string bounds = (min_ && max_ ? "in " : "") + Bounds();
+  if (!std::isfinite(x)) {
+    return "must be finite" + (bounds.empty() ? "" : " and " + bounds) + ", got " + FormatValue(x);
+  }
+  const bool low = min_ && (min_->inclusive ? x < min_->value : x <= min_->value);
+  const bool high = max_ && (max_->inclusive ? x > max_->value : x >= max_->value);
+  if (low || high) return "must be " + bounds + ", got " + FormatValue(x);
+  return std::nullopt;
+}
+
+std::optional<std::string> Rule::Violation(std::int64_t x) const {
+  if (min_ || max_) {
+    if (auto v = Violation(static_cast<double>(x))) {
+      // The integer as written, not as the double that compared.
+      return v->substr(0, v->rfind(", got ")) + ", got " + std::to_string(x);
+    }
+  }
+  if (integers_ && std::find(integers_->begin(), integers_->end(), x) == integers_->end()) {
+    return "must be " + Text() + ", got " + std::to_string(x);
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> Rule::Violation(const std::string& x) const {
+  if (required_ && x.empty()) return kNotSet;
+  if (strings_ && std::find(strings_->begin(), strings_->end(), x) == strings_->end()) {
+    return "must be one of: " + JoinTexts(*strings_) + ", got '" + x + "'";
+  }
+  return std::nullopt;
+}
+
+void Rule::CheckApplies(const std::string& variable, VarType type) const {
+  const auto refuse = [&](const std::string& what) {
+    throw std::logic_error("parameter '" + variable + "' is " + std::string(ToString(type)) + ": " +
+                           what);
+  };
+  switch (type) {
+    case VarType::kReal:
+    case VarType::kRealArray:
+      if (strings_ || integers_) refuse("a set of allowed values applies to String or Integer");
+      break;
+    case VarType::kInteger:
+      if (strings_) refuse("a set of strings applies to a String");
+      if (required_) refuse("an integer has no 'not set' value, so it cannot be required");
+      break;
+    case VarType::kBoolean:
+      if (!empty()) refuse("a Boolean takes no rule");
+      break;
+    case VarType::kString:
+      if (numeric_ || integers_) refuse("a number rule applies to a Real or an Integer");
+      break;
+  }
+}
+
+namespace {
+
 template <typename T>
 constexpr VarType kTypeOf = VarType::kReal;
 template <>
@@ -112,6 +273,15 @@ Variability SignalVariability(VarType t) {
   return (t == VarType::kReal || t == VarType::kRealArray) ? Variability::kContinuous
                                                            : Variability::kDiscrete;
 }
+
+// A required parameter's start value: NaN, every element NaN, or "".
+bool IsUnset(double x) { return std::isnan(x); }
+bool IsUnset(const std::vector<double>& x) {
+  return std::all_of(x.begin(), x.end(), [](double e) { return std::isnan(e); });
+}
+bool IsUnset(const std::string& x) { return x.empty(); }
+bool IsUnset(std::int64_t) { return false; }
+bool IsUnset(bool) { return false; }
 
 }  // namespace
 
@@ -141,6 +311,7 @@ ValueRef VariableTable::Bind(std::string name, Causality causality, Variability 
   }
   infos_.push_back(std::move(info));
   storage_.push_back(storage);
+  read_only_.push_back(variability == Variability::kConstant ? 1 : 0);
   return infos_.back().ref;
 }
 
@@ -160,6 +331,83 @@ ValueRef VariableTable::Parameter(std::string name, bool* s, std::string d, Vari
 }
 ValueRef VariableTable::Parameter(std::string name, std::string* s, std::string d, Variability v) {
   return Bind(std::move(name), Causality::kParameter, v, "", s, std::move(d));
+}
+
+ValueRef VariableTable::Parameter(std::string name, std::string unit, double* s, std::string d,
+                                  Rule rule, Variability v) {
+  const ValueRef ref = Parameter(std::move(name), std::move(unit), s, std::move(d), v);
+  SetRule(ref, std::move(rule));
+  return ref;
+}
+ValueRef VariableTable::Parameter(std::string name, std::string unit, std::vector<double>* s,
+                                  std::string d, Rule rule, Variability v) {
+  const ValueRef ref = Parameter(std::move(name), std::move(unit), s, std::move(d), v);
+  SetRule(ref, std::move(rule));
+  return ref;
+}
+ValueRef VariableTable::Parameter(std::string name, std::int64_t* s, std::string d, Rule rule,
+                                  Variability v) {
+  const ValueRef ref = Parameter(std::move(name), s, std::move(d), v);
+  SetRule(ref, std::move(rule));
+  return ref;
+}
+ValueRef VariableTable::Parameter(std::string name, std::string* s, std::string d, Rule rule,
+                                  Variability v) {
+  const ValueRef ref = Parameter(std::move(name), s, std::move(d), v);
+  SetRule(ref, std::move(rule));
+  return ref;
+}
+
+void VariableTable::SetRule(ValueRef ref, Rule rule) {
+  VariableInfo& i = infos_.at(ref);
+  if (i.causality != Causality::kParameter) {
+    throw std::logic_error("'" + i.name + "' is " + std::string(ToString(i.causality)) +
+                           ": only parameters have rules");
+  }
+  rule.CheckApplies(i.name, i.type);
+  if (rule.required()) {
+    // No default means no default: a start value would hide a missing one.
+    const auto& start = i.start;
+    const bool unset = std::visit([](const auto& x) { return IsUnset(x); }, start);
+    if (!unset) {
+      throw std::logic_error("parameter '" + i.name + "' is required (no default) but starts at " +
+                             FormatValue(start) + ": start it at NaN (or \"\")");
+    }
+  }
+  i.rule = std::move(rule);
+}
+
+void VariableTable::Lock() {
+  locked_ = true;
+  for (const auto& i : infos_) {
+    if (i.causality == Causality::kParameter && i.variability == Variability::kFixed) {
+      read_only_[i.ref] = 1;
+    }
+  }
+}
+
+void VariableTable::ThrowReadOnly(ValueRef ref) const {
+  const VariableInfo& i = infos_[ref];
+  if (i.variability == Variability::kConstant) {
+    throw std::logic_error(std::string(ToString(i.causality)) + " '" + i.name +
+                           "' is a constant of the unit: it cannot be set");
+  }
+  throw std::logic_error("parameter '" + i.name +
+                         "' is fixed: it is set before the run and cannot change once the unit "
+                         "is initialized (a parameter that may change between steps is declared "
+                         "tunable)");
+}
+
+void VariableTable::RestoreValue(ValueRef ref, const Value& v) {
+  const char was = read_only_.at(ref);
+  read_only_[ref] = 0;
+  try {
+    SetValue(ref, v);
+  } catch (...) {
+    read_only_[ref] = was;
+    throw;
+  }
+  read_only_[ref] = was;
 }
 
 ValueRef VariableTable::Input(std::string name, std::string unit, double* s, std::string d) {
@@ -254,7 +502,7 @@ std::span<const double> VariableTable::GetRealArray(ValueRef ref) const {
 }
 
 void VariableTable::SetRealArray(ValueRef ref, std::span<const double> v) {
-  auto* dst = Slot<std::vector<double>>(ref, VarType::kRealArray);
+  auto* dst = Writable<std::vector<double>>(ref, VarType::kRealArray);
   if (v.size() != dst->size()) {
     throw std::invalid_argument("'" + infos_[ref].name + "' holds " + std::to_string(dst->size()) +
                                 " elements, got " + std::to_string(v.size()));
@@ -267,7 +515,7 @@ double VariableTable::GetRealElement(ValueRef ref, std::size_t index) const {
 }
 
 void VariableTable::SetRealElement(ValueRef ref, std::size_t index, double v) {
-  Slot<std::vector<double>>(ref, VarType::kRealArray)->at(index) = v;
+  Writable<std::vector<double>>(ref, VarType::kRealArray)->at(index) = v;
 }
 
 Value VariableTable::GetValue(ValueRef ref) const {
@@ -360,6 +608,36 @@ std::optional<std::string> FirstNonFinite(const VariableTable& table,
     }
   }
   return std::nullopt;
+}
+
+std::vector<ParameterProblem> CheckRule(const VariableInfo& info, const Value& v) {
+  std::vector<ParameterProblem> problems;
+  if (info.rule.empty()) return problems;
+  const auto add = [&](std::optional<std::size_t> index, std::optional<std::string> message) {
+    if (message) problems.push_back({info.name, index, std::move(*message)});
+  };
+  const bool real = info.type == VarType::kReal || info.type == VarType::kRealArray;
+  if (const auto* d = std::get_if<double>(&v); d && real) {
+    add(std::nullopt, info.rule.Violation(*d));
+  } else if (const auto* n = std::get_if<std::int64_t>(&v)) {
+    if (real) add(std::nullopt, info.rule.Violation(static_cast<double>(*n)));
+    if (info.type == VarType::kInteger) add(std::nullopt, info.rule.Violation(*n));
+  } else if (const auto* a = std::get_if<std::vector<double>>(&v);
+             a && info.type == VarType::kRealArray) {
+    for (std::size_t k = 0; k < a->size(); ++k) add(k, info.rule.Violation((*a)[k]));
+  } else if (const auto* t = std::get_if<std::string>(&v); t && info.type == VarType::kString) {
+    add(std::nullopt, info.rule.Violation(*t));
+  }
+  return problems;
+}
+
+std::vector<ParameterProblem> CheckRules(const VariableTable& table) {
+  std::vector<ParameterProblem> problems;
+  for (const auto& info : table.infos()) {
+    if (info.causality != Causality::kParameter || info.rule.empty()) continue;
+    for (auto& p : CheckRule(info, table.GetValue(info.ref))) problems.push_back(std::move(p));
+  }
+  return problems;
 }
 
 }  // namespace linesim::cosim

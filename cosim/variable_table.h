@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <initializer_list>
 #include <optional>
 #include <span>
 #include <string>
@@ -17,9 +18,12 @@ using ValueRef = std::uint32_t;
 
 enum class VarType { kReal, kInteger, kBoolean, kString, kRealArray };
 enum class Causality { kParameter, kInput, kOutput, kLocal };
-/// FMI variability: fixed parameters are set before initialize only; tunable
-/// ones may change between steps; discrete values change only at
-/// communication points; continuous ones may change at any time.
+/// FMI variability. Checked by the table's setters: a constant is never set
+/// from outside the unit (only RestoreState writes it); a fixed parameter is
+/// set before the run only (the table refuses it once the master has
+/// initialized the unit, see VariableTable::Lock); a tunable one may change
+/// between steps. Discrete and continuous describe signals (inputs, outputs,
+/// locals), which the master writes at communication points.
 enum class Variability { kConstant, kFixed, kTunable, kDiscrete, kContinuous };
 
 std::string_view ToString(VarType t);
@@ -39,6 +43,85 @@ std::string FormatValue(double x);
 /// leading '+'), whatever the locale; nothing for anything else.
 std::optional<double> ParseFiniteValue(std::string_view text);
 
+/// A value a unit refuses (a parameter's rule, or a unit's own check),
+/// found before time zero.
+struct ParameterProblem {
+  std::string variable;
+  std::optional<std::size_t> index;  // element of an array parameter
+  std::string message;               // what was expected, and the value
+};
+
+/// The values a parameter accepts, declared with it (FMI's min/max and
+/// more): a range (each end inclusive or exclusive), positivity, finiteness,
+/// an allowed set of strings or integers, and "required" (no default: the
+/// start value is NaN or "" and the scenario must set it). Every numeric rule
+/// also requires a finite value. For an array the rule applies to each
+/// element. A default-constructed Rule accepts everything.
+///
+///   v.Parameter("mass", "kg", &mass_, "total mass", Rule::Positive().NoDefault());
+///   v.Parameter("eta", "1", &eta_, "efficiency", Rule::Range(0, false, 1, true));
+///   v.Parameter("mode", &mode_, "how", Rule::OneOf({"full", "current_only"}));
+class Rule {
+ public:
+  Rule() = default;
+
+  /// Any finite number.
+  static Rule Finite();
+  /// > 0.
+  static Rule Positive();
+  /// >= 0.
+  static Rule NonNegative();
+  /// >= min, or > min when not inclusive.
+  static Rule AtLeast(double min, bool inclusive = true);
+  /// <= max, or < max when not inclusive.
+  static Rule AtMost(double max, bool inclusive = true);
+  /// [min, max]; each end inclusive unless said otherwise ("(0, 1]" is
+  /// Range(0, false, 1, true)).
+  static Rule Range(double min, bool min_inclusive, double max, bool max_inclusive);
+  static Rule Range(double min, double max) { return Range(min, true, max, true); }
+  /// A String parameter: one of these.
+  static Rule OneOf(std::vector<std::string> allowed);
+  static Rule OneOf(std::initializer_list<const char*> allowed);
+  /// An Integer parameter: one of these.
+  static Rule OneOf(std::vector<std::int64_t> allowed);
+  static Rule OneOf(std::initializer_list<int> allowed);
+  /// No default, any finite number (or any non-empty string): the start
+  /// value is NaN (or "") and the parameter must be set.
+  static Rule Required() { return Rule().NoDefault(); }
+
+  /// The same rule, and the parameter has no default (robot-specific): NaN
+  /// or "" means "not set" and is reported as "must be set (robot-specific:
+  /// no default)".
+  Rule NoDefault() const;
+
+  bool empty() const;
+  bool required() const { return required_; }
+  /// For tables: "> 0", "[0, 1]", "(0, 1]", "finite", "one of: a, b",
+  /// "required", "required, > 0"; "" when there is no rule.
+  std::string Text() const;
+
+  /// Why `x` breaks the rule ("must be > 0, got -1"), or nothing.
+  std::optional<std::string> Violation(double x) const;
+  std::optional<std::string> Violation(std::int64_t x) const;
+  std::optional<std::string> Violation(const std::string& x) const;
+
+  /// Throws std::logic_error when the rule cannot apply to a variable of
+  /// this type (a set of strings on a Real, a range on a Boolean).
+  void CheckApplies(const std::string& variable, VarType type) const;
+
+ private:
+  struct Bound {
+    double value = 0;
+    bool inclusive = true;
+  };
+  std::string Bounds() const;  // "> 0", "[0, 1]"; "" without bounds
+  bool numeric_ = false;       // a number rule: finite, maybe bounded
+  std::optional<Bound> min_, max_;
+  std::optional<std::vector<std::string>> strings_;
+  std::optional<std::vector<std::int64_t>> integers_;
+  bool required_ = false;
+};
+
 struct VariableInfo {
   ValueRef ref = 0;
   std::string name;
@@ -49,6 +132,8 @@ struct VariableInfo {
   std::string unit;  // SI unit string, "1" for dimensionless
   std::string description;
   Value start;
+  /// Parameters only: the values it accepts (empty: any).
+  Rule rule;
   /// Outputs only: the inputs this output depends on directly (feedthrough
   /// within one communication point). Empty means none.
   std::vector<ValueRef> depends_on;
@@ -64,6 +149,9 @@ class VariableTable {
   VariableTable(const VariableTable&) = delete;
   VariableTable& operator=(const VariableTable&) = delete;
 
+  /// A parameter; `rule` says which values it accepts (Unit::CheckParameters
+  /// reports every value that breaks it). A rule that cannot apply to the
+  /// type, or a required parameter with a start value, is a std::logic_error.
   ValueRef Parameter(std::string name, std::string unit, double* storage, std::string description,
                      Variability v = Variability::kFixed);
   ValueRef Parameter(std::string name, std::string unit, std::vector<double>* storage,
@@ -74,6 +162,17 @@ class VariableTable {
                      Variability v = Variability::kFixed);
   ValueRef Parameter(std::string name, std::string* storage, std::string description,
                      Variability v = Variability::kFixed);
+  ValueRef Parameter(std::string name, std::string unit, double* storage, std::string description,
+                     Rule rule, Variability v = Variability::kFixed);
+  ValueRef Parameter(std::string name, std::string unit, std::vector<double>* storage,
+                     std::string description, Rule rule, Variability v = Variability::kFixed);
+  ValueRef Parameter(std::string name, std::int64_t* storage, std::string description, Rule rule,
+                     Variability v = Variability::kFixed);
+  ValueRef Parameter(std::string name, std::string* storage, std::string description, Rule rule,
+                     Variability v = Variability::kFixed);
+  /// Sets the rule of a parameter declared earlier (for parameters declared
+  /// in a loop or by a helper); same checks as at declaration.
+  void SetRule(ValueRef ref, Rule rule);
 
   ValueRef Input(std::string name, std::string unit, double* storage, std::string description);
   ValueRef Input(std::string name, std::string unit, std::vector<double>* storage,
@@ -106,10 +205,18 @@ class VariableTable {
   const std::vector<ValueRef>& real_inputs() const { return real_inputs_; }
   const std::vector<ValueRef>& real_outputs() const { return real_outputs_; }
 
-  // Typed access. Each checks the type and throws std::logic_error on misuse;
-  // array setters check the element count.
+  /// Ends the configuration of the unit: from now on the setters refuse a
+  /// fixed parameter (std::logic_error), as they always refuse a constant.
+  /// The master calls it once every unit is initialized; RestoreState still
+  /// writes every variable.
+  void Lock();
+  bool locked() const { return locked_; }
+
+  // Typed access. Each checks the type and throws std::logic_error on misuse
+  // or on a variable its variability makes read-only (see Lock); array
+  // setters check the element count.
   double GetReal(ValueRef ref) const { return *Slot<double>(ref, VarType::kReal); }
-  void SetReal(ValueRef ref, double v) { *Slot<double>(ref, VarType::kReal) = v; }
+  void SetReal(ValueRef ref, double v) { *Writable<double>(ref, VarType::kReal) = v; }
   std::span<const double> GetRealArray(ValueRef ref) const;
   void SetRealArray(ValueRef ref, std::span<const double> v);
   double GetRealElement(ValueRef ref, std::size_t index) const;
@@ -117,14 +224,16 @@ class VariableTable {
   std::int64_t GetInteger(ValueRef ref) const {
     return *Slot<std::int64_t>(ref, VarType::kInteger);
   }
-  void SetInteger(ValueRef ref, std::int64_t v) { *Slot<std::int64_t>(ref, VarType::kInteger) = v; }
+  void SetInteger(ValueRef ref, std::int64_t v) {
+    *Writable<std::int64_t>(ref, VarType::kInteger) = v;
+  }
   bool GetBoolean(ValueRef ref) const { return *Slot<bool>(ref, VarType::kBoolean); }
-  void SetBoolean(ValueRef ref, bool v) { *Slot<bool>(ref, VarType::kBoolean) = v; }
+  void SetBoolean(ValueRef ref, bool v) { *Writable<bool>(ref, VarType::kBoolean) = v; }
   const std::string& GetString(ValueRef ref) const {
     return *Slot<std::string>(ref, VarType::kString);
   }
   void SetString(ValueRef ref, std::string v) {
-    *Slot<std::string>(ref, VarType::kString) = std::move(v);
+    *Writable<std::string>(ref, VarType::kString) = std::move(v);
   }
 
   /// Generic access for the boundary. SetValue converts an integer to a real
@@ -150,13 +259,39 @@ class VariableTable {
     return static_cast<T*>(storage_[ref]);
   }
   [[noreturn]] void ThrowTypeMisuse(ValueRef ref, VarType expected) const;
+  template <typename T>
+  T* Writable(ValueRef ref, VarType expected) {
+    T* slot = Slot<T>(ref, expected);
+    if (read_only_[ref]) ThrowReadOnly(ref);
+    return slot;
+  }
+  [[noreturn]] void ThrowReadOnly(ValueRef ref) const;
+
+  // Unit::RestoreState writes every variable, read-only or not.
+  friend class Unit;
+  void RestoreValue(ValueRef ref, const Value& v);
 
   std::vector<VariableInfo> infos_;
   std::vector<void*> storage_;
   std::unordered_map<std::string, ValueRef> by_name_;
   std::vector<ValueRef> real_inputs_;
   std::vector<ValueRef> real_outputs_;
+  // Per variable: the setters refuse it (a constant, or a fixed parameter
+  // after Lock). One flag, so that the hot path pays one load.
+  std::vector<char> read_only_;
+  bool locked_ = false;
 };
+
+/// Every element of `v` that breaks the rule of parameter `info`, worded as
+/// Unit::CheckParameters reports them ("must be > 0, got -1", index set for
+/// an element of a list). A scalar given for an array parameter is checked
+/// once, without an index. For the loader and sweeps, to refuse a value at
+/// its key before running. Values of the wrong type are not this check's
+/// business (SetValue refuses them): they give no problem here.
+std::vector<ParameterProblem> CheckRule(const VariableInfo& info, const Value& v);
+/// Every parameter of `table` whose current value breaks its rule: what the
+/// default Unit::CheckParameters returns.
+std::vector<ParameterProblem> CheckRules(const VariableTable& table);
 
 /// The first non-finite value among `refs` (Real or Real[] variables of
 /// `table`), as "input 'x[k]' is nan" (the variable's causality, its name

@@ -10,6 +10,7 @@
 #include <limits>
 #include <optional>
 
+#include "cosim/system.h"
 #include "cosim/variable_table.h"
 #include "loader/scenario.h"
 #include "loader/yaml_files.h"
@@ -196,6 +197,132 @@ void CheckParameterPath(const SweepSpec& spec, const ParameterSpec& p, const YAM
   }
 }
 
+// A unit parameter a sweep path names in the base scenario
+// (units.NAME.parameters.KEY, or KEY.N for one element of a list) and
+// declares a rule for.
+struct RuledParameter {
+  const cosim::Unit* unit = nullptr;
+  const cosim::VariableInfo* info = nullptr;
+  bool element = false;  // KEY.N: one number of a list
+};
+
+std::optional<RuledParameter> FindRuledParameter(const loader::Scenario& base,
+                                                 const std::string& path) {
+  std::vector<std::string> parts;
+  for (std::size_t start = 0;;) {
+    const std::size_t dot = path.find('.', start);
+    parts.push_back(path.substr(start, dot - start));
+    if (dot == std::string::npos) break;
+    start = dot + 1;
+  }
+  if ((parts.size() != 4 && parts.size() != 5) || parts[0] != "units" || parts[2] != "parameters" ||
+      !base.system) {
+    return std::nullopt;
+  }
+  const auto u = base.system->FindUnit(parts[1]);
+  if (!u) return std::nullopt;
+  const cosim::Unit& unit = base.system->unit(*u);
+  const auto ref = unit.variables().Find(parts[3]);
+  if (!ref) return std::nullopt;
+  const cosim::VariableInfo& info = unit.variables().info(*ref);
+  if (info.causality != cosim::Causality::kParameter || info.rule.empty()) return std::nullopt;
+  if (parts.size() == 5) {
+    const bool digits =
+        !parts[4].empty() && parts[4].find_first_not_of("0123456789") == std::string::npos;
+    if (info.type != cosim::VarType::kRealArray || !digits) return std::nullopt;
+  }
+  return RuledParameter{&unit, &info, parts.size() == 5};
+}
+
+// A sweep value as the unit would take it; nothing for one of another type
+// (the run's loader reports that).
+std::optional<cosim::Value> ValueOf(const YAML::Node& node, const RuledParameter& p) {
+  const auto real = [&]() -> std::optional<cosim::Value> {
+    if (const auto x = YamlReader::DecodeReal(node)) return *x;
+    return std::nullopt;
+  };
+  switch (p.info->type) {
+    case cosim::VarType::kReal:
+      return real();
+    case cosim::VarType::kRealArray: {
+      if (p.element || !node.IsSequence()) return real();
+      std::vector<double> list;
+      for (const auto& item : node) {
+        const auto x = YamlReader::DecodeReal(item);
+        if (!x) return std::nullopt;
+        list.push_back(*x);
+      }
+      return list;
+    }
+    case cosim::VarType::kInteger: {
+      std::int64_t n = 0;
+      if (node.IsScalar() && YAML::convert<std::int64_t>::decode(node, n)) return n;
+      return std::nullopt;
+    }
+    case cosim::VarType::kString:
+      if (node.IsScalar()) return node.Scalar();
+      return std::nullopt;
+    case cosim::VarType::kBoolean:
+      break;
+  }
+  return std::nullopt;
+}
+
+// Refuses, at its key, a value the unit's declared rule refuses: every run
+// with it would fail the same way before time zero.
+void CheckValueAgainstRule(const ParameterSpec& spec, const RuledParameter& p,
+                           const YAML::Node& node, const std::string& key_path, YamlReader& r) {
+  const auto value = ValueOf(node, p);
+  if (!value) return;
+  for (const auto& problem : cosim::CheckRule(*p.info, *value)) {
+    const std::string element = problem.index ? "." + std::to_string(*problem.index) : "";
+    // "units.m.parameters.resistance.1: must be > 0, got -1 (the rule of
+    // unit 'm' (dc_motor): > 0)".
+    r.Error(problem.index ? node[*problem.index] : node, key_path + element,
+            spec.path + element + ": " + problem.message + " (the rule of " + p.unit->Where() +
+                ": " + p.info->rule.Text() + ")");
+  }
+}
+
+// Every listed value, both ends of a range and the bounds of a bounded
+// distribution of a unit parameter, against the rule the unit declares.
+// (A rule is an interval or a set; the values of a range lie between its
+// ends. A normal draw is unbounded: its mean is checked.)
+void CheckParameterRule(const loader::Scenario& base, const ParameterSpec& p,
+                        const YAML::Node& node, const std::string& path, YamlReader& r) {
+  const auto ruled = FindRuledParameter(base, p.path);
+  if (!ruled) return;
+  const auto check = [&](const YAML::Node& at, const std::string& at_path) {
+    CheckValueAgainstRule(p, *ruled, at, at_path, r);
+  };
+  switch (p.kind) {
+    case ParameterKind::kValues: {
+      const YAML::Node values = Child(node, "values");
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        check(values[i], JoinPath(path, "values." + std::to_string(i)));
+      }
+      break;
+    }
+    case ParameterKind::kRange: {
+      const YAML::Node range = Child(node, "range");
+      for (const char* end : {"from", "to"}) {
+        check(Child(range, end), JoinPath(path, std::string("range.") + end));
+      }
+      break;
+    }
+    case ParameterKind::kRandom: {
+      const YAML::Node random = Child(node, "random");
+      const std::vector<const char*> keys = p.distribution == Distribution::kNormal
+                                                ? std::vector<const char*>{"mean"}
+                                                : std::vector<const char*>{"min", "max"};
+      for (const char* key : keys) {
+        check(Child(random, key), JoinPath(path, std::string("random.") + key));
+      }
+      break;
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> FixedOverrides(const SweepSpec& spec) {
@@ -333,6 +460,8 @@ SweepSpec LoadSweepSpec(const std::string& file) {
   for (std::size_t i = 0; i < spec.parameters.size(); ++i) {
     const std::string path = "parameters." + std::to_string(i) + ".path";
     CheckParameterPath(spec, spec.parameters[i], Child(parameters[i], "path"), path, r);
+    CheckParameterRule(base, spec.parameters[i], parameters[i], "parameters." + std::to_string(i),
+                       r);
   }
   if (!r.ok()) throw ScenarioError(r.issues());
   return spec;

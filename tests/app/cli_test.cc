@@ -236,6 +236,21 @@ TEST(Cli, InspectTypeAndFile) {
        {"resistance", "parameter", "Ohm", "voltage", "input", "torque", "output", "N.m"}) {
     EXPECT_NE(type.out.find(part), std::string::npos) << part;
   }
+  // Each parameter's declared rule, in its own column after the start value.
+  const auto start = type.out.find(" start ");
+  const auto rule_column = type.out.find(" rule ");
+  EXPECT_LT(start, rule_column) << type.out;
+  EXPECT_LT(rule_column, type.out.find(" description\n")) << type.out;
+  for (const char* rule : {"> 0", ">= 0", "(0, 1]", "finite"}) {
+    EXPECT_NE(type.out.find(rule), std::string::npos) << rule;
+  }
+  const auto line_of = [&](const std::string& name) {
+    const auto at = type.out.find("\n  " + name + " ");
+    return at == std::string::npos ? std::string()
+                                   : type.out.substr(at + 1, type.out.find('\n', at + 1) - at - 1);
+  };
+  EXPECT_NE(line_of("gear_efficiency").find("(0, 1]"), std::string::npos) << type.out;
+  EXPECT_NE(line_of("resistance").find("> 0"), std::string::npos) << type.out;
   const Result file =
       Linesim("inspect " + kMotorStep + " --set units.motors.parameters.gear_ratio.1=5");
   ASSERT_EQ(file.status, 0) << file.err;

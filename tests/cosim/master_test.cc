@@ -79,6 +79,26 @@ TEST(MasterMultirate, EachUnitStepsAtItsOwnMultipleOfTheBaseStep) {
   }
 }
 
+// Guards variability through the master: parameters are set before Start;
+// once the units are initialized a fixed parameter refuses a new value
+// (the run keeps the value it was initialized with), and a saved state
+// still restores into the locked unit.
+TEST(MasterVariability, FixedParametersAreLockedOnceTheUnitsAreInitialized) {
+  auto m = MakeMultirate();
+  VariableTable& source = m->source->variables();
+  source.SetReal(*source.Find("slope"), 2.0);  // before the run: fine
+  Master master(m->system, MultirateOptions(Algorithm::kJacobi));
+  EXPECT_FALSE(source.locked());
+  master.Start();
+  EXPECT_TRUE(source.locked());
+  EXPECT_THROW(source.SetReal(*source.Find("slope"), 3.0), std::logic_error);
+  EXPECT_EQ(source.GetReal(*source.Find("slope")), 2.0);
+  const UnitState saved = m->source->SaveState();
+  ASSERT_TRUE(master.Step());
+  m->source->RestoreState(saved);
+  EXPECT_EQ(source.GetReal(*source.Find("slope")), 2.0);
+}
+
 // Guards against: transferring when only the destination is due (which
 // would leak the source's output between common points). Rule: a link
 // transfers only when its destination is due and its source is at a

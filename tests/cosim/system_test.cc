@@ -145,6 +145,14 @@ TEST(SystemBuild, WrongCausality) {
   EXPECT_THAT(OnlyMessage(BuildProblems({{"a.gain", "b.pos"}})), HasSubstr("a.gain is parameter"));
 }
 
+// Guards variability at the system level: a parameter keeps its value over
+// the run, so no signal may drive it; the message says where it is set.
+TEST(SystemBuild, AConnectionIntoAParameterIsRefused) {
+  EXPECT_THAT(OnlyMessage(BuildProblems({{"a.pos_out", "b.gain"}})),
+              HasSubstr("connection a.pos_out -> b.gain: b.gain is a parameter: parameters are "
+                        "set before the run (under parameters:), not connected"));
+}
+
 // Guards against: a speed in m/s fed into a position input in m.
 TEST(SystemBuild, DifferentUnitsOfMeasure) {
   const std::string m = OnlyMessage(BuildProblems({{"a.speed_out", "b.pos"}}));

@@ -332,6 +332,22 @@ TEST(SweepCli, BadInputExitsTwoAndWritesNothing) {
   EXPECT_NE(r.err.find("control.compensation"), std::string::npos) << r.err;  // the closest key
   EXPECT_FALSE(fs::exists(dir));
 
+  // A value the unit's declared rule refuses (dc_motor: resistance > 0):
+  // the sweep file is refused at that value, no run is made.
+  const std::string ruled =
+      WriteSweep("ruled.yaml",
+                 "scenario: " LINESIM_SOURCE_DIR
+                 "/scenarios/motor_step.yaml\n"
+                 "parameters: [{path: units.motors.parameters.resistance, values: [0.3, -1]}]\n");
+  const Result refused_value = Sweep(ruled, dir);
+  EXPECT_EQ(refused_value.status, 2);
+  EXPECT_NE(
+      refused_value.err.find(ruled + ":2: parameters.0.values.1: "
+                                     "units.motors.parameters.resistance: must be > 0, got -1"),
+      std::string::npos)
+      << refused_value.err;
+  EXPECT_FALSE(fs::exists(dir));
+
   EXPECT_EQ(Sweep(Temp("absent.yaml"), dir).status, 2);
   // A folder name the system refuses (over NAME_MAX, 255 bytes on Linux).
   const Result long_name = Sweep(SmallSweep("long.yaml"), Temp(std::string(300, 'a')));

@@ -355,6 +355,47 @@ TEST(SweepSpec, ShippedSweepsLoad) {
   }
 }
 
+// Guards the rules a unit declares reaching the sweep file: a unit parameter
+// value the unit would refuse fails every run it is in the same way, so the
+// sweep is refused before running, at the value's own key, naming the value
+// and the rule (dc_motor: resistance > 0, gear_efficiency in (0, 1]).
+TEST(SweepSpec, AUnitParameterValueBreakingItsDeclaredRuleIsRefusedAtItsKey) {
+  const std::string motor_step = LINESIM_SOURCE_DIR "/scenarios/motor_step.yaml";
+  const std::string file = WriteFile(
+      "rules.yaml",
+      "scenario: " + motor_step +
+          "\n"
+          "combine: monte_carlo\n"
+          "samples: 2\n"
+          "parameters:\n"
+          "  - {path: units.motors.parameters.resistance, values: [0.3, -1, [0.3, 0]]}\n"
+          "  - {path: units.motors.parameters.gear_efficiency.1, range: {from: 0.5, to: 1.5, "
+          "count: 3}}\n"
+          "  - {path: units.motors.parameters.inductance, random: {distribution: uniform, min: 0, "
+          "max: 1e-4}}\n"
+          "  - {path: units.supply.parameters.initial, values: [0, 1]}\n");
+  const auto texts = IssueTexts(file);
+  ASSERT_EQ(texts.size(), 4u) << (texts.empty() ? "" : texts[0]);
+  EXPECT_TRUE(
+      AnyContains(texts, file + ":5: parameters.0.values.1: units.motors.parameters.resistance: "
+                                "must be > 0, got -1 (the rule of unit 'motors' (dc_motor): > 0)"))
+      << texts[0];
+  EXPECT_TRUE(AnyContains(texts, "parameters.0.values.2.1: units.motors.parameters.resistance.1: ",
+                          "must be > 0, got 0"));
+  EXPECT_TRUE(
+      AnyContains(texts, file + ":6: parameters.1.range.to: ", "must be in (0, 1], got 1.5"));
+  EXPECT_TRUE(AnyContains(texts, "parameters.2.random.min: units.motors.parameters.inductance: ",
+                          "must be > 0, got 0"));
+  // Within the rules (and a unit parameter with no rule): accepted.
+  EXPECT_NO_THROW(LoadSweepSpec(WriteFile(
+      "rules_ok.yaml",
+      "scenario: " + motor_step +
+          "\nparameters:\n"
+          "  - {path: units.motors.parameters.resistance, values: [0.3, [0.3, 0.5]]}\n"
+          "  - {path: units.motors.parameters.gear_efficiency.1, range: {from: 0.5, to: 1, "
+          "count: 3}}\n")));
+}
+
 TEST(SweepSpec, AnOutOfRangeValueIsARunProblemNotASweepProblem) {
   // A value the scenario refuses fails its own run only: the others may be
   // what the user wants to see.

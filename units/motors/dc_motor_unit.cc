@@ -12,8 +12,6 @@
 #include <cstring>
 #include <utility>
 
-#include "cosim/parameter_checks.h"
-
 namespace linesim::motors {
 
 namespace {
@@ -101,34 +99,45 @@ DcMotorUnit::DcMotorUnit(std::string name, int count, MotorMode mode)
   }
 
   auto& v = variables();
-  v.Parameter("resistance", "Ohm", &resistance_, "armature (terminal) resistance");
-  v.Parameter("inductance", "H", &inductance_, "armature (terminal) inductance");
+  v.Parameter("resistance", "Ohm", &resistance_, "armature (terminal) resistance",
+              cosim::Rule::Positive());
+  v.Parameter("inductance", "H", &inductance_, "armature (terminal) inductance",
+              cosim::Rule::Positive());
   v.Parameter("torque_constant", "N.m/A", &torque_constant_,
-              "torque constant k_t, equal to the back-EMF constant in V.s/rad");
-  v.Parameter("rotor_inertia", "kg.m2", &rotor_inertia_, "rotor inertia");
+              "torque constant k_t, equal to the back-EMF constant in V.s/rad",
+              cosim::Rule::Positive());
+  v.Parameter("rotor_inertia", "kg.m2", &rotor_inertia_, "rotor inertia", cosim::Rule::Positive());
   v.Parameter("viscous_friction", "N.m.s/rad", &viscous_friction_,
-              "viscous friction on the rotor, b (friction torque b * rotor speed)");
+              "viscous friction on the rotor, b (friction torque b * rotor speed)",
+              cosim::Rule::NonNegative());
   v.Parameter("gear_ratio", "1", &gear_ratio_,
-              "N: rotor revolutions per output revolution (1 = no gearbox)");
+              "N: rotor revolutions per output revolution (1 = no gearbox)",
+              cosim::Rule::Positive());
   v.Parameter("gear_efficiency", "1", &gear_efficiency_,
-              "eta in (0, 1]: fraction of the motor torque reaching the output");
-  v.Parameter("initial_current", "A", &initial_current_, "armature current at the start");
+              "eta: fraction of the motor torque reaching the output",
+              cosim::Rule::Range(0.0, false, 1.0, true));
+  v.Parameter("initial_current", "A", &initial_current_, "armature current at the start",
+              cosim::Rule::Finite());
   if (full) {
     v.Parameter("load_inertia", "kg.m2", &load_inertia_,
-                "inertia at the gearbox output, reflected to the rotor as J / (eta N^2)");
-    v.Parameter("initial_speed", "rad/s", &initial_speed_, "output shaft speed at the start");
+                "inertia at the gearbox output, reflected to the rotor as J / (eta N^2)",
+                cosim::Rule::NonNegative());
+    v.Parameter("initial_speed", "rad/s", &initial_speed_, "output shaft speed at the start",
+                cosim::Rule::Finite());
   }
   if (!full) {
     v.Parameter("shaft_speed_hold", &shaft_speed_hold_,
                 "zero_order: the shaft speed is held constant over a step and a new value "
                 "restarts CVODE (exact for a piecewise-constant input); first_order: it is "
                 "extrapolated along the slope of its last two samples and a new value does not "
-                "restart CVODE (only a new voltage does), for a speed that varies continuously");
+                "restart CVODE (only a new voltage does), for a speed that varies continuously",
+                cosim::Rule::OneOf({"zero_order", "first_order"}));
   }
-  v.Parameter("rel_tol", "1", &rel_tol_, "CVODE relative tolerance");
+  v.Parameter("rel_tol", "1", &rel_tol_, "CVODE relative tolerance", cosim::Rule::Positive());
   v.Parameter("abs_tol", "1", &abs_tol_,
               "CVODE absolute tolerance, relative to the stall current per volt 1 V/R "
-              "and the no-load rotor speed per volt 1 V/k_t of each motor");
+              "and the no-load rotor speed per volt 1 V/k_t of each motor",
+              cosim::Rule::Positive());
 
   v.Input("voltage", "V", &voltage_, "terminal voltage, held over a communication step");
   if (full) {
@@ -248,32 +257,6 @@ std::string DcMotorUnit::WorstState() const {
   if (weights) N_VDestroy(weights);
   if (errors) N_VDestroy(errors);
   return text;
-}
-
-std::vector<cosim::ParameterProblem> DcMotorUnit::CheckParameters() const {
-  cosim::ParameterChecks c;
-  c.Positive("resistance", resistance_);
-  c.Positive("inductance", inductance_);
-  c.Positive("torque_constant", torque_constant_);
-  c.Positive("rotor_inertia", rotor_inertia_);
-  c.NonNegative("viscous_friction", viscous_friction_);
-  c.Positive("gear_ratio", gear_ratio_);
-  c.Check(
-      "gear_efficiency", gear_efficiency_, [](double x) { return x > 0.0 && x <= 1.0; },
-      "must be in (0, 1]");
-  c.Finite("initial_current", initial_current_);
-  if (mode_ == MotorMode::kFull) {
-    c.NonNegative("load_inertia", load_inertia_);
-    c.Finite("initial_speed", initial_speed_);
-  }
-  if (mode_ == MotorMode::kCurrentOnly && shaft_speed_hold_ != "zero_order" &&
-      shaft_speed_hold_ != "first_order") {
-    c.Add({"shaft_speed_hold", std::nullopt,
-           "must be zero_order or first_order, got '" + shaft_speed_hold_ + "'"});
-  }
-  c.Positive("rel_tol", rel_tol_);
-  c.Positive("abs_tol", abs_tol_);
-  return c.Take();
 }
 
 void DcMotorUnit::ComputeCoefficients() {

@@ -51,13 +51,11 @@ class DcMotorUnit : public cosim::Unit {
   DcMotorUnit(std::string name, int count, MotorMode mode);
   ~DcMotorUnit() override;
 
-  /// Validates the parameters (throws cosim::UnitError naming the unit, the
-  /// variable, the element and the bad value), sets the states to the
-  /// initial values and computes the outputs.
+  /// Validates the parameters against the rules declared with them (throws
+  /// cosim::UnitError naming the unit, the variable, the element and the bad
+  /// value, every one at once), sets the states to the initial values and
+  /// computes the outputs.
   void Initialize() override;
-  /// Every parameter value out of range, with the element index and the bad
-  /// value; Initialize throws them all as one cosim::UnitError.
-  std::vector<cosim::ParameterProblem> CheckParameters() const override;
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
   /// Current-only mode: the torque follows a new shaft speed at once.
   void UpdateOutputs() override { ComputeOutputs(); }

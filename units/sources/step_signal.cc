@@ -3,8 +3,6 @@
 #include <cmath>
 #include <string>
 
-#include "cosim/parameter_checks.h"
-
 namespace linesim::sources {
 
 StepSignalUnit::StepSignalUnit(std::string name, int count, std::string unit,
@@ -23,28 +21,28 @@ StepSignalUnit::StepSignalUnit(std::string name, int count, std::string unit,
     }
   }
   auto& v = variables();
-  v.Parameter("initial", unit, &initial_, "value before the first step");
+  // A non-finite value is named here, not later as a NaN output.
+  v.Parameter("initial", unit, &initial_, "value before the first step", cosim::Rule::Finite());
   v.Output("value", unit, &value_, "the signal, one element per channel", {});
 }
 
 std::vector<cosim::ParameterProblem> StepSignalUnit::CheckParameters() const {
-  cosim::ParameterChecks c;
-  // A non-finite value is named here, not later as a NaN output.
-  c.Finite("initial", initial_);
+  // The declared rules (initial), then the schedule, which is no variable.
+  auto problems = cosim::Unit::CheckParameters();
   for (std::size_t i = 0; i < steps_.size(); ++i) {
     for (double v : steps_[i].value) {
       if (!std::isfinite(v)) {
-        c.Add({"steps", i, "values must be finite, got " + cosim::FormatValue(v)});
+        problems.push_back({"steps", i, "values must be finite, got " + cosim::FormatValue(v)});
         break;
       }
     }
     if (i > 0 && steps_[i].time <= steps_[i - 1].time) {
-      c.Add({"steps", i,
-             "step times must increase, got " + cosim::FormatSeconds(steps_[i].time) + " s after " +
-                 cosim::FormatSeconds(steps_[i - 1].time) + " s"});
+      problems.push_back({"steps", i,
+                          "step times must increase, got " + cosim::FormatSeconds(steps_[i].time) +
+                              " s after " + cosim::FormatSeconds(steps_[i - 1].time) + " s"});
     }
   }
-  return c.Take();
+  return problems;
 }
 
 void StepSignalUnit::Evaluate(cosim::TimeNs t) {

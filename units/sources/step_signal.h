@@ -24,6 +24,8 @@ class StepSignalUnit : public cosim::Unit {
   /// in increasing time order with `count` values each.
   StepSignalUnit(std::string name, int count, std::string unit, std::vector<Step> steps);
 
+  /// The rule of `initial` (finite), and the schedule: finite values, times
+  /// that increase.
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
   void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
   void Initialize() override;

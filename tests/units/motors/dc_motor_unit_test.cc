@@ -573,14 +573,45 @@ TEST(DcMotorUnit, CheckParametersListsEveryProblem) {
   ASSERT_EQ(problems.size(), 5u);
   EXPECT_EQ(problems[0].variable, "resistance");
   EXPECT_EQ(problems[0].index, 1u);
-  EXPECT_NE(problems[0].message.find("-1"), std::string::npos) << problems[0].message;
+  EXPECT_EQ(problems[0].message, "must be > 0, got -1");
   EXPECT_EQ(problems[1].variable, "gear_efficiency");
   EXPECT_EQ(problems[1].index, 2u);
+  EXPECT_EQ(problems[1].message, "must be in (0, 1], got 0");
   for (std::size_t k = 0; k < 3; ++k) {
     EXPECT_EQ(problems[2 + k].variable, "load_inertia");
     EXPECT_EQ(problems[2 + k].index, k);
   }
   EXPECT_THROW(u.Initialize(), cosim::UnitError);
+}
+
+// Guards the rules the motor declares with its parameters (what inspect
+// prints and what the loader and sweeps check before running): the physical
+// quantities of the model equations that divide or scale must be > 0, the
+// efficiency is a fraction in (0, 1], the hold one of its two algorithms.
+TEST(DcMotorUnit, DeclaresTheRangeOfEveryParameter) {
+  const std::vector<std::pair<std::string, std::string>> full = {{"resistance", "> 0"},
+                                                                 {"inductance", "> 0"},
+                                                                 {"torque_constant", "> 0"},
+                                                                 {"rotor_inertia", "> 0"},
+                                                                 {"viscous_friction", ">= 0"},
+                                                                 {"gear_ratio", "> 0"},
+                                                                 {"gear_efficiency", "(0, 1]"},
+                                                                 {"initial_current", "finite"},
+                                                                 {"load_inertia", ">= 0"},
+                                                                 {"initial_speed", "finite"},
+                                                                 {"rel_tol", "> 0"},
+                                                                 {"abs_tol", "> 0"}};
+  DcMotorUnit u("m", 2, MotorMode::kFull);
+  for (const auto& [name, rule] : full) {
+    EXPECT_EQ(u.variables().info(*u.variables().Find(name)).rule.Text(), rule) << name;
+  }
+  DcMotorUnit c("c", 1, MotorMode::kCurrentOnly);
+  const auto hold = *c.variables().Find("shaft_speed_hold");
+  EXPECT_EQ(c.variables().info(hold).rule.Text(), "one of: zero_order, first_order");
+  c.variables().SetString(hold, "second_order");
+  const auto problems = c.CheckParameters();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].message, "must be one of: zero_order, first_order, got 'second_order'");
 }
 
 // Guards against SUNDIALS failures being lost or reported without context:

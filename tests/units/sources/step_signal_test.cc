@@ -52,6 +52,7 @@ TEST(StepSignalUnit, RefusesNonFiniteValuesNamingTheStep) {
   ASSERT_EQ(problems.size(), 2u);
   EXPECT_EQ(problems[0].variable, "initial");
   EXPECT_EQ(problems[0].index, 1u);
+  EXPECT_EQ(problems[0].message, "must be finite, got inf");
   EXPECT_EQ(problems[1].variable, "steps");
   EXPECT_EQ(problems[1].index, 1u);
   EXPECT_NE(problems[1].message.find("got nan"), std::string::npos) << problems[1].message;

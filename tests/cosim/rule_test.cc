@@ -1,0 +1,216 @@
+// Rules declared with a parameter (FMI's min/max and more), the default
+// Unit::CheckParameters that walks them, and the variability the table's
+// setters enforce.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "cosim/unit.h"
+
+namespace linesim::cosim {
+namespace {
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Guards the one wording of a broken rule: what was expected, then the
+// value, for every kind of rule; and the text inspect prints.
+TEST(Rule, WordsWhatWasExpectedAndTheValue) {
+  EXPECT_EQ(Rule::Positive().Violation(-1.0), "must be > 0, got -1");
+  EXPECT_EQ(Rule::Positive().Violation(0.0), "must be > 0, got 0");
+  EXPECT_EQ(Rule::Positive().Violation(kInf), "must be finite and > 0, got inf");
+  EXPECT_FALSE(Rule::Positive().Violation(1e-300));
+  EXPECT_EQ(Rule::NonNegative().Violation(-0.5), "must be >= 0, got -0.5");
+  EXPECT_FALSE(Rule::NonNegative().Violation(0.0));
+  const Rule eta = Rule::Range(0, false, 1, true);
+  EXPECT_EQ(eta.Violation(0.0), "must be in (0, 1], got 0");
+  EXPECT_EQ(eta.Violation(1.5), "must be in (0, 1], got 1.5");
+  EXPECT_FALSE(eta.Violation(1.0));
+  EXPECT_EQ(Rule::Range(-1, 1).Violation(kNan), "must be finite and in [-1, 1], got nan");
+  EXPECT_EQ(Rule::AtMost(2, false).Violation(2.0), "must be < 2, got 2");
+  EXPECT_EQ(Rule::Finite().Violation(-kInf), "must be finite, got -inf");
+  EXPECT_FALSE(Rule().Violation(kNan));
+  EXPECT_EQ(Rule::Required().Violation(kNan), "must be set (robot-specific: no default)");
+  EXPECT_EQ(Rule::Positive().NoDefault().Violation(kNan),
+            "must be set (robot-specific: no default)");
+  EXPECT_EQ(Rule::Positive().NoDefault().Violation(-1.0), "must be > 0, got -1");
+  EXPECT_EQ(Rule::OneOf({"full", "current_only"}).Violation(std::string("half")),
+            "must be one of: full, current_only, got 'half'");
+  EXPECT_EQ(Rule::Required().Violation(std::string()), "must be set (robot-specific: no default)");
+  EXPECT_EQ(Rule::OneOf({1, 2, 4}).Violation(std::int64_t{3}), "must be one of: 1, 2, 4, got 3");
+  EXPECT_EQ(Rule::AtLeast(1).Violation(std::int64_t{0}), "must be >= 1, got 0");
+
+  EXPECT_EQ(Rule::Positive().Text(), "> 0");
+  EXPECT_EQ(Rule::Range(0, 1).Text(), "[0, 1]");
+  EXPECT_EQ(eta.Text(), "(0, 1]");
+  EXPECT_EQ(Rule::Finite().Text(), "finite");
+  EXPECT_EQ(Rule::OneOf({"full", "current_only"}).Text(), "one of: full, current_only");
+  EXPECT_EQ(Rule::Required().Text(), "required");
+  EXPECT_EQ(Rule::Positive().NoDefault().Text(), "required, > 0");
+  EXPECT_EQ(Rule().Text(), "");
+  EXPECT_THROW(Rule::Range(1, 0), std::logic_error);
+  EXPECT_THROW(Rule::AtLeast(kNan), std::logic_error);
+}
+
+class Ruled : public Unit {
+ public:
+  Ruled() : Unit("ruled", "u") {
+    auto& v = variables();
+    v.Parameter("mass", "kg", &mass_, "total mass", Rule::Positive());
+    v.Parameter("wheel_x", "m", &wheel_x_, "wheel positions", Rule::Required());
+    v.Parameter("mode", &mode_, "how", Rule::OneOf({"full", "current_only"}));
+    v.Parameter("count", &count_, "how many", Rule::OneOf({1, 2, 4}));
+    v.Parameter("gain", "1", &gain_, "tuned between steps", Rule::NonNegative(),
+                Variability::kTunable);
+    v.Parameter("free", "1", &free_, "no rule");
+    v.Output("y", "1", &y_, "output", {});
+  }
+  StepResult DoStep(TimeNs, TimeNs) override { return StepResult::kOk; }
+  void Initialize() override { ThrowIfBadParameters(); }
+
+  double mass_ = 1.0;
+  std::vector<double> wheel_x_ = std::vector<double>(3, kNan);
+  std::string mode_ = "full";
+  std::int64_t count_ = 2;
+  double gain_ = 0.5;
+  double free_ = kNan;
+  double y_ = 0.0;
+};
+
+// Guards the default CheckParameters: every rule of every parameter, each
+// element of an array on its own, in declaration order; ThrowIfBadParameters
+// names them all.
+TEST(Rule, DefaultCheckParametersReportsEveryBrokenRule) {
+  Ruled u;
+  auto& t = u.variables();
+  t.SetValue(*t.Find("mass"), -1.0);
+  t.SetValue(*t.Find("wheel_x"), std::vector<double>{0.3, 0.3, kNan});
+  t.SetValue(*t.Find("mode"), std::string("half"));
+  t.SetValue(*t.Find("count"), std::int64_t{3});
+  const auto problems = u.CheckParameters();
+  ASSERT_EQ(problems.size(), 4u);
+  EXPECT_EQ(problems[0].variable, "mass");
+  EXPECT_EQ(problems[0].message, "must be > 0, got -1");
+  EXPECT_EQ(problems[1].variable, "wheel_x");
+  EXPECT_EQ(problems[1].index, 2u);
+  EXPECT_EQ(problems[1].message, "must be set (robot-specific: no default)");
+  EXPECT_EQ(problems[2].variable, "mode");
+  EXPECT_EQ(problems[3].variable, "count");
+  try {
+    u.Initialize();
+    FAIL() << "no error";
+  } catch (const UnitError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("unit 'u' (ruled): parameter 'mass' must be > 0, got -1; "
+                       "parameter 'wheel_x[2]' must be set (robot-specific: no default)"),
+              std::string::npos)
+        << msg;
+  }
+  t.SetValue(*t.Find("mass"), 2.0);
+  t.SetValue(*t.Find("wheel_x"), 0.3);
+  t.SetValue(*t.Find("mode"), std::string("current_only"));
+  t.SetValue(*t.Find("count"), std::int64_t{4});
+  EXPECT_TRUE(u.CheckParameters().empty());
+}
+
+// Guards the check the loader and sweeps use before running: a value is
+// judged against the declared rule without setting it.
+TEST(Rule, CheckRuleJudgesAValueAtItsKey) {
+  Ruled u;
+  const auto& t = u.variables();
+  const VariableInfo& mass = t.info(*t.Find("mass"));
+  EXPECT_TRUE(CheckRule(mass, 2.0).empty());
+  EXPECT_EQ(CheckRule(mass, std::int64_t{-2}).at(0).message, "must be > 0, got -2");
+  const VariableInfo& wheel_x = t.info(*t.Find("wheel_x"));
+  const auto list = CheckRule(wheel_x, std::vector<double>{1, kInf, kNan});
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_EQ(list[0].index, 1u);
+  EXPECT_EQ(list[1].index, 2u);
+  // A scalar for a list stands for every element: one problem, no index.
+  const auto scalar = CheckRule(wheel_x, kNan);
+  ASSERT_EQ(scalar.size(), 1u);
+  EXPECT_FALSE(scalar[0].index);
+  // Wrong types are SetValue's business.
+  EXPECT_TRUE(CheckRule(mass, std::string("x")).empty());
+  EXPECT_TRUE(CheckRule(t.info(*t.Find("free")), kNan).empty());
+  EXPECT_EQ(t.info(*t.Find("mode")).rule.Text(), "one of: full, current_only");
+}
+
+// Guards declarations that cannot mean anything: a rule for another type, a
+// required parameter with a default, a rule on a signal.
+TEST(Rule, MisdeclaredRulesAreLogicErrors) {
+  struct Bad : Unit {
+    Bad() : Unit("bad", "b") {}
+    StepResult DoStep(TimeNs, TimeNs) override { return StepResult::kOk; }
+    double x = 1.0;
+    bool flag = false;
+    std::string s = "a";
+    std::int64_t n = 1;
+  };
+  Bad b;
+  auto& v = b.variables();
+  EXPECT_THROW(v.Parameter("x", "1", &b.x, "", Rule::OneOf({"a"})), std::logic_error);
+  EXPECT_THROW(v.Parameter("x2", "1", &b.x, "", Rule::Required()), std::logic_error);
+  EXPECT_THROW(v.Parameter("s", &b.s, "", Rule::Positive()), std::logic_error);
+  EXPECT_THROW(v.Parameter("n", &b.n, "", Rule::Required()), std::logic_error);
+  const ValueRef flag = v.Parameter("flag", &b.flag, "");
+  EXPECT_THROW(v.SetRule(flag, Rule::Positive()), std::logic_error);
+  const ValueRef out = v.Output("o", "1", &b.x, "", {});
+  EXPECT_THROW(v.SetRule(out, Rule::Positive()), std::logic_error);
+}
+
+// Guards variability: a fixed parameter is set before the run only, a
+// tunable one also between steps, a constant never from outside; inputs stay
+// writable; RestoreState still restores everything.
+TEST(Variability, FixedParametersAreReadOnlyOnceLockedAndRestoreStillWorks) {
+  Ruled u;
+  auto& t = u.variables();
+  const ValueRef mass = *t.Find("mass");
+  const ValueRef gain = *t.Find("gain");
+  t.SetReal(mass, 3.0);  // before the run: fine
+  const UnitState saved = u.SaveState();
+  t.Lock();
+  EXPECT_TRUE(t.locked());
+  try {
+    t.SetReal(mass, 4.0);
+    FAIL() << "a fixed parameter changed after initialization";
+  } catch (const std::logic_error& e) {
+    EXPECT_NE(std::string(e.what()).find("parameter 'mass' is fixed"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(t.SetValue(mass, 4.0), std::logic_error);
+  EXPECT_THROW(t.SetRealElement(*t.Find("wheel_x"), 0, 1.0), std::logic_error);
+  EXPECT_THROW(t.SetString(*t.Find("mode"), "full"), std::logic_error);
+  EXPECT_THROW(t.SetInteger(*t.Find("count"), 1), std::logic_error);
+  EXPECT_EQ(t.GetReal(mass), 3.0);
+  t.SetReal(gain, 0.7);          // tunable
+  t.SetReal(*t.Find("y"), 1.0);  // the unit's own output
+  u.mass_ = 9.0;                 // the unit may still do what it likes with its members
+  u.RestoreState(saved);
+  EXPECT_EQ(t.GetReal(mass), 3.0);
+  EXPECT_EQ(t.GetReal(gain), 0.5);
+  EXPECT_THROW(t.SetReal(mass, 4.0), std::logic_error);  // still locked
+
+  struct WithConstant : Unit {
+    WithConstant() : Unit("const", "c") {
+      variables().Parameter("g", "m/s2", &g, "gravity", Variability::kConstant);
+    }
+    StepResult DoStep(TimeNs, TimeNs) override { return StepResult::kOk; }
+    double g = 9.81;
+  };
+  WithConstant c;
+  try {
+    c.variables().SetValue(0, 1.0);
+    FAIL() << "a constant was set";
+  } catch (const std::logic_error& e) {
+    EXPECT_STREQ(e.what(), "parameter 'g' is a constant of the unit: it cannot be set");
+  }
+  c.g = 1.0;
+  c.RestoreState(WithConstant().SaveState());
+  EXPECT_EQ(c.g, 9.81);
+}
+
+}  // namespace
+}  // namespace linesim::cosim
