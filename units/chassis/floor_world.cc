@@ -51,12 +51,19 @@ FloorWorld::FloorWorld() {
   group_ = dJointGroupCreate(0);
   // Not in a space: geoms are collided with the floor one by one.
   floor_ = dCreatePlane(nullptr, 0.0, 0.0, 1.0, 0.0);
+  obstacle_space_ = dHashSpaceCreate(nullptr);
+  carried_space_ = dSimpleSpaceCreate(nullptr);
+  // The spaces destroy the geoms in them.
+  dSpaceSetCleanup(obstacle_space_, 1);
+  dSpaceSetCleanup(carried_space_, 1);
 }
 
 FloorWorld::~FloorWorld() {
   EnsureOdeForThisThread();
   dJointGroupDestroy(group_);
   dGeomDestroy(floor_);
+  dSpaceDestroy(obstacle_space_);
+  dSpaceDestroy(carried_space_);
   dWorldDestroy(world_);
   dThreadingFreeImplementation(threading_);
 }
@@ -65,6 +72,7 @@ void FloorWorld::SetBelts(std::vector<BeltPatch> belts) {
   belts_ = std::move(belts);
   collided_ = false;
   belt_velocity_mps_.assign(belts_.size(), {0.0, 0.0});
+  belt_travel_m_.assign(belts_.size(), 0.0);
   belt_axes_.clear();
   for (const BeltPatch& b : belts_) {
     const double c = std::cos(b.direction_rad);
@@ -75,6 +83,121 @@ void FloorWorld::SetBelts(std::vector<BeltPatch> belts) {
 
 void FloorWorld::SetBeltVelocity(int k, double vx_mps, double vy_mps) {
   belt_velocity_mps_.at(static_cast<std::size_t>(k)) = {vx_mps, vy_mps};
+}
+
+namespace {
+
+// A geom for a solid standing on the floor (bottom_m above it), in `space`.
+dGeomID SolidGeom(dSpaceID space, const models::Solid& s, double* z_m) {
+  dGeomID g = s.kind == models::Solid::Kind::kBox
+                  ? dCreateBox(space, s.length_m, s.width_m, s.height_m)
+                  : dCreateCylinder(space, s.radius_m, s.height_m);  // axis along z
+  *z_m = s.bottom_m + 0.5 * s.height_m;
+  dGeomSetPosition(g, s.x_m, s.y_m, *z_m);
+  dMatrix3 rot;
+  dRFromAxisAndAngle(rot, 0.0, 0.0, 1.0, s.yaw_rad);
+  dGeomSetRotation(g, rot);
+  return g;
+}
+
+}  // namespace
+
+void FloorWorld::AddObstacle(const models::Solid& solid) {
+  double z = 0.0;
+  obstacles_.push_back(SolidGeom(obstacle_space_, solid, &z));
+}
+
+void FloorWorld::AddCarried(const models::Solid& solid, int belt) {
+  if (belt < 0 || belt >= belt_count()) throw std::out_of_range("FloorWorld: no such belt");
+  Carried c;
+  c.geom = SolidGeom(carried_space_, solid, &c.z_m);
+  c.belt = belt;
+  c.x0_m = solid.x_m;
+  c.y0_m = solid.y_m;
+  carried_.push_back(c);
+  PlaceCarried(travel_elapsed_s_);
+}
+
+void FloorWorld::SetBeltTravel(int k, double travel_m) {
+  belt_travel_m_.at(static_cast<std::size_t>(k)) = travel_m;
+  travel_elapsed_s_ = 0.0;
+}
+
+double FloorWorld::CarriedSpeed(std::size_t i) const {
+  const auto b = static_cast<std::size_t>(carried_[i].belt);
+  const auto& v = belt_velocity_mps_[b];
+  return v[0] * belt_axes_[b][0] + v[1] * belt_axes_[b][1];
+}
+
+void FloorWorld::PlaceCarried(double elapsed_s) {
+  for (std::size_t i = 0; i < carried_.size(); ++i) {
+    const Carried& c = carried_[i];
+    const auto b = static_cast<std::size_t>(c.belt);
+    const double s = belt_travel_m_[b] + CarriedSpeed(i) * elapsed_s;
+    dGeomSetPosition(c.geom, c.x0_m + s * belt_axes_[b][0], c.y0_m + s * belt_axes_[b][1], c.z_m);
+  }
+}
+
+void FloorWorld::ObjectCallback(void* data, dGeomID o1, dGeomID o2) {
+  auto* self = static_cast<FloorWorld*>(data);
+  // The body geom first, so that the normal points into it (from the object).
+  const dGeomID object = o1 == self->body_geom_ ? o2 : o1;
+  std::array<dContact, kMaxPoints> pts{};
+  const int n = dCollide(self->body_geom_, object, kMaxPoints, &pts[0].geom, sizeof(dContact));
+  if (n == 0) return;
+  // Velocity of the object: a carried one moves along its belt.
+  double v[3] = {0.0, 0.0, 0.0};
+  for (std::size_t i = 0; i < self->carried_.size(); ++i) {
+    if (self->carried_[i].geom != object) continue;
+    const double speed = self->CarriedSpeed(i);
+    const auto& a = self->belt_axes_[static_cast<std::size_t>(self->carried_[i].belt)];
+    v[0] = speed * a[0];
+    v[1] = speed * a[1];
+  }
+  const dBodyID body = dGeomGetBody(self->body_geom_);
+  for (int j = 0; j < n; ++j) {
+    dContact& p = pts[static_cast<std::size_t>(j)];
+    const dReal* nrm = p.geom.normal;
+    // A tangent: map z x normal, or map x when the normal is vertical.
+    double t1[3] = {-nrm[1], nrm[0], 0.0};
+    double len = std::hypot(t1[0], t1[1]);
+    if (len < 1e-6) {
+      t1[0] = 1.0 - nrm[0] * nrm[0];
+      t1[1] = -nrm[0] * nrm[1];
+      t1[2] = -nrm[0] * nrm[2];
+      len = std::sqrt(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]);
+    }
+    for (double& e : t1) e /= len;
+    const double t2[3] = {nrm[1] * t1[2] - nrm[2] * t1[1], nrm[2] * t1[0] - nrm[0] * t1[2],
+                          nrm[0] * t1[1] - nrm[1] * t1[0]};
+    // Contact rows with body2 = 0: n . v_body >= pushout + motionN, so
+    // motionN = n . v_object keeps the body from moving into the object;
+    // fdir . v_body = motion makes a sticking contact move with it.
+    p.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP | dContactMotion1 |
+                     dContactMotion2 | dContactMotionN | dContactFDir1;
+    p.surface.mu = self->body_mu_;
+    p.surface.soft_erp = self->object_erp_;
+    p.surface.soft_cfm = self->object_cfm_;
+    p.surface.motion1 = v[0] * t1[0] + v[1] * t1[1] + v[2] * t1[2];
+    p.surface.motion2 = v[0] * t2[0] + v[1] * t2[1] + v[2] * t2[2];
+    p.surface.motionN = v[0] * nrm[0] + v[1] * nrm[1] + v[2] * nrm[2];
+    for (int d = 0; d < 3; ++d) p.fdir1[d] = t1[d];
+    const dJointID joint = dJointCreateContact(self->world_, self->group_, &p);
+    dJointAttach(joint, body, nullptr);
+  }
+}
+
+void FloorWorld::CollideObjects(double erp, double cfm) {
+  if (body_geom_ == nullptr) return;
+  object_erp_ = erp;
+  object_cfm_ = cfm;
+  if (!obstacles_.empty()) {
+    dSpaceCollide2(body_geom_, reinterpret_cast<dGeomID>(obstacle_space_), this, &ObjectCallback);
+  }
+  if (!carried_.empty()) {
+    PlaceCarried(travel_elapsed_s_);
+    dSpaceCollide2(body_geom_, reinterpret_cast<dGeomID>(carried_space_), this, &ObjectCallback);
+  }
 }
 
 int FloorWorld::AddGeom(dGeomID geom) {
@@ -199,7 +322,9 @@ void FloorWorld::MakeJoints(std::size_t i, double erp, double cfm) {
     const bool sliding = slip_mps > kSlipAlignMps;
     p.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP | dContactMotion1 |
                      dContactMotion2 | dContactFDir1 | (sliding ? dContactSlip2 : 0);
-    p.surface.mu = surface_.mu;
+    p.surface.mu = pts.surface[j] > 0
+                       ? belts_[static_cast<std::size_t>(pts.surface[j] - 1)].mu
+                       : surface_.mu;
     p.surface.slip2 = 1.0 / surface_.slip_damping_n_s_per_m;
     p.surface.soft_erp = erp;
     p.surface.soft_cfm = cfm;
@@ -221,7 +346,9 @@ bool FloorWorld::Step(double h_s) {
   try {
     if (!collided_) Probe();
     for (std::size_t i = 0; i < geoms_.size(); ++i) MakeJoints(i, erp, cfm);
+    CollideObjects(erp, cfm);
     ok = dWorldStep(world_, h_s);
+    travel_elapsed_s_ += h_s;
     dJointGroupEmpty(group_);
     // At the new positions: for contact(i) now and the next step's joints.
     if (ok != 0) Probe();

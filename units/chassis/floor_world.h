@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "models/scene.h"
+
 namespace linesim::chassis {
 
 /// Standard gravity, m/s^2, pointing along -z in every ODE world made here.
@@ -49,11 +51,13 @@ struct BeltPatch {
   double length_m = 1.0;       // along the belt direction
   double width_m = 1.0;        // across it
   double direction_rad = 0.0;  // of the length axis, counter-clockwise from map x
+  double mu = 0.8;             // Coulomb coefficient of a wheel on its surface
 };
 
-/// Contact parameters shared by every contact with the floor and the belts.
+/// Contact parameters shared by every contact with the floor and the belts
+/// (each belt has its own mu: BeltPatch::mu).
 struct ContactSurface {
-  double mu = 0.8;                 // Coulomb coefficient (dContactApprox1)
+  double mu = 0.8;                 // Coulomb coefficient on the floor (dContactApprox1)
   double stiffness_n_per_m = 1e6;  // per contact point
   double damping_n_s_per_m = 1e4;  // per contact point
   // A sliding contact's resistance to sideways slip (across its slip
@@ -104,6 +108,15 @@ struct GeomContact {
 /// A slower (sticking) contact keeps both rows, fdir1 along the surface
 /// velocity, or map x on the still floor.
 ///
+/// Objects: static obstacles and belt-carried objects are collision
+/// geometry for one registered body geom (the robot's body box; wheels touch
+/// the floor only). Obstacles sit in a hash space and carried objects in a
+/// small simple space, each collided with the body geom by one
+/// dSpaceCollide2 at the start of every step, so that objects far from the
+/// robot cost an AABB test each. A carried object has no body: it is placed
+/// from its belt's travelled distance and its contacts move with it through
+/// the contact's surface motion (normal motionN and tangential motion1/2 =
+/// the object's velocity), as the belt contacts do.
 class FloorWorld {
  public:
   FloorWorld();
@@ -126,6 +139,24 @@ class FloorWorld {
   /// destroying it.
   int AddGeom(dGeomID geom);
   void ClearGeoms();
+
+  /// The geom (attached to a body of this world) that collides with
+  /// obstacles and carried objects, or nullptr; the caller keeps ownership.
+  void SetBodyGeom(dGeomID geom, double mu) {
+    body_geom_ = geom;
+    body_mu_ = mu;
+  }
+  /// Adds a static obstacle (box or vertical cylinder standing on the
+  /// floor); FloorWorld owns its geom.
+  void AddObstacle(const models::Solid& solid);
+  int obstacle_count() const { return static_cast<int>(obstacles_.size()); }
+  /// Adds an object carried by belt `belt` (0-based, < belt_count()), at
+  /// `solid` when the belt has travelled 0 m.
+  void AddCarried(const models::Solid& solid, int belt);
+  /// Distance belt k's surface has moved since time zero: carried objects
+  /// are placed at it (and move on at the belt velocity along the belt
+  /// direction within the step).
+  void SetBeltTravel(int k, double travel_m);
 
   /// Surface at map point (x, y): 0 floor, k + 1 for the first belt k that
   /// contains it (edges included).
@@ -167,6 +198,19 @@ class FloorWorld {
   void Collide(std::size_t i);
   /// Contact joints for the points of geom i.
   void MakeJoints(std::size_t i, double erp, double cfm);
+  /// Places the carried objects at `elapsed_s` into the step.
+  void PlaceCarried(double elapsed_s);
+  /// Contact joints between the body geom and the objects it touches.
+  void CollideObjects(double erp, double cfm);
+  static void ObjectCallback(void* data, dGeomID o1, dGeomID o2);
+  /// Speed of carried object i along its belt's direction.
+  double CarriedSpeed(std::size_t i) const;
+
+  struct Carried {
+    dGeomID geom = nullptr;
+    int belt = 0;
+    double x0_m = 0.0, y0_m = 0.0, z_m = 0.0;
+  };
 
   dWorldID world_ = nullptr;
   // Each world steps with its own threading object: without one, ODE steps
@@ -181,6 +225,17 @@ class FloorWorld {
   // Per belt, the unit vectors along and across its length axis.
   std::vector<std::array<double, 4>> belt_axes_;
   std::vector<dGeomID> geoms_;
+  dGeomID body_geom_ = nullptr;
+  double body_mu_ = 0.5;
+  dSpaceID obstacle_space_ = nullptr;
+  dSpaceID carried_space_ = nullptr;
+  std::vector<dGeomID> obstacles_;
+  std::vector<Carried> carried_;
+  std::vector<double> belt_travel_m_;
+  // Time since the last SetBeltTravel (substeps of one step).
+  double travel_elapsed_s_ = 0.0;
+  // ERP and CFM of the object contacts in the current CollideObjects.
+  double object_erp_ = 0.0, object_cfm_ = 0.0;
   std::vector<GeomContact> contacts_;
   std::vector<Points> points_;
   // Whether points_ hold the current positions of every geom (a Probe or
