@@ -51,19 +51,14 @@ FloorWorld::FloorWorld() {
   group_ = dJointGroupCreate(0);
   // Not in a space: geoms are collided with the floor one by one.
   floor_ = dCreatePlane(nullptr, 0.0, 0.0, 1.0, 0.0);
-  obstacle_space_ = dHashSpaceCreate(nullptr);
-  carried_space_ = dSimpleSpaceCreate(nullptr);
-  // The spaces destroy the geoms in them.
-  dSpaceSetCleanup(obstacle_space_, 1);
-  dSpaceSetCleanup(carried_space_, 1);
 }
 
 FloorWorld::~FloorWorld() {
   EnsureOdeForThisThread();
   dJointGroupDestroy(group_);
   dGeomDestroy(floor_);
-  dSpaceDestroy(obstacle_space_);
-  dSpaceDestroy(carried_space_);
+  for (dGeomID g : obstacles_) dGeomDestroy(g);
+  for (const Carried& c : carried_) dGeomDestroy(c.geom);
   dWorldDestroy(world_);
   dThreadingFreeImplementation(threading_);
 }
@@ -87,11 +82,11 @@ void FloorWorld::SetBeltVelocity(int k, double vx_mps, double vy_mps) {
 
 namespace {
 
-// A geom for a solid standing on the floor (bottom_m above it), in `space`.
-dGeomID SolidGeom(dSpaceID space, const models::Solid& s, double* z_m) {
+// A geom (in no space) for a solid standing on the floor (bottom_m above it).
+dGeomID SolidGeom(const models::Solid& s, double* z_m) {
   dGeomID g = s.kind == models::Solid::Kind::kBox
-                  ? dCreateBox(space, s.length_m, s.width_m, s.height_m)
-                  : dCreateCylinder(space, s.radius_m, s.height_m);  // axis along z
+                  ? dCreateBox(nullptr, s.length_m, s.width_m, s.height_m)
+                  : dCreateCylinder(nullptr, s.radius_m, s.height_m);  // axis along z
   *z_m = s.bottom_m + 0.5 * s.height_m;
   dGeomSetPosition(g, s.x_m, s.y_m, *z_m);
   dMatrix3 rot;
@@ -104,18 +99,22 @@ dGeomID SolidGeom(dSpaceID space, const models::Solid& s, double* z_m) {
 
 void FloorWorld::AddObstacle(const models::Solid& solid) {
   double z = 0.0;
-  obstacles_.push_back(SolidGeom(obstacle_space_, solid, &z));
+  obstacles_.push_back(SolidGeom(solid, &z));
+  Aabb box;
+  dGeomGetAABB(obstacles_.back(), box.data());
+  obstacle_aabbs_.push_back(box);
+  near_region_ = {1.0, -1.0, 1.0, -1.0, 1.0, -1.0};  // list again
 }
 
 void FloorWorld::AddCarried(const models::Solid& solid, int belt) {
   if (belt < 0 || belt >= belt_count()) throw std::out_of_range("FloorWorld: no such belt");
   Carried c;
-  c.geom = SolidGeom(carried_space_, solid, &c.z_m);
+  c.geom = SolidGeom(solid, &c.z_m);
   c.belt = belt;
   c.x0_m = solid.x_m;
   c.y0_m = solid.y_m;
+  dGeomGetAABB(c.geom, c.aabb0.data());
   carried_.push_back(c);
-  PlaceCarried(travel_elapsed_s_);
 }
 
 void FloorWorld::SetBeltTravel(int k, double travel_m) {
@@ -129,36 +128,16 @@ double FloorWorld::CarriedSpeed(std::size_t i) const {
   return v[0] * belt_axes_[b][0] + v[1] * belt_axes_[b][1];
 }
 
-void FloorWorld::PlaceCarried(double elapsed_s) {
-  for (std::size_t i = 0; i < carried_.size(); ++i) {
-    const Carried& c = carried_[i];
-    const auto b = static_cast<std::size_t>(c.belt);
-    const double s = belt_travel_m_[b] + CarriedSpeed(i) * elapsed_s;
-    dGeomSetPosition(c.geom, c.x0_m + s * belt_axes_[b][0], c.y0_m + s * belt_axes_[b][1], c.z_m);
-  }
-}
-
-void FloorWorld::ObjectCallback(void* data, dGeomID o1, dGeomID o2) {
-  auto* self = static_cast<FloorWorld*>(data);
+void FloorWorld::CollideObject(dGeomID object, const double v[3]) {
   // The body geom first, so that the normal points into it (from the object).
-  const dGeomID object = o1 == self->body_geom_ ? o2 : o1;
   std::array<dContact, kMaxPoints> pts{};
-  const int n = dCollide(self->body_geom_, object, kMaxPoints, &pts[0].geom, sizeof(dContact));
-  if (n == 0) return;
-  // Velocity of the object: a carried one moves along its belt.
-  double v[3] = {0.0, 0.0, 0.0};
-  for (std::size_t i = 0; i < self->carried_.size(); ++i) {
-    if (self->carried_[i].geom != object) continue;
-    const double speed = self->CarriedSpeed(i);
-    const auto& a = self->belt_axes_[static_cast<std::size_t>(self->carried_[i].belt)];
-    v[0] = speed * a[0];
-    v[1] = speed * a[1];
-  }
-  const dBodyID body = dGeomGetBody(self->body_geom_);
+  const int n = dCollide(body_geom_, object, kMaxPoints, &pts[0].geom, sizeof(dContact));
+  const dBodyID body = dGeomGetBody(body_geom_);
   for (int j = 0; j < n; ++j) {
     dContact& p = pts[static_cast<std::size_t>(j)];
     const dReal* nrm = p.geom.normal;
-    // A tangent: map z x normal, or map x when the normal is vertical.
+    // A tangent: map z x normal, or map x less its normal part when the
+    // normal is vertical.
     double t1[3] = {-nrm[1], nrm[0], 0.0};
     double len = std::hypot(t1[0], t1[1]);
     if (len < 1e-6) {
@@ -175,28 +154,53 @@ void FloorWorld::ObjectCallback(void* data, dGeomID o1, dGeomID o2) {
     // fdir . v_body = motion makes a sticking contact move with it.
     p.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP | dContactMotion1 |
                      dContactMotion2 | dContactMotionN | dContactFDir1;
-    p.surface.mu = self->body_mu_;
-    p.surface.soft_erp = self->object_erp_;
-    p.surface.soft_cfm = self->object_cfm_;
+    p.surface.mu = body_mu_;
+    p.surface.soft_erp = object_erp_;
+    p.surface.soft_cfm = object_cfm_;
     p.surface.motion1 = v[0] * t1[0] + v[1] * t1[1] + v[2] * t1[2];
     p.surface.motion2 = v[0] * t2[0] + v[1] * t2[1] + v[2] * t2[2];
     p.surface.motionN = v[0] * nrm[0] + v[1] * nrm[1] + v[2] * nrm[2];
     for (int d = 0; d < 3; ++d) p.fdir1[d] = t1[d];
-    const dJointID joint = dJointCreateContact(self->world_, self->group_, &p);
+    const dJointID joint = dJointCreateContact(world_, group_, &p);
     dJointAttach(joint, body, nullptr);
   }
 }
 
 void FloorWorld::CollideObjects(double erp, double cfm) {
-  if (body_geom_ == nullptr) return;
+  if (body_geom_ == nullptr || (obstacles_.empty() && carried_.empty())) return;
   object_erp_ = erp;
   object_cfm_ = cfm;
+  Aabb body;
+  dGeomGetAABB(body_geom_, body.data());
+  const double still[3] = {0.0, 0.0, 0.0};
   if (!obstacles_.empty()) {
-    dSpaceCollide2(body_geom_, reinterpret_cast<dGeomID>(obstacle_space_), this, &ObjectCallback);
+    const Aabb& r = near_region_;
+    if (!(r[0] <= body[0] && body[1] <= r[1] && r[2] <= body[2] && body[3] <= r[3] &&
+          r[4] <= body[4] && body[5] <= r[5])) {
+      near_region_ = {body[0] - kNearMarginM, body[1] + kNearMarginM,
+                      body[2] - kNearMarginM, body[3] + kNearMarginM,
+                      body[4] - kNearMarginM, body[5] + kNearMarginM};
+      near_obstacles_.clear();
+      for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+        if (Overlap(obstacle_aabbs_[i], near_region_)) near_obstacles_.push_back(i);
+      }
+    }
+    for (std::size_t i : near_obstacles_) {
+      if (Overlap(obstacle_aabbs_[i], body)) CollideObject(obstacles_[i], still);
+    }
   }
-  if (!carried_.empty()) {
-    PlaceCarried(travel_elapsed_s_);
-    dSpaceCollide2(body_geom_, reinterpret_cast<dGeomID>(carried_space_), this, &ObjectCallback);
+  for (std::size_t i = 0; i < carried_.size(); ++i) {
+    const Carried& c = carried_[i];
+    const auto b = static_cast<std::size_t>(c.belt);
+    const double speed = CarriedSpeed(i);
+    const double s = belt_travel_m_[b] + speed * travel_elapsed_s_;
+    const double dx = s * belt_axes_[b][0], dy = s * belt_axes_[b][1];
+    const Aabb moved = {c.aabb0[0] + dx, c.aabb0[1] + dx, c.aabb0[2] + dy,
+                        c.aabb0[3] + dy, c.aabb0[4],      c.aabb0[5]};
+    if (!Overlap(moved, body)) continue;
+    dGeomSetPosition(c.geom, c.x0_m + dx, c.y0_m + dy, c.z_m);
+    const double v[3] = {speed * belt_axes_[b][0], speed * belt_axes_[b][1], 0.0};
+    CollideObject(c.geom, v);
   }
 }
 

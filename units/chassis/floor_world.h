@@ -110,13 +110,16 @@ struct GeomContact {
 ///
 /// Objects: static obstacles and belt-carried objects are collision
 /// geometry for one registered body geom (the robot's body box; wheels touch
-/// the floor only). Obstacles sit in a hash space and carried objects in a
-/// small simple space, each collided with the body geom by one
-/// dSpaceCollide2 at the start of every step, so that objects far from the
-/// robot cost an AABB test each. A carried object has no body: it is placed
-/// from its belt's travelled distance and its contacts move with it through
-/// the contact's surface motion (normal motionN and tangential motion1/2 =
-/// the object's velocity), as the belt contacts do.
+/// the floor only), collided with it at the start of every step. Objects far
+/// from the robot cost next to nothing: the obstacles near the body (AABBs
+/// within kNearMarginM of its AABB) are listed once and listed again only
+/// when the body's AABB leaves that margin, so a step tests the body's AABB
+/// against one box and the near obstacles only; a carried object is tested
+/// by its AABB translated along its belt, and its geom is moved and
+/// collided only when that overlaps the body's. A carried object has no
+/// body: it is placed from its belt's travelled distance and its contacts
+/// move with it through the contact's surface motion (normal motionN and
+/// tangential motion1/2 = the object's velocity), as the belt contacts do.
 class FloorWorld {
  public:
   FloorWorld();
@@ -198,18 +201,29 @@ class FloorWorld {
   void Collide(std::size_t i);
   /// Contact joints for the points of geom i.
   void MakeJoints(std::size_t i, double erp, double cfm);
-  /// Places the carried objects at `elapsed_s` into the step.
-  void PlaceCarried(double elapsed_s);
   /// Contact joints between the body geom and the objects it touches.
   void CollideObjects(double erp, double cfm);
-  static void ObjectCallback(void* data, dGeomID o1, dGeomID o2);
+  /// Contact joints for the points where the body geom touches `object`
+  /// (moving at velocity v in map).
+  void CollideObject(dGeomID object, const double v[3]);
   /// Speed of carried object i along its belt's direction.
   double CarriedSpeed(std::size_t i) const;
+
+  // ODE's AABB layout: min x, max x, min y, max y, min z, max z.
+  using Aabb = std::array<dReal, 6>;
+  static bool Overlap(const Aabb& a, const Aabb& b) {
+    return a[0] <= b[1] && b[0] <= a[1] && a[2] <= b[3] && b[2] <= a[3] && a[4] <= b[5] &&
+           b[4] <= a[5];
+  }
+  // How far around the body's AABB obstacles are listed as near: the
+  // list is redone after the body moved about this far.
+  static constexpr double kNearMarginM = 0.5;
 
   struct Carried {
     dGeomID geom = nullptr;
     int belt = 0;
     double x0_m = 0.0, y0_m = 0.0, z_m = 0.0;
+    Aabb aabb0{};  // at zero travel
   };
 
   dWorldID world_ = nullptr;
@@ -227,9 +241,12 @@ class FloorWorld {
   std::vector<dGeomID> geoms_;
   dGeomID body_geom_ = nullptr;
   double body_mu_ = 0.5;
-  dSpaceID obstacle_space_ = nullptr;
-  dSpaceID carried_space_ = nullptr;
   std::vector<dGeomID> obstacles_;
+  std::vector<Aabb> obstacle_aabbs_;
+  // The region the near list holds for (empty at first: min > max), and
+  // the obstacles whose AABB overlaps it.
+  Aabb near_region_{1.0, -1.0, 1.0, -1.0, 1.0, -1.0};
+  std::vector<std::size_t> near_obstacles_;
   std::vector<Carried> carried_;
   std::vector<double> belt_travel_m_;
   // Time since the last SetBeltTravel (substeps of one step).
