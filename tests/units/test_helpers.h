@@ -20,8 +20,11 @@ inline void SetAll(cosim::Unit& u, const std::string& name, double v) {
   u.variables().SetValue(*u.variables().Find(name), cosim::Value{v});
 }
 
+/// A real array, or a real scalar as one element.
 inline std::vector<double> Get(const cosim::Unit& u, const std::string& name) {
-  const auto s = u.variables().GetRealArray(*u.variables().Find(name));
+  const auto ref = *u.variables().Find(name);
+  if (u.variables().info(ref).type == cosim::VarType::kReal) return {u.variables().GetReal(ref)};
+  const auto s = u.variables().GetRealArray(ref);
   return {s.begin(), s.end()};
 }
 
@@ -30,6 +33,10 @@ inline std::vector<double> Outputs(const cosim::Unit& u) {
   std::vector<double> out;
   for (const auto& info : u.variables().infos()) {
     if (info.causality != cosim::Causality::kOutput) continue;
+    if (info.type == cosim::VarType::kReal) {
+      out.push_back(u.variables().GetReal(info.ref));
+      continue;
+    }
     const auto a = u.variables().GetRealArray(info.ref);
     out.insert(out.end(), a.begin(), a.end());
   }

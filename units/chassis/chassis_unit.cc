@@ -2,7 +2,9 @@
 
 #include <ode/ode.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 #include <utility>
@@ -51,8 +53,14 @@ bool AllFinite(const dReal* v, int n) {
 struct ChassisUnit::Ode {
   std::unique_ptr<FloorWorld> floor;
   dBodyID body = nullptr;
+  // The body's collision box (obstacles and carried objects only).
+  dGeomID body_geom = nullptr;
   std::vector<dBodyID> wheels;
+  // Per wheel: its joint to the body, hinge2 when steered, else hinge.
   std::vector<dJointID> joints;
+  std::vector<bool> steered;
+  // Angular motors coupling the wheels of a drive motor to its first wheel.
+  std::vector<dJointID> couplings;
   std::vector<dGeomID> geoms;
   // Internal step for which the suspension ERP/CFM were set (0: not yet).
   double suspension_h_s = 0.0;
@@ -69,10 +77,15 @@ struct ChassisUnit::Ode {
     if (!floor) return;
     EnsureOdeForThisThread();
     floor->ClearGeoms();
+    floor->SetBodyGeom(nullptr, 0.0);
     for (dGeomID g : geoms) dGeomDestroy(g);
+    if (body_geom) dGeomDestroy(body_geom);
+    body_geom = nullptr;
     geoms.clear();
     wheels.clear();
     joints.clear();
+    steered.clear();
+    couplings.clear();
     body = nullptr;
     floor.reset();
     suspension_h_s = 0.0;
@@ -84,122 +97,224 @@ struct ChassisUnit::Ode {
   std::size_t BodyCount() const { return wheels.size() + 1; }
 };
 
-ChassisUnit::ChassisUnit(std::string name, int wheel_count, int belt_count)
-    : cosim::Unit(kTypeName, std::move(name)),
-      wheel_count_(wheel_count),
-      belt_count_(belt_count),
-      ode_(std::make_unique<Ode>()) {
-  if (wheel_count < 1 || belt_count < 0) {
-    throw cosim::UnitError(Where() + ": needs wheel_count >= 1 and belt_count >= 0, got " +
-                           std::to_string(wheel_count) + " and " + std::to_string(belt_count));
+namespace {
+
+// Number of motors a per-wheel index list uses (largest index + 1).
+int MotorCount(const std::vector<int>& motor) {
+  int n = 0;
+  for (int m : motor) n = std::max(n, m + 1);
+  return n;
+}
+
+// Force limit of a drive coupling: far above any torque a wheel can take
+// from the floor (mu m g r is about 200 N.m for a 500 kg robot on 0.2 m
+// wheels), so that the coupled wheels never slip against each other.
+constexpr double kCouplingMaxTorqueNm = 1e5;
+// CFM of a coupling row: the relative spin it lets through is CFM x torque
+// (1e-10 x 1e2 N.m = 1e-8 rad/s), where ODE's default world CFM (1e-5)
+// would let 1e-3 rad/s through.
+constexpr double kCouplingCfm = 1e-10;
+
+}  // namespace
+
+std::string ChassisUnit::TopologyProblem(const std::vector<int>& steer_motor,
+                                         const std::vector<int>& drive_motor) {
+  const std::size_t n = steer_motor.size();
+  if (n < 1 || n > 64) return "wheel_count: expected 1 to 64 wheels, got " + std::to_string(n);
+  if (drive_motor.size() != n) {
+    return "drive_motor: expected one entry per wheel (wheel_count " + std::to_string(n) +
+           "), got " + std::to_string(drive_motor.size());
   }
-  const auto w = static_cast<std::size_t>(wheel_count);
-  const auto b = static_cast<std::size_t>(belt_count);
-  if (wheel_count == 4) {
-    // Rob@Work 3's steering axes.
-    wheel_x_.assign(models::raw3::kWheelXM.begin(), models::raw3::kWheelXM.end());
-    wheel_y_.assign(models::raw3::kWheelYM.begin(), models::raw3::kWheelYM.end());
-  } else {
-    // No robot to copy: evenly on a circle of 0.3 m, a placeholder.
-    for (std::size_t k = 0; k < w; ++k) {
-      const double a = 2.0 * kPi * static_cast<double>(k) / static_cast<double>(w) + 0.25 * kPi;
-      wheel_x_.push_back(0.3 * std::cos(a));
-      wheel_y_.push_back(0.3 * std::sin(a));
+  const int steer_count = MotorCount(steer_motor);
+  const int drive_count = MotorCount(drive_motor);
+  std::vector<int> steer_uses(static_cast<std::size_t>(steer_count), 0);
+  std::vector<int> drive_first(static_cast<std::size_t>(drive_count), -1);
+  for (std::size_t k = 0; k < n; ++k) {
+    const int s = steer_motor[k];
+    if (s < -1) {
+      return "steer_motor[" + std::to_string(k) +
+             "]: expected a steering motor index >= 0 or -1 (fixed wheel), got " +
+             std::to_string(s);
+    }
+    if (s >= 0 && ++steer_uses[static_cast<std::size_t>(s)] > 1) {
+      return "steer_motor[" + std::to_string(k) + "]: steering motor " + std::to_string(s) +
+             " already steers another wheel (one steered wheel per steering motor)";
+    }
+    const int d = drive_motor[k];
+    if (d < 0) {
+      return "drive_motor[" + std::to_string(k) + "]: expected a drive motor index >= 0, got " +
+             std::to_string(d);
+    }
+    int& first = drive_first[static_cast<std::size_t>(d)];
+    if (first < 0) {
+      first = static_cast<int>(k);
+    } else if (s >= 0 || steer_motor[static_cast<std::size_t>(first)] >= 0) {
+      return "drive_motor[" + std::to_string(k) + "]: wheels " + std::to_string(first) + " and " +
+             std::to_string(k) + " share drive motor " + std::to_string(d) +
+             ", which needs both fixed (steer_motor -1): coupled steered wheels are not modelled";
     }
   }
-  // Placeholder belts (scenarios set their own): along map x, 20 m x 3 m,
-  // centred 2.5 m, 7.5 m, ... to the left of the origin.
-  for (std::size_t k = 0; k < b; ++k) {
-    belt_center_x_.push_back(0.0);
-    belt_center_y_.push_back(2.5 + 5.0 * static_cast<double>(k));
-    belt_length_.push_back(20.0);
-    belt_width_.push_back(3.0);
-    belt_direction_.push_back(0.0);
+  for (int m = 0; m < steer_count; ++m) {
+    if (steer_uses[static_cast<std::size_t>(m)] == 0) {
+      return "steer_motor: steering motor " + std::to_string(m) +
+             " steers no wheel (indices must be 0..M-1, each used)";
+    }
   }
-  steer_torque_.assign(w, 0.0);
-  drive_torque_.assign(w, 0.0);
+  for (int m = 0; m < drive_count; ++m) {
+    if (drive_first[static_cast<std::size_t>(m)] < 0) {
+      return "drive_motor: drive motor " + std::to_string(m) +
+             " drives no wheel (indices must be 0..M-1, each used)";
+    }
+  }
+  return {};
+}
+
+ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
+                         std::vector<int> drive_motor, models::Scene scene)
+    : cosim::Unit(kTypeName, std::move(name)),
+      wheel_count_(static_cast<int>(steer_motor.size())),
+      belt_count_(static_cast<int>(scene.belts.size())),
+      steer_motor_(std::move(steer_motor)),
+      drive_motor_(std::move(drive_motor)),
+      scene_(std::move(scene)),
+      ode_(std::make_unique<Ode>()) {
+  if (const std::string bad = TopologyProblem(steer_motor_, drive_motor_); !bad.empty()) {
+    throw cosim::UnitError(Where() + ": " + bad);
+  }
+  const auto surface_ok = [&](int s) {
+    return s >= 0 && static_cast<std::size_t>(s) < scene_.surfaces.size();
+  };
+  if (!surface_ok(scene_.floor.surface)) {
+    throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': the floor's surface " +
+                           std::to_string(scene_.floor.surface) + " is not one of its " +
+                           std::to_string(scene_.surfaces.size()) + " surfaces");
+  }
+  for (const auto& belt : scene_.belts) {
+    if (!surface_ok(belt.surface)) {
+      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': belt '" + belt.name +
+                             "' has surface " + std::to_string(belt.surface) + ", not one of its " +
+                             std::to_string(scene_.surfaces.size()) + " surfaces");
+    }
+  }
+  for (const auto& obj : scene_.carried) {
+    if (obj.belt < 0 || obj.belt >= belt_count_) {
+      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': carried object '" +
+                             obj.name + "' is on belt " + std::to_string(obj.belt) +
+                             ", not one of its " + std::to_string(belt_count_) + " belts");
+    }
+  }
+  steer_motor_count_ = MotorCount(steer_motor_);
+  drive_motor_count_ = MotorCount(drive_motor_);
+  const auto w = static_cast<std::size_t>(wheel_count_);
+  const auto b = static_cast<std::size_t>(belt_count_);
+  const auto ms = static_cast<std::size_t>(steer_motor_count_);
+  const auto md = static_cast<std::size_t>(drive_motor_count_);
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  body_length_ = body_width_ = body_height_ = kNaN;
+  mass_ = module_mass_ = com_height_ = kNaN;
+  steer_rotor_inertia_ = drive_rotor_inertia_ = kNaN;
+  wheel_radius_.assign(w, kNaN);
+  wheel_x_.assign(w, kNaN);
+  wheel_y_.assign(w, kNaN);
+  if (ms == 0) steer_rotor_inertia_ = 0.0;  // no steering motor to reflect
+  steer_torque_.assign(ms, 0.0);
+  drive_torque_.assign(md, 0.0);
   belt_velocity_.assign(2 * b, 0.0);
-  steer_angle_.assign(w, 0.0);
-  steer_rate_.assign(w, 0.0);
-  drive_rate_.assign(w, 0.0);
-  pose_.assign(3, 0.0);
-  velocity_.assign(3, 0.0);
-  body_velocity_.assign(3, 0.0);
+  belt_travel_.assign(b, 0.0);
+  steer_angle_.assign(ms, 0.0);
+  steer_rate_.assign(ms, 0.0);
+  drive_rate_.assign(md, 0.0);
+  position_.assign(2, 0.0);
+  linear_velocity_.assign(2, 0.0);
+  body_linear_velocity_.assign(2, 0.0);
   wheel_surface_.assign(w, -1.0);
   wheel_surface_velocity_.assign(2 * w, 0.0);
   wheel_contact_.assign(2 * w, 0.0);
 
   auto& v = variables();
-  v.Parameter("body_length", "m", &body_length_, "body box length along base_link x");
-  v.Parameter("body_width", "m", &body_width_, "body box width along base_link y");
-  v.Parameter("body_height", "m", &body_height_, "body box height (for its inertia only)");
-  v.Parameter("mass", "kg", &mass_, "total mass: body box plus all modules");
+  v.Parameter("body_length", "m", &body_length_,
+              "body box length along base_link x (inertia and collision with objects)");
+  v.Parameter("body_width", "m", &body_width_,
+              "body box width along base_link y (inertia and collision with objects)");
+  v.Parameter("body_height", "m", &body_height_,
+              "body box height, centred on com_height (inertia and collision with objects)");
+  v.Parameter("mass", "kg", &mass_, "total mass: body box plus all wheels");
   v.Parameter("module_mass", "kg", &module_mass_,
-              "mass of one steer+drive module (wheel, motors, housing), lumped into the wheel");
+              "mass of one wheel: a steered module (wheel, motors, housing) or a fixed wheel");
   v.Parameter("com_height", "m", &com_height_,
-              "height of the body box's centre of mass above the floor (modules excluded)");
-  v.Parameter("wheel_radius", "m", &wheel_radius_, "wheel radius (sphere contact geometry)");
-  v.Parameter("wheel_x", "m", &wheel_x_, "steering axis x in base_link, per module");
-  v.Parameter("wheel_y", "m", &wheel_y_, "steering axis y in base_link, per module");
+              "height of the body box's centre of mass above the floor (wheels excluded)");
+  v.Parameter("wheel_radius", "m", &wheel_radius_,
+              "radius of each wheel (sphere contact geometry)");
+  v.Parameter("wheel_x", "m", &wheel_x_,
+              "x in base_link of each wheel's steering axis (fixed wheel: axle centre)");
+  v.Parameter("wheel_y", "m", &wheel_y_,
+              "y in base_link of each wheel's steering axis (fixed wheel: axle centre)");
   v.Parameter("steer_rotor_inertia", "kg.m2", &steer_rotor_inertia_,
-              "steer motor rotor inertia seen at the steering joint (J_rotor N^2), added to the "
-              "module inertia about the axes perpendicular to the axle");
+              "steer motor rotor inertia seen at the steering joint (eta N^2 J_rotor), added to "
+              "each steered module's inertia about the axes perpendicular to the axle");
   v.Parameter("drive_rotor_inertia", "kg.m2", &drive_rotor_inertia_,
-              "drive motor rotor inertia seen at the wheel (J_rotor N^2), added about the axle");
+              "drive motor rotor inertia seen at the wheel (eta N^2 J_rotor), added once per "
+              "drive motor about the axle of its first wheel");
   v.Parameter("steer_friction", "N.m.s/rad", &steer_friction_,
-              "viscous friction of the steering joint");
+              "viscous friction of the steering joint (default 0.01: small against the motor "
+              "torques, it only damps a free joint)");
   v.Parameter("drive_friction", "N.m.s/rad", &drive_friction_,
-              "viscous friction of the wheel joint");
-  v.Parameter("friction", "1", &friction_,
-              "Coulomb coefficient of the wheels on floor and belts (force limit mu N)");
+              "viscous friction of each wheel joint (default 0.01, as steer_friction)");
+  v.Parameter("body_friction", "1", &body_friction_,
+              "Coulomb coefficient of the body box on obstacles and carried objects (default "
+              "0.5: painted steel or plastic on steel, typically 0.3 to 0.6)");
   v.Parameter("contact_stiffness", "N/m", &contact_stiffness_,
-              "normal stiffness of one wheel contact");
-  v.Parameter("contact_damping", "N.s/m", &contact_damping_, "normal damping of one wheel contact");
+              "normal stiffness of one wheel or body contact point (default 1e6: a tread "
+              "deflecting 0.3 mm under 30 kg)");
+  v.Parameter("contact_damping", "N.s/m", &contact_damping_,
+              "normal damping of one contact point (default 1e4: well damped)");
   v.Parameter("slip_damping", "N.s/m", &slip_damping_,
               "sliding contact: resistance to slip across its slip direction, bounded by "
-              "friction x normal force (damps a step-to-step swing of the slip direction)");
+              "friction x normal force (damps a step-to-step swing of the slip direction; "
+              "default 1e5, see units/chassis/floor_world.h)");
   v.Parameter("suspension_stiffness", "N/m", &suspension_stiffness_,
-              "stiffness of a module along its steering axis (hinge2 suspension)");
+              "stiffness of a steered module along its steering axis (hinge2 suspension; "
+              "default 1e7: a near-rigid mount)");
   v.Parameter("suspension_damping", "N.s/m", &suspension_damping_,
-              "damping of a module along its steering axis");
+              "damping of a steered module along its steering axis (default 1e4)");
   v.Parameter("brake_torque", "N.m", &brake_torque_,
-              "holding torque of each joint's brake when brake is true");
+              "holding torque of each joint's brake when brake is true (default 30)");
   v.Parameter("substeps", &substeps_, "ODE steps per communication step");
   v.Parameter("initial_x", "m", &initial_x_, "base_link x in map at the start");
   v.Parameter("initial_y", "m", &initial_y_, "base_link y in map at the start");
   v.Parameter("initial_yaw", "rad", &initial_yaw_, "base_link yaw in map at the start");
-  if (belt_count_ > 0) {
-    v.Parameter("belt_center_x", "m", &belt_center_x_, "belt patch centre x in map");
-    v.Parameter("belt_center_y", "m", &belt_center_y_, "belt patch centre y in map");
-    v.Parameter("belt_length", "m", &belt_length_, "belt patch size along its direction");
-    v.Parameter("belt_width", "m", &belt_width_, "belt patch size across its direction");
-    v.Parameter("belt_direction", "rad", &belt_direction_,
-                "direction of the belt patch's length axis in map, counter-clockwise from x");
-  }
 
-  v.Input("steer_torque", "N.m", &steer_torque_,
-          "torque on each module about its steering axis, + counter-clockwise seen from above");
+  if (ms > 0) {
+    v.Input("steer_torque", "N.m", &steer_torque_,
+            "torque of each steering motor about its wheel's steering axis, + counter-clockwise "
+            "seen from above");
+  }
   v.Input("drive_torque", "N.m", &drive_torque_,
-          "torque on each wheel about its axle, + drives it forward along its heading");
-  if (belt_count_ > 0) {
+          "torque of each drive motor about the axle of its wheels, + drives them forward");
+  if (b > 0) {
     v.Input("belt_velocity", "m/s", &belt_velocity_,
-            "surface velocity of each belt in map: vx, vy per belt");
+            "surface velocity of each scene belt in map: vx, vy per belt");
+    v.Input("belt_travel", "m", &belt_travel_,
+            "distance each scene belt's surface has moved since t = 0 (places carried objects)");
   }
-  v.Input("brake", &brake_,
-          "true: both joints of every module held (velocity 0, up to brake_torque)");
+  v.Input("brake", &brake_, "true: every wheel joint held (velocity 0, up to brake_torque)");
 
-  v.Output("steer_angle", "rad", &steer_angle_,
-           "wheel heading relative to base_link x, in (-pi, pi]", {});
-  v.Output("steer_rate", "rad/s", &steer_rate_, "steering rate relative to the body", {});
+  if (ms > 0) {
+    v.Output("steer_angle", "rad", &steer_angle_,
+             "heading of each steering motor's wheel relative to base_link x, in (-pi, pi]", {});
+    v.Output("steer_rate", "rad/s", &steer_rate_,
+             "steering rate of each steering motor's wheel relative to the body", {});
+  }
   v.Output("drive_rate", "rad/s", &drive_rate_,
-           "wheel spin relative to its module, + rolling forward along the heading", {});
-  v.Output("pose", "m", &pose_, "x, y (m) and yaw (rad, in (-pi, pi]) of base_link in map", {});
-  v.Output("velocity", "m/s", &velocity_, "vx, vy (m/s) of base_link in map and yaw rate (rad/s)",
-           {});
-  v.Output("body_velocity", "m/s", &body_velocity_,
-           "vx, vy (m/s) of base_link in base_link and yaw rate (rad/s)", {});
+           "spin of each drive motor's wheels relative to the body, + rolling forward", {});
+  v.Output("position", "m", &position_, "x, y of base_link in map", {});
+  v.Output("yaw", "rad", &yaw_, "yaw of base_link in map, in (-pi, pi]", {});
+  v.Output("linear_velocity", "m/s", &linear_velocity_, "vx, vy of base_link in map", {});
+  v.Output("yaw_rate", "rad/s", &yaw_rate_, "yaw rate of base_link", {});
+  v.Output("body_linear_velocity", "m/s", &body_linear_velocity_,
+           "vx, vy of base_link in base_link", {});
   v.Output("wheel_surface", "1", &wheel_surface_,
-           "surface under each wheel: -1 no contact, 0 floor, k + 1 belt k", {});
+           "surface under each wheel: -1 no contact, 0 floor, k + 1 scene belt k", {});
   v.Output("wheel_surface_velocity", "m/s", &wheel_surface_velocity_,
            "velocity of the surface under each wheel in base_link: vx, vy per wheel (zero on "
            "the floor or without contact)",
@@ -212,25 +327,60 @@ ChassisUnit::~ChassisUnit() = default;
 
 std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
   cosim::ParameterChecks c;
-  c.Positive("body_length", body_length_);
-  c.Positive("body_width", body_width_);
-  c.Positive("body_height", body_height_);
-  c.Positive("mass", mass_);
-  c.Positive("module_mass", module_mass_);
+  static constexpr const char* kUnset = "must be set (robot-specific: no default)";
+  const auto robot = [&](const char* name, double value, auto check) {
+    if (std::isnan(value)) {
+      c.Add({name, std::nullopt, kUnset});
+    } else {
+      check(name, value);
+    }
+  };
+  const auto robot_list = [&](const char* name, const std::vector<double>& values, auto check) {
+    if (std::all_of(values.begin(), values.end(), [](double x) { return std::isnan(x); })) {
+      c.Add({name, std::nullopt, kUnset});
+    } else {
+      for (std::size_t k = 0; k < values.size(); ++k) {
+        if (std::isnan(values[k])) c.Add({name, k, kUnset});
+      }
+      check(name, values);
+    }
+  };
+  const auto positive = [&](const char* n, const auto& x) { c.Positive(n, x); };
+  const auto non_negative = [&](const char* n, const auto& x) { c.NonNegative(n, x); };
+  const auto finite = [&](const char* n, const auto& x) { c.Finite(n, x); };
+  robot("body_length", body_length_, positive);
+  robot("body_width", body_width_, positive);
+  robot("body_height", body_height_, positive);
+  robot("mass", mass_, positive);
+  robot("module_mass", module_mass_, positive);
   if (mass_ > 0.0 && module_mass_ > 0.0 && !(wheel_count_ * module_mass_ < mass_)) {
     c.Add({"module_mass", std::nullopt,
-           "times " + std::to_string(wheel_count_) + " modules must be less than mass " +
+           "times " + std::to_string(wheel_count_) + " wheels must be less than mass " +
                cosim::FormatValue(mass_) + ", got " + cosim::FormatValue(module_mass_)});
   }
-  c.Positive("com_height", com_height_);
-  c.Positive("wheel_radius", wheel_radius_);
-  c.Finite("wheel_x", wheel_x_);
-  c.Finite("wheel_y", wheel_y_);
-  c.NonNegative("steer_rotor_inertia", steer_rotor_inertia_);
-  c.NonNegative("drive_rotor_inertia", drive_rotor_inertia_);
+  robot("com_height", com_height_, positive);
+  const auto positive_set = [&](const char* n, const std::vector<double>& x) {
+    for (std::size_t k = 0; k < x.size(); ++k) {
+      if (!std::isnan(x[k]) && !(x[k] > 0.0 && std::isfinite(x[k]))) {
+        c.Add({n, k, "must be positive and finite, got " + cosim::FormatValue(x[k])});
+      }
+    }
+  };
+  const auto finite_set = [&](const char* n, const std::vector<double>& x) {
+    for (std::size_t k = 0; k < x.size(); ++k) {
+      if (!std::isnan(x[k]) && !std::isfinite(x[k])) {
+        c.Add({n, k, "must be finite, got " + cosim::FormatValue(x[k])});
+      }
+    }
+  };
+  robot_list("wheel_radius", wheel_radius_, positive_set);
+  robot_list("wheel_x", wheel_x_, finite_set);
+  robot_list("wheel_y", wheel_y_, finite_set);
+  robot("steer_rotor_inertia", steer_rotor_inertia_, non_negative);
+  robot("drive_rotor_inertia", drive_rotor_inertia_, non_negative);
   c.NonNegative("steer_friction", steer_friction_);
   c.NonNegative("drive_friction", drive_friction_);
-  c.NonNegative("friction", friction_);
+  c.NonNegative("body_friction", body_friction_);
   c.Positive("contact_stiffness", contact_stiffness_);
   c.NonNegative("contact_damping", contact_damping_);
   c.Positive("slip_damping", slip_damping_);
@@ -240,14 +390,9 @@ std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
   if (substeps_ < 1 || substeps_ > 1000) {
     c.Add({"substeps", std::nullopt, "must be 1 to 1000, got " + std::to_string(substeps_)});
   }
-  c.Finite("initial_x", initial_x_);
-  c.Finite("initial_y", initial_y_);
-  c.Finite("initial_yaw", initial_yaw_);
-  c.Finite("belt_center_x", belt_center_x_);
-  c.Finite("belt_center_y", belt_center_y_);
-  c.Positive("belt_length", belt_length_);
-  c.Positive("belt_width", belt_width_);
-  c.Finite("belt_direction", belt_direction_);
+  finite("initial_x", initial_x_);
+  finite("initial_y", initial_y_);
+  finite("initial_yaw", initial_yaw_);
   return c.Take();
 }
 
@@ -257,13 +402,20 @@ void ChassisUnit::Build() {
   o.Clear();
   o.floor = std::make_unique<FloorWorld>();
   FloorWorld& f = *o.floor;
+  const auto mu_of = [&](int surface) {
+    return scene_.surfaces[static_cast<std::size_t>(surface)].friction;
+  };
   std::vector<BeltPatch> belts;
-  for (std::size_t k = 0; k < belt_center_x_.size(); ++k) {
-    belts.push_back({belt_center_x_[k], belt_center_y_[k], belt_length_[k], belt_width_[k],
-                     belt_direction_[k]});
+  for (const models::Belt& belt : scene_.belts) {
+    const models::Rect& r = belt.area;
+    belts.push_back({r.center_x_m, r.center_y_m, r.length_m, r.width_m, r.direction_rad,
+                     mu_of(belt.surface)});
   }
   f.SetBelts(std::move(belts));
-  f.SetSurface({friction_, contact_stiffness_, contact_damping_, slip_damping_});
+  f.SetSurface({mu_of(scene_.floor.surface), contact_stiffness_, contact_damping_,
+                slip_damping_});
+  for (const models::Obstacle& obstacle : scene_.obstacles) f.AddObstacle(obstacle.solid);
+  for (const models::CarriedObject& obj : scene_.carried) f.AddCarried(obj.solid, obj.belt);
 
   // Start with the contacts pressed in by equal shares of the weight, so
   // that the settle has little to do. The suspension starts unloaded (its
@@ -281,43 +433,79 @@ void ChassisUnit::Build() {
   dBodySetMass(o.body, &m);
   dBodySetPosition(o.body, initial_x_, initial_y_, com_height_ - drop_m);
   dBodySetRotation(o.body, rot);
+  o.body_geom = dCreateBox(nullptr, body_length_, body_width_, body_height_);
+  dGeomSetBody(o.body_geom, o.body);
+  f.SetBodyGeom(o.body_geom, body_friction_);
 
-  // Module inertia: a thin disc of the wheel radius (axial m r^2 / 2,
-  // diametral m r^2 / 4) plus the reflected rotor inertias. The axle is the
-  // wheel body's local y axis.
-  const double r2 = wheel_radius_ * wheel_radius_;
-  const double i_axle = 0.5 * module_mass_ * r2 + drive_rotor_inertia_;
-  const double i_perp = 0.25 * module_mass_ * r2 + steer_rotor_inertia_;
+  // Wheel inertia: a thin disc of the wheel radius (axial m r^2 / 2,
+  // diametral m r^2 / 4) plus the reflected rotor inertias: the steering
+  // rotor on a steered module, the drive rotor on the first wheel of each
+  // drive motor. The axle is the wheel body's local y axis.
   const double axle[3] = {-s, c, 0.0};
   const double up[3] = {0.0, 0.0, 1.0};
+  std::vector<bool> motor_seen(static_cast<std::size_t>(drive_motor_count_), false);
+  std::vector<int> first_wheel(static_cast<std::size_t>(drive_motor_count_), -1);
   for (std::size_t k = 0; k < static_cast<std::size_t>(wheel_count_); ++k) {
+    const double radius = wheel_radius_[k];
+    const double r2 = radius * radius;
+    const bool steered = steer_motor_[k] >= 0;
+    const auto motor = static_cast<std::size_t>(drive_motor_[k]);
+    const bool first = first_wheel[motor] < 0;
+    const double i_axle = 0.5 * module_mass_ * r2 + (first ? drive_rotor_inertia_ : 0.0);
+    const double i_perp = 0.25 * module_mass_ * r2 + (steered ? steer_rotor_inertia_ : 0.0);
     const double x = initial_x_ + c * wheel_x_[k] - s * wheel_y_[k];
     const double y = initial_y_ + s * wheel_x_[k] + c * wheel_y_[k];
-    const double z = wheel_radius_ - drop_m;
+    const double z = radius - drop_m;
     dBodyID w = dBodyCreate(f.world());
     dMassSetParameters(&m, module_mass_, 0.0, 0.0, 0.0, i_perp, i_axle, i_perp, 0.0, 0.0, 0.0);
     dBodySetMass(w, &m);
     dBodySetPosition(w, x, y, z);
     dBodySetRotation(w, rot);
-    dGeomID g = dCreateSphere(nullptr, wheel_radius_);
+    dGeomID g = dCreateSphere(nullptr, radius);
     dGeomSetBody(g, w);
     f.AddGeom(g);
-    dJointID j = dJointCreateHinge2(f.world(), nullptr);
-    dJointAttach(j, o.body, w);
-    dJointSetHinge2Anchor(j, x, y, z);
-    dJointSetHinge2Axes(j, up, axle);
+    dJointID j = nullptr;
+    if (steered) {
+      j = dJointCreateHinge2(f.world(), nullptr);
+      dJointAttach(j, o.body, w);
+      dJointSetHinge2Anchor(j, x, y, z);
+      dJointSetHinge2Axes(j, up, axle);
+    } else {
+      j = dJointCreateHinge(f.world(), nullptr);
+      dJointAttach(j, o.body, w);
+      dJointSetHingeAnchor(j, x, y, z);
+      dJointSetHingeAxis(j, axle[0], axle[1], axle[2]);
+    }
+    if (first) {
+      first_wheel[motor] = static_cast<int>(k);
+    } else {
+      // Zero spin of this wheel relative to the motor's first wheel about
+      // the axle (axis 0 fixed in the first wheel's frame: its local y).
+      const dBodyID lead = o.wheels[static_cast<std::size_t>(first_wheel[motor])];
+      dJointID cj = dJointCreateAMotor(f.world(), nullptr);
+      dJointAttach(cj, lead, w);
+      dJointSetAMotorMode(cj, dAMotorUser);
+      dJointSetAMotorNumAxes(cj, 1);
+      dJointSetAMotorAxis(cj, 0, 1, axle[0], axle[1], axle[2]);
+      dJointSetAMotorParam(cj, dParamVel, 0.0);
+      dJointSetAMotorParam(cj, dParamFMax, kCouplingMaxTorqueNm);
+      dJointSetAMotorParam(cj, dParamCFM, kCouplingCfm);
+      o.couplings.push_back(cj);
+    }
     o.wheels.push_back(w);
     o.geoms.push_back(g);
     o.joints.push_back(j);
+    o.steered.push_back(steered);
   }
 }
 
 void ChassisUnit::SetSuspension(double h_s) {
   if (h_s == ode_->suspension_h_s) return;
   const auto [erp, cfm] = ErpCfm(h_s, suspension_stiffness_, suspension_damping_);
-  for (dJointID j : ode_->joints) {
-    dJointSetHinge2Param(j, dParamSuspensionERP, erp);
-    dJointSetHinge2Param(j, dParamSuspensionCFM, cfm);
+  for (std::size_t k = 0; k < ode_->joints.size(); ++k) {
+    if (!ode_->steered[k]) continue;
+    dJointSetHinge2Param(ode_->joints[k], dParamSuspensionERP, erp);
+    dJointSetHinge2Param(ode_->joints[k], dParamSuspensionCFM, cfm);
   }
   ode_->suspension_h_s = h_s;
 }
@@ -327,11 +515,17 @@ void ChassisUnit::SetJointMotors(bool hold, double max_torque_nm) {
   const double fmax = hold ? max_torque_nm : 0.0;
   if (fmax == ode_->motor_fmax_nm) return;
   ode_->motor_fmax_nm = fmax;
-  for (dJointID j : ode_->joints) {
-    dJointSetHinge2Param(j, dParamVel, 0.0);
-    dJointSetHinge2Param(j, dParamFMax, fmax);
-    dJointSetHinge2Param(j, dParamVel2, 0.0);
-    dJointSetHinge2Param(j, dParamFMax2, fmax);
+  for (std::size_t k = 0; k < ode_->joints.size(); ++k) {
+    const dJointID j = ode_->joints[k];
+    if (ode_->steered[k]) {
+      dJointSetHinge2Param(j, dParamVel, 0.0);
+      dJointSetHinge2Param(j, dParamFMax, fmax);
+      dJointSetHinge2Param(j, dParamVel2, 0.0);
+      dJointSetHinge2Param(j, dParamFMax2, fmax);
+    } else {
+      dJointSetHingeParam(j, dParamVel, 0.0);
+      dJointSetHingeParam(j, dParamFMax, fmax);
+    }
   }
 }
 
@@ -340,14 +534,24 @@ void ChassisUnit::ApplyTorques() {
   double up[3], axle[3];
   Column(dBodyGetRotation(o.body), 2, up);
   const dReal* wb = dBodyGetAngularVel(o.body);
+  // A drive motor's torque goes to the first wheel of its group only.
+  std::uint64_t driven = 0;  // bit m: motor m's torque applied (<= 16 wheels)
   for (std::size_t k = 0; k < o.wheels.size(); ++k) {
     const dBodyID w = o.wheels[k];
     Column(dBodyGetRotation(w), 1, axle);
     const dReal* ww = dBodyGetAngularVel(w);
     const double rel[3] = {ww[0] - wb[0], ww[1] - wb[1], ww[2] - wb[2]};
-    const double steer = steer_torque_[k] - steer_friction_ * Dot(up, rel);
-    const double drive = drive_torque_[k] - drive_friction_ * Dot(axle, rel);
-    // The module turns the wheel and reacts on the body: equal and opposite.
+    const int sm = steer_motor_[k];
+    const auto dm = static_cast<unsigned>(drive_motor_[k]);
+    const double steer = sm >= 0 ? steer_torque_[static_cast<std::size_t>(sm)] -
+                                       steer_friction_ * Dot(up, rel)
+                                 : 0.0;
+    double drive = -drive_friction_ * Dot(axle, rel);
+    if ((driven & (std::uint64_t{1} << dm)) == 0) {
+      driven |= std::uint64_t{1} << dm;
+      drive = drive_torque_[dm] - drive_friction_ * Dot(axle, rel);
+    }
+    // The motor turns the wheel and reacts on the body: equal and opposite.
     const double t[3] = {steer * up[0] + drive * axle[0], steer * up[1] + drive * axle[1],
                          steer * up[2] + drive * axle[2]};
     dBodyAddTorque(w, t[0], t[1], t[2]);
@@ -407,21 +611,46 @@ void ChassisUnit::Initialize() {
     settled_parameters_ = std::move(parameters);
     stepped_since_settle_ = false;
   }
-  FloorWorld& f = *ode_->floor;
-  for (int k = 0; k < f.belt_count(); ++k) {
-    const auto kk = static_cast<std::size_t>(k);
-    f.SetBeltVelocity(k, belt_velocity_[2 * kk], belt_velocity_[2 * kk + 1]);
-  }
+  SetBeltInputs();
   ComputeOutputs();
   initialized_ = true;
 }
 
+void ChassisUnit::SetBeltInputs() {
+  FloorWorld& f = *ode_->floor;
+  for (int k = 0; k < f.belt_count(); ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    f.SetBeltVelocity(k, belt_velocity_[2 * kk], belt_velocity_[2 * kk + 1]);
+    f.SetBeltTravel(k, belt_travel_[kk]);
+  }
+}
+
+double ChassisUnit::WheelRate(int k) const {
+  if (!ode_->body || k < 0 || k >= wheel_count_) return std::numeric_limits<double>::quiet_NaN();
+  const dBodyID w = ode_->wheels[static_cast<std::size_t>(k)];
+  double axle[3];
+  Column(dBodyGetRotation(w), 1, axle);
+  const dReal* ww = dBodyGetAngularVel(w);
+  const dReal* wb = dBodyGetAngularVel(ode_->body);
+  const double rel[3] = {ww[0] - wb[0], ww[1] - wb[1], ww[2] - wb[2]};
+  return Dot(axle, rel);
+}
+
 std::string ChassisUnit::NonFiniteState() const {
   // Runs every step: the names are built only for a body that failed.
-  const auto who = [](std::size_t i) {
-    return i == 0 ? std::string("the body (outputs pose, velocity, body_velocity)")
-                  : "wheel module " + std::to_string(i - 1) + " (outputs steer_angle[" +
-                        std::to_string(i - 1) + "], steer_rate, drive_rate, wheel_contact)";
+  const auto who = [this](std::size_t i) {
+    if (i == 0) {
+      return std::string(
+          "the body (outputs position, yaw, linear_velocity, yaw_rate, body_linear_velocity)");
+    }
+    const std::size_t k = i - 1;
+    const int sm = steer_motor_[k];
+    const std::string d = std::to_string(drive_motor_[k]);
+    return "wheel " + std::to_string(k) + " (outputs " +
+           (sm >= 0 ? "steer_angle[" + std::to_string(sm) + "], steer_rate[" +
+                          std::to_string(sm) + "], "
+                    : std::string()) +
+           "drive_rate[" + d + "], wheel_contact[" + std::to_string(2 * k) + "])";
   };
   for (std::size_t i = 0; i < ode_->BodyCount(); ++i) {
     const dBodyID b = ode_->Body(i);
@@ -441,29 +670,37 @@ void ChassisUnit::ComputeOutputs() {
   const dReal* wb = dBodyGetAngularVel(o.body);
   const double yaw = Yaw(rb);
   const double c = std::cos(yaw), s = std::sin(yaw);
-  pose_[0] = pb[0];
-  pose_[1] = pb[1];
-  pose_[2] = models::WrapAngle(yaw);
-  velocity_[0] = vb[0];
-  velocity_[1] = vb[1];
-  velocity_[2] = wb[2];
-  body_velocity_[0] = c * vb[0] + s * vb[1];
-  body_velocity_[1] = -s * vb[0] + c * vb[1];
-  body_velocity_[2] = wb[2];
+  position_[0] = pb[0];
+  position_[1] = pb[1];
+  yaw_ = models::WrapAngle(yaw);
+  linear_velocity_[0] = vb[0];
+  linear_velocity_[1] = vb[1];
+  yaw_rate_ = wb[2];
+  body_linear_velocity_[0] = c * vb[0] + s * vb[1];
+  body_linear_velocity_[1] = -s * vb[0] + c * vb[1];
 
   double ex[3], ey[3], ez[3], axle[3];
   Column(rb, 0, ex);
   Column(rb, 1, ey);
   Column(rb, 2, ez);
+  // drive_rate is the first wheel's of each motor (the others are coupled to it).
+  std::uint64_t seen = 0;
   for (std::size_t k = 0; k < o.wheels.size(); ++k) {
     const dBodyID w = o.wheels[k];
     Column(dBodyGetRotation(w), 1, axle);
-    // Heading = axle x up; in base_link: (ax_y, -ax_x) of the axle there.
-    steer_angle_[k] = models::WrapAngle(std::atan2(-Dot(axle, ex), Dot(axle, ey)));
     const dReal* ww = dBodyGetAngularVel(w);
     const double rel[3] = {ww[0] - wb[0], ww[1] - wb[1], ww[2] - wb[2]};
-    steer_rate_[k] = Dot(ez, rel);
-    drive_rate_[k] = Dot(axle, rel);
+    if (const int sm = steer_motor_[k]; sm >= 0) {
+      const auto m = static_cast<std::size_t>(sm);
+      // Heading = axle x up; in base_link: (ax_y, -ax_x) of the axle there.
+      steer_angle_[m] = models::WrapAngle(std::atan2(-Dot(axle, ex), Dot(axle, ey)));
+      steer_rate_[m] = Dot(ez, rel);
+    }
+    const auto dm = static_cast<unsigned>(drive_motor_[k]);
+    if ((seen & (std::uint64_t{1} << dm)) == 0) {
+      seen |= std::uint64_t{1} << dm;
+      drive_rate_[dm] = Dot(axle, rel);
+    }
     const GeomContact& gc = o.floor->contact(static_cast<int>(k));
     wheel_surface_[k] = gc.surface;
     double vx = 0.0, vy = 0.0;
@@ -489,10 +726,7 @@ cosim::StepResult ChassisUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   EnsureOdeForThisThread();
   stepped_since_settle_ = true;
   FloorWorld& f = *ode_->floor;
-  for (int k = 0; k < f.belt_count(); ++k) {
-    const auto kk = static_cast<std::size_t>(k);
-    f.SetBeltVelocity(k, belt_velocity_[2 * kk], belt_velocity_[2 * kk + 1]);
-  }
+  SetBeltInputs();
   const double h_s = cosim::NsToSeconds(dt) / static_cast<double>(substeps_);
   SetSuspension(h_s);
   SetJointMotors(brake_, brake_torque_);
@@ -536,6 +770,8 @@ void ChassisUnit::SaveInternal(cosim::UnitState& state) const {
 void ChassisUnit::RestoreInternal(const cosim::UnitState& state) {
   stepped_since_settle_ = true;
   const std::size_t bodies = static_cast<std::size_t>(wheel_count_) + 1;
+  // Couplings are velocity rows and carried objects follow the inputs:
+  // neither holds state of its own.
   const bool init = state.integers.size() == 1 && state.integers[0] != 0;
   const std::size_t reals = init ? bodies * kRealsPerBody : 0;
   if (state.integers.size() != 1 || state.reals.size() != reals) {

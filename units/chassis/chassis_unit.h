@@ -7,33 +7,48 @@
 
 #include "cosim/time.h"
 #include "cosim/unit.h"
-#include "models/dc_motor_params.h"
-#include "models/raw3.h"
+#include "models/scene.h"
 
 namespace linesim::chassis {
 
-/// A Rob@Work 3 style robot with steer+drive wheel modules on a floor with
-/// conveyor-belt patches, simulated with ODE (dWorldStep).
+/// A wheeled robot base on a factory floor with conveyor-belt patches,
+/// obstacles and belt-carried objects, simulated with ODE (dWorldStep). One
+/// code for any wheel topology: a swerve base (Rob@Work 3: every wheel with
+/// its own steering and drive motor) and a skid-steer base (Husky A200: four
+/// fixed wheels, the two of a side on one drive motor through a belt).
 ///
-/// Model: a body box (no collision) and one body per module (the module
-/// mass lumped into its wheel), joined by one ODE hinge2 per module: axis 1
-/// the steering axis (vertical, on the body, soft along it: the suspension),
-/// axis 2 the wheel axle. Wheels are spheres of the wheel radius (one
-/// contact point each, directly below the steering axis: no scrub torque
-/// when steering in place). Each wheel contact takes the surface velocity of
-/// the belt patch under it, with Coulomb friction while it slides
-/// (units/chassis/floor_world.h). Input torques act between module and body
-/// (dBodyAddTorque in equal and opposite pairs about the body's vertical and
-/// the wheel's axle), with the viscous joint friction, every internal step;
-/// the brake is an ODE joint motor (target velocity 0, force limit
-/// brake_torque) on both hinge2 axes.
+/// Topology (structural): wheel k is steered by steering motor
+/// steer_motor[k] (-1: a fixed wheel) and driven by drive motor
+/// drive_motor[k]; wheels with the same drive motor are coupled.
+///
+/// Model: a body box and one body per wheel (a steered module's mass lumped
+/// into its wheel). A steered wheel hangs on an ODE hinge2: axis 1 the
+/// steering axis (vertical, on the body, soft along it: the suspension),
+/// axis 2 the wheel axle. A fixed wheel turns on a plain hinge about its
+/// axle, mounted rigidly (the soft contacts make four rigid wheels
+/// determinate). Wheels sharing a drive motor are coupled by an ODE angular
+/// motor between them (zero relative spin about the axle, a force limit far
+/// above any wheel torque): a real constraint, like the belt it models; the
+/// motor's torque acts on the first wheel of its group (reaction on the
+/// body) and the coupling carries its share to the others. Wheels are
+/// spheres of their radius (one contact point each, directly below the
+/// steering axis or axle centre). Each wheel contact takes the surface
+/// velocity and friction of the belt patch under it, else the floor's, with
+/// Coulomb friction while it slides (units/chassis/floor_world.h). The body
+/// box (body_length x body_width x body_height about the centre of mass)
+/// collides with the scene's obstacles and carried objects, never with the
+/// floor. Input torques act between wheel and body (dBodyAddTorque in equal
+/// and opposite pairs about the body's vertical and the wheel's axle), with
+/// the viscous joint friction, every internal step; the brake is an ODE
+/// joint motor (target velocity 0, force limit brake_torque) on every
+/// wheel joint axis.
 ///
 /// Frames: map (x, y, z up) and base_link (x forward, y left), whose origin
 /// in x and y is the planform centre of the body, which is also its centre of
 /// mass and the point wheel_x and wheel_y refer to. Wheel heading
 /// (steer angle) 0 is base_link +x, positive counter-clockwise seen from
-/// above. A positive drive torque or drive rate rolls the wheel forward
-/// along its heading.
+/// above; fixed wheels head along +x. A positive drive torque or drive rate
+/// rolls the wheel forward along its heading.
 ///
 /// Initialize builds the robot at the initial pose with every wheel
 /// pressed in by its share of the weight, then settles it for 0.3 s with
@@ -45,10 +60,17 @@ class ChassisUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "chassis";
 
-  /// wheel_count >= 1 modules and belt_count >= 0 belt patches (structural:
-  /// they size the arrays; with no belts there are no belt parameters and no
-  /// belt_velocity input). Throws cosim::UnitError otherwise.
-  ChassisUnit(std::string name, int wheel_count, int belt_count);
+  /// Checks a topology (steer_motor and drive_motor per wheel, as in the
+  /// class comment): empty when usable, else what is wrong, naming the key.
+  static std::string TopologyProblem(const std::vector<int>& steer_motor,
+                                     const std::vector<int>& drive_motor);
+
+  /// `steer_motor` and `drive_motor` give the topology (one entry per
+  /// wheel); `scene` the belts (one belt_velocity and belt_travel input
+  /// each), the floor's and the belts' friction, the obstacles and carried
+  /// objects. Throws cosim::UnitError for a bad topology or scene.
+  ChassisUnit(std::string name, std::vector<int> steer_motor, std::vector<int> drive_motor,
+              models::Scene scene);
   ~ChassisUnit() override;
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
@@ -59,6 +81,12 @@ class ChassisUnit : public cosim::Unit {
 
   int wheel_count() const { return wheel_count_; }
   int belt_count() const { return belt_count_; }
+  int steer_motor_count() const { return steer_motor_count_; }
+  int drive_motor_count() const { return drive_motor_count_; }
+  /// Spin rate of wheel k about its axle relative to the body (rad/s), as
+  /// drive_rate reports it for the first wheel of each drive motor; for
+  /// tests and diagnostics of coupled wheels.
+  double WheelRate(int k) const;
 
  protected:
   void SaveInternal(cosim::UnitState& state) const override;
@@ -75,35 +103,34 @@ class ChassisUnit : public cosim::Unit {
   void SetSuspension(double h_s);
   void SetJointMotors(bool hold, double max_torque_nm);
   void ApplyTorques();
+  /// Hands belt_velocity and belt_travel to the floor world.
+  void SetBeltInputs();
   /// Empty when every body state is finite, else what is not.
   std::string NonFiniteState() const;
   void ComputeOutputs();
 
   int wheel_count_;
   int belt_count_;
+  std::vector<int> steer_motor_, drive_motor_;
+  int steer_motor_count_ = 0;
+  int drive_motor_count_ = 0;
+  models::Scene scene_;
 
-  // Parameters.
-  double body_length_ = 1.03;
-  double body_width_ = 0.57;
-  double body_height_ = 0.40;
-  double mass_ = models::raw3::kMassKg;
-  double module_mass_ = 5.0;
-  double com_height_ = 0.13;
-  double wheel_radius_ = models::raw3::kWheelRadiusM;
-  std::vector<double> wheel_x_, wheel_y_;
-  // The RE 40 rotor (models::DcMotorParams) through the Rob@Work 3 steer
-  // belt and drive gear, as eta N^2 J_rotor: the rotor as the dc_motor
-  // unit's full-mode equations see it from the output (J_eff = J + J_load /
-  // (eta N^2)).
-  double steer_rotor_inertia_ = models::raw3::kSteerGearEfficiency * models::raw3::kSteerGearRatio *
-                                models::raw3::kSteerGearRatio *
-                                models::DcMotorParams{}.rotor_inertia_kgm2;
-  double drive_rotor_inertia_ = models::raw3::kDriveGearEfficiency * models::raw3::kDriveGearRatio *
-                                models::raw3::kDriveGearRatio *
-                                models::DcMotorParams{}.rotor_inertia_kgm2;
+  // Parameters. Robot-specific ones start NaN: CheckParameters asks for them.
+  double body_length_;
+  double body_width_;
+  double body_height_;
+  double mass_;
+  double module_mass_;
+  double com_height_;
+  std::vector<double> wheel_radius_, wheel_x_, wheel_y_;
+  // Rotor inertias reflected through the gears (eta N^2 J_rotor): robot-specific.
+  double steer_rotor_inertia_;
+  double drive_rotor_inertia_;
+  // Generic values, with the reasons in the parameter descriptions.
   double steer_friction_ = 0.01;
   double drive_friction_ = 0.01;
-  double friction_ = 0.8;
+  double body_friction_ = 0.5;
   double contact_stiffness_ = 1e6;
   double contact_damping_ = 1e4;
   double slip_damping_ = 1e5;
@@ -114,15 +141,16 @@ class ChassisUnit : public cosim::Unit {
   double initial_x_ = 0.0;
   double initial_y_ = 0.0;
   double initial_yaw_ = 0.0;
-  std::vector<double> belt_center_x_, belt_center_y_, belt_length_, belt_width_, belt_direction_;
 
   // Inputs.
-  std::vector<double> steer_torque_, drive_torque_, belt_velocity_;
+  std::vector<double> steer_torque_, drive_torque_, belt_velocity_, belt_travel_;
   bool brake_ = false;
 
   // Outputs.
   std::vector<double> steer_angle_, steer_rate_, drive_rate_;
-  std::vector<double> pose_, velocity_, body_velocity_;
+  std::vector<double> position_, linear_velocity_, body_linear_velocity_;
+  double yaw_ = 0.0;
+  double yaw_rate_ = 0.0;
   std::vector<double> wheel_surface_, wheel_surface_velocity_, wheel_contact_;
 
   bool initialized_ = false;

@@ -57,6 +57,8 @@ FloorWorld::~FloorWorld() {
   EnsureOdeForThisThread();
   dJointGroupDestroy(group_);
   dGeomDestroy(floor_);
+  for (dGeomID g : obstacles_) dGeomDestroy(g);
+  for (const Carried& c : carried_) dGeomDestroy(c.geom);
   dWorldDestroy(world_);
   dThreadingFreeImplementation(threading_);
 }
@@ -65,6 +67,7 @@ void FloorWorld::SetBelts(std::vector<BeltPatch> belts) {
   belts_ = std::move(belts);
   collided_ = false;
   belt_velocity_mps_.assign(belts_.size(), {0.0, 0.0});
+  belt_travel_m_.assign(belts_.size(), 0.0);
   belt_axes_.clear();
   for (const BeltPatch& b : belts_) {
     const double c = std::cos(b.direction_rad);
@@ -75,6 +78,130 @@ void FloorWorld::SetBelts(std::vector<BeltPatch> belts) {
 
 void FloorWorld::SetBeltVelocity(int k, double vx_mps, double vy_mps) {
   belt_velocity_mps_.at(static_cast<std::size_t>(k)) = {vx_mps, vy_mps};
+}
+
+namespace {
+
+// A geom (in no space) for a solid standing on the floor (bottom_m above it).
+dGeomID SolidGeom(const models::Solid& s, double* z_m) {
+  dGeomID g = s.kind == models::Solid::Kind::kBox
+                  ? dCreateBox(nullptr, s.length_m, s.width_m, s.height_m)
+                  : dCreateCylinder(nullptr, s.radius_m, s.height_m);  // axis along z
+  *z_m = s.bottom_m + 0.5 * s.height_m;
+  dGeomSetPosition(g, s.x_m, s.y_m, *z_m);
+  dMatrix3 rot;
+  dRFromAxisAndAngle(rot, 0.0, 0.0, 1.0, s.yaw_rad);
+  dGeomSetRotation(g, rot);
+  return g;
+}
+
+}  // namespace
+
+void FloorWorld::AddObstacle(const models::Solid& solid) {
+  double z = 0.0;
+  obstacles_.push_back(SolidGeom(solid, &z));
+  Aabb box;
+  dGeomGetAABB(obstacles_.back(), box.data());
+  obstacle_aabbs_.push_back(box);
+  near_region_ = {1.0, -1.0, 1.0, -1.0, 1.0, -1.0};  // list again
+}
+
+void FloorWorld::AddCarried(const models::Solid& solid, int belt) {
+  if (belt < 0 || belt >= belt_count()) throw std::out_of_range("FloorWorld: no such belt");
+  Carried c;
+  c.geom = SolidGeom(solid, &c.z_m);
+  c.belt = belt;
+  c.x0_m = solid.x_m;
+  c.y0_m = solid.y_m;
+  dGeomGetAABB(c.geom, c.aabb0.data());
+  carried_.push_back(c);
+}
+
+void FloorWorld::SetBeltTravel(int k, double travel_m) {
+  belt_travel_m_.at(static_cast<std::size_t>(k)) = travel_m;
+  travel_elapsed_s_ = 0.0;
+}
+
+double FloorWorld::CarriedSpeed(std::size_t i) const {
+  const auto b = static_cast<std::size_t>(carried_[i].belt);
+  const auto& v = belt_velocity_mps_[b];
+  return v[0] * belt_axes_[b][0] + v[1] * belt_axes_[b][1];
+}
+
+void FloorWorld::CollideObject(dGeomID object, const double v[3]) {
+  // The body geom first, so that the normal points into it (from the object).
+  std::array<dContact, kMaxPoints> pts{};
+  const int n = dCollide(body_geom_, object, kMaxPoints, &pts[0].geom, sizeof(dContact));
+  const dBodyID body = dGeomGetBody(body_geom_);
+  for (int j = 0; j < n; ++j) {
+    dContact& p = pts[static_cast<std::size_t>(j)];
+    const dReal* nrm = p.geom.normal;
+    // A tangent: map z x normal, or map x less its normal part when the
+    // normal is vertical.
+    double t1[3] = {-nrm[1], nrm[0], 0.0};
+    double len = std::hypot(t1[0], t1[1]);
+    if (len < 1e-6) {
+      t1[0] = 1.0 - nrm[0] * nrm[0];
+      t1[1] = -nrm[0] * nrm[1];
+      t1[2] = -nrm[0] * nrm[2];
+      len = std::sqrt(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]);
+    }
+    for (double& e : t1) e /= len;
+    const double t2[3] = {nrm[1] * t1[2] - nrm[2] * t1[1], nrm[2] * t1[0] - nrm[0] * t1[2],
+                          nrm[0] * t1[1] - nrm[1] * t1[0]};
+    // Contact rows with body2 = 0: n . v_body >= pushout + motionN, so
+    // motionN = n . v_object keeps the body from moving into the object;
+    // fdir . v_body = motion makes a sticking contact move with it.
+    p.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP | dContactMotion1 |
+                     dContactMotion2 | dContactMotionN | dContactFDir1;
+    p.surface.mu = body_mu_;
+    p.surface.soft_erp = object_erp_;
+    p.surface.soft_cfm = object_cfm_;
+    p.surface.motion1 = v[0] * t1[0] + v[1] * t1[1] + v[2] * t1[2];
+    p.surface.motion2 = v[0] * t2[0] + v[1] * t2[1] + v[2] * t2[2];
+    p.surface.motionN = v[0] * nrm[0] + v[1] * nrm[1] + v[2] * nrm[2];
+    for (int d = 0; d < 3; ++d) p.fdir1[d] = t1[d];
+    const dJointID joint = dJointCreateContact(world_, group_, &p);
+    dJointAttach(joint, body, nullptr);
+  }
+}
+
+void FloorWorld::CollideObjects(double erp, double cfm) {
+  if (body_geom_ == nullptr || (obstacles_.empty() && carried_.empty())) return;
+  object_erp_ = erp;
+  object_cfm_ = cfm;
+  Aabb body;
+  dGeomGetAABB(body_geom_, body.data());
+  const double still[3] = {0.0, 0.0, 0.0};
+  if (!obstacles_.empty()) {
+    const Aabb& r = near_region_;
+    if (!(r[0] <= body[0] && body[1] <= r[1] && r[2] <= body[2] && body[3] <= r[3] &&
+          r[4] <= body[4] && body[5] <= r[5])) {
+      near_region_ = {body[0] - kNearMarginM, body[1] + kNearMarginM,
+                      body[2] - kNearMarginM, body[3] + kNearMarginM,
+                      body[4] - kNearMarginM, body[5] + kNearMarginM};
+      near_obstacles_.clear();
+      for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+        if (Overlap(obstacle_aabbs_[i], near_region_)) near_obstacles_.push_back(i);
+      }
+    }
+    for (std::size_t i : near_obstacles_) {
+      if (Overlap(obstacle_aabbs_[i], body)) CollideObject(obstacles_[i], still);
+    }
+  }
+  for (std::size_t i = 0; i < carried_.size(); ++i) {
+    const Carried& c = carried_[i];
+    const auto b = static_cast<std::size_t>(c.belt);
+    const double speed = CarriedSpeed(i);
+    const double s = belt_travel_m_[b] + speed * travel_elapsed_s_;
+    const double dx = s * belt_axes_[b][0], dy = s * belt_axes_[b][1];
+    const Aabb moved = {c.aabb0[0] + dx, c.aabb0[1] + dx, c.aabb0[2] + dy,
+                        c.aabb0[3] + dy, c.aabb0[4],      c.aabb0[5]};
+    if (!Overlap(moved, body)) continue;
+    dGeomSetPosition(c.geom, c.x0_m + dx, c.y0_m + dy, c.z_m);
+    const double v[3] = {speed * belt_axes_[b][0], speed * belt_axes_[b][1], 0.0};
+    CollideObject(c.geom, v);
+  }
 }
 
 int FloorWorld::AddGeom(dGeomID geom) {
@@ -199,7 +326,9 @@ void FloorWorld::MakeJoints(std::size_t i, double erp, double cfm) {
     const bool sliding = slip_mps > kSlipAlignMps;
     p.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP | dContactMotion1 |
                      dContactMotion2 | dContactFDir1 | (sliding ? dContactSlip2 : 0);
-    p.surface.mu = surface_.mu;
+    p.surface.mu = pts.surface[j] > 0
+                       ? belts_[static_cast<std::size_t>(pts.surface[j] - 1)].mu
+                       : surface_.mu;
     p.surface.slip2 = 1.0 / surface_.slip_damping_n_s_per_m;
     p.surface.soft_erp = erp;
     p.surface.soft_cfm = cfm;
@@ -221,7 +350,9 @@ bool FloorWorld::Step(double h_s) {
   try {
     if (!collided_) Probe();
     for (std::size_t i = 0; i < geoms_.size(); ++i) MakeJoints(i, erp, cfm);
+    CollideObjects(erp, cfm);
     ok = dWorldStep(world_, h_s);
+    travel_elapsed_s_ += h_s;
     dJointGroupEmpty(group_);
     // At the new positions: for contact(i) now and the next step's joints.
     if (ok != 0) Probe();

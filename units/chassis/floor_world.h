@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "models/scene.h"
+
 namespace linesim::chassis {
 
 /// Standard gravity, m/s^2, pointing along -z in every ODE world made here.
@@ -49,11 +51,13 @@ struct BeltPatch {
   double length_m = 1.0;       // along the belt direction
   double width_m = 1.0;        // across it
   double direction_rad = 0.0;  // of the length axis, counter-clockwise from map x
+  double mu = 0.8;             // Coulomb coefficient of a wheel on its surface
 };
 
-/// Contact parameters shared by every contact with the floor and the belts.
+/// Contact parameters shared by every contact with the floor and the belts
+/// (each belt has its own mu: BeltPatch::mu).
 struct ContactSurface {
-  double mu = 0.8;                 // Coulomb coefficient (dContactApprox1)
+  double mu = 0.8;                 // Coulomb coefficient on the floor (dContactApprox1)
   double stiffness_n_per_m = 1e6;  // per contact point
   double damping_n_s_per_m = 1e4;  // per contact point
   // A sliding contact's resistance to sideways slip (across its slip
@@ -104,6 +108,18 @@ struct GeomContact {
 /// A slower (sticking) contact keeps both rows, fdir1 along the surface
 /// velocity, or map x on the still floor.
 ///
+/// Objects: static obstacles and belt-carried objects are collision
+/// geometry for one registered body geom (the robot's body box; wheels touch
+/// the floor only), collided with it at the start of every step. Objects far
+/// from the robot cost next to nothing: the obstacles near the body (AABBs
+/// within kNearMarginM of its AABB) are listed once and listed again only
+/// when the body's AABB leaves that margin, so a step tests the body's AABB
+/// against one box and the near obstacles only; a carried object is tested
+/// by its AABB translated along its belt, and its geom is moved and
+/// collided only when that overlaps the body's. A carried object has no
+/// body: it is placed from its belt's travelled distance and its contacts
+/// move with it through the contact's surface motion (normal motionN and
+/// tangential motion1/2 = the object's velocity), as the belt contacts do.
 class FloorWorld {
  public:
   FloorWorld();
@@ -126,6 +142,24 @@ class FloorWorld {
   /// destroying it.
   int AddGeom(dGeomID geom);
   void ClearGeoms();
+
+  /// The geom (attached to a body of this world) that collides with
+  /// obstacles and carried objects, or nullptr; the caller keeps ownership.
+  void SetBodyGeom(dGeomID geom, double mu) {
+    body_geom_ = geom;
+    body_mu_ = mu;
+  }
+  /// Adds a static obstacle (box or vertical cylinder standing on the
+  /// floor); FloorWorld owns its geom.
+  void AddObstacle(const models::Solid& solid);
+  int obstacle_count() const { return static_cast<int>(obstacles_.size()); }
+  /// Adds an object carried by belt `belt` (0-based, < belt_count()), at
+  /// `solid` when the belt has travelled 0 m.
+  void AddCarried(const models::Solid& solid, int belt);
+  /// Distance belt k's surface has moved since time zero: carried objects
+  /// are placed at it (and move on at the belt velocity along the belt
+  /// direction within the step).
+  void SetBeltTravel(int k, double travel_m);
 
   /// Surface at map point (x, y): 0 floor, k + 1 for the first belt k that
   /// contains it (edges included).
@@ -167,6 +201,30 @@ class FloorWorld {
   void Collide(std::size_t i);
   /// Contact joints for the points of geom i.
   void MakeJoints(std::size_t i, double erp, double cfm);
+  /// Contact joints between the body geom and the objects it touches.
+  void CollideObjects(double erp, double cfm);
+  /// Contact joints for the points where the body geom touches `object`
+  /// (moving at velocity v in map).
+  void CollideObject(dGeomID object, const double v[3]);
+  /// Speed of carried object i along its belt's direction.
+  double CarriedSpeed(std::size_t i) const;
+
+  // ODE's AABB layout: min x, max x, min y, max y, min z, max z.
+  using Aabb = std::array<dReal, 6>;
+  static bool Overlap(const Aabb& a, const Aabb& b) {
+    return a[0] <= b[1] && b[0] <= a[1] && a[2] <= b[3] && b[2] <= a[3] && a[4] <= b[5] &&
+           b[4] <= a[5];
+  }
+  // How far around the body's AABB obstacles are listed as near: the
+  // list is redone after the body moved about this far.
+  static constexpr double kNearMarginM = 0.5;
+
+  struct Carried {
+    dGeomID geom = nullptr;
+    int belt = 0;
+    double x0_m = 0.0, y0_m = 0.0, z_m = 0.0;
+    Aabb aabb0{};  // at zero travel
+  };
 
   dWorldID world_ = nullptr;
   // Each world steps with its own threading object: without one, ODE steps
@@ -181,6 +239,20 @@ class FloorWorld {
   // Per belt, the unit vectors along and across its length axis.
   std::vector<std::array<double, 4>> belt_axes_;
   std::vector<dGeomID> geoms_;
+  dGeomID body_geom_ = nullptr;
+  double body_mu_ = 0.5;
+  std::vector<dGeomID> obstacles_;
+  std::vector<Aabb> obstacle_aabbs_;
+  // The region the near list holds for (empty at first: min > max), and
+  // the obstacles whose AABB overlaps it.
+  Aabb near_region_{1.0, -1.0, 1.0, -1.0, 1.0, -1.0};
+  std::vector<std::size_t> near_obstacles_;
+  std::vector<Carried> carried_;
+  std::vector<double> belt_travel_m_;
+  // Time since the last SetBeltTravel (substeps of one step).
+  double travel_elapsed_s_ = 0.0;
+  // ERP and CFM of the object contacts in the current CollideObjects.
+  double object_erp_ = 0.0, object_cfm_ = 0.0;
   std::vector<GeomContact> contacts_;
   std::vector<Points> points_;
   // Whether points_ hold the current positions of every geom (a Probe or

@@ -14,6 +14,7 @@
 
 #include "cosim/time.h"
 #include "models/models_dir.h"
+#include "tests/units/chassis/robots.h"
 #include "tests/units/test_helpers.h"
 #include "units/chassis/floor_world.h"
 
@@ -29,17 +30,16 @@ using test_helpers::SetArray;
 constexpr TimeNs kMs = 1'000'000;
 constexpr double kPi = std::numbers::pi;
 
-// Rob@Work 3 defaults the expectations are computed from (FACTS.md and the
-// unit's documented defaults).
-constexpr double kMassKg = 120.0;
-constexpr double kModuleMassKg = 5.0;
-constexpr double kWheelRadiusM = 0.080;
-// eta N^2 J_rotor (maxon RE 40: 142 g.cm^2; gears and efficiencies of
-// models/motors/raw3_*.yaml).
-constexpr double kDriveRotorKgm2 = 0.75 * 21.0 * 21.0 * 142e-7;
-constexpr double kSteerRotorKgm2 = 0.9 * 4.0 * 4.0 * 142e-7;
-constexpr double kWheelXM[4] = {0.368, -0.368, -0.368, 0.368};
-constexpr double kWheelYM[4] = {0.186, 0.134, -0.186, -0.134};
+// Rob@Work 3 numbers the expectations are computed from (sources in
+// tests/units/chassis/robots.h).
+using namespace test_robots;  // NOLINT: the robots' numbers and builders
+constexpr double kMassKg = kRaw3MassKg;
+constexpr double kModuleMassKg = kRaw3ModuleMassKg;
+constexpr double kWheelRadiusM = kRaw3WheelRadiusM;
+constexpr double kDriveRotorKgm2 = kRaw3DriveRotorKgm2;
+constexpr double kSteerRotorKgm2 = kRaw3SteerRotorKgm2;
+constexpr const double* kWheelXM = kRaw3WheelXM;
+constexpr const double* kWheelYM = kRaw3WheelYM;
 
 // ---------------------------------------------------------------------------
 // Access through the variable table, as the master does.
@@ -52,13 +52,15 @@ void SetBrake(ChassisUnit& u, bool on) {
   u.variables().SetBoolean(*u.variables().Find("brake"), on);
 }
 
-// One big belt patch: a 40 x 40 m square centred at (cx, cy).
-void OneBelt(ChassisUnit& u, double cx_m, double cy_m, double size_m, double dir_rad) {
-  Set(u, "belt_center_x", cx_m);
-  Set(u, "belt_center_y", cy_m);
-  Set(u, "belt_length", size_m);
-  Set(u, "belt_width", size_m);
-  Set(u, "belt_direction", dir_rad);
+// A Rob@Work 3 on one big square belt patch centred at (cx, cy).
+std::unique_ptr<ChassisUnit> Raw3OnBelt(double cx_m, double cy_m, double size_m, double dir_rad) {
+  return Raw3(test_robots::OneBelt({cx_m, cy_m, size_m, size_m, dir_rad}));
+}
+
+// A far belt (20 x 3 m along map x, centred 2.5 m to the left of the
+// origin): a scene with one belt input that the robot does not touch.
+std::unique_ptr<ChassisUnit> Raw3FarBelt() {
+  return Raw3(test_robots::OneBelt({0.0, 2.5, 20.0, 3.0, 0.0}));
 }
 
 void Advance(ChassisUnit& u, TimeNs& t, int steps, TimeNs dt = kMs) {
@@ -72,16 +74,20 @@ void Advance(ChassisUnit& u, TimeNs& t, int steps, TimeNs dt = kMs) {
 // drift at rest on a plane) and against an Initialize that does not leave
 // it at rest. Expected: nothing moves; 1 mm over 5 s is the brief's bound.
 TEST(ChassisUnit, RestsOnTheFloorWithoutDrift) {
-  ChassisUnit u("robot", 4, 0);
+  auto robot = Raw3();
+  ChassisUnit& u = *robot;
   u.Initialize();
-  for (double v : Get(u, "velocity")) EXPECT_EQ(v, 0.0);
-  const auto p0 = Get(u, "pose");
+  for (double v : Get(u, "linear_velocity")) EXPECT_EQ(v, 0.0);
+  EXPECT_EQ(Get(u, "yaw_rate")[0], 0.0);
+  const auto p0 = Get(u, "position");
+  const double yaw0 = Get(u, "yaw")[0];
   TimeNs t = 0;
   Advance(u, t, 5000);
-  const auto p = Get(u, "pose");
+  const auto p = Get(u, "position");
   EXPECT_LT(std::hypot(p[0] - p0[0], p[1] - p0[1]), 1e-3);
-  EXPECT_LT(std::abs(p[2] - p0[2]), 1e-4);
-  for (double v : Get(u, "velocity")) EXPECT_LT(std::abs(v), 1e-6);
+  EXPECT_LT(std::abs(Get(u, "yaw")[0] - yaw0), 1e-4);
+  for (double v : Get(u, "linear_velocity")) EXPECT_LT(std::abs(v), 1e-6);
+  EXPECT_LT(std::abs(Get(u, "yaw_rate")[0]), 1e-6);
   for (double a : Get(u, "steer_angle")) EXPECT_LT(std::abs(a), 1e-6);
   for (double w : Get(u, "drive_rate")) EXPECT_LT(std::abs(w), 1e-6);
 }
@@ -90,16 +96,17 @@ TEST(ChassisUnit, RestsOnTheFloorWithoutDrift) {
 // against wrong frames in the wheel outputs. Expected by geometry: wheel k
 // in map = initial position + Rz(yaw) (wheel_x, wheel_y).
 TEST(ChassisUnit, InitializePlacesRobotAtInitialPose) {
-  ChassisUnit u("robot", 4, 1);  // default belt is far away (y 1 to 4 m)
+  auto robot = Raw3FarBelt();  // the belt is far away (y 1 to 4 m)
+  ChassisUnit& u = *robot;
   const double x0 = -1.5, y0 = -2.0, yaw0 = 2.5;
   Set(u, "initial_x", x0);
   Set(u, "initial_y", y0);
   Set(u, "initial_yaw", yaw0);
   u.Initialize();
-  const auto p = Get(u, "pose");
+  const auto p = Get(u, "position");
   EXPECT_NEAR(p[0], x0, 1e-12);
   EXPECT_NEAR(p[1], y0, 1e-12);
-  EXPECT_NEAR(p[2], yaw0, 1e-12);
+  EXPECT_NEAR(Get(u, "yaw")[0], yaw0, 1e-12);
   const auto contact = Get(u, "wheel_contact");
   const auto surface = Get(u, "wheel_surface");
   for (int k = 0; k < 4; ++k) {
@@ -119,8 +126,8 @@ TEST(ChassisUnit, InitializePlacesRobotAtInitialPose) {
 TEST(ChassisUnit, BrakedRobotOnBeltMovesWithIt) {
   for (const double dir_rad : {0.0, 2.0}) {
     SCOPED_TRACE(dir_rad);
-    ChassisUnit u("robot", 4, 1);
-    OneBelt(u, 0.0, 0.0, 40.0, dir_rad);
+    auto robot = Raw3OnBelt(0.0, 0.0, 40.0, dir_rad);
+    ChassisUnit& u = *robot;
     const double yaw0 = 0.7;
     Set(u, "initial_yaw", yaw0);
     SetBrake(u, true);
@@ -129,16 +136,16 @@ TEST(ChassisUnit, BrakedRobotOnBeltMovesWithIt) {
     SetArray(u, "belt_velocity", {vx, vy});
     TimeNs t = 0;
     Advance(u, t, 500);
-    const auto v = Get(u, "velocity");
+    const auto v = Get(u, "linear_velocity");
     EXPECT_NEAR(v[0], vx, 1e-4);
     EXPECT_NEAR(v[1], vy, 1e-4);
-    EXPECT_NEAR(v[2], 0.0, 1e-4);
-    EXPECT_NEAR(Get(u, "pose")[2], yaw0, 1e-3);
+    EXPECT_NEAR(Get(u, "yaw_rate")[0], 0.0, 1e-4);
+    EXPECT_NEAR(Get(u, "yaw")[0], yaw0, 1e-3);
     // In base_link: the map velocity turned by -yaw.
-    const double yaw = Get(u, "pose")[2];
+    const double yaw = Get(u, "yaw")[0];
     const double bx = std::cos(yaw) * vx + std::sin(yaw) * vy;
     const double by = -std::sin(yaw) * vx + std::cos(yaw) * vy;
-    const auto bv = Get(u, "body_velocity");
+    const auto bv = Get(u, "body_linear_velocity");
     EXPECT_NEAR(bv[0], bx, 1e-4);
     EXPECT_NEAR(bv[1], by, 1e-4);
     const auto sv = Get(u, "wheel_surface_velocity");
@@ -181,12 +188,14 @@ Eigen::Vector3d CoulombSlidingTwist(const std::vector<Eigen::Vector2d>& p,
 // Braked robot with the front wheels (x = +0.368) on a belt that covers
 // x > 0 in a frame turned by `turn_rad` from map and runs along that
 // frame's +y at 0.2 m/s; the robot is turned by the same angle. Returns
-// body_velocity after 0.2 s (a few friction time constants).
+// body_linear_velocity, yaw_rate and the yaw turned after 0.2 s (a few
+// friction time constants).
 std::vector<double> StraddleBodyVelocity(double turn_rad, std::vector<double>* surfaces_start,
                                          std::vector<double>* surfaces_end,
                                          std::vector<double>* surface_velocity) {
-  ChassisUnit u("robot", 4, 1);
-  OneBelt(u, 20.0 * std::cos(turn_rad), 20.0 * std::sin(turn_rad), 40.0, turn_rad + kPi / 2.0);
+  auto robot =
+      Raw3OnBelt(20.0 * std::cos(turn_rad), 20.0 * std::sin(turn_rad), 40.0, turn_rad + kPi / 2.0);
+  ChassisUnit& u = *robot;
   Set(u, "initial_yaw", turn_rad);
   SetBrake(u, true);
   u.Initialize();
@@ -196,8 +205,9 @@ std::vector<double> StraddleBodyVelocity(double turn_rad, std::vector<double>* s
   Advance(u, t, 200);
   *surfaces_end = Get(u, "wheel_surface");
   *surface_velocity = Get(u, "wheel_surface_velocity");
-  auto v = Get(u, "body_velocity");
-  v.push_back(Get(u, "pose")[2] - turn_rad);
+  auto v = Get(u, "body_linear_velocity");
+  v.push_back(Get(u, "yaw_rate")[0]);
+  v.push_back(Get(u, "yaw")[0] - turn_rad);
   return v;
 }
 
@@ -261,7 +271,8 @@ TEST(ChassisUnit, EqualDriveTorquesAccelerateForward) {
   const double a = 4.0 * tau_nm / r / (kMassKg + 4.0 * j_axle / (r * r));
   for (const std::int64_t substeps : {1, 4}) {
     SCOPED_TRACE(substeps);
-    ChassisUnit u("robot", 4, 0);
+    auto robot = Raw3();
+    ChassisUnit& u = *robot;
     Set(u, "drive_friction", 0.0);
     Set(u, "initial_yaw", yaw0);
     Set(u, "substeps", substeps);
@@ -270,26 +281,27 @@ TEST(ChassisUnit, EqualDriveTorquesAccelerateForward) {
     TimeNs t = 0;
     Advance(u, t, 1000);
     const double t_s = 1.0;
-    const auto bv = Get(u, "body_velocity");
+    const auto bv = Get(u, "body_linear_velocity");
     EXPECT_NEAR(bv[0], a * t_s, 0.005 * a * t_s);
     EXPECT_NEAR(bv[1], 0.0, 1e-3);
-    EXPECT_NEAR(bv[2], 0.0, 1e-3);
-    const auto v = Get(u, "velocity");
+    EXPECT_NEAR(Get(u, "yaw_rate")[0], 0.0, 1e-3);
+    const auto v = Get(u, "linear_velocity");
     EXPECT_NEAR(v[0], std::cos(yaw0) * bv[0], 1e-3);
     EXPECT_NEAR(v[1], std::sin(yaw0) * bv[0], 1e-3);
-    const auto p = Get(u, "pose");
+    const auto p = Get(u, "position");
     const double s_m = 0.5 * a * t_s * t_s;
     EXPECT_NEAR(std::hypot(p[0], p[1]), s_m, 0.01 * s_m);
     EXPECT_NEAR(std::atan2(p[1], p[0]), yaw0, 1e-2);
     for (double w : Get(u, "drive_rate")) EXPECT_NEAR(w, bv[0] / r, 1e-3 * bv[0] / r);
   }
   // Negative torques drive backwards.
-  ChassisUnit u("robot", 4, 0);
+  auto robot = Raw3();
+  ChassisUnit& u = *robot;
   u.Initialize();
   SetArray(u, "drive_torque", {-tau_nm, -tau_nm, -tau_nm, -tau_nm});
   TimeNs t = 0;
   Advance(u, t, 200);
-  EXPECT_LT(Get(u, "body_velocity")[0], 0.0);
+  EXPECT_LT(Get(u, "body_linear_velocity")[0], 0.0);
   for (double w : Get(u, "drive_rate")) EXPECT_LT(w, 0.0);
 }
 
@@ -299,7 +311,8 @@ TEST(ChassisUnit, EqualDriveTorquesAccelerateForward) {
 // I = m_mod r^2 / 4 + J_steer (thin disc plus reflected rotor): the angle
 // after t is tau t^2 / (2 I) and the rate tau t / I.
 TEST(ChassisUnit, SteerTorqueTurnsWheelCounterClockwise) {
-  ChassisUnit u("robot", 4, 0);
+  auto robot = Raw3();
+  ChassisUnit& u = *robot;
   Set(u, "steer_friction", 0.0);
   u.Initialize();
   const double tau_nm = 0.05;
@@ -321,7 +334,8 @@ TEST(ChassisUnit, SteerTorqueTurnsWheelCounterClockwise) {
 // 90 deg: a wheel driven round by a constant torque passes pi and comes
 // back in (-pi, pi].
 TEST(ChassisUnit, SteerAngleWrapsToHalfOpenInterval) {
-  ChassisUnit u("robot", 4, 0);
+  auto robot = Raw3();
+  ChassisUnit& u = *robot;
   Set(u, "steer_friction", 0.0);
   u.Initialize();
   SetArray(u, "steer_torque", {0.2, 0.0, 0.0, 0.0});
@@ -343,13 +357,14 @@ TEST(ChassisUnit, SteerAngleWrapsToHalfOpenInterval) {
 // Guards against a brake that does not hold: a braked robot on the floor
 // with drive torques below the brake torque does not move.
 TEST(ChassisUnit, BrakeHoldsAgainstDriveTorque) {
-  ChassisUnit u("robot", 4, 0);
+  auto robot = Raw3();
+  ChassisUnit& u = *robot;
   SetBrake(u, true);
   u.Initialize();
   SetArray(u, "drive_torque", {5.0, 5.0, 5.0, 5.0});
   TimeNs t = 0;
   Advance(u, t, 500);
-  EXPECT_LT(std::abs(Get(u, "pose")[0]), 1e-5);
+  EXPECT_LT(std::abs(Get(u, "position")[0]), 1e-5);
   for (double w : Get(u, "drive_rate")) EXPECT_LT(std::abs(w), 1e-4);
 }
 
@@ -370,21 +385,22 @@ std::vector<std::vector<double>> Drive(ChassisUnit& u, int from, int to) {
   return out;
 }
 
-void Straddle(ChassisUnit& u) { OneBelt(u, 20.0, 0.0, 40.0, kPi / 2.0); }
+std::unique_ptr<ChassisUnit> Straddle() { return Raw3OnBelt(20.0, 0.0, 40.0, kPi / 2.0); }
 
 // Guards against hidden state that a restore misses (renormalised
 // quaternions, joint settings, contact data): a restored unit, and a fresh
 // unit restored from the same state, continue exactly like the original.
 TEST(ChassisUnit, SaveRestoreIsBitForBit) {
-  ChassisUnit u("robot", 4, 1);
-  Straddle(u);
+  auto robot = Straddle();
+  ChassisUnit& u = *robot;
   u.Initialize();
   Drive(u, 0, 50);
   const cosim::UnitState saved = u.SaveState();
   const auto first = Drive(u, 50, 150);
   u.RestoreState(saved);
   const auto second = Drive(u, 50, 150);
-  ChassisUnit fresh("robot", 4, 1);
+  auto fresh_robot = Straddle();
+  ChassisUnit& fresh = *fresh_robot;
   fresh.RestoreState(saved);
   const auto third = Drive(fresh, 50, 150);
   for (std::size_t k = 0; k < first.size(); ++k) {
@@ -399,7 +415,8 @@ TEST(ChassisUnit, SaveRestoreIsBitForBit) {
 // 3 each) for the body and 4 modules, and one integer; one saved before
 // Initialize holds no reals.
 TEST(ChassisUnit, RestoreRefusesTruncatedInternalState) {
-  ChassisUnit u("robot", 4, 0);
+  auto robot = Raw3();
+  ChassisUnit& u = *robot;
   const cosim::UnitState before_init = u.SaveState();
   ASSERT_TRUE(before_init.reals.empty());
   u.Initialize();
@@ -413,7 +430,8 @@ TEST(ChassisUnit, RestoreRefusesTruncatedInternalState) {
   cosim::UnitState reals_without_init = before_init;
   reals_without_init.reals = saved.reals;
   for (const auto* bad : {&short_reals, &no_integers, &reals_without_init}) {
-    ChassisUnit fresh("robot", 4, 0);
+    auto fresh_robot = Raw3();
+    ChassisUnit& fresh = *fresh_robot;
     try {
       fresh.RestoreState(*bad);
       ADD_FAILURE() << "restored a state of " << bad->reals.size() << " reals and "
@@ -423,7 +441,8 @@ TEST(ChassisUnit, RestoreRefusesTruncatedInternalState) {
       EXPECT_NE(what.find("unit 'robot' (chassis): saved state has"), std::string::npos) << what;
     }
   }
-  ChassisUnit fresh("robot", 4, 0);
+  auto fresh_robot = Raw3();
+  ChassisUnit& fresh = *fresh_robot;
   EXPECT_NO_THROW(fresh.RestoreState(saved));
   TimeNs t = 0;
   Advance(fresh, t, 10);
@@ -432,9 +451,8 @@ TEST(ChassisUnit, RestoreRefusesTruncatedInternalState) {
 // Guards against Initialize depending on what ran before it (the master may
 // call it several times).
 TEST(ChassisUnit, InitializeIsIdempotent) {
-  ChassisUnit once("robot", 4, 1), twice("robot", 4, 1);
-  Straddle(once);
-  Straddle(twice);
+  auto once_robot = Straddle(), twice_robot = Straddle();
+  ChassisUnit &once = *once_robot, &twice = *twice_robot;
   once.Initialize();
   twice.Initialize();
   Drive(twice, 0, 20);
@@ -453,25 +471,45 @@ TEST(ChassisUnit, InitializeIsIdempotent) {
 // propagates initial values skip the rebuild): a parameter changed between
 // two calls must still take effect, here the start position.
 TEST(ChassisUnit, InitializeAgainHonoursChangedParameters) {
-  ChassisUnit u("robot", 4, 0);
+  auto robot = Raw3();
+  ChassisUnit& u = *robot;
   u.Initialize();
   Set(u, "initial_x", 2.5);
   u.Initialize();
   const auto& v = u.variables();
-  EXPECT_EQ(v.GetRealElement(*v.Find("pose"), 0), 2.5);
+  EXPECT_EQ(v.GetRealElement(*v.Find("position"), 0), 2.5);
 }
 
 // ---------------------------------------------------------------------------
 // Errors.
 
+// Guards the contract "no robot-specific defaults": a unit built with no
+// parameters names every robot-specific one and refuses to initialise.
+TEST(ChassisUnit, RobotSpecificParametersHaveNoDefault) {
+  ChassisUnit u("robot", {0, 1, 2, 3}, {0, 1, 2, 3}, models::OpenFloor());
+  std::vector<std::string> names;
+  for (const auto& p : u.CheckParameters()) {
+    EXPECT_EQ(p.message, "must be set (robot-specific: no default)") << p.variable;
+    names.push_back(p.variable);
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"body_length", "body_width", "body_height", "mass",
+                                             "module_mass", "com_height", "wheel_radius",
+                                             "wheel_x", "wheel_y", "steer_rotor_inertia",
+                                             "drive_rotor_inertia"}));
+  EXPECT_THROW(u.Initialize(), cosim::UnitError);
+  // Without a steerable wheel there is no steering rotor to ask for.
+  ChassisUnit fixed("robot", {-1, -1}, {0, 1}, models::OpenFloor());
+  for (const auto& p : fixed.CheckParameters()) EXPECT_NE(p.variable, "steer_rotor_inertia");
+}
+
 // Guards against bad parameters reaching ODE: each is named with its index.
 TEST(ChassisUnit, CheckParametersRejectsBadValues) {
-  ChassisUnit u("robot", 4, 2);
+  auto robot = Raw3();
+  ChassisUnit& u = *robot;
   EXPECT_TRUE(u.CheckParameters().empty());
   Set(u, "mass", 15.0);  // 4 modules of 5 kg weigh more
-  Set(u, "wheel_radius", 0.0);
+  u.variables().SetRealElement(*u.variables().Find("wheel_radius"), 1, 0.0);
   Set(u, "substeps", std::int64_t{0});
-  u.variables().SetRealElement(*u.variables().Find("belt_width"), 1, -1.0);
   u.variables().SetRealElement(*u.variables().Find("wheel_x"), 2, std::nan(""));
   Set(u, "contact_stiffness", -1.0);
   const auto problems = u.CheckParameters();
@@ -479,35 +517,75 @@ TEST(ChassisUnit, CheckParametersRejectsBadValues) {
   for (const auto& p : problems) {
     names.push_back(p.variable + (p.index ? "[" + std::to_string(*p.index) + "]" : ""));
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"module_mass", "wheel_radius", "wheel_x[2]",
-                                             "contact_stiffness", "substeps", "belt_width[1]"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"module_mass", "wheel_radius[1]", "wheel_x[2]",
+                                             "contact_stiffness", "substeps"}));
   try {
     u.Initialize();
     ADD_FAILURE() << "Initialize accepted bad parameters";
   } catch (const cosim::UnitError& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("unit 'robot' (chassis)"), std::string::npos) << what;
-    EXPECT_NE(what.find("'belt_width[1]' must be positive and finite, got -1"), std::string::npos)
+    EXPECT_NE(what.find("'wheel_radius[1]' must be positive and finite, got 0"),
+              std::string::npos)
         << what;
   }
 }
 
-// Guards against structural sizes the unit cannot build.
-TEST(ChassisUnit, ConstructorChecksCounts) {
-  EXPECT_THROW(ChassisUnit("robot", 0, 1), cosim::UnitError);
-  EXPECT_THROW(ChassisUnit("robot", 4, -1), cosim::UnitError);
-  ChassisUnit no_belts("robot", 3, 0);
-  EXPECT_FALSE(no_belts.variables().Find("belt_velocity"));
-  EXPECT_FALSE(no_belts.variables().Find("belt_width"));
-  EXPECT_NO_THROW(no_belts.Initialize());
+// Guards against topologies and scenes the unit cannot build: each refusal
+// names the key and what was expected.
+TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
+  const auto problem = [](std::vector<int> steer, std::vector<int> drive) {
+    try {
+      ChassisUnit u("robot", std::move(steer), std::move(drive), models::OpenFloor());
+    } catch (const cosim::UnitError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(problem({}, {}).find("wheel_count"), std::string::npos);
+  EXPECT_NE(problem({0, 1}, {0}).find("drive_motor: expected one entry per wheel"),
+            std::string::npos);
+  EXPECT_NE(problem({0, -2}, {0, 1}).find("steer_motor[1]"), std::string::npos);
+  EXPECT_NE(problem({0, 0}, {0, 1}).find("already steers another wheel"), std::string::npos);
+  EXPECT_NE(problem({0, 2, 1}, {0, 1, 1}).find("share drive motor 1"), std::string::npos);
+  EXPECT_NE(problem({-1, -1}, {0, 2}).find("drive motor 1 drives no wheel"), std::string::npos);
+  EXPECT_NE(problem({1, -1}, {0, 1}).find("steering motor 0 steers no wheel"), std::string::npos);
+  EXPECT_EQ(problem({-1, -1, -1, -1}, {0, 0, 1, 1}), "");
+
+  models::Scene bad = test_robots::OneBelt({0.0, 5.0, 10.0, 1.0, 0.0});
+  bad.belts[0].surface = 7;
+  EXPECT_THROW(ChassisUnit("robot", {0}, {0}, bad), cosim::UnitError);
+  bad = models::OpenFloor();
+  bad.carried.push_back({"car", 0, {}});  // belt 0 of a scene with none
+  EXPECT_THROW(ChassisUnit("robot", {0}, {0}, bad), cosim::UnitError);
+
+  // Three modules and no belts: no belt inputs, and it builds and steps.
+  auto three = std::make_unique<ChassisUnit>("robot", std::vector<int>{0, 1, 2},
+                                             std::vector<int>{0, 1, 2}, models::OpenFloor());
+  EXPECT_FALSE(three->variables().Find("belt_velocity"));
+  EXPECT_FALSE(three->variables().Find("belt_travel"));
+  Set(*three, "body_length", 0.8);
+  Set(*three, "body_width", 0.6);
+  Set(*three, "body_height", 0.3);
+  Set(*three, "mass", 60.0);
+  Set(*three, "module_mass", 3.0);
+  Set(*three, "com_height", 0.12);
+  Set(*three, "wheel_radius", 0.08);
+  // Evenly on a circle of 0.3 m (made-up geometry for a build test).
+  Set(*three, "wheel_x", std::vector<double>{0.3, -0.15, -0.15});
+  Set(*three, "wheel_y", std::vector<double>{0.0, 0.26, -0.26});
+  Set(*three, "steer_rotor_inertia", 0.0);
+  Set(*three, "drive_rotor_inertia", 0.0);
+  EXPECT_NO_THROW(three->Initialize());
   TimeNs t = 0;
-  Advance(no_belts, t, 10);
+  Advance(*three, t, 10);
 }
 
 // Guards against non-finite inputs or states passing silently: DoStep
 // fails and names the variable.
 TEST(ChassisUnit, NonFiniteInputOrStateFails) {
-  ChassisUnit u("robot", 4, 1);
+  auto robot = Raw3FarBelt();
+  ChassisUnit& u = *robot;
   u.Initialize();
   SetArray(u, "drive_torque", {0.0, std::nan(""), 0.0, 0.0});
   EXPECT_EQ(u.DoStep(0, kMs), cosim::StepResult::kError);
@@ -518,10 +596,12 @@ TEST(ChassisUnit, NonFiniteInputOrStateFails) {
   EXPECT_EQ(u.DoStep(0, kMs), cosim::StepResult::kError);
   EXPECT_NE(u.last_error().find("non-finite"), std::string::npos) << u.last_error();
   // The torque reaches every body through the joints; ODE stops at the
-  // first it cannot normalise. The message names a body and its outputs.
+  // first it cannot normalise. The message names a body and its outputs
+  // by their current names.
   EXPECT_NE(u.last_error().find("ODE state went non-finite: position of"), std::string::npos)
       << u.last_error();
   EXPECT_NE(u.last_error().find("(outputs "), std::string::npos) << u.last_error();
+  EXPECT_EQ(u.last_error().find("pose"), std::string::npos) << u.last_error();
   // The unit refuses to go on until it is initialised again.
   EXPECT_EQ(u.DoStep(kMs, kMs), cosim::StepResult::kError);
   EXPECT_NE(u.last_error().find("needs Initialize or RestoreState"), std::string::npos)
@@ -532,60 +612,16 @@ TEST(ChassisUnit, NonFiniteInputOrStateFails) {
 }
 
 // ---------------------------------------------------------------------------
-// Guards against the interface drifting from what the loader and the other
-// units are written against.
-TEST(ChassisUnit, VariableTable) {
-  using C = cosim::Causality;
-  ChassisUnit u("robot", 4, 2);
-  EXPECT_EQ(u.type_name(), "chassis");
-  struct Expected {
-    const char* name;
-    C causality;
-    const char* unit;
-    std::size_t size;  // 0: scalar
-  };
-  const std::vector<Expected> expected = {{"body_length", C::kParameter, "m", 0},
-                                          {"body_width", C::kParameter, "m", 0},
-                                          {"body_height", C::kParameter, "m", 0},
-                                          {"mass", C::kParameter, "kg", 0},
-                                          {"module_mass", C::kParameter, "kg", 0},
-                                          {"com_height", C::kParameter, "m", 0},
-                                          {"wheel_radius", C::kParameter, "m", 0},
-                                          {"wheel_x", C::kParameter, "m", 4},
-                                          {"wheel_y", C::kParameter, "m", 4},
-                                          {"steer_rotor_inertia", C::kParameter, "kg.m2", 0},
-                                          {"drive_rotor_inertia", C::kParameter, "kg.m2", 0},
-                                          {"steer_friction", C::kParameter, "N.m.s/rad", 0},
-                                          {"drive_friction", C::kParameter, "N.m.s/rad", 0},
-                                          {"friction", C::kParameter, "1", 0},
-                                          {"contact_stiffness", C::kParameter, "N/m", 0},
-                                          {"contact_damping", C::kParameter, "N.s/m", 0},
-                                          {"slip_damping", C::kParameter, "N.s/m", 0},
-                                          {"suspension_stiffness", C::kParameter, "N/m", 0},
-                                          {"suspension_damping", C::kParameter, "N.s/m", 0},
-                                          {"brake_torque", C::kParameter, "N.m", 0},
-                                          {"substeps", C::kParameter, "", 0},
-                                          {"initial_x", C::kParameter, "m", 0},
-                                          {"initial_y", C::kParameter, "m", 0},
-                                          {"initial_yaw", C::kParameter, "rad", 0},
-                                          {"belt_center_x", C::kParameter, "m", 2},
-                                          {"belt_center_y", C::kParameter, "m", 2},
-                                          {"belt_length", C::kParameter, "m", 2},
-                                          {"belt_width", C::kParameter, "m", 2},
-                                          {"belt_direction", C::kParameter, "rad", 2},
-                                          {"steer_torque", C::kInput, "N.m", 4},
-                                          {"drive_torque", C::kInput, "N.m", 4},
-                                          {"belt_velocity", C::kInput, "m/s", 4},
-                                          {"brake", C::kInput, "", 0},
-                                          {"steer_angle", C::kOutput, "rad", 4},
-                                          {"steer_rate", C::kOutput, "rad/s", 4},
-                                          {"drive_rate", C::kOutput, "rad/s", 4},
-                                          {"pose", C::kOutput, "m", 3},
-                                          {"velocity", C::kOutput, "m/s", 3},
-                                          {"body_velocity", C::kOutput, "m/s", 3},
-                                          {"wheel_surface", C::kOutput, "1", 4},
-                                          {"wheel_surface_velocity", C::kOutput, "m/s", 8},
-                                          {"wheel_contact", C::kOutput, "m", 8}};
+// Guards against the interface drifting from the contract
+// (notes: signals, one unit of measure per variable).
+struct Expected {
+  const char* name;
+  cosim::Causality causality;
+  const char* unit;
+  std::size_t size;  // 0: scalar
+};
+
+void ExpectTable(const ChassisUnit& u, const std::vector<Expected>& expected) {
   ASSERT_EQ(u.variables().size(), expected.size());
   for (const Expected& e : expected) {
     const auto ref = u.variables().Find(e.name);
@@ -598,20 +634,97 @@ TEST(ChassisUnit, VariableTable) {
     if (e.size > 0) {
       EXPECT_EQ(info.type, cosim::VarType::kRealArray) << e.name;
       EXPECT_EQ(info.size, e.size) << e.name;
+    } else if (e.causality == cosim::Causality::kOutput) {
+      EXPECT_EQ(info.type, cosim::VarType::kReal) << e.name;
     }
     EXPECT_TRUE(info.depends_on.empty()) << e.name;
   }
 }
 
+std::vector<Expected> Parameters(std::size_t wheels) {
+  using C = cosim::Causality;
+  return {{"body_length", C::kParameter, "m", 0},
+          {"body_width", C::kParameter, "m", 0},
+          {"body_height", C::kParameter, "m", 0},
+          {"mass", C::kParameter, "kg", 0},
+          {"module_mass", C::kParameter, "kg", 0},
+          {"com_height", C::kParameter, "m", 0},
+          {"wheel_radius", C::kParameter, "m", wheels},
+          {"wheel_x", C::kParameter, "m", wheels},
+          {"wheel_y", C::kParameter, "m", wheels},
+          {"steer_rotor_inertia", C::kParameter, "kg.m2", 0},
+          {"drive_rotor_inertia", C::kParameter, "kg.m2", 0},
+          {"steer_friction", C::kParameter, "N.m.s/rad", 0},
+          {"drive_friction", C::kParameter, "N.m.s/rad", 0},
+          {"body_friction", C::kParameter, "1", 0},
+          {"contact_stiffness", C::kParameter, "N/m", 0},
+          {"contact_damping", C::kParameter, "N.s/m", 0},
+          {"slip_damping", C::kParameter, "N.s/m", 0},
+          {"suspension_stiffness", C::kParameter, "N/m", 0},
+          {"suspension_damping", C::kParameter, "N.s/m", 0},
+          {"brake_torque", C::kParameter, "N.m", 0},
+          {"substeps", C::kParameter, "", 0},
+          {"initial_x", C::kParameter, "m", 0},
+          {"initial_y", C::kParameter, "m", 0},
+          {"initial_yaw", C::kParameter, "rad", 0}};
+}
+
+TEST(ChassisUnit, VariableTable) {
+  using C = cosim::Causality;
+  // Swerve, two belts.
+  models::Scene two = test_robots::OneBelt({0.0, 5.0, 10.0, 1.0, 0.0});
+  two.belts.push_back(two.belts[0]);
+  auto robot = Raw3(two);
+  EXPECT_EQ(robot->type_name(), "chassis");
+  std::vector<Expected> expected = Parameters(4);
+  const std::vector<Expected> swerve = {{"steer_torque", C::kInput, "N.m", 4},
+                                        {"drive_torque", C::kInput, "N.m", 4},
+                                        {"belt_velocity", C::kInput, "m/s", 4},
+                                        {"belt_travel", C::kInput, "m", 2},
+                                        {"brake", C::kInput, "", 0},
+                                        {"steer_angle", C::kOutput, "rad", 4},
+                                        {"steer_rate", C::kOutput, "rad/s", 4},
+                                        {"drive_rate", C::kOutput, "rad/s", 4},
+                                        {"position", C::kOutput, "m", 2},
+                                        {"yaw", C::kOutput, "rad", 0},
+                                        {"linear_velocity", C::kOutput, "m/s", 2},
+                                        {"yaw_rate", C::kOutput, "rad/s", 0},
+                                        {"body_linear_velocity", C::kOutput, "m/s", 2},
+                                        {"wheel_surface", C::kOutput, "1", 4},
+                                        {"wheel_surface_velocity", C::kOutput, "m/s", 8},
+                                        {"wheel_contact", C::kOutput, "m", 8}};
+  expected.insert(expected.end(), swerve.begin(), swerve.end());
+  ExpectTable(*robot, expected);
+
+  // Skid-steer, no belts: no steer_* variables, one drive variable per motor.
+  auto husky = Husky(models::OpenFloor());
+  expected = Parameters(4);
+  const std::vector<Expected> skid = {{"drive_torque", C::kInput, "N.m", 2},
+                                      {"brake", C::kInput, "", 0},
+                                      {"drive_rate", C::kOutput, "rad/s", 2},
+                                      {"position", C::kOutput, "m", 2},
+                                      {"yaw", C::kOutput, "rad", 0},
+                                      {"linear_velocity", C::kOutput, "m/s", 2},
+                                      {"yaw_rate", C::kOutput, "rad/s", 0},
+                                      {"body_linear_velocity", C::kOutput, "m/s", 2},
+                                      {"wheel_surface", C::kOutput, "1", 4},
+                                      {"wheel_surface_velocity", C::kOutput, "m/s", 8},
+                                      {"wheel_contact", C::kOutput, "m", 8}};
+  expected.insert(expected.end(), skid.begin(), skid.end());
+  ExpectTable(*husky, expected);
+}
+
 // Guards against the model file using keys the unit does not have, values
-// it refuses, or values that differ from the defaults it documents.
+// it refuses, or values that differ from the Rob@Work 3 numbers the tests
+// use (tests/units/chassis/robots.h) or from the generic defaults.
 TEST(ChassisUnit, ModelFileMatchesParameters) {
   const auto path = std::filesystem::path(models::ModelsDir()) / "chassis" / "raw3_chassis.yaml";
   const YAML::Node root = YAML::LoadFile(path.string());
   ASSERT_TRUE(root.IsMap());
   EXPECT_TRUE(root["source"] && root["source"].IsScalar());
-  ChassisUnit defaults("robot", 4, 0);
-  ChassisUnit u("robot", 4, 0);
+  auto reference = Raw3();
+  ChassisUnit& defaults = *reference;
+  ChassisUnit u("robot", {0, 1, 2, 3}, {0, 1, 2, 3}, models::OpenFloor());
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();
     if (key == "source" || key == "description") continue;
@@ -626,7 +739,7 @@ TEST(ChassisUnit, ModelFileMatchesParameters) {
     } else {
       u.variables().SetValue(*ref, cosim::Value{kv.second.as<double>()});
     }
-    // Equal to the default up to the rounding of a decimal literal.
+    // Equal to the reference up to the rounding of a decimal literal.
     const cosim::Value got = u.variables().GetValue(*ref);
     const cosim::Value want = defaults.variables().GetValue(*ref);
     if (const auto* g = std::get_if<double>(&got)) {

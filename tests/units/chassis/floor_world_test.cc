@@ -51,7 +51,7 @@ TEST(FloorWorld, BoxOnBeltReachesBeltSpeedAfterCoulombTime) {
   // Contacts as the chassis defaults: stiff and well damped, so the box
   // does not rock on its corners (which would lighten the friction).
   f.SetSurface({mu, 1e6, 1e4});
-  f.SetBelts({{0.0, 0.0, 4.0, 1.0, 0.0}});
+  f.SetBelts({{0.0, 0.0, 4.0, 1.0, 0.0, mu}});
   f.SetBeltVelocity(0, belt_mps, 0.0);
   Box on_belt(f, 0.0, 0.0, 2.0, 0.2);
   Box on_floor(f, 0.0, 1.0, 2.0, 0.2);  // 0.5 m from the belt edge

@@ -1,0 +1,124 @@
+#pragma once
+
+// The robots and scenes the chassis tests build, with the source of each
+// number. The unit itself has no robot-specific defaults.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cosim/unit.h"
+#include "models/scene.h"
+#include "units/chassis/chassis_unit.h"
+
+namespace linesim::chassis::test_robots {
+
+// ---------------------------------------------------------------------------
+// Fraunhofer IPA Rob@Work 3 (paper 1 and the raw3-1 configuration).
+
+/// Total mass: paper 1, Table I.
+inline constexpr double kRaw3MassKg = 120.0;
+/// Module mass and centre-of-mass height: ASSUMPTIONS of
+/// models/chassis/raw3_chassis.yaml (wheel, two motors, gears, housing;
+/// batteries low).
+inline constexpr double kRaw3ModuleMassKg = 5.0;
+inline constexpr double kRaw3ComHeightM = 0.13;
+/// Body 1.03 x 0.57 x 0.40 m: paper 1, Table I.
+inline constexpr double kRaw3BodyM[3] = {1.03, 0.57, 0.40};
+/// Wheel radius and steering-axis positions: raw3-1 Platform.ini
+/// (ipa320/cob_robots).
+inline constexpr double kRaw3WheelRadiusM = 0.080;
+inline constexpr double kRaw3WheelXM[4] = {0.368, -0.368, -0.368, 0.368};
+inline constexpr double kRaw3WheelYM[4] = {0.186, 0.134, -0.186, -0.134};
+/// eta N^2 J_rotor: maxon RE 40 rotor 142 g.cm^2 (maxon datasheet) through
+/// the drive gear 21 at 0.75 and the steer belt 4 at 0.9
+/// (models/motors/raw3_drive.yaml, raw3_steer.yaml).
+inline constexpr double kRaw3DriveRotorKgm2 = 0.75 * 21.0 * 21.0 * 142e-7;
+inline constexpr double kRaw3SteerRotorKgm2 = 0.9 * 4.0 * 4.0 * 142e-7;
+
+// ---------------------------------------------------------------------------
+// Clearpath Husky A200 (husky_description URDF, Clearpath user manual).
+
+/// Wheel radius 0.1651 m (URDF).
+inline constexpr double kHuskyWheelRadiusM = 0.1651;
+/// Half wheelbase: wheelbase 0.512 m (URDF and manual).
+inline constexpr double kHuskyHalfBaseM = 0.256;
+/// Half track: wheel separation 0.5708 m (URDF).
+inline constexpr double kHuskyHalfTrackM = 0.2854;
+/// Base box 0.9874 x 0.5709 x 0.2475 m (URDF).
+inline constexpr double kHuskyBodyM[3] = {0.9874, 0.5709, 0.2475};
+/// Total 50 kg (manual spec table), 2.637 kg per wheel (URDF).
+inline constexpr double kHuskyMassKg = 50.0;
+inline constexpr double kHuskyWheelMassKg = 2.637;
+/// Box centre: its bottom at the 130 mm ground clearance (manual) plus half
+/// its height.
+inline constexpr double kHuskyComHeightM = 0.130 + 0.5 * 0.2475;
+/// Wheel contact mu 1.0 (URDF gazebo tags).
+inline constexpr double kHuskyMu = 1.0;
+
+inline void Set(cosim::Unit& u, const std::string& name, const cosim::Value& v) {
+  u.variables().SetValue(*u.variables().Find(name), v);
+}
+
+/// Rob@Work 3: four modules, each its own steering and drive motor.
+inline std::unique_ptr<ChassisUnit> Raw3(models::Scene scene = models::OpenFloor(),
+                                         const std::string& name = "robot") {
+  auto u = std::make_unique<ChassisUnit>(name, std::vector<int>{0, 1, 2, 3},
+                                         std::vector<int>{0, 1, 2, 3}, std::move(scene));
+  Set(*u, "body_length", kRaw3BodyM[0]);
+  Set(*u, "body_width", kRaw3BodyM[1]);
+  Set(*u, "body_height", kRaw3BodyM[2]);
+  Set(*u, "mass", kRaw3MassKg);
+  Set(*u, "module_mass", kRaw3ModuleMassKg);
+  Set(*u, "com_height", kRaw3ComHeightM);
+  Set(*u, "wheel_radius", kRaw3WheelRadiusM);
+  Set(*u, "wheel_x", std::vector<double>(kRaw3WheelXM, kRaw3WheelXM + 4));
+  Set(*u, "wheel_y", std::vector<double>(kRaw3WheelYM, kRaw3WheelYM + 4));
+  Set(*u, "steer_rotor_inertia", kRaw3SteerRotorKgm2);
+  Set(*u, "drive_rotor_inertia", kRaw3DriveRotorKgm2);
+  return u;
+}
+
+/// Husky A200: four fixed wheels, order front-left, rear-left, front-right,
+/// rear-right; the left pair on drive motor 0, the right pair on 1.
+inline std::unique_ptr<ChassisUnit> Husky(models::Scene scene, const std::string& name = "husky") {
+  auto u = std::make_unique<ChassisUnit>(name, std::vector<int>{-1, -1, -1, -1},
+                                         std::vector<int>{0, 0, 1, 1}, std::move(scene));
+  const double a = kHuskyHalfBaseM, b = kHuskyHalfTrackM;
+  Set(*u, "body_length", kHuskyBodyM[0]);
+  Set(*u, "body_width", kHuskyBodyM[1]);
+  Set(*u, "body_height", kHuskyBodyM[2]);
+  Set(*u, "mass", kHuskyMassKg);
+  Set(*u, "module_mass", kHuskyWheelMassKg);
+  Set(*u, "com_height", kHuskyComHeightM);
+  Set(*u, "wheel_radius", kHuskyWheelRadiusM);
+  Set(*u, "wheel_x", std::vector<double>{a, -a, a, -a});
+  Set(*u, "wheel_y", std::vector<double>{b, b, -b, -b});
+  // The gear-motor rotor is not published (ratio "about 79:1, not
+  // confirmed"): the tests leave it out; none of their steady states
+  // depends on an inertia.
+  Set(*u, "drive_rotor_inertia", 0.0);
+  return u;
+}
+
+/// An open floor of friction `mu` with no belts.
+inline models::Scene Floor(double mu) {
+  models::Scene s = models::OpenFloor();
+  s.surfaces[0].friction = mu;
+  return s;
+}
+
+/// An open floor (friction mu) with one belt `area` whose top has friction
+/// mu too (0.8: the chassis tests' wheel friction, raw3_chassis.yaml).
+inline models::Scene OneBelt(const models::Rect& area, double mu = 0.8) {
+  models::Scene s = Floor(mu);
+  s.surfaces.push_back({"belt", mu, 0.2, 500.0});
+  models::Belt belt;
+  belt.name = "belt";
+  belt.area = area;
+  belt.surface = 1;
+  s.belts.push_back(belt);
+  return s;
+}
+
+}  // namespace linesim::chassis::test_robots
