@@ -174,8 +174,8 @@ TEST(Husky, TurnsInPlaceAtTheCoulombRateWithTheCoulombTorque) {
   // same rim speed (here over a hundred times).
   EXPECT_GT(turn_torque, 100.0 * straight_torque);
   RecordProperty("turn_yaw_rate", std::to_string(turn_rate) + " vs " + std::to_string(omega));
-  RecordProperty("turn_torque", std::to_string(turn_torque) + " vs " +
-                                    std::to_string(2.0 * tau_wheel));
+  RecordProperty("turn_torque",
+                 std::to_string(turn_torque) + " vs " + std::to_string(2.0 * tau_wheel));
   RecordProperty("straight_torque", std::to_string(straight_torque));
 }
 
