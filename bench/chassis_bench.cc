@@ -50,26 +50,38 @@ constexpr double kBeltMps = 0.2;
 models::Scene FactoryScene(bool furniture) {
   models::Scene s = robots::OneBelt({0.0, 4.5, 40.0, 3.0, 0.0});
   if (!furniture) return s;
-  using Kind = models::Solid::Kind;
+  const auto box = [](double x, double y, double yaw, double length, double width, double bottom,
+                      double height) {
+    models::Solid b;
+    b.x_m = x;
+    b.y_m = y;
+    b.yaw_rad = yaw;
+    b.length_m = length;
+    b.width_m = width;
+    b.bottom_m = bottom;
+    b.height_m = height;
+    return b;
+  };
   for (int i = 0; i < 12; ++i) {
-    models::Solid pillar{Kind::kCylinder, -15.0 + 6.0 * (i % 6), i < 6 ? -6.0 : 12.0, 0.0,
-                         0.0, 0.0, 0.3, 0.0, 6.0};
+    models::Solid pillar;
+    pillar.kind = models::Solid::Kind::kCylinder;
+    pillar.x_m = -15.0 + 6.0 * (i % 6);
+    pillar.y_m = i < 6 ? -6.0 : 12.0;
+    pillar.radius_m = 0.3;
+    pillar.height_m = 6.0;
     s.obstacles.push_back({"pillar", "pillar", pillar});
   }
+  s.obstacles.push_back({"wall", "wall", box(0.0, -10.0, 0.0, 40.0, 0.2, 0.0, 4.0)});
+  s.obstacles.push_back({"wall", "wall", box(0.0, 15.0, 0.0, 40.0, 0.2, 0.0, 4.0)});
+  s.obstacles.push_back(
+      {"wall", "wall", box(-20.0, 2.5, std::numbers::pi / 2, 25.0, 0.2, 0.0, 4.0)});
+  s.obstacles.push_back(
+      {"wall", "wall", box(20.0, 2.5, std::numbers::pi / 2, 25.0, 0.2, 0.0, 4.0)});
   for (int i = 0; i < 4; ++i) {
-    const bool along_x = i < 2;
-    models::Solid wall{Kind::kBox, along_x ? 0.0 : (i == 2 ? -20.0 : 20.0),
-                       along_x ? (i == 0 ? -10.0 : 15.0) : 2.5, along_x ? 0.0 : std::numbers::pi / 2,
-                       40.0, 0.2, 0.0, 0.0, 4.0};
-    s.obstacles.push_back({"wall", "wall", wall});
-  }
-  for (int i = 0; i < 4; ++i) {
-    models::Solid rack{Kind::kBox, -9.0 + 6.0 * i, -3.5, 0.0, 2.0, 0.8, 0.0, 0.0, 2.0};
-    s.obstacles.push_back({"rack", "rack", rack});
+    s.obstacles.push_back({"rack", "rack", box(-9.0 + 6.0 * i, -3.5, 0.0, 2.0, 0.8, 0.0, 2.0)});
   }
   for (int i = 0; i < 3; ++i) {
-    models::Solid car{Kind::kBox, -12.0 + 8.0 * i, 4.5, 0.0, 4.5, 1.8, 0.0, 0.3, 1.2};
-    s.carried.push_back({"car", 0, car});
+    s.carried.push_back({"car", 0, box(-12.0 + 8.0 * i, 4.5, 0.0, 4.5, 1.8, 0.3, 1.2)});
   }
   return s;
 }
@@ -105,8 +117,7 @@ void Run(benchmark::State& state, ChassisUnit& unit, double belt_vx, double belt
       v.SetRealArray(drive, torque);
     }
     if (travel) {
-      v.SetRealArray(*travel,
-                     std::vector<double>{belt_mps * linesim::cosim::NsToSeconds(window)});
+      v.SetRealArray(*travel, std::vector<double>{belt_mps * linesim::cosim::NsToSeconds(window)});
     }
     if (unit.DoStep(window, kMs) != linesim::cosim::StepResult::kOk) {
       state.SkipWithError(unit.last_error().c_str());

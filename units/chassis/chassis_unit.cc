@@ -408,12 +408,11 @@ void ChassisUnit::Build() {
   std::vector<BeltPatch> belts;
   for (const models::Belt& belt : scene_.belts) {
     const models::Rect& r = belt.area;
-    belts.push_back({r.center_x_m, r.center_y_m, r.length_m, r.width_m, r.direction_rad,
-                     mu_of(belt.surface)});
+    belts.push_back(
+        {r.center_x_m, r.center_y_m, r.length_m, r.width_m, r.direction_rad, mu_of(belt.surface)});
   }
   f.SetBelts(std::move(belts));
-  f.SetSurface({mu_of(scene_.floor.surface), contact_stiffness_, contact_damping_,
-                slip_damping_});
+  f.SetSurface({mu_of(scene_.floor.surface), contact_stiffness_, contact_damping_, slip_damping_});
   for (const models::Obstacle& obstacle : scene_.obstacles) f.AddObstacle(obstacle.solid);
   for (const models::CarriedObject& obj : scene_.carried) f.AddCarried(obj.solid, obj.belt);
 
@@ -543,9 +542,9 @@ void ChassisUnit::ApplyTorques() {
     const double rel[3] = {ww[0] - wb[0], ww[1] - wb[1], ww[2] - wb[2]};
     const int sm = steer_motor_[k];
     const auto dm = static_cast<unsigned>(drive_motor_[k]);
-    const double steer = sm >= 0 ? steer_torque_[static_cast<std::size_t>(sm)] -
-                                       steer_friction_ * Dot(up, rel)
-                                 : 0.0;
+    const double steer =
+        sm >= 0 ? steer_torque_[static_cast<std::size_t>(sm)] - steer_friction_ * Dot(up, rel)
+                : 0.0;
     double drive = -drive_friction_ * Dot(axle, rel);
     if ((driven & (std::uint64_t{1} << dm)) == 0) {
       driven |= std::uint64_t{1} << dm;
@@ -647,8 +646,8 @@ std::string ChassisUnit::NonFiniteState() const {
     const int sm = steer_motor_[k];
     const std::string d = std::to_string(drive_motor_[k]);
     return "wheel " + std::to_string(k) + " (outputs " +
-           (sm >= 0 ? "steer_angle[" + std::to_string(sm) + "], steer_rate[" +
-                          std::to_string(sm) + "], "
+           (sm >= 0 ? "steer_angle[" + std::to_string(sm) + "], steer_rate[" + std::to_string(sm) +
+                          "], "
                     : std::string()) +
            "drive_rate[" + d + "], wheel_contact[" + std::to_string(2 * k) + "])";
   };

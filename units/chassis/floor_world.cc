@@ -177,9 +177,8 @@ void FloorWorld::CollideObjects(double erp, double cfm) {
     const Aabb& r = near_region_;
     if (!(r[0] <= body[0] && body[1] <= r[1] && r[2] <= body[2] && body[3] <= r[3] &&
           r[4] <= body[4] && body[5] <= r[5])) {
-      near_region_ = {body[0] - kNearMarginM, body[1] + kNearMarginM,
-                      body[2] - kNearMarginM, body[3] + kNearMarginM,
-                      body[4] - kNearMarginM, body[5] + kNearMarginM};
+      near_region_ = {body[0] - kNearMarginM, body[1] + kNearMarginM, body[2] - kNearMarginM,
+                      body[3] + kNearMarginM, body[4] - kNearMarginM, body[5] + kNearMarginM};
       near_obstacles_.clear();
       for (std::size_t i = 0; i < obstacles_.size(); ++i) {
         if (Overlap(obstacle_aabbs_[i], near_region_)) near_obstacles_.push_back(i);
@@ -326,9 +325,8 @@ void FloorWorld::MakeJoints(std::size_t i, double erp, double cfm) {
     const bool sliding = slip_mps > kSlipAlignMps;
     p.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP | dContactMotion1 |
                      dContactMotion2 | dContactFDir1 | (sliding ? dContactSlip2 : 0);
-    p.surface.mu = pts.surface[j] > 0
-                       ? belts_[static_cast<std::size_t>(pts.surface[j] - 1)].mu
-                       : surface_.mu;
+    p.surface.mu =
+        pts.surface[j] > 0 ? belts_[static_cast<std::size_t>(pts.surface[j] - 1)].mu : surface_.mu;
     p.surface.slip2 = 1.0 / surface_.slip_damping_n_s_per_m;
     p.surface.soft_erp = erp;
     p.surface.soft_cfm = cfm;

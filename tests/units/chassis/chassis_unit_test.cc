@@ -492,10 +492,10 @@ TEST(ChassisUnit, RobotSpecificParametersHaveNoDefault) {
     EXPECT_EQ(p.message, "must be set (robot-specific: no default)") << p.variable;
     names.push_back(p.variable);
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"body_length", "body_width", "body_height", "mass",
-                                             "module_mass", "com_height", "wheel_radius",
-                                             "wheel_x", "wheel_y", "steer_rotor_inertia",
-                                             "drive_rotor_inertia"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"body_length", "body_width", "body_height", "mass",
+                                      "module_mass", "com_height", "wheel_radius", "wheel_x",
+                                      "wheel_y", "steer_rotor_inertia", "drive_rotor_inertia"}));
   EXPECT_THROW(u.Initialize(), cosim::UnitError);
   // Without a steerable wheel there is no steering rotor to ask for.
   ChassisUnit fixed("robot", {-1, -1}, {0, 1}, models::OpenFloor());
@@ -525,8 +525,7 @@ TEST(ChassisUnit, CheckParametersRejectsBadValues) {
   } catch (const cosim::UnitError& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("unit 'robot' (chassis)"), std::string::npos) << what;
-    EXPECT_NE(what.find("'wheel_radius[1]' must be positive and finite, got 0"),
-              std::string::npos)
+    EXPECT_NE(what.find("'wheel_radius[1]' must be positive and finite, got 0"), std::string::npos)
         << what;
   }
 }
@@ -699,17 +698,13 @@ TEST(ChassisUnit, VariableTable) {
   // Skid-steer, no belts: no steer_* variables, one drive variable per motor.
   auto husky = Husky(models::OpenFloor());
   expected = Parameters(4);
-  const std::vector<Expected> skid = {{"drive_torque", C::kInput, "N.m", 2},
-                                      {"brake", C::kInput, "", 0},
-                                      {"drive_rate", C::kOutput, "rad/s", 2},
-                                      {"position", C::kOutput, "m", 2},
-                                      {"yaw", C::kOutput, "rad", 0},
-                                      {"linear_velocity", C::kOutput, "m/s", 2},
-                                      {"yaw_rate", C::kOutput, "rad/s", 0},
-                                      {"body_linear_velocity", C::kOutput, "m/s", 2},
-                                      {"wheel_surface", C::kOutput, "1", 4},
-                                      {"wheel_surface_velocity", C::kOutput, "m/s", 8},
-                                      {"wheel_contact", C::kOutput, "m", 8}};
+  const std::vector<Expected> skid = {
+      {"drive_torque", C::kInput, "N.m", 2},  {"brake", C::kInput, "", 0},
+      {"drive_rate", C::kOutput, "rad/s", 2}, {"position", C::kOutput, "m", 2},
+      {"yaw", C::kOutput, "rad", 0},          {"linear_velocity", C::kOutput, "m/s", 2},
+      {"yaw_rate", C::kOutput, "rad/s", 0},   {"body_linear_velocity", C::kOutput, "m/s", 2},
+      {"wheel_surface", C::kOutput, "1", 4},  {"wheel_surface_velocity", C::kOutput, "m/s", 8},
+      {"wheel_contact", C::kOutput, "m", 8}};
   expected.insert(expected.end(), skid.begin(), skid.end());
   ExpectTable(*husky, expected);
 }

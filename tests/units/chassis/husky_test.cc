@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <vector>
 
@@ -67,7 +69,7 @@ TEST(Husky, WheelsOfASideTurnTogether) {
   EXPECT_EQ(Get(u, "wheel_surface"), (std::vector<double>{1.0, 0.0, 1.0, 0.0}));
   SetArray(u, "belt_velocity", {0.0, 0.3});
   TimeNs t = 0;
-  double max_rate = 0.0;
+  double max_rate = 0.0, max_difference = 0.0;
   for (int i = 0; i < 1500; ++i) {
     const double s = std::sin(0.01 * i);
     SetArray(u, "drive_torque", {8.0 * s, -3.0});
@@ -77,7 +79,14 @@ TEST(Husky, WheelsOfASideTurnTogether) {
     EXPECT_EQ(Get(u, "drive_rate")[0], u.WheelRate(0));
     EXPECT_EQ(Get(u, "drive_rate")[1], u.WheelRate(2));
     max_rate = std::max(max_rate, std::abs(u.WheelRate(1)));
+    max_difference = std::max({max_difference, std::abs(u.WheelRate(0) - u.WheelRate(1)),
+                               std::abs(u.WheelRate(2) - u.WheelRate(3))});
   }
+  RecordProperty("max_rate_difference", [&] {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.3g", max_difference);
+    return std::string(b);
+  }());
   EXPECT_GT(max_rate, 1.0);  // the uncoupled-side wheel did turn
 }
 
@@ -98,6 +107,11 @@ TEST(Husky, DrivesStraightAtTheRimSpeed) {
     StepOk(u, t);
   }
   EXPECT_NEAR(Get(u, "body_linear_velocity")[0], 0.5, 0.005);
+  RecordProperty("speed", [&] {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.7f", Get(u, "body_linear_velocity")[0]);
+    return std::string(b);
+  }());
   EXPECT_NEAR(Get(u, "body_linear_velocity")[1], 0.0, 1e-4);
   EXPECT_NEAR(Get(u, "yaw_rate")[0], 0.0, 1e-4);
   EXPECT_NEAR(Get(u, "position")[1], 0.0, 1e-3);
@@ -174,8 +188,8 @@ TEST(Husky, TurnsInPlaceAtTheCoulombRateWithTheCoulombTorque) {
   // same rim speed (here over a hundred times).
   EXPECT_GT(turn_torque, 100.0 * straight_torque);
   RecordProperty("turn_yaw_rate", std::to_string(turn_rate) + " vs " + std::to_string(omega));
-  RecordProperty("turn_torque", std::to_string(turn_torque) + " vs " +
-                                    std::to_string(2.0 * tau_wheel));
+  RecordProperty("turn_torque",
+                 std::to_string(turn_torque) + " vs " + std::to_string(2.0 * tau_wheel));
   RecordProperty("straight_torque", std::to_string(straight_torque));
 }
 
