@@ -34,10 +34,11 @@ models::Scene AddScene(SystemBuilder& b) {
     scene["belts"] = merged;
   }
   b.out()["scene"] = scene;
-  // The scene as the system loader will read it (its problems are
-  // reported once, there).
-  YamlReader quiet(r.file());
-  return ReadScenarioScene(quiet, scene, r.file());
+  // The scene as the system loader will read it; its problems are reported
+  // now, at the keys the user wrote (the expansion stops on them, so they
+  // are not reported twice).
+  r.SetOrigins(b.origins());
+  return ReadScenarioScene(r, scene, r.file());
 }
 
 void AddLine(SystemBuilder& b, const models::Scene& scene, Signals& s) {

@@ -81,14 +81,29 @@ TEST(RobotScenario, ControllerAndChassisShareGeometryAndMotorData) {
     EXPECT_EQ(Param(s, "wheel_controller", "wheel_x", k), Param(s, "chassis", "wheel_x", k));
     EXPECT_EQ(Param(s, "wheel_controller", "wheel_y", k), Param(s, "chassis", "wheel_y", k));
   }
-  EXPECT_EQ(Param(s, "wheel_controller", "wheel_radius"), 0.08);  // raw3_chassis.yaml
-  std::ifstream in(kCross);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string f = WriteScenario(
-      "robot_radius.yaml", text + "units:\n  chassis:\n    parameters: {wheel_radius: 0.08}\n");
-  const Scenario t = LoadScenario(f, {"units.chassis.parameters.wheel_radius=0.1"});
-  EXPECT_EQ(Param(t, "chassis", "wheel_radius"), 0.1);
+  EXPECT_EQ(Param(s, "wheel_controller", "wheel_radius"), 0.08);  // models/robots/raw3.yaml
+  // The robot description is the one source of the geometry: a robot file
+  // with other wheels changes the chassis and the controller together.
+  std::ifstream in(LINESIM_SOURCE_DIR "/models/robots/raw3.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (std::size_t at = text.find("radius_m: 0.080"); at != std::string::npos;
+       at = text.find("radius_m: 0.080")) {
+    text.replace(at, 15, "radius_m: 0.1");
+  }
+  const std::string model = WriteScenario("raw3_big_wheels.yaml", text);
+  const Scenario t = LoadScenario(kCross, {"robot.model=" + model});
+  EXPECT_EQ(Param(t, "chassis", "wheel_radius", 3), 0.1);
   EXPECT_EQ(Param(t, "wheel_controller", "wheel_radius"), 0.1);
+  // A unit's own parameter changes that unit alone: a controller whose
+  // model of the robot is wrong (here by 25 % in the wheel radius).
+  std::ifstream cross(kCross);
+  const std::string scenario((std::istreambuf_iterator<char>(cross)),
+                             std::istreambuf_iterator<char>());
+  const std::string f = WriteScenario(
+      "robot_radius.yaml", scenario + "units:\n  chassis:\n    parameters: {wheel_radius: 0.08}\n");
+  const Scenario u = LoadScenario(f, {"units.chassis.parameters.wheel_radius=0.1"});
+  EXPECT_EQ(Param(u, "chassis", "wheel_radius", 2), 0.1);
+  EXPECT_EQ(Param(u, "wheel_controller", "wheel_radius"), 0.08);
 }
 
 // Guards robots as data: the Husky (models/robots/husky.yaml) is built on

@@ -211,14 +211,14 @@ TEST(LoadScenario, NanParameterIsRefused) {
                   "units.motor.parameters.inductance.0 (set on the command line): expected a "
                   "number, got '.nan'"))
       << all;
-  // A Real (not array) parameter: the chassis's friction, in a robot scenario.
+  // A Real (not array) parameter: the chassis's brake torque, in a robot scenario.
   std::ifstream in(LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml");
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string g = WriteScenario(
-      "nan_robot.yaml", text + "units:\n  chassis:\n    parameters: {friction: 0.7}\n");
-  const std::string robot = Issues(g, {"units.chassis.parameters.friction=.nan"});
+      "nan_robot.yaml", text + "units:\n  chassis:\n    parameters: {brake_torque: 20}\n");
+  const std::string robot = Issues(g, {"units.chassis.parameters.brake_torque=.nan"});
   EXPECT_TRUE(Has(robot,
-                  "units.chassis.parameters.friction (set on the command line): expected a "
+                  "units.chassis.parameters.brake_torque (set on the command line): expected a "
                   "number, got '.nan'"))
       << robot;
 }
