@@ -1,7 +1,7 @@
 // Cost of one ChassisUnit communication step (1 ms, one ODE dWorldStep).
 //
-// Rob@Work 3 (four hinge2 modules, sphere wheels; FACTS.md: 5.3 us per step
-// for this variant in a stand-alone program) on the floor and straddling
+// Rob@Work 3 (four hinge2 modules, sphere wheels; 5.3 us per step for this
+// variant in a stand-alone reference program on this machine kind) on the floor and straddling
 // the edge of a running belt (the two front wheels on it), with drive
 // torques. Each simulated second starts from the state saved after
 // Initialize (restored with the timing paused): +2 N.m on every wheel for

@@ -34,7 +34,7 @@ class RobotPlotsTest : public ::testing::Test {
   // A synthetic run in the recorder's format: a Rob@Work-3-sized robot
   // crossing a belt along +y over 30 s, recorded every 10 ms (3001 rows, the
   // size the brief asks to plot quickly), wheels at the raw3-1 steering axes
-  // (FACTS.md), a belt that runs from 0 to 10 s and ramps up at 0.5 m/s^2.
+  // (docs/references.md), a belt that runs from 0 to 10 s and ramps up at 0.5 m/s^2.
   void WriteSignals(double speed_mps = 0.1) const {
     std::ofstream out(dir_ / "signals.csv");
     out << "time,chassis.pose[0],chassis.pose[1],chassis.pose[2]";

@@ -108,7 +108,7 @@ TEST(Paper1Scenarios, HoldOnBeltHoldsWithCompensation) {
 // yaw, see the chassis tests): the nominal robot both drifts, about half of
 // v/k since half of the wheels push, and turns; the compensated one holds
 // position and heading. Headings from the geometry: the belt-side and
-// floor-side wheel rows are 0.32 m apart (raw3_chassis.yaml wheel_y: 0.186
+// floor-side wheel rows are 0.32 m apart (models/robots/raw3.yaml y_m: 0.186
 // + 0.134 m), so a displacement d of one row against the other turns the
 // robot by d / 0.32 m. Compensated: the 5 mm final position bound (as on
 // the belt) at one row alone would be 0.016 rad; we ask 0.01 rad. Nominal:

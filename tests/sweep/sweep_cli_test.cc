@@ -172,7 +172,7 @@ TEST(SweepCli, OneMpiRankRunsAloneAndRanksWithOtherModelFilesAreRefused) {
   const fs::path models = Temp("models_copy");
   fs::remove_all(models);
   fs::copy(LINESIM_SOURCE_DIR "/models", models, fs::copy_options::recursive);
-  std::ofstream(models / "chassis" / "raw3_chassis.yaml", std::ios::app) << "\n# edited\n";
+  std::ofstream(models / "robots" / "raw3.yaml", std::ios::app) << "\n# edited\n";
   const std::string dir = Fresh("mpi_mismatch");
   const Result m = Exec({"mpirun",
                          "--allow-run-as-root",

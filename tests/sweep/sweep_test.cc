@@ -340,7 +340,7 @@ TEST(SweepFingerprint, ChangesWithTheSweepTheScenarioAndTheModelFiles) {
   fs::copy(LINESIM_SOURCE_DIR "/models", models, fs::copy_options::recursive);
   setenv("LINESIM_MODELS_DIR", models.c_str(), 1);
   const std::string copied = SweepFingerprint(spec);
-  { std::ofstream(models / "chassis" / "raw3_chassis.yaml", std::ios::app) << "\n# edited\n"; }
+  { std::ofstream(models / "robots" / "raw3.yaml", std::ios::app) << "\n# edited\n"; }
   const std::string edited = SweepFingerprint(spec);
   unsetenv("LINESIM_MODELS_DIR");
   EXPECT_EQ(copied, base);

@@ -30,10 +30,10 @@ struct WheelSetpoint {
   double drive_rate_rad_s = 0.0;
 };
 
-/// The wheel set point for a contact velocity (the flip rule of the IPA
-/// controller, FACTS.md). Two candidates reach the same velocity: heading
-/// atan2(v_y, v_x) rolling forward at |v| / R, or that heading + pi rolling
-/// backward. The one minimising
+/// The wheel set point for a contact velocity (the flip rule of IPA's
+/// cob_control, docs/references.md). Two candidates reach the same
+/// velocity: heading atan2(v_y, v_x) rolling forward at |v| / R, or that
+/// heading + pi rolling backward. The one minimising
 ///   0.6 |wrap(a - angle_now)| + 0.4 |wrap(a - last_target)|
 /// wins (ties go to rolling forward), so a wheel at its last target never
 /// turns more than 90 deg: it reverses instead; the second term keeps a

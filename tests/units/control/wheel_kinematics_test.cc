@@ -13,11 +13,11 @@ namespace linesim::control {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kRadiusM = 0.08;  // Rob@Work 3 wheel (FACTS.md)
+constexpr double kRadiusM = 0.08;  // Rob@Work 3 wheel (raw3-1 Platform.ini, docs/references.md)
 
 double Deg(double d) { return d * kPi / 180.0; }
 
-// Rob@Work 3 steering axes W1..W4 (FACTS.md, raw3-1 Platform.ini).
+// Rob@Work 3 steering axes W1..W4 (raw3-1 Platform.ini, docs/references.md).
 const std::array<Eigen::Vector2d, 4> kWheels = {
     Eigen::Vector2d(0.368, 0.186), Eigen::Vector2d(-0.368, 0.134), Eigen::Vector2d(-0.368, -0.186),
     Eigen::Vector2d(0.368, -0.134)};
@@ -71,7 +71,7 @@ TEST(CompensateSurface, SubtractsTheSurfaceVelocity) {
 }
 
 // Guards against the flip rule turning a wheel 180 deg for a command behind
-// it instead of reversing the drive (FACTS.md, IPA controller).
+// it instead of reversing the drive (IPA cob_control, docs/references.md).
 TEST(ToWheelSetpoint, CommandBehindTheWheelReversesTheDrive) {
   const WheelSetpoint s = ToWheelSetpoint({-0.4, 0.0}, kRadiusM, 0.0, 0.0, 1e-3);
   EXPECT_NEAR(s.steer_angle_rad, 0.0, 1e-15);

@@ -686,7 +686,7 @@ class RigidLoad : public cosim::Unit {
 };
 
 TEST(DcMotorUnit, CurrentOnlyInALoopThroughTheMasterFollowsFullModel) {
-  // A quarter of the 120 kg Rob@Work 3 on an 80 mm wheel (FACTS.md): m r^2.
+  // A quarter of the 120 kg Rob@Work 3 on an 80 mm wheel (paper 1, Table I; raw3-1 Platform.ini): m r^2.
   const double j_wheel = 30.0 * 0.08 * 0.08;
   Motor m;
   m.n = 21.0;
