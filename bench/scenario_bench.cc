@@ -55,5 +55,6 @@ LINESIM_SCENARIO(cross_line, "cross_line.yaml");
 LINESIM_SCENARIO(cross_line_nominal, "cross_line.yaml", "control.compensation=false");
 LINESIM_SCENARIO(hold_on_belt, "hold_on_belt.yaml");
 LINESIM_SCENARIO(hold_straddle, "hold_straddle.yaml");
+LINESIM_SCENARIO(husky_floor_path, "husky_floor_path.yaml");
 
 }  // namespace

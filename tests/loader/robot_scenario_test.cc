@@ -399,5 +399,28 @@ TEST(RobotScenario, UnitsSectionOverridesExpandedParameters) {
   EXPECT_TRUE(Has(e, "units.chassis.parameters.brake_torqe")) << e;
 }
 
+// Guards one unit of measure per variable: the chassis's yaw (rad) feeds
+// the path follower's yaw input (rad), which the expansion does; the same
+// yaw into a position input (m) is refused by the unit-of-measure check,
+// naming both ends and both units.
+TEST(RobotScenario, YawInRadiansConnectsOnlyToRadianInputs) {
+  const Scenario s = LoadScenario(kCross);
+  bool yaw_to_follower = false;
+  for (const auto& c : s.system->connections()) {
+    yaw_to_follower |= c.from.ToString() == "chassis.yaw" && c.to.ToString() == "path_follower.yaw";
+  }
+  EXPECT_TRUE(yaw_to_follower);
+  std::ifstream in(kCross);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string f = WriteScenario(
+      "robot_yaw_to_metres.yaml",
+      text + "units:\n  probe:\n    type: path_deviation\n    parameters: {path: [[0, 0]]}\n"
+             "connections:\n  - {from: chassis.yaw, to: \"probe.position[0]\"}\n");
+  const std::string e = Issues(f);
+  EXPECT_TRUE(Has(e, "connections.0")) << e;
+  EXPECT_TRUE(Has(e, "rad")) << e;
+  EXPECT_TRUE(Has(e, "'m'") || Has(e, " m ")) << e;
+}
+
 }  // namespace
 }  // namespace linesim::loader
