@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <numbers>
 #include <utility>
 
@@ -20,23 +22,33 @@ PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
       velocity_command_(2, 0.0) {
   if (mode_ == Mode::kPath) cumulative_m_ = models::CumulativeLengths(waypoints_m_);
   auto& v = variables();
-  v.Parameter("speed", "m/s", &speed_, "cruise speed along the path");
+  using cosim::Rule;
+  v.Parameter("speed", "m/s", &speed_, "cruise speed along the path", Rule::Positive());
   v.Parameter("acceleration", "m/s2", &acceleration_,
-              "along-path ramp up from the start and down before the goal");
+              "along-path ramp up from the start and down before the goal (and, differential "
+              "base, before a sharp corner)",
+              Rule::Positive());
   // Named heading, not yaw: `yaw` is the measured heading input.
   v.Parameter("heading", "rad", &yaw_,
-              "heading to hold in map while translating (omnidirectional base only)");
-  v.Parameter("k_cross", "1/s", &k_cross_, "cross-track gain");
+              "heading to hold in map while translating (omnidirectional base only)",
+              Rule::Finite());
+  // Gains of 0 switch a feedback off; they only have to be finite and >= 0.
+  v.Parameter("k_cross", "1/s", &k_cross_, "cross-track gain", Rule::NonNegative());
   v.Parameter("k_position", "1/s", &k_position_,
-              "position gain: along-track near the goal, and in hold mode");
-  v.Parameter("k_yaw", "1/s", &k_yaw_, "heading gain");
-  v.Parameter("max_speed", "m/s", &max_speed_, "limit on the commanded translation speed");
-  v.Parameter("max_yaw_rate", "rad/s", &max_yaw_rate_, "limit on the commanded yaw rate");
+              "position gain: along-track near the goal, and in hold mode", Rule::Positive());
+  v.Parameter("k_yaw", "1/s", &k_yaw_, "heading gain", Rule::NonNegative());
+  v.Parameter("max_speed", "m/s", &max_speed_, "limit on the commanded translation speed",
+              Rule::Positive());
+  v.Parameter("max_yaw_rate", "rad/s", &max_yaw_rate_, "limit on the commanded yaw rate",
+              Rule::NonNegative());
   v.Parameter("goal_tolerance", "m", &goal_tolerance_,
-              "distance from the goal (hold: the point) counted as arrived");
+              "distance from the goal (hold: the point) counted as arrived", Rule::Positive());
   if (base_ == Base::kDifferential) {
+    // Below pi/2: at pi/2 the robot would drive across its path.
     v.Parameter("turn_in_place_angle", "rad", &turn_in_place_angle_,
-                "heading error beyond which the robot stops and turns in place");
+                "heading error beyond which the robot stops and turns in place; a path corner "
+                "turning more than this is sharp (the robot stops at it)",
+                Rule::Range(0.0, true, 0.5 * std::numbers::pi, false));
   }
   v.Input("position", "m", &position_, "x, y of base_link in map");
   v.Input("yaw", "rad", &yaw_measured_, "heading of base_link in map");
@@ -89,29 +101,77 @@ std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
       c.Add({"waypoints", k, "repeats the previous waypoint (zero-length segment)"});
     }
   }
-  c.Positive("speed", speed_);
-  c.Positive("acceleration", acceleration_);
-  c.Finite("heading", yaw_);
-  c.NonNegative("k_cross", k_cross_);
-  c.Positive("k_position", k_position_);
-  c.NonNegative("k_yaw", k_yaw_);
-  c.Positive("max_speed", max_speed_);
-  c.NonNegative("max_yaw_rate", max_yaw_rate_);
-  c.Positive("goal_tolerance", goal_tolerance_);
-  if (base_ == Base::kDifferential) {
-    c.Check(
-        "turn_in_place_angle", turn_in_place_angle_,
-        [](double a) { return a >= 0.0 && a < 0.5 * std::numbers::pi; },
-        "must be in [0, pi/2) rad (at pi/2 the robot would drive across its path)");
-  }
-  return c.Take();
+  // The waypoints are no table parameter: checked here. Every single-value
+  // rule is declared with its parameter (Unit::CheckParameters walks them).
+  auto problems = c.Take();
+  for (auto& p : Unit::CheckParameters()) problems.push_back(std::move(p));
+  return problems;
 }
 
 void PathFollowerUnit::Initialize() {
   ThrowIfBadParameters();
   ramp_mps_ = 0.0;
   done_latched_ = false;
-  ComputeOutputs(FindNearest());
+  active_segment_ = 0;
+  const models::PolylinePoint n = FindNearest();
+  if (SavesSegment() && n.found) active_segment_ = n.segment;
+  ComputeOutputs(n);
+}
+
+bool PathFollowerUnit::SharpCorner(std::size_t k) const {
+  const auto& w = waypoints_m_;
+  const double in = std::atan2(w[k][1] - w[k - 1][1], w[k][0] - w[k - 1][0]);
+  const double out = std::atan2(w[k + 1][1] - w[k][1], w[k + 1][0] - w[k][0]);
+  return std::abs(models::WrapAngle(out - in)) > turn_in_place_angle_;
+}
+
+PathFollowerUnit::OnSegment PathFollowerUnit::ProjectOnSegment(std::size_t i) const {
+  const auto& a = waypoints_m_[i];
+  const double length = cumulative_m_[i + 1] - cumulative_m_[i];
+  const double tx = (waypoints_m_[i + 1][0] - a[0]) / length;
+  const double ty = (waypoints_m_[i + 1][1] - a[1]) / length;
+  const double dx = position_[0] - a[0], dy = position_[1] - a[1];
+  return {length - (tx * dx + ty * dy), tx * dy - ty * dx};
+}
+
+double PathFollowerUnit::ToSharpCorner(const OnSegment& on) const {
+  for (std::size_t k = active_segment_ + 1; k + 1 < waypoints_m_.size(); ++k) {
+    if (SharpCorner(k)) return cumulative_m_[k] - cumulative_m_[active_segment_ + 1] + on.to_end_m;
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+PathFollowerUnit::Sample PathFollowerUnit::EvaluateDifferentialPath(
+    const models::PolylinePoint& n) const {
+  Sample s;
+  const auto& goal = waypoints_m_.back();
+  s.at_goal = done_latched_ ||
+              std::hypot(position_[0] - goal[0], position_[1] - goal[1]) <= goal_tolerance_;
+  if (!n.found) return s;
+  s.progress_m = n.progress_m;
+  s.cross_track_m = n.cross_track_m;
+  if (s.at_goal) return s;
+  const std::size_t i = active_segment_;
+  const OnSegment on = ProjectOnSegment(i);
+  const double remaining = length_m() - s.progress_m;
+  const double corner = ToSharpCorner(on);
+  const double magnitude = std::min(
+      {ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * std::abs(remaining)),
+       k_position_ * std::abs(remaining), std::sqrt(2.0 * acceleration_ * std::max(corner, 0.0))});
+  const double length = cumulative_m_[i + 1] - cumulative_m_[i];
+  const double tx = (waypoints_m_[i + 1][0] - waypoints_m_[i][0]) / length;
+  const double ty = (waypoints_m_[i + 1][1] - waypoints_m_[i][1]) / length;
+  const double direction = std::copysign(1.0, remaining);
+  // a = sgn(r) t speed - n k_cross e, n = (-ty, tx).
+  const double aim_x = direction * tx * speed_ + ty * k_cross_ * on.cross_track_m;
+  const double aim_y = direction * ty * speed_ - tx * k_cross_ * on.cross_track_m;
+  const double h = models::WrapAngle(std::atan2(aim_y, aim_x) - yaw_measured_);
+  s.yaw_rate_rad_s = std::clamp(k_yaw_ * h, -max_yaw_rate_, max_yaw_rate_);
+  if (std::abs(h) > turn_in_place_angle_) return s;  // turn in place: the ramp starts again
+  const double cos_h = std::cos(h);
+  s.along_mps = direction * magnitude * cos_h;
+  s.forward_mps = direction * std::min(magnitude * cos_h, max_speed_);
+  return s;
 }
 
 models::PolylinePoint PathFollowerUnit::FindNearest() const {
@@ -123,6 +183,7 @@ models::PolylinePoint PathFollowerUnit::FindNearest() const {
 }
 
 PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const models::PolylinePoint& n) const {
+  if (base_ == Base::kDifferential && mode_ == Mode::kPath) return EvaluateDifferentialPath(n);
   Sample s;
   const double x = position_[0], y = position_[1];
   if (mode_ == Mode::kHold) {
@@ -224,23 +285,50 @@ cosim::StepResult PathFollowerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   // restarts gently after a slow-down.
   ramp_mps_ = std::min(speed_, std::abs(s.along_mps) + acceleration_ * cosim::NsToSeconds(dt));
   if (mode_ == Mode::kPath && s.at_goal) done_latched_ = true;
+  if (base_ == Base::kDifferential && mode_ == Mode::kPath) {
+    // The rule on progress: the robot has reached the end of the active
+    // segment (where the sqrt profile before a sharp corner ends; sampled,
+    // it gets within acceleration T^2 in finite time), or the nearest path
+    // point lies beyond it. Never back: no flipping between segments.
+    const double reached = acceleration_ * cosim::NsToSeconds(dt) * cosim::NsToSeconds(dt);
+    while (active_segment_ + 2 < waypoints_m_.size() &&
+           (ProjectOnSegment(active_segment_).to_end_m <= reached ||
+            (n.found && n.segment > active_segment_ &&
+             n.progress_m > cumulative_m_[active_segment_ + 1]))) {
+      ++active_segment_;
+    }
+  }
   ComputeOutputs(n);
   return cosim::StepResult::kOk;
+}
+
+bool PathFollowerUnit::SavesSegment() const {
+  return base_ == Base::kDifferential && mode_ == Mode::kPath;
 }
 
 void PathFollowerUnit::SaveInternal(cosim::UnitState& state) const {
   state.reals = {ramp_mps_};
   state.integers = {done_latched_ ? 1 : 0};
+  if (SavesSegment()) state.integers.push_back(static_cast<std::int64_t>(active_segment_));
 }
 
 void PathFollowerUnit::RestoreInternal(const cosim::UnitState& state) {
-  if (state.reals.size() != 1 || state.integers.size() != 1) {
+  const std::size_t integers = SavesSegment() ? 2 : 1;
+  if (state.reals.size() != 1 || state.integers.size() != integers) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
-                           " integers, expected 1 and 1");
+                           " integers, expected 1 and " + std::to_string(integers));
   }
   ramp_mps_ = state.reals[0];
   done_latched_ = state.integers[0] != 0;
+  if (SavesSegment()) {
+    const std::int64_t segment = state.integers[1];
+    if (segment < 0 || static_cast<std::size_t>(segment) + 1 >= waypoints_m_.size()) {
+      throw cosim::UnitError(Where() + ": saved active segment " + std::to_string(segment) +
+                             " is not a segment of the path");
+    }
+    active_segment_ = static_cast<std::size_t>(segment);
+  }
 }
 
 }  // namespace linesim::control

@@ -36,25 +36,53 @@ namespace linesim::control {
 /// max_yaw_rate, and the velocity is rotated into base_link by -yaw (the
 /// measured heading input).
 ///
-/// Differential base: velocity_command = [v, 0], and the yaw rate steers
-/// the heading psi onto the direction of a desired map velocity d:
-///   path: d = t * v_along - n * k_cross e (as above, before clamping),
-///         always driven forward; where d = 0 short of the goal (the ramp
-///         at 0 at the start, on the path) the direction of t towards the
-///         goal is aimed at instead, so the robot turns before it starts;
+/// Differential base: velocity_command = [v, 0]; the yaw rate steers the
+/// heading psi onto an aim direction, and v drives along it.
+///
+///   path: the robot follows one committed segment at a time, the ACTIVE
+///         segment i (state; at Initialize the nearest one). With t_i its
+///         unit tangent, n_i its left normal and e_i the signed distance
+///         from its line (+ left), the aim is
+///           a = sgn(r) t_i speed - n_i k_cross e_i,
+///         r the distance left along the path to the goal (nearest point,
+///         as above; past the goal the robot backs up by turning round).
+///         The aim never vanishes, and its direction depends on the active
+///         segment only, not on which segment is nearest: no flipping when
+///         the commanded speed is small (at the start, at a corner), and at
+///         a corner the robot turns onto the next tangent, not across it.
+///         At cruise the heading error is atan(k_cross e / speed) and the
+///         cross-track error obeys e'' + k_yaw e' + k_yaw k_cross e = 0
+///         (linearised; slower at lower speed, never less damped); with
+///         k_yaw >= 4 k_cross it is not oscillatory.
+///         Along-track speed: the ramp and the goal as above, and, for a
+///         SHARP corner (an interior waypoint whose heading change exceeds
+///         turn_in_place_angle, where the robot must turn in place),
+///           |v_along| <= sqrt(2 acceleration D),
+///         D the distance along the path from the projection on the active
+///         segment to the next sharp corner: the robot stops AT the corner
+///         (in finite time; sampled at period T it passes it by at most
+///         acceleration T^2 / 2) instead of arriving at full speed. Gentle
+///         corners (heading change <= turn_in_place_angle) are driven
+///         through without slowing (cos h >= cos turn_in_place_angle).
+///         Segment switch (a rule on progress, committed in DoStep): the
+///         next segment becomes active when the distance left along the
+///         active one is <= acceleration T^2 (the robot has reached its
+///         end: where the sqrt profile ends) or the nearest path point lies
+///         beyond its end; never back.
 ///   hold: d = -k_position (p - p_ref), driven forward or backward,
 ///         whichever heading is nearer (so a small correction never turns
-///         the robot round); zero within goal_tolerance.
-/// With h = wrap(atan2(d) - psi) (backward: wrap(atan2(-d) - psi)):
+///         the robot round); zero within goal_tolerance; the aim is d.
+/// With h = wrap(atan2(aim) - psi) (hold backward: wrap(atan2(-d) - psi)):
 ///   |h| > turn_in_place_angle: v = 0 (turn in place: at the start and at
-///                              sharp waypoint corners),
-///   otherwise:                 v = +-|d| cos h,
+///                              sharp corners),
+///   otherwise:                 path v = sgn(r) |v_along| cos h,
+///                              hold v = +-|d| cos h,
 ///   yaw rate = k_yaw h, clamped to max_yaw_rate; |v| clamped to max_speed.
-/// The along-track ramp continues from v_along cos h (0 while turning in
-/// place), so the robot accelerates gently out of every corner. The
-/// `heading` parameter is unused. At |h| <= turn_in_place_angle < pi/2 the robot
-/// heads towards the path; near it the cross-track error obeys
-/// e'' + k_yaw e' + k_yaw k_cross e = 0 (linearised, v_along > 0).
+/// The along-track ramp continues from |v_along| cos h (0 while turning in
+/// place), so the robot accelerates gently out of every corner. At a sharp
+/// corner the robot stops, turns in place with a yaw rate of one sign
+/// (h decays as (1 - k_yaw T)^k, no overshoot for k_yaw T < 1) and drives
+/// on. The `heading` parameter is unused.
 class PathFollowerUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "path_follower";
@@ -113,6 +141,22 @@ class PathFollowerUnit : public cosim::Unit {
   /// The differential base's steering of the heading onto the direction of
   /// the desired map velocity in s (see the class comment).
   void SteerDifferential(Sample& s) const;
+  /// The differential base in path mode (see the class comment).
+  Sample EvaluateDifferentialPath(const models::PolylinePoint& n) const;
+  /// Differential path: the robot's projection on segment i, as the
+  /// distance left to its end and the signed distance from its line.
+  struct OnSegment {
+    double to_end_m = 0.0, cross_track_m = 0.0;
+  };
+  OnSegment ProjectOnSegment(std::size_t i) const;
+  /// Differential path: the distance along the path from the projection on
+  /// the active segment to the next sharp corner (infinity: none ahead).
+  double ToSharpCorner(const OnSegment& on) const;
+  /// Whether interior waypoint k turns the path by more than
+  /// turn_in_place_angle (the robot must stop there and turn in place).
+  bool SharpCorner(std::size_t k) const;
+  /// Whether the saved state holds the active segment (differential path).
+  bool SavesSegment() const;
   void ComputeOutputs(const models::PolylinePoint& n);
 
   Mode mode_;
@@ -146,9 +190,12 @@ class PathFollowerUnit : public cosim::Unit {
   double progress_ = 0.0;
   bool done_ = false;
 
-  // State: the along-track speed the ramp allows at this sample, and done.
+  // State: the along-track speed the ramp allows at this sample, and done;
+  // differential path: the active segment (saved only for that base, so
+  // the omnidirectional state is unchanged).
   double ramp_mps_ = 0.0;
   bool done_latched_ = false;
+  std::size_t active_segment_ = 0;
 };
 
 }  // namespace linesim::control
