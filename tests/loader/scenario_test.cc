@@ -6,7 +6,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "loader/unit_types.h"
+#include "loader/config_names.h"
 #include "models/dc_motor_params.h"
 #include "scenario_test.h"
 
