@@ -11,10 +11,10 @@
 #include <nlohmann/json.hpp>
 
 #include "app/console.h"
+#include "config/unit_registry.h"
 #include "cosim/files.h"
 #include "cosim/observers.h"
 #include "loader/scenario.h"
-#include "loader/unit_types.h"
 #include "plots/robot_plots.h"
 
 namespace linesim::app {
@@ -95,7 +95,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   loader::Scenario s;
   try {
     s = loader::LoadScenario(file, set_args);
-  } catch (const loader::ScenarioError& e) {
+  } catch (const config::ScenarioError& e) {
     PrintIssues(e, "scenario", std::cerr);
     return kExitBadInput;
   }
@@ -223,7 +223,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
 int InspectCommand(const std::string& what, const std::vector<std::string>& set_args) {
   // A type name first: a file or folder of that name where linesim runs
   // (inspect chassis from inside units/) does not hide the type.
-  const loader::UnitType* type = loader::FindUnitType(what);
+  const config::UnitType* type = config::FindUnitType(what);
   std::error_code ec;
   const bool is_file =
       !type && (fs::exists(what, ec) || what.ends_with(".yaml") || what.ends_with(".yml"));
@@ -233,13 +233,13 @@ int InspectCommand(const std::string& what, const std::vector<std::string>& set_
       return kExitBadInput;
     }
     if (!type) {
-      std::cerr << "linesim: " << loader::UnknownTypeMessage(what) << "\n";
+      std::cerr << "linesim: " << config::UnknownTypeMessage(what) << "\n";
       return kExitBadInput;
     }
     std::unique_ptr<cosim::Unit> unit;
     try {
       unit = loader::CreateDefaultUnit(*type);
-    } catch (const loader::ScenarioError& e) {
+    } catch (const config::ScenarioError& e) {
       std::cerr << "linesim: " << e.what() << "\n";
       return kExitBadInput;
     }
@@ -259,7 +259,7 @@ int InspectCommand(const std::string& what, const std::vector<std::string>& set_
   loader::Scenario s;
   try {
     s = loader::LoadScenario(what, set_args);
-  } catch (const loader::ScenarioError& e) {
+  } catch (const config::ScenarioError& e) {
     PrintIssues(e, "scenario", std::cerr);
     return kExitBadInput;
   }

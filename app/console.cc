@@ -6,7 +6,7 @@
 
 namespace linesim::app {
 
-void PrintIssues(const loader::ScenarioError& e, const std::string& what, std::ostream& out) {
+void PrintIssues(const config::ScenarioError& e, const std::string& what, std::ostream& out) {
   out << "linesim: the " << what << " is refused (" << e.issues().size()
       << (e.issues().size() == 1 ? " problem" : " problems") << "):\n";
   for (const auto& i : e.issues()) out << "  " << i.ToString() << "\n";

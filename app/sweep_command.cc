@@ -15,7 +15,7 @@
 
 #include "app/commands.h"
 #include "app/console.h"
-#include "loader/scenario_error.h"
+#include "config/scenario_error.h"
 #include "sweep/executor.h"
 #include "sweep/mpi_sweep.h"
 #include "sweep/progress.h"
@@ -118,7 +118,7 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
   try {
     spec = sweep::LoadSweepSpec(args.file);
     fingerprint = sweep::SweepFingerprint(spec);
-  } catch (const loader::ScenarioError& e) {
+  } catch (const config::ScenarioError& e) {
     PrintIssues(e, "sweep", problems);
     status = kExitBadInput;
   }

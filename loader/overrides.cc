@@ -6,7 +6,7 @@
 #include <optional>
 #include <string_view>
 
-#include "loader/yaml_reader.h"
+#include "loader/config_names.h"
 
 namespace linesim::loader {
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "loader/scenario_error.h"
+#include "loader/config_names.h"
 
 namespace linesim::loader {
 

@@ -5,7 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "loader/yaml_reader.h"
+#include "loader/config_names.h"
 #include "models/robot_description.h"
 
 namespace linesim::loader {

@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "loader/yaml_reader.h"
+#include "loader/config_names.h"
 
 namespace linesim::loader {
 

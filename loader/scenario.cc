@@ -6,10 +6,9 @@
 
 #include "cosim/closest_names.h"
 #include "cosim/seed.h"
+#include "loader/config_names.h"
 #include "loader/scene_file.h"
-#include "loader/unit_types.h"
 #include "loader/yaml_files.h"
-#include "loader/yaml_reader.h"
 
 namespace linesim::loader {
 

@@ -11,9 +11,9 @@
 #include "cosim/master.h"
 #include "cosim/observers.h"
 #include "cosim/system.h"
+#include "loader/config_names.h"
 #include "loader/overrides.h"
 #include "loader/robot_scenario.h"
-#include "loader/scenario_error.h"
 #include "models/scene.h"
 
 namespace linesim::loader {
@@ -59,7 +59,6 @@ cosim::TimeNs ReadMasterStep(YamlReader& r, const YAML::Node& master);
 /// after its type (for `linesim inspect TYPE`); throws ScenarioError with the
 /// closest type names when the type is unknown.
 std::unique_ptr<cosim::Unit> CreateDefaultUnit(const std::string& type);
-struct UnitType;
 /// The same for a type already looked up (FindUnitType).
 std::unique_ptr<cosim::Unit> CreateDefaultUnit(const UnitType& type);
 

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "loader/yaml_reader.h"
+#include "loader/config_names.h"
 #include "models/scene.h"
 
 namespace linesim::loader {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "loader/yaml_reader.h"
+#include "loader/config_names.h"
 
 namespace linesim::loader {
 

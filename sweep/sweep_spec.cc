@@ -10,22 +10,22 @@
 #include <limits>
 #include <optional>
 
+#include "config/yaml_reader.h"
 #include "cosim/system.h"
 #include "cosim/variable_table.h"
 #include "loader/scenario.h"
 #include "loader/yaml_files.h"
-#include "loader/yaml_reader.h"
 #include "sweep/results_file.h"
 
 namespace linesim::sweep {
 
 namespace fs = std::filesystem;
-using loader::Child;
-using loader::Describe;
-using loader::Issue;
-using loader::JoinPath;
-using loader::ScenarioError;
-using loader::YamlReader;
+using config::Child;
+using config::Describe;
+using config::Issue;
+using config::JoinPath;
+using config::ScenarioError;
+using config::YamlReader;
 
 namespace {
 
@@ -56,7 +56,7 @@ std::optional<std::size_t> FirstRepeat(const std::vector<std::string>& items) {
 }
 
 // Finite numbers only: an infinite bound would make NaN or inf values.
-const loader::Range kFinite{std::numeric_limits<double>::lowest(),
+const config::Range kFinite{std::numeric_limits<double>::lowest(),
                             std::numeric_limits<double>::max()};
 
 void ReadRange(const YAML::Node& range, const std::string& path, YamlReader& r, ParameterSpec& p) {
@@ -104,7 +104,7 @@ void ReadRandom(const YAML::Node& random, const std::string& path, YamlReader& r
   } else if (d == "uniform" || d == "log_uniform") {
     r.CheckKeys(random, path, {"distribution", "min", "max"});
     p.distribution = d == "uniform" ? Distribution::kUniform : Distribution::kLogUniform;
-    const loader::Range range = d == "uniform" ? kFinite : loader::Range{0, kFinite.max, true};
+    const config::Range range = d == "uniform" ? kFinite : config::Range{0, kFinite.max, true};
     p.a = r.Real(random, path, "min", std::nullopt, range);
     p.b = r.Real(random, path, "max", std::nullopt, range);
     if (r.ok() && !(p.b >= p.a)) {
@@ -436,7 +436,7 @@ SweepSpec LoadSweepSpec(const std::string& file) {
       r.Error(metrics[i], "metrics." + std::to_string(i),
               "'" + spec.metrics[i] + "' is not a metric of " + spec.scenario +
                   (defined.empty() ? " (it defines none)"
-                                   : "; it defines: " + loader::JoinNames(defined)));
+                                   : "; it defines: " + config::JoinNames(defined)));
     }
   }
   if (const auto i = FirstRepeat(spec.metrics); i && metrics.IsDefined()) {

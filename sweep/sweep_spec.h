@@ -68,7 +68,7 @@ std::vector<std::string> FixedOverrides(const SweepSpec& spec);
 
 /// Reads and checks a sweep file, and that its base scenario loads with the
 /// fixed settings, every parameter path exists in it and every metric is
-/// one it defines. Throws loader::ScenarioError listing every problem (file,
+/// one it defines. Throws config::ScenarioError listing every problem (file,
 /// line, key path, what was expected).
 SweepSpec LoadSweepSpec(const std::string& file);
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "cosim/time.h"
-#include "loader/yaml_reader.h"
+#include "loader/config_names.h"
 
 /// The assembly of a robot scenario into a system-level tree: a builder the
 /// concerns add units and connections to, and the names of the units the

@@ -2,11 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 
-#include "loader/unit_types.h"
+#include "loader/config_names.h"
 #include "models/dc_motor_params.h"
 #include "scenario_test.h"
 
@@ -416,6 +417,17 @@ TEST(UnitTypes, EveryTypeBuildsWithDefaults) {
     EXPECT_GT(unit->variables().size(), 0u);
   }
   EXPECT_THROW(CreateDefaultUnit("dc_motorr"), ScenarioError);
+}
+
+// Guards the whole-archive link of the families' registrations: a program
+// that links only the loader knows every type, in the names' order.
+TEST(UnitTypes, EveryFamilyRegistersItsTypes) {
+  for (const char* name : {"belt", "chassis", "dc_motor", "diff_drive_controller", "path_deviation",
+                           "path_follower", "step_signal", "wheel_controller"}) {
+    EXPECT_NE(FindUnitType(name), nullptr) << name;
+  }
+  const std::vector<std::string> names = UnitTypeNames();
+  EXPECT_TRUE(std::is_sorted(names.begin(), names.end()));
 }
 
 }  // namespace

@@ -10,7 +10,7 @@
 #include <set>
 #include <sstream>
 
-#include "loader/scenario_error.h"
+#include "config/scenario_error.h"
 #include "sweep/executor.h"
 #include "sweep/progress.h"
 #include "sweep/results_file.h"
@@ -53,7 +53,7 @@ std::string BeltSweep(const std::string& extra = "") {
 std::vector<std::string> IssueTexts(const std::string& file) {
   try {
     LoadSweepSpec(file);
-  } catch (const loader::ScenarioError& e) {
+  } catch (const config::ScenarioError& e) {
     std::vector<std::string> out;
     for (const auto& i : e.issues()) out.push_back(i.ToString());
     return out;

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
+#include "config/scenario_error.h"
 #include "cosim/time.h"
-#include "loader/scenario_error.h"
 
-namespace linesim::loader {
+namespace linesim::config {
 
 /// "a.b" + "c" -> "a.b.c".
 std::string JoinPath(const std::string& path, const std::string& key);
@@ -136,4 +136,4 @@ YAML::Node Child(const YAML::Node& map, const std::string& key);
 /// A short rendering of a node for messages: the scalar, or "a map"/"a list".
 std::string Describe(const YAML::Node& node);
 
-}  // namespace linesim::loader
+}  // namespace linesim::config

@@ -1,6 +1,6 @@
-#include "loader/scenario_error.h"
+#include "config/scenario_error.h"
 
-namespace linesim::loader {
+namespace linesim::config {
 
 std::string Issue::ToString() const {
   std::string out = file;
@@ -22,4 +22,4 @@ std::string Join(const std::vector<Issue>& issues) {
 ScenarioError::ScenarioError(std::vector<Issue> issues)
     : std::runtime_error(Join(issues)), issues_(std::move(issues)) {}
 
-}  // namespace linesim::loader
+}  // namespace linesim::config

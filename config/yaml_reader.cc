@@ -1,10 +1,10 @@
-#include "loader/yaml_reader.h"
+#include "config/yaml_reader.h"
 
 #include <cmath>
 
 #include "cosim/closest_names.h"
 
-namespace linesim::loader {
+namespace linesim::config {
 
 std::string JoinPath(const std::string& path, const std::string& key) {
   return path.empty() ? key : path + "." + key;
@@ -277,4 +277,4 @@ std::string YamlReader::String(const YAML::Node& map, const std::string& path,
   return *s;
 }
 
-}  // namespace linesim::loader
+}  // namespace linesim::config

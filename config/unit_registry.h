@@ -2,6 +2,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -9,11 +11,11 @@
 #include <string_view>
 #include <vector>
 
+#include "config/yaml_reader.h"
 #include "cosim/unit.h"
-#include "loader/yaml_reader.h"
 #include "models/scene.h"
 
-namespace linesim::loader {
+namespace linesim::config {
 
 /// What a unit type's factory gets: the instance name, its seed, and the
 /// unit's `parameters` map for the structural keys that shape the variable
@@ -46,10 +48,30 @@ struct UnitType {
   std::function<std::unique_ptr<cosim::Unit>(const UnitBuildContext&)> create;
 };
 
+/// Adds a type to the registry (kept sorted by name). Called during static
+/// initialization by each family's registration file, through a
+/// UnitTypeRegistrar; a name registered twice aborts the program.
+void RegisterUnitType(UnitType type);
+
+/// `const config::UnitTypeRegistrar kRegistrar({...});` at namespace scope
+/// of a family's registration file registers the type when the program
+/// starts. The family library must be linked whole (see linesim_unit_family
+/// in the top-level CMakeLists.txt), or the linker drops the object.
+struct UnitTypeRegistrar {
+  explicit UnitTypeRegistrar(UnitType type) { RegisterUnitType(std::move(type)); }
+};
+
+/// Every registered type, sorted by name.
 const std::vector<UnitType>& UnitTypes();
 const UnitType* FindUnitType(std::string_view name);
 std::vector<std::string> UnitTypeNames();
 /// "unknown unit type 'x' (closest: ...); known types: a, b".
 std::string UnknownTypeMessage(const std::string& name);
 
-}  // namespace linesim::loader
+/// For factories: a list of points [x, y] at `key` (at least `min_points`
+/// of them); one point at the origin when the unit has no parameters at all
+/// (`linesim inspect TYPE`).
+std::vector<std::array<double, 2>> ReadPoints(const UnitBuildContext& c, const std::string& key,
+                                              std::size_t min_points);
+
+}  // namespace linesim::config

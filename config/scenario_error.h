@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-namespace linesim::loader {
+namespace linesim::config {
 
 /// One thing wrong with a scenario: where (file, line, key path) and what
 /// (the bad value and what was expected).
@@ -32,4 +32,4 @@ class ScenarioError : public std::runtime_error {
   std::vector<Issue> issues_;
 };
 
-}  // namespace linesim::loader
+}  // namespace linesim::config

@@ -1,8 +1,8 @@
-#include "loader/yaml_reader.h"
+#include "config/yaml_reader.h"
 
 #include <gtest/gtest.h>
 
-namespace linesim::loader {
+namespace linesim::config {
 namespace {
 
 bool Has(const std::string& text, const std::string& part) {
@@ -37,4 +37,4 @@ TEST(YamlReader, TimeIsWholeNanosecondsAndRefusesWhatTheyCannotHold) {
 }
 
 }  // namespace
-}  // namespace linesim::loader
+}  // namespace linesim::config
