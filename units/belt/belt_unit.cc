@@ -6,8 +6,6 @@
 #include <random>
 #include <utility>
 
-#include "cosim/parameter_checks.h"
-
 namespace linesim::belt {
 
 BeltUnit::BeltUnit(std::string name, int belt_count, std::vector<std::vector<Switch>> schedules,
@@ -62,17 +60,23 @@ BeltUnit::BeltUnit(std::string name, int belt_count, std::vector<std::vector<Swi
 
   auto& v = variables();
   v.Parameter("direction", "rad", &direction_,
-              "direction of motion in the map frame, counter-clockwise from x");
-  v.Parameter("nominal_speed", "m/s", &nominal_speed_, "speed while on before the variation (> 0)");
+              "direction of motion in the map frame, counter-clockwise from x",
+              cosim::Rule::Finite());
+  v.Parameter("nominal_speed", "m/s", &nominal_speed_, "speed while on before the variation",
+              cosim::Rule::Positive());
   v.Parameter("initially_on", "1", &initially_on_,
-              "1 if on before the first switch of the schedule, else 0");
+              "1 if on before the first switch of the schedule, else 0 (nothing in between)",
+              cosim::Rule::Range(0, 1));
   v.Parameter("speed_variation", "1", &speed_variation_,
-              "amplitude of the slow speed variation as a fraction of speed, in [0, 0.5]");
+              "amplitude of the slow speed variation as a fraction of speed",
+              cosim::Rule::Range(0, 0.5));
   v.Parameter("variation_period", "s", &variation_period_,
               "time scale of the speed variation: its three sinusoids have periods of about "
-              "0.6, 1 and 1.4 times this");
+              "0.6, 1 and 1.4 times this",
+              cosim::Rule::Positive());
   v.Parameter("acceleration", "m/s2", &acceleration_,
-              "slew limit of the speed: a start or stop takes nominal_speed / acceleration");
+              "slew limit of the speed: a start or stop takes nominal_speed / acceleration",
+              cosim::Rule::Positive());
 
   v.Output("velocity", "m/s", &velocity_,
            "surface velocity in the map frame: vx, vy of belt 0, then of belt 1, ...", {});
@@ -110,28 +114,28 @@ BeltUnit::BeltUnit(std::string name, const std::vector<models::Belt>& belts, std
 }
 
 std::vector<cosim::ParameterProblem> BeltUnit::CheckParameters() const {
-  cosim::ParameterChecks c;
-  c.Finite("direction", direction_);
-  c.Positive("nominal_speed", nominal_speed_);
-  c.Check(
-      "initially_on", initially_on_, [](double x) { return x == 0.0 || x == 1.0; },
-      "must be 0 (off) or 1 (on)");
-  c.Check(
-      "speed_variation", speed_variation_, [](double x) { return x >= 0.0 && x <= 0.5; },
-      "must be in [0, 0.5]");
-  c.Positive("variation_period", variation_period_);
-  c.Positive("acceleration", acceleration_);
+  // The declared rules, then what a rule cannot say: initially_on is 0 or 1
+  // (its rule [0, 1] reports the rest), and each schedule (structural, not a
+  // parameter) switches at increasing times.
+  auto problems = cosim::Unit::CheckParameters();
+  for (std::size_t b = 0; b < initially_on_.size(); ++b) {
+    const double x = initially_on_[b];
+    if (x > 0.0 && x < 1.0) {
+      problems.push_back(
+          {"initially_on", b, "must be 0 (off) or 1 (on), got " + cosim::FormatValue(x)});
+    }
+  }
   for (std::size_t b = 0; b < schedules_.size(); ++b) {
     const auto& s = schedules_[b];
     for (std::size_t i = 1; i < s.size(); ++i) {
       if (s[i].time <= s[i - 1].time) {
-        c.Add({"schedules." + std::to_string(b), i,
-               "switch times must increase, got " + cosim::FormatSeconds(s[i].time) + " s after " +
-                   cosim::FormatSeconds(s[i - 1].time) + " s"});
+        problems.push_back({"schedules." + std::to_string(b), i,
+                            "switch times must increase, got " + cosim::FormatSeconds(s[i].time) +
+                                " s after " + cosim::FormatSeconds(s[i - 1].time) + " s"});
       }
     }
   }
-  return c.Take();
+  return problems;
 }
 
 double BeltUnit::VariationSignal(int b, cosim::TimeNs t) const {

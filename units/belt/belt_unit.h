@@ -52,9 +52,9 @@ class BeltUnit : public cosim::Unit {
   /// scene's. Throws cosim::UnitError if `belts` is empty.
   BeltUnit(std::string name, const std::vector<models::Belt>& belts, std::uint64_t seed);
 
-  /// Every parameter value out of range, with the belt index; a schedule
-  /// whose times do not increase is reported as variable "schedules.<belt>"
-  /// with the index of the offending switch.
+  /// The declared rules (with the belt index), an initially_on between 0
+  /// and 1, and a schedule whose times do not increase, reported as variable
+  /// "schedules.<belt>" with the index of the offending switch.
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
   void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
   /// Validates the parameters (throws cosim::UnitError listing every

@@ -9,7 +9,6 @@
 #include <numbers>
 #include <utility>
 
-#include "cosim/parameter_checks.h"
 #include "models/angle.h"
 #include "units/chassis/floor_world.h"
 
@@ -233,56 +232,80 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
 
   auto& v = variables();
   v.Parameter("body_length", "m", &body_length_,
-              "body box length along base_link x (inertia and collision with objects)");
+              "body box length along base_link x (inertia and collision with objects)",
+              cosim::Rule::Positive().NoDefault());
   v.Parameter("body_width", "m", &body_width_,
-              "body box width along base_link y (inertia and collision with objects)");
+              "body box width along base_link y (inertia and collision with objects)",
+              cosim::Rule::Positive().NoDefault());
   v.Parameter("body_height", "m", &body_height_,
-              "body box height, centred on com_height (inertia and collision with objects)");
-  v.Parameter("mass", "kg", &mass_, "total mass: body box plus all wheels");
+              "body box height, centred on com_height (inertia and collision with objects)",
+              cosim::Rule::Positive().NoDefault());
+  v.Parameter("mass", "kg", &mass_, "total mass: body box plus all wheels",
+              cosim::Rule::Positive().NoDefault());
   v.Parameter("module_mass", "kg", &module_mass_,
-              "mass of one wheel: a steered module (wheel, motors, housing) or a fixed wheel");
+              "mass of one wheel: a steered module (wheel, motors, housing) or a fixed wheel",
+              cosim::Rule::Positive().NoDefault());
   v.Parameter("com_height", "m", &com_height_,
-              "height of the body box's centre of mass above the floor (wheels excluded)");
-  v.Parameter("wheel_radius", "m", &wheel_radius_,
-              "radius of each wheel (sphere contact geometry)");
+              "height of the body box's centre of mass above the floor (wheels excluded)",
+              cosim::Rule::Positive().NoDefault());
+  v.Parameter("wheel_radius", "m", &wheel_radius_, "radius of each wheel (sphere contact geometry)",
+              cosim::Rule::Positive().NoDefault());
   v.Parameter("wheel_x", "m", &wheel_x_,
-              "x in base_link of each wheel's steering axis (fixed wheel: axle centre)");
+              "x in base_link of each wheel's steering axis (fixed wheel: axle centre)",
+              cosim::Rule::Required());
   v.Parameter("wheel_y", "m", &wheel_y_,
-              "y in base_link of each wheel's steering axis (fixed wheel: axle centre)");
+              "y in base_link of each wheel's steering axis (fixed wheel: axle centre)",
+              cosim::Rule::Required());
   v.Parameter("steer_rotor_inertia", "kg.m2", &steer_rotor_inertia_,
               "steer motor rotor inertia seen at the steering joint (eta N^2 J_rotor), added to "
-              "each steered module's inertia about the axes perpendicular to the axle");
+              "each steered module's inertia about the axes perpendicular to the axle",
+              // Robot-specific, unless no wheel is steered (0: nothing to reflect).
+              ms > 0 ? cosim::Rule::NonNegative().NoDefault() : cosim::Rule::NonNegative());
   v.Parameter("drive_rotor_inertia", "kg.m2", &drive_rotor_inertia_,
               "drive motor rotor inertia seen at the wheel (eta N^2 J_rotor), added once per "
-              "drive motor about the axle of its first wheel");
+              "drive motor about the axle of its first wheel",
+              cosim::Rule::NonNegative().NoDefault());
   v.Parameter("steer_friction", "N.m.s/rad", &steer_friction_,
               "viscous friction of the steering joint (default 0.01: small against the motor "
-              "torques, it only damps a free joint)");
+              "torques, it only damps a free joint)",
+              cosim::Rule::NonNegative());
   v.Parameter("drive_friction", "N.m.s/rad", &drive_friction_,
-              "viscous friction of each wheel joint (default 0.01, as steer_friction)");
+              "viscous friction of each wheel joint (default 0.01, as steer_friction)",
+              cosim::Rule::NonNegative());
   v.Parameter("body_friction", "1", &body_friction_,
               "Coulomb coefficient of the body box on obstacles and carried objects (default "
-              "0.5: painted steel or plastic on steel, typically 0.3 to 0.6)");
+              "0.5: painted steel or plastic on steel, typically 0.3 to 0.6)",
+              cosim::Rule::NonNegative());
   v.Parameter("contact_stiffness", "N/m", &contact_stiffness_,
               "normal stiffness of one wheel or body contact point (default 1e6: a tread "
-              "deflecting 0.3 mm under 30 kg)");
+              "deflecting 0.3 mm under 30 kg)",
+              cosim::Rule::Positive());
   v.Parameter("contact_damping", "N.s/m", &contact_damping_,
-              "normal damping of one contact point (default 1e4: well damped)");
+              "normal damping of one contact point (default 1e4: well damped)",
+              cosim::Rule::NonNegative());
   v.Parameter("slip_damping", "N.s/m", &slip_damping_,
               "sliding contact: resistance to slip across its slip direction, bounded by "
               "friction x normal force (damps a step-to-step swing of the slip direction; "
-              "default 1e5, see units/chassis/floor_world.h)");
+              "default 1e5, see units/chassis/floor_world.h)",
+              cosim::Rule::Positive());
   v.Parameter("suspension_stiffness", "N/m", &suspension_stiffness_,
               "stiffness of a steered module along its steering axis (hinge2 suspension; "
-              "default 1e7: a near-rigid mount)");
+              "default 1e7: a near-rigid mount)",
+              cosim::Rule::Positive());
   v.Parameter("suspension_damping", "N.s/m", &suspension_damping_,
-              "damping of a steered module along its steering axis (default 1e4)");
+              "damping of a steered module along its steering axis (default 1e4)",
+              cosim::Rule::NonNegative());
   v.Parameter("brake_torque", "N.m", &brake_torque_,
-              "holding torque of each joint's brake when brake is true (default 30)");
-  v.Parameter("substeps", &substeps_, "ODE steps per communication step");
-  v.Parameter("initial_x", "m", &initial_x_, "base_link x in map at the start");
-  v.Parameter("initial_y", "m", &initial_y_, "base_link y in map at the start");
-  v.Parameter("initial_yaw", "rad", &initial_yaw_, "base_link yaw in map at the start");
+              "holding torque of each joint's brake when brake is true (default 30)",
+              cosim::Rule::NonNegative());
+  v.Parameter("substeps", &substeps_, "ODE steps per communication step",
+              cosim::Rule::Range(1, 1000));
+  v.Parameter("initial_x", "m", &initial_x_, "base_link x in map at the start",
+              cosim::Rule::Finite());
+  v.Parameter("initial_y", "m", &initial_y_, "base_link y in map at the start",
+              cosim::Rule::Finite());
+  v.Parameter("initial_yaw", "rad", &initial_yaw_, "base_link yaw in map at the start",
+              cosim::Rule::Finite());
 
   if (ms > 0) {
     v.Input("steer_torque", "N.m", &steer_torque_,
@@ -326,74 +349,16 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
 ChassisUnit::~ChassisUnit() = default;
 
 std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
-  cosim::ParameterChecks c;
-  static constexpr const char* kUnset = "must be set (robot-specific: no default)";
-  const auto robot = [&](const char* name, double value, auto check) {
-    if (std::isnan(value)) {
-      c.Add({name, std::nullopt, kUnset});
-    } else {
-      check(name, value);
-    }
-  };
-  const auto robot_list = [&](const char* name, const std::vector<double>& values, auto check) {
-    if (std::all_of(values.begin(), values.end(), [](double x) { return std::isnan(x); })) {
-      c.Add({name, std::nullopt, kUnset});
-    } else {
-      for (std::size_t k = 0; k < values.size(); ++k) {
-        if (std::isnan(values[k])) c.Add({name, k, kUnset});
-      }
-      check(name, values);
-    }
-  };
-  const auto positive = [&](const char* n, const auto& x) { c.Positive(n, x); };
-  const auto non_negative = [&](const char* n, const auto& x) { c.NonNegative(n, x); };
-  const auto finite = [&](const char* n, const auto& x) { c.Finite(n, x); };
-  robot("body_length", body_length_, positive);
-  robot("body_width", body_width_, positive);
-  robot("body_height", body_height_, positive);
-  robot("mass", mass_, positive);
-  robot("module_mass", module_mass_, positive);
+  // The rules of single parameters are declared with them; here only what
+  // relates several: the wheels weigh less than the whole robot.
+  auto problems = cosim::Unit::CheckParameters();
   if (mass_ > 0.0 && module_mass_ > 0.0 && !(wheel_count_ * module_mass_ < mass_)) {
-    c.Add({"module_mass", std::nullopt,
-           "times " + std::to_string(wheel_count_) + " wheels must be less than mass " +
-               cosim::FormatValue(mass_) + ", got " + cosim::FormatValue(module_mass_)});
+    problems.push_back({"module_mass", std::nullopt,
+                        "times " + std::to_string(wheel_count_) +
+                            " wheels must be less than mass " + cosim::FormatValue(mass_) +
+                            ", got " + cosim::FormatValue(module_mass_)});
   }
-  robot("com_height", com_height_, positive);
-  const auto positive_set = [&](const char* n, const std::vector<double>& x) {
-    for (std::size_t k = 0; k < x.size(); ++k) {
-      if (!std::isnan(x[k]) && !(x[k] > 0.0 && std::isfinite(x[k]))) {
-        c.Add({n, k, "must be positive and finite, got " + cosim::FormatValue(x[k])});
-      }
-    }
-  };
-  const auto finite_set = [&](const char* n, const std::vector<double>& x) {
-    for (std::size_t k = 0; k < x.size(); ++k) {
-      if (!std::isnan(x[k]) && !std::isfinite(x[k])) {
-        c.Add({n, k, "must be finite, got " + cosim::FormatValue(x[k])});
-      }
-    }
-  };
-  robot_list("wheel_radius", wheel_radius_, positive_set);
-  robot_list("wheel_x", wheel_x_, finite_set);
-  robot_list("wheel_y", wheel_y_, finite_set);
-  robot("steer_rotor_inertia", steer_rotor_inertia_, non_negative);
-  robot("drive_rotor_inertia", drive_rotor_inertia_, non_negative);
-  c.NonNegative("steer_friction", steer_friction_);
-  c.NonNegative("drive_friction", drive_friction_);
-  c.NonNegative("body_friction", body_friction_);
-  c.Positive("contact_stiffness", contact_stiffness_);
-  c.NonNegative("contact_damping", contact_damping_);
-  c.Positive("slip_damping", slip_damping_);
-  c.Positive("suspension_stiffness", suspension_stiffness_);
-  c.NonNegative("suspension_damping", suspension_damping_);
-  c.NonNegative("brake_torque", brake_torque_);
-  if (substeps_ < 1 || substeps_ > 1000) {
-    c.Add({"substeps", std::nullopt, "must be 1 to 1000, got " + std::to_string(substeps_)});
-  }
-  finite("initial_x", initial_x_);
-  finite("initial_y", initial_y_);
-  finite("initial_yaw", initial_yaw_);
-  return c.Take();
+  return problems;
 }
 
 void ChassisUnit::Build() {

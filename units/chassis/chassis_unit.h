@@ -73,6 +73,8 @@ class ChassisUnit : public cosim::Unit {
               models::Scene scene);
   ~ChassisUnit() override;
 
+  /// The declared rules, and: the wheels (wheel_count x module_mass) weigh
+  /// less than mass.
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
   /// Validates the parameters (throws cosim::UnitError listing every bad
   /// value), builds and settles the robot, computes the outputs.
@@ -116,7 +118,8 @@ class ChassisUnit : public cosim::Unit {
   int drive_motor_count_ = 0;
   models::Scene scene_;
 
-  // Parameters. Robot-specific ones start NaN: CheckParameters asks for them.
+  // Parameters, each declared with its rule. Robot-specific ones start NaN
+  // (Rule::NoDefault): Initialize refuses them until they are set.
   double body_length_;
   double body_width_;
   double body_height_;

@@ -5,8 +5,6 @@
 #include <string>
 #include <utility>
 
-#include "cosim/parameter_checks.h"
-
 namespace linesim::control {
 
 namespace {
@@ -25,21 +23,29 @@ DiffDriveControllerUnit::DiffDriveControllerUnit(std::string name)
       next_(kSides, 0.0),
       integral_(kSides, 0.0) {
   auto& v = variables();
-  v.Parameter("wheel_radius", "m", &wheel_radius_, "wheel radius");
+  v.Parameter("wheel_radius", "m", &wheel_radius_, "wheel radius",
+              cosim::Rule::Positive().NoDefault());
   v.Parameter("effective_track", "m", &effective_track_,
               "track of the yaw kinematics w = (v -+ omega T / 2) / r; for a skid-steer base "
-              "larger than the geometric track (wheel scrub)");
+              "larger than the geometric track (wheel scrub)",
+              cosim::Rule::Positive().NoDefault());
   v.Parameter("drive_feedforward", "V.s/rad", &drive_feedforward_,
-              "voltage per reference wheel rate (back-EMF constant at the wheel, k_e N)");
+              "voltage per reference wheel rate (back-EMF constant at the wheel, k_e N)",
+              cosim::Rule::NonNegative().NoDefault());
   v.Parameter("drive_acceleration_feedforward", "V.s2/rad", &drive_acceleration_feedforward_,
-              "voltage per reference wheel acceleration (joint inertia R / (eta N k_t))");
-  v.Parameter("drive_kp", "V.s/rad", &drive_kp_, "wheel rate error gain");
-  v.Parameter("drive_ki", "V/rad", &drive_ki_, "wheel rate error integral gain");
+              "voltage per reference wheel acceleration (joint inertia R / (eta N k_t))",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("drive_kp", "V.s/rad", &drive_kp_, "wheel rate error gain",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("drive_ki", "V/rad", &drive_ki_, "wheel rate error integral gain",
+              cosim::Rule::NonNegative().NoDefault());
   v.Parameter("max_rate", "rad/s", &max_rate_,
-              "wheel rate limit; both sides are scaled together to respect it");
+              "wheel rate limit; both sides are scaled together to respect it",
+              cosim::Rule::Positive().NoDefault());
   v.Parameter("max_acceleration", "rad/s2", &max_acceleration_,
-              "wheel rate reference acceleration limit");
-  v.Parameter("max_voltage", "V", &max_voltage_, "supply voltage: outputs saturate at +-this");
+              "wheel rate reference acceleration limit", cosim::Rule::Positive().NoDefault());
+  v.Parameter("max_voltage", "V", &max_voltage_, "supply voltage: outputs saturate at +-this",
+              cosim::Rule::Positive().NoDefault());
 
   v.Input("velocity_command", "m/s", &velocity_command_,
           "body velocity command in base_link: vx, vy (vy ignored: the base cannot follow it)");
@@ -51,28 +57,6 @@ DiffDriveControllerUnit::DiffDriveControllerUnit(std::string name)
            "drive motor voltage: left, right (+ drives forward)", {"drive_rate"});
   v.Output("drive_rate_target", "rad/s", &drive_rate_target_,
            "slew-limited wheel rate reference at this sample: left, right", {});
-}
-
-std::vector<cosim::ParameterProblem> DiffDriveControllerUnit::CheckParameters() const {
-  cosim::ParameterChecks c;
-  if (CheckSet(c, "wheel_radius", wheel_radius_)) c.Positive("wheel_radius", wheel_radius_);
-  if (CheckSet(c, "effective_track", effective_track_)) {
-    c.Positive("effective_track", effective_track_);
-  }
-  if (CheckSet(c, "drive_feedforward", drive_feedforward_)) {
-    c.NonNegative("drive_feedforward", drive_feedforward_);
-  }
-  if (CheckSet(c, "drive_acceleration_feedforward", drive_acceleration_feedforward_)) {
-    c.NonNegative("drive_acceleration_feedforward", drive_acceleration_feedforward_);
-  }
-  if (CheckSet(c, "drive_kp", drive_kp_)) c.NonNegative("drive_kp", drive_kp_);
-  if (CheckSet(c, "drive_ki", drive_ki_)) c.NonNegative("drive_ki", drive_ki_);
-  if (CheckSet(c, "max_rate", max_rate_)) c.Positive("max_rate", max_rate_);
-  if (CheckSet(c, "max_acceleration", max_acceleration_)) {
-    c.Positive("max_acceleration", max_acceleration_);
-  }
-  if (CheckSet(c, "max_voltage", max_voltage_)) c.Positive("max_voltage", max_voltage_);
-  return c.Take();
 }
 
 void DiffDriveControllerUnit::Initialize() {

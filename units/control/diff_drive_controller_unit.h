@@ -1,11 +1,11 @@
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "cosim/time.h"
 #include "cosim/unit.h"
-#include "units/control/required_parameters.h"
 
 namespace linesim::control {
 
@@ -39,14 +39,14 @@ namespace linesim::control {
 /// than max_voltage.
 ///
 /// Every parameter depends on the robot and its motors: none has a default
-/// (NaN until set; Initialize refuses them, naming each).
+/// (NaN until set, declared with Rule::NoDefault; Initialize refuses them,
+/// naming each).
 class DiffDriveControllerUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "diff_drive_controller";
 
   explicit DiffDriveControllerUnit(std::string name);
 
-  std::vector<cosim::ParameterProblem> CheckParameters() const override;
   /// Validates the parameters (throws cosim::UnitError listing every
   /// problem), sets the references and integrals to zero and computes the
   /// outputs. Idempotent.
@@ -63,6 +63,9 @@ class DiffDriveControllerUnit : public cosim::Unit {
   void RestoreInternal(const cosim::UnitState& state) override;
 
  private:
+  /// Start value of a robot-specific parameter (declared with
+  /// Rule::NoDefault): not set.
+  static constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
   static constexpr std::size_t kSides = 2;
   /// The voltage of side i before saturation.
   double Voltage(std::size_t i) const;

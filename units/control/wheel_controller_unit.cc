@@ -6,7 +6,6 @@
 #include <string>
 #include <utility>
 
-#include "cosim/parameter_checks.h"
 #include "units/control/wheel_kinematics.h"
 
 namespace linesim::control {
@@ -55,34 +54,48 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
   //    joint inertia from 0.002 to 0.01 kg.m^2 (back-EMF damping 0.044
   //    N.m.s at the joint); kd above about 0.7 goes unstable at 0.002.
   auto& v = variables();
-  v.Parameter("wheel_x", "m", &wheel_x_, "steering axis x in base_link, per wheel");
-  v.Parameter("wheel_y", "m", &wheel_y_, "steering axis y in base_link, per wheel");
-  v.Parameter("wheel_radius", "m", &wheel_radius_, "wheel radius");
+  v.Parameter("wheel_x", "m", &wheel_x_, "steering axis x in base_link, per wheel",
+              cosim::Rule::Required());
+  v.Parameter("wheel_y", "m", &wheel_y_, "steering axis y in base_link, per wheel",
+              cosim::Rule::Required());
+  v.Parameter("wheel_radius", "m", &wheel_radius_, "wheel radius",
+              cosim::Rule::Positive().NoDefault());
   v.Parameter("compensation", &compensation_,
               "subtract the surface velocity under each wheel from its command (paper 1 "
               "Algorithm 1); false = the nominal controller");
   v.Parameter("zero_speed_threshold", "m/s", &zero_speed_threshold_,
-              "below this contact speed a wheel keeps its heading and stops");
-  v.Parameter("steer_kp", "V/rad", &steer_kp_, "steering angle gain");
-  v.Parameter("steer_kd", "V.s/rad", &steer_kd_, "steering rate error gain");
+              "below this contact speed a wheel keeps its heading and stops",
+              cosim::Rule::NonNegative());
+  v.Parameter("steer_kp", "V/rad", &steer_kp_, "steering angle gain", cosim::Rule::NonNegative());
+  v.Parameter("steer_kd", "V.s/rad", &steer_kd_, "steering rate error gain",
+              cosim::Rule::NonNegative());
   v.Parameter("steer_feedforward", "V.s/rad", &steer_feedforward_,
-              "voltage per reference steering rate (back-EMF constant at the joint, k_e N)");
+              "voltage per reference steering rate (back-EMF constant at the joint, k_e N)",
+              cosim::Rule::NonNegative().NoDefault());
   v.Parameter("steer_acceleration_feedforward", "V.s2/rad", &steer_acceleration_feedforward_,
-              "voltage per reference steering acceleration (joint inertia R / (eta N k_t))");
-  v.Parameter("steer_max_rate", "rad/s", &steer_max_rate_, "steering reference rate limit");
+              "voltage per reference steering acceleration (joint inertia R / (eta N k_t))",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("steer_max_rate", "rad/s", &steer_max_rate_, "steering reference rate limit",
+              cosim::Rule::Positive());
   v.Parameter("steer_max_acceleration", "rad/s2", &steer_max_acceleration_,
-              "steering reference acceleration limit");
+              "steering reference acceleration limit", cosim::Rule::Positive());
   v.Parameter("drive_feedforward", "V.s/rad", &drive_feedforward_,
-              "voltage per reference wheel rate (back-EMF constant at the wheel, k_e N)");
+              "voltage per reference wheel rate (back-EMF constant at the wheel, k_e N)",
+              cosim::Rule::NonNegative().NoDefault());
   v.Parameter("drive_acceleration_feedforward", "V.s2/rad", &drive_acceleration_feedforward_,
-              "voltage per reference wheel acceleration (load inertia R / (eta N k_t))");
-  v.Parameter("drive_kp", "V.s/rad", &drive_kp_, "wheel rate error gain");
-  v.Parameter("drive_ki", "V/rad", &drive_ki_, "wheel rate error integral gain");
+              "voltage per reference wheel acceleration (load inertia R / (eta N k_t))",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("drive_kp", "V.s/rad", &drive_kp_, "wheel rate error gain",
+              cosim::Rule::NonNegative());
+  v.Parameter("drive_ki", "V/rad", &drive_ki_, "wheel rate error integral gain",
+              cosim::Rule::NonNegative());
   v.Parameter("drive_max_rate", "rad/s", &drive_max_rate_,
-              "wheel rate limit; all wheels are scaled together to respect it");
+              "wheel rate limit; all wheels are scaled together to respect it",
+              cosim::Rule::Positive().NoDefault());
   v.Parameter("drive_max_acceleration", "rad/s2", &drive_max_acceleration_,
-              "wheel rate reference acceleration limit");
-  v.Parameter("max_voltage", "V", &max_voltage_, "supply voltage: outputs saturate at +-this");
+              "wheel rate reference acceleration limit", cosim::Rule::Positive().NoDefault());
+  v.Parameter("max_voltage", "V", &max_voltage_, "supply voltage: outputs saturate at +-this",
+              cosim::Rule::Positive());
 
   v.Input("velocity_command", "m/s", &velocity_command_,
           "body velocity command of base_link in base_link: vx, vy");
@@ -108,11 +121,11 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
 }
 
 std::vector<cosim::ParameterProblem> WheelControllerUnit::CheckParameters() const {
-  cosim::ParameterChecks c;
-  if (CheckSet(c, "wheel_x", wheel_x_)) c.Finite("wheel_x", wheel_x_);
-  if (CheckSet(c, "wheel_y", wheel_y_)) c.Finite("wheel_y", wheel_y_);
-  // Two steering axes at one point are no robot, and the zero default for
-  // any count but 4 would quietly turn a yaw command into no wheel motion.
+  // The rules of single parameters are declared with them; here only what
+  // relates several: wheel_x and wheel_y put no two wheels at one point.
+  auto problems = cosim::Unit::CheckParameters();
+  // Two steering axes at one point are no robot: wheels all at the centre
+  // would quietly turn a yaw command into no wheel motion.
   const std::size_t n = wheel_x_.size();
   std::vector<bool> reported(n, false);
   for (std::size_t i = 0; i < n; ++i) {
@@ -128,31 +141,12 @@ std::vector<cosim::ParameterProblem> WheelControllerUnit::CheckParameters() cons
     for (std::size_t k = 1; k < same.size(); ++k) {
       wheels += (k + 1 == same.size() ? " and " : ", ") + std::to_string(same[k]);
     }
-    c.Add({"wheel_x", std::nullopt,
-           "with wheel_y puts wheels " + wheels + " at the same point (set the positions of all " +
-               std::to_string(n) + " wheels)"});
+    problems.push_back({"wheel_x", std::nullopt,
+                        "with wheel_y puts wheels " + wheels +
+                            " at the same point (set the positions of all " + std::to_string(n) +
+                            " wheels)"});
   }
-  if (CheckSet(c, "wheel_radius", wheel_radius_)) c.Positive("wheel_radius", wheel_radius_);
-  c.NonNegative("zero_speed_threshold", zero_speed_threshold_);
-  c.NonNegative("steer_kp", steer_kp_);
-  c.NonNegative("steer_kd", steer_kd_);
-  if (CheckSet(c, "steer_feedforward", steer_feedforward_))
-    c.NonNegative("steer_feedforward", steer_feedforward_);
-  if (CheckSet(c, "steer_acceleration_feedforward", steer_acceleration_feedforward_))
-    c.NonNegative("steer_acceleration_feedforward", steer_acceleration_feedforward_);
-  c.Positive("steer_max_rate", steer_max_rate_);
-  c.Positive("steer_max_acceleration", steer_max_acceleration_);
-  if (CheckSet(c, "drive_feedforward", drive_feedforward_))
-    c.NonNegative("drive_feedforward", drive_feedforward_);
-  if (CheckSet(c, "drive_acceleration_feedforward", drive_acceleration_feedforward_))
-    c.NonNegative("drive_acceleration_feedforward", drive_acceleration_feedforward_);
-  c.NonNegative("drive_kp", drive_kp_);
-  c.NonNegative("drive_ki", drive_ki_);
-  if (CheckSet(c, "drive_max_rate", drive_max_rate_)) c.Positive("drive_max_rate", drive_max_rate_);
-  if (CheckSet(c, "drive_max_acceleration", drive_max_acceleration_))
-    c.Positive("drive_max_acceleration", drive_max_acceleration_);
-  c.Positive("max_voltage", max_voltage_);
-  return c.Take();
+  return problems;
 }
 
 void WheelControllerUnit::Initialize() {

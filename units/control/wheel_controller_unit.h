@@ -1,11 +1,11 @@
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "cosim/time.h"
 #include "cosim/unit.h"
-#include "units/control/required_parameters.h"
 
 namespace linesim::control {
 
@@ -44,6 +44,7 @@ class WheelControllerUnit : public cosim::Unit {
   /// parameters start unset (NaN) and must be set before Initialize.
   explicit WheelControllerUnit(std::string name, int wheel_count = 4);
 
+  /// The declared rules, and: no two wheels at one point (wheel_x, wheel_y).
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
   /// Validates the parameters (throws cosim::UnitError listing every
   /// problem), takes the measured steering angles as the reference, zero
@@ -63,6 +64,9 @@ class WheelControllerUnit : public cosim::Unit {
   void RestoreInternal(const cosim::UnitState& state) override;
 
  private:
+  /// Start value of a robot-specific parameter (declared with
+  /// Rule::NoDefault): not set.
+  static constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
   struct Voltages {
     double steer_v;
     double drive_v;  // before saturation

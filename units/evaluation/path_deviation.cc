@@ -3,7 +3,6 @@
 #include <cmath>
 #include <limits>
 
-#include "cosim/parameter_checks.h"
 #include "cosim/variable_table.h"
 #include "models/polyline.h"
 
@@ -33,20 +32,23 @@ PathDeviationUnit::PathDeviationUnit(std::string name, std::vector<std::array<do
   v.Input("position", "m", &position_, "true position x, y of base_link in the map frame");
   v.Output("deviation", "m", &deviation_,
            "distance of the robot centre from the desired path or held point", {"position"});
-  v.Output("progress", "m", &progress_, "arc length of the nearest point along the path", {"position"});
+  v.Output("progress", "m", &progress_, "arc length of the nearest point along the path",
+           {"position"});
 }
 
 std::vector<cosim::ParameterProblem> PathDeviationUnit::CheckParameters() const {
-  cosim::ParameterChecks c;
-  if (path_.empty()) c.Add({"path", std::nullopt, "needs at least one point"});
+  // The unit declares no parameters; the path is structural (given at
+  // construction), so it is checked here, at its key.
+  auto problems = cosim::Unit::CheckParameters();
+  if (path_.empty()) problems.push_back({"path", std::nullopt, "needs at least one point"});
   for (std::size_t i = 0; i < path_.size(); ++i) {
     if (!std::isfinite(path_[i][0]) || !std::isfinite(path_[i][1])) {
-      c.Add({"path", i,
-             "must be finite, got (" + cosim::FormatValue(path_[i][0]) + ", " +
-                 cosim::FormatValue(path_[i][1]) + ")"});
+      problems.push_back({"path", i,
+                          "must be finite, got (" + cosim::FormatValue(path_[i][0]) + ", " +
+                              cosim::FormatValue(path_[i][1]) + ")"});
     }
   }
-  return c.Take();
+  return problems;
 }
 
 void PathDeviationUnit::Evaluate() {

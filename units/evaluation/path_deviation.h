@@ -32,6 +32,7 @@ class PathDeviationUnit : public cosim::Unit {
   /// `path`: one point (a hold target) or a polyline of at least two.
   PathDeviationUnit(std::string name, std::vector<std::array<double, 2>> path);
 
+  /// The path (structural): at least one point, every point finite.
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
   void Initialize() override {
     ThrowIfBadParameters();

@@ -261,10 +261,21 @@ TEST(BeltUnit, RefusesBadParametersNamingVariableAndBelt) {
   const auto problems = u.CheckParameters();
   std::vector<std::string> found;
   for (const auto& p : problems) found.push_back(p.variable + "[" + std::to_string(*p.index) + "]");
-  EXPECT_EQ(found, (std::vector<std::string>{"direction[1]", "nominal_speed[1]", "initially_on[0]",
-                                             "speed_variation[0]", "variation_period[0]",
-                                             "acceleration[1]", "schedules.1[1]"}));
+  // The declared rules in declaration order, then what a rule cannot say.
+  EXPECT_EQ(found,
+            (std::vector<std::string>{"direction[1]", "nominal_speed[1]", "speed_variation[0]",
+                                      "variation_period[0]", "acceleration[1]", "initially_on[0]",
+                                      "schedules.1[1]"}));
+  EXPECT_EQ(problems[1].message, "must be > 0, got 0");
+  EXPECT_EQ(problems[5].message, "must be 0 (off) or 1 (on), got 0.5");
   EXPECT_NE(problems.back().message.find("increase"), std::string::npos);
+  // A value outside initially_on's declared [0, 1] is its rule's.
+  SetArray(u, "initially_on", {2.0, 1.0});
+  const auto out = u.CheckParameters();
+  ASSERT_EQ(out.size(), problems.size());
+  EXPECT_EQ(out[2].variable, "initially_on");
+  EXPECT_EQ(out[2].message, "must be in [0, 1], got 2");
+  EXPECT_EQ(u.variables().info(*u.variables().Find("speed_variation")).rule.Text(), "[0, 0.5]");
   u.Setup(0, kS);
   try {
     u.Initialize();

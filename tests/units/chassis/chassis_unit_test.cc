@@ -70,9 +70,9 @@ void Advance(ChassisUnit& u, TimeNs& t, int steps, TimeNs dt = kMs) {
 }
 
 // ---------------------------------------------------------------------------
-// Guards against the robot creeping at rest (FACTS.md: ODE vehicles can
-// drift at rest on a plane) and against an Initialize that does not leave
-// it at rest. Expected: nothing moves; 1 mm over 5 s is the brief's bound.
+// Guards against the robot creeping at rest (ODE vehicles can drift at rest
+// on a plane) and against an Initialize that does not leave it at rest. Expected: nothing moves; 1
+// mm over 5 s is the brief's bound.
 TEST(ChassisUnit, RestsOnTheFloorWithoutDrift) {
   auto robot = Raw3();
   ChassisUnit& u = *robot;
@@ -218,8 +218,7 @@ std::vector<double> StraddleBodyVelocity(double turn_rad, std::vector<double>* s
 // Coulomb balance above gives omega = 0.229 rad/s (13.1 deg/s,
 // counter-clockwise: the belt pushes the front to the left) and V = (0,
 // 0.1) m/s. A pure pivot about the rear wheels would give
-// 0.2 / 0.736 = 0.272 rad/s; FACTS.md's 26 deg/s is for a car with a
-// shorter wheelbase.
+// 0.2 / 0.736 = 0.272 rad/s.
 TEST(ChassisUnit, BrakedRobotStraddlingBeltEdgeTurns) {
   const double belt_mps = 0.2;
   std::vector<Eigen::Vector2d> p, u;
@@ -487,10 +486,10 @@ TEST(ChassisUnit, InitializeAgainHonoursChangedParameters) {
 // parameters names every robot-specific one and refuses to initialise.
 TEST(ChassisUnit, RobotSpecificParametersHaveNoDefault) {
   ChassisUnit u("robot", {0, 1, 2, 3}, {0, 1, 2, 3}, models::OpenFloor());
-  std::vector<std::string> names;
+  std::vector<std::string> names;  // each parameter once: a list reports every wheel
   for (const auto& p : u.CheckParameters()) {
     EXPECT_EQ(p.message, "must be set (robot-specific: no default)") << p.variable;
-    names.push_back(p.variable);
+    if (names.empty() || names.back() != p.variable) names.push_back(p.variable);
   }
   EXPECT_EQ(names,
             (std::vector<std::string>{"body_length", "body_width", "body_height", "mass",
@@ -517,16 +516,62 @@ TEST(ChassisUnit, CheckParametersRejectsBadValues) {
   for (const auto& p : problems) {
     names.push_back(p.variable + (p.index ? "[" + std::to_string(*p.index) + "]" : ""));
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"module_mass", "wheel_radius[1]", "wheel_x[2]",
-                                             "contact_stiffness", "substeps"}));
+  // The declared rules in declaration order, then the rule between
+  // parameters.
+  EXPECT_EQ(names, (std::vector<std::string>{"wheel_radius[1]", "wheel_x[2]", "contact_stiffness",
+                                             "substeps", "module_mass"}));
+  EXPECT_EQ(problems[2].message, "must be > 0, got -1");
+  EXPECT_EQ(problems[3].message, "must be in [1, 1000], got 0");
+  EXPECT_EQ(problems[4].message, "times 4 wheels must be less than mass 15, got 5");
   try {
     u.Initialize();
     ADD_FAILURE() << "Initialize accepted bad parameters";
   } catch (const cosim::UnitError& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("unit 'robot' (chassis)"), std::string::npos) << what;
-    EXPECT_NE(what.find("'wheel_radius[1]' must be positive and finite, got 0"), std::string::npos)
-        << what;
+    EXPECT_NE(what.find("'wheel_radius[1]' must be > 0, got 0"), std::string::npos) << what;
+  }
+}
+
+// Guards the rules declared with the parameters: each is in the table (what
+// inspect and the loader show), and a value outside it is refused at its
+// name with the rule in the message, before anything is built.
+TEST(ChassisUnit, DeclaredRulesRefuseValuesOutsideThem) {
+  auto robot = Raw3();
+  ChassisUnit& u = *robot;
+  const auto rule = [&](const std::string& name) {
+    return u.variables().info(*u.variables().Find(name)).rule.Text();
+  };
+  EXPECT_EQ(rule("mass"), "required, > 0");
+  EXPECT_EQ(rule("wheel_x"), "required");
+  EXPECT_EQ(rule("steer_rotor_inertia"), "required, >= 0");
+  EXPECT_EQ(rule("body_friction"), ">= 0");
+  EXPECT_EQ(rule("slip_damping"), "> 0");
+  EXPECT_EQ(rule("substeps"), "[1, 1000]");
+  EXPECT_EQ(rule("initial_yaw"), "finite");
+  // Without a steered wheel the steering rotor inertia has a default (0).
+  ChassisUnit fixed("robot", {-1, -1}, {0, 1}, models::OpenFloor());
+  EXPECT_EQ(fixed.variables().info(*fixed.variables().Find("steer_rotor_inertia")).rule.Text(),
+            ">= 0");
+
+  Set(u, "body_friction", -0.1);
+  Set(u, "substeps", std::int64_t{1001});
+  Set(u, "initial_yaw", INFINITY);
+  const auto problems = u.CheckParameters();
+  ASSERT_EQ(problems.size(), 3u);
+  EXPECT_EQ(problems[0].variable, "body_friction");
+  EXPECT_EQ(problems[0].message, "must be >= 0, got -0.1");
+  EXPECT_EQ(problems[1].variable, "substeps");
+  EXPECT_EQ(problems[1].message, "must be in [1, 1000], got 1001");
+  EXPECT_EQ(problems[2].variable, "initial_yaw");
+  EXPECT_EQ(problems[2].message, "must be finite, got inf");
+  try {
+    u.Initialize();
+    ADD_FAILURE() << "Initialize accepted bad parameters";
+  } catch (const cosim::UnitError& e) {
+    EXPECT_NE(std::string(e.what()).find("parameter 'substeps' must be in [1, 1000], got 1001"),
+              std::string::npos)
+        << e.what();
   }
 }
 
@@ -709,20 +754,23 @@ TEST(ChassisUnit, VariableTable) {
   ExpectTable(*husky, expected);
 }
 
-// Guards against the model file using keys the unit does not have, values
-// it refuses, or values that differ from the Rob@Work 3 numbers the tests
-// use (tests/units/chassis/robots.h) or from the generic defaults.
-TEST(ChassisUnit, ModelFileMatchesParameters) {
-  const auto path = std::filesystem::path(models::ModelsDir()) / "chassis" / "raw3_chassis.yaml";
+// Guards against the Rob@Work 3 robot description (models/robots/raw3.yaml)
+// and the test robot drifting apart: its `chassis:` section uses only the
+// unit's parameters, with the values the tests use (robots.h) or the
+// generic defaults, and its body and wheels are the test robot's.
+TEST(ChassisUnit, RobotDescriptionMatchesTestRobot) {
+  const auto path = std::filesystem::path(models::ModelsDir()) / "robots" / "raw3.yaml";
   const YAML::Node root = YAML::LoadFile(path.string());
   ASSERT_TRUE(root.IsMap());
   EXPECT_TRUE(root["source"] && root["source"].IsScalar());
   auto reference = Raw3();
-  ChassisUnit& defaults = *reference;
-  ChassisUnit u("robot", {0, 1, 2, 3}, {0, 1, 2, 3}, models::OpenFloor());
-  for (const auto& kv : root) {
+  const ChassisUnit& defaults = *reference;
+  auto robot = Raw3();
+  ChassisUnit& u = *robot;
+  const YAML::Node chassis = root["chassis"];
+  ASSERT_TRUE(chassis && chassis.IsMap());
+  for (const auto& kv : chassis) {
     const std::string key = kv.first.as<std::string>();
-    if (key == "source" || key == "description") continue;
     const auto ref = u.variables().Find(key);
     ASSERT_TRUE(ref) << "unknown key " << key;
     const auto& info = u.variables().info(*ref);
@@ -748,6 +796,23 @@ TEST(ChassisUnit, ModelFileMatchesParameters) {
     }
   }
   EXPECT_TRUE(u.CheckParameters().empty());
+
+  const YAML::Node body = root["body"];
+  ASSERT_TRUE(body && body.IsMap());
+  EXPECT_EQ(body["length_m"].as<double>(), kRaw3BodyM[0]);
+  EXPECT_EQ(body["width_m"].as<double>(), kRaw3BodyM[1]);
+  EXPECT_EQ(body["height_m"].as<double>(), kRaw3BodyM[2]);
+  EXPECT_EQ(body["mass_kg"].as<double>(), kRaw3MassKg);
+  EXPECT_EQ(body["com_height_m"].as<double>(), kRaw3ComHeightM);
+  const YAML::Node wheels = root["wheels"];
+  ASSERT_TRUE(wheels && wheels.IsSequence());
+  ASSERT_EQ(wheels.size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(wheels[k]["x_m"].as<double>(), kRaw3WheelXM[k]) << k;
+    EXPECT_EQ(wheels[k]["y_m"].as<double>(), kRaw3WheelYM[k]) << k;
+    EXPECT_EQ(wheels[k]["radius_m"].as<double>(), kRaw3WheelRadiusM) << k;
+    EXPECT_EQ(wheels[k]["mass_kg"].as<double>(), kRaw3ModuleMassKg) << k;
+  }
 }
 
 }  // namespace

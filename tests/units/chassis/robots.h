@@ -19,8 +19,8 @@ namespace linesim::chassis::test_robots {
 /// Total mass: paper 1, Table I.
 inline constexpr double kRaw3MassKg = 120.0;
 /// Module mass and centre-of-mass height: ASSUMPTIONS of
-/// models/chassis/raw3_chassis.yaml (wheel, two motors, gears, housing;
-/// batteries low).
+/// models/robots/raw3.yaml (wheel, two motors, gears, housing; batteries
+/// low).
 inline constexpr double kRaw3ModuleMassKg = 5.0;
 inline constexpr double kRaw3ComHeightM = 0.13;
 /// Body 1.03 x 0.57 x 0.40 m: paper 1, Table I.
@@ -30,9 +30,10 @@ inline constexpr double kRaw3BodyM[3] = {1.03, 0.57, 0.40};
 inline constexpr double kRaw3WheelRadiusM = 0.080;
 inline constexpr double kRaw3WheelXM[4] = {0.368, -0.368, -0.368, 0.368};
 inline constexpr double kRaw3WheelYM[4] = {0.186, 0.134, -0.186, -0.134};
-/// eta N^2 J_rotor: maxon RE 40 rotor 142 g.cm^2 (maxon datasheet) through
-/// the drive gear 21 at 0.75 and the steer belt 4 at 0.9
-/// (models/motors/raw3_drive.yaml, raw3_steer.yaml).
+/// eta N^2 J_rotor: maxon RE 40 rotor 142 g.cm^2 (maxon data sheet, the
+/// stand-in motor) through the drive gear 21 and the steer belt 4 (ipa320
+/// cob_robots configuration) at the efficiencies 0.75 and 0.9 that
+/// models/robots/raw3.yaml assumes; docs/references.md.
 inline constexpr double kRaw3DriveRotorKgm2 = 0.75 * 21.0 * 21.0 * 142e-7;
 inline constexpr double kRaw3SteerRotorKgm2 = 0.9 * 4.0 * 4.0 * 142e-7;
 
@@ -109,7 +110,8 @@ inline models::Scene Floor(double mu) {
 }
 
 /// An open floor (friction mu) with one belt `area` whose top has friction
-/// mu too (0.8: the chassis tests' wheel friction, raw3_chassis.yaml).
+/// mu too (0.8: the chassis tests' wheel friction, polyurethane tread on
+/// sealed concrete as in models/scenes/factory_line.yaml).
 inline models::Scene OneBelt(const models::Rect& area, double mu = 0.8) {
   models::Scene s = Floor(mu);
   s.surfaces.push_back({"belt", mu, 0.2, 500.0});

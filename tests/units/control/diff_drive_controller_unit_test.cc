@@ -157,7 +157,10 @@ TEST(DiffDriveControllerUnit, MissingParametersAreRefusedByName) {
   const auto bad = u.CheckParameters();
   ASSERT_EQ(bad.size(), 2u);
   EXPECT_EQ(bad[0].variable, "effective_track");
+  EXPECT_EQ(bad[0].message, "must be > 0, got 0");
   EXPECT_EQ(bad[1].variable, "drive_ki");
+  EXPECT_EQ(bad[1].message, "must be >= 0, got -1");
+  EXPECT_EQ(u.variables().info(*u.variables().Find("drive_ki")).rule.Text(), "required, >= 0");
 }
 
 // Guards the kinematics (signs, sides, effective track) against the

@@ -27,7 +27,7 @@ using test_helpers::SetAll;
 using test_helpers::SetArray;
 
 constexpr TimeNs kMs = 1'000'000;
-constexpr TimeNs kPeriod = 20 * kMs;  // control cycle (FACTS.md)
+constexpr TimeNs kPeriod = 20 * kMs;  // control cycle (ipa320 configs, docs/references.md)
 constexpr double kPeriodS = 0.02;
 constexpr double kPi = std::numbers::pi;
 constexpr double kRadiusM = 0.08;
@@ -42,7 +42,7 @@ double GetScalar(const cosim::Unit& u, const std::string& name) {
 // 30.2 mNm/A, R 0.299 Ohm, rotor 142 g.cm^2, maxon catalogue data sheet),
 // drive gear 21 and steering belt 4 (ipa320 cob_robots / cob_control
 // configs), gear efficiencies 0.75 / 0.9 (ASSUMPTIONS of
-// models/motors/raw3_{drive,steer}.yaml).
+// models/robots/raw3.yaml); docs/references.md.
 constexpr double kKe = 30.2e-3, kOhm = 0.299, kRotor = 142e-7;
 constexpr double kDriveGear = 21.0, kDriveEta = 0.75, kSteerGear = 4.0, kSteerEta = 0.9;
 // Joint inertias, as the drive-train model computes them (reflected rotor
@@ -175,13 +175,15 @@ TEST(WheelControllerUnit, RobotSpecificParametersHaveNoDefault) {
                                              "drive_acceleration_feedforward",
                                              "drive_max_rate",
                                              "drive_max_acceleration"};
-  const auto problems = u.CheckParameters();
-  ASSERT_EQ(problems.size(), required.size());
-  for (std::size_t k = 0; k < required.size(); ++k) {
-    EXPECT_EQ(problems[k].variable, required[k]);
-    EXPECT_FALSE(problems[k].index.has_value()) << required[k];
-    EXPECT_EQ(problems[k].message, "must be set (robot-specific: no default)");
+  // Each named once, a list at every wheel.
+  std::vector<std::string> names;
+  for (const auto& p : u.CheckParameters()) {
+    EXPECT_EQ(p.message, "must be set (robot-specific: no default)") << p.variable;
+    EXPECT_EQ(p.index.has_value(), p.variable == "wheel_x" || p.variable == "wheel_y")
+        << p.variable;
+    if (names.empty() || names.back() != p.variable) names.push_back(p.variable);
   }
+  EXPECT_EQ(names, required);
   try {
     u.Initialize();
     FAIL() << "unset parameters accepted";
@@ -232,7 +234,8 @@ TEST(WheelControllerUnit, AlgorithmOneDrivesOnlyTheWheelsOnTheBelt) {
 // Guards against a reference that exceeds the steering rate or acceleration
 // limits, overshoots its target, or never arrives; and against a drive ramp
 // steeper than its limit. Target: heading 45 deg (command (0.1, 0.1) m/s).
-// Limits 10 rad/s and 40 rad/s^2 (FACTS.md); 45 deg takes at least
+// Limits 10 rad/s and 40 rad/s^2 (IPA steering control, docs/references.md);
+// 45 deg takes at least
 // 2 sqrt(0.785 / 40) = 0.28 s with this acceleration.
 TEST(WheelControllerUnit, ReferenceRespectsSlewLimitsAndArrives) {
   Raw3Controller u("ctl");
@@ -386,9 +389,9 @@ struct Trace {
 };
 
 // Steering load 0.01 kg.m^2 (the controller's documented nominal module
-// inertia), drive load a quarter of 120 kg at r = 0.08 m, 0.192 kg.m^2
-// (FACTS.md); gear 21 (eta 0.75) and belt 4 (eta 0.9) as
-// models/motors/raw3_{drive,steer}.yaml.
+// inertia), drive load a quarter of 120 kg (paper 1, Table I) at r = 0.08 m
+// (raw3-1 Platform.ini), 0.192 kg.m^2; gear 21 (eta 0.75) and belt 4 (eta
+// 0.9) as models/robots/raw3.yaml.
 Trace RunClosedLoop(const std::vector<double>& twist, TimeNs duration,
                     double drive_load_kgm2 = 30.0 * kRadiusM * kRadiusM,
                     double steer_load_kgm2 = 0.01) {
@@ -611,11 +614,19 @@ TEST(WheelControllerUnit, CheckParametersListsEveryProblem) {
   ASSERT_EQ(problems.size(), 5u);
   EXPECT_EQ(problems[0].variable, "wheel_x");
   EXPECT_EQ(problems[0].index, 1u);
+  EXPECT_EQ(problems[0].message, "must be set (robot-specific: no default)");
+  // A value outside a declared rule: named, with the rule and the value.
   EXPECT_EQ(problems[1].variable, "wheel_radius");
-  EXPECT_NE(problems[1].message.find("got 0"), std::string::npos) << problems[1].message;
+  EXPECT_EQ(problems[1].message, "must be > 0, got 0");
   EXPECT_EQ(problems[2].variable, "steer_kp");
+  EXPECT_EQ(problems[2].message, "must be >= 0, got -1");
   EXPECT_EQ(problems[3].variable, "drive_max_acceleration");
+  EXPECT_EQ(problems[3].message, "must be > 0, got 0");
   EXPECT_EQ(problems[4].variable, "max_voltage");
+  EXPECT_EQ(problems[4].message, "must be finite and > 0, got inf");
+  const auto& t = u.variables();
+  EXPECT_EQ(t.info(*t.Find("wheel_radius")).rule.Text(), "required, > 0");
+  EXPECT_EQ(t.info(*t.Find("steer_kp")).rule.Text(), ">= 0");
   try {
     u.Initialize();
     FAIL() << "bad parameters accepted";
