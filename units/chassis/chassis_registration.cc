@@ -52,15 +52,14 @@ const config::UnitTypeRegistrar kChassis(
     {chassis::ChassisUnit::kTypeName,
      "robot body, steered or fixed wheels (coupled per drive motor) and wheel/floor/belt "
      "contact in ODE, the body colliding with the scene's obstacles and carried objects",
-     "chassis",
+     "",
      {{"wheel_count", "number of wheels (default 4)"},
       {"steer_motor",
        "per wheel: index of its steering motor, -1 for a fixed wheel (default: wheel k on "
        "motor k)"},
       {"drive_motor",
        "per wheel: index of its drive motor; wheels with one index are coupled (default: "
-       "wheel k on motor k)"},
-      {"model", "model file from models/chassis/ (name) or a path relative to the scenario"}},
+       "wheel k on motor k)"}},
      MakeChassis});
 
 }  // namespace

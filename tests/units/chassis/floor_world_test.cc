@@ -43,8 +43,8 @@ struct Box {
 // against the belt, or not at all), a belt velocity applied outside its
 // patch, and sliding friction that is not Coulomb's mu N. Numbers: a body
 // put at rest on a belt of speed v slides with acceleration mu g until it
-// reaches v, at t = v / (mu g) = 0.0204 s for 0.2 m/s and mu 1
-// (FACTS.md: 1 % of belt speed in 0.021 s); afterwards it sticks.
+// reaches v, at t = v / (mu g) = 0.0204 s for 0.2 m/s and mu 1; afterwards
+// it sticks.
 TEST(FloorWorld, BoxOnBeltReachesBeltSpeedAfterCoulombTime) {
   const double belt_mps = 0.2, mu = 1.0;
   FloorWorld f;
