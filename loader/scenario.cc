@@ -381,6 +381,7 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
     }
   }
   YAML::Node tree = LoadYamlOrThrow(file);
+  ExposeSceneModelToOverrides(tree, s.overrides, file);
   ApplyOverrides(tree, s.overrides, file, issues);
   std::set<std::string> overridden;
   for (const auto& o : s.overrides) overridden.insert(o.path);

@@ -454,4 +454,28 @@ models::Scene ReadScenarioScene(YamlReader& r, const YAML::Node& scene,
   return out;
 }
 
+void ExposeSceneModelToOverrides(YAML::Node& root, const std::vector<Override>& overrides,
+                                 const std::string& scenario_file) {
+  YAML::Node scene = Child(root, "scene");
+  const YAML::Node model = Child(scene, "model");
+  if (!scene.IsMap() || !model.IsScalar()) return;
+  std::optional<YAML::Node> file_scene;
+  for (const Override& o : overrides) {
+    const std::string prefix = "scene.";
+    if (!o.path.starts_with(prefix)) continue;
+    const std::string rest = o.path.substr(prefix.size());
+    const std::string key = rest.substr(0, rest.find('.'));
+    // A whole top-level value set at once needs nothing from the file.
+    if (key.empty() || key == rest || Child(scene, key).IsDefined()) continue;
+    if (!file_scene) {
+      YamlReader quiet(scenario_file);
+      file_scene = LoadModel(quiet, model, "scene.model", "scene", model.Scalar(), "scenes",
+                             scenario_file);
+    }
+    if (const YAML::Node value = Child(*file_scene, key); value.IsDefined()) {
+      scene[key] = YAML::Clone(value);
+    }
+  }
+}
+
 }  // namespace linesim::loader

@@ -3,8 +3,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include <string>
+#include <vector>
 
 #include "loader/config_names.h"
+#include "loader/overrides.h"
 #include "models/scene.h"
 
 namespace linesim::loader {
@@ -31,5 +33,15 @@ models::Scene LoadSceneFile(const std::string& file);
 /// values set with --set say so.
 models::Scene ReadScenarioScene(YamlReader& r, const YAML::Node& scene,
                                 const std::string& scenario_file);
+
+/// Makes the keys of the scene file that `root`'s `scene: {model: ...}`
+/// names reachable by --set: for each override under `scene.` whose first
+/// key below `scene` the scenario does not write, that key's value is copied
+/// from the scene file into the scenario's scene (merging a copy of the
+/// file's own value changes nothing), so `scene.belts.0.speed_mps=0.2` sets
+/// the file's first belt. A scene file that cannot be read is left for the
+/// scene reader to report.
+void ExposeSceneModelToOverrides(YAML::Node& root, const std::vector<Override>& overrides,
+                                 const std::string& scenario_file);
 
 }  // namespace linesim::loader

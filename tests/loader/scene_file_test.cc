@@ -192,6 +192,25 @@ TEST(ScenarioScene, OverridesByIndexAndAddedItems) {
 // Guards where problems are reported: the scenario's bad override at its
 // own line and key path under scene; an added item missing a required value
 // at the item; a scene file's own problem in the scene file.
+// Guards --set on a scene the scenario only names: a key of the scene file
+// is reachable without copying it into the scenario (the first belt's speed,
+// the floor's friction), a value out of range is reported as set on the
+// command line, and keys the file lacks are still refused with the closest.
+TEST(ScenarioScene, SetReachesTheNamedSceneFile) {
+  const std::string f = WriteScenario("named_scene.yaml", std::string(kValidScenario) +
+                                                              "scene: {model: factory_line}\n");
+  const Scenario s =
+      LoadScenario(f, {"scene.belts.0.speed_mps=0.2", "scene.surfaces.0.friction=0.5"});
+  ASSERT_FALSE(s.scene.belts.empty());
+  EXPECT_EQ(s.scene.belts[0].nominal_speed_mps, 0.2);
+  EXPECT_EQ(s.scene.surfaces[0].friction, 0.5);
+  EXPECT_EQ(s.scene.obstacles.size(), LoadScenario(f).scene.obstacles.size());
+  const std::string bad = Issues(f, {"scene.belts.0.speed_mps=-1"});
+  EXPECT_TRUE(Has(bad, "scene.belts.0.speed_mps (set on the command line)")) << bad;
+  const std::string typo = Issues(f, {"scene.belt.0.speed_mps=0.2"});
+  EXPECT_TRUE(Has(typo, "scene.belt")) << typo;
+}
+
 TEST(ScenarioScene, ProblemsAreReportedWhereTheyAreWritten) {
   const std::string f = WriteScenario("bad_merge.yaml", std::string(kValidScenario) + R"(scene:
   model: factory_line
