@@ -66,9 +66,10 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
   v.Parameter("zero_speed_threshold", "m/s", &zero_speed_threshold_,
               "below this contact speed a wheel keeps its heading and stops",
               cosim::Rule::NonNegative());
-  v.Parameter("steer_kp", "V/rad", &steer_kp_, "steering angle gain", cosim::Rule::NonNegative());
+  v.Parameter("steer_kp", "V/rad", &steer_kp_, "steering angle gain",
+              cosim::Rule::NonNegative().NoDefault());
   v.Parameter("steer_kd", "V.s/rad", &steer_kd_, "steering rate error gain",
-              cosim::Rule::NonNegative());
+              cosim::Rule::NonNegative().NoDefault());
   v.Parameter("steer_feedforward", "V.s/rad", &steer_feedforward_,
               "voltage per reference steering rate (back-EMF constant at the joint, k_e N)",
               cosim::Rule::NonNegative().NoDefault());
@@ -76,9 +77,9 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
               "voltage per reference steering acceleration (joint inertia R / (eta N k_t))",
               cosim::Rule::NonNegative().NoDefault());
   v.Parameter("steer_max_rate", "rad/s", &steer_max_rate_, "steering reference rate limit",
-              cosim::Rule::Positive());
+              cosim::Rule::Positive().NoDefault());
   v.Parameter("steer_max_acceleration", "rad/s2", &steer_max_acceleration_,
-              "steering reference acceleration limit", cosim::Rule::Positive());
+              "steering reference acceleration limit", cosim::Rule::Positive().NoDefault());
   v.Parameter("drive_feedforward", "V.s/rad", &drive_feedforward_,
               "voltage per reference wheel rate (back-EMF constant at the wheel, k_e N)",
               cosim::Rule::NonNegative().NoDefault());
@@ -86,16 +87,16 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
               "voltage per reference wheel acceleration (load inertia R / (eta N k_t))",
               cosim::Rule::NonNegative().NoDefault());
   v.Parameter("drive_kp", "V.s/rad", &drive_kp_, "wheel rate error gain",
-              cosim::Rule::NonNegative());
+              cosim::Rule::NonNegative().NoDefault());
   v.Parameter("drive_ki", "V/rad", &drive_ki_, "wheel rate error integral gain",
-              cosim::Rule::NonNegative());
+              cosim::Rule::NonNegative().NoDefault());
   v.Parameter("drive_max_rate", "rad/s", &drive_max_rate_,
               "wheel rate limit; all wheels are scaled together to respect it",
               cosim::Rule::Positive().NoDefault());
   v.Parameter("drive_max_acceleration", "rad/s2", &drive_max_acceleration_,
               "wheel rate reference acceleration limit", cosim::Rule::Positive().NoDefault());
   v.Parameter("max_voltage", "V", &max_voltage_, "supply voltage: outputs saturate at +-this",
-              cosim::Rule::Positive());
+              cosim::Rule::Positive().NoDefault());
 
   v.Input("velocity_command", "m/s", &velocity_command_,
           "body velocity command of base_link in base_link: vx, vy");

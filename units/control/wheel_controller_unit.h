@@ -84,19 +84,19 @@ class WheelControllerUnit : public cosim::Unit {
   double wheel_radius_ = kUnset;
   bool compensation_ = true;
   double zero_speed_threshold_ = 1e-3;
-  double steer_kp_ = 10.0;
-  double steer_kd_ = 0.5;
+  double steer_kp_ = kUnset;
+  double steer_kd_ = kUnset;
   double steer_feedforward_ = kUnset;
   double steer_acceleration_feedforward_ = kUnset;
-  double steer_max_rate_ = 10.0;
-  double steer_max_acceleration_ = 40.0;
+  double steer_max_rate_ = kUnset;
+  double steer_max_acceleration_ = kUnset;
   double drive_feedforward_ = kUnset;
   double drive_acceleration_feedforward_ = kUnset;
-  double drive_kp_ = 0.5;
-  double drive_ki_ = 5.0;
+  double drive_kp_ = kUnset;
+  double drive_ki_ = kUnset;
   double drive_max_rate_ = kUnset;
   double drive_max_acceleration_ = kUnset;
-  double max_voltage_ = 24.0;
+  double max_voltage_ = kUnset;
 
   // Inputs.
   std::vector<double> velocity_command_;

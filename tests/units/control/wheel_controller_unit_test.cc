@@ -59,8 +59,17 @@ constexpr double TorquePerVolt(double gear, double eta) { return eta * gear * kK
 
 // The robot-specific parameters but the wheel positions (any wheel count):
 // wheel radius 0.080 m, drive limit 12.267 rad/s (IPA config), 1 m/s^2 at
-// the rim.
+// the rim; the steering reference limits of IPA's cob_control (10 rad/s,
+// 40 rad/s^2); the 24 V supply of the RE 40 winding; the loop gains of
+// models/robots/raw3.yaml (designed for the 20 ms cycle, see there).
 void SetRaw3Drives(cosim::Unit& u) {
+  SetAll(u, "steer_kp", 10.0);
+  SetAll(u, "steer_kd", 0.5);
+  SetAll(u, "steer_max_rate", 10.0);
+  SetAll(u, "steer_max_acceleration", 40.0);
+  SetAll(u, "drive_kp", 0.5);
+  SetAll(u, "drive_ki", 5.0);
+  SetAll(u, "max_voltage", 24.0);
   SetAll(u, "wheel_radius", kRadiusM);
   SetAll(u, "steer_feedforward", kKe * kSteerGear);
   SetAll(u, "steer_acceleration_feedforward", kSteerJ / TorquePerVolt(kSteerGear, kSteerEta));
@@ -162,19 +171,29 @@ TEST(WheelControllerUnit, VariableTable) {
 }
 
 // Guards against another robot's numbers used silently: every
-// robot-specific parameter starts unset, Initialize refuses the unit naming
-// each, and the generic ones keep their defaults.
+// robot-specific parameter starts unset (gains and limits too: they are
+// tuned for one robot's motors), Initialize refuses the unit naming each,
+// and the generic ones keep their defaults.
 TEST(WheelControllerUnit, RobotSpecificParametersHaveNoDefault) {
   WheelControllerUnit u("ctl");
+  // In declaration order: the geometry, the loop gains and limits (tuned
+  // for one robot's motors and cycle), the feedforwards (its drive train).
   const std::vector<std::string> required = {"wheel_x",
                                              "wheel_y",
                                              "wheel_radius",
+                                             "steer_kp",
+                                             "steer_kd",
                                              "steer_feedforward",
                                              "steer_acceleration_feedforward",
+                                             "steer_max_rate",
+                                             "steer_max_acceleration",
                                              "drive_feedforward",
                                              "drive_acceleration_feedforward",
+                                             "drive_kp",
+                                             "drive_ki",
                                              "drive_max_rate",
-                                             "drive_max_acceleration"};
+                                             "drive_max_acceleration",
+                                             "max_voltage"};
   // Each named once, a list at every wheel.
   std::vector<std::string> names;
   for (const auto& p : u.CheckParameters()) {
@@ -201,8 +220,6 @@ TEST(WheelControllerUnit, RobotSpecificParametersHaveNoDefault) {
   SetRobAtWork3(u);
   EXPECT_TRUE(u.CheckParameters().empty());
   // Generic defaults (design values with their reason in the unit).
-  EXPECT_EQ(GetScalar(u, "max_voltage"), 24.0);
-  EXPECT_EQ(GetScalar(u, "steer_max_acceleration"), 40.0);
   EXPECT_TRUE(u.variables().GetBoolean(*u.variables().Find("compensation")));
 }
 
@@ -626,7 +643,7 @@ TEST(WheelControllerUnit, CheckParametersListsEveryProblem) {
   EXPECT_EQ(problems[4].message, "must be finite and > 0, got inf");
   const auto& t = u.variables();
   EXPECT_EQ(t.info(*t.Find("wheel_radius")).rule.Text(), "required, > 0");
-  EXPECT_EQ(t.info(*t.Find("steer_kp")).rule.Text(), ">= 0");
+  EXPECT_EQ(t.info(*t.Find("steer_kp")).rule.Text(), "required, >= 0");
   try {
     u.Initialize();
     FAIL() << "bad parameters accepted";
