@@ -83,10 +83,10 @@ void YamlReader::Error(const std::string& file, const YAML::Node& at, const std:
   const bool translated = origin != origins_.end();
   const bool exact = translated && rest.empty();
   Issue issue;
-  issue.file = file;
+  issue.file = translated && !origin->second.file.empty() ? origin->second.file : file;
   issue.key_path = translated ? origin->second.path + rest : path;
   issue.message = std::move(message);
-  issue.from_command_line = file == own_file_ && FromCommandLine(issue.key_path);
+  issue.from_command_line = issue.file == own_file_ && FromCommandLine(issue.key_path);
   issue.line = issue.from_command_line ? 0 : LineOf(exact ? origin->second.node : at);
   issues_.push_back(std::move(issue));
 }

@@ -39,6 +39,9 @@ struct Range {
 struct Origin {
   YAML::Node node;
   std::string path;
+  /// The file `path` is in, when not the reader's own (a robot description
+  /// a scenario names).
+  std::string file;
 };
 
 /// Reads a YAML tree and collects issues with file, line and key path

@@ -116,7 +116,7 @@ class Reader {
           if (!motor_names_.insert(*name).second) {
             r_.Error(motors[k], kp, "motor '" + *name + "' is named twice");
           }
-          motor_at_[*name] = {motors[k], kp};
+          motor_at_[*name] = {motors[k], kp, ""};
           group.motors.push_back(*name);
         }
         if (motors.size() == 0) r_.Error(motors, mp, "expected at least one motor");

@@ -64,11 +64,23 @@ void SystemBuilder::Connect(const std::string& from, const std::string& to) {
 void SystemBuilder::Derived(const std::string& expanded, const YAML::Node& parent,
                             const std::string& path, const std::string& key) {
   const YAML::Node node = Child(parent, key);
-  origins_[expanded] = {node.IsDefined() ? node : parent, JoinPath(path, key)};
+  origins_[expanded] = {node.IsDefined() ? node : parent, JoinPath(path, key), ""};
 }
 
 void SystemBuilder::Origin(const std::string& expanded, loader::Origin origin) {
   origins_[expanded] = std::move(origin);
+}
+
+void SystemBuilder::MergeSettings(const std::string& unit, const YAML::Node& settings,
+                                  const std::string& file, const std::string& section) {
+  if (!settings.IsMap()) return;
+  YAML::Node params = Params(unit);
+  for (const auto& kv : settings) {
+    const std::string key = kv.first.Scalar();
+    params[key] = kv.second;
+    origins_[JoinPath(JoinPath(JoinPath("units", unit), "parameters"), key)] = {
+        kv.second, JoinPath(section, key), file};
+  }
 }
 
 YAML::Node SystemBuilder::Section(const YAML::Node& parent, const std::string& path,

@@ -57,6 +57,11 @@ class SystemBuilder {
   void Derived(const std::string& expanded, const YAML::Node& parent, const std::string& path,
                const std::string& key);
   void Origin(const std::string& expanded, loader::Origin origin);
+  /// Merges the robot description's settings for `unit` (its section
+  /// `section` of `file`) into the unit's parameters; a problem found in one
+  /// of them is reported in that file, at its line and key.
+  void MergeSettings(const std::string& unit, const YAML::Node& settings, const std::string& file,
+                     const std::string& section);
   /// A map section of the robot scenario (empty when absent), its keys
   /// checked.
   YAML::Node Section(const YAML::Node& parent, const std::string& path, const std::string& key,

@@ -41,7 +41,7 @@ void AddMotors(SystemBuilder& b, const RobotFile& file) {
     }
     p[key] = List(values);
   }
-  MergeInto(p, file.motor_settings);
+  b.MergeSettings(kMotors, file.motor_settings, robot.file, "motors");
 }
 
 // The joint view of a motor group (the drive-train algebra of models/).
@@ -93,7 +93,7 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
   c["wheel_count"] = robot.wheels.size();
   c["steer_motor"] = IntList(s.wheel_steer_joint);
   c["drive_motor"] = IntList(s.wheel_drive_joint);
-  MergeInto(c, file.chassis_settings);
+  b.MergeSettings(kChassis, file.chassis_settings, robot.file, "chassis");
   c["body_length"] = Num(robot.body.length_m);
   c["body_width"] = Num(robot.body.width_m);
   c["body_height"] = Num(robot.body.height_m);

@@ -29,7 +29,7 @@ models::Scene AddScene(SystemBuilder& b) {
         item[key] = kv.second;
         b.Derived("scene.belts." + std::to_string(i) + "." + key, belts[i], path, key);
       }
-      b.Origin("scene.belts." + std::to_string(i), {belts[i], path});
+      b.Origin("scene.belts." + std::to_string(i), {belts[i], path, ""});
     }
     scene["belts"] = merged;
   }

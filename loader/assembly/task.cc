@@ -17,7 +17,7 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
   info.task = r.String(task, "task", "type", std::nullopt, {"path", "hold"});
   b.Unit(kPathFollower, "path_follower");
   YAML::Node p = b.Params(kPathFollower);
-  MergeInto(p, file.follower_settings);
+  b.MergeSettings(kPathFollower, file.follower_settings, file.robot.file, "path_follower");
   const bool differential = file.robot.controller == models::ControllerKind::kDifferential;
   if (info.task == "path") {
     const YAML::Node waypoints = Child(task, "waypoints");

@@ -385,6 +385,28 @@ TEST(RobotScenario, UnknownKeyInTheRobotModelFileIsNamedThere) {
   EXPECT_TRUE(Has(e, "motor_group: unknown key; closest: motor_groups")) << e;
 }
 
+// Guards where a robot description's unit settings are reported: a value a
+// unit refuses, and a setting no unit has, are named in the robot file at
+// their line and key (chassis.contact_stiffness, controller.drive_kpp), not
+// at the expanded unit the user never wrote.
+TEST(RobotScenario, RobotFileSettingsAreReportedInTheRobotFile) {
+  std::ifstream in(LINESIM_SOURCE_DIR "/models/robots/raw3.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  };
+  replace("contact_stiffness: 1.0e6", "contact_stiffness: -1");
+  replace("drive_kp: 0.5", "drive_kpp: 0.5");
+  const std::string model = WriteScenario("raw3_bad_settings.yaml", text);
+  const std::string e = Issues(kCross, {"robot.model=" + model});
+  EXPECT_TRUE(Has(e, model + ":")) << e;
+  EXPECT_TRUE(Has(e, "chassis.contact_stiffness: ")) << e;
+  EXPECT_TRUE(Has(e, "controller.drive_kpp: ")) << e;
+  EXPECT_FALSE(Has(e, "units.chassis")) << e;
+}
+
 // Guards the pass-through: `units.NAME.parameters` in a robot scenario
 // overrides the expansion (so every unit parameter is sweepable), and an
 // unknown parameter there is reported at that path.
@@ -397,6 +419,42 @@ TEST(RobotScenario, UnitsSectionOverridesExpandedParameters) {
   EXPECT_EQ(Param(s, "chassis", "brake_torque"), 25.0);
   const std::string e = Issues(f, {"units.chassis.parameters.brake_torqe=25"});
   EXPECT_TRUE(Has(e, "units.chassis.parameters.brake_torqe")) << e;
+}
+
+// Guards the declared parameter rules at the loader: for a unit type of
+// each family in a robot's system (belt, chassis, motors, both controllers
+// of the control family), a value outside the rule its unit declares is
+// refused before time zero at its key path, naming the rule; all at once.
+// The bounds are the units' declared rules: speed variation in [0, 0.5]
+// (paper 1's +-10 % with room), a positive mass, a gear efficiency in
+// (0, 1], non-negative gains, a positive cruise speed.
+TEST(RobotScenario, DeclaredRulesRefuseOutOfRangeValuesAtTheirKeys) {
+  const Scenario robot = LoadScenario(kCross);
+  YAML::Emitter out;
+  out << robot.expanded;
+  const std::string f = WriteScenario("expanded_rules.yaml", out.c_str());
+  const std::string e = Issues(
+      f, {"units.belt.parameters={speed_variation: 0.9}", "units.chassis.parameters.mass=-1",
+          "units.motors.parameters.gear_efficiency.5=1.5",
+          "units.wheel_controller.parameters.steer_kp=-1", "units.path_follower.parameters.speed=0"});
+  for (const char* expected :
+       {"units.belt.parameters.speed_variation.0 (set on the command line): must be in [0, 0.5], "
+        "got 0.9",
+        "units.chassis.parameters.mass (set on the command line): must be > 0, got -1",
+        "units.motors.parameters.gear_efficiency.5 (set on the command line): must be in (0, 1], "
+        "got 1.5",
+        "units.wheel_controller.parameters.steer_kp (set on the command line): must be >= 0, got -1",
+        "units.path_follower.parameters.speed (set on the command line): must be > 0, got 0"}) {
+    EXPECT_TRUE(Has(e, expected)) << expected << "\n" << e;
+  }
+  const Scenario husky = LoadScenario(kHusky);
+  YAML::Emitter husky_out;
+  husky_out << husky.expanded;
+  const std::string g = WriteScenario("expanded_husky_rules.yaml", husky_out.c_str());
+  const std::string h = Issues(g, {"units.wheel_controller.parameters.effective_track=0"});
+  EXPECT_TRUE(Has(h, "units.wheel_controller.parameters.effective_track (set on the command "
+                     "line): must be > 0, got 0"))
+      << h;
 }
 
 // Guards one unit of measure per variable: the chassis's yaw (rad) feeds
