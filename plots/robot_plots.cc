@@ -311,8 +311,11 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
         }
       }
     }
+    // Above the outline whatever the heading (half the body's diagonal),
+    // so that the label's box hides no wheel contact.
+    const double above_m = 0.5 * std::hypot(spec.body_length_m, spec.body_width_m);
     for (const auto& [at, times] : placed) {
-      labels += Num(at.x) + "," + Num(at.y) + ",t = " + times + " s\n";
+      labels += Num(at.x) + "," + Num(at.y + above_m) + ",t = " + times + " s\n";
     }
   }
   // The scene's solids: obstacles, and carried objects at time zero and
@@ -461,7 +464,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
         "$contacts using 1:2 with points pt 7 ps 0.8 lc rgb '#2ca02c' title 'wheel contacts'");
   }
   if (!labels.empty()) {
-    items.push_back("$labels using 1:2:3 with labels boxed offset 0,1 font ',8' notitle");
+    items.push_back("$labels using 1:2:3 with labels boxed offset 0,0.6 font ',8' notitle");
   }
   for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
   s += "\n\n# Back to defaults for the time plots.\n"
