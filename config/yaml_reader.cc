@@ -88,6 +88,11 @@ void YamlReader::Error(const std::string& file, const YAML::Node& at, const std:
   issue.message = std::move(message);
   issue.from_command_line = issue.file == own_file_ && FromCommandLine(issue.key_path);
   issue.line = issue.from_command_line ? 0 : LineOf(exact ? origin->second.node : at);
+  // Below a derived key, a node the expansion made has no line: the user's
+  // key it derives from has.
+  if (translated && issue.line == 0 && !issue.from_command_line) {
+    issue.line = LineOf(origin->second.node);
+  }
   issues_.push_back(std::move(issue));
 }
 

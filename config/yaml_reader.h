@@ -120,8 +120,10 @@ class YamlReader {
   std::optional<std::array<double, 2>> AsPoint(const YAML::Node& node, const std::string& path,
                                                Range range = {});
 
- private:
+  /// Whether `path`, or a key above it, was set with --set.
   bool FromCommandLine(const std::string& path) const;
+
+ private:
   const YAML::Node Lookup(const YAML::Node& map, const std::string& path, const std::string& key,
                           bool required);
 

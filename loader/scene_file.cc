@@ -153,8 +153,14 @@ class SceneParser {
           {"name", "surface", "center_x_m", "center_y_m", "length_m", "width_m", "direction_deg",
            "speed_mps", "speed_variation", "variation_period_s", "acceleration_mps2", "schedule"});
       models::Belt belt;
-      belt.name = Name(b, p, belt_names_);
-      belt.surface = Reference(b, p, "surface", surface_names_, "surface");
+      // A belt without a name is "belt_<index>"; without a surface its top
+      // is the floor's covering.
+      belt.name = Child(b, "name").IsDefined()
+                      ? Name(b, p, belt_names_)
+                      : "belt_" + std::to_string(s_.belts.size());
+      belt.surface = Child(b, "surface").IsDefined()
+                         ? Reference(b, p, "surface", surface_names_, "surface")
+                         : s_.floor.surface;
       // Keys, defaults and ranges as robot scenarios' line.belts items.
       belt.area.center_x_m = r_.Real(b, p, "center_x_m", std::nullopt, kCoordinate);
       belt.area.center_y_m = r_.Real(b, p, "center_y_m", std::nullopt, kCoordinate);
@@ -390,16 +396,40 @@ models::Scene LoadSceneFile(const std::string& file) {
   return scene;
 }
 
+// models::OpenFloor() as a scene file would write it.
+YAML::Node OpenFloorTree() {
+  const models::Scene open = models::OpenFloor();
+  YAML::Node tree(YAML::NodeType::Map);
+  for (const models::Surface& surface : open.surfaces) {
+    YAML::Node item;
+    item["name"] = surface.name;
+    item["friction"] = surface.friction;
+    item["texture_contrast"] = surface.texture_contrast;
+    item["illumination_lux"] = surface.illumination_lux;
+    tree["surfaces"].push_back(item);
+  }
+  tree["floor"]["min_x_m"] = open.floor.min_x_m;
+  tree["floor"]["max_x_m"] = open.floor.max_x_m;
+  tree["floor"]["min_y_m"] = open.floor.min_y_m;
+  tree["floor"]["max_y_m"] = open.floor.max_y_m;
+  tree["floor"]["surface"] = open.surfaces[static_cast<std::size_t>(open.floor.surface)].name;
+  return tree;
+}
+
 models::Scene ReadScenarioScene(YamlReader& r, const YAML::Node& scene,
                                 const std::string& scenario_file) {
   if (!scene.IsDefined() || scene.IsNull()) return models::OpenFloor();
   if (!r.ExpectMap(scene, "scene")) return models::OpenFloor();
   const YAML::Node model_node = Child(scene, "model");
   if (!model_node.IsDefined()) {
+    // No file: the open floor, with what the scenario writes added to it or
+    // overriding it.
+    std::map<std::string, ScenarioSource> sources;
+    const YAML::Node merged = Merge(OpenFloorTree(), scene, "scene", sources);
     models::Scene out;
     out.name = fs::path(scenario_file).stem().string();
     out.file = scenario_file;
-    SceneParser(r, out).Parse(scene, "scene", true);
+    SceneParser(r, out).Parse(merged, "scene", true);
     return out;
   }
   const auto model_name = r.AsString(model_node, "scene.model");

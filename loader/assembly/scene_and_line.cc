@@ -1,3 +1,5 @@
+#include <algorithm>
+
 #include "loader/assembly/concerns.h"
 #include "loader/scene_file.h"
 
@@ -6,33 +8,51 @@ namespace linesim::loader::assembly {
 models::Scene AddScene(SystemBuilder& b) {
   YamlReader& r = b.reader();
   const YAML::Node root = b.root();
-  YAML::Node scene(YAML::NodeType::Map);
   const YAML::Node given = Child(root, "scene");
-  if (given.IsDefined() && !given.IsNull() && r.ExpectMap(given, "scene")) {
-    scene = YAML::Clone(given);
+  const bool written = given.IsDefined() && !given.IsNull();
+  if (written && !r.ExpectMap(given, "scene")) return models::OpenFloor();
+  // A new map whose values are the scenario's own nodes, so that problems
+  // found in them keep their lines.
+  YAML::Node scene(YAML::NodeType::Map);
+  if (written) {
+    for (const auto& kv : given) scene[kv.first.Scalar()] = kv.second;
   }
   // line.belts: paper 1's shorthand for the scene's belts, item by item
-  // (an item past the scene's list adds a belt). The scene file checks the
-  // keys; what is wrong is reported here, where the user wrote it.
+  // (an item past the scene's list adds a belt). The scene reader checks
+  // the keys; what is wrong is reported here, where the user wrote it.
   const YAML::Node line = b.Section(root, "", "line", {"belts"});
   const YAML::Node belts = Child(line, "belts");
   if (belts.IsDefined() && !belts.IsNull() && r.ExpectSequence(belts, "line.belts")) {
-    YAML::Node merged = scene["belts"];
-    if (!merged.IsSequence()) merged = YAML::Node(YAML::NodeType::Sequence);
-    for (std::size_t i = 0; i < belts.size(); ++i) {
-      const std::string path = JoinPath("line.belts", std::to_string(i));
-      if (!r.ExpectMap(belts[i], path)) continue;
-      while (merged.size() <= i) merged.push_back(YAML::Node(YAML::NodeType::Map));
-      YAML::Node item = merged[i];
-      for (const auto& kv : belts[i]) {
-        const std::string key = kv.first.Scalar();
-        item[key] = kv.second;
-        b.Derived("scene.belts." + std::to_string(i) + "." + key, belts[i], path, key);
+    const YAML::Node own = Child(scene, "belts");
+    YAML::Node merged(YAML::NodeType::Sequence);
+    for (std::size_t i = 0; i < std::max(belts.size(), own.IsSequence() ? own.size() : 0); ++i) {
+      YAML::Node item(YAML::NodeType::Map);
+      if (own.IsSequence() && i < own.size() && own[i].IsMap()) {
+        for (const auto& kv : own[i]) item[kv.first.Scalar()] = kv.second;
       }
-      b.Origin("scene.belts." + std::to_string(i), {belts[i], path, ""});
+      const std::string path = JoinPath("line.belts", std::to_string(i));
+      if (i < belts.size() && r.ExpectMap(belts[i], path)) {
+        const std::string index = "scene.belts." + std::to_string(i);
+        for (const auto& kv : belts[i]) {
+          const std::string key = kv.first.Scalar();
+          // The line wins over the scene: a value set for the scene's belt
+          // on the command line would be lost without a word.
+          if (r.FromCommandLine(JoinPath(index, key))) {
+            r.Error(kv.second, JoinPath(index, key),
+                    "the scenario's line.belts." + std::to_string(i) + "." + key +
+                        " sets this belt value and overrides the scene's: set line.belts." +
+                        std::to_string(i) + "." + key + " instead");
+          }
+          item[key] = kv.second;
+          b.Derived(JoinPath(index, key), belts[i], path, key);
+        }
+        b.Origin(index, {belts[i], path, ""});
+      }
+      merged.push_back(item);
     }
     scene["belts"] = merged;
   }
+  if (scene.size() == 0) return models::OpenFloor();
   b.out()["scene"] = scene;
   // The scene as the system loader will read it; its problems are reported
   // now, at the keys the user wrote (the expansion stops on them, so they
