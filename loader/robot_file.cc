@@ -1,10 +1,13 @@
 #include "loader/robot_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
 #include <set>
 
+#include "cosim/variable_table.h"
+#include "loader/scenario.h"
 #include "loader/yaml_files.h"
 
 namespace linesim::loader {
@@ -41,6 +44,15 @@ class Reader {
     out.chassis_settings = Settings(root, "chassis");
     out.motor_settings = Settings(root, "motors");
     out.follower_settings = Settings(root, "path_follower");
+    // The robot's top speed and turn rate bound every task it is given.
+    for (const char* key : {"max_speed", "max_yaw_rate"}) {
+      if (!Child(out.follower_settings, key).IsDefined()) {
+        r_.Error(Child(root, "path_follower").IsDefined() ? Child(root, "path_follower") : root,
+                 JoinPath("path_follower", key),
+                 "missing required key: the robot's top speed (m/s) and yaw rate (rad/s) for its "
+                 "path follower");
+      }
+    }
     return out;
   }
 
@@ -134,10 +146,30 @@ class Reader {
   void Motor(const YAML::Node& motor, models::MotorGroup& group) {
     YamlReader::InFile in(r_, group.model_file);
     if (!r_.ExpectMap(motor, "")) return;
+    // The keys are the dc_motor unit's Real parameters.
+    const auto unit = CreateDefaultUnit("dc_motor");
+    std::vector<std::string> names;
+    for (const auto& info : unit->variables().infos()) {
+      if (info.causality == cosim::Causality::kParameter &&
+          (info.type == cosim::VarType::kReal || info.type == cosim::VarType::kRealArray)) {
+        names.push_back(info.name);
+      }
+    }
     for (const auto& kv : motor) {
       const std::string key = kv.first.Scalar();
       if (key == "source" || key == "description") continue;
+      if (std::find(names.begin(), names.end(), key) == names.end()) {
+        r_.UnknownPath(kv.first, key,
+                       "not a number parameter of a dc_motor unit" +
+                           ClosestPathsHint("", key, names));
+        continue;
+      }
       if (const auto v = r_.AsReal(kv.second, key)) group.motor[key] = *v;
+    }
+    for (const char* key : {"resistance", "torque_constant", "rotor_inertia"}) {
+      if (!group.motor.contains(key)) {
+        r_.Error(motor, key, "missing required key: the controllers' feedforwards need it");
+      }
     }
   }
 
@@ -216,12 +248,25 @@ class Reader {
     }
     if (!r_.ExpectMap(node, path)) return;
     const std::string kind = r_.String(node, path, "kind", std::nullopt, {"swerve", "differential"});
+    // A kind that is not one of them is reported once, above; its topology
+    // is not checked against a kind the file did not ask for.
+    if (!Child(node, "kind").IsScalar() || Child(node, "kind").Scalar() != kind) return;
     for (const auto& kv : node) {
       if (kv.first.Scalar() != "kind") out.controller_settings[kv.first.Scalar()] = kv.second;
     }
     const auto error = [&](const std::string& message) {
       r_.Error(Child(node, "kind"), JoinPath(path, "kind"), message);
     };
+    // Both controllers take one wheel radius for every wheel.
+    for (std::size_t i = 1; i < robot.wheels.size(); ++i) {
+      if (robot.wheels[i].radius_m != robot.wheels[0].radius_m) {
+        error("the " + kind + " controller takes one wheel radius for every wheel; wheel '" +
+              robot.wheels[i].name + "' has " + cosim::FormatValue(robot.wheels[i].radius_m) +
+              " m, wheel '" + robot.wheels[0].name + "' " +
+              cosim::FormatValue(robot.wheels[0].radius_m) + " m");
+        break;
+      }
+    }
     if (kind == "swerve") {
       robot.controller = models::ControllerKind::kSwerve;
       // Each wheel its own steering and drive motor: a swerve base.

@@ -72,14 +72,41 @@ void SystemBuilder::Origin(const std::string& expanded, loader::Origin origin) {
 }
 
 void SystemBuilder::MergeSettings(const std::string& unit, const YAML::Node& settings,
-                                  const std::string& file, const std::string& section) {
-  if (!settings.IsMap()) return;
+                                  const std::string& file, const std::string& section,
+                                  bool complete) {
   YAML::Node params = Params(unit);
-  for (const auto& kv : settings) {
-    const std::string key = kv.first.Scalar();
-    params[key] = kv.second;
-    origins_[JoinPath(JoinPath(JoinPath("units", unit), "parameters"), key)] = {
-        kv.second, JoinPath(section, key), file};
+  const std::string prefix = JoinPath(JoinPath("units", unit), "parameters");
+  if (settings.IsMap()) {
+    for (const auto& kv : settings) {
+      const std::string key = kv.first.Scalar();
+      // What the assembly derives (geometry, feedforwards, counts) has one
+      // source; a second one here would silently lose or win.
+      if (Child(params, key).IsDefined()) {
+        r_.Error(file, kv.second, JoinPath(section, key),
+                 "the assembly derives " + unit + "'s '" + key +
+                     "' from the robot's description (body, wheels, motor groups): leave it out "
+                     "here");
+        continue;
+      }
+      params[key] = kv.second;
+      origins_[JoinPath(prefix, key)] = {kv.second, JoinPath(section, key), file};
+    }
+  }
+  // Every parameter the unit has no default for must now be set: by the
+  // assembly or by this section of the robot file.
+  if (!complete) return;
+  const YAML::Node type = Child(Child(Child(out_, "units"), unit), "type");
+  const config::UnitType* unit_type = type.IsScalar() ? FindUnitType(type.Scalar()) : nullptr;
+  if (!unit_type) return;
+  const auto defaults = CreateDefaultUnit(*unit_type);
+  for (const auto& info : defaults->variables().infos()) {
+    if (info.causality != cosim::Causality::kParameter || !info.rule.required()) continue;
+    if (Child(params, info.name).IsDefined()) continue;
+    r_.Error(file, settings.IsMap() && settings.size() > 0 ? settings.begin()->second : YAML::Node(),
+             JoinPath(section, info.name),
+             "missing required key: the " + unit_type->name + " parameter '" + info.name +
+                 "' has no default (robot-specific)" +
+                 (info.description.empty() ? "" : ": " + info.description));
   }
 }
 

@@ -41,7 +41,7 @@ void AddMotors(SystemBuilder& b, const RobotFile& file) {
     }
     p[key] = List(values);
   }
-  b.MergeSettings(kMotors, file.motor_settings, robot.file, "motors");
+  b.MergeSettings(kMotors, file.motor_settings, robot.file, "motors", /*complete=*/false);
 }
 
 // The joint view of a motor group (the drive-train algebra of models/).
@@ -93,7 +93,6 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
   c["wheel_count"] = robot.wheels.size();
   c["steer_motor"] = IntList(s.wheel_steer_joint);
   c["drive_motor"] = IntList(s.wheel_drive_joint);
-  b.MergeSettings(kChassis, file.chassis_settings, robot.file, "chassis");
   c["body_length"] = Num(robot.body.length_m);
   c["body_width"] = Num(robot.body.width_m);
   c["body_height"] = Num(robot.body.height_m);
@@ -122,6 +121,8 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
   c["initial_x"] = Num(start.x_m);
   c["initial_y"] = Num(start.y_m);
   c["initial_yaw"] = Num(start.yaw_rad);
+  b.MergeSettings(kChassis, file.chassis_settings, robot.file, "chassis",
+                  /*complete=*/false);
   const YAML::Node pose = Child(Child(b.root(), "robot"), "pose");
   b.Derived("units.chassis.parameters.initial_x", pose, "robot.pose", "x_m");
   b.Derived("units.chassis.parameters.initial_y", pose, "robot.pose", "y_m");

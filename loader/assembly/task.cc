@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <numbers>
 
 #include "loader/assembly/concerns.h"
@@ -17,7 +18,6 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
   info.task = r.String(task, "task", "type", std::nullopt, {"path", "hold"});
   b.Unit(kPathFollower, "path_follower");
   YAML::Node p = b.Params(kPathFollower);
-  b.MergeSettings(kPathFollower, file.follower_settings, file.robot.file, "path_follower");
   const bool differential = file.robot.controller == models::ControllerKind::kDifferential;
   if (info.task == "path") {
     const YAML::Node waypoints = Child(task, "waypoints");
@@ -35,8 +35,11 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
       }
     }
     p["mode"] = "path";
-    // Paper 1, Table I: the Rob@Work 3's top speed is 1.2 m/s.
-    p["speed"] = Num(r.Real(task, "task", "speed_mps", 0.3, {0.0, 1.2, true}));
+    // Up to the robot's top speed (its description's path_follower.max_speed).
+    const double top_mps =
+        YamlReader::DecodeReal(Child(file.follower_settings, "max_speed")).value_or(0.0);
+    p["speed"] = Num(r.Real(task, "task", "speed_mps", std::min(0.3, top_mps),
+                            {0.0, top_mps, true}));
   } else if (info.task == "hold") {
     std::array<double, 2> point{start.x_m, start.y_m};
     if (Child(task, "point").IsDefined()) {
@@ -66,6 +69,9 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
   waypoints.SetStyle(YAML::EmitterStyle::Flow);
   for (const auto& pt : info.path) waypoints.push_back(List({pt[0], pt[1]}));
   p["waypoints"] = waypoints;
+
+  b.MergeSettings(kPathFollower, file.follower_settings, file.robot.file, "path_follower",
+                  /*complete=*/true);
 
   b.Connect(s.position, Signal(kPathFollower, "position"));
   b.Connect(s.yaw, Signal(kPathFollower, "yaw"));

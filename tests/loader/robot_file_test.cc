@@ -37,7 +37,8 @@ std::string Robot(const std::string& wheel0) {
          "motor_groups:\n"
          "  - {name: drive, model: maxon_re40_148877, gear_ratio: 20, gear_efficiency: 0.8,\n"
          "     motors: [left, right]}\n"
-         "controller: {kind: differential, effective_track: 0.8}\n";
+         "controller: {kind: differential, effective_track: 0.8}\n"
+         "path_follower: {max_speed: 1.0, max_yaw_rate: 1.0}\n";
 }
 
 const char* kLeft =

@@ -386,25 +386,38 @@ TEST(RobotScenario, UnknownKeyInTheRobotModelFileIsNamedThere) {
 }
 
 // Guards where a robot description's unit settings are reported: a value a
-// unit refuses, and a setting no unit has, are named in the robot file at
-// their line and key (chassis.contact_stiffness, controller.drive_kpp), not
-// at the expanded unit the user never wrote.
+// unit refuses, a setting no unit has, a required value the file leaves out
+// and a value the assembly derives are named in the robot file at their key
+// (chassis.contact_stiffness, controller.drive_kpp, controller.drive_kp,
+// chassis.mass), not at the expanded unit the user never wrote.
 TEST(RobotScenario, RobotFileSettingsAreReportedInTheRobotFile) {
   std::ifstream in(LINESIM_SOURCE_DIR "/models/robots/raw3.yaml");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto replace = [&](const std::string& from, const std::string& to) {
+  const std::string original((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
+  const auto edited = [&](const std::string& from, const std::string& to) {
+    std::string text = original;
     const auto at = text.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    text.replace(at, from.size(), to);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    return WriteScenario("raw3_edited.yaml", text);
   };
-  replace("contact_stiffness: 1.0e6", "contact_stiffness: -1");
-  replace("drive_kp: 0.5", "drive_kpp: 0.5");
-  const std::string model = WriteScenario("raw3_bad_settings.yaml", text);
-  const std::string e = Issues(kCross, {"robot.model=" + model});
+  std::string model = edited("contact_stiffness: 1.0e6", "contact_stiffness: -1\n  mass: 90");
+  std::string e = Issues(kCross, {"robot.model=" + model});
+  EXPECT_TRUE(Has(e, model + ":")) << e;
+  EXPECT_TRUE(Has(e, "chassis.mass: the assembly derives")) << e;
+  model = edited("contact_stiffness: 1.0e6", "contact_stiffness: -1");
+  e = Issues(kCross, {"robot.model=" + model});
   EXPECT_TRUE(Has(e, model + ":")) << e;
   EXPECT_TRUE(Has(e, "chassis.contact_stiffness: ")) << e;
-  EXPECT_TRUE(Has(e, "controller.drive_kpp: ")) << e;
   EXPECT_FALSE(Has(e, "units.chassis")) << e;
+  model = edited("drive_kp: 0.5", "drive_kp: 0.5\n  drive_kpp: 0.5");
+  e = Issues(kCross, {"robot.model=" + model});
+  EXPECT_TRUE(Has(e, model + ":")) << e;
+  EXPECT_TRUE(Has(e, "controller.drive_kpp: ")) << e;
+  model = edited("drive_kp: 0.5", "");
+  e = Issues(kCross, {"robot.model=" + model});
+  EXPECT_TRUE(Has(e, model + ":")) << e;
+  EXPECT_TRUE(Has(e, "controller.drive_kp: missing required key")) << e;
 }
 
 // Guards the pass-through: `units.NAME.parameters` in a robot scenario
