@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "cosim/variable_table.h"
 #include "loader/assembly/concerns.h"
 #include "loader/robot_file.h"
 
@@ -68,6 +69,40 @@ std::optional<double> PositiveChassisValue(assembly::SystemBuilder& b, const std
   return std::nullopt;
 }
 
+// The robot's start position must be on the scene's floor and outside its
+// obstacles and the objects its belts carry (at time zero): the physics
+// would otherwise start with the body inside a solid.
+void CheckStartPose(assembly::SystemBuilder& b, const models::Scene& scene,
+                    const assembly::StartPose& start) {
+  const YAML::Node pose = Child(Child(b.root(), "robot"), "pose");
+  const auto refuse = [&](const std::string& message) {
+    b.reader().Error(pose.IsDefined() ? pose : Child(b.root(), "robot"), "robot.pose", message);
+  };
+  const models::Floor& f = scene.floor;
+  if (start.x_m < f.min_x_m || start.x_m > f.max_x_m || start.y_m < f.min_y_m ||
+      start.y_m > f.max_y_m) {
+    refuse("(" + cosim::FormatValue(start.x_m) + ", " + cosim::FormatValue(start.y_m) +
+           ") m is off the scene's floor, x " + cosim::FormatValue(f.min_x_m) + " to " +
+           cosim::FormatValue(f.max_x_m) + " m, y " + cosim::FormatValue(f.min_y_m) + " to " +
+           cosim::FormatValue(f.max_y_m) + " m");
+  }
+  const auto inside = [&](const models::Solid& solid) {
+    const double dx = start.x_m - solid.x_m, dy = start.y_m - solid.y_m;
+    if (solid.kind == models::Solid::Kind::kCylinder) {
+      return std::hypot(dx, dy) < solid.radius_m;
+    }
+    const double c = std::cos(solid.yaw_rad), s = std::sin(solid.yaw_rad);
+    return std::abs(c * dx + s * dy) < 0.5 * solid.length_m &&
+           std::abs(-s * dx + c * dy) < 0.5 * solid.width_m;
+  };
+  for (const auto& o : scene.obstacles) {
+    if (inside(o.solid)) refuse("the robot would start inside obstacle '" + o.name + "'");
+  }
+  for (const auto& o : scene.carried) {
+    if (inside(o.solid)) refuse("the robot would start inside carried object '" + o.name + "'");
+  }
+}
+
 }  // namespace
 
 bool IsRobotScenario(const YAML::Node& root) {
@@ -96,6 +131,7 @@ YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
                     : ReadRobotFile(r, Child(robot, "model"), "robot.model", model, r.file());
 
   const models::Scene scene = assembly::AddScene(b);
+  CheckStartPose(b, scene, start);
   if (file) {
     assembly::Signals s = assembly::AddDriveTrain(b, *file, start, info);
     assembly::AddLine(b, scene, s);

@@ -456,6 +456,17 @@ models::Scene ReadScenarioScene(YamlReader& r, const YAML::Node& scene,
     if (scene.size() == 1) return alone;  // only `model`
   }
 
+  // Lists merge item by item: an empty one would silently remove nothing.
+  for (const auto& kv : scene) {
+    const YAML::Node own = Child(model, kv.first.Scalar());
+    if (kv.second.IsSequence() && kv.second.size() == 0 && own.IsSequence() && own.size() > 0) {
+      r.Error(kv.second, JoinPath("scene", kv.first.Scalar()),
+              "an empty list removes nothing: lists merge item by item onto the scene file's " +
+                  std::to_string(own.size()) + " items; to leave them out, write the scene "
+                  "without model");
+    }
+  }
+
   // Then the scenario's keys on top. What goes wrong now is the scenario's
   // doing: each problem is reported at the scenario's key path under
   // `scene`, at the line of the nearest node the scenario writes.

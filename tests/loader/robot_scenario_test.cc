@@ -420,6 +420,25 @@ TEST(RobotScenario, RobotFileSettingsAreReportedInTheRobotFile) {
   EXPECT_TRUE(Has(e, "controller.drive_kp: missing required key")) << e;
 }
 
+// Guards the start pose against the scene (models/scenes/factory_line.yaml):
+// off the 30 x 20 m floor, or inside the car body that starts at x = -7 m on
+// the line, is refused at robot.pose; a robot scenario with no scene and no
+// line runs on the open floor.
+TEST(RobotScenario, StartPoseMustBeOnTheFloorAndOutsideSolids) {
+  const std::string off = Issues(kCross, {"robot.pose.x_m=100"});
+  EXPECT_TRUE(Has(off, "robot.pose: (100, -2) m is off the scene's floor")) << off;
+  const std::string in_car = Issues(kCross, {"robot.pose.x_m=-7", "robot.pose.y_m=0"});
+  EXPECT_TRUE(Has(in_car, "inside carried object 'body_1'")) << in_car;
+  const std::string f = WriteScenario("robot_no_scene.yaml", R"(name: bare
+duration_s: 1
+robot: {model: raw3, pose: {x_m: 100, y_m: 0, yaw_deg: 0}}
+task: {type: hold}
+)");
+  const Scenario s = LoadScenario(f);
+  EXPECT_EQ(s.scene.name, "open_floor");
+  EXPECT_FALSE(s.system->FindUnit("belt"));
+}
+
 // Guards the pass-through: `units.NAME.parameters` in a robot scenario
 // overrides the expansion (so every unit parameter is sweepable), and an
 // unknown parameter there is reported at that path.

@@ -211,6 +211,16 @@ TEST(ScenarioScene, SetReachesTheNamedSceneFile) {
   EXPECT_TRUE(Has(typo, "scene.belt")) << typo;
 }
 
+// Guards the merge by index: an empty list would silently remove nothing
+// from the scene file's list, so it is refused at its key.
+TEST(ScenarioScene, EmptyListOverTheFilesItemsIsRefused) {
+  const std::string f = WriteScenario("empty_list.yaml", std::string(kValidScenario) +
+                                                             "scene: {model: factory_line}\n");
+  const std::string e = Issues(f, {"scene.obstacles=[]"});
+  EXPECT_TRUE(Has(e, "scene.obstacles (set on the command line): an empty list removes nothing"))
+      << e;
+}
+
 TEST(ScenarioScene, ProblemsAreReportedWhereTheyAreWritten) {
   const std::string f = WriteScenario("bad_merge.yaml", std::string(kValidScenario) + R"(scene:
   model: factory_line
