@@ -145,32 +145,44 @@ PathFollowerUnit::Sample PathFollowerUnit::EvaluateDifferentialPath(
     const models::PolylinePoint& n) const {
   Sample s;
   const auto& goal = waypoints_m_.back();
-  s.at_goal = done_latched_ ||
-              std::hypot(position_[0] - goal[0], position_[1] - goal[1]) <= goal_tolerance_;
+  const double to_goal_m = std::hypot(position_[0] - goal[0], position_[1] - goal[1]);
+  s.at_goal = done_latched_ || to_goal_m <= goal_tolerance_;
   if (!n.found) return s;
   s.progress_m = n.progress_m;
   s.cross_track_m = n.cross_track_m;
   if (s.at_goal) return s;
   const std::size_t i = active_segment_;
+  const bool last = i + 2 == waypoints_m_.size();
   const OnSegment on = ProjectOnSegment(i);
-  const double remaining = length_m() - s.progress_m;
+  // The distance left: along the path, and on the last segment straight to
+  // the goal (>= the distance along it: never 0 while the robot is beside
+  // the goal, outside goal_tolerance).
+  const double remaining = last ? on.to_end_m : length_m() - s.progress_m;
+  const double left = last ? to_goal_m : std::abs(remaining);
   const double corner = ToSharpCorner(on);
-  const double magnitude = std::min(
-      {ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * std::abs(remaining)),
-       k_position_ * std::abs(remaining), std::sqrt(2.0 * acceleration_ * std::max(corner, 0.0))});
+  const double magnitude =
+      std::min({ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * left), k_position_ * left,
+                std::sqrt(2.0 * acceleration_ * std::max(corner, 0.0))});
   const double length = cumulative_m_[i + 1] - cumulative_m_[i];
   const double tx = (waypoints_m_[i + 1][0] - waypoints_m_[i][0]) / length;
   const double ty = (waypoints_m_[i + 1][1] - waypoints_m_[i][1]) / length;
-  const double direction = std::copysign(1.0, remaining);
-  // a = sgn(r) t speed - n k_cross e, n = (-ty, tx).
-  const double aim_x = direction * tx * speed_ + ty * k_cross_ * on.cross_track_m;
-  const double aim_y = direction * ty * speed_ - tx * k_cross_ * on.cross_track_m;
+  // a = t along - n k_cross e, n = (-ty, tx): along = sgn(r) speed, and on
+  // the last segment within speed / k_cross of the goal along it, k_cross r,
+  // so that a = k_cross (goal - p) points at the goal.
+  double along = std::copysign(speed_, remaining);
+  if (last && k_cross_ > 0.0 && k_cross_ * std::abs(remaining) < speed_) {
+    along = k_cross_ * remaining;
+  }
+  const double aim_x = tx * along + ty * k_cross_ * on.cross_track_m;
+  const double aim_y = ty * along - tx * k_cross_ * on.cross_track_m;
   const double h = models::WrapAngle(std::atan2(aim_y, aim_x) - yaw_measured_);
   s.yaw_rate_rad_s = std::clamp(k_yaw_ * h, -max_yaw_rate_, max_yaw_rate_);
   if (std::abs(h) > turn_in_place_angle_) return s;  // turn in place: the ramp starts again
+  // The aim already points towards the goal (backwards along the path past
+  // it): the robot drives forwards along it.
   const double cos_h = std::cos(h);
-  s.along_mps = direction * magnitude * cos_h;
-  s.forward_mps = direction * std::min(magnitude * cos_h, max_speed_);
+  s.along_mps = magnitude * cos_h;
+  s.forward_mps = std::min(magnitude * cos_h, max_speed_);
   return s;
 }
 

@@ -45,7 +45,13 @@ namespace linesim::control {
 ///         from its line (+ left), the aim is
 ///           a = sgn(r) t_i speed - n_i k_cross e_i,
 ///         r the distance left along the path to the goal (nearest point,
-///         as above; past the goal the robot backs up by turning round).
+///         as above; on the last segment, from the projection on it), and
+///         on the last segment, once k_cross |r| < speed,
+///           a = t_i k_cross r - n_i k_cross e_i = k_cross (goal - p):
+///         the robot aims AT the goal (continuous at k_cross |r| = speed),
+///         so a sideways offset at the goal's perpendicular is driven out
+///         too. The aim points towards the goal (past it, backwards along
+///         the path): the robot turns round and drives forwards along it.
 ///         The aim never vanishes, and its direction depends on the active
 ///         segment only, not on which segment is nearest: no flipping when
 ///         the commanded speed is small (at the start, at a corner), and at
@@ -54,7 +60,9 @@ namespace linesim::control {
 ///         cross-track error obeys e'' + k_yaw e' + k_yaw k_cross e = 0
 ///         (linearised; slower at lower speed, never less damped); with
 ///         k_yaw >= 4 k_cross it is not oscillatory.
-///         Along-track speed: the ramp and the goal as above, and, for a
+///         Along-track speed: the ramp and the goal as above (on the last
+///         segment d is the straight-line distance to the goal, never 0
+///         outside goal_tolerance: no stall beside the goal), and, for a
 ///         SHARP corner (an interior waypoint whose heading change exceeds
 ///         turn_in_place_angle, where the robot must turn in place),
 ///           |v_along| <= sqrt(2 acceleration D),
@@ -75,7 +83,8 @@ namespace linesim::control {
 /// With h = wrap(atan2(aim) - psi) (hold backward: wrap(atan2(-d) - psi)):
 ///   |h| > turn_in_place_angle: v = 0 (turn in place: at the start and at
 ///                              sharp corners),
-///   otherwise:                 path v = sgn(r) |v_along| cos h,
+///   otherwise:                 path v = |v_along| cos h (forwards:
+///                              the aim already points to the goal),
 ///                              hold v = +-|d| cos h,
 ///   yaw rate = k_yaw h, clamped to max_yaw_rate; |v| clamped to max_speed.
 /// The along-track ramp continues from |v_along| cos h (0 while turning in

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cosim/time.h"
@@ -597,6 +598,70 @@ TEST(PathFollowerUnitDifferential, SaveStepRestoreStepThroughACorner) {
   cosim::UnitState bad = saved;
   bad.integers[1] = 3;  // three segments: 0, 1, 2
   EXPECT_THROW(fresh.RestoreState(bad), cosim::UnitError);
+}
+
+// Guards the differential base past the goal, path (0,0) -> (2,0), the
+// robot 0.3 m beyond the goal facing away from it (defaults): the aim
+// points back at the goal, so the robot turns round in place (no motion
+// while the heading error exceeds turn_in_place_angle) and drives FORWARDS
+// to the goal: the forward command is never negative (the law once drove
+// the turned robot backwards, away from the goal, and never finished), the
+// robot never gets farther from the goal than at the start, and done
+// latches within goal_tolerance of it.
+TEST(PathFollowerUnitDifferential, PastTheGoalTurnsRoundAndDrivesToIt) {
+  PathFollowerUnit u("f", Mode::kPath, {{0, 0}, {2, 0}}, Base::kDifferential);
+  Unicycle r;
+  r.x = 2.3;
+  SetPose(u, r.x, r.y, r.yaw);
+  u.Initialize();
+  EXPECT_EQ(Twist(u)[0], 0.0);  // turn in place first
+  double farthest = 0.0;
+  int k = 0;
+  for (; k < 3000 && !Done(u); ++k) {
+    const auto cmd = Sample(u, r, k);
+    ASSERT_GE(cmd[0], 0.0) << k;
+    r.Move(cmd[0], cmd[2], kPeriodS);
+    farthest = std::max(farthest, std::hypot(r.x - 2.0, r.y));
+  }
+  std::cout << "differential past the goal: done after " << k * kPeriodS << " s at (" << r.x
+            << ", " << r.y << ")\n";
+  ASSERT_TRUE(Done(u));
+  EXPECT_LE(std::hypot(r.x - 2.0, r.y), Real(u, "goal_tolerance"));
+  EXPECT_LE(farthest, 0.3 + 1e-9);
+  // A half turn at the 0.5 rad/s limit (6.3 s) and 0.3 m: well inside 15 s.
+  EXPECT_LT(k * kPeriodS, 15.0);
+}
+
+// Guards the differential base beside the goal, path (0,0) -> (2,0): a
+// robot whose projection reaches the goal's perpendicular with a sideways
+// offset beyond goal_tolerance must still reach the goal (the approach
+// speed once depended on the distance left ALONG the path only: 0 on the
+// perpendicular, the robot stalled at (2.000, 0.068) and done never
+// latched). On the last segment the speed is limited by the straight-line
+// distance to the goal, and near it the aim points at the goal. Two starts:
+// 0.3 m left of the path 0.4 m before the goal, and exactly on the goal's
+// perpendicular 0.1 m to the side; both finish forwards, within 10 s.
+TEST(PathFollowerUnitDifferential, BesideTheGoalStillReachesIt) {
+  for (const auto& [x0, y0] : {std::pair{1.6, 0.3}, std::pair{2.0, 0.1}}) {
+    PathFollowerUnit u("f", Mode::kPath, {{0, 0}, {2, 0}}, Base::kDifferential);
+    Unicycle r;
+    r.x = x0;
+    r.y = y0;
+    SetPose(u, r.x, r.y, r.yaw);
+    u.Initialize();
+    int k = 0;
+    for (; k < 3000 && !Done(u); ++k) {
+      const auto cmd = Sample(u, r, k);
+      ASSERT_GE(cmd[0], 0.0) << k;
+      r.Move(cmd[0], cmd[2], kPeriodS);
+    }
+    std::cout << "differential beside the goal from (" << x0 << ", " << y0 << "): done after "
+              << k * kPeriodS << " s at (" << r.x << ", " << r.y << ")\n";
+    ASSERT_TRUE(Done(u)) << x0 << ", " << y0 << ": stopped at (" << r.x << ", " << r.y << ")";
+    EXPECT_LE(std::hypot(r.x - 2.0, r.y), Real(u, "goal_tolerance"));
+    EXPECT_LT(k * kPeriodS, 10.0);
+    EXPECT_EQ(Sample(u, r, k), (std::vector<double>{0.0, 0.0, 0.0}));
+  }
 }
 
 // Guards the hold law of the differential base: a point behind is reached
