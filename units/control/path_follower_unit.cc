@@ -36,19 +36,25 @@ PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
   v.Parameter("k_cross", "1/s", &k_cross_, "cross-track gain", Rule::NonNegative());
   v.Parameter("k_position", "1/s", &k_position_,
               "position gain: along-track near the goal, and in hold mode", Rule::Positive());
-  v.Parameter("k_yaw", "1/s", &k_yaw_, "heading gain", Rule::NonNegative());
+  // The differential base steers only by the yaw rate: a heading gain or a
+  // yaw-rate limit of 0 would leave it unable to turn (frozen at the start
+  // or at the first corner). The omnidirectional base may switch it off.
+  const bool differential = base_ == Base::kDifferential;
+  v.Parameter("k_yaw", "1/s", &k_yaw_, "heading gain",
+              differential ? Rule::Positive() : Rule::NonNegative());
   v.Parameter("max_speed", "m/s", &max_speed_, "limit on the commanded translation speed",
               Rule::Positive());
   v.Parameter("max_yaw_rate", "rad/s", &max_yaw_rate_, "limit on the commanded yaw rate",
-              Rule::NonNegative());
+              differential ? Rule::Positive() : Rule::NonNegative());
   v.Parameter("goal_tolerance", "m", &goal_tolerance_,
               "distance from the goal (hold: the point) counted as arrived", Rule::Positive());
-  if (base_ == Base::kDifferential) {
-    // Below pi/2: at pi/2 the robot would drive across its path.
+  if (differential) {
+    // Below pi/2: at pi/2 the robot would drive across its path. Above 0:
+    // at 0 any heading error stops the robot, which then never drives.
     v.Parameter("turn_in_place_angle", "rad", &turn_in_place_angle_,
                 "heading error beyond which the robot stops and turns in place; a path corner "
                 "turning more than this is sharp (the robot stops at it)",
-                Rule::Range(0.0, true, 0.5 * std::numbers::pi, false));
+                Rule::Range(0.0, false, 0.5 * std::numbers::pi, false));
   }
   v.Input("position", "m", &position_, "x, y of base_link in map");
   v.Input("yaw", "rad", &yaw_measured_, "heading of base_link in map");

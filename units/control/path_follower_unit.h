@@ -103,7 +103,9 @@ class PathFollowerUnit : public cosim::Unit {
 
   /// kPath needs at least two waypoints without zero-length segments, kHold
   /// at least one (extra ones are ignored); CheckParameters reports them.
-  /// The differential base adds the parameter turn_in_place_angle.
+  /// The differential base adds the parameter turn_in_place_angle, in
+  /// (0, pi/2), and requires k_yaw and max_yaw_rate > 0 (it turns only by
+  /// the yaw rate; the omnidirectional base may switch them off with 0).
   PathFollowerUnit(std::string name, Mode mode, std::vector<std::array<double, 2>> waypoints_m,
                    Base base = Base::kOmnidirectional);
 

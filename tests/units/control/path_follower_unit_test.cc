@@ -373,12 +373,34 @@ TEST(PathFollowerUnitDifferential, VariableTableAndRange) {
   // Declared with the parameter (the table's rule), not in CheckParameters.
   const auto& v = u.variables();
   EXPECT_EQ(v.info(*v.Find("speed")).rule.Text(), "> 0");
-  EXPECT_EQ(v.info(*v.Find("k_yaw")).rule.Text(), ">= 0");
   EXPECT_EQ(v.info(*v.Find("heading")).rule.Text(), "finite");
+  // The differential base turns only by the yaw rate: k_yaw and
+  // max_yaw_rate must be > 0 (0 froze it); the omnidirectional base may
+  // switch its heading loop off.
+  EXPECT_EQ(v.info(*v.Find("k_yaw")).rule.Text(), "> 0");
+  EXPECT_EQ(v.info(*v.Find("max_yaw_rate")).rule.Text(), "> 0");
+  EXPECT_EQ(omni.variables().info(*omni.variables().Find("k_yaw")).rule.Text(), ">= 0");
+  EXPECT_EQ(omni.variables().info(*omni.variables().Find("max_yaw_rate")).rule.Text(), ">= 0");
+  // turn_in_place_angle in (0, pi/2): at 0 the robot never drives.
   const cosim::Rule& angle = v.info(*v.Find("turn_in_place_angle")).rule;
   ASSERT_TRUE(angle.Violation(kPi / 2));
-  EXPECT_EQ(angle.Violation(kPi / 2)->rfind("must be in [0, ", 0), 0u) << *angle.Violation(kPi / 2);
-  EXPECT_FALSE(angle.Violation(0.0));
+  EXPECT_EQ(angle.Violation(kPi / 2)->rfind("must be in (0, ", 0), 0u) << *angle.Violation(kPi / 2);
+  ASSERT_TRUE(angle.Violation(0.0));
+  EXPECT_EQ(angle.Violation(0.0)->rfind("must be in (0, ", 0), 0u) << *angle.Violation(0.0);
+  EXPECT_FALSE(angle.Violation(1e-3));
+  PathFollowerUnit frozen("f", Mode::kPath, {{0, 0}, {1, 0}}, Base::kDifferential);
+  SetParam(frozen, "turn_in_place_angle", 0.0);
+  SetParam(frozen, "k_yaw", 0.0);
+  SetParam(frozen, "max_yaw_rate", 0.0);
+  std::vector<std::string> refused;
+  for (const auto& p : frozen.CheckParameters()) refused.push_back(p.variable);
+  std::sort(refused.begin(), refused.end());
+  EXPECT_EQ(refused, (std::vector<std::string>{"k_yaw", "max_yaw_rate", "turn_in_place_angle"}));
+  EXPECT_THROW(frozen.Initialize(), cosim::UnitError);
+  PathFollowerUnit omni_off("f", Mode::kPath, {{0, 0}, {1, 0}});
+  SetParam(omni_off, "k_yaw", 0.0);
+  SetParam(omni_off, "max_yaw_rate", 0.0);
+  EXPECT_TRUE(omni_off.CheckParameters().empty());
 }
 
 // Guards the differential law on an L-shaped path (0,0) -> (2,0) -> (2,2),
