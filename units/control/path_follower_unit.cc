@@ -74,6 +74,22 @@ PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
            {"position"});
   v.Output("done", &done_, "path: the goal was reached (latched); hold: within tolerance",
            {"position"});
+  FindSharpCorners();
+}
+
+void PathFollowerUnit::FindSharpCorners() {
+  sharp_corner_after_m_.clear();
+  if (!SavesSegment() || waypoints_m_.size() < 2) return;
+  // Backwards: the next sharp corner at or after the end of each segment.
+  // The distance is only used on a valid path (CheckParameters).
+  const std::size_t segments = waypoints_m_.size() - 1;
+  sharp_corner_after_m_.assign(segments, std::numeric_limits<double>::infinity());
+  std::size_t next = 0;  // 0: none ahead
+  for (std::size_t i = segments; i-- > 0;) {
+    const std::size_t k = i + 1;  // the waypoint at the end of segment i
+    if (k + 1 < waypoints_m_.size() && SharpCorner(k)) next = k;
+    if (next != 0) sharp_corner_after_m_[i] = cumulative_m_[next] - cumulative_m_[k];
+  }
 }
 
 bool PathFollowerUnit::ZeroSegment(std::size_t k) const {
@@ -116,6 +132,7 @@ std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
 
 void PathFollowerUnit::Initialize() {
   ThrowIfBadParameters();
+  FindSharpCorners();  // turn_in_place_angle is locked from here on
   ramp_mps_ = 0.0;
   done_latched_ = false;
   active_segment_ = 0;
@@ -141,10 +158,7 @@ PathFollowerUnit::OnSegment PathFollowerUnit::ProjectOnSegment(std::size_t i) co
 }
 
 double PathFollowerUnit::ToSharpCorner(const OnSegment& on) const {
-  for (std::size_t k = active_segment_ + 1; k + 1 < waypoints_m_.size(); ++k) {
-    if (SharpCorner(k)) return cumulative_m_[k] - cumulative_m_[active_segment_ + 1] + on.to_end_m;
-  }
-  return std::numeric_limits<double>::infinity();
+  return sharp_corner_after_m_[active_segment_] + on.to_end_m;
 }
 
 PathFollowerUnit::Sample PathFollowerUnit::EvaluateDifferentialPath(
@@ -337,6 +351,7 @@ void PathFollowerUnit::RestoreInternal(const cosim::UnitState& state) {
                            " reals and " + std::to_string(state.integers.size()) +
                            " integers, expected 1 and " + std::to_string(integers));
   }
+  FindSharpCorners();  // restored into a unit not initialized since a parameter change
   ramp_mps_ = state.reals[0];
   done_latched_ = state.integers[0] != 0;
   if (SavesSegment()) {

@@ -161,8 +161,13 @@ class PathFollowerUnit : public cosim::Unit {
   };
   OnSegment ProjectOnSegment(std::size_t i) const;
   /// Differential path: the distance along the path from the projection on
-  /// the active segment to the next sharp corner (infinity: none ahead).
+  /// the active segment to the next sharp corner (infinity: none ahead),
+  /// from the table sharp_corner_after_m_.
   double ToSharpCorner(const OnSegment& on) const;
+  /// Differential path: fills sharp_corner_after_m_ from the waypoints and
+  /// turn_in_place_angle (at construction, Initialize and restore: not per
+  /// step; the parameters are locked after Initialize).
+  void FindSharpCorners();
   /// Whether interior waypoint k turns the path by more than
   /// turn_in_place_angle (the robot must stop there and turn in place).
   bool SharpCorner(std::size_t k) const;
@@ -175,6 +180,9 @@ class PathFollowerUnit : public cosim::Unit {
   std::vector<std::array<double, 2>> waypoints_m_;
   // Path length at each waypoint (path mode), once for the search.
   std::vector<double> cumulative_m_;
+  // Differential path: per segment, the distance along the path from its
+  // end to the next sharp corner (infinity: none ahead). Empty otherwise.
+  std::vector<double> sharp_corner_after_m_;
 
   // Parameters.
   double speed_ = 0.3;

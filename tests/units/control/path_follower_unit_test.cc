@@ -585,6 +585,29 @@ TEST(PathFollowerUnitDifferential, DrivesThroughAGentleCorner) {
   EXPECT_GT(slowest_near_corner, 0.15);
 }
 
+// Guards the table of sharp corners (computed once, not per step): it
+// follows turn_in_place_angle as set before Initialize. The same 0.3 rad
+// corner is sharp for a 0.2 rad turn_in_place_angle: the robot stops at
+// it (within a T^2 / 2 sample of it, the forward command is 0 there) and
+// turns in place, where at 0.5 rad it drove through.
+TEST(PathFollowerUnitDifferential, SharpCornersFollowTheAngleSetBeforeInitialize) {
+  const double c = std::cos(0.3), s = std::sin(0.3);
+  PathFollowerUnit u("f", Mode::kPath, {{0, 0}, {2, 0}, {2 + 2 * c, 2 * s}}, Base::kDifferential);
+  SetParam(u, "turn_in_place_angle", 0.2);
+  Unicycle r;
+  SetPose(u, r.x, r.y, r.yaw);
+  u.Initialize();
+  double slowest_near_corner = 1.0;
+  int k = 0;
+  for (; k < 3000 && !Done(u); ++k) {
+    const auto cmd = Sample(u, r, k);
+    if (std::hypot(r.x - 2.0, r.y) < 0.2) slowest_near_corner = std::min(slowest_near_corner, cmd[0]);
+    r.Move(cmd[0], cmd[2], kPeriodS);
+  }
+  ASSERT_TRUE(Done(u));
+  EXPECT_EQ(slowest_near_corner, 0.0);
+}
+
 // Guards the saved state of the differential base: the active segment is
 // saved and restored (a restored unit continues bit for bit through a
 // corner), and a segment that is not one of the path is refused.
