@@ -233,8 +233,6 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const models::PolylinePoint&
           std::min({ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * std::abs(remaining)),
                     k_position_ * std::abs(remaining)});
       s.along_mps = std::copysign(magnitude, remaining);
-      s.toward_goal_x = std::copysign(1.0, remaining) * n.tangent_x;
-      s.toward_goal_y = std::copysign(1.0, remaining) * n.tangent_y;
       s.vx_map_mps = n.tangent_x * s.along_mps + n.tangent_y * k_cross_ * n.cross_track_m;
       s.vy_map_mps = n.tangent_y * s.along_mps - n.tangent_x * k_cross_ * n.cross_track_m;
     }
@@ -244,8 +242,8 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const models::PolylinePoint&
       s.vx_map_mps = s.vy_map_mps = s.along_mps = 0.0;
     }
   }
-  if (base_ == Base::kDifferential) {
-    SteerDifferential(s);
+  if (base_ == Base::kDifferential) {  // hold mode: the path mode returned above
+    SteerHold(s);
     return s;
   }
   const double speed = std::hypot(s.vx_map_mps, s.vy_map_mps);
@@ -260,35 +258,25 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const models::PolylinePoint&
   return s;
 }
 
-void PathFollowerUnit::SteerDifferential(Sample& s) const {
-  const double speed = std::hypot(s.vx_map_mps, s.vy_map_mps);
+void PathFollowerUnit::SteerHold(Sample& s) const {
+  // The hold law leaves the along-track speed at 0 (no ramp in hold).
   s.forward_mps = 0.0;
   s.yaw_rate_rad_s = 0.0;
-  double aim_x = s.vx_map_mps, aim_y = s.vy_map_mps;
-  if (!(speed > 0.0)) {
-    aim_x = s.toward_goal_x;
-    aim_y = s.toward_goal_y;
-  }
-  if (s.at_goal || (aim_x == 0.0 && aim_y == 0.0)) {
-    s.along_mps = 0.0;
-    return;
-  }
-  double h = models::WrapAngle(std::atan2(aim_y, aim_x) - yaw_measured_);
+  // Outside goal_tolerance (> 0) the velocity -k_position (p - p_ref) is
+  // not zero (k_position > 0): it has a direction.
+  if (s.at_goal) return;
+  const double speed = std::hypot(s.vx_map_mps, s.vy_map_mps);
+  double h = models::WrapAngle(std::atan2(s.vy_map_mps, s.vx_map_mps) - yaw_measured_);
   double direction = 1.0;
-  // Hold: backing up is as good as driving forward, and needs less turning
-  // when the point is behind.
-  if (mode_ == Mode::kHold && std::abs(h) > 0.5 * std::numbers::pi) {
+  // Backing up is as good as driving forward, and needs less turning when
+  // the point is behind.
+  if (std::abs(h) > 0.5 * std::numbers::pi) {
     h = models::WrapAngle(h - std::numbers::pi);
     direction = -1.0;
   }
   s.yaw_rate_rad_s = std::clamp(k_yaw_ * h, -max_yaw_rate_, max_yaw_rate_);
-  if (std::abs(h) > turn_in_place_angle_) {
-    s.along_mps = 0.0;  // the ramp starts again after the turn
-    return;
-  }
-  const double cos_h = std::cos(h);
-  s.forward_mps = direction * std::min(speed * cos_h, max_speed_);
-  s.along_mps *= cos_h;
+  if (std::abs(h) > turn_in_place_angle_) return;  // turn in place
+  s.forward_mps = direction * std::min(speed * std::cos(h), max_speed_);
 }
 
 void PathFollowerUnit::ComputeOutputs(const models::PolylinePoint& n) {

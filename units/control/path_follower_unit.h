@@ -133,9 +133,6 @@ class PathFollowerUnit : public cosim::Unit {
     // Differential base: the forward speed command (the body velocity is
     // [forward, 0]); the omnidirectional base rotates the map velocity.
     double forward_mps = 0.0;
-    // Path mode: the path direction towards the goal, the heading to aim
-    // for when the desired velocity is zero (at the start: ramp at 0).
-    double toward_goal_x = 0.0, toward_goal_y = 0.0;
     double along_mps = 0.0;  // path mode: the along-track speed used
     double cross_track_m = 0.0, progress_m = 0.0;
     bool at_goal = false;
@@ -149,9 +146,10 @@ class PathFollowerUnit : public cosim::Unit {
   models::PolylinePoint FindNearest() const;
   /// The command for the position whose nearest path point is n, from the state.
   Sample Evaluate(const models::PolylinePoint& n) const;
-  /// The differential base's steering of the heading onto the direction of
-  /// the desired map velocity in s (see the class comment).
-  void SteerDifferential(Sample& s) const;
+  /// The differential base in hold mode: steers the heading onto the
+  /// direction of the hold velocity in s, forwards or backwards, and sets
+  /// the forward speed (see the class comment).
+  void SteerHold(Sample& s) const;
   /// The differential base in path mode (see the class comment).
   Sample EvaluateDifferentialPath(const models::PolylinePoint& n) const;
   /// Differential path: the robot's projection on segment i, as the
