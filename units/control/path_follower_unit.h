@@ -46,13 +46,16 @@ namespace linesim::control {
 ///           a = sgn(r) t_i speed - n_i k_cross e_i,
 ///         r the distance left along the path to the goal (nearest point,
 ///         as above; on the last segment, from the projection on it), and
-///         on the last segment, once k_cross |r| < speed,
+///         on the last segment, once k_cross |r| < speed (k_cross > 0),
 ///           a = t_i k_cross r - n_i k_cross e_i = k_cross (goal - p):
-///         the robot aims AT the goal (continuous at k_cross |r| = speed),
-///         so a sideways offset at the goal's perpendicular is driven out
-///         too. The aim points towards the goal (past it, backwards along
-///         the path): the robot turns round and drives forwards along it.
-///         The aim never vanishes, and its direction depends on the active
+///         the robot aims AT the goal (continuous at k_cross |r| = speed;
+///         the ratio e / r then stays constant: a straight line to the
+///         goal), so a sideways offset at the goal's perpendicular is
+///         driven out too. The aim points towards the goal (past it,
+///         backwards along the path): the robot turns round and drives
+///         forwards along it, never backwards.
+///         The aim vanishes only at the goal (done has latched there:
+///         goal_tolerance > 0), and its direction depends on the active
 ///         segment only, not on which segment is nearest: no flipping when
 ///         the commanded speed is small (at the start, at a corner), and at
 ///         a corner the robot turns onto the next tangent, not across it.
