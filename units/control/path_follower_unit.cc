@@ -36,19 +36,25 @@ PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
   v.Parameter("k_cross", "1/s", &k_cross_, "cross-track gain", Rule::NonNegative());
   v.Parameter("k_position", "1/s", &k_position_,
               "position gain: along-track near the goal, and in hold mode", Rule::Positive());
-  v.Parameter("k_yaw", "1/s", &k_yaw_, "heading gain", Rule::NonNegative());
+  // The differential base steers only by the yaw rate: a heading gain or a
+  // yaw-rate limit of 0 would leave it unable to turn (frozen at the start
+  // or at the first corner). The omnidirectional base may switch it off.
+  const bool differential = base_ == Base::kDifferential;
+  v.Parameter("k_yaw", "1/s", &k_yaw_, "heading gain",
+              differential ? Rule::Positive() : Rule::NonNegative());
   v.Parameter("max_speed", "m/s", &max_speed_, "limit on the commanded translation speed",
               Rule::Positive());
   v.Parameter("max_yaw_rate", "rad/s", &max_yaw_rate_, "limit on the commanded yaw rate",
-              Rule::NonNegative());
+              differential ? Rule::Positive() : Rule::NonNegative());
   v.Parameter("goal_tolerance", "m", &goal_tolerance_,
               "distance from the goal (hold: the point) counted as arrived", Rule::Positive());
-  if (base_ == Base::kDifferential) {
-    // Below pi/2: at pi/2 the robot would drive across its path.
+  if (differential) {
+    // Below pi/2: at pi/2 the robot would drive across its path. Above 0:
+    // at 0 any heading error stops the robot, which then never drives.
     v.Parameter("turn_in_place_angle", "rad", &turn_in_place_angle_,
                 "heading error beyond which the robot stops and turns in place; a path corner "
                 "turning more than this is sharp (the robot stops at it)",
-                Rule::Range(0.0, true, 0.5 * std::numbers::pi, false));
+                Rule::Range(0.0, false, 0.5 * std::numbers::pi, false));
   }
   v.Input("position", "m", &position_, "x, y of base_link in map");
   v.Input("yaw", "rad", &yaw_measured_, "heading of base_link in map");
@@ -68,6 +74,22 @@ PathFollowerUnit::PathFollowerUnit(std::string name, Mode mode,
            {"position"});
   v.Output("done", &done_, "path: the goal was reached (latched); hold: within tolerance",
            {"position"});
+  FindSharpCorners();
+}
+
+void PathFollowerUnit::FindSharpCorners() {
+  sharp_corner_after_m_.clear();
+  if (!SavesSegment() || waypoints_m_.size() < 2) return;
+  // Backwards: the next sharp corner at or after the end of each segment.
+  // The distance is only used on a valid path (CheckParameters).
+  const std::size_t segments = waypoints_m_.size() - 1;
+  sharp_corner_after_m_.assign(segments, std::numeric_limits<double>::infinity());
+  std::size_t next = 0;  // 0: none ahead
+  for (std::size_t i = segments; i-- > 0;) {
+    const std::size_t k = i + 1;  // the waypoint at the end of segment i
+    if (k + 1 < waypoints_m_.size() && SharpCorner(k)) next = k;
+    if (next != 0) sharp_corner_after_m_[i] = cumulative_m_[next] - cumulative_m_[k];
+  }
 }
 
 bool PathFollowerUnit::ZeroSegment(std::size_t k) const {
@@ -110,6 +132,7 @@ std::vector<cosim::ParameterProblem> PathFollowerUnit::CheckParameters() const {
 
 void PathFollowerUnit::Initialize() {
   ThrowIfBadParameters();
+  FindSharpCorners();  // turn_in_place_angle is locked from here on
   ramp_mps_ = 0.0;
   done_latched_ = false;
   active_segment_ = 0;
@@ -135,42 +158,51 @@ PathFollowerUnit::OnSegment PathFollowerUnit::ProjectOnSegment(std::size_t i) co
 }
 
 double PathFollowerUnit::ToSharpCorner(const OnSegment& on) const {
-  for (std::size_t k = active_segment_ + 1; k + 1 < waypoints_m_.size(); ++k) {
-    if (SharpCorner(k)) return cumulative_m_[k] - cumulative_m_[active_segment_ + 1] + on.to_end_m;
-  }
-  return std::numeric_limits<double>::infinity();
+  return sharp_corner_after_m_[active_segment_] + on.to_end_m;
 }
 
 PathFollowerUnit::Sample PathFollowerUnit::EvaluateDifferentialPath(
     const models::PolylinePoint& n) const {
   Sample s;
   const auto& goal = waypoints_m_.back();
-  s.at_goal = done_latched_ ||
-              std::hypot(position_[0] - goal[0], position_[1] - goal[1]) <= goal_tolerance_;
+  const double to_goal_m = std::hypot(position_[0] - goal[0], position_[1] - goal[1]);
+  s.at_goal = done_latched_ || to_goal_m <= goal_tolerance_;
   if (!n.found) return s;
   s.progress_m = n.progress_m;
   s.cross_track_m = n.cross_track_m;
   if (s.at_goal) return s;
   const std::size_t i = active_segment_;
+  const bool last = i + 2 == waypoints_m_.size();
   const OnSegment on = ProjectOnSegment(i);
-  const double remaining = length_m() - s.progress_m;
+  // The distance left: along the path, and on the last segment straight to
+  // the goal (>= the distance along it: never 0 while the robot is beside
+  // the goal, outside goal_tolerance).
+  const double remaining = last ? on.to_end_m : length_m() - s.progress_m;
+  const double left = last ? to_goal_m : std::abs(remaining);
   const double corner = ToSharpCorner(on);
-  const double magnitude = std::min(
-      {ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * std::abs(remaining)),
-       k_position_ * std::abs(remaining), std::sqrt(2.0 * acceleration_ * std::max(corner, 0.0))});
+  const double magnitude =
+      std::min({ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * left), k_position_ * left,
+                std::sqrt(2.0 * acceleration_ * std::max(corner, 0.0))});
   const double length = cumulative_m_[i + 1] - cumulative_m_[i];
   const double tx = (waypoints_m_[i + 1][0] - waypoints_m_[i][0]) / length;
   const double ty = (waypoints_m_[i + 1][1] - waypoints_m_[i][1]) / length;
-  const double direction = std::copysign(1.0, remaining);
-  // a = sgn(r) t speed - n k_cross e, n = (-ty, tx).
-  const double aim_x = direction * tx * speed_ + ty * k_cross_ * on.cross_track_m;
-  const double aim_y = direction * ty * speed_ - tx * k_cross_ * on.cross_track_m;
+  // a = t along - n k_cross e, n = (-ty, tx): along = sgn(r) speed, and on
+  // the last segment within speed / k_cross of the goal along it, k_cross r,
+  // so that a = k_cross (goal - p) points at the goal.
+  double along = std::copysign(speed_, remaining);
+  if (last && k_cross_ > 0.0 && k_cross_ * std::abs(remaining) < speed_) {
+    along = k_cross_ * remaining;
+  }
+  const double aim_x = tx * along + ty * k_cross_ * on.cross_track_m;
+  const double aim_y = ty * along - tx * k_cross_ * on.cross_track_m;
   const double h = models::WrapAngle(std::atan2(aim_y, aim_x) - yaw_measured_);
   s.yaw_rate_rad_s = std::clamp(k_yaw_ * h, -max_yaw_rate_, max_yaw_rate_);
   if (std::abs(h) > turn_in_place_angle_) return s;  // turn in place: the ramp starts again
+  // The aim already points towards the goal (backwards along the path past
+  // it): the robot drives forwards along it.
   const double cos_h = std::cos(h);
-  s.along_mps = direction * magnitude * cos_h;
-  s.forward_mps = direction * std::min(magnitude * cos_h, max_speed_);
+  s.along_mps = magnitude * cos_h;
+  s.forward_mps = std::min(magnitude * cos_h, max_speed_);
   return s;
 }
 
@@ -201,8 +233,6 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const models::PolylinePoint&
           std::min({ramp_mps_, speed_, std::sqrt(2.0 * acceleration_ * std::abs(remaining)),
                     k_position_ * std::abs(remaining)});
       s.along_mps = std::copysign(magnitude, remaining);
-      s.toward_goal_x = std::copysign(1.0, remaining) * n.tangent_x;
-      s.toward_goal_y = std::copysign(1.0, remaining) * n.tangent_y;
       s.vx_map_mps = n.tangent_x * s.along_mps + n.tangent_y * k_cross_ * n.cross_track_m;
       s.vy_map_mps = n.tangent_y * s.along_mps - n.tangent_x * k_cross_ * n.cross_track_m;
     }
@@ -212,8 +242,8 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const models::PolylinePoint&
       s.vx_map_mps = s.vy_map_mps = s.along_mps = 0.0;
     }
   }
-  if (base_ == Base::kDifferential) {
-    SteerDifferential(s);
+  if (base_ == Base::kDifferential) {  // hold mode: the path mode returned above
+    SteerHold(s);
     return s;
   }
   const double speed = std::hypot(s.vx_map_mps, s.vy_map_mps);
@@ -228,35 +258,25 @@ PathFollowerUnit::Sample PathFollowerUnit::Evaluate(const models::PolylinePoint&
   return s;
 }
 
-void PathFollowerUnit::SteerDifferential(Sample& s) const {
-  const double speed = std::hypot(s.vx_map_mps, s.vy_map_mps);
+void PathFollowerUnit::SteerHold(Sample& s) const {
+  // The hold law leaves the along-track speed at 0 (no ramp in hold).
   s.forward_mps = 0.0;
   s.yaw_rate_rad_s = 0.0;
-  double aim_x = s.vx_map_mps, aim_y = s.vy_map_mps;
-  if (!(speed > 0.0)) {
-    aim_x = s.toward_goal_x;
-    aim_y = s.toward_goal_y;
-  }
-  if (s.at_goal || (aim_x == 0.0 && aim_y == 0.0)) {
-    s.along_mps = 0.0;
-    return;
-  }
-  double h = models::WrapAngle(std::atan2(aim_y, aim_x) - yaw_measured_);
+  // Outside goal_tolerance (> 0) the velocity -k_position (p - p_ref) is
+  // not zero (k_position > 0): it has a direction.
+  if (s.at_goal) return;
+  const double speed = std::hypot(s.vx_map_mps, s.vy_map_mps);
+  double h = models::WrapAngle(std::atan2(s.vy_map_mps, s.vx_map_mps) - yaw_measured_);
   double direction = 1.0;
-  // Hold: backing up is as good as driving forward, and needs less turning
-  // when the point is behind.
-  if (mode_ == Mode::kHold && std::abs(h) > 0.5 * std::numbers::pi) {
+  // Backing up is as good as driving forward, and needs less turning when
+  // the point is behind.
+  if (std::abs(h) > 0.5 * std::numbers::pi) {
     h = models::WrapAngle(h - std::numbers::pi);
     direction = -1.0;
   }
   s.yaw_rate_rad_s = std::clamp(k_yaw_ * h, -max_yaw_rate_, max_yaw_rate_);
-  if (std::abs(h) > turn_in_place_angle_) {
-    s.along_mps = 0.0;  // the ramp starts again after the turn
-    return;
-  }
-  const double cos_h = std::cos(h);
-  s.forward_mps = direction * std::min(speed * cos_h, max_speed_);
-  s.along_mps *= cos_h;
+  if (std::abs(h) > turn_in_place_angle_) return;  // turn in place
+  s.forward_mps = direction * std::min(speed * std::cos(h), max_speed_);
 }
 
 void PathFollowerUnit::ComputeOutputs(const models::PolylinePoint& n) {
@@ -319,6 +339,7 @@ void PathFollowerUnit::RestoreInternal(const cosim::UnitState& state) {
                            " reals and " + std::to_string(state.integers.size()) +
                            " integers, expected 1 and " + std::to_string(integers));
   }
+  FindSharpCorners();  // restored into a unit not initialized since a parameter change
   ramp_mps_ = state.reals[0];
   done_latched_ = state.integers[0] != 0;
   if (SavesSegment()) {

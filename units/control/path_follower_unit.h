@@ -45,8 +45,17 @@ namespace linesim::control {
 ///         from its line (+ left), the aim is
 ///           a = sgn(r) t_i speed - n_i k_cross e_i,
 ///         r the distance left along the path to the goal (nearest point,
-///         as above; past the goal the robot backs up by turning round).
-///         The aim never vanishes, and its direction depends on the active
+///         as above; on the last segment, from the projection on it), and
+///         on the last segment, once k_cross |r| < speed (k_cross > 0),
+///           a = t_i k_cross r - n_i k_cross e_i = k_cross (goal - p):
+///         the robot aims AT the goal (continuous at k_cross |r| = speed;
+///         the ratio e / r then stays constant: a straight line to the
+///         goal), so a sideways offset at the goal's perpendicular is
+///         driven out too. The aim points towards the goal (past it,
+///         backwards along the path): the robot turns round and drives
+///         forwards along it, never backwards.
+///         The aim vanishes only at the goal (done has latched there:
+///         goal_tolerance > 0), and its direction depends on the active
 ///         segment only, not on which segment is nearest: no flipping when
 ///         the commanded speed is small (at the start, at a corner), and at
 ///         a corner the robot turns onto the next tangent, not across it.
@@ -54,7 +63,9 @@ namespace linesim::control {
 ///         cross-track error obeys e'' + k_yaw e' + k_yaw k_cross e = 0
 ///         (linearised; slower at lower speed, never less damped); with
 ///         k_yaw >= 4 k_cross it is not oscillatory.
-///         Along-track speed: the ramp and the goal as above, and, for a
+///         Along-track speed: the ramp and the goal as above (on the last
+///         segment d is the straight-line distance to the goal, never 0
+///         outside goal_tolerance: no stall beside the goal), and, for a
 ///         SHARP corner (an interior waypoint whose heading change exceeds
 ///         turn_in_place_angle, where the robot must turn in place),
 ///           |v_along| <= sqrt(2 acceleration D),
@@ -75,7 +86,8 @@ namespace linesim::control {
 /// With h = wrap(atan2(aim) - psi) (hold backward: wrap(atan2(-d) - psi)):
 ///   |h| > turn_in_place_angle: v = 0 (turn in place: at the start and at
 ///                              sharp corners),
-///   otherwise:                 path v = sgn(r) |v_along| cos h,
+///   otherwise:                 path v = |v_along| cos h (forwards:
+///                              the aim already points to the goal),
 ///                              hold v = +-|d| cos h,
 ///   yaw rate = k_yaw h, clamped to max_yaw_rate; |v| clamped to max_speed.
 /// The along-track ramp continues from |v_along| cos h (0 while turning in
@@ -94,7 +106,9 @@ class PathFollowerUnit : public cosim::Unit {
 
   /// kPath needs at least two waypoints without zero-length segments, kHold
   /// at least one (extra ones are ignored); CheckParameters reports them.
-  /// The differential base adds the parameter turn_in_place_angle.
+  /// The differential base adds the parameter turn_in_place_angle, in
+  /// (0, pi/2), and requires k_yaw and max_yaw_rate > 0 (it turns only by
+  /// the yaw rate; the omnidirectional base may switch them off with 0).
   PathFollowerUnit(std::string name, Mode mode, std::vector<std::array<double, 2>> waypoints_m,
                    Base base = Base::kOmnidirectional);
 
@@ -122,9 +136,6 @@ class PathFollowerUnit : public cosim::Unit {
     // Differential base: the forward speed command (the body velocity is
     // [forward, 0]); the omnidirectional base rotates the map velocity.
     double forward_mps = 0.0;
-    // Path mode: the path direction towards the goal, the heading to aim
-    // for when the desired velocity is zero (at the start: ramp at 0).
-    double toward_goal_x = 0.0, toward_goal_y = 0.0;
     double along_mps = 0.0;  // path mode: the along-track speed used
     double cross_track_m = 0.0, progress_m = 0.0;
     bool at_goal = false;
@@ -138,9 +149,10 @@ class PathFollowerUnit : public cosim::Unit {
   models::PolylinePoint FindNearest() const;
   /// The command for the position whose nearest path point is n, from the state.
   Sample Evaluate(const models::PolylinePoint& n) const;
-  /// The differential base's steering of the heading onto the direction of
-  /// the desired map velocity in s (see the class comment).
-  void SteerDifferential(Sample& s) const;
+  /// The differential base in hold mode: steers the heading onto the
+  /// direction of the hold velocity in s, forwards or backwards, and sets
+  /// the forward speed (see the class comment).
+  void SteerHold(Sample& s) const;
   /// The differential base in path mode (see the class comment).
   Sample EvaluateDifferentialPath(const models::PolylinePoint& n) const;
   /// Differential path: the robot's projection on segment i, as the
@@ -150,8 +162,13 @@ class PathFollowerUnit : public cosim::Unit {
   };
   OnSegment ProjectOnSegment(std::size_t i) const;
   /// Differential path: the distance along the path from the projection on
-  /// the active segment to the next sharp corner (infinity: none ahead).
+  /// the active segment to the next sharp corner (infinity: none ahead),
+  /// from the table sharp_corner_after_m_.
   double ToSharpCorner(const OnSegment& on) const;
+  /// Differential path: fills sharp_corner_after_m_ from the waypoints and
+  /// turn_in_place_angle (at construction, Initialize and restore: not per
+  /// step; the parameters are locked after Initialize).
+  void FindSharpCorners();
   /// Whether interior waypoint k turns the path by more than
   /// turn_in_place_angle (the robot must stop there and turn in place).
   bool SharpCorner(std::size_t k) const;
@@ -164,6 +181,9 @@ class PathFollowerUnit : public cosim::Unit {
   std::vector<std::array<double, 2>> waypoints_m_;
   // Path length at each waypoint (path mode), once for the search.
   std::vector<double> cumulative_m_;
+  // Differential path: per segment, the distance along the path from its
+  // end to the next sharp corner (infinity: none ahead). Empty otherwise.
+  std::vector<double> sharp_corner_after_m_;
 
   // Parameters.
   double speed_ = 0.3;

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cosim/time.h"
@@ -372,12 +373,34 @@ TEST(PathFollowerUnitDifferential, VariableTableAndRange) {
   // Declared with the parameter (the table's rule), not in CheckParameters.
   const auto& v = u.variables();
   EXPECT_EQ(v.info(*v.Find("speed")).rule.Text(), "> 0");
-  EXPECT_EQ(v.info(*v.Find("k_yaw")).rule.Text(), ">= 0");
   EXPECT_EQ(v.info(*v.Find("heading")).rule.Text(), "finite");
+  // The differential base turns only by the yaw rate: k_yaw and
+  // max_yaw_rate must be > 0 (0 froze it); the omnidirectional base may
+  // switch its heading loop off.
+  EXPECT_EQ(v.info(*v.Find("k_yaw")).rule.Text(), "> 0");
+  EXPECT_EQ(v.info(*v.Find("max_yaw_rate")).rule.Text(), "> 0");
+  EXPECT_EQ(omni.variables().info(*omni.variables().Find("k_yaw")).rule.Text(), ">= 0");
+  EXPECT_EQ(omni.variables().info(*omni.variables().Find("max_yaw_rate")).rule.Text(), ">= 0");
+  // turn_in_place_angle in (0, pi/2): at 0 the robot never drives.
   const cosim::Rule& angle = v.info(*v.Find("turn_in_place_angle")).rule;
   ASSERT_TRUE(angle.Violation(kPi / 2));
-  EXPECT_EQ(angle.Violation(kPi / 2)->rfind("must be in [0, ", 0), 0u) << *angle.Violation(kPi / 2);
-  EXPECT_FALSE(angle.Violation(0.0));
+  EXPECT_EQ(angle.Violation(kPi / 2)->rfind("must be in (0, ", 0), 0u) << *angle.Violation(kPi / 2);
+  ASSERT_TRUE(angle.Violation(0.0));
+  EXPECT_EQ(angle.Violation(0.0)->rfind("must be in (0, ", 0), 0u) << *angle.Violation(0.0);
+  EXPECT_FALSE(angle.Violation(1e-3));
+  PathFollowerUnit frozen("f", Mode::kPath, {{0, 0}, {1, 0}}, Base::kDifferential);
+  SetParam(frozen, "turn_in_place_angle", 0.0);
+  SetParam(frozen, "k_yaw", 0.0);
+  SetParam(frozen, "max_yaw_rate", 0.0);
+  std::vector<std::string> refused;
+  for (const auto& p : frozen.CheckParameters()) refused.push_back(p.variable);
+  std::sort(refused.begin(), refused.end());
+  EXPECT_EQ(refused, (std::vector<std::string>{"k_yaw", "max_yaw_rate", "turn_in_place_angle"}));
+  EXPECT_THROW(frozen.Initialize(), cosim::UnitError);
+  PathFollowerUnit omni_off("f", Mode::kPath, {{0, 0}, {1, 0}});
+  SetParam(omni_off, "k_yaw", 0.0);
+  SetParam(omni_off, "max_yaw_rate", 0.0);
+  EXPECT_TRUE(omni_off.CheckParameters().empty());
 }
 
 // Guards the differential law on an L-shaped path (0,0) -> (2,0) -> (2,2),
@@ -562,6 +585,29 @@ TEST(PathFollowerUnitDifferential, DrivesThroughAGentleCorner) {
   EXPECT_GT(slowest_near_corner, 0.15);
 }
 
+// Guards the table of sharp corners (computed once, not per step): it
+// follows turn_in_place_angle as set before Initialize. The same 0.3 rad
+// corner is sharp for a 0.2 rad turn_in_place_angle: the robot stops at
+// it (within a T^2 / 2 sample of it, the forward command is 0 there) and
+// turns in place, where at 0.5 rad it drove through.
+TEST(PathFollowerUnitDifferential, SharpCornersFollowTheAngleSetBeforeInitialize) {
+  const double c = std::cos(0.3), s = std::sin(0.3);
+  PathFollowerUnit u("f", Mode::kPath, {{0, 0}, {2, 0}, {2 + 2 * c, 2 * s}}, Base::kDifferential);
+  SetParam(u, "turn_in_place_angle", 0.2);
+  Unicycle r;
+  SetPose(u, r.x, r.y, r.yaw);
+  u.Initialize();
+  double slowest_near_corner = 1.0;
+  int k = 0;
+  for (; k < 3000 && !Done(u); ++k) {
+    const auto cmd = Sample(u, r, k);
+    if (std::hypot(r.x - 2.0, r.y) < 0.2) slowest_near_corner = std::min(slowest_near_corner, cmd[0]);
+    r.Move(cmd[0], cmd[2], kPeriodS);
+  }
+  ASSERT_TRUE(Done(u));
+  EXPECT_EQ(slowest_near_corner, 0.0);
+}
+
 // Guards the saved state of the differential base: the active segment is
 // saved and restored (a restored unit continues bit for bit through a
 // corner), and a segment that is not one of the path is refused.
@@ -597,6 +643,70 @@ TEST(PathFollowerUnitDifferential, SaveStepRestoreStepThroughACorner) {
   cosim::UnitState bad = saved;
   bad.integers[1] = 3;  // three segments: 0, 1, 2
   EXPECT_THROW(fresh.RestoreState(bad), cosim::UnitError);
+}
+
+// Guards the differential base past the goal, path (0,0) -> (2,0), the
+// robot 0.3 m beyond the goal facing away from it (defaults): the aim
+// points back at the goal, so the robot turns round in place (no motion
+// while the heading error exceeds turn_in_place_angle) and drives FORWARDS
+// to the goal: the forward command is never negative (the law once drove
+// the turned robot backwards, away from the goal, and never finished), the
+// robot never gets farther from the goal than at the start, and done
+// latches within goal_tolerance of it.
+TEST(PathFollowerUnitDifferential, PastTheGoalTurnsRoundAndDrivesToIt) {
+  PathFollowerUnit u("f", Mode::kPath, {{0, 0}, {2, 0}}, Base::kDifferential);
+  Unicycle r;
+  r.x = 2.3;
+  SetPose(u, r.x, r.y, r.yaw);
+  u.Initialize();
+  EXPECT_EQ(Twist(u)[0], 0.0);  // turn in place first
+  double farthest = 0.0;
+  int k = 0;
+  for (; k < 3000 && !Done(u); ++k) {
+    const auto cmd = Sample(u, r, k);
+    ASSERT_GE(cmd[0], 0.0) << k;
+    r.Move(cmd[0], cmd[2], kPeriodS);
+    farthest = std::max(farthest, std::hypot(r.x - 2.0, r.y));
+  }
+  std::cout << "differential past the goal: done after " << k * kPeriodS << " s at (" << r.x
+            << ", " << r.y << ")\n";
+  ASSERT_TRUE(Done(u));
+  EXPECT_LE(std::hypot(r.x - 2.0, r.y), Real(u, "goal_tolerance"));
+  EXPECT_LE(farthest, 0.3 + 1e-9);
+  // A half turn at the 0.5 rad/s limit (6.3 s) and 0.3 m: well inside 15 s.
+  EXPECT_LT(k * kPeriodS, 15.0);
+}
+
+// Guards the differential base beside the goal, path (0,0) -> (2,0): a
+// robot whose projection reaches the goal's perpendicular with a sideways
+// offset beyond goal_tolerance must still reach the goal (the approach
+// speed once depended on the distance left ALONG the path only: 0 on the
+// perpendicular, the robot stalled at (2.000, 0.068) and done never
+// latched). On the last segment the speed is limited by the straight-line
+// distance to the goal, and near it the aim points at the goal. Two starts:
+// 0.3 m left of the path 0.4 m before the goal, and exactly on the goal's
+// perpendicular 0.1 m to the side; both finish forwards, within 10 s.
+TEST(PathFollowerUnitDifferential, BesideTheGoalStillReachesIt) {
+  for (const auto& [x0, y0] : {std::pair{1.6, 0.3}, std::pair{2.0, 0.1}}) {
+    PathFollowerUnit u("f", Mode::kPath, {{0, 0}, {2, 0}}, Base::kDifferential);
+    Unicycle r;
+    r.x = x0;
+    r.y = y0;
+    SetPose(u, r.x, r.y, r.yaw);
+    u.Initialize();
+    int k = 0;
+    for (; k < 3000 && !Done(u); ++k) {
+      const auto cmd = Sample(u, r, k);
+      ASSERT_GE(cmd[0], 0.0) << k;
+      r.Move(cmd[0], cmd[2], kPeriodS);
+    }
+    std::cout << "differential beside the goal from (" << x0 << ", " << y0 << "): done after "
+              << k * kPeriodS << " s at (" << r.x << ", " << r.y << ")\n";
+    ASSERT_TRUE(Done(u)) << x0 << ", " << y0 << ": stopped at (" << r.x << ", " << r.y << ")";
+    EXPECT_LE(std::hypot(r.x - 2.0, r.y), Real(u, "goal_tolerance"));
+    EXPECT_LT(k * kPeriodS, 10.0);
+    EXPECT_EQ(Sample(u, r, k), (std::vector<double>{0.0, 0.0, 0.0}));
+  }
 }
 
 // Guards the hold law of the differential base: a point behind is reached
