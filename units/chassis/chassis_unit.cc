@@ -17,9 +17,13 @@ namespace linesim::chassis {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-// Settling before time zero: 300 steps of 1 ms is about ten periods of the
-// slowest vertical mode (about 20 Hz with the default contacts) and its
-// damping time.
+// Settling before time zero: 300 steps of 1 ms (0.3 s). The slowest
+// vertical mode, the body on the four contact springs (default 1e6 N/m
+// each, 4e6 N/m in all), is at sqrt(4e6 / m) / 2 pi: about 29 Hz for the
+// Rob@Work 3 (120 kg: 0.3 s is about 9 periods) and about 45 Hz for the
+// Husky (50 kg: about 13 periods); the contact damping (1e4 N.s/m per
+// point) damps it within a few periods. Kept at 300 steps: the paper-1
+// numbers depend on the settled state.
 constexpr double kSettleStepS = 1e-3;
 constexpr int kSettleSteps = 300;
 // Holding torque on every joint while settling, whatever brake_torque is.
