@@ -3,14 +3,17 @@
 // collisions with the scene's obstacles and carried objects.
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <vector>
 
 #include "cosim/time.h"
+#include "models/models_dir.h"
 #include "tests/units/chassis/robots.h"
 #include "tests/units/test_helpers.h"
 #include "units/chassis/chassis_unit.h"
@@ -274,6 +277,21 @@ TEST(Obstacles, CarBodyPushesABrakedRobot) {
   RecordProperty("car_min_gap_m", std::to_string(min_gap));
   EXPECT_GT(min_gap, -0.003);
   EXPECT_LT(min_gap, 0.001);
+}
+
+// Guards against the Husky's robot description and the test robot
+// drifting apart: models/robots/husky.yaml's body (its com_height_m the
+// derived 0.13 m clearance + 0.2475 / 2 m) is the test robot's.
+TEST(Husky, RobotDescriptionBodyMatchesTestRobot) {
+  const auto path = std::filesystem::path(models::ModelsDir()) / "robots" / "husky.yaml";
+  const YAML::Node body = YAML::LoadFile(path.string())["body"];
+  ASSERT_TRUE(body && body.IsMap());
+  EXPECT_EQ(body["length_m"].as<double>(), kHuskyBodyM[0]);
+  EXPECT_EQ(body["width_m"].as<double>(), kHuskyBodyM[1]);
+  EXPECT_EQ(body["height_m"].as<double>(), kHuskyBodyM[2]);
+  EXPECT_EQ(body["mass_kg"].as<double>(), kHuskyMassKg);
+  EXPECT_NEAR(body["com_height_m"].as<double>(), kHuskyComHeightM, 1e-15);
+  EXPECT_NEAR(kHuskyComHeightM, 0.25375, 1e-15);
 }
 
 // Guards against hidden state in the coupling joints, the obstacle lists or
