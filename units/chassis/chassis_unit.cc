@@ -102,7 +102,8 @@ struct ChassisUnit::Ode {
 
 namespace {
 
-// Number of motors a per-wheel index list uses (largest index + 1).
+// Number of motors a per-wheel index list uses (largest index + 1). Only
+// for lists that TopologyProblem accepted (every index < the wheel count).
 int MotorCount(const std::vector<int>& motor) {
   int n = 0;
   for (int m : motor) n = std::max(n, m + 1);
@@ -123,10 +124,31 @@ constexpr double kCouplingCfm = 1e-10;
 std::string ChassisUnit::TopologyProblem(const std::vector<int>& steer_motor,
                                          const std::vector<int>& drive_motor) {
   const std::size_t n = steer_motor.size();
-  if (n < 1 || n > 64) return "wheel_count: expected 1 to 64 wheels, got " + std::to_string(n);
+  if (n < 1 || n > static_cast<std::size_t>(kMaxWheels)) {
+    return "wheel_count: expected 1 to " + std::to_string(kMaxWheels) + " wheels, got " +
+           std::to_string(n);
+  }
   if (drive_motor.size() != n) {
     return "drive_motor: expected one entry per wheel (wheel_count " + std::to_string(n) +
            "), got " + std::to_string(drive_motor.size());
+  }
+  // The ranges first, before anything is sized by an index: a motor index
+  // is below the wheel count (each motor serves at least one wheel).
+  const int wheels = static_cast<int>(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const int s = steer_motor[k];
+    if (s < -1 || s >= wheels) {
+      return "steer_motor[" + std::to_string(k) +
+             "]: expected a steering motor index in [0, " + std::to_string(wheels - 1) +
+             "] (below the wheel count " + std::to_string(wheels) +
+             ") or -1 (fixed wheel), got " + std::to_string(s);
+    }
+    const int d = drive_motor[k];
+    if (d < 0 || d >= wheels) {
+      return "drive_motor[" + std::to_string(k) + "]: expected a drive motor index in [0, " +
+             std::to_string(wheels - 1) + "] (below the wheel count " + std::to_string(wheels) +
+             "), got " + std::to_string(d);
+    }
   }
   const int steer_count = MotorCount(steer_motor);
   const int drive_count = MotorCount(drive_motor);
@@ -134,20 +156,11 @@ std::string ChassisUnit::TopologyProblem(const std::vector<int>& steer_motor,
   std::vector<int> drive_first(static_cast<std::size_t>(drive_count), -1);
   for (std::size_t k = 0; k < n; ++k) {
     const int s = steer_motor[k];
-    if (s < -1) {
-      return "steer_motor[" + std::to_string(k) +
-             "]: expected a steering motor index >= 0 or -1 (fixed wheel), got " +
-             std::to_string(s);
-    }
     if (s >= 0 && ++steer_uses[static_cast<std::size_t>(s)] > 1) {
       return "steer_motor[" + std::to_string(k) + "]: steering motor " + std::to_string(s) +
              " already steers another wheel (one steered wheel per steering motor)";
     }
     const int d = drive_motor[k];
-    if (d < 0) {
-      return "drive_motor[" + std::to_string(k) + "]: expected a drive motor index >= 0, got " +
-             std::to_string(d);
-    }
     int& first = drive_first[static_cast<std::size_t>(d)];
     if (first < 0) {
       first = static_cast<int>(k);
@@ -503,7 +516,9 @@ void ChassisUnit::ApplyTorques() {
   Column(dBodyGetRotation(o.body), 2, up);
   const dReal* wb = dBodyGetAngularVel(o.body);
   // A drive motor's torque goes to the first wheel of its group only.
-  std::uint64_t driven = 0;  // bit m: motor m's torque applied (<= 16 wheels)
+  // Bit m: motor m's torque applied (m < wheel count <= kMaxWheels = 64).
+  std::uint64_t driven = 0;
+  static_assert(kMaxWheels <= 64, "one bit per drive motor in a 64-bit mask");
   for (std::size_t k = 0; k < o.wheels.size(); ++k) {
     const dBodyID w = o.wheels[k];
     Column(dBodyGetRotation(w), 1, axle);
@@ -651,7 +666,8 @@ void ChassisUnit::ComputeOutputs() {
   Column(rb, 0, ex);
   Column(rb, 1, ey);
   Column(rb, 2, ez);
-  // drive_rate is the first wheel's of each motor (the others are coupled to it).
+  // drive_rate is the first wheel's of each motor (the others are coupled to
+  // it). Bit m: motor m seen (m < wheel count <= kMaxWheels = 64).
   std::uint64_t seen = 0;
   for (std::size_t k = 0; k < o.wheels.size(); ++k) {
     const dBodyID w = o.wheels[k];

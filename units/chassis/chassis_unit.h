@@ -59,9 +59,17 @@ namespace linesim::chassis {
 class ChassisUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "chassis";
+  /// Most wheels a chassis may have (wheel_count 1 to kMaxWheels). Motor
+  /// indices are below the wheel count (one wheel per steering motor, at
+  /// least one per drive motor), so a 64-bit mask holds one bit per drive
+  /// motor.
+  static constexpr int kMaxWheels = 64;
 
   /// Checks a topology (steer_motor and drive_motor per wheel, as in the
   /// class comment): empty when usable, else what is wrong, naming the key.
+  /// 1 to kMaxWheels wheels; every motor index in [0, wheel count), or -1
+  /// for a fixed wheel's steer_motor; checked before anything is sized by
+  /// an index.
   static std::string TopologyProblem(const std::vector<int>& steer_motor,
                                      const std::vector<int>& drive_motor);
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <variant>
@@ -592,7 +593,8 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   EXPECT_NE(problem({0, -2}, {0, 1}).find("steer_motor[1]"), std::string::npos);
   EXPECT_NE(problem({0, 0}, {0, 1}).find("already steers another wheel"), std::string::npos);
   EXPECT_NE(problem({0, 2, 1}, {0, 1, 1}).find("share drive motor 1"), std::string::npos);
-  EXPECT_NE(problem({-1, -1}, {0, 2}).find("drive motor 1 drives no wheel"), std::string::npos);
+  EXPECT_NE(problem({-1, -1, -1}, {0, 2, 2}).find("drive motor 1 drives no wheel"),
+            std::string::npos);
   EXPECT_NE(problem({1, -1}, {0, 1}).find("steering motor 0 steers no wheel"), std::string::npos);
   EXPECT_EQ(problem({-1, -1, -1, -1}, {0, 0, 1, 1}), "");
 
@@ -623,6 +625,52 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   EXPECT_NO_THROW(three->Initialize());
   TimeNs t = 0;
   Advance(*three, t, 10);
+}
+
+// Guards against motor indices that size vectors before they are checked
+// (a huge index allocated gigabytes; INT_MAX + 1 overflowed) and against
+// wheel-count limits that disagree: every index must be in [0, wheel
+// count) (steer -1: a fixed wheel), checked first; 1 to kMaxWheels wheels.
+TEST(ChassisUnit, TopologyRefusesOutOfRangeIndicesAndWheelCounts) {
+  constexpr int kMax = std::numeric_limits<int>::max();
+  const auto problem = [](std::vector<int> steer, std::vector<int> drive) {
+    return ChassisUnit::TopologyProblem(steer, drive);
+  };
+  for (const int huge : {2000000000, kMax}) {
+    SCOPED_TRACE(huge);
+    std::string p = problem({huge}, {0});
+    EXPECT_NE(p.find("steer_motor[0]: expected a steering motor index in [0, 0]"),
+              std::string::npos)
+        << p;
+    EXPECT_NE(p.find("got " + std::to_string(huge)), std::string::npos) << p;
+    p = problem({-1, -1}, {0, huge});
+    EXPECT_NE(p.find("drive_motor[1]: expected a drive motor index in [0, 1]"), std::string::npos)
+        << p;
+    EXPECT_NE(p.find("got " + std::to_string(huge)), std::string::npos) << p;
+    // The constructor refuses them with the same message, before it sizes
+    // anything (a std::bad_alloc would fail the test).
+    try {
+      ChassisUnit u("robot", {-1, -1}, {0, huge}, models::OpenFloor());
+      ADD_FAILURE() << "accepted drive motor " << huge;
+    } catch (const cosim::UnitError& e) {
+      EXPECT_NE(std::string(e.what()).find("drive_motor[1]"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NE(problem({std::numeric_limits<int>::min()}, {0}).find("steer_motor[0]"),
+            std::string::npos);
+  EXPECT_NE(problem({0, 1}, {0, 2}).find("drive_motor[1]: expected a drive motor index in [0, 1]"),
+            std::string::npos);
+
+  // kMaxWheels fixed wheels on one motor each: accepted; one more: refused.
+  const auto n = static_cast<std::size_t>(ChassisUnit::kMaxWheels);
+  static_assert(ChassisUnit::kMaxWheels == 64);
+  std::vector<int> fixed(n, -1), drive(n);
+  for (std::size_t k = 0; k < n; ++k) drive[k] = static_cast<int>(k);
+  EXPECT_EQ(problem(fixed, drive), "");
+  fixed.push_back(-1);
+  drive.push_back(static_cast<int>(n));
+  EXPECT_EQ(problem(fixed, drive), "wheel_count: expected 1 to 64 wheels, got 65");
+  EXPECT_EQ(problem({}, {}), "wheel_count: expected 1 to 64 wheels, got 0");
 }
 
 // Guards against non-finite inputs or states passing silently: DoStep
