@@ -218,6 +218,17 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
                              obj.name + "' is on belt " + std::to_string(obj.belt) +
                              ", not one of its " + std::to_string(belt_count_) + " belts");
     }
+    // It leaves the scene at its belt's end (FloorWorld), so it must start
+    // on the belt.
+    const models::Belt& belt = scene_.belts[static_cast<std::size_t>(obj.belt)];
+    const models::Rect& r = belt.area;
+    const auto range = CarriedTravelRange(
+        {r.center_x_m, r.center_y_m, r.length_m, r.width_m, r.direction_rad, 0.0}, obj.solid);
+    if (!(range[0] <= 0.0 && 0.0 <= range[1])) {
+      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': carried object '" +
+                             obj.name + "' overhangs an end of belt '" + belt.name +
+                             "' at time zero (its footprint must lie along the belt's length)");
+    }
   }
   steer_motor_count_ = MotorCount(steer_motor_);
   drive_motor_count_ = MotorCount(drive_motor_);

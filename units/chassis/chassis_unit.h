@@ -76,7 +76,8 @@ class ChassisUnit : public cosim::Unit {
   /// `steer_motor` and `drive_motor` give the topology (one entry per
   /// wheel); `scene` the belts (one belt_velocity and belt_travel input
   /// each), the floor's and the belts' friction, the obstacles and carried
-  /// objects. Throws cosim::UnitError for a bad topology or scene.
+  /// objects. Throws cosim::UnitError for a bad topology or scene: a
+  /// carried object not lying along its belt's length at zero travel.
   ChassisUnit(std::string name, std::vector<int> steer_motor, std::vector<int> drive_motor,
               models::Scene scene);
   ~ChassisUnit() override;

@@ -604,6 +604,29 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   bad = models::OpenFloor();
   bad.carried.push_back({"car", 0, {}});  // belt 0 of a scene with none
   EXPECT_THROW(ChassisUnit("robot", {0}, {0}, bad), cosim::UnitError);
+  const auto scene_problem = [](const models::Scene& scene) {
+    try {
+      ChassisUnit u("robot", {0}, {0}, scene);
+    } catch (const cosim::UnitError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  // A car body overhanging its belt's end at time zero (it would leave the
+  // scene at once: it leaves with the belt's end).
+  bad = test_robots::OneBelt({0.0, 5.0, 10.0, 3.0, 0.0});
+  models::Solid car;
+  car.x_m = 3.0;  // 4.5 m long: its front at 5.25 m, past the belt's end at 5 m
+  car.y_m = 5.0;
+  car.length_m = 4.5;
+  car.width_m = 1.8;
+  car.height_m = 1.2;
+  bad.carried.push_back({"car", 0, car});
+  EXPECT_NE(scene_problem(bad).find("carried object 'car' overhangs an end of belt 'belt'"),
+            std::string::npos)
+      << scene_problem(bad);
+  bad.carried[0].solid.x_m = 2.75;  // its front exactly at the end: on the belt
+  EXPECT_EQ(scene_problem(bad), "");
 
   // Three modules and no belts: no belt inputs, and it builds and steps.
   auto three = std::make_unique<ChassisUnit>("robot", std::vector<int>{0, 1, 2},
