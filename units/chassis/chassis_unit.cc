@@ -230,6 +230,20 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
                              "' at time zero (its footprint must lie along the belt's length)");
     }
   }
+  // The wheels drive on the flat floor only (a later issue adds ramps):
+  // a terrain piece would be driven through, not on.
+  if (!scene_.terrain.empty()) {
+    throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': terrain '" +
+                           scene_.terrain.front().name + "' is not simulated by the chassis yet");
+  }
+  if (!(scene_.floor.min_x_m < scene_.floor.max_x_m &&
+        scene_.floor.min_y_m < scene_.floor.max_y_m)) {
+    throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': the floor's rectangle is " +
+                           "empty (x " + cosim::FormatValue(scene_.floor.min_x_m) + " to " +
+                           cosim::FormatValue(scene_.floor.max_x_m) + ", y " +
+                           cosim::FormatValue(scene_.floor.min_y_m) + " to " +
+                           cosim::FormatValue(scene_.floor.max_y_m) + ")");
+  }
   steer_motor_count_ = MotorCount(steer_motor_);
   drive_motor_count_ = MotorCount(drive_motor_);
   const auto w = static_cast<std::size_t>(wheel_count_);
@@ -586,6 +600,9 @@ void ChassisUnit::Settle() {
   }
   // The contacts at the moved positions, for the outputs and the first step.
   f.Probe();
+  if (const std::string bad = OffFloorWheel(); !bad.empty()) {
+    throw cosim::UnitError(Where() + ": at the initial pose, " + bad);
+  }
 }
 
 void ChassisUnit::Initialize() {
@@ -652,6 +669,23 @@ std::string ChassisUnit::NonFiniteState() const {
     if (!AllFinite(dBodyGetQuaternion(b), 4)) return "orientation of " + who(i);
     if (!AllFinite(dBodyGetLinearVel(b), 3)) return "linear velocity of " + who(i);
     if (!AllFinite(dBodyGetAngularVel(b), 3)) return "angular velocity of " + who(i);
+  }
+  return {};
+}
+
+std::string ChassisUnit::OffFloorWheel() const {
+  const models::Floor& fl = scene_.floor;
+  for (int k = 0; k < wheel_count_; ++k) {
+    const GeomContact& gc = ode_->floor->contact(k);
+    if (fl.min_x_m <= gc.x_m && gc.x_m <= fl.max_x_m && fl.min_y_m <= gc.y_m &&
+        gc.y_m <= fl.max_y_m) {
+      continue;
+    }
+    return "wheel " + std::to_string(k) + "'s contact (" + cosim::FormatValue(gc.x_m) + ", " +
+           cosim::FormatValue(gc.y_m) + ") m is off the floor of scene '" + scene_.name +
+           "' (x " + cosim::FormatValue(fl.min_x_m) + " to " + cosim::FormatValue(fl.max_x_m) +
+           ", y " + cosim::FormatValue(fl.min_y_m) + " to " + cosim::FormatValue(fl.max_y_m) +
+           " m): the robot ran off the scene's floor";
   }
   return {};
 }
@@ -743,6 +777,12 @@ cosim::StepResult ChassisUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   }
   // FloorWorld::Step collided at the new positions already.
   ComputeOutputs();
+  // Nothing is simulated off the floor: stop there (the world stays
+  // consistent, the outputs show where the robot went).
+  if (const std::string bad = OffFloorWheel(); !bad.empty()) {
+    return Fail(Where() + ": at the end of the step at t = " + cosim::FormatSeconds(t) + " s, " +
+                bad);
+  }
   return cosim::StepResult::kOk;
 }
 

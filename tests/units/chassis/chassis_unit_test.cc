@@ -627,6 +627,18 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
       << scene_problem(bad);
   bad.carried[0].solid.x_m = 2.75;  // its front exactly at the end: on the belt
   EXPECT_EQ(scene_problem(bad), "");
+  // Terrain is not simulated yet: refused, naming the piece.
+  bad = models::OpenFloor();
+  bad.terrain.push_back({});
+  bad.terrain.back().name = "ramp";
+  EXPECT_NE(scene_problem(bad).find("terrain 'ramp' is not simulated by the chassis yet"),
+            std::string::npos)
+      << scene_problem(bad);
+  // A floor with no area: every wheel would be off it.
+  bad = models::OpenFloor();
+  bad.floor.max_x_m = bad.floor.min_x_m;
+  EXPECT_NE(scene_problem(bad).find("the floor's rectangle is empty"), std::string::npos)
+      << scene_problem(bad);
 
   // Three modules and no belts: no belt inputs, and it builds and steps.
   auto three = std::make_unique<ChassisUnit>("robot", std::vector<int>{0, 1, 2},
@@ -694,6 +706,60 @@ TEST(ChassisUnit, TopologyRefusesOutOfRangeIndicesAndWheelCounts) {
   drive.push_back(static_cast<int>(n));
   EXPECT_EQ(problem(fixed, drive), "wheel_count: expected 1 to 64 wheels, got 65");
   EXPECT_EQ(problem({}, {}), "wheel_count: expected 1 to 64 wheels, got 0");
+}
+
+// Guards against a robot that drives off the scene's floor without notice
+// (nothing is simulated there): the step whose end finds a wheel contact
+// outside the floor's rectangle fails, naming the unit, the time and the
+// wheel and its contact point; an initial pose off the floor is refused.
+TEST(ChassisUnit, LeavingTheFloorFails) {
+  models::Scene hall = models::OpenFloor();
+  hall.name = "hall";
+  hall.floor = {-1.0, 1.0, -2.0, 2.0, 0};
+  auto robot = Raw3(hall);
+  ChassisUnit& u = *robot;
+  u.Initialize();
+  SetArray(u, "drive_torque", {2.0, 2.0, 2.0, 2.0});
+  TimeNs t = 0;
+  cosim::StepResult result = cosim::StepResult::kOk;
+  for (int i = 0; i < 3000 && result == cosim::StepResult::kOk; ++i) {
+    result = u.DoStep(t, kMs);
+    if (result == cosim::StepResult::kOk) t += kMs;
+  }
+  ASSERT_EQ(result, cosim::StepResult::kError);
+  const std::string e = u.last_error();
+  // The front wheels (x 0.368 in base_link) cross x = 1 first: wheel 0 (or
+  // 3, its mirror; 0 is checked first).
+  EXPECT_NE(e.find("robot"), std::string::npos) << e;
+  EXPECT_NE(e.find("at the end of the step at t = " + cosim::FormatSeconds(t) + " s"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("wheel 0's contact (1"), std::string::npos) << e;
+  EXPECT_NE(e.find("is off the floor of scene 'hall' (x -1 to 1, y -2 to 2 m): the robot ran "
+                   "off the scene's floor"),
+            std::string::npos)
+      << e;
+  // About 0.63 m at 0.83 m/s^2 (a = 4 tau / r / m): after about 1.2 s.
+  EXPECT_GT(cosim::NsToSeconds(t), 1.0);
+  EXPECT_LT(cosim::NsToSeconds(t), 1.5);
+  // The outputs show where it went: the step's end.
+  EXPECT_GT(Get(u, "wheel_contact")[0], 1.0);
+
+  // Placed off the floor: refused at Initialize.
+  auto outside = Raw3(hall);
+  Set(*outside, "initial_x", 5.0);
+  try {
+    outside->Initialize();
+    ADD_FAILURE() << "initialised off the floor";
+  } catch (const cosim::UnitError& err) {
+    EXPECT_NE(std::string(err.what()).find("at the initial pose, wheel 0's contact (5.368"),
+              std::string::npos)
+        << err.what();
+  }
+  // Within the floor to the edge: fine (the open floor is +-1e6 m).
+  auto open = Raw3();
+  Set(*open, "initial_x", 1e6 - 0.5);
+  EXPECT_NO_THROW(open->Initialize());
 }
 
 // Guards against non-finite inputs or states passing silently: DoStep
