@@ -138,9 +138,8 @@ std::string ChassisUnit::TopologyProblem(const std::vector<int>& steer_motor,
   for (std::size_t k = 0; k < n; ++k) {
     const int s = steer_motor[k];
     if (s < -1 || s >= wheels) {
-      return "steer_motor[" + std::to_string(k) +
-             "]: expected a steering motor index in [0, " + std::to_string(wheels - 1) +
-             "] (below the wheel count " + std::to_string(wheels) +
+      return "steer_motor[" + std::to_string(k) + "]: expected a steering motor index in [0, " +
+             std::to_string(wheels - 1) + "] (below the wheel count " + std::to_string(wheels) +
              ") or -1 (fixed wheel), got " + std::to_string(s);
     }
     const int d = drive_motor[k];
@@ -682,9 +681,9 @@ std::string ChassisUnit::OffFloorWheel() const {
       continue;
     }
     return "wheel " + std::to_string(k) + "'s contact (" + cosim::FormatValue(gc.x_m) + ", " +
-           cosim::FormatValue(gc.y_m) + ") m is off the floor of scene '" + scene_.name +
-           "' (x " + cosim::FormatValue(fl.min_x_m) + " to " + cosim::FormatValue(fl.max_x_m) +
-           ", y " + cosim::FormatValue(fl.min_y_m) + " to " + cosim::FormatValue(fl.max_y_m) +
+           cosim::FormatValue(gc.y_m) + ") m is off the floor of scene '" + scene_.name + "' (x " +
+           cosim::FormatValue(fl.min_x_m) + " to " + cosim::FormatValue(fl.max_x_m) + ", y " +
+           cosim::FormatValue(fl.min_y_m) + " to " + cosim::FormatValue(fl.max_y_m) +
            " m): the robot ran off the scene's floor";
   }
   return {};

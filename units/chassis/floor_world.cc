@@ -122,8 +122,9 @@ void FloorWorld::AddCarried(const models::Solid& solid, int belt) {
   if (belt < 0 || belt >= belt_count()) throw std::out_of_range("FloorWorld: no such belt");
   const auto range = CarriedTravelRange(belts_[static_cast<std::size_t>(belt)], solid);
   if (!(range[0] <= 0.0 && 0.0 <= range[1])) {
-    throw std::invalid_argument("FloorWorld: a carried object's footprint overhangs an end of "
-                                "its belt at zero travel");
+    throw std::invalid_argument(
+        "FloorWorld: a carried object's footprint overhangs an end of "
+        "its belt at zero travel");
   }
   Carried c;
   c.travel_min_m = range[0];

@@ -164,7 +164,7 @@ TEST(FloorWorld, CarriedTravelRangeEndsAtTheBeltsEnds) {
   auto r = CarriedTravelRange(belt, box);
   EXPECT_NEAR(r[0], -2.0, 1e-12);  // its rear face reaches y = -4
   EXPECT_NEAR(r[1], 4.0, 1e-12);   // its front face reaches y = 6
-  box.yaw_rad = 0.0;  // across the belt: 1 m either side along it
+  box.yaw_rad = 0.0;               // across the belt: 1 m either side along it
   r = CarriedTravelRange(belt, box);
   EXPECT_NEAR(r[0], -3.0, 1e-12);
   EXPECT_NEAR(r[1], 5.0, 1e-12);
