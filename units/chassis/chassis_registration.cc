@@ -1,4 +1,6 @@
 // Registers the chassis family's unit types (see config/unit_registry.h).
+#include <string>
+
 #include "config/unit_registry.h"
 #include "units/chassis/chassis_unit.h"
 
@@ -10,7 +12,8 @@ using config::JoinPath;
 using config::UnitBuildContext;
 
 // A per-wheel list of motor indices (`key`) of `wheels` entries, each in
-// [min, wheels - 1]; `fallback` when the key is absent.
+// [min, wheels - 1] (motor indices are below the wheel count, at most
+// ChassisUnit::kMaxWheels); `fallback` when the key is absent.
 std::vector<int> ReadMotorList(const UnitBuildContext& c, const std::string& key, int wheels,
                                int min, std::vector<int> fallback) {
   const YAML::Node list = Child(c.parameters, key);
@@ -33,8 +36,8 @@ std::vector<int> ReadMotorList(const UnitBuildContext& c, const std::string& key
 }
 
 std::unique_ptr<cosim::Unit> MakeChassis(const UnitBuildContext& c) {
-  const int wheels =
-      static_cast<int>(c.reader.Integer(c.parameters, c.path, "wheel_count", 4, 1, 16));
+  const int wheels = static_cast<int>(c.reader.Integer(c.parameters, c.path, "wheel_count", 4, 1,
+                                                       chassis::ChassisUnit::kMaxWheels));
   // Without the keys: every wheel with its own steering and drive motor (a
   // generic swerve topology, not a robot).
   std::vector<int> own(static_cast<std::size_t>(wheels));
@@ -53,7 +56,8 @@ const config::UnitTypeRegistrar kChassis(
      "robot body, steered or fixed wheels (coupled per drive motor) and wheel/floor/belt "
      "contact in ODE, the body colliding with the scene's obstacles and carried objects",
      "",
-     {{"wheel_count", "number of wheels (default 4)"},
+     {{"wheel_count", "number of wheels, 1 to " + std::to_string(chassis::ChassisUnit::kMaxWheels) +
+                          " (default 4)"},
       {"steer_motor",
        "per wheel: index of its steering motor, -1 for a fixed wheel (default: wheel k on "
        "motor k)"},

@@ -17,9 +17,13 @@ namespace linesim::chassis {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-// Settling before time zero: 300 steps of 1 ms is about ten periods of the
-// slowest vertical mode (about 20 Hz with the default contacts) and its
-// damping time.
+// Settling before time zero: 300 steps of 1 ms (0.3 s). The slowest
+// vertical mode, the body on the four contact springs (default 1e6 N/m
+// each, 4e6 N/m in all), is at sqrt(4e6 / m) / 2 pi: about 29 Hz for the
+// Rob@Work 3 (120 kg: 0.3 s is about 9 periods) and about 45 Hz for the
+// Husky (50 kg: about 13 periods); the contact damping (1e4 N.s/m per
+// point) damps it within a few periods. Kept at 300 steps: the paper-1
+// numbers depend on the settled state.
 constexpr double kSettleStepS = 1e-3;
 constexpr int kSettleSteps = 300;
 // Holding torque on every joint while settling, whatever brake_torque is.
@@ -98,7 +102,8 @@ struct ChassisUnit::Ode {
 
 namespace {
 
-// Number of motors a per-wheel index list uses (largest index + 1).
+// Number of motors a per-wheel index list uses (largest index + 1). Only
+// for lists that TopologyProblem accepted (every index < the wheel count).
 int MotorCount(const std::vector<int>& motor) {
   int n = 0;
   for (int m : motor) n = std::max(n, m + 1);
@@ -119,10 +124,30 @@ constexpr double kCouplingCfm = 1e-10;
 std::string ChassisUnit::TopologyProblem(const std::vector<int>& steer_motor,
                                          const std::vector<int>& drive_motor) {
   const std::size_t n = steer_motor.size();
-  if (n < 1 || n > 64) return "wheel_count: expected 1 to 64 wheels, got " + std::to_string(n);
+  if (n < 1 || n > static_cast<std::size_t>(kMaxWheels)) {
+    return "wheel_count: expected 1 to " + std::to_string(kMaxWheels) + " wheels, got " +
+           std::to_string(n);
+  }
   if (drive_motor.size() != n) {
     return "drive_motor: expected one entry per wheel (wheel_count " + std::to_string(n) +
            "), got " + std::to_string(drive_motor.size());
+  }
+  // The ranges first, before anything is sized by an index: a motor index
+  // is below the wheel count (each motor serves at least one wheel).
+  const int wheels = static_cast<int>(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const int s = steer_motor[k];
+    if (s < -1 || s >= wheels) {
+      return "steer_motor[" + std::to_string(k) + "]: expected a steering motor index in [0, " +
+             std::to_string(wheels - 1) + "] (below the wheel count " + std::to_string(wheels) +
+             ") or -1 (fixed wheel), got " + std::to_string(s);
+    }
+    const int d = drive_motor[k];
+    if (d < 0 || d >= wheels) {
+      return "drive_motor[" + std::to_string(k) + "]: expected a drive motor index in [0, " +
+             std::to_string(wheels - 1) + "] (below the wheel count " + std::to_string(wheels) +
+             "), got " + std::to_string(d);
+    }
   }
   const int steer_count = MotorCount(steer_motor);
   const int drive_count = MotorCount(drive_motor);
@@ -130,20 +155,11 @@ std::string ChassisUnit::TopologyProblem(const std::vector<int>& steer_motor,
   std::vector<int> drive_first(static_cast<std::size_t>(drive_count), -1);
   for (std::size_t k = 0; k < n; ++k) {
     const int s = steer_motor[k];
-    if (s < -1) {
-      return "steer_motor[" + std::to_string(k) +
-             "]: expected a steering motor index >= 0 or -1 (fixed wheel), got " +
-             std::to_string(s);
-    }
     if (s >= 0 && ++steer_uses[static_cast<std::size_t>(s)] > 1) {
       return "steer_motor[" + std::to_string(k) + "]: steering motor " + std::to_string(s) +
              " already steers another wheel (one steered wheel per steering motor)";
     }
     const int d = drive_motor[k];
-    if (d < 0) {
-      return "drive_motor[" + std::to_string(k) + "]: expected a drive motor index >= 0, got " +
-             std::to_string(d);
-    }
     int& first = drive_first[static_cast<std::size_t>(d)];
     if (first < 0) {
       first = static_cast<int>(k);
@@ -201,6 +217,31 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
                              obj.name + "' is on belt " + std::to_string(obj.belt) +
                              ", not one of its " + std::to_string(belt_count_) + " belts");
     }
+    // It leaves the scene at its belt's end (FloorWorld), so it must start
+    // on the belt.
+    const models::Belt& belt = scene_.belts[static_cast<std::size_t>(obj.belt)];
+    const models::Rect& r = belt.area;
+    const auto range = CarriedTravelRange(
+        {r.center_x_m, r.center_y_m, r.length_m, r.width_m, r.direction_rad, 0.0}, obj.solid);
+    if (!(range[0] <= 0.0 && 0.0 <= range[1])) {
+      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': carried object '" +
+                             obj.name + "' overhangs an end of belt '" + belt.name +
+                             "' at time zero (its footprint must lie along the belt's length)");
+    }
+  }
+  // The wheels drive on the flat floor only (a later issue adds ramps):
+  // a terrain piece would be driven through, not on.
+  if (!scene_.terrain.empty()) {
+    throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': terrain '" +
+                           scene_.terrain.front().name + "' is not simulated by the chassis yet");
+  }
+  if (!(scene_.floor.min_x_m < scene_.floor.max_x_m &&
+        scene_.floor.min_y_m < scene_.floor.max_y_m)) {
+    throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': the floor's rectangle is " +
+                           "empty (x " + cosim::FormatValue(scene_.floor.min_x_m) + " to " +
+                           cosim::FormatValue(scene_.floor.max_x_m) + ", y " +
+                           cosim::FormatValue(scene_.floor.min_y_m) + " to " +
+                           cosim::FormatValue(scene_.floor.max_y_m) + ")");
   }
   steer_motor_count_ = MotorCount(steer_motor_);
   drive_motor_count_ = MotorCount(drive_motor_);
@@ -499,7 +540,9 @@ void ChassisUnit::ApplyTorques() {
   Column(dBodyGetRotation(o.body), 2, up);
   const dReal* wb = dBodyGetAngularVel(o.body);
   // A drive motor's torque goes to the first wheel of its group only.
-  std::uint64_t driven = 0;  // bit m: motor m's torque applied (<= 16 wheels)
+  // Bit m: motor m's torque applied (m < wheel count <= kMaxWheels = 64).
+  std::uint64_t driven = 0;
+  static_assert(kMaxWheels <= 64, "one bit per drive motor in a 64-bit mask");
   for (std::size_t k = 0; k < o.wheels.size(); ++k) {
     const dBodyID w = o.wheels[k];
     Column(dBodyGetRotation(w), 1, axle);
@@ -556,6 +599,9 @@ void ChassisUnit::Settle() {
   }
   // The contacts at the moved positions, for the outputs and the first step.
   f.Probe();
+  if (const std::string bad = OffFloorWheel(); !bad.empty()) {
+    throw cosim::UnitError(Where() + ": at the initial pose, " + bad);
+  }
 }
 
 void ChassisUnit::Initialize() {
@@ -626,6 +672,23 @@ std::string ChassisUnit::NonFiniteState() const {
   return {};
 }
 
+std::string ChassisUnit::OffFloorWheel() const {
+  const models::Floor& fl = scene_.floor;
+  for (int k = 0; k < wheel_count_; ++k) {
+    const GeomContact& gc = ode_->floor->contact(k);
+    if (fl.min_x_m <= gc.x_m && gc.x_m <= fl.max_x_m && fl.min_y_m <= gc.y_m &&
+        gc.y_m <= fl.max_y_m) {
+      continue;
+    }
+    return "wheel " + std::to_string(k) + "'s contact (" + cosim::FormatValue(gc.x_m) + ", " +
+           cosim::FormatValue(gc.y_m) + ") m is off the floor of scene '" + scene_.name + "' (x " +
+           cosim::FormatValue(fl.min_x_m) + " to " + cosim::FormatValue(fl.max_x_m) + ", y " +
+           cosim::FormatValue(fl.min_y_m) + " to " + cosim::FormatValue(fl.max_y_m) +
+           " m): the robot ran off the scene's floor";
+  }
+  return {};
+}
+
 void ChassisUnit::ComputeOutputs() {
   const Ode& o = *ode_;
   const dReal* rb = dBodyGetRotation(o.body);
@@ -647,7 +710,8 @@ void ChassisUnit::ComputeOutputs() {
   Column(rb, 0, ex);
   Column(rb, 1, ey);
   Column(rb, 2, ez);
-  // drive_rate is the first wheel's of each motor (the others are coupled to it).
+  // drive_rate is the first wheel's of each motor (the others are coupled to
+  // it). Bit m: motor m seen (m < wheel count <= kMaxWheels = 64).
   std::uint64_t seen = 0;
   for (std::size_t k = 0; k < o.wheels.size(); ++k) {
     const dBodyID w = o.wheels[k];
@@ -712,6 +776,12 @@ cosim::StepResult ChassisUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   }
   // FloorWorld::Step collided at the new positions already.
   ComputeOutputs();
+  // Nothing is simulated off the floor: stop there (the world stays
+  // consistent, the outputs show where the robot went).
+  if (const std::string bad = OffFloorWheel(); !bad.empty()) {
+    return Fail(Where() + ": at the end of the step at t = " + cosim::FormatSeconds(t) + " s, " +
+                bad);
+  }
   return cosim::StepResult::kOk;
 }
 

@@ -50,6 +50,10 @@ namespace linesim::chassis {
 /// above; fixed wheels head along +x. A positive drive torque or drive rate
 /// rolls the wheel forward along its heading.
 ///
+/// Scene: the flat floor (bounded by its rectangle: a step that ends with a
+/// wheel contact outside it fails), its belts, obstacles and carried
+/// objects; terrain pieces are refused (not simulated yet).
+///
 /// Initialize builds the robot at the initial pose with every wheel
 /// pressed in by its share of the weight, then settles it for 0.3 s with
 /// the joints held and every belt still, and finally moves it rigidly back
@@ -59,16 +63,27 @@ namespace linesim::chassis {
 class ChassisUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "chassis";
+  /// Most wheels a chassis may have (wheel_count 1 to kMaxWheels). Motor
+  /// indices are below the wheel count (one wheel per steering motor, at
+  /// least one per drive motor), so a 64-bit mask holds one bit per drive
+  /// motor.
+  static constexpr int kMaxWheels = 64;
 
   /// Checks a topology (steer_motor and drive_motor per wheel, as in the
   /// class comment): empty when usable, else what is wrong, naming the key.
+  /// 1 to kMaxWheels wheels; every motor index in [0, wheel count), or -1
+  /// for a fixed wheel's steer_motor; checked before anything is sized by
+  /// an index.
   static std::string TopologyProblem(const std::vector<int>& steer_motor,
                                      const std::vector<int>& drive_motor);
 
   /// `steer_motor` and `drive_motor` give the topology (one entry per
   /// wheel); `scene` the belts (one belt_velocity and belt_travel input
   /// each), the floor's and the belts' friction, the obstacles and carried
-  /// objects. Throws cosim::UnitError for a bad topology or scene.
+  /// objects. Throws cosim::UnitError for a bad topology or scene: a scene
+  /// with terrain pieces (not simulated yet: the wheels drive on the flat
+  /// floor only), or a carried object not lying along its belt's length at
+  /// zero travel.
   ChassisUnit(std::string name, std::vector<int> steer_motor, std::vector<int> drive_motor,
               models::Scene scene);
   ~ChassisUnit() override;
@@ -77,8 +92,13 @@ class ChassisUnit : public cosim::Unit {
   /// less than mass.
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
   /// Validates the parameters (throws cosim::UnitError listing every bad
-  /// value), builds and settles the robot, computes the outputs.
+  /// value), builds and settles the robot, computes the outputs. Throws
+  /// cosim::UnitError when a settled wheel contact is off the scene's floor.
   void Initialize() override;
+  /// Fails (kError, naming the wheel, its contact point and the time) when
+  /// a wheel contact ends the step outside the floor's rectangle
+  /// (models::Scene::floor): the robot ran off the scene's floor, where
+  /// nothing is simulated. The world stays consistent.
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
 
   int wheel_count() const { return wheel_count_; }
@@ -109,6 +129,9 @@ class ChassisUnit : public cosim::Unit {
   void SetBeltInputs();
   /// Empty when every body state is finite, else what is not.
   std::string NonFiniteState() const;
+  /// Empty when every wheel contact (as last collided) is on the scene's
+  /// floor rectangle, else which wheel is off it and where.
+  std::string OffFloorWheel() const;
   void ComputeOutputs();
 
   int wheel_count_;

@@ -106,9 +106,29 @@ void FloorWorld::AddObstacle(const models::Solid& solid) {
   near_region_ = {1.0, -1.0, 1.0, -1.0, 1.0, -1.0};  // list again
 }
 
+std::array<double, 2> CarriedTravelRange(const BeltPatch& b, const models::Solid& solid) {
+  const double ax = std::cos(b.direction_rad), ay = std::sin(b.direction_rad);
+  // Half the footprint's extent along the belt axis.
+  double half = solid.radius_m;
+  if (solid.kind == models::Solid::Kind::kBox) {
+    const double d = solid.yaw_rad - b.direction_rad;
+    half = 0.5 * (solid.length_m * std::abs(std::cos(d)) + solid.width_m * std::abs(std::sin(d)));
+  }
+  const double along = (solid.x_m - b.center_x_m) * ax + (solid.y_m - b.center_y_m) * ay;
+  return {-0.5 * b.length_m + half - along, 0.5 * b.length_m - half - along};
+}
+
 void FloorWorld::AddCarried(const models::Solid& solid, int belt) {
   if (belt < 0 || belt >= belt_count()) throw std::out_of_range("FloorWorld: no such belt");
+  const auto range = CarriedTravelRange(belts_[static_cast<std::size_t>(belt)], solid);
+  if (!(range[0] <= 0.0 && 0.0 <= range[1])) {
+    throw std::invalid_argument(
+        "FloorWorld: a carried object's footprint overhangs an end of "
+        "its belt at zero travel");
+  }
   Carried c;
+  c.travel_min_m = range[0];
+  c.travel_max_m = range[1];
   c.geom = SolidGeom(solid, &c.z_m);
   c.belt = belt;
   c.x0_m = solid.x_m;
@@ -193,6 +213,8 @@ void FloorWorld::CollideObjects(double erp, double cfm) {
     const auto b = static_cast<std::size_t>(c.belt);
     const double speed = CarriedSpeed(i);
     const double s = belt_travel_m_[b] + speed * travel_elapsed_s_;
+    // Past an end of its belt: lifted off the line, gone from the scene.
+    if (s < c.travel_min_m || s > c.travel_max_m) continue;
     const double dx = s * belt_axes_[b][0], dy = s * belt_axes_[b][1];
     const Aabb moved = {c.aabb0[0] + dx, c.aabb0[1] + dx, c.aabb0[2] + dy,
                         c.aabb0[3] + dy, c.aabb0[4],      c.aabb0[5]};

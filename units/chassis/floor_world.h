@@ -54,6 +54,12 @@ struct BeltPatch {
   double mu = 0.8;             // Coulomb coefficient of a wheel on its surface
 };
 
+/// The belt travel over which a carried object (its footprint at zero
+/// travel: `solid`) lies along belt `b`'s length: its footprint's extent
+/// along the belt axis within the belt's two ends. {min, max}; min > 0 or
+/// max < 0 when it does not lie on the belt at zero travel.
+std::array<double, 2> CarriedTravelRange(const BeltPatch& b, const models::Solid& solid);
+
 /// Contact parameters shared by every contact with the floor and the belts
 /// (each belt has its own mu: BeltPatch::mu).
 struct ContactSurface {
@@ -120,6 +126,13 @@ struct GeomContact {
 /// body: it is placed from its belt's travelled distance and its contacts
 /// move with it through the contact's surface motion (normal motionN and
 /// tangential motion1/2 = the object's velocity), as the belt contacts do.
+///
+/// A carried object leaves with the belt's end, as a car body is lifted off
+/// the line at its end: it rides while its footprint lies along the belt's
+/// length (CarriedTravelRange) and, once its leading face passes an end of
+/// the belt (travelled beyond that range), it is gone from the scene: it
+/// collides with nothing, whatever the belt travels afterwards. (A belt
+/// running backwards takes it off at its start the same way.)
 class FloorWorld {
  public:
   FloorWorld();
@@ -154,7 +167,10 @@ class FloorWorld {
   void AddObstacle(const models::Solid& solid);
   int obstacle_count() const { return static_cast<int>(obstacles_.size()); }
   /// Adds an object carried by belt `belt` (0-based, < belt_count()), at
-  /// `solid` when the belt has travelled 0 m.
+  /// `solid` when the belt has travelled 0 m; it leaves the scene when its
+  /// footprint passes an end of the belt (see the class comment). Throws
+  /// std::out_of_range for a bad belt, std::invalid_argument when its
+  /// footprint does not lie along the belt's length at zero travel.
   void AddCarried(const models::Solid& solid, int belt);
   /// Distance belt k's surface has moved since time zero: carried objects
   /// are placed at it (and move on at the belt velocity along the belt
@@ -224,6 +240,9 @@ class FloorWorld {
     int belt = 0;
     double x0_m = 0.0, y0_m = 0.0, z_m = 0.0;
     Aabb aabb0{};  // at zero travel
+    // The belt travel over which it is on the belt (CarriedTravelRange);
+    // outside it, it has left the scene.
+    double travel_min_m = 0.0, travel_max_m = 0.0;
   };
 
   dWorldID world_ = nullptr;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <variant>
@@ -592,7 +593,8 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   EXPECT_NE(problem({0, -2}, {0, 1}).find("steer_motor[1]"), std::string::npos);
   EXPECT_NE(problem({0, 0}, {0, 1}).find("already steers another wheel"), std::string::npos);
   EXPECT_NE(problem({0, 2, 1}, {0, 1, 1}).find("share drive motor 1"), std::string::npos);
-  EXPECT_NE(problem({-1, -1}, {0, 2}).find("drive motor 1 drives no wheel"), std::string::npos);
+  EXPECT_NE(problem({-1, -1, -1}, {0, 2, 2}).find("drive motor 1 drives no wheel"),
+            std::string::npos);
   EXPECT_NE(problem({1, -1}, {0, 1}).find("steering motor 0 steers no wheel"), std::string::npos);
   EXPECT_EQ(problem({-1, -1, -1, -1}, {0, 0, 1, 1}), "");
 
@@ -602,6 +604,41 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   bad = models::OpenFloor();
   bad.carried.push_back({"car", 0, {}});  // belt 0 of a scene with none
   EXPECT_THROW(ChassisUnit("robot", {0}, {0}, bad), cosim::UnitError);
+  const auto scene_problem = [](const models::Scene& scene) {
+    try {
+      ChassisUnit u("robot", {0}, {0}, scene);
+    } catch (const cosim::UnitError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  // A car body overhanging its belt's end at time zero (it would leave the
+  // scene at once: it leaves with the belt's end).
+  bad = test_robots::OneBelt({0.0, 5.0, 10.0, 3.0, 0.0});
+  models::Solid car;
+  car.x_m = 3.0;  // 4.5 m long: its front at 5.25 m, past the belt's end at 5 m
+  car.y_m = 5.0;
+  car.length_m = 4.5;
+  car.width_m = 1.8;
+  car.height_m = 1.2;
+  bad.carried.push_back({"car", 0, car});
+  EXPECT_NE(scene_problem(bad).find("carried object 'car' overhangs an end of belt 'belt'"),
+            std::string::npos)
+      << scene_problem(bad);
+  bad.carried[0].solid.x_m = 2.75;  // its front exactly at the end: on the belt
+  EXPECT_EQ(scene_problem(bad), "");
+  // Terrain is not simulated yet: refused, naming the piece.
+  bad = models::OpenFloor();
+  bad.terrain.push_back({});
+  bad.terrain.back().name = "ramp";
+  EXPECT_NE(scene_problem(bad).find("terrain 'ramp' is not simulated by the chassis yet"),
+            std::string::npos)
+      << scene_problem(bad);
+  // A floor with no area: every wheel would be off it.
+  bad = models::OpenFloor();
+  bad.floor.max_x_m = bad.floor.min_x_m;
+  EXPECT_NE(scene_problem(bad).find("the floor's rectangle is empty"), std::string::npos)
+      << scene_problem(bad);
 
   // Three modules and no belts: no belt inputs, and it builds and steps.
   auto three = std::make_unique<ChassisUnit>("robot", std::vector<int>{0, 1, 2},
@@ -623,6 +660,106 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   EXPECT_NO_THROW(three->Initialize());
   TimeNs t = 0;
   Advance(*three, t, 10);
+}
+
+// Guards against motor indices that size vectors before they are checked
+// (a huge index allocated gigabytes; INT_MAX + 1 overflowed) and against
+// wheel-count limits that disagree: every index must be in [0, wheel
+// count) (steer -1: a fixed wheel), checked first; 1 to kMaxWheels wheels.
+TEST(ChassisUnit, TopologyRefusesOutOfRangeIndicesAndWheelCounts) {
+  constexpr int kMax = std::numeric_limits<int>::max();
+  const auto problem = [](std::vector<int> steer, std::vector<int> drive) {
+    return ChassisUnit::TopologyProblem(steer, drive);
+  };
+  for (const int huge : {2000000000, kMax}) {
+    SCOPED_TRACE(huge);
+    std::string p = problem({huge}, {0});
+    EXPECT_NE(p.find("steer_motor[0]: expected a steering motor index in [0, 0]"),
+              std::string::npos)
+        << p;
+    EXPECT_NE(p.find("got " + std::to_string(huge)), std::string::npos) << p;
+    p = problem({-1, -1}, {0, huge});
+    EXPECT_NE(p.find("drive_motor[1]: expected a drive motor index in [0, 1]"), std::string::npos)
+        << p;
+    EXPECT_NE(p.find("got " + std::to_string(huge)), std::string::npos) << p;
+    // The constructor refuses them with the same message, before it sizes
+    // anything (a std::bad_alloc would fail the test).
+    try {
+      ChassisUnit u("robot", {-1, -1}, {0, huge}, models::OpenFloor());
+      ADD_FAILURE() << "accepted drive motor " << huge;
+    } catch (const cosim::UnitError& e) {
+      EXPECT_NE(std::string(e.what()).find("drive_motor[1]"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NE(problem({std::numeric_limits<int>::min()}, {0}).find("steer_motor[0]"),
+            std::string::npos);
+  EXPECT_NE(problem({0, 1}, {0, 2}).find("drive_motor[1]: expected a drive motor index in [0, 1]"),
+            std::string::npos);
+
+  // kMaxWheels fixed wheels on one motor each: accepted; one more: refused.
+  const auto n = static_cast<std::size_t>(ChassisUnit::kMaxWheels);
+  static_assert(ChassisUnit::kMaxWheels == 64);
+  std::vector<int> fixed(n, -1), drive(n);
+  for (std::size_t k = 0; k < n; ++k) drive[k] = static_cast<int>(k);
+  EXPECT_EQ(problem(fixed, drive), "");
+  fixed.push_back(-1);
+  drive.push_back(static_cast<int>(n));
+  EXPECT_EQ(problem(fixed, drive), "wheel_count: expected 1 to 64 wheels, got 65");
+  EXPECT_EQ(problem({}, {}), "wheel_count: expected 1 to 64 wheels, got 0");
+}
+
+// Guards against a robot that drives off the scene's floor without notice
+// (nothing is simulated there): the step whose end finds a wheel contact
+// outside the floor's rectangle fails, naming the unit, the time and the
+// wheel and its contact point; an initial pose off the floor is refused.
+TEST(ChassisUnit, LeavingTheFloorFails) {
+  models::Scene hall = models::OpenFloor();
+  hall.name = "hall";
+  hall.floor = {-1.0, 1.0, -2.0, 2.0, 0};
+  auto robot = Raw3(hall);
+  ChassisUnit& u = *robot;
+  u.Initialize();
+  SetArray(u, "drive_torque", {2.0, 2.0, 2.0, 2.0});
+  TimeNs t = 0;
+  cosim::StepResult result = cosim::StepResult::kOk;
+  for (int i = 0; i < 3000 && result == cosim::StepResult::kOk; ++i) {
+    result = u.DoStep(t, kMs);
+    if (result == cosim::StepResult::kOk) t += kMs;
+  }
+  ASSERT_EQ(result, cosim::StepResult::kError);
+  const std::string e = u.last_error();
+  // The front wheels (x 0.368 in base_link) cross x = 1 first: wheel 0 (or
+  // 3, its mirror; 0 is checked first).
+  EXPECT_NE(e.find("robot"), std::string::npos) << e;
+  EXPECT_NE(e.find("at the end of the step at t = " + cosim::FormatSeconds(t) + " s"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("wheel 0's contact (1"), std::string::npos) << e;
+  EXPECT_NE(e.find("is off the floor of scene 'hall' (x -1 to 1, y -2 to 2 m): the robot ran "
+                   "off the scene's floor"),
+            std::string::npos)
+      << e;
+  // About 0.63 m at 0.83 m/s^2 (a = 4 tau / r / m): after about 1.2 s.
+  EXPECT_GT(cosim::NsToSeconds(t), 1.0);
+  EXPECT_LT(cosim::NsToSeconds(t), 1.5);
+  // The outputs show where it went: the step's end.
+  EXPECT_GT(Get(u, "wheel_contact")[0], 1.0);
+
+  // Placed off the floor: refused at Initialize.
+  auto outside = Raw3(hall);
+  Set(*outside, "initial_x", 5.0);
+  try {
+    outside->Initialize();
+    ADD_FAILURE() << "initialised off the floor";
+  } catch (const cosim::UnitError& err) {
+    EXPECT_NE(std::string(err.what()).find("at the initial pose, wheel 0's contact (5.368"),
+              std::string::npos)
+        << err.what();
+  }
+  // Within the floor to the edge: fine (the open floor is +-1e6 m).
+  auto open = Raw3();
+  Set(*open, "initial_x", 1e6 - 0.5);
+  EXPECT_NO_THROW(open->Initialize());
 }
 
 // Guards against non-finite inputs or states passing silently: DoStep

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 
 namespace linesim::chassis {
 namespace {
@@ -145,6 +146,43 @@ TEST(FloorWorld, SurfaceAtRotatedPatches) {
   EXPECT_EQ(f.SurfaceAt(2.6, 1.0), 2);    // 0.6 across: outside belt 0, inside belt 1
   EXPECT_EQ(f.SurfaceAt(2.0, 3.1), 2);
   EXPECT_EQ(f.SurfaceAt(6.0, 0.0), 0);  // outside both
+}
+
+// Guards against carried objects that ride past their belt's end: the
+// travel over which a footprint lies along a belt's length, for a belt
+// along map y and boxes turned on it, and a cylinder; AddCarried refuses
+// one that overhangs an end at zero travel.
+TEST(FloorWorld, CarriedTravelRangeEndsAtTheBeltsEnds) {
+  // Belt along +y from y = -4 to 6 (centre (2, 1), 10 m long, 3 m wide).
+  const BeltPatch belt{2.0, 1.0, 10.0, 3.0, std::numbers::pi / 2.0};
+  models::Solid box;
+  box.x_m = 2.0;
+  box.y_m = 0.0;
+  box.length_m = 4.0;
+  box.width_m = 2.0;
+  box.yaw_rad = std::numbers::pi / 2.0;  // along the belt: 2 m either side along it
+  auto r = CarriedTravelRange(belt, box);
+  EXPECT_NEAR(r[0], -2.0, 1e-12);  // its rear face reaches y = -4
+  EXPECT_NEAR(r[1], 4.0, 1e-12);   // its front face reaches y = 6
+  box.yaw_rad = 0.0;               // across the belt: 1 m either side along it
+  r = CarriedTravelRange(belt, box);
+  EXPECT_NEAR(r[0], -3.0, 1e-12);
+  EXPECT_NEAR(r[1], 5.0, 1e-12);
+  models::Solid drum;
+  drum.kind = models::Solid::Kind::kCylinder;
+  drum.x_m = 2.5;
+  drum.y_m = 5.0;
+  drum.radius_m = 0.5;
+  r = CarriedTravelRange(belt, drum);
+  EXPECT_NEAR(r[0], -8.5, 1e-12);
+  EXPECT_NEAR(r[1], 0.5, 1e-12);
+
+  FloorWorld f;
+  f.SetBelts({belt});
+  EXPECT_NO_THROW(f.AddCarried(drum, 0));
+  drum.y_m = 5.6;  // 0.1 m past the end
+  EXPECT_THROW(f.AddCarried(drum, 0), std::invalid_argument);
+  EXPECT_THROW(f.AddCarried(drum, 1), std::out_of_range);
 }
 
 // Guards against a slip in the one spring-damper formula the contacts and

@@ -3,14 +3,17 @@
 // collisions with the scene's obstacles and carried objects.
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <vector>
 
 #include "cosim/time.h"
+#include "models/models_dir.h"
 #include "tests/units/chassis/robots.h"
 #include "tests/units/test_helpers.h"
 #include "units/chassis/chassis_unit.h"
@@ -232,16 +235,22 @@ TEST(Obstacles, PillarStopsTheRobot) {
   EXPECT_GT(Get(u, "drive_rate")[0], 0.5 * rate);
 }
 
-// Guards against carried objects that do not move with belt_travel or do
-// not push: a car body (4.5 x 1.8 x 1.2 m on skids 5 cm up) carried by a
-// belt at 0.3 m/s reaches a braked Husky standing on the floor beyond the
-// belt's end and pushes it along at the belt speed (its locked wheels
-// slide: the brake's 30 N.m exceeds the mu N r = 20 N.m a wheel can take),
-// its rear face at the car's front face to a few mm.
+// Guards against carried objects that do not move with belt_travel, do
+// not push, or do not leave with their belt's end: a car body (4.5 x 1.8 x
+// 1.2 m on skids 5 cm up) carried by a belt at 0.3 m/s reaches a braked
+// Husky standing on the floor at the belt's end (the belt reaches under the
+// robot's rear, short of its rear wheels) and pushes it along at the belt
+// speed (its locked wheels slide: the brake's 30 N.m exceeds the mu N r =
+// 20 N.m a wheel can take), its rear face at the car's front face to a few
+// mm. When the car's front reaches the belt's end it is lifted off the
+// line: gone from the scene, so the robot slides to a stop there, pushed
+// 0.19 m in all.
 TEST(Obstacles, CarBodyPushesABrakedRobot) {
   const double belt_mps = 0.3;
-  // Belt along map x from x = -8 to -2 (3 m wide); the robot at the origin.
-  models::Scene scene = OneBelt({-5.0, 0.0, 6.0, 3.0, 0.0}, kHuskyMu);
+  // Belt along map x from x = -8 to -0.3 (3 m wide); the robot at the
+  // origin: its rear face at -0.494, its rear wheels' contacts at -0.256.
+  const double belt_end = -0.3;
+  models::Scene scene = OneBelt({-4.15, 0.0, 7.7, 3.0, 0.0}, kHuskyMu);
   models::Solid car;
   car.x_m = -3.5;  // front face at -1.25 m at zero travel
   car.length_m = 4.5;
@@ -257,23 +266,50 @@ TEST(Obstacles, CarBodyPushesABrakedRobot) {
   TimeNs t = 0;
   const double rear = 0.5 * kHuskyBodyM[0];
   double min_gap = 1e9;
+  double pushed_velocity = 0.0;
   for (int i = 0; i < 6000; ++i) {
     const double travel = belt_mps * cosim::NsToSeconds(t);
     SetArray(u, "belt_travel", {travel});
     StepOk(u, t);
     const double car_front = -1.25 + belt_mps * cosim::NsToSeconds(t);
-    min_gap = std::min(min_gap, Get(u, "position")[0] - rear - car_front);
+    if (car_front <= belt_end) {
+      min_gap = std::min(min_gap, Get(u, "position")[0] - rear - car_front);
+    }
     // Before it arrives (0.756 m at 0.3 m/s: 2.5 s) the robot stands still.
     if (car_front < -rear - 0.01) {
       ASSERT_LT(std::abs(Get(u, "position")[0]), 1e-4) << "step " << i;
     }
+    // 0.5 s into the push, 0.15 s before the car leaves.
+    if (i == 3000) pushed_velocity = Get(u, "linear_velocity")[0];
+    // The wheels stay on the floor.
+    for (double s : Get(u, "wheel_surface")) ASSERT_EQ(s, 0.0) << "step " << i;
   }
-  // Pushed for the last 3.5 s: at the belt speed, 3.5 x 0.3 = 1.05 m on.
-  EXPECT_NEAR(Get(u, "linear_velocity")[0], belt_mps, 0.01 * belt_mps);
-  EXPECT_GT(Get(u, "position")[0], 0.9);
+  EXPECT_NEAR(pushed_velocity, belt_mps, 0.01 * belt_mps);
   RecordProperty("car_min_gap_m", std::to_string(min_gap));
   EXPECT_GT(min_gap, -0.003);
   EXPECT_LT(min_gap, 0.001);
+  // The car left at 3.17 s (its front at the belt's end): the robot slid
+  // to a stop (mu g = 9.8 m/s^2: 5 mm from 0.3 m/s) right after it, its
+  // rear at the belt's end, and stood there for the remaining 2.8 s though
+  // the belt ran on.
+  EXPECT_NEAR(Get(u, "linear_velocity")[0], 0.0, 1e-4);
+  EXPECT_GT(Get(u, "position")[0] - rear, belt_end - 0.003);
+  EXPECT_LT(Get(u, "position")[0] - rear, belt_end + 0.01);
+}
+
+// Guards against the Husky's robot description and the test robot
+// drifting apart: models/robots/husky.yaml's body (its com_height_m the
+// derived 0.13 m clearance + 0.2475 / 2 m) is the test robot's.
+TEST(Husky, RobotDescriptionBodyMatchesTestRobot) {
+  const auto path = std::filesystem::path(models::ModelsDir()) / "robots" / "husky.yaml";
+  const YAML::Node body = YAML::LoadFile(path.string())["body"];
+  ASSERT_TRUE(body && body.IsMap());
+  EXPECT_EQ(body["length_m"].as<double>(), kHuskyBodyM[0]);
+  EXPECT_EQ(body["width_m"].as<double>(), kHuskyBodyM[1]);
+  EXPECT_EQ(body["height_m"].as<double>(), kHuskyBodyM[2]);
+  EXPECT_EQ(body["mass_kg"].as<double>(), kHuskyMassKg);
+  EXPECT_NEAR(body["com_height_m"].as<double>(), kHuskyComHeightM, 1e-15);
+  EXPECT_NEAR(kHuskyComHeightM, 0.25375, 1e-15);
 }
 
 // Guards against hidden state in the coupling joints, the obstacle lists or
@@ -281,7 +317,9 @@ TEST(Obstacles, CarBodyPushesABrakedRobot) {
 // pillar while a car body catches up and pushes it, saved mid-push and
 // restored (in itself and in a fresh unit), continues bit for bit.
 TEST(Obstacles, SaveRestoreWithObjectsIsBitForBit) {
-  models::Scene scene = OneBelt({-5.0, 0.0, 6.0, 3.0, 0.0}, kHuskyMu);
+  // Belt from x = -8 to -0.3: the car leaves at its end (belt travel
+  // 0.25 m, step 833), within the compared stretch.
+  models::Scene scene = OneBelt({-4.15, 0.0, 7.7, 3.0, 0.0}, kHuskyMu);
   models::Solid car;
   car.x_m = -2.8;  // front face 0.05 m behind the robot's rear at zero travel
   car.length_m = 4.5;

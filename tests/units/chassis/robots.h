@@ -52,8 +52,8 @@ inline constexpr double kHuskyBodyM[3] = {0.9874, 0.5709, 0.2475};
 inline constexpr double kHuskyMassKg = 50.0;
 inline constexpr double kHuskyWheelMassKg = 2.637;
 /// Box centre: its bottom at the 130 mm ground clearance (manual) plus half
-/// its height.
-inline constexpr double kHuskyComHeightM = 0.130 + 0.5 * 0.2475;
+/// its height: 0.25375 m, as models/robots/husky.yaml's com_height_m.
+inline constexpr double kHuskyComHeightM = 0.130 + 0.5 * kHuskyBodyM[2];
 /// Wheel contact mu 1.0 (URDF gazebo tags).
 inline constexpr double kHuskyMu = 1.0;
 
