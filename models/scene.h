@@ -1,5 +1,7 @@
 #pragma once
 
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -133,6 +135,24 @@ struct Scene {
     return std::nullopt;
   }
 };
+
+/// The belt travel over which an object a belt carries (its footprint at
+/// zero travel: `solid`) lies along the belt's length (`belt_area`): its
+/// footprint's extent along the belt axis within the belt's two ends.
+/// {min, max}; min > 0 or max < 0 when it does not lie on the belt at zero
+/// travel. Outside the range the object has been lifted off the line.
+inline std::array<double, 2> CarriedTravelRange(const Rect& belt_area, const Solid& solid) {
+  const double ax = std::cos(belt_area.direction_rad), ay = std::sin(belt_area.direction_rad);
+  // Half the footprint's extent along the belt axis.
+  double half = solid.radius_m;
+  if (solid.kind == Solid::Kind::kBox) {
+    const double d = solid.yaw_rad - belt_area.direction_rad;
+    half = 0.5 * (solid.length_m * std::abs(std::cos(d)) + solid.width_m * std::abs(std::sin(d)));
+  }
+  const double along =
+      (solid.x_m - belt_area.center_x_m) * ax + (solid.y_m - belt_area.center_y_m) * ay;
+  return {-0.5 * belt_area.length_m + half - along, 0.5 * belt_area.length_m - half - along};
+}
 
 /// The scene of a scenario that names none: an unbounded floor of one
 /// surface, sealed concrete under a polyurethane tread (friction 0.8, the

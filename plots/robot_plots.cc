@@ -330,7 +330,13 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     AppendSolid(carried, c.solid, 0.0, 0.0);
     footprints.push_back(Footprint(c.solid, 0.0, 0.0));
     const auto b = static_cast<std::size_t>(c.belt);
-    if (b < travel.size() && travel[b] && b < spec.scene.belts.size()) {
+    // An object past its belt's end has been lifted off the line (as the
+    // chassis simulates it): nothing is drawn at the end.
+    const auto on_belt = [&](double d) {
+      const auto range = models::CarriedTravelRange(spec.scene.belts[b].area, c.solid);
+      return range[0] <= d && d <= range[1];
+    };
+    if (b < travel.size() && travel[b] && b < spec.scene.belts.size() && on_belt(*travel[b])) {
       const double heading = spec.scene.belts[b].area.direction_rad;
       const double dx = *travel[b] * std::cos(heading), dy = *travel[b] * std::sin(heading);
       AppendSolid(carried_end, c.solid, dx, dy);

@@ -107,15 +107,8 @@ void FloorWorld::AddObstacle(const models::Solid& solid) {
 }
 
 std::array<double, 2> CarriedTravelRange(const BeltPatch& b, const models::Solid& solid) {
-  const double ax = std::cos(b.direction_rad), ay = std::sin(b.direction_rad);
-  // Half the footprint's extent along the belt axis.
-  double half = solid.radius_m;
-  if (solid.kind == models::Solid::Kind::kBox) {
-    const double d = solid.yaw_rad - b.direction_rad;
-    half = 0.5 * (solid.length_m * std::abs(std::cos(d)) + solid.width_m * std::abs(std::sin(d)));
-  }
-  const double along = (solid.x_m - b.center_x_m) * ax + (solid.y_m - b.center_y_m) * ay;
-  return {-0.5 * b.length_m + half - along, 0.5 * b.length_m - half - along};
+  return models::CarriedTravelRange(
+      {b.center_x_m, b.center_y_m, b.length_m, b.width_m, b.direction_rad}, solid);
 }
 
 void FloorWorld::AddCarried(const models::Solid& solid, int belt) {
