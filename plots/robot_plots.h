@@ -10,8 +10,8 @@
 namespace linesim::plots {
 
 /// What to draw for one robot run. Column names are header names of
-/// signals.csv as the recorder writes them ("chassis.pose[0]"); an empty name
-/// leaves out what it would draw.
+/// signals.csv as the recorder writes them ("chassis.position[0]"); an
+/// empty name leaves out what it would draw.
 struct RobotPlotSpec {
   std::string title;
   /// What the top view draws around the robot: belts (rectangles with
