@@ -72,8 +72,7 @@ void SystemBuilder::Origin(const std::string& expanded, loader::Origin origin) {
 }
 
 void SystemBuilder::MergeSettings(const std::string& unit, const YAML::Node& settings,
-                                  const std::string& file, const std::string& section,
-                                  bool complete) {
+                                  const std::string& file, const std::string& section) {
   YAML::Node params = Params(unit);
   const std::string prefix = JoinPath(JoinPath("units", unit), "parameters");
   if (settings.IsMap()) {
@@ -92,9 +91,11 @@ void SystemBuilder::MergeSettings(const std::string& unit, const YAML::Node& set
       origins_[JoinPath(prefix, key)] = {kv.second, JoinPath(section, key), file};
     }
   }
-  // Every parameter the unit has no default for must now be set: by the
-  // assembly or by this section of the robot file.
-  if (!complete) return;
+}
+
+void SystemBuilder::RequireParameters(const std::string& unit, const YAML::Node& settings,
+                                      const std::string& file, const std::string& section) {
+  const YAML::Node params = Params(unit);
   const YAML::Node type = Child(Child(Child(out_, "units"), unit), "type");
   const config::UnitType* unit_type = type.IsScalar() ? FindUnitType(type.Scalar()) : nullptr;
   if (!unit_type) return;

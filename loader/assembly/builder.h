@@ -60,11 +60,13 @@ class SystemBuilder {
   /// Merges the robot description's settings for `unit` (its section
   /// `section` of `file`) into the unit's parameters; a problem found in one
   /// of them is reported in that file, at its line and key.
-  /// With `complete`, every parameter the unit type has no default for must
-  /// then be set (by the assembly or the section), else it is reported as
-  /// missing from the section.
   void MergeSettings(const std::string& unit, const YAML::Node& settings, const std::string& file,
-                     const std::string& section, bool complete);
+                     const std::string& section);
+  /// Reports, as missing from that section of the robot file, every
+  /// parameter of `unit`'s type with no default that neither the assembly
+  /// nor the section sets.
+  void RequireParameters(const std::string& unit, const YAML::Node& settings,
+                         const std::string& file, const std::string& section);
   /// A map section of the robot scenario (empty when absent), its keys
   /// checked.
   YAML::Node Section(const YAML::Node& parent, const std::string& path, const std::string& key,

@@ -81,8 +81,8 @@ void AddSwerve(SystemBuilder& b, const RobotFile& file, bool compensation, Signa
   p["drive_feedforward"] = Num(drive.rate_v_per_rad_s);
   p["drive_acceleration_feedforward"] = Num(drive.acceleration_v_per_rad_s2);
   p["compensation"] = compensation;
-  b.MergeSettings(kWheelController, file.controller_settings, robot.file, "controller",
-                  /*complete=*/true);
+  b.MergeSettings(kWheelController, file.controller_settings, robot.file, "controller");
+  b.RequireParameters(kWheelController, file.controller_settings, robot.file, "controller");
   for (std::size_t i = 0; i < n; ++i) {
     const auto steer_joint = static_cast<std::size_t>(s.wheel_steer_joint[i]);
     const auto drive_joint = static_cast<std::size_t>(s.wheel_drive_joint[i]);
@@ -125,8 +125,8 @@ void AddDifferential(SystemBuilder& b, const RobotFile& file, const YAML::Node& 
       GroupOf(robot, left->drive_motor), 0.5 * robot.body.mass_kg * left->radius_m * left->radius_m);
   p["drive_feedforward"] = Num(drive.rate_v_per_rad_s);
   p["drive_acceleration_feedforward"] = Num(drive.acceleration_v_per_rad_s2);
-  b.MergeSettings(kWheelController, file.controller_settings, robot.file, "controller",
-                  /*complete=*/true);
+  b.MergeSettings(kWheelController, file.controller_settings, robot.file, "controller");
+  b.RequireParameters(kWheelController, file.controller_settings, robot.file, "controller");
   for (std::size_t side = 0; side < 2; ++side) {
     const auto joint = static_cast<std::size_t>(joints[side]);
     b.Connect(Element(kWheelController, "drive_voltage", side),

@@ -41,7 +41,7 @@ void AddMotors(SystemBuilder& b, const RobotFile& file) {
     }
     p[key] = List(values);
   }
-  b.MergeSettings(kMotors, file.motor_settings, robot.file, "motors", /*complete=*/false);
+  b.MergeSettings(kMotors, file.motor_settings, robot.file, "motors");
 }
 
 // The joint view of a motor group (the drive-train algebra of models/).
@@ -121,8 +121,7 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
   c["initial_x"] = Num(start.x_m);
   c["initial_y"] = Num(start.y_m);
   c["initial_yaw"] = Num(start.yaw_rad);
-  b.MergeSettings(kChassis, file.chassis_settings, robot.file, "chassis",
-                  /*complete=*/false);
+  b.MergeSettings(kChassis, file.chassis_settings, robot.file, "chassis");
   const YAML::Node pose = Child(Child(b.root(), "robot"), "pose");
   b.Derived("units.chassis.parameters.initial_x", pose, "robot.pose", "x_m");
   b.Derived("units.chassis.parameters.initial_y", pose, "robot.pose", "y_m");

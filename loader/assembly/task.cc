@@ -17,6 +17,9 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
                 {"type", "waypoints", "point", "speed_mps", "acceleration_mps2", "yaw_deg"});
   info.task = r.String(task, "task", "type", std::nullopt, {"path", "hold"});
   b.Unit(kPathFollower, "path_follower");
+  // The robot's follower settings first: the task's own values (speed,
+  // acceleration) override them.
+  b.MergeSettings(kPathFollower, file.follower_settings, file.robot.file, "path_follower");
   YAML::Node p = b.Params(kPathFollower);
   const bool differential = file.robot.controller == models::ControllerKind::kDifferential;
   if (info.task == "path") {
@@ -50,6 +53,7 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
   }
   if (Child(task, "acceleration_mps2").IsDefined()) {
     p["acceleration"] = Num(r.Real(task, "task", "acceleration_mps2", 0.3, {0.0, 10.0, true}));
+    b.Derived("units.path_follower.parameters.acceleration", task, "task", "acceleration_mps2");
   }
   if (differential) {
     // A differential base heads along its motion; it holds no heading.
@@ -70,8 +74,7 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
   for (const auto& pt : info.path) waypoints.push_back(List({pt[0], pt[1]}));
   p["waypoints"] = waypoints;
 
-  b.MergeSettings(kPathFollower, file.follower_settings, file.robot.file, "path_follower",
-                  /*complete=*/true);
+  b.RequireParameters(kPathFollower, file.follower_settings, file.robot.file, "path_follower");
 
   b.Connect(s.position, Signal(kPathFollower, "position"));
   b.Connect(s.yaw, Signal(kPathFollower, "yaw"));

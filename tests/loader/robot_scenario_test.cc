@@ -128,6 +128,12 @@ TEST(RobotScenario, HuskyIsBuiltFromItsDescriptionOnTheSameUnits) {
   for (const auto& c : s.expanded["connections"]) {
     EXPECT_FALSE(Has(c["to"].as<std::string>(), "steer")) << c["to"].as<std::string>();
   }
+  // The robot's follower settings are defaults the task overrides
+  // (husky.yaml: acceleration 0.5 m/s^2).
+  EXPECT_EQ(Param(s, "path_follower", "acceleration"), 0.5);
+  EXPECT_EQ(Param(LoadScenario(kHusky, {"task.acceleration_mps2=0.4"}), "path_follower",
+                  "acceleration"),
+            0.4);
   // A differential base cannot run Algorithm 1, nor hold a heading.
   const std::string e = Issues(kHusky, {"control.compensation=true"});
   EXPECT_TRUE(Has(e, "control.compensation")) << e;
