@@ -6,6 +6,7 @@
 
 #include "cosim/time.h"
 #include "cosim/unit.h"
+#include "units/control/drive_rate_loop.h"
 
 namespace linesim::control {
 
@@ -29,8 +30,8 @@ namespace linesim::control {
 /// measured rates act at once. Outputs are meant to be held by the master
 /// over the period.
 ///
-/// Voltage per side (PI plus feedforward, saturated at +-max_voltage,
-/// conditional integration):
+/// Voltage per side (DriveRateLoop: PI plus feedforward, saturated at
+/// +-max_voltage, conditional integration):
 ///   k_ff mean(w_ref over the period) + k_acc dw_ref/dt + kp (w_ref - w) + ki I,
 /// with k_ff the back-EMF constant at the wheel (k_e N) and k_acc the joint
 /// inertia over the torque per volt, J R / (eta N k_t), so a well-modelled
@@ -67,19 +68,12 @@ class DiffDriveControllerUnit : public cosim::Unit {
   /// Rule::NoDefault): not set.
   static constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
   static constexpr std::size_t kSides = 2;
-  /// The voltage of side i before saturation.
-  double Voltage(std::size_t i) const;
   void ComputeOutputs();
 
-  // Parameters (all robot-specific).
+  // Parameters (all robot-specific; the drive gains and limits are in
+  // drive_.gains).
   double wheel_radius_ = kUnset;
   double effective_track_ = kUnset;
-  double drive_feedforward_ = kUnset;
-  double drive_acceleration_feedforward_ = kUnset;
-  double drive_kp_ = kUnset;
-  double drive_ki_ = kUnset;
-  double max_rate_ = kUnset;
-  double max_acceleration_ = kUnset;
   double max_voltage_ = kUnset;
 
   // Inputs.
@@ -90,10 +84,10 @@ class DiffDriveControllerUnit : public cosim::Unit {
   // Outputs.
   std::vector<double> drive_voltage_, drive_rate_target_;
 
-  // State per side: the reference at this sample and at the next one, and
-  // the integral of the rate error. period_s_ is the step that produced the
-  // next reference (0 before the first step: no motion in the reference).
-  std::vector<double> ref_, next_, integral_;
+  // State: per side the drive rate loop (references and integral).
+  // period_s_ is the step that produced the next reference (0 before the
+  // first step: no motion in the reference).
+  DriveRateLoop drive_;
   double period_s_ = 0.0;
 };
 

@@ -10,14 +10,10 @@
 
 namespace linesim::control {
 
-namespace {
-
-double SignedMin(double x, double limit) { return std::clamp(x, -limit, limit); }
-
-}  // namespace
-
 WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
-    : cosim::Unit(kTypeName, std::move(name)), wheel_count_(wheel_count) {
+    : cosim::Unit(kTypeName, std::move(name)),
+      wheel_count_(wheel_count),
+      drive_(static_cast<std::size_t>(std::max(wheel_count, 0))) {
   if (wheel_count < 1) {
     throw cosim::UnitError(Where() + ": wheel_count must be at least 1, got " +
                            std::to_string(wheel_count));
@@ -34,8 +30,7 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
   drive_voltage_.assign(n, 0.0);
   steer_target_.assign(n, 0.0);
   drive_rate_target_.assign(n, 0.0);
-  for (auto* v : {&steer_ref_, &steer_next_, &steer_prev_rate_, &flip_angle_, &drive_ref_,
-                  &drive_next_, &drive_integral_, &drive_setpoint_}) {
+  for (auto* v : {&steer_ref_, &steer_next_, &steer_prev_rate_, &flip_angle_, &drive_setpoint_}) {
     v->assign(n, 0.0);
   }
 
@@ -80,20 +75,20 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
               cosim::Rule::Positive().NoDefault());
   v.Parameter("steer_max_acceleration", "rad/s2", &steer_max_acceleration_,
               "steering reference acceleration limit", cosim::Rule::Positive().NoDefault());
-  v.Parameter("drive_feedforward", "V.s/rad", &drive_feedforward_,
+  v.Parameter("drive_feedforward", "V.s/rad", &drive_.gains.feedforward,
               "voltage per reference wheel rate (back-EMF constant at the wheel, k_e N)",
               cosim::Rule::NonNegative().NoDefault());
-  v.Parameter("drive_acceleration_feedforward", "V.s2/rad", &drive_acceleration_feedforward_,
+  v.Parameter("drive_acceleration_feedforward", "V.s2/rad", &drive_.gains.acceleration_feedforward,
               "voltage per reference wheel acceleration (load inertia R / (eta N k_t))",
               cosim::Rule::NonNegative().NoDefault());
-  v.Parameter("drive_kp", "V.s/rad", &drive_kp_, "wheel rate error gain",
+  v.Parameter("drive_kp", "V.s/rad", &drive_.gains.kp, "wheel rate error gain",
               cosim::Rule::NonNegative().NoDefault());
-  v.Parameter("drive_ki", "V/rad", &drive_ki_, "wheel rate error integral gain",
+  v.Parameter("drive_ki", "V/rad", &drive_.gains.ki, "wheel rate error integral gain",
               cosim::Rule::NonNegative().NoDefault());
-  v.Parameter("drive_max_rate", "rad/s", &drive_max_rate_,
+  v.Parameter("drive_max_rate", "rad/s", &drive_.gains.max_rate,
               "wheel rate limit; all wheels are scaled together to respect it",
               cosim::Rule::Positive().NoDefault());
-  v.Parameter("drive_max_acceleration", "rad/s2", &drive_max_acceleration_,
+  v.Parameter("drive_max_acceleration", "rad/s2", &drive_.gains.max_acceleration,
               "wheel rate reference acceleration limit", cosim::Rule::Positive().NoDefault());
   v.Parameter("max_voltage", "V", &max_voltage_, "supply voltage: outputs saturate at +-this",
               cosim::Rule::Positive().NoDefault());
@@ -157,8 +152,8 @@ void WheelControllerUnit::Initialize() {
     const double a = WrapAngle(steer_angle_[i]);
     steer_ref_[i] = steer_next_[i] = flip_angle_[i] = a;
     steer_prev_rate_[i] = 0.0;
-    drive_ref_[i] = drive_next_[i] = drive_integral_[i] = 0.0;
   }
+  drive_.Reset();
   period_s_ = 0.0;
   ComputeOutputs();
 }
@@ -167,32 +162,21 @@ double WheelControllerUnit::SteerRateReference(std::size_t i) const {
   return period_s_ > 0.0 ? WrapAngle(steer_next_[i] - steer_ref_[i]) / period_s_ : 0.0;
 }
 
-WheelControllerUnit::Voltages WheelControllerUnit::Compute(std::size_t i) const {
+double WheelControllerUnit::SteerVoltage(std::size_t i) const {
   const double steer_rate_ref = SteerRateReference(i);
-  double steer_accel_ref = 0.0, drive_accel_ref = 0.0;
-  if (period_s_ > 0.0) {
-    steer_accel_ref = (steer_rate_ref - steer_prev_rate_[i]) / period_s_;
-    drive_accel_ref = (drive_next_[i] - drive_ref_[i]) / period_s_;
-  }
-  const double steer_v = steer_kp_ * WrapAngle(steer_ref_[i] - steer_angle_[i]) +
-                         steer_kd_ * (steer_rate_ref - steer_rate_[i]) +
-                         steer_feedforward_ * steer_rate_ref +
-                         steer_acceleration_feedforward_ * steer_accel_ref;
-  // The back-EMF grows over the period with the reference: feed the mean.
-  const double drive_v = drive_feedforward_ * 0.5 * (drive_ref_[i] + drive_next_[i]) +
-                         drive_acceleration_feedforward_ * drive_accel_ref +
-                         drive_kp_ * (drive_ref_[i] - drive_rate_[i]) +
-                         drive_ki_ * drive_integral_[i];
-  return {steer_v, drive_v};
+  const double steer_accel_ref =
+      period_s_ > 0.0 ? (steer_rate_ref - steer_prev_rate_[i]) / period_s_ : 0.0;
+  return steer_kp_ * WrapAngle(steer_ref_[i] - steer_angle_[i]) +
+         steer_kd_ * (steer_rate_ref - steer_rate_[i]) + steer_feedforward_ * steer_rate_ref +
+         steer_acceleration_feedforward_ * steer_accel_ref;
 }
 
 void WheelControllerUnit::ComputeOutputs() {
   for (std::size_t i = 0; i < steer_voltage_.size(); ++i) {
-    const Voltages u = Compute(i);
-    steer_voltage_[i] = SignedMin(u.steer_v, max_voltage_);
-    drive_voltage_[i] = SignedMin(u.drive_v, max_voltage_);
+    steer_voltage_[i] = ClampSymmetric(SteerVoltage(i), max_voltage_);
+    drive_voltage_[i] = ClampSymmetric(drive_.Voltage(i, drive_rate_[i], period_s_), max_voltage_);
     steer_target_[i] = steer_ref_[i];
-    drive_rate_target_[i] = drive_ref_[i];
+    drive_rate_target_[i] = drive_.reference(i);
   }
 }
 
@@ -219,22 +203,10 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
   }
   // Scale all wheels alike, so that a too fast command keeps its direction
   // and curvature instead of being distorted wheel by wheel.
-  const double scale = fastest_rad_s > drive_max_rate_ ? drive_max_rate_ / fastest_rad_s : 1.0;
+  const double max_rate = drive_.gains.max_rate;
+  const double scale = fastest_rad_s > max_rate ? max_rate / fastest_rad_s : 1.0;
 
   for (std::size_t i = 0; i < n; ++i) {
-    // Drive integrator on the error of this sample; it stops while the
-    // output saturates in the error's direction (anti-windup) and never
-    // holds more than the full voltage. Computed again, not taken from
-    // UpdateOutputs: Gauss-Seidel transfers new inputs right before DoStep.
-    const Voltages u = Compute(i);
-    const double error = drive_ref_[i] - drive_rate_[i];
-    if (!(std::abs(u.drive_v) > max_voltage_ && error * u.drive_v > 0.0)) {
-      drive_integral_[i] += error * dt_s;
-    }
-    if (drive_ki_ > 0.0) {
-      drive_integral_[i] = SignedMin(drive_integral_[i], max_voltage_ / drive_ki_);
-    }
-
     // Steering reference: second-order slew towards the flip-rule heading,
     // at the largest rate from which the acceleration limit still stops the
     // discrete profile exactly at the target: rates (m + f) dv, (m - 1 + f)
@@ -250,14 +222,12 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
     const double stoppable = (m + f) * dv;
     const double wanted =
         std::copysign(std::min({steer_max_rate_, stoppable, std::abs(gap) / dt_s}), gap);
-    const double rate_next = rate_now + SignedMin(wanted - rate_now, dv);
+    const double rate_next = rate_now + ClampSymmetric(wanted - rate_now, dv);
     steer_next_[i] = WrapAngle(steer_ref_[i] + rate_next * dt_s);
 
-    // Drive reference: rate-limited ramp towards the scaled set point.
-    drive_ref_[i] = drive_next_[i];
-    const double drive_goal = SignedMin(scale * drive_setpoint_[i], drive_max_rate_);
-    drive_next_[i] =
-        drive_ref_[i] + SignedMin(drive_goal - drive_ref_[i], drive_max_acceleration_ * dt_s);
+    // Drive: integrator on the error of this sample, reference ramped
+    // towards the scaled set point.
+    drive_.Step(i, scale * drive_setpoint_[i], drive_rate_[i], period_s_, dt_s, max_voltage_);
   }
   period_s_ = dt_s;
   ComputeOutputs();
@@ -266,29 +236,28 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
 
 void WheelControllerUnit::SaveInternal(cosim::UnitState& state) const {
   state.reals.clear();
-  for (const auto* v : {&steer_ref_, &steer_next_, &steer_prev_rate_, &flip_angle_, &drive_ref_,
-                        &drive_next_, &drive_integral_}) {
+  for (const auto* v : {&steer_ref_, &steer_next_, &steer_prev_rate_, &flip_angle_}) {
     state.reals.insert(state.reals.end(), v->begin(), v->end());
   }
+  drive_.AppendState(state.reals);
   state.reals.push_back(period_s_);
   state.integers.clear();
 }
 
 void WheelControllerUnit::RestoreInternal(const cosim::UnitState& state) {
   const std::size_t n = steer_ref_.size();
-  const std::size_t expected = 7 * n + 1;
+  const std::size_t expected = (4 + DriveRateLoop::kStatePerChannel) * n + 1;
   if (state.reals.size() != expected || !state.integers.empty()) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
                            " integers, expected " + std::to_string(expected) + " and 0");
   }
   auto it = state.reals.begin();
-  for (auto* v : {&steer_ref_, &steer_next_, &steer_prev_rate_, &flip_angle_, &drive_ref_,
-                  &drive_next_, &drive_integral_}) {
+  for (auto* v : {&steer_ref_, &steer_next_, &steer_prev_rate_, &flip_angle_}) {
     std::copy(it, it + static_cast<std::ptrdiff_t>(n), v->begin());
     it += static_cast<std::ptrdiff_t>(n);
   }
-  period_s_ = *it;
+  period_s_ = *drive_.RestoreState(it);
 }
 
 }  // namespace linesim::control

@@ -6,6 +6,7 @@
 
 #include "cosim/time.h"
 #include "cosim/unit.h"
+#include "units/control/drive_rate_loop.h"
 
 namespace linesim::control {
 
@@ -27,7 +28,8 @@ namespace linesim::control {
 ///   kp wrap(a_ref - a) + kd (r_ref - r) + k_ff r_ref + k_acc alpha_ref,
 /// with a_ref, r_ref, alpha_ref the slewed reference angle at the sample,
 /// its rate over the coming period and the change of that rate.
-/// Drive voltage (PI plus feedforward, saturated, conditional integration):
+/// Drive voltage (DriveRateLoop: PI plus feedforward, saturated, conditional
+/// integration):
 ///   k_ff mean(w_ref over the period) + k_acc dw_ref/dt + kp (w_ref - w) + ki I.
 /// The feedforward gains are the back-EMF constant and the load inertia
 /// seen through the gearbox, so a well-modelled wheel follows its reference
@@ -67,11 +69,8 @@ class WheelControllerUnit : public cosim::Unit {
   /// Start value of a robot-specific parameter (declared with
   /// Rule::NoDefault): not set.
   static constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
-  struct Voltages {
-    double steer_v;
-    double drive_v;  // before saturation
-  };
-  Voltages Compute(std::size_t i) const;
+  /// The steering voltage of wheel i before saturation.
+  double SteerVoltage(std::size_t i) const;
   /// Reference steering rate of wheel i over the coming period (0 before
   /// the first step).
   double SteerRateReference(std::size_t i) const;
@@ -79,7 +78,7 @@ class WheelControllerUnit : public cosim::Unit {
 
   int wheel_count_;
 
-  // Parameters.
+  // Parameters (the drive gains and limits are in drive_.gains).
   std::vector<double> wheel_x_, wheel_y_;
   double wheel_radius_ = kUnset;
   bool compensation_ = true;
@@ -90,12 +89,6 @@ class WheelControllerUnit : public cosim::Unit {
   double steer_acceleration_feedforward_ = kUnset;
   double steer_max_rate_ = kUnset;
   double steer_max_acceleration_ = kUnset;
-  double drive_feedforward_ = kUnset;
-  double drive_acceleration_feedforward_ = kUnset;
-  double drive_kp_ = kUnset;
-  double drive_ki_ = kUnset;
-  double drive_max_rate_ = kUnset;
-  double drive_max_acceleration_ = kUnset;
   double max_voltage_ = kUnset;
 
   // Inputs.
@@ -107,13 +100,14 @@ class WheelControllerUnit : public cosim::Unit {
   // Outputs.
   std::vector<double> steer_voltage_, drive_voltage_, steer_target_, drive_rate_target_;
 
-  // State, per wheel. The reference at this sample and at the next one
-  // (wrapped angles, rates), the reference steering rate over the previous
-  // period (for its acceleration), the last flip-rule heading and the drive
-  // integrator. period_s_ is the step that produced the next reference (0
-  // before the first step: no motion in the reference yet).
+  // State, per wheel. The steering reference at this sample and at the next
+  // one (wrapped angles), the reference steering rate over the previous
+  // period (for its acceleration), the last flip-rule heading, and the drive
+  // rate loop (references and integrator). period_s_ is the step that
+  // produced the next reference (0 before the first step: no motion in the
+  // reference yet).
   std::vector<double> steer_ref_, steer_next_, steer_prev_rate_, flip_angle_;
-  std::vector<double> drive_ref_, drive_next_, drive_integral_;
+  DriveRateLoop drive_;
   double period_s_ = 0.0;
   // DoStep's scratch (not state): the flip-rule drive rate of this sample.
   std::vector<double> drive_setpoint_;
