@@ -795,32 +795,7 @@ TEST(ChassisUnit, NonFiniteInputOrStateFails) {
 // ---------------------------------------------------------------------------
 // Guards against the interface drifting from the contract
 // (notes: signals, one unit of measure per variable).
-struct Expected {
-  const char* name;
-  cosim::Causality causality;
-  const char* unit;
-  std::size_t size;  // 0: scalar
-};
-
-void ExpectTable(const ChassisUnit& u, const std::vector<Expected>& expected) {
-  ASSERT_EQ(u.variables().size(), expected.size());
-  for (const Expected& e : expected) {
-    const auto ref = u.variables().Find(e.name);
-    ASSERT_TRUE(ref) << e.name;
-    const auto& info = u.variables().info(*ref);
-    EXPECT_EQ(info.causality, e.causality) << e.name;
-    if (std::string(e.unit) != "") {
-      EXPECT_EQ(info.unit, e.unit) << e.name;
-    }
-    if (e.size > 0) {
-      EXPECT_EQ(info.type, cosim::VarType::kRealArray) << e.name;
-      EXPECT_EQ(info.size, e.size) << e.name;
-    } else if (e.causality == cosim::Causality::kOutput) {
-      EXPECT_EQ(info.type, cosim::VarType::kReal) << e.name;
-    }
-    EXPECT_TRUE(info.depends_on.empty()) << e.name;
-  }
-}
+using Expected = test_helpers::ExpectedVariable;
 
 std::vector<Expected> Parameters(std::size_t wheels) {
   using C = cosim::Causality;
@@ -875,7 +850,7 @@ TEST(ChassisUnit, VariableTable) {
                                         {"wheel_surface_velocity", C::kOutput, "m/s", 8},
                                         {"wheel_contact", C::kOutput, "m", 8}};
   expected.insert(expected.end(), swerve.begin(), swerve.end());
-  ExpectTable(*robot, expected);
+  test_helpers::ExpectTable(*robot, expected);
 
   // Skid-steer, no belts: no steer_* variables, one drive variable per motor.
   auto husky = Husky(models::OpenFloor());
@@ -888,7 +863,7 @@ TEST(ChassisUnit, VariableTable) {
       {"wheel_surface", C::kOutput, "1", 4},  {"wheel_surface_velocity", C::kOutput, "m/s", 8},
       {"wheel_contact", C::kOutput, "m", 8}};
   expected.insert(expected.end(), skid.begin(), skid.end());
-  ExpectTable(*husky, expected);
+  test_helpers::ExpectTable(*husky, expected);
 }
 
 // Guards against the Rob@Work 3 robot description (models/robots/raw3.yaml)

@@ -92,40 +92,22 @@ TEST(DiffDriveControllerUnit, VariableTable) {
   DiffDriveControllerUnit u("ctl");
   EXPECT_EQ(u.type_name(), "diff_drive_controller");
   using C = cosim::Causality;
-  struct Expected {
-    std::string name;
-    C causality;
-    std::string unit;
-    std::size_t size;
-    std::vector<std::string> depends_on;
-  };
-  const std::vector<Expected> expected = {
-      {"wheel_radius", C::kParameter, "m", 1, {}},
-      {"effective_track", C::kParameter, "m", 1, {}},
-      {"drive_feedforward", C::kParameter, "V.s/rad", 1, {}},
-      {"drive_acceleration_feedforward", C::kParameter, "V.s2/rad", 1, {}},
-      {"drive_kp", C::kParameter, "V.s/rad", 1, {}},
-      {"drive_ki", C::kParameter, "V/rad", 1, {}},
-      {"max_rate", C::kParameter, "rad/s", 1, {}},
-      {"max_acceleration", C::kParameter, "rad/s2", 1, {}},
-      {"max_voltage", C::kParameter, "V", 1, {}},
+  const std::vector<test_helpers::ExpectedVariable> expected = {
+      {"wheel_radius", C::kParameter, "m", 0, {}},
+      {"effective_track", C::kParameter, "m", 0, {}},
+      {"drive_feedforward", C::kParameter, "V.s/rad", 0, {}},
+      {"drive_acceleration_feedforward", C::kParameter, "V.s2/rad", 0, {}},
+      {"drive_kp", C::kParameter, "V.s/rad", 0, {}},
+      {"drive_ki", C::kParameter, "V/rad", 0, {}},
+      {"max_rate", C::kParameter, "rad/s", 0, {}},
+      {"max_acceleration", C::kParameter, "rad/s2", 0, {}},
+      {"max_voltage", C::kParameter, "V", 0, {}},
       {"velocity_command", C::kInput, "m/s", 2, {}},
-      {"yaw_rate_command", C::kInput, "rad/s", 1, {}},
+      {"yaw_rate_command", C::kInput, "rad/s", 0, {}},
       {"drive_rate", C::kInput, "rad/s", 2, {}},
       {"drive_voltage", C::kOutput, "V", 2, {"drive_rate"}},
       {"drive_rate_target", C::kOutput, "rad/s", 2, {}}};
-  ASSERT_EQ(u.variables().size(), expected.size());
-  for (const Expected& e : expected) {
-    const auto ref = u.variables().Find(e.name);
-    ASSERT_TRUE(ref) << e.name;
-    const auto& info = u.variables().info(*ref);
-    EXPECT_EQ(info.causality, e.causality) << e.name;
-    EXPECT_EQ(info.unit, e.unit) << e.name;
-    EXPECT_EQ(info.size, e.size) << e.name;
-    std::vector<std::string> deps;
-    for (auto d : info.depends_on) deps.push_back(u.variables().info(d).name);
-    EXPECT_EQ(deps, e.depends_on) << e.name;
-  }
+  test_helpers::ExpectTable(u, expected);
 }
 
 // Guards against a robot description that forgets a parameter: none has a

@@ -113,35 +113,28 @@ void Sample(WheelControllerUnit& u, TimeNs t) {
 TEST(WheelControllerUnit, VariableTable) {
   Raw3Controller u("ctl");
   EXPECT_EQ(u.type_name(), "wheel_controller");
-  struct Expected {
-    std::string name;
-    cosim::Causality causality;
-    std::string unit;
-    std::size_t size;
-    std::vector<std::string> depends_on;
-  };
   using C = cosim::Causality;
-  const std::vector<Expected> expected = {
+  const std::vector<test_helpers::ExpectedVariable> expected = {
       {"wheel_x", C::kParameter, "m", 4, {}},
       {"wheel_y", C::kParameter, "m", 4, {}},
-      {"wheel_radius", C::kParameter, "m", 1, {}},
-      {"compensation", C::kParameter, "", 1, {}},
-      {"zero_speed_threshold", C::kParameter, "m/s", 1, {}},
-      {"steer_kp", C::kParameter, "V/rad", 1, {}},
-      {"steer_kd", C::kParameter, "V.s/rad", 1, {}},
-      {"steer_feedforward", C::kParameter, "V.s/rad", 1, {}},
-      {"steer_acceleration_feedforward", C::kParameter, "V.s2/rad", 1, {}},
-      {"steer_max_rate", C::kParameter, "rad/s", 1, {}},
-      {"steer_max_acceleration", C::kParameter, "rad/s2", 1, {}},
-      {"drive_feedforward", C::kParameter, "V.s/rad", 1, {}},
-      {"drive_acceleration_feedforward", C::kParameter, "V.s2/rad", 1, {}},
-      {"drive_kp", C::kParameter, "V.s/rad", 1, {}},
-      {"drive_ki", C::kParameter, "V/rad", 1, {}},
-      {"drive_max_rate", C::kParameter, "rad/s", 1, {}},
-      {"drive_max_acceleration", C::kParameter, "rad/s2", 1, {}},
-      {"max_voltage", C::kParameter, "V", 1, {}},
+      {"wheel_radius", C::kParameter, "m", 0, {}},
+      {"compensation", C::kParameter, "", 0, {}},
+      {"zero_speed_threshold", C::kParameter, "m/s", 0, {}},
+      {"steer_kp", C::kParameter, "V/rad", 0, {}},
+      {"steer_kd", C::kParameter, "V.s/rad", 0, {}},
+      {"steer_feedforward", C::kParameter, "V.s/rad", 0, {}},
+      {"steer_acceleration_feedforward", C::kParameter, "V.s2/rad", 0, {}},
+      {"steer_max_rate", C::kParameter, "rad/s", 0, {}},
+      {"steer_max_acceleration", C::kParameter, "rad/s2", 0, {}},
+      {"drive_feedforward", C::kParameter, "V.s/rad", 0, {}},
+      {"drive_acceleration_feedforward", C::kParameter, "V.s2/rad", 0, {}},
+      {"drive_kp", C::kParameter, "V.s/rad", 0, {}},
+      {"drive_ki", C::kParameter, "V/rad", 0, {}},
+      {"drive_max_rate", C::kParameter, "rad/s", 0, {}},
+      {"drive_max_acceleration", C::kParameter, "rad/s2", 0, {}},
+      {"max_voltage", C::kParameter, "V", 0, {}},
       {"velocity_command", C::kInput, "m/s", 2, {}},
-      {"yaw_rate_command", C::kInput, "rad/s", 1, {}},
+      {"yaw_rate_command", C::kInput, "rad/s", 0, {}},
       {"surface_velocity", C::kInput, "m/s", 8, {}},
       {"steer_angle", C::kInput, "rad", 4, {}},
       {"steer_rate", C::kInput, "rad/s", 4, {}},
@@ -150,20 +143,7 @@ TEST(WheelControllerUnit, VariableTable) {
       {"drive_voltage", C::kOutput, "V", 4, {"drive_rate"}},
       {"steer_target", C::kOutput, "rad", 4, {}},
       {"drive_rate_target", C::kOutput, "rad/s", 4, {}}};
-  ASSERT_EQ(u.variables().size(), expected.size());
-  for (const Expected& e : expected) {
-    const auto ref = u.variables().Find(e.name);
-    ASSERT_TRUE(ref) << e.name;
-    const auto& info = u.variables().info(*ref);
-    EXPECT_EQ(info.causality, e.causality) << e.name;
-    if (!e.unit.empty()) {
-      EXPECT_EQ(info.unit, e.unit) << e.name;
-    }
-    EXPECT_EQ(info.size, e.size) << e.name;
-    std::vector<std::string> deps;
-    for (auto d : info.depends_on) deps.push_back(u.variables().info(d).name);
-    EXPECT_EQ(deps, e.depends_on) << e.name;
-  }
+  test_helpers::ExpectTable(u, expected);
   // Sizes follow the wheel count.
   WheelControllerUnit six("six", 6);
   EXPECT_EQ(six.variables().info(*six.variables().Find("surface_velocity")).size, 12u);
