@@ -7,6 +7,7 @@
 #include <cstring>
 #include <iostream>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -563,26 +564,33 @@ TEST(PathFollowerUnitDifferential, AimAtTheCornerDoesNotFlip) {
   }
 }
 
+// Follows a path with one 0.3 rad corner at (2, 0) with the exact unicycle
+// (turn_in_place_angle as given, else its default) and returns the slowest
+// forward command within 0.2 m of the corner; the goal must be reached.
+double SlowestNearAGentleCorner(std::optional<double> turn_in_place_angle) {
+  const double c = std::cos(0.3), s = std::sin(0.3);
+  PathFollowerUnit u("f", Mode::kPath, {{0, 0}, {2, 0}, {2 + 2 * c, 2 * s}}, Base::kDifferential);
+  if (turn_in_place_angle) SetParam(u, "turn_in_place_angle", *turn_in_place_angle);
+  Unicycle r;
+  SetPose(u, r.x, r.y, r.yaw);
+  u.Initialize();
+  double slowest = 1.0;
+  for (int k = 0; k < 3000 && !Done(u); ++k) {
+    const auto cmd = Sample(u, r, k);
+    if (std::hypot(r.x - 2.0, r.y) < 0.2) slowest = std::min(slowest, cmd[0]);
+    r.Move(cmd[0], cmd[2], kPeriodS);
+  }
+  EXPECT_TRUE(Done(u));
+  return slowest;
+}
+
 // Guards the other side of the corner rule: a gentle corner (0.3 rad, less
 // than the 0.5 rad turn_in_place_angle) is driven through without stopping
 // or turning in place. The speed dips (the ramp continues from v cos h,
 // which settles at a T / (1 - cos h) = 0.13 m/s for a standing 0.3 rad
 // error, here briefly: 0.2 m/s) but stays above half the 0.3 m/s cruise.
 TEST(PathFollowerUnitDifferential, DrivesThroughAGentleCorner) {
-  const double c = std::cos(0.3), s = std::sin(0.3);
-  PathFollowerUnit u("f", Mode::kPath, {{0, 0}, {2, 0}, {2 + 2 * c, 2 * s}}, Base::kDifferential);
-  Unicycle r;
-  SetPose(u, r.x, r.y, r.yaw);
-  u.Initialize();
-  double slowest_near_corner = 1.0;
-  int k = 0;
-  for (; k < 3000 && !Done(u); ++k) {
-    const auto cmd = Sample(u, r, k);
-    if (std::hypot(r.x - 2.0, r.y) < 0.2) slowest_near_corner = std::min(slowest_near_corner, cmd[0]);
-    r.Move(cmd[0], cmd[2], kPeriodS);
-  }
-  ASSERT_TRUE(Done(u));
-  EXPECT_GT(slowest_near_corner, 0.15);
+  EXPECT_GT(SlowestNearAGentleCorner(std::nullopt), 0.15);
 }
 
 // Guards the table of sharp corners (computed once, not per step): it
@@ -591,21 +599,7 @@ TEST(PathFollowerUnitDifferential, DrivesThroughAGentleCorner) {
 // it (within a T^2 / 2 sample of it, the forward command is 0 there) and
 // turns in place, where at 0.5 rad it drove through.
 TEST(PathFollowerUnitDifferential, SharpCornersFollowTheAngleSetBeforeInitialize) {
-  const double c = std::cos(0.3), s = std::sin(0.3);
-  PathFollowerUnit u("f", Mode::kPath, {{0, 0}, {2, 0}, {2 + 2 * c, 2 * s}}, Base::kDifferential);
-  SetParam(u, "turn_in_place_angle", 0.2);
-  Unicycle r;
-  SetPose(u, r.x, r.y, r.yaw);
-  u.Initialize();
-  double slowest_near_corner = 1.0;
-  int k = 0;
-  for (; k < 3000 && !Done(u); ++k) {
-    const auto cmd = Sample(u, r, k);
-    if (std::hypot(r.x - 2.0, r.y) < 0.2) slowest_near_corner = std::min(slowest_near_corner, cmd[0]);
-    r.Move(cmd[0], cmd[2], kPeriodS);
-  }
-  ASSERT_TRUE(Done(u));
-  EXPECT_EQ(slowest_near_corner, 0.0);
+  EXPECT_EQ(SlowestNearAGentleCorner(0.2), 0.0);
 }
 
 // Guards the saved state of the differential base: the active segment is
