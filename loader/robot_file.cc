@@ -139,6 +139,22 @@ class Reader {
       }
       robot.motor_groups.push_back(std::move(group));
     }
+    // The groups form one dc_motor unit, whose parameters are element
+    // arrays: every model gives the same keys.
+    for (std::size_t g = 1; g < robot.motor_groups.size(); ++g) {
+      for (const auto* pair : {&robot.motor_groups[0], &robot.motor_groups[g]}) {
+        const auto& other = pair == &robot.motor_groups[0] ? robot.motor_groups[g]
+                                                           : robot.motor_groups[0];
+        for (const auto& [key, value] : pair->motor) {
+          if (!other.motor.contains(key)) {
+            const std::string gp = JoinPath(path, std::to_string(g));
+            r_.Error(Child(list[g], "model"), JoinPath(gp, "model"),
+                     "the motor models of one robot must set the same keys: '" + key +
+                         "' is in " + pair->model_file + " but not in " + other.model_file);
+          }
+        }
+      }
+    }
   }
 
   // The motor model file's numbers (dc_motor parameter names); a gear in it
@@ -207,6 +223,13 @@ class Reader {
       if (w.steer_motor && *w.steer_motor == w.drive_motor) {
         r_.Error(Child(node, "steer_motor"), JoinPath(wp, "steer_motor"),
                  "a wheel cannot be steered and driven by the same motor '" + w.drive_motor + "'");
+      }
+      if (!robot.wheels.empty() && w.mass_kg != robot.wheels.front().mass_kg &&
+          Child(node, "mass_kg").IsDefined()) {
+        r_.Error(Child(node, "mass_kg"), JoinPath(wp, "mass_kg"),
+                 "every wheel must have the mass of the first (" +
+                     cosim::FormatValue(robot.wheels.front().mass_kg) +
+                     " kg): the chassis lumps one module mass into each wheel");
       }
       robot.wheels.push_back(std::move(w));
     }

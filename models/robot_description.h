@@ -1,9 +1,12 @@
 #pragma once
 
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "models/drive_train.h"
 
 /// The typed description of a robot (models/robots/*.yaml): its body, its
 /// wheels and which motors steer and drive them, the motor groups, the kind
@@ -54,6 +57,17 @@ struct MotorGroup {
   double gear_ratio = 1.0;
   double gear_efficiency = 1.0;
   std::vector<std::string> motors;
+
+  /// A value of the motor model (NaN when the file does not give it).
+  double Value(const std::string& key) const {
+    const auto it = motor.find(key);
+    return it == motor.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
+  }
+  /// What a joint sees of one of these motors through the group's gear.
+  JointDrive Joint() const {
+    return ReflectThroughGear(Value("rotor_inertia"), Value("torque_constant"), gear_ratio,
+                              gear_efficiency);
+  }
 };
 
 /// A frame on the robot where a sensor is mounted (its type is the

@@ -1,17 +1,8 @@
-#include <cmath>
-#include <limits>
-
 #include "loader/assembly/concerns.h"
-#include "models/drive_train.h"
 
 namespace linesim::loader::assembly {
 
 namespace {
-
-double MotorValue(const models::MotorGroup& g, const char* key) {
-  const auto it = g.motor.find(key);
-  return it == g.motor.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
-}
 
 // What a controller's feedforward needs of a motor group: the back-EMF at
 // the joint (k_e N), and the voltage per unit of joint acceleration for a
@@ -23,10 +14,8 @@ struct Feedforward {
 };
 
 Feedforward JointFeedforward(const models::MotorGroup& g, double load_kgm2) {
-  const models::JointDrive d =
-      models::ReflectThroughGear(MotorValue(g, "rotor_inertia"), MotorValue(g, "torque_constant"),
-                                 g.gear_ratio, g.gear_efficiency);
-  const double torque_per_volt = d.torque_per_amp_nm / MotorValue(g, "resistance");
+  const models::JointDrive d = g.Joint();
+  const double torque_per_volt = d.torque_per_amp_nm / g.Value("resistance");
   return {d.back_emf_v_per_rad_s, (load_kgm2 + d.reflected_inertia_kgm2) / torque_per_volt};
 }
 

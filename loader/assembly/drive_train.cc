@@ -1,9 +1,7 @@
-#include <cmath>
 #include <limits>
 #include <map>
 
 #include "loader/assembly/concerns.h"
-#include "models/drive_train.h"
 
 namespace linesim::loader::assembly {
 
@@ -29,29 +27,9 @@ void AddMotors(SystemBuilder& b, const RobotFile& file) {
       values[e] = value;
     }
   }
-  for (const auto& [key, values] : arrays) {
-    for (std::size_t e = 0; e < values.size(); ++e) {
-      if (std::isnan(values[e])) {
-        const auto& group = robot.motor_groups[motors[e].first];
-        b.reader().Error(robot.file, YAML::Node(), "motor_groups",
-                         "every motor model must set the same keys; '" + key + "' is not in " +
-                             group.model_file + " (group '" + group.name + "')");
-        return;
-      }
-    }
-    p[key] = List(values);
-  }
+  // The robot file checked that every group's model sets the same keys.
+  for (const auto& [key, values] : arrays) p[key] = List(values);
   b.MergeSettings(kMotors, file.motor_settings, robot.file, "motors");
-}
-
-// The joint view of a motor group (the drive-train algebra of models/).
-models::JointDrive Drive(const models::MotorGroup& g) {
-  const auto get = [&](const char* key) {
-    const auto it = g.motor.find(key);
-    return it == g.motor.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
-  };
-  return models::ReflectThroughGear(get("rotor_inertia"), get("torque_constant"), g.gear_ratio,
-                                    g.gear_efficiency);
 }
 
 }  // namespace
@@ -98,16 +76,9 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
   c["body_height"] = Num(robot.body.height_m);
   c["mass"] = Num(robot.body.mass_kg);
   c["com_height"] = Num(robot.body.com_height_m);
-  // One mass for every wheel module: the chassis lumps it into each wheel.
+  // One mass for every wheel module (the robot file checked that the wheels
+  // agree): the chassis lumps it into each wheel.
   c["module_mass"] = Num(robot.wheels.front().mass_kg);
-  for (const auto& w : robot.wheels) {
-    if (w.mass_kg != robot.wheels.front().mass_kg) {
-      b.reader().Error(robot.file, YAML::Node(), "wheels",
-                       "every wheel must have the same mass_kg (the chassis lumps one module "
-                       "mass into each wheel); '" + w.name + "' differs");
-      break;
-    }
-  }
   c["wheel_x"] = List(x);
   c["wheel_y"] = List(y);
   c["wheel_radius"] = List(radius);
@@ -116,7 +87,7 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
        {std::pair{"steer", &s.steer_motor_element}, std::pair{"drive", &s.drive_motor_element}}) {
     if (joints->empty()) continue;
     const auto& group = robot.motor_groups[motors[joints->front()].first];
-    c[std::string(joint) + "_rotor_inertia"] = Num(Drive(group).reflected_inertia_kgm2);
+    c[std::string(joint) + "_rotor_inertia"] = Num(group.Joint().reflected_inertia_kgm2);
   }
   c["initial_x"] = Num(start.x_m);
   c["initial_y"] = Num(start.y_m);

@@ -112,6 +112,35 @@ TEST(RobotFile, TopologyProblemsAreNamed) {
   EXPECT_TRUE(ReadModel(WriteScenario("robot_ok.yaml", Robot(kLeft))).file);
 }
 
+// Guards what the chassis and the one motor unit need to be consistent:
+// wheels of one mass (the chassis lumps one module mass into each), and
+// motor models that give the same keys (element arrays of one dc_motor
+// unit). Each is named at its key in the robot file.
+TEST(RobotFile, WheelMassesAndMotorModelsMustAgree) {
+  std::string text = Robot(kLeft);
+  text.replace(text.find("mass_kg: 2, drive_motor: right"), 9, "mass_kg: 3");
+  const std::string f = WriteScenario("robot_heavy.yaml", text);
+  const Read a = ReadModel(f);
+  EXPECT_FALSE(a.file);
+  EXPECT_TRUE(Has(a.issues, "wheels.1.mass_kg: every wheel must have the mass of the first"))
+      << a.issues;
+
+  const std::string motor = WriteScenario("bare_motor.yaml", "resistance: 0.3\n"
+                                                             "inductance: 1.0e-4\n"
+                                                             "torque_constant: 0.03\n"
+                                                             "rotor_inertia: 1.0e-5\n");
+  std::string two = Robot(kLeft);
+  two.replace(two.find("  - {name: drive, model: maxon_re40_148877,"), 0,
+              "  - {name: other, model: " + motor + ", gear_ratio: 10, gear_efficiency: 0.9,\n"
+              "     motors: [spare]}\n");
+  two.replace(two.find("drive_motor: right}"), 19, "drive_motor: right}\n  - {name: s, x_m: 0.2, "
+              "y_m: 0.3, radius_m: 0.1, width_m: 0.05, mass_kg: 2, drive_motor: spare}");
+  const Read b = ReadModel(WriteScenario("robot_two_motors.yaml", two));
+  EXPECT_TRUE(Has(b.issues, "motor_groups.1.model: the motor models of one robot must set the "
+                            "same keys: 'viscous_friction'"))
+      << b.issues;
+}
+
 // Guards the name: an unknown robot lists the shipped ones.
 TEST(RobotFile, UnknownRobotNamesTheClosest) {
   const Read read = ReadModel("huskey");
