@@ -217,10 +217,26 @@ class Builder {
     if (params.IsDefined() && !params.IsNull() && !r_.ExpectMap(params, params_path)) return;
 
     const std::size_t issues_before = r_.issues().size();
+    // The model file (`parameters.model`) is read before the unit is made:
+    // its structural keys (a laser's beam count) shape the variable table.
+    YAML::Node model;
+    std::string model_file;
+    if (params.IsMap() && Child(params, "model").IsDefined() && !type->model_folder.empty()) {
+      const std::string model_path = JoinPath(params_path, "model");
+      if (const auto value = r_.AsString(Child(params, "model"), model_path)) {
+        model = LoadModel(r_, Child(params, "model"), model_path, "model", *value,
+                          type->model_folder, s_.file, &model_file);
+        if (model.IsDefined()) {
+          const YamlReader::InFile in_model(r_, model_file);
+          if (!r_.ExpectMap(model, "")) model = YAML::Node();
+        }
+      }
+      if (r_.issues().size() != issues_before) return;
+    }
     std::unique_ptr<cosim::Unit> unit;
     try {
-      unit = type->create(
-          {name, cosim::DeriveSeed(s_.seed, name), r_, params, params_path, s_.scene});
+      unit = type->create({name, cosim::DeriveSeed(s_.seed, name), r_, params, params_path,
+                           s_.scene, model, model_file});
     } catch (const std::exception& e) {
       r_.Error(spec, path, std::string("cannot create the unit: ") + e.what());
       return;
@@ -231,20 +247,13 @@ class Builder {
     for (const auto& k : type->structural_keys) structural.push_back(k.name);
     std::map<std::string, ParameterOrigin> origins;
 
-    // Model file first, then the scenario's own values on top.
-    if (params.IsMap() && Child(params, "model").IsDefined() && !type->model_folder.empty()) {
-      const std::string model_path = JoinPath(params_path, "model");
-      if (const auto value = r_.AsString(Child(params, "model"), model_path)) {
-        std::string file;
-        const YAML::Node model = LoadModel(r_, Child(params, "model"), model_path, "model", *value,
-                                           type->model_folder, s_.file, &file);
-        if (model.IsDefined()) {
-          const YamlReader::InFile in_model(r_, file);
-          if (r_.ExpectMap(model, "")) {
-            ApplyParameters(*unit, model, "", {"source", "description"}, r_, origins);
-          }
-        }
-      }
+    // Model file first, then the scenario's own values on top. The model's
+    // structural keys were the factory's.
+    if (model.IsDefined()) {
+      const YamlReader::InFile in_model(r_, model_file);
+      std::vector<std::string> skipped = structural;
+      skipped.insert(skipped.end(), {"source", "description"});
+      ApplyParameters(*unit, model, "", skipped, r_, origins);
     }
     if (params.IsMap()) ApplyParameters(*unit, params, params_path, structural, r_, origins);
 
@@ -426,7 +435,7 @@ std::unique_ptr<cosim::Unit> CreateDefaultUnit(const UnitType& type) {
   belt.variation_period_s = 20.0;
   belt.acceleration_mps2 = 0.5;
   scene.belts.push_back(belt);
-  auto unit = type.create({type.name, 1, reader, none, path, scene});
+  auto unit = type.create({type.name, 1, reader, none, path, scene, none, ""});
   if (!reader.ok() || !unit) throw ScenarioError(reader.issues());
   return unit;
 }

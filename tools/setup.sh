@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config git
-  libode-dev libeigen3-dev libsundials-dev libfcl-dev
+  libode-dev libeigen3-dev libsundials-dev libfcl-dev libembree-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libtbb-dev
   libopenmpi-dev openmpi-bin gnuplot-nox

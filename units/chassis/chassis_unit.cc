@@ -264,7 +264,13 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   steer_angle_.assign(ms, 0.0);
   steer_rate_.assign(ms, 0.0);
   drive_rate_.assign(md, 0.0);
+  drive_angle_.assign(md, 0.0);
   position_.assign(2, 0.0);
+  position_3d_.assign(3, 0.0);
+  orientation_.assign(4, 0.0);
+  orientation_[0] = 1.0;
+  velocity_3d_.assign(3, 0.0);
+  angular_velocity_.assign(3, 0.0);
   linear_velocity_.assign(2, 0.0);
   body_linear_velocity_.assign(2, 0.0);
   wheel_surface_.assign(w, -1.0);
@@ -371,12 +377,28 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   }
   v.Output("drive_rate", "rad/s", &drive_rate_,
            "spin of each drive motor's wheels relative to the body, + rolling forward", {});
+  v.Output("drive_angle", "rad", &drive_angle_,
+           "angle each drive motor's wheels have turned relative to the body since the start "
+           "(the trapezoid of drive_rate over each step): what a wheel encoder counts",
+           {});
   v.Output("position", "m", &position_, "x, y of base_link in map", {});
   v.Output("yaw", "rad", &yaw_, "yaw of base_link in map, in (-pi, pi]", {});
   v.Output("linear_velocity", "m/s", &linear_velocity_, "vx, vy of base_link in map", {});
   v.Output("yaw_rate", "rad/s", &yaw_rate_, "yaw rate of base_link", {});
   v.Output("body_linear_velocity", "m/s", &body_linear_velocity_,
            "vx, vy of base_link in base_link", {});
+  v.Output("position_3d", "m", &position_3d_,
+           "x, y, z in map of base_link's origin: on the floor under the body's centre at rest "
+           "(the body's centre of mass minus com_height along the body's z axis), the point "
+           "sensor mounts refer to",
+           {});
+  v.Output("orientation", "1", &orientation_,
+           "attitude of base_link in map as a unit quaternion w, x, y, z", {});
+  v.Output("velocity_3d", "m/s", &velocity_3d_, "velocity of base_link's origin in map", {});
+  v.Output("angular_velocity", "rad/s", &angular_velocity_,
+           "angular velocity of the body in base_link (x roll rate, y pitch rate, z yaw rate): "
+           "what a gyro on it measures",
+           {});
   v.Output("wheel_surface", "1", &wheel_surface_,
            "surface under each wheel: -1 no contact, 0 floor, k + 1 scene belt k", {});
   v.Output("wheel_surface_velocity", "m/s", &wheel_surface_velocity_,
@@ -623,6 +645,7 @@ void ChassisUnit::Initialize() {
   }
   SetBeltInputs();
   ComputeOutputs();
+  std::fill(drive_angle_.begin(), drive_angle_.end(), 0.0);
   initialized_ = true;
 }
 
@@ -710,6 +733,17 @@ void ChassisUnit::ComputeOutputs() {
   Column(rb, 0, ex);
   Column(rb, 1, ey);
   Column(rb, 2, ez);
+  // base_link's origin: com_height below the body's centre along its z axis;
+  // its velocity v + w x (-com_height ez).
+  const dReal* q = dBodyGetQuaternion(o.body);
+  for (int i = 0; i < 3; ++i) position_3d_[i] = pb[i] - com_height_ * ez[i];
+  for (int i = 0; i < 4; ++i) orientation_[i] = q[i];
+  const double wxez[3] = {wb[1] * ez[2] - wb[2] * ez[1], wb[2] * ez[0] - wb[0] * ez[2],
+                          wb[0] * ez[1] - wb[1] * ez[0]};
+  for (int i = 0; i < 3; ++i) velocity_3d_[i] = vb[i] - com_height_ * wxez[i];
+  angular_velocity_[0] = Dot(ex, wb);
+  angular_velocity_[1] = Dot(ey, wb);
+  angular_velocity_[2] = Dot(ez, wb);
   // drive_rate is the first wheel's of each motor (the others are coupled to
   // it). Bit m: motor m seen (m < wheel count <= kMaxWheels = 64).
   std::uint64_t seen = 0;
@@ -775,7 +809,12 @@ cosim::StepResult ChassisUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     return Fail(Where() + ": ODE state went non-finite" + at() + ": " + bad);
   }
   // FloorWorld::Step collided at the new positions already.
+  drive_rate_before_ = drive_rate_;  // same size: no allocation
   ComputeOutputs();
+  const double dt_s = cosim::NsToSeconds(dt);
+  for (std::size_t m = 0; m < drive_angle_.size(); ++m) {
+    drive_angle_[m] += 0.5 * (drive_rate_before_[m] + drive_rate_[m]) * dt_s;
+  }
   // Nothing is simulated off the floor: stop there (the world stays
   // consistent, the outputs show where the robot went).
   if (const std::string bad = OffFloorWheel(); !bad.empty()) {

@@ -173,8 +173,11 @@ class ChassisUnit : public cosim::Unit {
   bool brake_ = false;
 
   // Outputs.
-  std::vector<double> steer_angle_, steer_rate_, drive_rate_;
+  std::vector<double> steer_angle_, steer_rate_, drive_rate_, drive_angle_;
   std::vector<double> position_, linear_velocity_, body_linear_velocity_;
+  std::vector<double> position_3d_, orientation_, velocity_3d_, angular_velocity_;
+  // drive_rate_ at the start of the step (drive_angle_'s trapezoid).
+  std::vector<double> drive_rate_before_;
   double yaw_ = 0.0;
   double yaw_rate_ = 0.0;
   std::vector<double> wheel_surface_, wheel_surface_velocity_, wheel_contact_;

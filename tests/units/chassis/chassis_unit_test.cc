@@ -841,11 +841,16 @@ TEST(ChassisUnit, VariableTable) {
                                         {"steer_angle", C::kOutput, "rad", 4},
                                         {"steer_rate", C::kOutput, "rad/s", 4},
                                         {"drive_rate", C::kOutput, "rad/s", 4},
+                                        {"drive_angle", C::kOutput, "rad", 4},
                                         {"position", C::kOutput, "m", 2},
                                         {"yaw", C::kOutput, "rad", 0},
                                         {"linear_velocity", C::kOutput, "m/s", 2},
                                         {"yaw_rate", C::kOutput, "rad/s", 0},
                                         {"body_linear_velocity", C::kOutput, "m/s", 2},
+                                        {"position_3d", C::kOutput, "m", 3},
+                                        {"orientation", C::kOutput, "1", 4},
+                                        {"velocity_3d", C::kOutput, "m/s", 3},
+                                        {"angular_velocity", C::kOutput, "rad/s", 3},
                                         {"wheel_surface", C::kOutput, "1", 4},
                                         {"wheel_surface_velocity", C::kOutput, "m/s", 8},
                                         {"wheel_contact", C::kOutput, "m", 8}};
@@ -857,9 +862,12 @@ TEST(ChassisUnit, VariableTable) {
   expected = Parameters(4);
   const std::vector<Expected> skid = {
       {"drive_torque", C::kInput, "N.m", 2},  {"brake", C::kInput, "", 0},
-      {"drive_rate", C::kOutput, "rad/s", 2}, {"position", C::kOutput, "m", 2},
-      {"yaw", C::kOutput, "rad", 0},          {"linear_velocity", C::kOutput, "m/s", 2},
-      {"yaw_rate", C::kOutput, "rad/s", 0},   {"body_linear_velocity", C::kOutput, "m/s", 2},
+      {"drive_rate", C::kOutput, "rad/s", 2}, {"drive_angle", C::kOutput, "rad", 2},
+      {"position", C::kOutput, "m", 2},       {"yaw", C::kOutput, "rad", 0},
+      {"linear_velocity", C::kOutput, "m/s", 2}, {"yaw_rate", C::kOutput, "rad/s", 0},
+      {"body_linear_velocity", C::kOutput, "m/s", 2}, {"position_3d", C::kOutput, "m", 3},
+      {"orientation", C::kOutput, "1", 4},    {"velocity_3d", C::kOutput, "m/s", 3},
+      {"angular_velocity", C::kOutput, "rad/s", 3},
       {"wheel_surface", C::kOutput, "1", 4},  {"wheel_surface_velocity", C::kOutput, "m/s", 8},
       {"wheel_contact", C::kOutput, "m", 8}};
   expected.insert(expected.end(), skid.begin(), skid.end());
