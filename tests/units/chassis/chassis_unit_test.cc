@@ -305,6 +305,57 @@ TEST(ChassisUnit, EqualDriveTorquesAccelerateForward) {
   for (double w : Get(u, "drive_rate")) EXPECT_LT(w, 0.0);
 }
 
+// Guards against wrong frames in the 3D outputs the sensors use and against
+// a drive_angle that is not the integral of drive_rate. Expected by
+// definition: at rest base_link's origin is on the floor (z within the
+// contact deflection, 0.3 mm at 1e6 N/m) at the initial pose and the
+// attitude is the yaw quaternion (cos(yaw/2), 0, 0, sin(yaw/2)); under equal
+// drive torques the body accelerates at a (as in the test above), so after
+// t the wheels have turned a t^2 / (2 r) and velocity_3d is the planar
+// velocity; angular_velocity is zero when driving straight.
+TEST(ChassisUnit, PoseTwistAndWheelAnglesIn3D) {
+  const double tau_nm = 2.0, yaw0 = 0.5;
+  const double r = kWheelRadiusM;
+  const double j_axle = 0.5 * kModuleMassKg * r * r + kDriveRotorKgm2;
+  const double a = 4.0 * tau_nm / r / (kMassKg + 4.0 * j_axle / (r * r));
+  auto robot = Raw3();
+  ChassisUnit& u = *robot;
+  Set(u, "drive_friction", 0.0);
+  Set(u, "initial_x", 1.0);
+  Set(u, "initial_y", -2.0);
+  Set(u, "initial_yaw", yaw0);
+  u.Initialize();
+  auto p = Get(u, "position_3d");
+  EXPECT_NEAR(p[0], 1.0, 1e-9);
+  EXPECT_NEAR(p[1], -2.0, 1e-9);
+  EXPECT_NEAR(p[2], 0.0, 5e-4);
+  const auto q = Get(u, "orientation");
+  EXPECT_NEAR(q[0], std::cos(yaw0 / 2), 1e-6);
+  EXPECT_NEAR(q[1], 0.0, 1e-6);
+  EXPECT_NEAR(q[2], 0.0, 1e-6);
+  EXPECT_NEAR(q[3], std::sin(yaw0 / 2), 1e-6);
+  for (double d : Get(u, "drive_angle")) EXPECT_EQ(d, 0.0);
+
+  SetArray(u, "drive_torque", {tau_nm, tau_nm, tau_nm, tau_nm});
+  TimeNs t = 0;
+  Advance(u, t, 1000);
+  const double t_s = 1.0;
+  for (double d : Get(u, "drive_angle")) EXPECT_NEAR(d, 0.5 * a * t_s * t_s / r, 0.01 * d);
+  const auto v = Get(u, "velocity_3d");
+  const auto v2 = Get(u, "linear_velocity");
+  EXPECT_NEAR(v[0], v2[0], 1e-3);
+  EXPECT_NEAR(v[1], v2[1], 1e-3);
+  EXPECT_NEAR(v[2], 0.0, 1e-3);
+  for (double w : Get(u, "angular_velocity")) EXPECT_NEAR(w, 0.0, 1e-3);
+  p = Get(u, "position_3d");
+  const auto p2 = Get(u, "position");
+  EXPECT_NEAR(p[0], p2[0], 1e-3);
+  EXPECT_NEAR(p[1], p2[1], 1e-3);
+  // Initialize again: the wheel angles start from zero.
+  u.Initialize();
+  for (double d : Get(u, "drive_angle")) EXPECT_EQ(d, 0.0);
+}
+
 // Guards against a wrong steering torque sign or module inertia. Analytic:
 // the sphere wheel has one contact on the steering axis, so nothing resists
 // steering but the module's inertia about the vertical,
