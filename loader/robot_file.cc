@@ -6,6 +6,7 @@
 #include <numbers>
 #include <set>
 
+#include "cosim/system.h"
 #include "cosim/variable_table.h"
 #include "loader/scenario.h"
 #include "loader/yaml_files.h"
@@ -40,7 +41,7 @@ class Reader {
     MotorGroups(Child(root, "motor_groups"), robot);
     Wheels(Child(root, "wheels"), robot);
     Controller(Child(root, "controller"), out);
-    SensorMounts(Child(root, "sensor_mounts"), robot);
+    SensorMounts(Child(root, "sensor_mounts"), out);
     out.chassis_settings = Settings(root, "chassis");
     out.motor_settings = Settings(root, "motors");
     out.follower_settings = Settings(root, "path_follower");
@@ -320,7 +321,8 @@ class Reader {
     }
   }
 
-  void SensorMounts(const YAML::Node& list, models::RobotDescription& robot) {
+  void SensorMounts(const YAML::Node& list, RobotFile& out) {
+    models::RobotDescription& robot = out.robot;
     const std::string path = "sensor_mounts";
     if (!list.IsDefined() || list.IsNull() || !r_.ExpectSequence(list, path)) return;
     std::set<std::string> names;
@@ -328,22 +330,39 @@ class Reader {
       const std::string sp = JoinPath(path, std::to_string(i));
       const YAML::Node node = list[i];
       if (!r_.ExpectMap(node, sp)) continue;
-      r_.CheckKeys(node, sp,
-                   {"name", "kind", "x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg",
-                    "source"});
       models::SensorMount m;
+      m.kind = r_.String(node, sp, "kind", std::nullopt, models::SensorKinds());
+      const bool posed = models::SensorKindHasPose(m.kind);
+      std::vector<std::string> keys = {"name", "kind", "model", "step_s", "parameters", "source"};
+      if (posed) keys.insert(keys.end(), {"x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg"});
+      r_.CheckKeys(node, sp, keys);
       m.name = r_.String(node, sp, "name", std::nullopt);
-      m.kind = r_.String(node, sp, "kind", std::nullopt);
-      m.x_m = r_.Real(node, sp, "x_m", std::nullopt, kPositionM);
-      m.y_m = r_.Real(node, sp, "y_m", std::nullopt, kPositionM);
-      m.z_m = r_.Real(node, sp, "z_m", std::nullopt, {0.0, 10.0});
-      m.roll_rad = r_.Real(node, sp, "roll_deg", 0.0, {-360.0, 360.0}) * kDegToRad;
-      m.pitch_rad = r_.Real(node, sp, "pitch_deg", 0.0, {-360.0, 360.0}) * kDegToRad;
-      m.yaw_rad = r_.Real(node, sp, "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad;
+      if (!m.name.empty() && !cosim::IsIdentifier(m.name)) {
+        r_.Error(Child(node, "name"), JoinPath(sp, "name"),
+                 "mount name '" + m.name + "' is not valid: expected letters, digits and _ (it "
+                 "names the sensor's unit)");
+      }
+      m.model = r_.String(node, sp, "model", "");
+      m.step_s = r_.Real(node, sp, "step_s", 0.0, {0.0, 10.0});
+      if (posed) {
+        m.x_m = r_.Real(node, sp, "x_m", std::nullopt, kPositionM);
+        m.y_m = r_.Real(node, sp, "y_m", std::nullopt, kPositionM);
+        m.z_m = r_.Real(node, sp, "z_m", std::nullopt, {0.0, 10.0});
+        m.roll_rad = r_.Real(node, sp, "roll_deg", 0.0, {-360.0, 360.0}) * kDegToRad;
+        m.pitch_rad = r_.Real(node, sp, "pitch_deg", 0.0, {-360.0, 360.0}) * kDegToRad;
+        m.yaw_rad = r_.Real(node, sp, "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad;
+      }
       if (!m.name.empty() && !names.insert(m.name).second) {
         r_.Error(Child(node, "name"), JoinPath(sp, "name"), "mount '" + m.name + "' is named twice");
       }
+      const YAML::Node params = Child(node, "parameters");
+      YAML::Node settings(YAML::NodeType::Map);
+      if (params.IsDefined() && !params.IsNull() &&
+          r_.ExpectMap(params, JoinPath(sp, "parameters"))) {
+        settings = params;
+      }
       robot.sensor_mounts.push_back(std::move(m));
+      out.sensor_settings.push_back(settings);
     }
   }
 

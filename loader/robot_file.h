@@ -27,6 +27,10 @@ struct RobotFile {
   /// Map of path_follower parameters the robot sets (its speed and yaw
   /// rate limits).
   YAML::Node follower_settings;
+  /// Per sensor mount (same order as robot.sensor_mounts): the map of
+  /// unit parameters its `parameters:` key gives (device options, counts
+  /// per revolution), or an empty map.
+  std::vector<YAML::Node> sensor_settings;
 };
 
 /// Reads the robot description `model` names (a file in models/robots, or a

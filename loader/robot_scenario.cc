@@ -112,7 +112,7 @@ bool IsRobotScenario(const YAML::Node& root) {
 YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
   r.CheckKeys(root, "",
               {"name", "description", "duration_s", "seed", "master", "robot", "scene", "line",
-               "control", "task", "sensing", "localization", "units", "connections", "recording",
+               "control", "task", "sensors", "sensing", "localization", "units", "connections", "recording",
                "metrics"});
   assembly::SystemBuilder b(root, r);
   for (const char* key : {"name", "description", "duration_s", "seed", "master"}) {
@@ -135,6 +135,7 @@ YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
   if (file) {
     assembly::Signals s = assembly::AddDriveTrain(b, *file, start, info);
     assembly::AddLine(b, scene, s);
+    assembly::AddSensors(b, *file, s);
     assembly::AddSensing(b, s);
     assembly::AddControl(b, *file, s);
     assembly::AddTask(b, *file, start, s, info);

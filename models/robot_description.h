@@ -74,10 +74,25 @@ struct MotorGroup {
 /// sensor's own description).
 struct SensorMount {
   std::string name;
-  std::string kind;  // px4flow, laser_scanner, imu, ...
+  /// The sensor unit type: px4flow, laser_scanner, imu, wheel_encoder.
+  std::string kind;
+  /// The device's model file in models/sensors (sick_s300), or empty.
+  std::string model;
+  /// The sensor's communication step (s); 0: the kind's default.
+  double step_s = 0.0;
+  /// Pose in base_link (a wheel encoder has none: it reads the joints).
   double x_m = 0.0, y_m = 0.0, z_m = 0.0;
   double roll_rad = 0.0, pitch_rad = 0.0, yaw_rad = 0.0;
 };
+
+/// The sensor kinds a robot description may mount, and whether a mount of
+/// that kind has a pose on the body.
+inline bool SensorKindHasPose(const std::string& kind) { return kind != "wheel_encoder"; }
+inline const std::vector<std::string>& SensorKinds() {
+  static const std::vector<std::string> kinds = {"px4flow", "laser_scanner", "imu",
+                                                 "wheel_encoder"};
+  return kinds;
+}
 
 enum class ControllerKind { kSwerve, kDifferential };
 

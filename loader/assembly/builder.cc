@@ -121,6 +121,14 @@ YAML::Node SystemBuilder::Section(const YAML::Node& parent, const std::string& p
   return node;
 }
 
+cosim::TimeNs SystemBuilder::ControlPeriod() const {
+  YamlReader quiet(r_.file());
+  const YAML::Node control = Child(root_, "control");
+  if (!control.IsMap()) return kControlPeriod;
+  return quiet.Time(control, "control", "period_s", cosim::NsToSeconds(kControlPeriod),
+                    {0.0, 10.0, true});
+}
+
 cosim::TimeNs SystemBuilder::MasterStep() const {
   YamlReader quiet(r_.file());
   return ReadMasterStep(quiet, Child(root_, "master"));

@@ -20,6 +20,12 @@ inline constexpr const char* kMotors = "motors";
 inline constexpr const char* kWheelController = "wheel_controller";
 inline constexpr const char* kPathFollower = "path_follower";
 inline constexpr const char* kDeviation = "deviation";
+inline constexpr const char* kClearance = "clearance";
+/// The Rob@Work 3 control cycle (IPA cob_control configuration): the
+/// controllers' period unless control.period_s says otherwise.
+inline constexpr cosim::TimeNs kControlPeriod = cosim::kNsPerSecond / 50;
+/// Paper 1's encoder wheel on the belt, off the robot.
+inline constexpr const char* kBeltGroundTruth = "belt_ground_truth";
 
 /// "unit.variable".
 std::string Signal(const std::string& unit, const std::string& variable);
@@ -75,6 +81,9 @@ class SystemBuilder {
   /// The master step as the system loader reads it (its default if absent
   /// or bad: the system loader reports a bad one at master.step_s).
   cosim::TimeNs MasterStep() const;
+  /// The controllers' period (control.period_s, 20 ms by default), as
+  /// AddControl reads it and reports its problems.
+  cosim::TimeNs ControlPeriod() const;
 
   YAML::Node& out() { return out_; }
   std::vector<YAML::Node>& connections() { return connections_; }

@@ -35,6 +35,16 @@ struct Signals {
   /// Belts of the scene: how many, and the belt unit's outputs.
   std::size_t belt_count = 0;
 
+  /// The sensor units on the robot, one per enabled mount (the unit is
+  /// named after the mount), and the belt's ground-truth speed ("" when
+  /// there is none).
+  struct Sensor {
+    std::string unit, kind;
+    models::SensorMount mount;
+  };
+  std::vector<Sensor> sensors;
+  std::string belt_ground_truth;
+
   /// What each concern wants recorded, in order.
   std::vector<std::string> recorded;
 };
@@ -56,6 +66,11 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& robot, const StartPose&
 
 /// The line's belt unit, driving the scene's belts under the chassis.
 void AddLine(SystemBuilder& b, const models::Scene& scene, Signals& s);
+
+/// sensors: a unit per sensor mount of the robot description (PX4Flow,
+/// lasers, IMU, wheel encoders) and the belt's ground-truth encoder, as
+/// the scenario's `sensors:` section enables and configures them.
+void AddSensors(SystemBuilder& b, const RobotFile& robot, Signals& s);
 
 /// sensing.surface_velocity and localization.source: who tells the
 /// controllers the surface velocity under each wheel and the pose.

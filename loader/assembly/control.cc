@@ -132,7 +132,8 @@ void AddControl(SystemBuilder& b, const RobotFile& file, Signals& s) {
   YamlReader& r = b.reader();
   const bool compensation = r.Boolean(control, "control", "compensation", true);
   // The Rob@Work 3 control cycle is 20 ms (IPA cob_control configuration).
-  const cosim::TimeNs period = r.Time(control, "control", "period_s", 0.02, {0.0, 10.0, true});
+  const cosim::TimeNs period = r.Time(control, "control", "period_s",
+                                      cosim::NsToSeconds(kControlPeriod), {0.0, 10.0, true});
   // The master checks the controllers' step against its own; its problems
   // are reported here, where the step comes from.
   for (const char* name : {kWheelController, kPathFollower}) {

@@ -1,0 +1,230 @@
+#include <map>
+#include <set>
+
+#include "cosim/time.h"
+#include "loader/assembly/concerns.h"
+
+namespace linesim::loader::assembly {
+
+namespace {
+
+// How a mount of each kind is built: the parameters its pose becomes, the
+// chassis outputs it reads, the belt outputs it reads (when the scene has
+// belts), and its default step (0: the master's).
+struct KindWiring {
+  std::vector<std::pair<std::string, std::string>> chassis_inputs;  // chassis output -> input
+  std::vector<std::pair<std::string, std::string>> belt_inputs;     // belt output -> input
+  cosim::TimeNs default_step = 0;
+};
+
+const std::map<std::string, KindWiring>& Wiring() {
+  static const std::map<std::string, KindWiring> wiring = {
+      // The PX4Flow steps with the physics and computes the camera frames
+      // that fall in each step (about 400 per second).
+      {"px4flow",
+       {{{"position", "position"},
+         {"yaw", "yaw"},
+         {"linear_velocity", "linear_velocity"},
+         {"yaw_rate", "yaw_rate"},
+         {"angular_velocity", "angular_velocity"}},
+        {{"velocity", "belt_velocity"}},
+        0}},
+      // A laser steps with the physics and casts the beams whose time falls
+      // in each step (the mirror turns while the robot and the cars move).
+      {"laser_scanner",
+       {{{"position_3d", "position_3d"},
+         {"orientation", "orientation"},
+         {"velocity_3d", "velocity_3d"},
+         {"angular_velocity", "angular_velocity"}},
+        {{"travel", "belt_travel"}, {"speed", "belt_speed"}},
+        0}},
+      // 100 Hz: a typical output rate of a robot base's IMU driver.
+      {"imu",
+       {{{"orientation", "orientation"},
+         {"velocity_3d", "velocity_3d"},
+         {"angular_velocity", "angular_velocity"}},
+        {},
+        cosim::kNsPerSecond / 100}},
+      // Sampled at the control period (set below).
+      {"wheel_encoder", {{}, {}, 0}},
+  };
+  return wiring;
+}
+
+// The mount's pose as the sensor unit's parameters.
+void SetMountParameters(YAML::Node params, const models::SensorMount& m) {
+  if (m.kind == "px4flow") {
+    // Looks straight down: only its place on the planform, its height and
+    // its heading about the vertical matter.
+    params["mount_x"] = Num(m.x_m);
+    params["mount_y"] = Num(m.y_m);
+    params["mount_height"] = Num(m.z_m);
+    params["mount_yaw"] = Num(m.yaw_rad);
+    return;
+  }
+  params["mount_x"] = Num(m.x_m);
+  params["mount_y"] = Num(m.y_m);
+  params["mount_z"] = Num(m.z_m);
+  params["mount_roll"] = Num(m.roll_rad);
+  params["mount_pitch"] = Num(m.pitch_rad);
+  params["mount_yaw"] = Num(m.yaw_rad);
+}
+
+// A wheel encoder reads every steering joint, then every drive joint, of
+// the chassis: its channels in that order.
+void WireEncoder(SystemBuilder& b, const std::string& name, const Signals& s) {
+  const std::size_t steer = s.steer_motor_element.size();
+  const std::size_t drive = s.drive_motor_element.size();
+  b.Params(name)["channels"] = static_cast<int>(steer + drive);
+  for (std::size_t j = 0; j < steer; ++j) {
+    b.Connect(Element(kChassis, "steer_angle", j), Element(name, "angle", j));
+  }
+  for (std::size_t j = 0; j < drive; ++j) {
+    b.Connect(Element(kChassis, "drive_angle", j), Element(name, "angle", steer + j));
+  }
+}
+
+}  // namespace
+
+void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
+  YamlReader& r = b.reader();
+  const models::RobotDescription& robot = file.robot;
+  std::vector<std::string> keys = {"default", kBeltGroundTruth};
+  for (const auto& m : robot.sensor_mounts) keys.push_back(m.name);
+  const YAML::Node section = b.Section(b.root(), "", "sensors", keys);
+  const bool by_default = r.Boolean(section, "sensors", "default", true);
+
+  // A sensor's entry: true/false, or a map of step_s, model and parameters.
+  struct Choice {
+    bool on = false;
+    YAML::Node node;  // the map, if one was given
+  };
+  const auto choice = [&](const std::string& name) {
+    Choice c{by_default, YAML::Node()};
+    const YAML::Node entry = Child(section, name);
+    const std::string path = JoinPath("sensors", name);
+    if (!entry.IsDefined() || entry.IsNull()) return c;
+    if (entry.IsScalar()) {
+      if (const auto on = r.AsBoolean(entry, path)) c.on = *on;
+      return c;
+    }
+    if (!r.ExpectMap(entry, path)) return c;
+    c.on = r.Boolean(entry, path, "enabled", true);
+    c.node = entry;
+    return c;
+  };
+  // The scenario's step_s, model and parameters on top of the mount's.
+  const auto apply = [&](const std::string& name, const Choice& c, cosim::TimeNs step,
+                         const std::vector<std::string>& extra_keys,
+                         const std::set<std::string>& derived) {
+    const std::string path = JoinPath("sensors", name);
+    if (c.node.IsDefined()) {
+      std::vector<std::string> allowed = {"enabled", "step_s", "model", "parameters"};
+      allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
+      r.CheckKeys(c.node, path, allowed);
+      if (Child(c.node, "model").IsDefined()) {
+        b.Params(name)["model"] = Child(c.node, "model");
+        b.Derived(JoinPath(JoinPath(JoinPath("units", name), "parameters"), "model"), c.node, path,
+                  "model");
+      }
+      if (Child(c.node, "step_s").IsDefined()) {
+        step = r.Time(c.node, path, "step_s", 0.0, {0.0, 10.0, true});
+        b.Derived(JoinPath(JoinPath("units", name), "step_s"), c.node, path, "step_s");
+      }
+      const YAML::Node params = Child(c.node, "parameters");
+      if (params.IsDefined() && !params.IsNull() &&
+          r.ExpectMap(params, JoinPath(path, "parameters"))) {
+        // The scenario may override what the robot file says, but not what
+        // the assembly derives (the mount's pose, channels, connections).
+        YAML::Node merged = b.Params(name);
+        const std::string prefix = JoinPath(JoinPath("units", name), "parameters");
+        for (const auto& kv : params) {
+          const std::string key = kv.first.Scalar();
+          if (derived.count(key) != 0) {
+            r.Error(kv.second, JoinPath(JoinPath(path, "parameters"), key),
+                    "the assembly derives '" + key + "' from the robot's sensor mount (pose, "
+                    "joints): change the mount in " + file.robot.file + " instead");
+            continue;
+          }
+          merged[key] = kv.second;
+          b.Origin(JoinPath(prefix, key), {kv.second, JoinPath(JoinPath(path, "parameters"), key),
+                                           ""});
+        }
+      }
+    }
+    if (step > 0) b.SetStep(name, step);
+  };
+
+  const cosim::TimeNs control_period = b.ControlPeriod();
+  for (std::size_t i = 0; i < robot.sensor_mounts.size(); ++i) {
+    const models::SensorMount& m = robot.sensor_mounts[i];
+    const Choice c = choice(m.name);
+    if (!c.on) continue;
+    if (b.HasUnit(m.name)) {
+      r.Error(Child(section, m.name).IsDefined() ? Child(section, m.name) : section,
+              JoinPath("sensors", m.name),
+              "the robot's sensor mount '" + m.name + "' is named like another unit of the "
+              "scenario: rename the mount in " + robot.file);
+      continue;
+    }
+    const auto wiring = Wiring().find(m.kind);
+    if (wiring == Wiring().end()) continue;  // the robot file checked the kind
+    b.Unit(m.name, m.kind);
+    YAML::Node params = b.Params(m.name);
+    const std::string mount_path = JoinPath("sensor_mounts", std::to_string(i));
+    if (!m.model.empty()) {
+      params["model"] = m.model;
+      b.Origin(JoinPath(JoinPath(JoinPath("units", m.name), "parameters"), "model"),
+               {YAML::Node(), JoinPath(mount_path, "model"), robot.file});
+    }
+    if (m.kind == "wheel_encoder") {
+      WireEncoder(b, m.name, s);
+    } else {
+      SetMountParameters(params, m);
+    }
+    std::set<std::string> derived;
+    for (const auto& kv : params) {
+      if (kv.first.Scalar() != "model") derived.insert(kv.first.Scalar());
+    }
+    b.MergeSettings(m.name, file.sensor_settings[i], robot.file,
+                    JoinPath(mount_path, "parameters"));
+    for (const auto& [from, to] : wiring->second.chassis_inputs) {
+      b.Connect(Signal(kChassis, from), Signal(m.name, to));
+    }
+    if (s.belt_count > 0) {
+      for (const auto& [from, to] : wiring->second.belt_inputs) {
+        b.Connect(Signal(kBelt, from), Signal(m.name, to));
+      }
+    }
+    cosim::TimeNs step = wiring->second.default_step;
+    if (m.kind == "wheel_encoder") step = control_period;
+    if (m.step_s > 0) step = cosim::SecondsToNs(m.step_s);
+    apply(m.name, c, step, {}, derived);
+    s.sensors.push_back({m.name, m.kind, m});
+  }
+
+  // Paper 1's ground truth of the line: a free wheel with a quadrature
+  // encoder on the belt, mounted off the robot.
+  const Choice gt = choice(kBeltGroundTruth);
+  if (gt.on && s.belt_count > 0) {
+    const std::string path = JoinPath("sensors", kBeltGroundTruth);
+    const std::int64_t belt =
+        gt.node.IsDefined()
+            ? r.Integer(gt.node, path, "belt", 0, 0, static_cast<std::int64_t>(s.belt_count) - 1)
+            : 0;
+    b.Unit(kBeltGroundTruth, "belt_encoder");
+    b.Params(kBeltGroundTruth)["model"] = "belt_ground_truth_encoder";
+    b.Connect(Element(kBelt, "travel", static_cast<std::size_t>(belt)),
+              Signal(kBeltGroundTruth, "travel"));
+    // The Arduino of paper 1's sensor reports at 50 Hz (ASSUMPTION: the
+    // paper gives no rate; fast enough to show a belt start of ~0.5 s).
+    apply(kBeltGroundTruth, gt, cosim::kNsPerSecond / 50, {"belt"}, {});
+    s.recorded.push_back(Signal(kBeltGroundTruth, "speed"));
+    s.belt_ground_truth = Signal(kBeltGroundTruth, "speed");
+  } else if (gt.node.IsDefined() && gt.on && s.belt_count == 0) {
+    r.Error(gt.node, JoinPath("sensors", kBeltGroundTruth),
+            "the scene has no belts for the belt's ground-truth sensor to measure");
+  }
+}
+
+}  // namespace linesim::loader::assembly
