@@ -1,6 +1,7 @@
 // Registers the evaluation family's unit types (see config/unit_registry.h).
 #include "config/unit_registry.h"
 #include "units/evaluation/path_deviation.h"
+#include "units/evaluation/surface_velocity_error.h"
 
 namespace linesim::evaluation {
 namespace {
@@ -18,6 +19,29 @@ const config::UnitTypeRegistrar kPathDeviation(
      "",
      {{"path", "list of points [x, y] (m): a polyline, or one point for a hold"}},
      MakePathDeviation});
+
+std::unique_ptr<cosim::Unit> MakeSurfaceVelocityError(const UnitBuildContext& c) {
+  const auto sensors = c.reader.Integer(c.parameters, c.path, "sensors", 1, 1, 64);
+  if (c.scene.belts.empty()) {
+    c.reader.Error(c.parameters, c.path,
+                   "the scene has no belts: the unit compares optic flow with a belt's "
+                   "ground-truth speed (scene.belts)");
+    return nullptr;
+  }
+  const auto belt = c.reader.Integer(c.parameters, c.path, "belt", 0, 0,
+                                     static_cast<std::int64_t>(c.scene.belts.size()) - 1);
+  return std::make_unique<evaluation::SurfaceVelocityErrorUnit>(
+      c.name, static_cast<int>(sensors), c.scene.belts[static_cast<std::size_t>(belt)]);
+}
+
+const config::UnitTypeRegistrar kSurfaceVelocityError(
+    {evaluation::SurfaceVelocityErrorUnit::kTypeName,
+     "raw optic-flow surface velocity (paper 1 Eq. 2 with the true robot motion) against a "
+     "belt's ground-truth speed, for the sensors over that belt; running RMSE",
+     "",
+     {{"sensors", "number of sensors compared (default 1)"},
+      {"belt", "index of the scene belt the reference measures (default 0)"}},
+     MakeSurfaceVelocityError});
 
 }  // namespace
 }  // namespace linesim::evaluation

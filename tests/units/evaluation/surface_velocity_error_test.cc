@@ -1,0 +1,110 @@
+#include "units/evaluation/surface_velocity_error.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "tests/units/test_helpers.h"
+
+namespace linesim::evaluation {
+namespace {
+
+using test_helpers::Get;
+using test_helpers::SetArray;
+
+constexpr double kPi = std::numbers::pi;
+
+// A 4 x 2 m belt along map x at the origin, as a treadmill under the robot.
+models::Belt Treadmill() {
+  models::Belt b;
+  b.name = "treadmill";
+  b.area = {0.0, 0.0, 4.0, 2.0, 0.0};
+  return b;
+}
+
+void Set(cosim::Unit& u, const std::string& name, double v) {
+  u.variables().SetReal(*u.variables().Find(name), v);
+}
+
+// Two sensors at opposite corners, the second turned by 90 deg.
+std::unique_ptr<SurfaceVelocityErrorUnit> TwoSensors() {
+  auto u = std::make_unique<SurfaceVelocityErrorUnit>("e", 2, Treadmill());
+  SetArray(*u, "mount_x", {0.5, -0.5});
+  SetArray(*u, "mount_y", {0.25, -0.25});
+  SetArray(*u, "mount_yaw", {0.0, kPi / 2});
+  return u;
+}
+
+// Guards against a wrong frame in Eq. 2. Expected by kinematics: a robot
+// at rest turned by yaw over a belt moving at 0.2 m/s along x sees the
+// surface move at R(-(yaw + mount_yaw)) (0.2, 0) in each sensor frame; made
+// absolute again this is 0.2 m/s along the belt, error 0.
+TEST(SurfaceVelocityError, StandingRobotSeesTheBeltSpeed) {
+  for (double yaw : {0.0, 0.7, -2.0}) {
+    auto u = TwoSensors();
+    Set(*u, "yaw", yaw);
+    Set(*u, "reference", 0.2);
+    std::vector<double> m;
+    for (double mount_yaw : {0.0, kPi / 2}) {
+      const double a = yaw + mount_yaw;
+      m.push_back(std::cos(a) * 0.2);
+      m.push_back(-std::sin(a) * 0.2);
+    }
+    SetArray(*u, "measured", m);
+    u->Initialize();
+    ASSERT_EQ(u->DoStep(0, 1'000'000), cosim::StepResult::kOk);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_NEAR(Get(*u, "surface_speed")[k], 0.2, 1e-12);
+      EXPECT_NEAR(Get(*u, "error")[k], 0.0, 1e-12);
+      EXPECT_EQ(Get(*u, "over_belt")[k], 1.0);
+    }
+  }
+}
+
+// Guards against leaving out omega x r. Expected: a robot turning in place
+// at w over a still belt: the floor under the sensor at r moves at
+// -(w ez x r) relative to it; Eq. 2 adds the sensor's own w ez x r back, so
+// the absolute surface speed is 0.
+TEST(SurfaceVelocityError, TurningRobotOverStillBeltReadsZero) {
+  auto u = TwoSensors();
+  const double w = 0.8;
+  Set(*u, "yaw_rate", w);
+  // Sensor 0 at (0.5, 0.25), frame = base_link: relative surface velocity
+  // -(w ez x r) = -w (-0.25, 0.5) = (0.2, -0.4).
+  // Sensor 1 at (-0.5, -0.25): -w (0.25, -0.5) = (-0.2, 0.4) in base_link,
+  // in its frame (turned +90 deg): (0.4, 0.2).
+  SetArray(*u, "measured", {0.2, -0.4, 0.4, 0.2});
+  u->Initialize();
+  ASSERT_EQ(u->DoStep(0, 1'000'000), cosim::StepResult::kOk);
+  for (int k = 0; k < 2; ++k) EXPECT_NEAR(Get(*u, "surface_speed")[k], 0.0, 1e-12);
+}
+
+// Guards against counting sensors that are off the belt and against a
+// wrong running mean. Expected by definition: errors 0.1 and 0.3 over two
+// steps on one sensor give sqrt((0.01 + 0.09) / 2); a sensor off the belt
+// adds nothing.
+TEST(SurfaceVelocityError, RmseOverSensorsOverTheBelt) {
+  auto u = TwoSensors();
+  // The robot at x = 1.7: sensor 0 at x = 2.2 is past the belt's end (2 m).
+  SetArray(*u, "position", {1.7, 0.0});
+  Set(*u, "reference", 0.0);
+  u->Initialize();
+  SetArray(*u, "measured", {0.5, 0.0, 0.0, -0.1});
+  ASSERT_EQ(u->DoStep(0, 1'000'000), cosim::StepResult::kOk);
+  EXPECT_EQ(Get(*u, "over_belt")[0], 0.0);
+  EXPECT_EQ(Get(*u, "error")[0], 0.0);
+  SetArray(*u, "measured", {0.5, 0.0, 0.0, -0.3});
+  ASSERT_EQ(u->DoStep(1'000'000, 1'000'000), cosim::StepResult::kOk);
+  EXPECT_NEAR(Get(*u, "rmse")[0], std::sqrt((0.01 + 0.09) / 2), 1e-12);
+  EXPECT_EQ(Get(*u, "samples")[0], 2.0);
+}
+
+TEST(SurfaceVelocityError, MountsAreRequired) {
+  SurfaceVelocityErrorUnit u("e", 1, Treadmill());
+  EXPECT_EQ(u.CheckParameters().size(), 3u);
+  EXPECT_THROW(SurfaceVelocityErrorUnit("e", 0, Treadmill()), cosim::UnitError);
+}
+
+}  // namespace
+}  // namespace linesim::evaluation

@@ -1,0 +1,59 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cosim/unit.h"
+#include "models/scene.h"
+
+namespace linesim::evaluation {
+
+/// How well downward optic-flow sensors see a belt (paper 1, Sec. VI-A and
+/// Fig. 4): each sensor's raw measurement (the surface's velocity relative
+/// to the sensor, in the sensor frame) is made absolute with the robot's
+/// TRUE motion (paper 1 Eq. 2 with ground truth in place of the
+/// localization, so that only the sensor's error remains):
+///   v_surf = R(yaw + mount_yaw) v_meas + v_robot + yaw_rate ez x R(yaw) r_mount,
+/// and its component along the belt's direction is compared with the belt's
+/// ground-truth speed (`reference`, paper 1's encoder wheel on the belt).
+/// Only sensors whose point lies over the belt (true pose, scene geometry)
+/// are compared; `rmse` is the root mean square of the error over every
+/// (sensor, step) pair compared so far.
+class SurfaceVelocityErrorUnit : public cosim::Unit {
+ public:
+  static constexpr const char* kTypeName = "surface_velocity_error";
+
+  /// `sensors` >= 1; `belt` is the scene belt the reference measures.
+  SurfaceVelocityErrorUnit(std::string name, int sensors, const models::Belt& belt);
+
+  void Initialize() override;
+  cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
+
+ protected:
+  void SaveInternal(cosim::UnitState& state) const override;
+  void RestoreInternal(const cosim::UnitState& state) override;
+
+ private:
+  void Evaluate();
+
+  std::size_t sensors_;
+  models::Rect belt_area_;
+
+  // Parameters, one element per sensor.
+  std::vector<double> mount_x_, mount_y_, mount_yaw_;
+  // Inputs.
+  std::vector<double> measured_;
+  std::vector<double> linear_velocity_ = std::vector<double>(2, 0.0);
+  double yaw_ = 0.0, yaw_rate_ = 0.0, reference_ = 0.0;
+  std::vector<double> position_ = std::vector<double>(2, 0.0);
+  // Outputs.
+  std::vector<double> surface_speed_, error_, over_belt_;
+  double rmse_ = 0.0;
+  // Sum of squared errors and the number of samples in it.
+  double sum_squared_ = 0.0;
+  std::int64_t samples_ = 0;
+  double samples_out_ = 0.0;
+};
+
+}  // namespace linesim::evaluation
