@@ -83,6 +83,9 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
   spec.belt_speed_columns = robot.belt_speed_columns;
   spec.belt_on_columns = robot.belt_on_columns;
   spec.belt_travel_columns = robot.belt_travel_columns;
+  spec.flow_columns = robot.flow_columns;
+  spec.flow_labels = robot.flow_sensor_names;
+  spec.flow_reference_column = robot.flow_reference_column;
   if (robot.body_length_m) spec.body_length_m = *robot.body_length_m;
   if (robot.body_width_m) spec.body_width_m = *robot.body_width_m;
   return spec;

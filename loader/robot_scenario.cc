@@ -139,7 +139,7 @@ YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
     assembly::AddSensing(b, s);
     assembly::AddControl(b, *file, s);
     assembly::AddTask(b, *file, start, s, info);
-    assembly::AddEvaluation(b, s, info);
+    assembly::AddEvaluation(b, file->robot, s, info);
     assembly::AddRecording(b, s, info);
   }
   Passthrough(b);

@@ -30,6 +30,11 @@ struct RobotInfo {
   std::vector<std::pair<std::string, std::string>> wheel_columns;
   std::string error_column;
   std::vector<std::string> belt_speed_columns, belt_on_columns, belt_travel_columns;
+  /// Optic flow against the belt's ground truth (paper 1 Fig. 4): each
+  /// PX4Flow's absolute surface speed along the belt, its sensor's name,
+  /// and the ground-truth speed; empty without both.
+  std::vector<std::string> flow_columns, flow_sensor_names;
+  std::string flow_reference_column;
 };
 
 /// A robot scenario is written at the level of robot, scene, line, control,

@@ -204,6 +204,11 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   for (const auto& name : spec.belt_on_columns) ons.push_back(column(name, "belt on"));
   std::vector<int> travels;
   for (const auto& name : spec.belt_travel_columns) travels.push_back(column(name, "belt travel"));
+  std::vector<int> flows;
+  for (const auto& name : spec.flow_columns) flows.push_back(column(name, "optic flow"));
+  const int iref = spec.flow_reference_column.empty()
+                       ? 0
+                       : column(spec.flow_reference_column, "ground-truth surface speed");
   column.ThrowIfUnknown();
   if (!travels.empty() && travels.size() != spec.scene.belts.size()) {
     throw std::runtime_error("robot plots: " + std::to_string(travels.size()) +
@@ -502,6 +507,26 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
                       " axes x1y2 with steps dt 2 lw 1.5 title " +
                       GnuplotQuote(spec.belt_on_columns[i]));
     }
+    for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
+    s += "\n";
+  }
+  if (!flows.empty() && iref > 0) {
+    outputs->push_back("optic_flow.png");
+    s += "\nset output 'optic_flow.png'\nset title " +
+         GnuplotQuote(title_prefix + "raw optic flow against the belt's ground truth") +
+         "\nset xlabel 'time (s)'\nset ylabel 'surface speed along the belt (m/s)'\n"
+         "unset y2label\nunset y2tics\nset ytics mirror\nset autoscale y\n"
+         "set offsets 0, 0, graph 0.05, graph 0.05\nplot ";
+    items.clear();
+    static const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd"};
+    for (std::size_t i = 0; i < flows.size(); ++i) {
+      const std::string label = i < spec.flow_labels.size() ? spec.flow_labels[i] : "sensor";
+      items.push_back(signals_file + " skip 1 using 1:" + std::to_string(flows[i]) +
+                      " with lines lw 1 lc rgb '" + kColours[i % 4] + "' title " +
+                      GnuplotQuote("raw optic flow, " + label));
+    }
+    items.push_back(signals_file + " skip 1 using 1:" + std::to_string(iref) +
+                    " with lines lw 2.5 lc rgb 'black' title 'ground truth (encoder wheel)'");
     for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
     s += "\n";
   }

@@ -42,6 +42,11 @@ struct RobotPlotSpec {
   /// Belt speed (m/s) and on state (0/1) columns for belt.png; none when
   /// both are empty.
   std::vector<std::string> belt_speed_columns, belt_on_columns;
+  /// Optic flow against ground truth (optic_flow.png, as paper 1 Fig. 4):
+  /// each sensor's raw surface speed along the belt (m/s) with its label,
+  /// and the belt's ground-truth speed; none when empty.
+  std::vector<std::string> flow_columns, flow_labels;
+  std::string flow_reference_column;
   /// Robot outlines and wheel footprints drawn at this many instants,
   /// evenly spaced over the recorded rows from first to last.
   int footprint_count = 5;
@@ -51,7 +56,7 @@ struct RobotPlotSpec {
   double body_width_m = 0.57;
 };
 
-/// Writes top_view.png, and error.png and belt.png when the spec asks for
+/// Writes top_view.png, and error.png, belt.png and optic_flow.png when the spec asks for
 /// them, into `dir`, from `dir`/signals.csv. The gnuplot script is left in
 /// `dir`/plots.gp with paths relative to `dir`, so `gnuplot plots.gp` run in
 /// `dir` redraws the plots. Returns the paths of the PNG files written.

@@ -21,6 +21,7 @@ inline constexpr const char* kWheelController = "wheel_controller";
 inline constexpr const char* kPathFollower = "path_follower";
 inline constexpr const char* kDeviation = "deviation";
 inline constexpr const char* kClearance = "clearance";
+inline constexpr const char* kFlowError = "flow_error";
 /// The Rob@Work 3 control cycle (IPA cob_control configuration): the
 /// controllers' period unless control.period_s says otherwise.
 inline constexpr cosim::TimeNs kControlPeriod = cosim::kNsPerSecond / 50;

@@ -44,6 +44,7 @@ struct Signals {
   };
   std::vector<Sensor> sensors;
   std::string belt_ground_truth;
+  int belt_ground_truth_belt = 0;  // the scene belt it measures
 
   /// What each concern wants recorded, in order.
   std::vector<std::string> recorded;
@@ -85,8 +86,11 @@ void AddControl(SystemBuilder& b, const RobotFile& robot, Signals& s);
 void AddTask(SystemBuilder& b, const RobotFile& robot, const StartPose& start, Signals& s,
              RobotInfo& info);
 
-/// Evaluation: the ground-truth deviation from the task and the metrics.
-void AddEvaluation(SystemBuilder& b, Signals& s, RobotInfo& info);
+/// Evaluation: the ground-truth deviation from the task, the body's
+/// clearance, raw optic flow against the belt's ground truth, and the
+/// metrics.
+void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Signals& s,
+                   RobotInfo& info);
 
 /// recording: what signals.csv holds (unless the scenario says), at about
 /// 100 Hz; and the columns the plots read.

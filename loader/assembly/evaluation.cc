@@ -3,7 +3,8 @@
 
 namespace linesim::loader::assembly {
 
-void AddEvaluation(SystemBuilder& b, Signals& s, RobotInfo& info) {
+void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Signals& s,
+                   RobotInfo& info) {
   // The deviation is measured on the ground truth, whatever the robot
   // believes.
   b.Unit(kDeviation, "path_deviation");
@@ -36,6 +37,62 @@ void AddEvaluation(SystemBuilder& b, Signals& s, RobotInfo& info) {
     add("final_position_drift_m", deviation, "final");
   }
   add("final_yaw_rad", s.true_yaw, "final");
+
+  // Clearance of the robot's body from everything in the scene (FCL).
+  const models::BodyDescription& body = robot.body;
+  b.Unit(kClearance, "clearance");
+  YAML::Node c = b.Params(kClearance);
+  c["body_length"] = Num(body.length_m);
+  c["body_width"] = Num(body.width_m);
+  c["body_height"] = Num(body.height_m);
+  // The chassis centres the body box on com_height.
+  c["body_bottom"] = Num(body.com_height_m - 0.5 * body.height_m);
+  b.Connect(Signal(kChassis, "position_3d"), Signal(kClearance, "position_3d"));
+  b.Connect(Signal(kChassis, "orientation"), Signal(kClearance, "orientation"));
+  if (s.belt_count > 0) b.Connect(Signal(kBelt, "travel"), Signal(kClearance, "belt_travel"));
+  s.recorded.push_back(Signal(kClearance, "clearance"));
+  add("min_clearance_m", Signal(kClearance, "clearance"), "min");
+  add("collisions", Signal(kClearance, "collisions"), "final");
+
+  // Raw optic flow against the belt's ground truth (paper 1 Fig. 4), when
+  // both are there.
+  std::vector<const Signals::Sensor*> flows;
+  for (const auto& sensor : s.sensors) {
+    if (sensor.kind == "px4flow") flows.push_back(&sensor);
+  }
+  if (!flows.empty() && !s.belt_ground_truth.empty()) {
+    b.Unit(kFlowError, "surface_velocity_error");
+    YAML::Node p = b.Params(kFlowError);
+    p["sensors"] = static_cast<int>(flows.size());
+    p["belt"] = s.belt_ground_truth_belt;
+    std::vector<double> x, y, yaw;
+    for (std::size_t k = 0; k < flows.size(); ++k) {
+      x.push_back(flows[k]->mount.x_m);
+      y.push_back(flows[k]->mount.y_m);
+      yaw.push_back(flows[k]->mount.yaw_rad);
+      for (std::size_t i = 0; i < 2; ++i) {
+        b.Connect(Element(flows[k]->unit, "velocity", i), Element(kFlowError, "measured", 2 * k + i));
+      }
+    }
+    p["mount_x"] = List(x);
+    p["mount_y"] = List(y);
+    p["mount_yaw"] = List(yaw);
+    b.Connect(s.true_position, Signal(kFlowError, "position"));
+    b.Connect(s.true_yaw, Signal(kFlowError, "yaw"));
+    b.Connect(Signal(kChassis, "linear_velocity"), Signal(kFlowError, "linear_velocity"));
+    b.Connect(Signal(kChassis, "yaw_rate"), Signal(kFlowError, "yaw_rate"));
+    b.Connect(s.belt_ground_truth, Signal(kFlowError, "reference"));
+    s.recorded.push_back(Signal(kFlowError, "surface_speed"));
+    add("surface_velocity_rmse_raw_mps", Signal(kFlowError, "rmse"), "final");
+    // The first sensor's quality (0..255, OPTICAL_FLOW_RAD's mean over its
+    // publishing interval), over the run.
+    add("optic_flow_quality_mean", Signal(flows.front()->unit, "quality"), "mean");
+    for (std::size_t k = 0; k < flows.size(); ++k) {
+      info.flow_columns.push_back(Element(kFlowError, "surface_speed", k));
+      info.flow_sensor_names.push_back(flows[k]->unit);
+    }
+    info.flow_reference_column = s.belt_ground_truth;
+  }
   b.out()["metrics"] = metrics;
   info.error_column = deviation;
 }

@@ -221,6 +221,7 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
     apply(kBeltGroundTruth, gt, cosim::kNsPerSecond / 50, {"belt"}, {});
     s.recorded.push_back(Signal(kBeltGroundTruth, "speed"));
     s.belt_ground_truth = Signal(kBeltGroundTruth, "speed");
+    s.belt_ground_truth_belt = static_cast<int>(belt);
   } else if (gt.node.IsDefined() && gt.on && s.belt_count == 0) {
     r.Error(gt.node, JoinPath("sensors", kBeltGroundTruth),
             "the scene has no belts for the belt's ground-truth sensor to measure");
