@@ -1,0 +1,436 @@
+#include "units/sensors/laser_scanner_unit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <utility>
+
+namespace linesim::sensors {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+using Quat = std::array<double, 4>;  // w x y z
+
+Quat Multiply(const Quat& a, const Quat& b) {
+  return {a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+          a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+          a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+          a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
+}
+
+// v rotated by the unit quaternion q.
+std::array<double, 3> Rotate(const Quat& q, const std::array<double, 3>& v) {
+  // v + 2 w (u x v) + 2 u x (u x v), u = (x, y, z).
+  const double ux = q[1], uy = q[2], uz = q[3], w = q[0];
+  const double cx = uy * v[2] - uz * v[1], cy = uz * v[0] - ux * v[2], cz = ux * v[1] - uy * v[0];
+  return {v[0] + 2.0 * (w * cx + uy * cz - uz * cy), v[1] + 2.0 * (w * cy + uz * cx - ux * cz),
+          v[2] + 2.0 * (w * cz + ux * cy - uy * cx)};
+}
+
+Quat FromRpy(double roll, double pitch, double yaw) {
+  const double cr = std::cos(0.5 * roll), sr = std::sin(0.5 * roll);
+  const double cp = std::cos(0.5 * pitch), sp = std::sin(0.5 * pitch);
+  const double cy = std::cos(0.5 * yaw), sy = std::sin(0.5 * yaw);
+  return {cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+          cr * cp * sy - sr * sp * cy};
+}
+
+}  // namespace
+
+LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene, int beam_count,
+                                   std::vector<std::array<double, 2>> protective_field,
+                                   std::uint64_t seed)
+    : cosim::Unit(kTypeName, std::move(name)),
+      beam_count_(beam_count),
+      has_field_(!protective_field.empty()),
+      field_(std::move(protective_field)),
+      rays_(scene),
+      rng_(seed) {
+  if (beam_count < 1) {
+    throw cosim::UnitError(Where() + ": beam_count must be at least 1, got " +
+                           std::to_string(beam_count));
+  }
+  if (has_field_ && field_.size() < 3) {
+    throw cosim::UnitError(Where() + ": the protective field needs at least 3 corners, got " +
+                           std::to_string(field_.size()));
+  }
+  const auto n = static_cast<std::size_t>(beam_count);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  scan_period_ = first_beam_angle_ = angular_step_ = range_min_ = range_max_ = range_resolution_ =
+      noise_sigma_ = max_incidence_ = echo_separation_ = no_return_value_ = nan;
+  position_.assign(3, 0.0);
+  orientation_ = {1.0, 0.0, 0.0, 0.0};
+  velocity_.assign(3, 0.0);
+  angular_velocity_.assign(3, 0.0);
+  belt_travel_.assign(scene.belts.size(), 0.0);
+  belt_speed_.assign(scene.belts.size(), 0.0);
+  ranges_.assign(n, 0.0);
+  beam_rays_.resize(n);
+  centre_.resize(n);
+  samples_.resize(n);
+  scan_ranges_.assign(n, 0.0);
+  beam_perp_.resize(n);
+
+  auto& v = variables();
+  const auto mount = [&](const char* key, const char* unit, double* x, const char* what) {
+    v.Parameter(key, unit, x, what, cosim::Rule::Finite());
+  };
+  mount("mount_x", "m", &mount_x_, "scanner origin in base_link, x");
+  mount("mount_y", "m", &mount_y_, "scanner origin in base_link, y");
+  mount("mount_z", "m", &mount_z_, "scanner origin in base_link, z (scan plane height at rest)");
+  mount("mount_roll", "rad", &mount_roll_, "scanner roll in base_link (pi: mounted upside down)");
+  mount("mount_pitch", "rad", &mount_pitch_, "scanner pitch in base_link");
+  mount("mount_yaw", "rad", &mount_yaw_, "scanner yaw in base_link (direction of beam angle 0)");
+  v.Parameter("scan_period", "s", &scan_period_, "one turn of the mirror (one scan)",
+              cosim::Rule::Positive().NoDefault());
+  v.Parameter("first_beam_angle", "rad", &first_beam_angle_,
+              "direction of beam 0 in the scanner frame, counter-clockwise from x",
+              cosim::Rule::Range(-2 * std::numbers::pi, 2 * std::numbers::pi).NoDefault());
+  v.Parameter("angular_step", "rad", &angular_step_, "angle between neighbouring beams",
+              cosim::Rule::Range(0, false, std::numbers::pi, true).NoDefault());
+  v.Parameter("range_min", "m", &range_min_, "nearest distance measured",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("range_max", "m", &range_max_, "farthest distance measured",
+              cosim::Rule::Positive().NoDefault());
+  v.Parameter("range_resolution", "m", &range_resolution_, "step of the reported range",
+              cosim::Rule::Positive().NoDefault());
+  v.Parameter("noise_sigma", "m", &noise_sigma_, "statistical range error (1 sigma), per beam",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("bias_sigma", "m", &bias_sigma_,
+              "systematic range error: one bias per device drawn from N(0, bias_sigma)",
+              cosim::Rule::NonNegative());
+  v.Parameter("bias_max", "m", &bias_max_, "the drawn bias is clamped to +-bias_max",
+              cosim::Rule::NonNegative());
+  v.Parameter("max_incidence", "rad", &max_incidence_,
+              "no return when the beam meets the surface further than this from its normal",
+              cosim::Rule::Range(0, false, std::numbers::pi / 2, true).NoDefault());
+  v.Parameter("spot_divergence", "rad", &spot_divergence_,
+              "spot diameter = range * spot_divergence + spot_offset", cosim::Rule::NonNegative());
+  v.Parameter("spot_offset", "m", &spot_offset_, "spot diameter at the front window",
+              cosim::Rule::NonNegative());
+  v.Parameter("echo_separation", "m", &echo_separation_,
+              "two surfaces within one spot further apart than this give separate echoes "
+              "(the first is reported); closer, one mixed echo",
+              cosim::Rule::Positive().NoDefault());
+  v.Parameter("no_return_value", "m", &no_return_value_,
+              "the range the device reports for a beam without echo", cosim::Rule::Finite().NoDefault());
+  if (has_field_) {
+    v.Parameter("multiple_sampling", &multiple_sampling_,
+                "consecutive scans with an object in the protective field before field_clear "
+                "goes to 0",
+                cosim::Rule::OneOf({2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16}));
+  }
+
+  v.Input("position_3d", "m", &position_, "base_link origin in map");
+  v.Input("orientation", "1", &orientation_, "base_link in map, quaternion w x y z");
+  v.Input("velocity_3d", "m/s", &velocity_, "base_link origin velocity in map");
+  v.Input("angular_velocity", "rad/s", &angular_velocity_, "angular velocity in base_link");
+  if (!scene.belts.empty()) {
+    v.Input("belt_travel", "m", &belt_travel_, "distance each scene belt has moved");
+    v.Input("belt_speed", "m/s", &belt_speed_, "speed of each scene belt");
+  }
+  v.Output("ranges", "m", &ranges_,
+           "range of each beam of the last complete scan (no_return_value: no echo)", {});
+  v.Output("scan_time", "s", &scan_time_, "start time of the last complete scan", {});
+  v.Output("scan_count", "1", &scan_count_, "complete scans so far", {});
+  if (has_field_) {
+    v.Output("field_clear", "1", &field_clear_,
+             "1: protective field clear (OSSDs on), 0: object in the field (OSSDs off)", {});
+  }
+
+  // The device's bias, drawn once, first (as a unit normal: scaled by
+  // bias_sigma and clamped when the parameters are known).
+  bias_draw_ = Normal();
+}
+
+double LaserScannerUnit::Normal() {
+  // Box-Muller without a cached second value, so that the generator is the
+  // whole state. u1 in (0, 1].
+  const double u1 = (static_cast<double>(rng_() >> 11) + 1.0) * 0x1.0p-53;
+  const double u2 = static_cast<double>(rng_() >> 11) * 0x1.0p-53;
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+}
+
+std::vector<cosim::ParameterProblem> LaserScannerUnit::CheckParameters() const {
+  auto problems = cosim::Unit::CheckParameters();
+  if (range_min_ >= range_max_) {
+    problems.push_back({"range_max", std::nullopt,
+                        "must be > range_min (" + cosim::FormatValue(range_min_) + "), got " +
+                            cosim::FormatValue(range_max_)});
+  }
+  if (angular_step_ * (beam_count_ - 1) >= 2.0 * std::numbers::pi) {
+    problems.push_back({"angular_step", std::nullopt,
+                        "the " + std::to_string(beam_count_) +
+                            " beams must fit in one turn: angular_step < 2 pi / (beams - 1)"});
+  }
+  return problems;
+}
+
+bool LaserScannerUnit::InField(double x, double y) const {
+  // Even-odd rule.
+  bool inside = false;
+  for (std::size_t i = 0, j = field_.size() - 1; i < field_.size(); j = i++) {
+    const auto& a = field_[i];
+    const auto& b = field_[j];
+    if ((a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0]) {
+      inside = !inside;
+    }
+  }
+  return inside;
+}
+
+void LaserScannerUnit::Derive() {
+  period_ns_ = cosim::SecondsToNs(scan_period_);
+  beam_offset_ns_.resize(static_cast<std::size_t>(beam_count_));
+  cos_a_.resize(beam_offset_ns_.size());
+  sin_a_.resize(beam_offset_ns_.size());
+  for (int i = 0; i < beam_count_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    beam_offset_ns_[k] = static_cast<cosim::TimeNs>(std::llround(
+        static_cast<double>(period_ns_) * i * angular_step_ / (2.0 * std::numbers::pi)));
+    const double a = first_beam_angle_ + i * angular_step_;
+    cos_a_[k] = std::cos(a);
+    sin_a_[k] = std::sin(a);
+  }
+  q_mount_ = FromRpy(mount_roll_, mount_pitch_, mount_yaw_);
+  cos_max_incidence_ = std::cos(max_incidence_);
+  bias_ = std::clamp(bias_draw_ * bias_sigma_, -bias_max_, bias_max_);
+}
+
+void LaserScannerUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }
+
+void LaserScannerUnit::Initialize() {
+  ThrowIfBadParameters();
+  Derive();
+  scan_start_ = start_;
+  next_beam_ = 0;
+  finalized_ = 0;
+  infringing_scans_ = 0;
+  scan_time_ = cosim::NsToSeconds(start_);
+  scan_count_ = 0.0;
+  field_clear_ = 1.0;
+  std::fill(ranges_.begin(), ranges_.end(), no_return_value_);
+}
+
+Ray LaserScannerUnit::BeamRay(int i, double s) {
+  // The base pose at step start + s.
+  Quat q{orientation_[0], orientation_[1], orientation_[2], orientation_[3]};
+  const double wx = angular_velocity_[0], wy = angular_velocity_[1], wz = angular_velocity_[2];
+  const double w = std::sqrt(wx * wx + wy * wy + wz * wz);
+  if (w > 0.0 && s != 0.0) {
+    const double half = 0.5 * w * s;
+    const double k = std::sin(half) / w;
+    q = Multiply(q, {std::cos(half), wx * k, wy * k, wz * k});
+  }
+  const auto mount = Rotate(q, {mount_x_, mount_y_, mount_z_});
+  const Quat qs = Multiply(q, q_mount_);
+  const auto k = static_cast<std::size_t>(i);
+  Ray r;
+  r.origin = {position_[0] + velocity_[0] * s + mount[0],
+              position_[1] + velocity_[1] * s + mount[1],
+              position_[2] + velocity_[2] * s + mount[2]};
+  r.direction = Rotate(qs, {cos_a_[k], sin_a_[k], 0.0});
+  beam_perp_[k] = Rotate(qs, {-sin_a_[k], cos_a_[k], 0.0});
+  // Far enough for a spot sample beyond range_max to still be met.
+  r.max_range = range_max_ * 1.5;
+  r.dt_s = s;
+  return r;
+}
+
+void LaserScannerUnit::CastBeams(int first, int end, cosim::TimeNs t) {
+  step_t_ = t;
+  const auto n = static_cast<std::size_t>(end - first);
+  for (int i = first; i < end; ++i) {
+    const double s = cosim::NsToSeconds(scan_start_ + BeamOffset(i) - t);
+    beam_rays_[static_cast<std::size_t>(i)] = BeamRay(i, s);
+  }
+  rays_.Cast(std::span<const Ray>(beam_rays_.data() + first, n),
+             std::span<RayHit>(centre_.data() + first, n), belt_travel_, belt_speed_);
+  for (int i = first; i < end; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const RayHit& h = centre_[k];
+    const double e = std::isinf(h.range) ? 0.0 : h.cos_incidence / (h.range * h.range);
+    samples_[k].fill({h.range, e, h.cos_incidence});
+  }
+  // Edges between neighbours, each side sampled across its spot.
+  if (spot_divergence_ > 0.0 || spot_offset_ > 0.0) {
+    for (int i = std::max(first, 1); i < end; ++i) {
+      const RayHit& a = centre_[static_cast<std::size_t>(i - 1)];
+      const RayHit& b = centre_[static_cast<std::size_t>(i)];
+      const bool edge = a.object != b.object ||
+                        (a.object >= 0 && std::abs(a.range - b.range) > echo_separation_);
+      if (edge) RefineEdge(i);
+    }
+  }
+}
+
+void LaserScannerUnit::RefineEdge(int i) {
+  // Beam i - 1 is sampled towards + (its +h/2 and +h), beam i towards -.
+  std::array<Ray, 4> sub;
+  std::array<RayHit, 4> hit;
+  for (int side = 0; side < 2; ++side) {
+    const auto k = static_cast<std::size_t>(i - 1 + side);
+    const Ray& r = beam_rays_[k];
+    double d = centre_[k].range;
+    if (std::isinf(d)) d = centre_[static_cast<std::size_t>(i - side)].range;
+    const double h = 0.5 * (spot_divergence_ + spot_offset_ / std::max(d, 1e-3));
+    const double sgn = side == 0 ? 1.0 : -1.0;
+    for (int j = 0; j < 2; ++j) {
+      const double alpha = sgn * h * (j == 0 ? 0.5 : 1.0);
+      const double ca = std::cos(alpha), sa = std::sin(alpha);
+      Ray& s = sub[static_cast<std::size_t>(2 * side + j)];
+      s = r;
+      // The sample's time relative to this step's inputs.
+      s.dt_s = cosim::NsToSeconds(scan_start_ + BeamOffset(i - 1 + side) - step_t_);
+      for (std::size_t c = 0; c < 3; ++c) s.direction[c] = ca * r.direction[c] + sa * beam_perp_[k][c];
+    }
+  }
+  rays_.Cast(sub, hit, belt_travel_, belt_speed_);
+  // Sample slots: 0: -h, 1: -h/2, 2: centre, 3: +h/2, 4: +h.
+  constexpr std::size_t kSlot[4] = {3, 4, 1, 0};
+  for (std::size_t j = 0; j < 4; ++j) {
+    const auto k = static_cast<std::size_t>(i - 1 + (j < 2 ? 0 : 1));
+    const RayHit& h = hit[j];
+    const double e = std::isinf(h.range) ? 0.0 : h.cos_incidence / (h.range * h.range);
+    samples_[k][kSlot[j]] = {h.range, e, h.cos_incidence};
+  }
+}
+
+void LaserScannerUnit::Finalize(int i) {
+  const auto k = static_cast<std::size_t>(i);
+  auto& sm = samples_[k];
+  // Nearest echo: the samples within echo_separation of one another,
+  // starting from the nearest.
+  std::array<Sample, kSpotSamples> sorted = sm;
+  std::sort(sorted.begin(), sorted.end(),
+            [](const Sample& a, const Sample& b) { return a.range < b.range; });
+  double r = kInf, cos_inc = 0.0;
+  if (!std::isinf(sorted[0].range)) {
+    double sum_e = 0.0, sum_er = 0.0;
+    for (std::size_t j = 0; j < sorted.size(); ++j) {
+      if (std::isinf(sorted[j].range)) break;
+      if (j > 0 && sorted[j].range - sorted[j - 1].range > echo_separation_) break;
+      sum_e += sorted[j].energy;
+      sum_er += sorted[j].energy * sorted[j].range;
+      cos_inc = std::max(cos_inc, sorted[j].cos_incidence);
+    }
+    r = sum_e > 0.0 ? sum_er / sum_e : sorted[0].range;
+  }
+  double out = no_return_value_;
+  if (r >= range_min_ && r <= range_max_ && cos_inc >= cos_max_incidence_) {
+    const double m = r + bias_ + noise_sigma_ * Normal();
+    out = std::max(0.0, std::round(m / range_resolution_) * range_resolution_);
+  }
+  scan_ranges_[k] = out;
+}
+
+void LaserScannerUnit::CompleteScan() {
+  std::copy(scan_ranges_.begin(), scan_ranges_.end(), ranges_.begin());
+  scan_time_ = cosim::NsToSeconds(scan_start_);
+  scan_count_ += 1.0;
+  if (has_field_) {
+    bool infringed = false;
+    for (int i = 0; i < beam_count_ && !infringed; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      const double r = ranges_[k];
+      if (r == no_return_value_) continue;
+      infringed = InField(r * cos_a_[k], r * sin_a_[k]);
+    }
+    infringing_scans_ = infringed ? infringing_scans_ + 1 : 0;
+    if (infringing_scans_ >= multiple_sampling_) field_clear_ = 0.0;
+    if (!infringed) field_clear_ = 1.0;
+  }
+  scan_start_ += period_ns_;
+  next_beam_ = 0;
+  finalized_ = 0;
+}
+
+cosim::StepResult LaserScannerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
+  ClearError();
+  if (!InputsFinite(t)) return cosim::StepResult::kError;
+  const cosim::TimeNs t_end = t + dt;
+  while (true) {
+    int end = next_beam_;
+    while (end < beam_count_ && scan_start_ + BeamOffset(end) < t_end) ++end;
+    if (end > next_beam_) {
+      CastBeams(next_beam_, end, t);
+      // The edge between the last beam of the previous batch and the first
+      // of this one.
+      next_beam_ = end;
+    }
+    // Every beam but the last cast one is final (its right edge is known).
+    const int final_end = next_beam_ == beam_count_ ? beam_count_ : next_beam_ - 1;
+    for (; finalized_ < final_end; ++finalized_) Finalize(finalized_);
+    if (next_beam_ == beam_count_) {
+      CompleteScan();
+      continue;
+    }
+    break;
+  }
+  return cosim::StepResult::kOk;
+}
+
+void LaserScannerUnit::SaveInternal(cosim::UnitState& state) const {
+  std::ostringstream rng;
+  rng << rng_;
+  state.strings = {rng.str()};
+  state.integers = {start_, scan_start_, next_beam_, finalized_, infringing_scans_};
+  state.reals = {bias_draw_};
+  state.reals.insert(state.reals.end(), scan_ranges_.begin(), scan_ranges_.end());
+  for (int i = 0; i < next_beam_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const Ray& r = beam_rays_[k];
+    state.reals.insert(state.reals.end(), {r.origin[0], r.origin[1], r.origin[2], r.direction[0],
+                                           r.direction[1], r.direction[2], r.max_range, r.dt_s,
+                                           centre_[k].range, centre_[k].cos_incidence,
+                                           static_cast<double>(centre_[k].object),
+                                           beam_perp_[k][0], beam_perp_[k][1], beam_perp_[k][2]});
+    for (const Sample& s : samples_[k]) {
+      state.reals.insert(state.reals.end(), {s.range, s.energy, s.cos_incidence});
+    }
+  }
+}
+
+void LaserScannerUnit::RestoreInternal(const cosim::UnitState& state) {
+  const auto n = static_cast<std::size_t>(beam_count_);
+  if (state.strings.size() != 1 || state.integers.size() != 5 || state.reals.size() < 1 + n) {
+    throw cosim::UnitError(Where() + ": saved state does not fit this unit");
+  }
+  std::istringstream rng(state.strings[0]);
+  rng >> rng_;
+  start_ = state.integers[0];
+  scan_start_ = state.integers[1];
+  next_beam_ = static_cast<int>(state.integers[2]);
+  finalized_ = static_cast<int>(state.integers[3]);
+  infringing_scans_ = state.integers[4];
+  const std::size_t per_beam = 14 + 3 * kSpotSamples;
+  if (next_beam_ < 0 || next_beam_ > beam_count_ ||
+      state.reals.size() != 1 + n + per_beam * static_cast<std::size_t>(next_beam_)) {
+    throw cosim::UnitError(Where() + ": saved state does not fit this unit");
+  }
+  bias_draw_ = state.reals[0];
+  std::copy(state.reals.begin() + 1, state.reals.begin() + 1 + static_cast<std::ptrdiff_t>(n),
+            scan_ranges_.begin());
+  std::size_t p = 1 + n;
+  for (int i = 0; i < next_beam_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    Ray& r = beam_rays_[k];
+    r.origin = {state.reals[p], state.reals[p + 1], state.reals[p + 2]};
+    r.direction = {state.reals[p + 3], state.reals[p + 4], state.reals[p + 5]};
+    r.max_range = state.reals[p + 6];
+    r.dt_s = state.reals[p + 7];
+    centre_[k] = {state.reals[p + 8], state.reals[p + 9], static_cast<int>(state.reals[p + 10])};
+    beam_perp_[k] = {state.reals[p + 11], state.reals[p + 12], state.reals[p + 13]};
+    p += 14;
+    for (Sample& s : samples_[k]) {
+      s = {state.reals[p], state.reals[p + 1], state.reals[p + 2]};
+      p += 3;
+    }
+  }
+  Derive();
+}
+
+}  // namespace linesim::sensors
