@@ -105,8 +105,12 @@ class LaserScannerUnit : public cosim::Unit {
   /// Beam i's ray, s seconds after the step's start; stores its in-plane
   /// perpendicular.
   Ray BeamRay(int i, double s);
+  /// The step's pose terms from the inputs (see the .cc).
+  void PrepareStep();
   void RefineEdge(int i);  // the edge between beams i - 1 and i
   void Finalize(int i);
+  /// The first echo of a spot's samples: its range and best incidence cosine.
+  void MixEcho(const std::array<Sample, kSpotSamples>& samples, double& r, double& cos_inc) const;
   void CompleteScan();
   double Normal();
 
@@ -137,11 +141,17 @@ class LaserScannerUnit : public cosim::Unit {
   cosim::TimeNs period_ns_ = 0;
   std::array<double, 4> q_mount_{};  // w x y z
   double cos_max_incidence_ = 0.0;
+  // PrepareStep(): |angular_velocity|, and per vector (scanner x, y axes,
+  // mount offset) R0 v, R0 (k x v), R0 (k x (k x v)).
+  double rate_ = 0.0;
+  std::array<std::array<std::array<double, 3>, 3>, 3> frame_{};
 
   // State of the scan under way.
   cosim::TimeNs start_ = 0, scan_start_ = 0;
   int next_beam_ = 0;    // first beam not yet cast
   int finalized_ = 0;    // beams [0, finalized_) have their reported range
+  double spare_ = 0.0;       // Box-Muller's second normal
+  bool has_spare_ = false;
   double bias_draw_ = 0.0;  // N(0, 1), drawn in the constructor
   double bias_ = 0.0;       // bias_draw_ * bias_sigma clamped to +-bias_max
   std::int64_t infringing_scans_ = 0;  // consecutive

@@ -221,7 +221,12 @@ RayScene::RayScene(const models::Scene& scene)
     carried_.push_back({co.solid, co.belt, std::cos(belt.area.direction_rad),
                         std::sin(belt.area.direction_rad), range[0], range[1],
                         std::cos(co.solid.yaw_rad), std::sin(co.solid.yaw_rad),
-                        ObjectOfCarried(static_cast<int>(i))});
+                        ObjectOfCarried(static_cast<int>(i)), 0.0});
+    const models::Solid& s = co.solid;
+    const double br = s.kind == models::Solid::Kind::kCylinder
+                          ? s.radius_m
+                          : 0.5 * std::hypot(s.length_m, s.width_m);
+    carried_.back().bound_radius2 = (br + 1e-6) * (br + 1e-6);
   }
 
   RTCGeometry mesh = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -302,6 +307,15 @@ void RayScene::CastCarried(const Ray& ray, std::span<const double> belt_travel,
     if (travel < c.travel_min || travel > c.travel_max) continue;  // lifted off
     const double x = c.solid.x_m + travel * c.ux, y = c.solid.y_m + travel * c.uy;
     const double t_max = std::isinf(best.range) ? ray.max_range : best.range;
+    // Cull with the footprint's bounding circle: the ray's horizontal
+    // line passes farther from its centre, or the object is behind.
+    {
+      const double px = x - ray.origin[0], py = y - ray.origin[1];
+      const double cross = px * ray.direction[1] - py * ray.direction[0];
+      const double h2 = ray.direction[0] * ray.direction[0] + ray.direction[1] * ray.direction[1];
+      if (cross * cross > c.bound_radius2 * h2) continue;
+      if (px * ray.direction[0] + py * ray.direction[1] < -std::sqrt(c.bound_radius2 * h2)) continue;
+    }
     double n[3] = {0.0, 0.0, 0.0};
     double t;
     if (c.solid.kind == models::Solid::Kind::kCylinder) {
@@ -326,47 +340,47 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
                     std::span<const double> belt_travel, std::span<const double> belt_speed) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  // The beams of a scan are neighbours: a coherent stream.
+  // The beams of a scan are neighbours: coherent packets of 8.
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  std::array<RTCRayHit, kStream> stream;
-  for (std::size_t first = 0; first < rays.size(); first += kStream) {
-    const std::size_t count = std::min<std::size_t>(kStream, rays.size() - first);
-    for (std::size_t k = 0; k < count; ++k) {
-      const Ray& r = rays[first + k];
-      RTCRayHit& rh = stream[k];
-      rh.ray.org_x = static_cast<float>(r.origin[0]);
-      rh.ray.org_y = static_cast<float>(r.origin[1]);
-      rh.ray.org_z = static_cast<float>(r.origin[2]);
-      rh.ray.dir_x = static_cast<float>(r.direction[0]);
-      rh.ray.dir_y = static_cast<float>(r.direction[1]);
-      rh.ray.dir_z = static_cast<float>(r.direction[2]);
-      rh.ray.tnear = 0.0f;
+  alignas(32) RTCRayHit8 packet;
+  alignas(32) int valid[8];
+  for (std::size_t first = 0; first < rays.size(); first += 8) {
+    const std::size_t count = std::min<std::size_t>(8, rays.size() - first);
+    for (std::size_t k = 0; k < 8; ++k) {
+      valid[k] = k < count ? -1 : 0;
+      const Ray& r = rays[first + std::min(k, count - 1)];
+      packet.ray.org_x[k] = static_cast<float>(r.origin[0]);
+      packet.ray.org_y[k] = static_cast<float>(r.origin[1]);
+      packet.ray.org_z[k] = static_cast<float>(r.origin[2]);
+      packet.ray.dir_x[k] = static_cast<float>(r.direction[0]);
+      packet.ray.dir_y[k] = static_cast<float>(r.direction[1]);
+      packet.ray.dir_z[k] = static_cast<float>(r.direction[2]);
+      packet.ray.tnear[k] = 0.0f;
       // Beyond max_range by a margin: the exact distance is decided below.
-      rh.ray.tfar = static_cast<float>(r.max_range * (1.0 + 1e-5) + 1e-4);
-      rh.ray.time = 0.0f;
-      rh.ray.mask = ~0u;
-      rh.ray.id = 0;
-      rh.ray.flags = 0;
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      packet.ray.tfar[k] = static_cast<float>(r.max_range * (1.0 + 1e-5) + 1e-4);
+      packet.ray.time[k] = 0.0f;
+      packet.ray.mask[k] = ~0u;
+      packet.ray.id[k] = 0;
+      packet.ray.flags[k] = 0;
+      packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      packet.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+      packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
     }
-    rtcIntersect1M(scene_, &context, stream.data(), static_cast<unsigned>(count),
-                   sizeof(RTCRayHit));
+    rtcIntersect8(valid, scene_, &context, &packet);
     for (std::size_t k = 0; k < count; ++k) {
       const Ray& r = rays[first + k];
-      const RTCRayHit& rh = stream[k];
       RayHit& h = hits[first + k];
       h = {std::numeric_limits<double>::infinity(), 0.0, -1};
-      if (rh.hit.geomID == mesh_geom_) {
+      const unsigned geom = packet.hit.geomID[k];
+      if (geom == mesh_geom_) {
         // The exact distance to the face's plane.
-        const Face& f = faces_[rh.hit.primID];
+        const Face& f = faces_[packet.hit.primID[k]];
         const double dn = f.nx * r.direction[0] + f.ny * r.direction[1] + f.nz * r.direction[2];
         const double on = f.nx * r.origin[0] + f.ny * r.origin[1] + f.nz * r.origin[2];
-        const double t = dn != 0.0 ? (f.c - on) / dn : static_cast<double>(rh.ray.tfar);
+        const double t = dn != 0.0 ? (f.c - on) / dn : static_cast<double>(packet.ray.tfar[k]);
         if (t > 0.0 && t <= r.max_range) h = {t, std::abs(dn), f.object};
-      } else if (rh.hit.geomID == cylinder_geom_ && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
-        const Cylinder& c = cylinders_[rh.hit.primID];
+      } else if (geom == cylinder_geom_ && geom != RTC_INVALID_GEOMETRY_ID) {
+        const Cylinder& c = cylinders_[packet.hit.primID[k]];
         double n[3];
         const double t = IntersectCylinder(c, r.origin.data(), r.direction.data(),
                                            r.max_range * 1.001 + 1e-3, n);

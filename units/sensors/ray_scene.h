@@ -95,6 +95,7 @@ class RayScene {
     double travel_min, travel_max;  // models::CarriedTravelRange
     double cos_yaw, sin_yaw;
     int object;
+    double bound_radius2;  // squared radius of the footprint's bounding circle
   };
 
  private:

@@ -256,6 +256,37 @@ TEST(LaserScanner, PitchedRobotMeetsTheFloorAtHOverSinPitch) {
   EXPECT_NEAR(r[270], h / std::sin(p), kHalfStep);
 }
 
+// Guards against a pose not extrapolated with the angular velocity within
+// a step. The robot turns at 2 rad/s about z (yaw input 2 t at each 1 ms
+// step start, angular_velocity 2 rad/s); beam i, measured t_i after the
+// scan's start, leaves at a_i + 2 t_i and meets the wall x = 5 at
+// 5 / cos(a_i + 2 t_i): over the 30 ms sweep the turn is 3.4 deg, and
+// within a step up to 0.11 deg, 0.1 mm at the beams checked (1 mm steps).
+TEST(LaserScanner, TurningRobotBeamsFollowTheRotation) {
+  auto u = FromModel("sick_s300", WithBox(5.5, 0.0, 1.0, 10.0, 2.0));
+  Exact(*u);
+  SetAll(*u, "mount_z", 0.2);
+  SetAll(*u, "range_resolution", 0.0001);
+  Start(*u);
+  SetArray(*u, "angular_velocity", {0.0, 0.0, 2.0});
+  TimeNs t = 0;
+  while (Get(*u, "scan_count")[0] < 1.0) {
+    const double yaw = 2.0 * cosim::NsToSeconds(t);
+    SetArray(*u, "orientation", {std::cos(0.5 * yaw), 0.0, 0.0, std::sin(0.5 * yaw)});
+    ASSERT_EQ(u->DoStep(t, kMs), cosim::StepResult::kOk);
+    t += kMs;
+  }
+  const auto r = Get(*u, "ranges");
+  int checked = 0;
+  for (int i = 0; i < 541; ++i) {
+    const double dir = BeamAngle(i) + 2.0 * (i * 0.5 / 360.0 * 0.04);
+    if (std::cos(dir) <= 0 || std::abs(5.0 * std::tan(dir)) > 4.5) continue;
+    ++checked;
+    EXPECT_NEAR(r[static_cast<std::size_t>(i)], 5.0 / std::cos(dir), 0.00005 + 1e-9) << i;
+  }
+  EXPECT_GT(checked, 150);
+}
+
 // Guards against casting all beams of a scan at one time. A car body on a
 // belt running at 2 m/s along +x (the belt unit's travel input grows by
 // 2 mm per 1 ms step): beam i is measured at t_i = k * 40 ms + i * 0.5/360 *
