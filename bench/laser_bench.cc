@@ -1,0 +1,163 @@
+// Cost of the laser scanner (units/sensors): one scan and one 1 ms step of a
+// SICK S300 / LMS151 in the factory_line scene (models/scenes/factory_line.yaml:
+// 4 walls, 10 pillars, 3 carts, a rack, 2 car bodies on the line), read here
+// with yaml-cpp (this program links the sensors family only, not the loader).
+#include <benchmark/benchmark.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "units/sensors/laser_scanner_unit.h"
+
+namespace linesim::sensors {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr cosim::TimeNs kMs = 1'000'000;
+
+models::Solid ReadSolid(const YAML::Node& item) {
+  models::Solid s;
+  const bool box = static_cast<bool>(item["box"]);
+  const YAML::Node n = box ? item["box"] : item["cylinder"];
+  s.kind = box ? models::Solid::Kind::kBox : models::Solid::Kind::kCylinder;
+  s.x_m = n["x_m"].as<double>();
+  s.y_m = n["y_m"].as<double>();
+  s.height_m = n["height_m"].as<double>();
+  s.bottom_m = n["bottom_m"] ? n["bottom_m"].as<double>() : 0.0;
+  if (box) {
+    s.yaw_rad = (n["yaw_deg"] ? n["yaw_deg"].as<double>() : 0.0) * kDeg;
+    s.length_m = n["length_m"].as<double>();
+    s.width_m = n["width_m"].as<double>();
+  } else {
+    s.radius_m = n["radius_m"].as<double>();
+  }
+  return s;
+}
+
+// The geometry of models/scenes/factory_line.yaml (what a laser sees).
+models::Scene FactoryLine() {
+  const YAML::Node f =
+      YAML::LoadFile(std::string(LINESIM_SOURCE_DIR) + "/models/scenes/factory_line.yaml");
+  models::Scene s;
+  s.name = "factory_line";
+  s.floor = {f["floor"]["min_x_m"].as<double>(), f["floor"]["max_x_m"].as<double>(),
+             f["floor"]["min_y_m"].as<double>(), f["floor"]["max_y_m"].as<double>(), 0};
+  for (const auto& b : f["belts"]) {
+    models::Belt belt;
+    belt.name = b["name"].as<std::string>();
+    belt.area = {b["center_x_m"].as<double>(), b["center_y_m"].as<double>(),
+                 b["length_m"].as<double>(), b["width_m"].as<double>(),
+                 b["direction_deg"].as<double>() * kDeg};
+    belt.nominal_speed_mps = b["speed_mps"].as<double>();
+    s.belts.push_back(belt);
+  }
+  for (const auto& o : f["obstacles"]) {
+    s.obstacles.push_back({o["name"].as<std::string>(), o["kind"].as<std::string>(), ReadSolid(o)});
+  }
+  for (const auto& c : f["carried"]) {
+    s.carried.push_back({c["name"].as<std::string>(), 0, ReadSolid(c)});
+  }
+  return s;
+}
+
+std::unique_ptr<LaserScannerUnit> FromModel(const std::string& name, const models::Scene& scene) {
+  const YAML::Node m =
+      YAML::LoadFile(std::string(LINESIM_SOURCE_DIR) + "/models/sensors/" + name + ".yaml");
+  std::vector<std::array<double, 2>> field;
+  if (m["protective_field"]) {
+    for (const auto& p : m["protective_field"]) field.push_back({p[0].as<double>(), p[1].as<double>()});
+  }
+  auto u = std::make_unique<LaserScannerUnit>("laser", scene, m["beam_count"].as<int>(),
+                                              std::move(field), 42);
+  for (const auto& kv : m) {
+    const std::string key = kv.first.as<std::string>();
+    const auto ref = u->variables().Find(key);
+    if (!ref || u->variables().info(*ref).causality != cosim::Causality::kParameter) continue;
+    if (u->variables().info(*ref).type == cosim::VarType::kInteger) {
+      u->variables().SetInteger(*ref, kv.second.as<std::int64_t>());
+    } else {
+      u->variables().SetReal(*ref, kv.second.as<double>());
+    }
+  }
+  return u;
+}
+
+// A Rob@Work 3 front S300 (mount (0.465, -0.232, 0.178) m, yaw -45 deg;
+// raw3-1 calibration, ipa320/cob_robots) on a robot at (1, -2.5) heading
+// +x, moving at 0.3 m/s and turning at 0.2 rad/s; the line's car bodies
+// ahead and to its left, pillars and walls around it.
+std::unique_ptr<LaserScannerUnit> Scanner(const std::string& model, const models::Scene& scene) {
+  auto u = FromModel(model, scene);
+  auto set = [&](const char* key, double v) { u->variables().SetReal(*u->variables().Find(key), v); };
+  set("mount_x", 0.465);
+  set("mount_y", -0.232);
+  set("mount_z", 0.178);
+  set("mount_yaw", -45.0 * kDeg);
+  u->Setup(0, 1'000'000'000 * kMs);
+  u->Initialize();
+  auto& v = u->variables();
+  v.SetRealArray(*v.Find("position_3d"), std::vector<double>{1.0, -2.5, 0.0});
+  v.SetRealArray(*v.Find("velocity_3d"), std::vector<double>{0.3, 0.0, 0.0});
+  v.SetRealArray(*v.Find("angular_velocity"), std::vector<double>{0.0, 0.0, 0.2});
+  v.SetRealArray(*v.Find("belt_travel"), std::vector<double>{1.0});
+  v.SetRealArray(*v.Find("belt_speed"), std::vector<double>{0.1});
+  return u;
+}
+
+// One whole scan: a step as long as the scan period casts all its beams.
+void ScanBench(benchmark::State& state, const std::string& model, double period_s) {
+  const models::Scene scene = FactoryLine();
+  auto u = Scanner(model, scene);
+  const cosim::TimeNs period = cosim::SecondsToNs(period_s);
+  cosim::TimeNs t = 0;
+  for (auto _ : state) {
+    u->DoStep(t, period);
+    t += period;
+  }
+  state.counters["beams"] = static_cast<double>(u->beam_count());
+}
+
+void BM_LaserS300ScanFactory(benchmark::State& state) { ScanBench(state, "sick_s300", 0.04); }
+BENCHMARK(BM_LaserS300ScanFactory);
+void BM_LaserLms151ScanFactory(benchmark::State& state) { ScanBench(state, "sick_lms151", 0.02); }
+BENCHMARK(BM_LaserLms151ScanFactory);
+
+// The unit as the master drives it: one 1 ms physics step (about 13.5
+// beams of the S300's 541 per 40 ms), averaged over whole scans.
+void BM_LaserS300Step1ms(benchmark::State& state) {
+  const models::Scene scene = FactoryLine();
+  auto u = Scanner("sick_s300", scene);
+  cosim::TimeNs t = 0;
+  for (auto _ : state) {
+    u->DoStep(t, kMs);
+    t += kMs;
+  }
+}
+BENCHMARK(BM_LaserS300Step1ms);
+
+// The geometry alone: 541 rays of a level scan through RayScene::Cast
+// (Embree stream + exact refinement + the two car bodies).
+void BM_RaySceneCast541(benchmark::State& state) {
+  const models::Scene scene = FactoryLine();
+  RayScene rs(scene);
+  std::vector<Ray> rays(541);
+  std::vector<RayHit> hits(541);
+  for (int i = 0; i < 541; ++i) {
+    const double a = (-135.0 + 0.5 * i - 45.0) * kDeg;
+    rays[static_cast<std::size_t>(i)] = {{1.465, -2.732, 0.178}, {std::cos(a), std::sin(a), 0.0},
+                                         44.25, 0.0};
+  }
+  const std::vector<double> travel{1.0}, speed{0.1};
+  for (auto _ : state) {
+    rs.Cast(rays, hits, travel, speed);
+    benchmark::DoNotOptimize(hits.data());
+  }
+}
+BENCHMARK(BM_RaySceneCast541);
+
+}  // namespace
+}  // namespace linesim::sensors

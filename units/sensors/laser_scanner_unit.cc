@@ -1,0 +1,493 @@
+#include "units/sensors/laser_scanner_unit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <utility>
+
+namespace linesim::sensors {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+using Quat = std::array<double, 4>;  // w x y z
+
+// v rotated by the unit quaternion q.
+std::array<double, 3> Rotate(const Quat& q, const std::array<double, 3>& v) {
+  // v + 2 w (u x v) + 2 u x (u x v), u = (x, y, z).
+  const double ux = q[1], uy = q[2], uz = q[3], w = q[0];
+  const double cx = uy * v[2] - uz * v[1], cy = uz * v[0] - ux * v[2], cz = ux * v[1] - uy * v[0];
+  return {v[0] + 2.0 * (w * cx + uy * cz - uz * cy), v[1] + 2.0 * (w * cy + uz * cx - ux * cz),
+          v[2] + 2.0 * (w * cz + ux * cy - uy * cx)};
+}
+
+Quat FromRpy(double roll, double pitch, double yaw) {
+  const double cr = std::cos(0.5 * roll), sr = std::sin(0.5 * roll);
+  const double cp = std::cos(0.5 * pitch), sp = std::sin(0.5 * pitch);
+  const double cy = std::cos(0.5 * yaw), sy = std::sin(0.5 * yaw);
+  return {cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+          cr * cp * sy - sr * sp * cy};
+}
+
+}  // namespace
+
+LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene, int beam_count,
+                                   std::vector<std::array<double, 2>> protective_field,
+                                   std::uint64_t seed)
+    : cosim::Unit(kTypeName, std::move(name)),
+      beam_count_(beam_count),
+      has_field_(!protective_field.empty()),
+      field_(std::move(protective_field)),
+      rays_(scene),
+      rng_(seed) {
+  if (beam_count < 1) {
+    throw cosim::UnitError(Where() + ": beam_count must be at least 1, got " +
+                           std::to_string(beam_count));
+  }
+  if (has_field_ && field_.size() < 3) {
+    throw cosim::UnitError(Where() + ": the protective field needs at least 3 corners, got " +
+                           std::to_string(field_.size()));
+  }
+  const auto n = static_cast<std::size_t>(beam_count);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  scan_period_ = first_beam_angle_ = angular_step_ = range_min_ = range_max_ = range_resolution_ =
+      noise_sigma_ = max_incidence_ = echo_separation_ = no_return_value_ = nan;
+  position_.assign(3, 0.0);
+  orientation_ = {1.0, 0.0, 0.0, 0.0};
+  velocity_.assign(3, 0.0);
+  angular_velocity_.assign(3, 0.0);
+  belt_travel_.assign(scene.belts.size(), 0.0);
+  belt_speed_.assign(scene.belts.size(), 0.0);
+  ranges_.assign(n, 0.0);
+  beam_rays_.resize(n);
+  centre_.resize(n);
+  samples_.resize(n);
+  scan_ranges_.assign(n, 0.0);
+  beam_perp_.resize(n);
+
+  auto& v = variables();
+  const auto mount = [&](const char* key, const char* unit, double* x, const char* what) {
+    v.Parameter(key, unit, x, what, cosim::Rule::Finite());
+  };
+  mount("mount_x", "m", &mount_x_, "scanner origin in base_link, x");
+  mount("mount_y", "m", &mount_y_, "scanner origin in base_link, y");
+  mount("mount_z", "m", &mount_z_, "scanner origin in base_link, z (scan plane height at rest)");
+  mount("mount_roll", "rad", &mount_roll_, "scanner roll in base_link (pi: mounted upside down)");
+  mount("mount_pitch", "rad", &mount_pitch_, "scanner pitch in base_link");
+  mount("mount_yaw", "rad", &mount_yaw_, "scanner yaw in base_link (direction of beam angle 0)");
+  v.Parameter("scan_period", "s", &scan_period_, "one turn of the mirror (one scan)",
+              cosim::Rule::Positive().NoDefault());
+  v.Parameter("first_beam_angle", "rad", &first_beam_angle_,
+              "direction of beam 0 in the scanner frame, counter-clockwise from x",
+              cosim::Rule::Range(-2 * std::numbers::pi, 2 * std::numbers::pi).NoDefault());
+  v.Parameter("angular_step", "rad", &angular_step_, "angle between neighbouring beams",
+              cosim::Rule::Range(0, false, std::numbers::pi, true).NoDefault());
+  v.Parameter("range_min", "m", &range_min_, "nearest distance measured",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("range_max", "m", &range_max_, "farthest distance measured",
+              cosim::Rule::Positive().NoDefault());
+  v.Parameter("range_resolution", "m", &range_resolution_, "step of the reported range",
+              cosim::Rule::Positive().NoDefault());
+  v.Parameter("noise_sigma", "m", &noise_sigma_, "statistical range error (1 sigma), per beam",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("bias_sigma", "m", &bias_sigma_,
+              "systematic range error: one bias per device drawn from N(0, bias_sigma)",
+              cosim::Rule::NonNegative());
+  v.Parameter("bias_max", "m", &bias_max_, "the drawn bias is clamped to +-bias_max",
+              cosim::Rule::NonNegative());
+  v.Parameter("max_incidence", "rad", &max_incidence_,
+              "no return when the beam meets the surface further than this from its normal",
+              cosim::Rule::Range(0, false, std::numbers::pi / 2, true).NoDefault());
+  v.Parameter("spot_divergence", "rad", &spot_divergence_,
+              "spot diameter = range * spot_divergence + spot_offset", cosim::Rule::NonNegative());
+  v.Parameter("spot_offset", "m", &spot_offset_, "spot diameter at the front window",
+              cosim::Rule::NonNegative());
+  v.Parameter("echo_separation", "m", &echo_separation_,
+              "two surfaces within one spot further apart than this give separate echoes "
+              "(the first is reported); closer, one mixed echo",
+              cosim::Rule::Positive().NoDefault());
+  v.Parameter("no_return_value", "m", &no_return_value_,
+              "the range the device reports for a beam without echo", cosim::Rule::Finite().NoDefault());
+  if (has_field_) {
+    v.Parameter("multiple_sampling", &multiple_sampling_,
+                "consecutive scans with an object in the protective field before field_clear "
+                "goes to 0",
+                cosim::Rule::OneOf({2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16}));
+  }
+
+  v.Input("position_3d", "m", &position_, "base_link origin in map");
+  v.Input("orientation", "1", &orientation_, "base_link in map, quaternion w x y z");
+  v.Input("velocity_3d", "m/s", &velocity_, "base_link origin velocity in map");
+  v.Input("angular_velocity", "rad/s", &angular_velocity_, "angular velocity in base_link");
+  if (!scene.belts.empty()) {
+    v.Input("belt_travel", "m", &belt_travel_, "distance each scene belt has moved");
+    v.Input("belt_speed", "m/s", &belt_speed_, "speed of each scene belt");
+  }
+  v.Output("ranges", "m", &ranges_,
+           "range of each beam of the last complete scan (no_return_value: no echo)", {});
+  v.Output("scan_time", "s", &scan_time_, "start time of the last complete scan", {});
+  v.Output("scan_count", "1", &scan_count_, "complete scans so far", {});
+  if (has_field_) {
+    v.Output("field_clear", "1", &field_clear_,
+             "1: protective field clear (OSSDs on), 0: object in the field (OSSDs off)", {});
+  }
+
+  // The device's bias, drawn once, first (as a unit normal: scaled by
+  // bias_sigma and clamped when the parameters are known).
+  bias_draw_ = Normal();
+}
+
+double LaserScannerUnit::Normal() {
+  // Marsaglia's polar method: two normals from a uniform point of the unit
+  // disc, the second kept for the next call (saved with the state).
+  if (has_spare_) {
+    has_spare_ = false;
+    return spare_;
+  }
+  double u, v, r2;
+  do {
+    u = static_cast<double>(rng_() >> 11) * 0x1.0p-52 - 1.0;
+    v = static_cast<double>(rng_() >> 11) * 0x1.0p-52 - 1.0;
+    r2 = u * u + v * v;
+  } while (r2 >= 1.0 || r2 == 0.0);
+  const double f = std::sqrt(-2.0 * std::log(r2) / r2);
+  spare_ = v * f;
+  has_spare_ = true;
+  return u * f;
+}
+
+std::vector<cosim::ParameterProblem> LaserScannerUnit::CheckParameters() const {
+  auto problems = cosim::Unit::CheckParameters();
+  if (range_min_ >= range_max_) {
+    problems.push_back({"range_max", std::nullopt,
+                        "must be > range_min (" + cosim::FormatValue(range_min_) + "), got " +
+                            cosim::FormatValue(range_max_)});
+  }
+  if (angular_step_ * (beam_count_ - 1) >= 2.0 * std::numbers::pi) {
+    problems.push_back({"angular_step", std::nullopt,
+                        "the " + std::to_string(beam_count_) +
+                            " beams must fit in one turn: angular_step < 2 pi / (beams - 1)"});
+  }
+  return problems;
+}
+
+bool LaserScannerUnit::InField(double x, double y) const {
+  // Even-odd rule.
+  bool inside = false;
+  for (std::size_t i = 0, j = field_.size() - 1; i < field_.size(); j = i++) {
+    const auto& a = field_[i];
+    const auto& b = field_[j];
+    if ((a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0]) {
+      inside = !inside;
+    }
+  }
+  return inside;
+}
+
+void LaserScannerUnit::Derive() {
+  period_ns_ = cosim::SecondsToNs(scan_period_);
+  beam_offset_ns_.resize(static_cast<std::size_t>(beam_count_));
+  cos_a_.resize(beam_offset_ns_.size());
+  sin_a_.resize(beam_offset_ns_.size());
+  for (int i = 0; i < beam_count_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    beam_offset_ns_[k] = static_cast<cosim::TimeNs>(std::llround(
+        static_cast<double>(period_ns_) * i * angular_step_ / (2.0 * std::numbers::pi)));
+    const double a = first_beam_angle_ + i * angular_step_;
+    cos_a_[k] = std::cos(a);
+    sin_a_[k] = std::sin(a);
+  }
+  q_mount_ = FromRpy(mount_roll_, mount_pitch_, mount_yaw_);
+  PrepareStep();
+  cos_max_incidence_ = std::cos(max_incidence_);
+  bias_ = std::clamp(bias_draw_ * bias_sigma_, -bias_max_, bias_max_);
+}
+
+void LaserScannerUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }
+
+void LaserScannerUnit::Initialize() {
+  ThrowIfBadParameters();
+  Derive();
+  scan_start_ = start_;
+  next_beam_ = 0;
+  finalized_ = 0;
+  infringing_scans_ = 0;
+  scan_time_ = cosim::NsToSeconds(start_);
+  scan_count_ = 0.0;
+  field_clear_ = 1.0;
+  std::fill(ranges_.begin(), ranges_.end(), no_return_value_);
+}
+
+void LaserScannerUnit::PrepareStep() {
+  // Over the step the base turns at the constant body rate w = |w| k:
+  // R(s) = R0 E(s), E(s) v = v + sin(w s) k x v + (1 - cos(w s)) k x (k x v)
+  // (Rodrigues). For the three vectors the beams need (the scanner's x and
+  // y axes and its origin, in base_link) R0 v, R0 (k x v) and
+  // R0 (k x (k x v)) are fixed over the step: a beam's pose is then two
+  // scalars and a few multiply-adds.
+  const Quat q0{orientation_[0], orientation_[1], orientation_[2], orientation_[3]};
+  const double wx = angular_velocity_[0], wy = angular_velocity_[1], wz = angular_velocity_[2];
+  rate_ = std::sqrt(wx * wx + wy * wy + wz * wz);
+  const std::array<double, 3> k =
+      rate_ > 0.0 ? std::array<double, 3>{wx / rate_, wy / rate_, wz / rate_}
+                  : std::array<double, 3>{0.0, 0.0, 0.0};
+  const auto cross = [](const std::array<double, 3>& u, const std::array<double, 3>& v) {
+    return std::array<double, 3>{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                                 u[0] * v[1] - u[1] * v[0]};
+  };
+  const std::array<std::array<double, 3>, 3> in_base = {
+      Rotate(q_mount_, {1.0, 0.0, 0.0}), Rotate(q_mount_, {0.0, 1.0, 0.0}),
+      std::array<double, 3>{mount_x_, mount_y_, mount_z_}};
+  for (std::size_t j = 0; j < 3; ++j) {
+    const auto kv = cross(k, in_base[j]);
+    frame_[j][0] = Rotate(q0, in_base[j]);
+    frame_[j][1] = Rotate(q0, kv);
+    frame_[j][2] = Rotate(q0, cross(k, kv));
+  }
+}
+
+Ray LaserScannerUnit::BeamRay(int i, double s) {
+  // sin(w s) and 1 - cos(w s); within a step the turn is small and the
+  // series are exact to double rounding for |w s| < 0.1 (the next terms are
+  // below 0.1^11 / 11! = 2.5e-19) and cheaper than sin and cos.
+  const double th = rate_ * s;
+  double sn, vc;
+  if (std::abs(th) < 0.1) {
+    const double t2 = th * th;
+    sn = th * (1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0))));
+    vc = t2 / 2.0 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0))));
+  } else {
+    sn = std::sin(th);
+    vc = 1.0 - std::cos(th);
+  }
+  double e[3][3];  // the scanner's x, y axes and origin offset in map
+  for (std::size_t j = 0; j < 3; ++j) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      e[j][c] = frame_[j][0][c] + sn * frame_[j][1][c] + vc * frame_[j][2][c];
+    }
+  }
+  const auto k = static_cast<std::size_t>(i);
+  const double ca = cos_a_[k], sa = sin_a_[k];
+  Ray r;
+  for (std::size_t c = 0; c < 3; ++c) {
+    r.origin[c] = position_[c] + velocity_[c] * s + e[2][c];
+    r.direction[c] = ca * e[0][c] + sa * e[1][c];
+    beam_perp_[k][c] = -sa * e[0][c] + ca * e[1][c];
+  }
+  // Far enough for a spot sample beyond range_max to still be met.
+  r.max_range = range_max_ * 1.5;
+  r.dt_s = s;
+  return r;
+}
+
+void LaserScannerUnit::CastBeams(int first, int end, cosim::TimeNs t) {
+  step_t_ = t;
+  const auto n = static_cast<std::size_t>(end - first);
+  for (int i = first; i < end; ++i) {
+    const double s = cosim::NsToSeconds(scan_start_ + BeamOffset(i) - t);
+    beam_rays_[static_cast<std::size_t>(i)] = BeamRay(i, s);
+  }
+  rays_.Cast(std::span<const Ray>(beam_rays_.data() + first, n),
+             std::span<RayHit>(centre_.data() + first, n), belt_travel_, belt_speed_);
+  for (int i = first; i < end; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const RayHit& h = centre_[k];
+    const double e = std::isinf(h.range) ? 0.0 : h.cos_incidence / (h.range * h.range);
+    samples_[k].fill({h.range, e, h.cos_incidence});
+  }
+  // Edges between neighbours, each side sampled across its spot.
+  if (spot_divergence_ > 0.0 || spot_offset_ > 0.0) {
+    for (int i = std::max(first, 1); i < end; ++i) {
+      const RayHit& a = centre_[static_cast<std::size_t>(i - 1)];
+      const RayHit& b = centre_[static_cast<std::size_t>(i)];
+      const bool edge = a.object != b.object ||
+                        (a.object >= 0 && std::abs(a.range - b.range) > echo_separation_);
+      if (edge) RefineEdge(i);
+    }
+  }
+}
+
+void LaserScannerUnit::RefineEdge(int i) {
+  // Beam i - 1 is sampled towards + (its +h/2 and +h), beam i towards -.
+  std::array<Ray, 4> sub;
+  std::array<RayHit, 4> hit;
+  for (int side = 0; side < 2; ++side) {
+    const auto k = static_cast<std::size_t>(i - 1 + side);
+    const Ray& r = beam_rays_[k];
+    double d = centre_[k].range;
+    if (std::isinf(d)) d = centre_[static_cast<std::size_t>(i - side)].range;
+    const double h = 0.5 * (spot_divergence_ + spot_offset_ / std::max(d, 1e-3));
+    const double sgn = side == 0 ? 1.0 : -1.0;
+    for (int j = 0; j < 2; ++j) {
+      const double alpha = sgn * h * (j == 0 ? 0.5 : 1.0);
+      const double ca = std::cos(alpha), sa = std::sin(alpha);
+      Ray& s = sub[static_cast<std::size_t>(2 * side + j)];
+      s = r;
+      // The sample's time relative to this step's inputs.
+      s.dt_s = cosim::NsToSeconds(scan_start_ + BeamOffset(i - 1 + side) - step_t_);
+      for (std::size_t c = 0; c < 3; ++c) s.direction[c] = ca * r.direction[c] + sa * beam_perp_[k][c];
+    }
+  }
+  rays_.Cast(sub, hit, belt_travel_, belt_speed_);
+  // Sample slots: 0: -h, 1: -h/2, 2: centre, 3: +h/2, 4: +h.
+  constexpr std::size_t kSlot[4] = {3, 4, 1, 0};
+  for (std::size_t j = 0; j < 4; ++j) {
+    const auto k = static_cast<std::size_t>(i - 1 + (j < 2 ? 0 : 1));
+    const RayHit& h = hit[j];
+    const double e = std::isinf(h.range) ? 0.0 : h.cos_incidence / (h.range * h.range);
+    samples_[k][kSlot[j]] = {h.range, e, h.cos_incidence};
+  }
+}
+
+void LaserScannerUnit::Finalize(int i) {
+  const auto k = static_cast<std::size_t>(i);
+  const auto& sm = samples_[k];
+  bool uniform = true;
+  for (const Sample& x : sm) uniform = uniform && x.range == sm[2].range;
+  double r = kInf, cos_inc = 0.0;
+  if (uniform) {
+    r = sm[2].range;
+    cos_inc = sm[2].cos_incidence;
+  } else {
+    MixEcho(sm, r, cos_inc);
+  }
+  double out = no_return_value_;
+  if (r >= range_min_ && r <= range_max_ && cos_inc >= cos_max_incidence_) {
+    const double m = r + bias_ + noise_sigma_ * Normal();
+    out = std::max(0.0, std::nearbyint(m / range_resolution_) * range_resolution_);
+  }
+  scan_ranges_[k] = out;
+}
+
+void LaserScannerUnit::MixEcho(const std::array<Sample, kSpotSamples>& sm, double& r,
+                               double& cos_inc) const {
+  // Nearest echo: the samples within echo_separation of one another,
+  // starting from the nearest.
+  std::array<Sample, kSpotSamples> sorted = sm;
+  std::sort(sorted.begin(), sorted.end(),
+            [](const Sample& a, const Sample& b) { return a.range < b.range; });
+  if (!std::isinf(sorted[0].range)) {
+    double sum_e = 0.0, sum_er = 0.0;
+    for (std::size_t j = 0; j < sorted.size(); ++j) {
+      if (std::isinf(sorted[j].range)) break;
+      if (j > 0 && sorted[j].range - sorted[j - 1].range > echo_separation_) break;
+      sum_e += sorted[j].energy;
+      sum_er += sorted[j].energy * sorted[j].range;
+      cos_inc = std::max(cos_inc, sorted[j].cos_incidence);
+    }
+    r = sum_e > 0.0 ? sum_er / sum_e : sorted[0].range;
+  }
+}
+
+void LaserScannerUnit::CompleteScan() {
+  std::copy(scan_ranges_.begin(), scan_ranges_.end(), ranges_.begin());
+  scan_time_ = cosim::NsToSeconds(scan_start_);
+  scan_count_ += 1.0;
+  if (has_field_) {
+    bool infringed = false;
+    for (int i = 0; i < beam_count_ && !infringed; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      const double r = ranges_[k];
+      if (r == no_return_value_) continue;
+      infringed = InField(r * cos_a_[k], r * sin_a_[k]);
+    }
+    infringing_scans_ = infringed ? infringing_scans_ + 1 : 0;
+    if (infringing_scans_ >= multiple_sampling_) field_clear_ = 0.0;
+    if (!infringed) field_clear_ = 1.0;
+  }
+  scan_start_ += period_ns_;
+  next_beam_ = 0;
+  finalized_ = 0;
+}
+
+cosim::StepResult LaserScannerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
+  ClearError();
+  if (!InputsFinite(t)) return cosim::StepResult::kError;
+  const cosim::TimeNs t_end = t + dt;
+  PrepareStep();
+  while (true) {
+    int end = next_beam_;
+    while (end < beam_count_ && scan_start_ + BeamOffset(end) < t_end) ++end;
+    if (end > next_beam_) {
+      CastBeams(next_beam_, end, t);
+      // The edge between the last beam of the previous batch and the first
+      // of this one.
+      next_beam_ = end;
+    }
+    // Every beam but the last cast one is final (its right edge is known).
+    const int final_end = next_beam_ == beam_count_ ? beam_count_ : next_beam_ - 1;
+    for (; finalized_ < final_end; ++finalized_) Finalize(finalized_);
+    if (next_beam_ == beam_count_) {
+      CompleteScan();
+      continue;
+    }
+    break;
+  }
+  return cosim::StepResult::kOk;
+}
+
+void LaserScannerUnit::SaveInternal(cosim::UnitState& state) const {
+  std::ostringstream rng;
+  rng << rng_;
+  state.strings = {rng.str()};
+  state.integers = {start_, scan_start_, next_beam_, finalized_, infringing_scans_, has_spare_ ? 1 : 0};
+  state.reals = {bias_draw_, spare_};
+  state.reals.insert(state.reals.end(), scan_ranges_.begin(), scan_ranges_.end());
+  for (int i = 0; i < next_beam_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const Ray& r = beam_rays_[k];
+    state.reals.insert(state.reals.end(), {r.origin[0], r.origin[1], r.origin[2], r.direction[0],
+                                           r.direction[1], r.direction[2], r.max_range, r.dt_s,
+                                           centre_[k].range, centre_[k].cos_incidence,
+                                           static_cast<double>(centre_[k].object),
+                                           beam_perp_[k][0], beam_perp_[k][1], beam_perp_[k][2]});
+    for (const Sample& s : samples_[k]) {
+      state.reals.insert(state.reals.end(), {s.range, s.energy, s.cos_incidence});
+    }
+  }
+}
+
+void LaserScannerUnit::RestoreInternal(const cosim::UnitState& state) {
+  const auto n = static_cast<std::size_t>(beam_count_);
+  if (state.strings.size() != 1 || state.integers.size() != 6 || state.reals.size() < 2 + n) {
+    throw cosim::UnitError(Where() + ": saved state does not fit this unit");
+  }
+  std::istringstream rng(state.strings[0]);
+  rng >> rng_;
+  start_ = state.integers[0];
+  scan_start_ = state.integers[1];
+  next_beam_ = static_cast<int>(state.integers[2]);
+  finalized_ = static_cast<int>(state.integers[3]);
+  infringing_scans_ = state.integers[4];
+  has_spare_ = state.integers[5] != 0;
+  const std::size_t per_beam = 14 + 3 * kSpotSamples;
+  if (next_beam_ < 0 || next_beam_ > beam_count_ ||
+      state.reals.size() != 2 + n + per_beam * static_cast<std::size_t>(next_beam_)) {
+    throw cosim::UnitError(Where() + ": saved state does not fit this unit");
+  }
+  bias_draw_ = state.reals[0];
+  spare_ = state.reals[1];
+  std::copy(state.reals.begin() + 2, state.reals.begin() + 2 + static_cast<std::ptrdiff_t>(n),
+            scan_ranges_.begin());
+  std::size_t p = 2 + n;
+  for (int i = 0; i < next_beam_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    Ray& r = beam_rays_[k];
+    r.origin = {state.reals[p], state.reals[p + 1], state.reals[p + 2]};
+    r.direction = {state.reals[p + 3], state.reals[p + 4], state.reals[p + 5]};
+    r.max_range = state.reals[p + 6];
+    r.dt_s = state.reals[p + 7];
+    centre_[k] = {state.reals[p + 8], state.reals[p + 9], static_cast<int>(state.reals[p + 10])};
+    beam_perp_[k] = {state.reals[p + 11], state.reals[p + 12], state.reals[p + 13]};
+    p += 14;
+    for (Sample& s : samples_[k]) {
+      s = {state.reals[p], state.reals[p + 1], state.reals[p + 2]};
+      p += 3;
+    }
+  }
+  Derive();
+}
+
+}  // namespace linesim::sensors

@@ -1,0 +1,398 @@
+#include "units/sensors/ray_scene.h"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace linesim::sensors {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kTMin = 1e-9;
+
+// Embree user-geometry callbacks for the cylinders.
+void CylinderBounds(const RTCBoundsFunctionArguments* args) {
+  const auto* cyl = static_cast<const RayScene::Cylinder*>(args->geometryUserPtr);
+  const RayScene::Cylinder& c = cyl[args->primID];
+  // Widened by a relative float epsilon so that rounding never cuts a hit.
+  const double pad = 1e-5 * (1.0 + std::abs(c.x) + std::abs(c.y) + c.radius + std::abs(c.z1));
+  RTCBounds* b = args->bounds_o;
+  b->lower_x = static_cast<float>(c.x - c.radius - pad);
+  b->lower_y = static_cast<float>(c.y - c.radius - pad);
+  b->lower_z = static_cast<float>(c.z0 - pad);
+  b->upper_x = static_cast<float>(c.x + c.radius + pad);
+  b->upper_y = static_cast<float>(c.y + c.radius + pad);
+  b->upper_z = static_cast<float>(c.z1 + pad);
+}
+
+void CylinderIntersect(const RTCIntersectFunctionNArguments* args) {
+  const auto* cyl = static_cast<const RayScene::Cylinder*>(args->geometryUserPtr);
+  const RayScene::Cylinder& c = cyl[args->primID];
+  RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, args->N);
+  RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, args->N);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (!args->valid[i]) continue;
+    const double o[3] = {RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i),
+                         RTCRayN_org_z(ray, args->N, i)};
+    const double d[3] = {RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i),
+                         RTCRayN_dir_z(ray, args->N, i)};
+    const double tfar = RTCRayN_tfar(ray, args->N, i);
+    double n[3] = {0.0, 0.0, 0.0};
+    const double t = IntersectCylinder(c, o, d, tfar, n);
+    if (!(t < tfar) || t < RTCRayN_tnear(ray, args->N, i)) continue;
+    RTCRayN_tfar(ray, args->N, i) = static_cast<float>(t);
+    RTCHitN_Ng_x(hit, args->N, i) = static_cast<float>(n[0]);
+    RTCHitN_Ng_y(hit, args->N, i) = static_cast<float>(n[1]);
+    RTCHitN_Ng_z(hit, args->N, i) = static_cast<float>(n[2]);
+    RTCHitN_u(hit, args->N, i) = 0.0f;
+    RTCHitN_v(hit, args->N, i) = 0.0f;
+    RTCHitN_primID(hit, args->N, i) = args->primID;
+    RTCHitN_geomID(hit, args->N, i) = args->geomID;
+    RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
+  }
+}
+
+void CylinderOccluded(const RTCOccludedFunctionNArguments* args) {
+  const auto* cyl = static_cast<const RayScene::Cylinder*>(args->geometryUserPtr);
+  const RayScene::Cylinder& c = cyl[args->primID];
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (!args->valid[i]) continue;
+    RTCRayN* ray = args->ray;
+    const double o[3] = {RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i),
+                         RTCRayN_org_z(ray, args->N, i)};
+    const double d[3] = {RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i),
+                         RTCRayN_dir_z(ray, args->N, i)};
+    double n[3] = {0.0, 0.0, 0.0};
+    const double tfar = RTCRayN_tfar(ray, args->N, i);
+    if (IntersectCylinder(c, o, d, tfar, n) < tfar) {
+      RTCRayN_tfar(ray, args->N, i) = -std::numeric_limits<float>::infinity();
+    }
+  }
+}
+
+}  // namespace
+
+double IntersectCylinder(const RayScene::Cylinder& c, const double* o, const double* d,
+                         double t_max, double* normal) {
+  double best = kInf;
+  const double px = o[0] - c.x, py = o[1] - c.y;
+  // Side: |p_xy + t d_xy| = r.
+  const double a = d[0] * d[0] + d[1] * d[1];
+  if (a > 0.0) {
+    const double b = px * d[0] + py * d[1];  // half of the linear coefficient
+    const double cc = px * px + py * py - c.radius * c.radius;
+    const double disc = b * b - a * cc;
+    if (disc >= 0.0) {
+      const double s = std::sqrt(disc);
+      // Entry first; from inside (cc < 0) the exit, the inner wall.
+      // The root formula without cancellation: t1 t2 = cc / a.
+      const double q = -(b + std::copysign(s, b));
+      double t1 = q / a, t2 = q != 0.0 ? cc / q : t1;
+      if (t1 > t2) std::swap(t1, t2);
+      for (double t : {t1, t2}) {
+        if (t <= kTMin || t >= t_max || t >= best) continue;
+        const double z = o[2] + t * d[2];
+        if (z < c.z0 || z > c.z1) continue;
+        best = t;
+        normal[0] = (px + t * d[0]) / c.radius;
+        normal[1] = (py + t * d[1]) / c.radius;
+        normal[2] = 0.0;
+        break;
+      }
+    }
+  }
+  // Caps.
+  if (d[2] != 0.0) {
+    for (double z : {c.z0, c.z1}) {
+      const double t = (z - o[2]) / d[2];
+      if (t <= kTMin || t >= t_max || t >= best) continue;
+      const double x = px + t * d[0], y = py + t * d[1];
+      if (x * x + y * y > c.radius * c.radius) continue;
+      best = t;
+      normal[0] = 0.0;
+      normal[1] = 0.0;
+      normal[2] = z == c.z1 ? 1.0 : -1.0;
+    }
+  }
+  return best;
+}
+
+double IntersectYawedBox(double cx, double cy, double cz, double hx, double hy, double hz,
+                         double cos_yaw, double sin_yaw, const double* o, const double* d,
+                         double t_max, double* normal) {
+  // Into the box frame (yaw only).
+  const double px = o[0] - cx, py = o[1] - cy, pz = o[2] - cz;
+  const double lo[3] = {cos_yaw * px + sin_yaw * py, -sin_yaw * px + cos_yaw * py, pz};
+  const double ld[3] = {cos_yaw * d[0] + sin_yaw * d[1], -sin_yaw * d[0] + cos_yaw * d[1], d[2]};
+  const double h[3] = {hx, hy, hz};
+  double t_in = -kInf, t_out = kInf;
+  int axis = -1;
+  double sign = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    if (ld[k] == 0.0) {
+      if (lo[k] < -h[k] || lo[k] > h[k]) return kInf;
+      continue;
+    }
+    const double inv = 1.0 / ld[k];
+    double t0 = (-h[k] - lo[k]) * inv, t1 = (h[k] - lo[k]) * inv;
+    double s = -1.0;  // the face entered: -h when moving +
+    if (t0 > t1) {
+      std::swap(t0, t1);
+      s = 1.0;
+    }
+    if (t0 > t_in) {
+      t_in = t0;
+      axis = k;
+      sign = s;
+    }
+    t_out = std::min(t_out, t1);
+  }
+  // A ray starting inside sees nothing of it (a sensor is never inside).
+  if (axis < 0 || t_in > t_out || t_in <= kTMin || t_in >= t_max) return kInf;
+  double ln[3] = {0.0, 0.0, 0.0};
+  ln[axis] = sign;
+  normal[0] = cos_yaw * ln[0] - sin_yaw * ln[1];
+  normal[1] = sin_yaw * ln[0] + cos_yaw * ln[1];
+  normal[2] = ln[2];
+  return t_in;
+}
+
+RayScene::RayScene(const models::Scene& scene)
+    : obstacle_count_(static_cast<int>(scene.obstacles.size())),
+      terrain_count_(static_cast<int>(scene.terrain.size())) {
+  // Single-threaded: without "threads=1" Embree starts a worker per core.
+  device_ = rtcNewDevice("threads=1");
+  if (!device_) {
+    throw std::runtime_error("Embree: cannot create a device (error " +
+                             std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")");
+  }
+  scene_ = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+
+  std::vector<float> vertices;
+  std::vector<unsigned> indices;
+  // The floor: its rectangle at z = 0, two triangles facing up.
+  {
+    const models::Floor& f = scene.floor;
+    const unsigned base = static_cast<unsigned>(vertices.size() / 3);
+    const double xs[4] = {f.min_x_m, f.max_x_m, f.max_x_m, f.min_x_m};
+    const double ys[4] = {f.min_y_m, f.min_y_m, f.max_y_m, f.max_y_m};
+    for (int k = 0; k < 4; ++k) {
+      vertices.insert(vertices.end(), {static_cast<float>(xs[k]), static_cast<float>(ys[k]), 0.f});
+    }
+    indices.insert(indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    faces_.push_back({0.0, 0.0, 1.0, 0.0, kFloor});
+    faces_.push_back({0.0, 0.0, 1.0, 0.0, kFloor});
+  }
+  for (int i = 0; i < obstacle_count_; ++i) {
+    const models::Solid& s = scene.obstacles[static_cast<std::size_t>(i)].solid;
+    if (s.kind == models::Solid::Kind::kCylinder) {
+      cylinders_.push_back({s.x_m, s.y_m, s.radius_m, s.bottom_m, s.bottom_m + s.height_m,
+                            ObjectOfObstacle(i)});
+      continue;
+    }
+    const double c = std::cos(s.yaw_rad), sn = std::sin(s.yaw_rad);
+    AddBox(vertices, indices, {s.x_m, s.y_m, s.bottom_m + 0.5 * s.height_m},
+           {0.5 * s.length_m, 0.5 * s.width_m, 0.5 * s.height_m},
+           {{{c, sn, 0.0}, {-sn, c, 0.0}, {0.0, 0.0, 1.0}}}, ObjectOfObstacle(i));
+  }
+  for (int i = 0; i < terrain_count_; ++i) {
+    const models::TerrainPiece& t = scene.terrain[static_cast<std::size_t>(i)];
+    // R = Rz(yaw) Ry(-pitch) Rx(roll): + pitch raises the far (+length)
+    // end, as models::TerrainPiece says; its columns are the piece's axes.
+    const double cy = std::cos(t.yaw_rad), sy = std::sin(t.yaw_rad);
+    const double cp = std::cos(-t.pitch_rad), sp = std::sin(-t.pitch_rad);
+    const double cr = std::cos(t.roll_rad), sr = std::sin(t.roll_rad);
+    const std::array<double, 3> ax = {cy * cp, sy * cp, -sp};
+    const std::array<double, 3> ay = {cy * sp * sr - sy * cr, sy * sp * sr + cy * cr, cp * sr};
+    const std::array<double, 3> az = {cy * sp * cr + sy * sr, sy * sp * cr - cy * sr, cp * cr};
+    AddBox(vertices, indices, {t.center_x_m, t.center_y_m, t.center_z_m},
+           {0.5 * t.length_m, 0.5 * t.width_m, 0.5 * t.thickness_m}, {{ax, ay, az}},
+           ObjectOfTerrain(i));
+  }
+  for (std::size_t i = 0; i < scene.carried.size(); ++i) {
+    const models::CarriedObject& co = scene.carried[i];
+    const models::Belt& belt = scene.belts.at(static_cast<std::size_t>(co.belt));
+    const auto range = models::CarriedTravelRange(belt.area, co.solid);
+    carried_.push_back({co.solid, co.belt, std::cos(belt.area.direction_rad),
+                        std::sin(belt.area.direction_rad), range[0], range[1],
+                        std::cos(co.solid.yaw_rad), std::sin(co.solid.yaw_rad),
+                        ObjectOfCarried(static_cast<int>(i)), 0.0});
+    const models::Solid& s = co.solid;
+    const double br = s.kind == models::Solid::Kind::kCylinder
+                          ? s.radius_m
+                          : 0.5 * std::hypot(s.length_m, s.width_m);
+    carried_.back().bound_radius2 = (br + 1e-6) * (br + 1e-6);
+  }
+
+  RTCGeometry mesh = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+      mesh, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertices.size() / 3));
+  std::copy(vertices.begin(), vertices.end(), vb);
+  auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+      mesh, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), indices.size() / 3));
+  std::copy(indices.begin(), indices.end(), ib);
+  rtcCommitGeometry(mesh);
+  mesh_geom_ = rtcAttachGeometry(scene_, mesh);
+  rtcReleaseGeometry(mesh);
+
+  if (!cylinders_.empty()) {
+    RTCGeometry user = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
+    rtcSetGeometryUserPrimitiveCount(user, static_cast<unsigned>(cylinders_.size()));
+    rtcSetGeometryUserData(user, cylinders_.data());
+    rtcSetGeometryBoundsFunction(user, CylinderBounds, nullptr);
+    rtcSetGeometryIntersectFunction(user, CylinderIntersect);
+    rtcSetGeometryOccludedFunction(user, CylinderOccluded);
+    rtcCommitGeometry(user);
+    cylinder_geom_ = rtcAttachGeometry(scene_, user);
+    rtcReleaseGeometry(user);
+  }
+  rtcCommitScene(scene_);
+  if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) {
+    rtcReleaseScene(scene_);
+    rtcReleaseDevice(device_);
+    throw std::runtime_error("Embree: building the scene failed");
+  }
+}
+
+RayScene::~RayScene() {
+  rtcReleaseScene(scene_);
+  rtcReleaseDevice(device_);
+}
+
+void RayScene::AddBox(std::vector<float>& vertices, std::vector<unsigned>& indices,
+                      const std::array<double, 3>& center, const std::array<double, 3>& half,
+                      const std::array<std::array<double, 3>, 3>& axes, int object) {
+  const unsigned base = static_cast<unsigned>(vertices.size() / 3);
+  for (int k = 0; k < 8; ++k) {
+    const double s[3] = {(k & 1) ? 1.0 : -1.0, (k & 2) ? 1.0 : -1.0, (k & 4) ? 1.0 : -1.0};
+    for (int j = 0; j < 3; ++j) {
+      double p = center[static_cast<std::size_t>(j)];
+      for (int a = 0; a < 3; ++a) {
+        p += s[a] * half[static_cast<std::size_t>(a)] *
+             axes[static_cast<std::size_t>(a)][static_cast<std::size_t>(j)];
+      }
+      vertices.push_back(static_cast<float>(p));
+    }
+  }
+  // Per axis a, the faces at -half and +half: corners with bit a clear / set.
+  for (int a = 0; a < 3; ++a) {
+    const int b1 = 1 << ((a + 1) % 3), b2 = 1 << ((a + 2) % 3), ba = 1 << a;
+    for (int side = 0; side < 2; ++side) {
+      const unsigned o = side ? static_cast<unsigned>(ba) : 0u;
+      const unsigned q[4] = {base + o, base + o + static_cast<unsigned>(b1),
+                             base + o + static_cast<unsigned>(b1 | b2),
+                             base + o + static_cast<unsigned>(b2)};
+      indices.insert(indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+      const double sg = side ? 1.0 : -1.0;
+      const auto& n = axes[static_cast<std::size_t>(a)];
+      Face f{sg * n[0], sg * n[1], sg * n[2], 0.0, object};
+      f.c = f.nx * center[0] + f.ny * center[1] + f.nz * center[2] +
+            half[static_cast<std::size_t>(a)];
+      faces_.push_back(f);
+      faces_.push_back(f);
+    }
+  }
+}
+
+void RayScene::CastCarried(const Ray& ray, std::span<const double> belt_travel,
+                           std::span<const double> belt_speed, RayHit& best) const {
+  for (const Carried& c : carried_) {
+    const auto b = static_cast<std::size_t>(c.belt);
+    const double travel = belt_travel[b] + belt_speed[b] * ray.dt_s;
+    if (travel < c.travel_min || travel > c.travel_max) continue;  // lifted off
+    const double x = c.solid.x_m + travel * c.ux, y = c.solid.y_m + travel * c.uy;
+    const double t_max = std::isinf(best.range) ? ray.max_range : best.range;
+    // Cull with the footprint's bounding circle: the ray's horizontal
+    // line passes farther from its centre, or the object is behind.
+    {
+      const double px = x - ray.origin[0], py = y - ray.origin[1];
+      const double cross = px * ray.direction[1] - py * ray.direction[0];
+      const double h2 = ray.direction[0] * ray.direction[0] + ray.direction[1] * ray.direction[1];
+      if (cross * cross > c.bound_radius2 * h2) continue;
+      if (px * ray.direction[0] + py * ray.direction[1] < -std::sqrt(c.bound_radius2 * h2)) continue;
+    }
+    double n[3] = {0.0, 0.0, 0.0};
+    double t;
+    if (c.solid.kind == models::Solid::Kind::kCylinder) {
+      const Cylinder cyl{x, y, c.solid.radius_m, c.solid.bottom_m,
+                         c.solid.bottom_m + c.solid.height_m, c.object};
+      t = IntersectCylinder(cyl, ray.origin.data(), ray.direction.data(), t_max, n);
+    } else {
+      t = IntersectYawedBox(x, y, c.solid.bottom_m + 0.5 * c.solid.height_m, 0.5 * c.solid.length_m,
+                            0.5 * c.solid.width_m, 0.5 * c.solid.height_m, c.cos_yaw, c.sin_yaw,
+                            ray.origin.data(), ray.direction.data(), t_max, n);
+    }
+    if (t < t_max) {
+      best.range = t;
+      best.object = c.object;
+      best.cos_incidence = std::abs(n[0] * ray.direction[0] + n[1] * ray.direction[1] +
+                                    n[2] * ray.direction[2]);
+    }
+  }
+}
+
+void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
+                    std::span<const double> belt_travel, std::span<const double> belt_speed) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  // The beams of a scan are neighbours: coherent packets of 8.
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  alignas(32) RTCRayHit8 packet;
+  alignas(32) int valid[8];
+  for (std::size_t first = 0; first < rays.size(); first += 8) {
+    const std::size_t count = std::min<std::size_t>(8, rays.size() - first);
+    for (std::size_t k = 0; k < 8; ++k) {
+      valid[k] = k < count ? -1 : 0;
+      const Ray& r = rays[first + std::min(k, count - 1)];
+      packet.ray.org_x[k] = static_cast<float>(r.origin[0]);
+      packet.ray.org_y[k] = static_cast<float>(r.origin[1]);
+      packet.ray.org_z[k] = static_cast<float>(r.origin[2]);
+      packet.ray.dir_x[k] = static_cast<float>(r.direction[0]);
+      packet.ray.dir_y[k] = static_cast<float>(r.direction[1]);
+      packet.ray.dir_z[k] = static_cast<float>(r.direction[2]);
+      packet.ray.tnear[k] = 0.0f;
+      // Beyond max_range by a margin: the exact distance is decided below.
+      packet.ray.tfar[k] = static_cast<float>(r.max_range * (1.0 + 1e-5) + 1e-4);
+      packet.ray.time[k] = 0.0f;
+      packet.ray.mask[k] = ~0u;
+      packet.ray.id[k] = 0;
+      packet.ray.flags[k] = 0;
+      packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      packet.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+      packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, scene_, &context, &packet);
+    for (std::size_t k = 0; k < count; ++k) {
+      const Ray& r = rays[first + k];
+      RayHit& h = hits[first + k];
+      h = {std::numeric_limits<double>::infinity(), 0.0, -1};
+      const unsigned geom = packet.hit.geomID[k];
+      if (geom == mesh_geom_) {
+        // The exact distance to the face's plane.
+        const Face& f = faces_[packet.hit.primID[k]];
+        const double dn = f.nx * r.direction[0] + f.ny * r.direction[1] + f.nz * r.direction[2];
+        const double on = f.nx * r.origin[0] + f.ny * r.origin[1] + f.nz * r.origin[2];
+        const double t = dn != 0.0 ? (f.c - on) / dn : static_cast<double>(packet.ray.tfar[k]);
+        if (t > 0.0 && t <= r.max_range) h = {t, std::abs(dn), f.object};
+      } else if (geom == cylinder_geom_ && geom != RTC_INVALID_GEOMETRY_ID) {
+        const Cylinder& c = cylinders_[packet.hit.primID[k]];
+        double n[3];
+        const double t = IntersectCylinder(c, r.origin.data(), r.direction.data(),
+                                           r.max_range * 1.001 + 1e-3, n);
+        if (t <= r.max_range) {
+          h = {t,
+               std::abs(n[0] * r.direction[0] + n[1] * r.direction[1] + n[2] * r.direction[2]),
+               c.object};
+        }
+      }
+      if (!carried_.empty()) CastCarried(r, belt_travel, belt_speed, h);
+    }
+  }
+}
+
+}  // namespace linesim::sensors

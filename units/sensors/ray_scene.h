@@ -1,0 +1,129 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "models/scene.h"
+
+// Embree's handles, without its header.
+struct RTCDeviceTy;
+struct RTCSceneTy;
+
+namespace linesim::sensors {
+
+/// One ray for RayScene::Cast: origin and unit direction in the map frame,
+/// the longest range of interest, and when it is cast, as seconds after the
+/// time at which the belts' travels passed to Cast hold (the carried objects
+/// are placed where the belts have moved them by then).
+struct Ray {
+  std::array<double, 3> origin{};
+  std::array<double, 3> direction{};
+  double max_range = 0.0;
+  double dt_s = 0.0;
+};
+
+/// What a ray meets first.
+struct RayHit {
+  /// Distance along the ray (m); +inf when it meets nothing within max_range.
+  double range = 0.0;
+  /// |cos| of the angle between the ray and the surface normal there.
+  double cos_incidence = 0.0;
+  /// Which scene object: RayScene::kFloor, then the obstacles, the terrain
+  /// pieces and the carried objects in scene order (RayScene::ObjectOf*);
+  /// -1 when nothing is met.
+  int object = -1;
+};
+
+/// The geometry a range sensor sees, built once from a models::Scene.
+///
+/// Static geometry (the floor's rectangle at z = 0, obstacle boxes, terrain
+/// pieces) is one committed Embree scene of triangles; vertical cylinders are
+/// an Embree user geometry intersected analytically (exact, not a mesh).
+/// Embree works in single precision: its hit only says which face (or
+/// cylinder) is met first; the distance is then recomputed in double from
+/// that face's plane (or the cylinder's equation) and the ray's double
+/// origin, so ranges are exact to double rounding.
+///
+/// Objects carried by belts move every step; re-committing Embree instance
+/// transforms costs 10-15 us a frame, so they are not in the Embree scene:
+/// each ray is intersected analytically with each carried box or cylinder in
+/// its own frame at the ray's time (footprint moved along the belt's
+/// direction by the belt's travel then; absent once the travel leaves
+/// models::CarriedTravelRange, the object has been lifted off the line).
+///
+/// One RayScene per unit: it owns its Embree device (created single-threaded
+/// with "threads=1") and is not shared between threads. Not copyable.
+class RayScene {
+ public:
+  static constexpr int kFloor = 0;
+  /// Rays handed to Embree in one rtcIntersect1M stream.
+  static constexpr int kStream = 64;
+
+  explicit RayScene(const models::Scene& scene);
+  ~RayScene();
+  RayScene(const RayScene&) = delete;
+  RayScene& operator=(const RayScene&) = delete;
+
+  /// The first hit of each ray (`hits` has room for rays.size()).
+  /// `belt_travel` and `belt_speed` (m, m/s; one per scene belt) are the
+  /// belts' travel at the rays' reference time and their speed: a carried
+  /// object is at travel + speed * dt_s along its belt. No allocation.
+  void Cast(std::span<const Ray> rays, std::span<RayHit> hits, std::span<const double> belt_travel,
+            std::span<const double> belt_speed);
+
+  int ObjectOfObstacle(int i) const { return 1 + i; }
+  int ObjectOfTerrain(int i) const { return 1 + obstacle_count_ + i; }
+  int ObjectOfCarried(int i) const { return 1 + obstacle_count_ + terrain_count_ + i; }
+
+  /// A cylinder of the user geometry (public for the Embree callbacks).
+  struct Cylinder {
+    double x, y, radius, z0, z1;
+    int object;
+  };
+  /// A face of the triangle mesh: its plane n.p = c (n unit) and object.
+  struct Face {
+    double nx, ny, nz, c;
+    int object;
+  };
+  /// A carried object with its belt: footprint at zero travel.
+  struct Carried {
+    models::Solid solid;
+    int belt;
+    double ux, uy;                 // the belt's direction
+    double travel_min, travel_max;  // models::CarriedTravelRange
+    double cos_yaw, sin_yaw;
+    int object;
+    double bound_radius2;  // squared radius of the footprint's bounding circle
+  };
+
+ private:
+  void AddBox(std::vector<float>& vertices, std::vector<unsigned>& indices,
+              const std::array<double, 3>& center, const std::array<double, 3>& half,
+              const std::array<std::array<double, 3>, 3>& axes, int object);
+  /// The carried objects met before `best` (updated in place).
+  void CastCarried(const Ray& ray, std::span<const double> belt_travel,
+                   std::span<const double> belt_speed, RayHit& best) const;
+
+  RTCDeviceTy* device_ = nullptr;
+  RTCSceneTy* scene_ = nullptr;
+  unsigned mesh_geom_ = ~0u, cylinder_geom_ = ~0u;
+  int obstacle_count_ = 0, terrain_count_ = 0;
+  std::vector<Face> faces_;  // per triangle
+  std::vector<Cylinder> cylinders_;
+  std::vector<Carried> carried_;
+};
+
+/// Exact first intersection (t > 1e-9, t < t_max) of a ray with a vertical
+/// cylinder (side and caps): t, and the unit normal in `normal`; +inf when
+/// none. Used by RayScene and its tests.
+double IntersectCylinder(const RayScene::Cylinder& c, const double* o, const double* d,
+                         double t_max, double* normal);
+/// The same for a box given by its centre, half sizes along its yaw-rotated
+/// x, y and the vertical, and cos / sin of its yaw.
+double IntersectYawedBox(double cx, double cy, double cz, double hx, double hy, double hz,
+                         double cos_yaw, double sin_yaw, const double* o, const double* d,
+                         double t_max, double* normal);
+
+}  // namespace linesim::sensors
