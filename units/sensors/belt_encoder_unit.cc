@@ -75,7 +75,10 @@ void BeltEncoderUnit::UpdateOutputs() {
 cosim::StepResult BeltEncoderUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
   if (!InputsFinite(t)) return cosim::StepResult::kError;
-  count_ = IncrementalCount(count_, Position(), hysteresis_);
+  // Commit the sample taken at t by UpdateOutputs (or Initialize), not one
+  // from the inputs now (Gauss-Seidel hands over the belt's travel at
+  // t + dt before this step).
+  count_ = static_cast<std::int64_t>(counts_);
   // Push the sample at t, dropping the oldest once the window is full.
   const std::size_t window = ring_counts_.size();
   const std::size_t slot = (ring_head_ + ring_size_) % window;

@@ -25,7 +25,8 @@ namespace linesim::sensors {
 /// sample interval as the microcontroller computes it (average_window 1), or
 /// its moving average over the last average_window intervals. The wheel
 /// rolls without slip on the belt (no slip model). The first sample reads
-/// speed 0.
+/// speed 0. DoStep(t, dt) commits the sample taken at t by UpdateOutputs
+/// (or Initialize), whatever input it is given since.
 class BeltEncoderUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "belt_encoder";

@@ -172,6 +172,10 @@ void ImuUnit::UpdateOutputs() {
                     s * (x * y + w * zq), 1.0 - s * (x * x + zq * zq), s * (y * zq - w * x),
                     s * (x * zq - w * y), s * (y * zq + w * x), 1.0 - s * (x * x + y * y)};
   const Vec3 omega = {angular_velocity_in_[0], angular_velocity_in_[1], angular_velocity_in_[2]};
+  for (std::size_t i = 0; i < 3; ++i) {
+    sampled_velocity_[i] = velocity_[i];
+    sampled_angular_velocity_[i] = omega[i];
+  }
   Vec3 accel_origin{0.0, 0.0, 0.0}, alpha{0.0, 0.0, 0.0};
   if (interval_ > 0) {
     const double inv_dt = 1.0 / cosim::NsToSeconds(interval_);
@@ -210,11 +214,9 @@ cosim::StepResult ImuUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     return Fail("input 'orientation' is not a rotation (zero quaternion) at t = " +
                 cosim::FormatSeconds(t) + " s");
   }
-  // Commit the sample at t.
-  for (std::size_t i = 0; i < 3; ++i) {
-    previous_velocity_[i] = velocity_[i];
-    previous_angular_velocity_[i] = angular_velocity_in_[i];
-  }
+  // Commit the sample taken at t.
+  previous_velocity_ = sampled_velocity_;
+  previous_angular_velocity_ = sampled_angular_velocity_;
   interval_ = dt;
   // The biases of the sample at t + dt and its white noise.
   const double dt_s = cosim::NsToSeconds(dt);
@@ -237,7 +239,8 @@ cosim::StepResult ImuUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
 
 void ImuUnit::SaveInternal(cosim::UnitState& state) const {
   state.reals.clear();
-  for (const auto* a : {&previous_velocity_, &previous_angular_velocity_}) {
+  for (const auto* a : {&previous_velocity_, &previous_angular_velocity_, &sampled_velocity_,
+                        &sampled_angular_velocity_}) {
     state.reals.insert(state.reals.end(), a->begin(), a->end());
   }
   for (const auto* a : {&bias_, &noise_}) {
@@ -250,17 +253,19 @@ void ImuUnit::SaveInternal(cosim::UnitState& state) const {
 }
 
 void ImuUnit::RestoreInternal(const cosim::UnitState& state) {
-  if (state.reals.size() != 18 || state.integers.size() != 1 || state.strings.size() != 1) {
+  if (state.reals.size() != 24 || state.integers.size() != 1 || state.strings.size() != 1) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals, " + std::to_string(state.integers.size()) + " integers and " +
                            std::to_string(state.strings.size()) +
-                           " strings, expected 18, 1 and 1");
+                           " strings, expected 24, 1 and 1");
   }
   auto it = state.reals.begin();
   std::copy(it, it + 3, previous_velocity_.begin());
   std::copy(it + 3, it + 6, previous_angular_velocity_.begin());
-  std::copy(it + 6, it + 12, bias_.begin());
-  std::copy(it + 12, it + 18, noise_.begin());
+  std::copy(it + 6, it + 9, sampled_velocity_.begin());
+  std::copy(it + 9, it + 12, sampled_angular_velocity_.begin());
+  std::copy(it + 12, it + 18, bias_.begin());
+  std::copy(it + 18, it + 24, noise_.begin());
   interval_ = state.integers[0];
   std::istringstream rng(state.strings[0]);
   rng >> rng_;

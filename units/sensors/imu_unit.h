@@ -40,7 +40,10 @@ namespace linesim::sensors {
 ///    the datasheet's bias instability at the averaging time tau =
 ///    bias_instability_time of the Allan curve's floor.
 /// The first sample (no predecessor) has zero linear and angular
-/// acceleration of the origin and no white noise (only bias).
+/// acceleration of the origin and no white noise (only bias). DoStep(t, dt)
+/// commits the sample UpdateOutputs (or Initialize) took at t, whatever
+/// inputs it is given since (a Gauss-Seidel master hands it the chassis'
+/// values at t + dt).
 ///
 /// Random numbers: one std::mt19937_64 seeded with the constructor's seed
 /// (reseeded at Initialize, so Initialize is idempotent), standard normals
@@ -94,6 +97,8 @@ class ImuUnit : public cosim::Unit {
   // biases (gyro x y z, accel x y z) and the white noise of the coming
   // sample (same order).
   std::array<double, 3> previous_velocity_{}, previous_angular_velocity_{};
+  // The inputs of the sample UpdateOutputs took last (what DoStep commits).
+  std::array<double, 3> sampled_velocity_{}, sampled_angular_velocity_{};
   cosim::TimeNs interval_ = 0;
   std::array<double, 6> bias_{}, noise_{};
 };

@@ -72,11 +72,12 @@ void WheelEncoderUnit::UpdateOutputs() {
 cosim::StepResult WheelEncoderUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
   if (!InputsFinite(t)) return cosim::StepResult::kError;
-  // The sample at t (the inputs are still those of t): commit its count;
-  // the outputs keep showing it until the inputs of t + dt arrive.
+  // Commit the sample taken at t (by UpdateOutputs or Initialize), not one
+  // from the inputs now: a Gauss-Seidel master transfers its predecessors'
+  // end-of-step values right before DoStep. The outputs keep showing it
+  // until the inputs of t + dt arrive.
   for (std::size_t i = 0; i < angle_.size(); ++i) {
-    committed_[i] = IncrementalCount(committed_[i],
-                                     angle_[i] * counts_per_revolution_[i] / kTwoPi, hysteresis_);
+    committed_[i] = static_cast<std::int64_t>(counts_[i]);
   }
   interval_ = dt;
   return cosim::StepResult::kOk;

@@ -43,8 +43,10 @@ inline std::int64_t IncrementalCount(std::int64_t previous, double position, dou
 /// i.e. the counter is zero where the angle is zero (the driver's reset),
 /// counts down for negative angles, and the rate is what a driver computes
 /// from two successive readings (quantized to 2 pi / cpr / dt; 0 at the
-/// first sample, which has no predecessor). DoStep commits the sample taken
-/// at its start time.
+/// first sample, which has no predecessor). DoStep(t, dt) commits the
+/// sample taken at t by UpdateOutputs (or Initialize), whatever inputs it
+/// is given since (a Gauss-Seidel master hands it its sources' values at
+/// t + dt).
 ///
 /// counts_per_revolution is counts per JOINT revolution: encoder counts per
 /// motor revolution (x4 for quadrature decoding where the device does it)

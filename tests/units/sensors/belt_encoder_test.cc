@@ -90,6 +90,25 @@ TEST(BeltEncoderUnit, SpeedIsQuantizedToWholeCountsPerSample) {
   EXPECT_NEAR(sum / n, v, quantum / n * 1.0001);
 }
 
+// Guards the sampling instant under Gauss-Seidel (the belt's travel at
+// t + 1 ms handed over before DoStep): the counts committed are those of the
+// communication point, so the mean speed over the run is the belt's 0.1 m/s
+// within one count (not 19/20 of it).
+TEST(BeltEncoderUnit, CommitsTheSampleTakenAtTheCommunicationPoint) {
+  auto u = Make();
+  const TimeNs dt = 20 * kMs;
+  double sum = 0.0;
+  const int n = 1000;
+  for (int k = 0; k <= n; ++k) {
+    SetAll(*u, "travel", 0.1 * 0.02 * k);
+    u->UpdateOutputs();
+    sum += Get(*u, "speed")[0];
+    SetAll(*u, "travel", 0.1 * (0.02 * k + 0.001));
+    ASSERT_EQ(u->DoStep(k * dt, dt), cosim::StepResult::kOk);
+  }
+  EXPECT_NEAR(sum / n, 0.1, kMetresPerCount / 0.02 / n * 1.0001);
+}
+
 // Guards the moving average: with a window of 5 the speed is the count
 // difference over the last 5 intervals; backwards travel reads negative.
 TEST(BeltEncoderUnit, MovingAverageSpansTheWindow) {

@@ -312,6 +312,28 @@ TEST(ImuUnit, OriginAccelerationIsRotatedIntoTheBody) {
   }
 }
 
+// Guards the sampling instant under Gauss-Seidel (the chassis' values at
+// t + 1 ms handed over before DoStep): the velocity committed is the one of
+// the communication point, so a 0.5 m/s^2 ramp reads 0.5 (committing the
+// later value would read 0.5 * 4/5 over these 5 ms samples).
+TEST(ImuUnit, CommitsTheSampleTakenAtTheCommunicationPoint) {
+  ImuUnit u("imu", 1);
+  SetIdeal(u);
+  Start(u);
+  const TimeNs dt = 5 * kMs;
+  for (int k = 0; k < 50; ++k) {
+    const double t_s = 0.005 * k;
+    SetArray(u, "velocity_3d", {0.5 * t_s, 0.0, 0.0});
+    SetArray(u, "base_angular_velocity", {0.0, 0.0, 0.0});
+    u.UpdateOutputs();
+    if (k > 0) {
+      EXPECT_NEAR(Get(u, "linear_acceleration")[0], 0.5, 1e-9) << k;
+    }
+    SetArray(u, "velocity_3d", {0.5 * (t_s + 0.001), 0.0, 0.0});
+    ASSERT_EQ(u.DoStep(k * dt, dt), cosim::StepResult::kOk);
+  }
+}
+
 // Guards range and resolution (ADIS16470: +-2000 deg/s, 0.1 deg/s LSB): a
 // rate beyond the range reads the range; every reading is a whole number of
 // LSBs.

@@ -126,6 +126,34 @@ TEST(WheelEncoderUnit, RateIsTheCountDifferenceOverTheSampleInterval) {
   }
 }
 
+// Guards the sampling instant under a Gauss-Seidel master, which hands a
+// unit its sources' end-of-step values right before DoStep: the count
+// committed is the one sampled at the communication point, so the next rate
+// spans the whole 20 ms (the ramp's exact rate within one count's quantum),
+// not the 19 ms left after a 1 ms source step.
+TEST(WheelEncoderUnit, CommitsTheSampleTakenAtTheCommunicationPoint) {
+  WheelEncoderUnit u("enc", 1);
+  SetAll(u, "counts_per_revolution", kRaw3DriveCpr);
+  Start(u);
+  const double omega = 5.0;
+  const double quantum = kTwoPi / kRaw3DriveCpr / 0.02;
+  double sum = 0.0;
+  const int n = 500;
+  for (int k = 0; k <= n; ++k) {
+    const double t_s = 0.02 * k;
+    SetArray(u, "angle", {omega * t_s});
+    u.UpdateOutputs();
+    if (k > 0) {
+      EXPECT_NEAR(Get(u, "rate")[0], omega, quantum * 1.0000001) << k;
+      sum += Get(u, "rate")[0];
+    }
+    SetArray(u, "angle", {omega * (t_s + 0.001)});  // the source's value at t + 1 ms
+    ASSERT_EQ(u.DoStep(k * kCycle, kCycle), cosim::StepResult::kOk);
+  }
+  // The mean telescopes: (c_n - c_0) over n intervals, within one count.
+  EXPECT_NEAR(sum / n, omega, quantum / n * 1.0000001);
+}
+
 // Guards the hysteresis model: after counting up past an edge, a shaft that
 // falls back less than `hysteresis` counts keeps the count; beyond, it
 // counts down. With 0 it would drop at once (floor).
