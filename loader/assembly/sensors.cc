@@ -42,7 +42,7 @@ const std::map<std::string, KindWiring>& Wiring() {
       {"imu",
        {{{"orientation", "orientation"},
          {"velocity_3d", "velocity_3d"},
-         {"angular_velocity", "angular_velocity"}},
+         {"angular_velocity", "base_angular_velocity"}},
         {},
         cosim::kNsPerSecond / 100}},
       // Sampled at the control period (set below).
