@@ -19,6 +19,7 @@ namespace linesim::evaluation {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 void* IndexTag(std::size_t i) { return reinterpret_cast<void*>(static_cast<std::uintptr_t>(i)); }
 std::size_t IndexOf(const fcl::CollisionObjectd* o) {
@@ -40,14 +41,28 @@ fcl::Matrix3d Yaw(double yaw_rad) {
   return fcl::Matrix3d(Eigen::AngleAxisd(yaw_rad, fcl::Vector3d::UnitZ()));
 }
 
+/// A collision object whose AABB can be set: the tree keeps a carried
+/// object's AABB enlarged by a margin, so that it is updated only when the
+/// object leaves it (the object's own AABB is put back afterwards).
+class Object : public fcl::CollisionObjectd {
+ public:
+  using fcl::CollisionObjectd::CollisionObjectd;
+  void SetAabb(const fcl::AABBd& box) { aabb = box; }
+};
+
 }  // namespace
 
 struct ClearanceUnit::Fcl {
   // Obstacles then carried objects, each tagged with its index.
-  std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
+  std::vector<std::unique_ptr<Object>> objects;
+  // Per carried object: the AABB its tree node holds (pruned query).
+  std::vector<fcl::AABBd> fat;
   fcl::DynamicAABBTreeCollisionManagerd manager;
   std::unique_ptr<fcl::CollisionObjectd> body;
   std::vector<fcl::CollisionObjectd*> moved;  // reserved: no allocation per step
+  // The body's pose at the last evaluation (pruned query's bounds).
+  fcl::Vector3d previous_centre = fcl::Vector3d::Zero();
+  Eigen::Quaterniond previous_q = Eigen::Quaterniond::Identity();
 
   fcl::DistanceRequestd distance_request;
   fcl::DistanceResultd distance_result;
@@ -92,9 +107,12 @@ struct ClearanceCallbacks {
                      double& dist) {
     auto& q = *static_cast<ClearanceCallbacks*>(data);
     const std::size_t i = IndexOf(o1);
-    if (q.unit->active_[i] && static_cast<std::int64_t>(i) != q.skip &&
+    ClearanceUnit& u = *q.unit;
+    if (u.active_[i] && static_cast<std::int64_t>(i) != q.skip && u.lower_bound_[i] < q.best &&
         o1->getAABB().distance(o2->getAABB()) < q.best) {
-      q.Offer(q.Narrow(o1, o2), i);
+      const double d = q.Narrow(o1, o2);
+      u.lower_bound_[i] = d;
+      q.Offer(d, i);
     }
     dist = q.best;
     return q.best <= 0.0;
@@ -123,8 +141,8 @@ ClearanceUnit::ClearanceUnit(std::string name, const models::Scene& scene)
   for (const models::Obstacle& o : scene.obstacles) {
     double z = 0.0;
     auto shape = SolidShape(o.solid, &z);
-    f.objects.push_back(std::make_unique<fcl::CollisionObjectd>(
-        shape, Yaw(o.solid.yaw_rad), fcl::Vector3d(o.solid.x_m, o.solid.y_m, z)));
+    f.objects.push_back(std::make_unique<Object>(shape, Yaw(o.solid.yaw_rad),
+                                                 fcl::Vector3d(o.solid.x_m, o.solid.y_m, z)));
   }
   for (const models::CarriedObject& c : scene.carried) {
     if (c.belt < 0 || static_cast<std::size_t>(c.belt) >= scene.belts.size()) {
@@ -143,8 +161,8 @@ ClearanceUnit::ClearanceUnit(std::string name, const models::Scene& scene)
     k.travel_min_m = range[0];
     k.travel_max_m = range[1];
     auto shape = SolidShape(c.solid, &k.z_m);
-    f.objects.push_back(std::make_unique<fcl::CollisionObjectd>(
-        shape, Yaw(c.solid.yaw_rad), fcl::Vector3d(k.x0_m, k.y0_m, k.z_m)));
+    f.objects.push_back(std::make_unique<Object>(shape, Yaw(c.solid.yaw_rad),
+                                                 fcl::Vector3d(k.x0_m, k.y0_m, k.z_m)));
     carried_.push_back(k);
   }
   for (std::size_t i = 0; i < f.objects.size(); ++i) {
@@ -155,6 +173,9 @@ ClearanceUnit::ClearanceUnit(std::string name, const models::Scene& scene)
   for (auto& o : f.objects) f.manager.registerObject(o.get());
   f.manager.setup();
   f.moved.reserve(carried_.size());
+  for (std::size_t k = 0; k < carried_.size(); ++k) {
+    f.fat.push_back(f.objects[obstacle_count_ + k]->getAABB());
+  }
   // libccd's GJK (FCL's default) for both queries; one contact is enough
   // to know that an object touches.
   f.distance_request.gjk_solver_type = fcl::GST_LIBCCD;
@@ -162,6 +183,7 @@ ClearanceUnit::ClearanceUnit(std::string name, const models::Scene& scene)
 
   const std::size_t n = f.objects.size();
   active_.assign(n, 1);
+  lower_bound_.assign(n, -kInf);
   contact_now_.assign(n, 0);
   contact_before_.assign(n, 0);
   carried_travel_.assign(carried_.size(), kNaN);
@@ -178,8 +200,9 @@ ClearanceUnit::ClearanceUnit(std::string name, const models::Scene& scene)
               cosim::Rule::Positive().NoDefault());
   v.Parameter("body_bottom", "m", &body_bottom_,
               "height of the body box's bottom above base_link's origin, along base_link z "
-              "(the box is centred on base_link x, y)",
-              cosim::Rule::NonNegative().NoDefault());
+              "(the box is centred on base_link x, y; negative: below it, as the chassis's "
+              "collision box centred on com_height can be)",
+              cosim::Rule::Finite().NoDefault());
   v.Parameter("max_clearance", "m", &max_clearance_,
               "clearance reported when no object is nearer (none, or all lifted off); also "
               "the farthest the distance query looks",
@@ -226,6 +249,14 @@ std::vector<cosim::ParameterProblem> ClearanceUnit::CheckParameters() const {
 void ClearanceUnit::BuildBody() {
   fcl_->body = std::make_unique<fcl::CollisionObjectd>(
       std::make_shared<fcl::Boxd>(body_length_, body_width_, body_height_));
+  body_radius_ =
+      0.5 * std::sqrt(body_length_ * body_length_ + body_width_ * body_width_ +
+                      body_height_ * body_height_);
+}
+
+void ClearanceUnit::ForgetBounds() {
+  std::fill(lower_bound_.begin(), lower_bound_.end(), -kInf);
+  have_previous_pose_ = false;
 }
 
 void ClearanceUnit::Initialize() {
@@ -238,6 +269,7 @@ void ClearanceUnit::Initialize() {
   committed_collisions_ = 0;
   previous_nearest_ = -1;
   std::fill(evaluated_inputs_.begin(), evaluated_inputs_.end(), kNaN);
+  ForgetBounds();
   EvaluateIfChanged();
 }
 
@@ -250,17 +282,32 @@ void ClearanceUnit::MoveCarried() {
     const Carried& c = carried_[k];
     const double s = belt_travel_[static_cast<std::size_t>(c.belt)];
     if (s == carried_travel_[k]) continue;  // did not move
-    carried_travel_[k] = s;
     const std::size_t i = obstacle_count_ + k;
+    // Its distance bound drops by the distance it moved along its belt.
+    lower_bound_[i] -= std::abs(s - carried_travel_[k]);
+    if (!(lower_bound_[i] >= -kInf)) lower_bound_[i] = -kInf;  // first placement: NaN
+    carried_travel_[k] = s;
     // Past an end of its belt: lifted off the line, gone from the scene.
     active_[i] = (c.travel_min_m <= s && s <= c.travel_max_m) ? 1 : 0;
     if (!active_[i]) continue;
-    fcl::CollisionObjectd& o = *f.objects[i];
+    Object& o = *f.objects[i];
     o.setTranslation(fcl::Vector3d(c.x0_m + s * c.axis_x, c.y0_m + s * c.axis_y, c.z_m));
     o.computeAABB();
-    f.moved.push_back(&o);
+    if (!pruned_) {
+      f.moved.push_back(&o);  // "full": the tree follows every move
+    } else if (!f.fat[k].contain(o.getAABB())) {
+      // Left the box its tree node holds: a new one, kCarriedMarginM
+      // larger on every side, so that the next ~margin / speed steps need
+      // no update of the tree.
+      f.fat[k] = o.getAABB();
+      f.fat[k].expand(fcl::Vector3d::Constant(kCarriedMarginM));
+      o.SetAabb(f.fat[k]);
+      f.moved.push_back(&o);
+    }
   }
-  if (!f.moved.empty()) f.manager.update(f.moved);
+  if (f.moved.empty()) return;
+  f.manager.update(f.moved);
+  for (fcl::CollisionObjectd* o : f.moved) o->computeAABB();  // its own box again
 }
 
 void ClearanceUnit::Evaluate() {
@@ -279,9 +326,26 @@ void ClearanceUnit::Evaluate() {
   }
   const fcl::Matrix3d r = q.toRotationMatrix();
   const fcl::Vector3d p(position_3d_[0], position_3d_[1], position_3d_[2]);
+  const fcl::Vector3d centre =
+      p + r * fcl::Vector3d(0.0, 0.0, body_bottom_ + 0.5 * body_height_);
   fcl::CollisionObjectd& body = *f.body;
-  body.setTransform(r, p + r * fcl::Vector3d(0.0, 0.0, body_bottom_ + 0.5 * body_height_));
+  body.setTransform(r, centre);
   body.computeAABB();
+
+  // How far any point of the body moved since the last evaluation: its
+  // centre's displacement plus, for the turn between the two orientations
+  // (angle a), 2 sin(a / 2) times the half diagonal; 2 sin(a / 2) is twice
+  // the norm of the vector part of q q_prev^-1. Every object's distance
+  // bound drops by it (the distance is 1-Lipschitz in each body's motion).
+  if (have_previous_pose_) {
+    const Eigen::Quaterniond turn = q * f.previous_q.conjugate();
+    const double moved =
+        (centre - f.previous_centre).norm() + 2.0 * turn.vec().norm() * body_radius_;
+    for (double& b : lower_bound_) b -= moved;
+  }
+  f.previous_centre = centre;
+  f.previous_q = q;
+  have_previous_pose_ = true;
 
   ClearanceCallbacks query{this, max_clearance_, -1, -1};
   const auto n = static_cast<std::int64_t>(f.objects.size());
@@ -290,8 +354,10 @@ void ClearanceUnit::Evaluate() {
     // distance bounds the search from the start.
     const std::int64_t seed = previous_nearest_;
     if (seed >= 0 && seed < n && active_[static_cast<std::size_t>(seed)]) {
-      query.Offer(query.Narrow(f.objects[static_cast<std::size_t>(seed)].get(), &body),
-                  static_cast<std::size_t>(seed));
+      const auto i = static_cast<std::size_t>(seed);
+      const double d = query.Narrow(f.objects[i].get(), &body);
+      lower_bound_[i] = d;
+      query.Offer(d, i);
       query.skip = seed;
     }
     f.manager.distance(&body, &query, &ClearanceCallbacks::Pruned);
@@ -384,6 +450,7 @@ void ClearanceUnit::RestoreInternal(const cosim::UnitState& state) {
   // Evaluate the restored inputs afresh (carried objects placed again).
   std::fill(evaluated_inputs_.begin(), evaluated_inputs_.end(), kNaN);
   std::fill(carried_travel_.begin(), carried_travel_.end(), kNaN);
+  ForgetBounds();
 }
 
 }  // namespace linesim::evaluation

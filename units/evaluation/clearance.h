@@ -55,6 +55,9 @@ class ClearanceUnit : public cosim::Unit {
   /// Below this distance the collide query decides the contacts (pruned
   /// query); GJK's distance tolerance (1e-6 m) is far below it.
   static constexpr double kContactSkinM = 1e-3;
+  /// Pruned query: margin of the box a carried object's tree node holds
+  /// (at 0.1 m/s the tree is updated every 1 s instead of every step).
+  static constexpr double kCarriedMarginM = 0.1;
 
   /// Throws cosim::UnitError if a carried object names no belt of the scene.
   ClearanceUnit(std::string name, const models::Scene& scene);
@@ -93,6 +96,8 @@ class ClearanceUnit : public cosim::Unit {
   friend struct ClearanceCallbacks;
 
   void BuildBody();
+  /// Every distance bound unknown (start, restore).
+  void ForgetBounds();
   /// Evaluates the current inputs unless they are those of the last
   /// evaluation; then fills the outputs from the committed state.
   void EvaluateIfChanged();
@@ -130,6 +135,12 @@ class ClearanceUnit : public cosim::Unit {
   std::vector<std::uint8_t> contact_now_;  // per object, this evaluation
   std::vector<double> carried_travel_;    // travel each carried object was placed at
   int narrow_calls_ = 0;
+  // Pruned query: per object a lower bound of its distance (its last exact
+  // distance less how far the body and it moved since), and the body's last
+  // pose (in Fcl).
+  std::vector<double> lower_bound_;
+  double body_radius_ = 0.0;  // half diagonal of the body box
+  bool have_previous_pose_ = false;
 
   // Committed at each step.
   std::vector<std::uint8_t> contact_before_;  // per object, at the last step

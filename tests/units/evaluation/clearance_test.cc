@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -340,7 +341,8 @@ TEST(Clearance, DeterministicPrunedEqualsFullAndRestores) {
   EXPECT_EQ(ra, Drive(b, 0, 600));
   const auto rf = Drive(full, 0, 600);
   ASSERT_EQ(ra.size(), rf.size());
-  for (std::size_t i = 0; i < ra.size(); ++i) EXPECT_NEAR(ra[i], rf[i], 1e-9) << i;
+  // (GJK's tolerance: 1e-6 m.)
+  for (std::size_t i = 0; i < ra.size(); ++i) EXPECT_NEAR(ra[i], rf[i], 1e-6) << i;
   // The run touched something (the trajectory crosses the car body).
   EXPECT_GT(ra.back(), 0.0);
 
@@ -355,9 +357,35 @@ TEST(Clearance, DeterministicPrunedEqualsFullAndRestores) {
   EXPECT_EQ(Drive(c, 600, 900), cont);
 }
 
+// Guards the pruned query's bounds against large moves between steps: poses
+// jumping anywhere in the scene (seeded std::mt19937_64), tilted and turned,
+// the belt jumping, give the same distances, nearest objects, contacts and
+// counts as the full query.
+TEST(Clearance, PrunedEqualsFullForJumpingPoses) {
+  Rig pruned(RunScene()), full(RunScene(), "full");
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> x(-6.0, 6.0), y(-1.5, 5.5), a(-kPi, kPi),
+      tilt(-0.05, 0.05), s(0.0, 8.0);
+  for (int k = 0; k < 400; ++k) {
+    const double px = x(rng), py = y(rng), yaw = a(rng), roll = tilt(rng), travel = s(rng);
+    for (Rig* r : {&pruned, &full}) {
+      r->Pose(px, py, yaw, roll);
+      r->Travel(travel);
+      if (k == 0) r->unit.Initialize();
+      r->Step();
+    }
+    ASSERT_NEAR(pruned.Clearance(), full.Clearance(), 1e-6) << k;
+    ASSERT_EQ(pruned.Int("nearest"), full.Int("nearest")) << k;
+    ASSERT_EQ(pruned.Real("in_contact"), full.Real("in_contact")) << k;
+    ASSERT_EQ(pruned.Int("collisions"), full.Int("collisions")) << k;
+  }
+  EXPECT_GT(full.Int("collisions"), 0);
+}
+
 // Guards the required body parameters: a unit without the body's size
-// refuses to start, naming each missing one; a body below base_link is
-// refused too.
+// refuses to start, naming each missing one; a non-finite body_bottom is
+// refused too (a negative one is allowed: the chassis's collision box,
+// centred on com_height, can reach below the floor).
 TEST(Clearance, MissingBodySizeIsRefused) {
   ClearanceUnit u("clearance", SceneWith({}));
   auto problems = u.CheckParameters();
@@ -368,10 +396,12 @@ TEST(Clearance, MissingBodySizeIsRefused) {
   EXPECT_THROW(u.Initialize(), cosim::UnitError);
 
   Rig r(SceneWith({}));
-  r.unit.variables().SetReal(*r.unit.variables().Find("body_bottom"), -0.1);
+  r.unit.variables().SetReal(*r.unit.variables().Find("body_bottom"), INFINITY);
   problems = r.unit.CheckParameters();
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_EQ(problems[0].variable, "body_bottom");
+  r.unit.variables().SetReal(*r.unit.variables().Find("body_bottom"), -0.07);
+  EXPECT_TRUE(r.unit.CheckParameters().empty());
 }
 
 // Guards the inputs: belt_travel only with belts; a zero quaternion fails
