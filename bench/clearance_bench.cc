@@ -18,6 +18,14 @@
 // libccd's and FCL's own GJK; collide), the unit of the costs above.
 //
 // Counters: narrow = narrow-phase calls (distance + collide) per step.
+//
+// Measured (2026-11-24, this machine kind, 2 cores shared, load ~5; CPU time
+// per step, median of 3): path pruned 1.07 us (1.00 narrow) / full 2.78 us
+// (2.59); near 0.80 / 2.16 us; open 1.48 / 2.55 us; contact 2.26 / 6.16 us.
+// Pair: box-box distance 0.44 us (libccd; FCL's own GJK 0.58), box-cylinder
+// 0.52 us, box-box collide 0.063 us. The first version of the pruned query
+// (updating the car bodies in the tree every step, AABB pruning only) cost
+// 2.40 us on the path with 1.74 narrow-phase calls.
 
 #include <benchmark/benchmark.h>
 #include <fcl/geometry/shape/box.h>
