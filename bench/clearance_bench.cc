@@ -19,12 +19,14 @@
 //
 // Counters: narrow = narrow-phase calls (distance + collide) per step.
 //
-// Measured (2026-11-24, this machine kind, 2 cores shared, load ~5; CPU time
-// per step, median of 3): path pruned 1.07 us (1.00 narrow) / full 2.78 us
-// (2.59); near 0.80 / 2.16 us; open 1.48 / 2.55 us; contact 2.26 / 6.16 us.
+// Measured (2026-11-24, this machine kind, 2 cores shared with other
+// builds, load 2.7-5; CPU time per step, median of 3-5 runs; pruned / full):
+// path 1.00-1.37 us (1.00 narrow-phase calls) / 2.76-2.81 us (2.54-2.59);
+// near 0.77-0.85 / 2.14-2.26 us; open (standing, nothing moves near it)
+// 0.22 us (0.00 calls: distances reused) / 2.56 us; contact 1.13 / 3.98 us.
 // Pair: box-box distance 0.44 us (libccd; FCL's own GJK 0.58), box-cylinder
 // 0.52 us, box-box collide 0.063 us. The first version of the pruned query
-// (updating the car bodies in the tree every step, AABB pruning only) cost
+// (car bodies updated in the tree every step, AABB pruning only) cost
 // 2.40 us on the path with 1.74 narrow-phase calls.
 
 #include <benchmark/benchmark.h>

@@ -83,6 +83,15 @@ struct ClearanceCallbacks {
     f.distance_result.clear();
     return fcl::distance(object, body, f.distance_request, f.distance_result);
   }
+  // The distance of object i, reused when neither it nor the body moved
+  // since it was computed (pruned query).
+  double Exact(std::size_t i, fcl::CollisionObjectd* object, fcl::CollisionObjectd* body) {
+    if (unit->exact_[i]) return unit->lower_bound_[i];
+    const double d = Narrow(object, body);
+    unit->lower_bound_[i] = d;
+    unit->exact_[i] = 1;
+    return d;
+  }
   void Offer(double d, std::size_t i) {
     if (d < best) {
       best = d;
@@ -110,9 +119,7 @@ struct ClearanceCallbacks {
     ClearanceUnit& u = *q.unit;
     if (u.active_[i] && static_cast<std::int64_t>(i) != q.skip && u.lower_bound_[i] < q.best &&
         o1->getAABB().distance(o2->getAABB()) < q.best) {
-      const double d = q.Narrow(o1, o2);
-      u.lower_bound_[i] = d;
-      q.Offer(d, i);
+      q.Offer(q.Exact(i, o1, o2), i);
     }
     dist = q.best;
     return q.best <= 0.0;
@@ -184,6 +191,7 @@ ClearanceUnit::ClearanceUnit(std::string name, const models::Scene& scene)
   const std::size_t n = f.objects.size();
   active_.assign(n, 1);
   lower_bound_.assign(n, -kInf);
+  exact_.assign(n, 0);
   contact_now_.assign(n, 0);
   contact_before_.assign(n, 0);
   carried_travel_.assign(carried_.size(), kNaN);
@@ -256,6 +264,7 @@ void ClearanceUnit::BuildBody() {
 
 void ClearanceUnit::ForgetBounds() {
   std::fill(lower_bound_.begin(), lower_bound_.end(), -kInf);
+  std::fill(exact_.begin(), exact_.end(), 0);
   have_previous_pose_ = false;
 }
 
@@ -285,6 +294,7 @@ void ClearanceUnit::MoveCarried() {
     const std::size_t i = obstacle_count_ + k;
     // Its distance bound drops by the distance it moved along its belt.
     lower_bound_[i] -= std::abs(s - carried_travel_[k]);
+    exact_[i] = 0;
     if (!(lower_bound_[i] >= -kInf)) lower_bound_[i] = -kInf;  // first placement: NaN
     carried_travel_[k] = s;
     // Past an end of its belt: lifted off the line, gone from the scene.
@@ -337,11 +347,13 @@ void ClearanceUnit::Evaluate() {
   // (angle a), 2 sin(a / 2) times the half diagonal; 2 sin(a / 2) is twice
   // the norm of the vector part of q q_prev^-1. Every object's distance
   // bound drops by it (the distance is 1-Lipschitz in each body's motion).
-  if (have_previous_pose_) {
+  if (have_previous_pose_ &&
+      !(centre == f.previous_centre && q.coeffs() == f.previous_q.coeffs())) {
     const Eigen::Quaterniond turn = q * f.previous_q.conjugate();
     const double moved =
         (centre - f.previous_centre).norm() + 2.0 * turn.vec().norm() * body_radius_;
     for (double& b : lower_bound_) b -= moved;
+    std::fill(exact_.begin(), exact_.end(), 0);
   }
   f.previous_centre = centre;
   f.previous_q = q;
@@ -355,9 +367,7 @@ void ClearanceUnit::Evaluate() {
     const std::int64_t seed = previous_nearest_;
     if (seed >= 0 && seed < n && active_[static_cast<std::size_t>(seed)]) {
       const auto i = static_cast<std::size_t>(seed);
-      const double d = query.Narrow(f.objects[i].get(), &body);
-      lower_bound_[i] = d;
-      query.Offer(d, i);
+      query.Offer(query.Exact(i, f.objects[i].get(), &body), i);
       query.skip = seed;
     }
     f.manager.distance(&body, &query, &ClearanceCallbacks::Pruned);

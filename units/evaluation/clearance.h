@@ -49,7 +49,8 @@ namespace linesim::evaluation {
 ///    manager's query skipping every object whose AABB lies at least that
 ///    far or whose distance bound does (its last exact distance less how far
 ///    any point of the body and the object moved since: the distance is
-///    1-Lipschitz in either's motion); carried objects' tree boxes are kept
+///    1-Lipschitz in either's motion), and reusing an object's distance when
+///    neither it nor the body moved; carried objects' tree boxes are kept
 ///    kCarriedMarginM larger than the objects, so the tree is updated only
 ///    when one leaves its box; the collide query only when the clearance is
 ///    below kContactSkinM (no object can touch otherwise).
@@ -145,6 +146,7 @@ class ClearanceUnit : public cosim::Unit {
   // distance less how far the body and it moved since), and the body's last
   // pose (in Fcl).
   std::vector<double> lower_bound_;
+  std::vector<std::uint8_t> exact_;  // lower_bound_[i] is its distance (nothing moved since)
   double body_radius_ = 0.0;  // half diagonal of the body box
   bool have_previous_pose_ = false;
 

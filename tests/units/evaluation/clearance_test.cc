@@ -212,6 +212,40 @@ TEST(Clearance, CarBodyApproachesWithBeltTravel) {
   EXPECT_EQ(r.Int("collisions"), 1);
 }
 
+// Guards the reuse of a distance when nothing moved (pruned query): a robot
+// standing at (0, 1.5) (body y 1.2..1.8) 0.7 m from a box spanning y
+// 2.5..3.5, while the car body (y -0.9..0.9, front at -4.7 + s) comes
+// along: hypot(4.2 - s, 0.3) away (front to the body's rear corner), the
+// nearest once that is below 0.7. While it is far the standing robot needs
+// no narrow-phase call; the values stay exact.
+TEST(Clearance, StandingRobotReusesDistances) {
+  models::Scene scene = LineScene();
+  scene.obstacles.push_back({"box", "cart", Box(0.0, 3.0, 0.0, 1.0, 1.0, 1.0)});
+  Rig r(scene);
+  r.Pose(0.0, 1.5);
+  r.Travel(0.0);
+  r.unit.Initialize();
+  r.Step();
+  for (double s : {1.0, 2.0, 3.0}) {
+    r.Travel(s);
+    r.Step();
+    EXPECT_NEAR(r.Clearance(), 0.7, kTol);
+    EXPECT_EQ(r.Int("nearest"), 0);
+    EXPECT_EQ(r.unit.last_narrow_phase_calls(), 0) << s;
+  }
+  r.Travel(3.9);
+  r.Step();
+  EXPECT_NEAR(r.Clearance(), std::hypot(0.3, 0.3), kTol);
+  EXPECT_EQ(r.Int("nearest"), 1);
+  r.Travel(4.0);  // the car body moved, the robot did not
+  r.Step();
+  EXPECT_NEAR(r.Clearance(), std::hypot(0.2, 0.3), kTol);
+  r.Pose(0.0, 1.6);  // moved away from the line by 0.1
+  r.Step();
+  EXPECT_NEAR(r.Clearance(), std::hypot(0.2, 0.4), kTol);
+  EXPECT_GT(r.unit.last_narrow_phase_calls(), 0);
+}
+
 // Guards the lift-off (models::CarriedTravelRange): the body leaves the
 // 20 m belt when its front reaches x = 10, at s = 10 - 2.3 + 7 = 14.7. A
 // robot with its rear at x = 10.5 sees it 10.5 - (-4.7 + s) away until
