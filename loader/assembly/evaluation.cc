@@ -51,7 +51,7 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
   b.Connect(Signal(kChassis, "orientation"), Signal(kClearance, "orientation"));
   if (s.belt_count > 0) b.Connect(Signal(kBelt, "travel"), Signal(kClearance, "belt_travel"));
   s.recorded.push_back(Signal(kClearance, "clearance"));
-  add("min_clearance_m", Signal(kClearance, "clearance"), "min");
+  add("min_clearance_m", Signal(kClearance, "min_clearance"), "final");
   add("collisions", Signal(kClearance, "collisions"), "final");
 
   // Raw optic flow against the belt's ground truth (paper 1 Fig. 4), when

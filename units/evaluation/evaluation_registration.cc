@@ -1,5 +1,6 @@
 // Registers the evaluation family's unit types (see config/unit_registry.h).
 #include "config/unit_registry.h"
+#include "units/evaluation/clearance.h"
 #include "units/evaluation/path_deviation.h"
 #include "units/evaluation/surface_velocity_error.h"
 
@@ -42,6 +43,28 @@ const config::UnitTypeRegistrar kSurfaceVelocityError(
      {{"sensors", "number of sensors compared (default 1)"},
       {"belt", "index of the scene belt the reference measures (default 0)"}},
      MakeSurfaceVelocityError});
+
+std::unique_ptr<cosim::Unit> MakeClearance(const UnitBuildContext& c) {
+  for (std::size_t k = 0; k < c.scene.carried.size(); ++k) {
+    const int belt = c.scene.carried[k].belt;
+    if (belt < 0 || static_cast<std::size_t>(belt) >= c.scene.belts.size()) {
+      c.reader.Error(c.parameters, c.path,
+                     "scene carried object '" + c.scene.carried[k].name + "' is on belt " +
+                         std::to_string(belt) + ", not one of the scene's " +
+                         std::to_string(c.scene.belts.size()) + " belts");
+      return nullptr;
+    }
+  }
+  return std::make_unique<evaluation::ClearanceUnit>(c.name, c.scene);
+}
+
+const config::UnitTypeRegistrar kClearance(
+    {evaluation::ClearanceUnit::kTypeName,
+     "ground-truth minimum distance of the robot's body box from the scene's obstacles and "
+     "carried objects (FCL), and its collisions",
+     "",
+     {},
+     MakeClearance});
 
 }  // namespace
 }  // namespace linesim::evaluation
