@@ -28,8 +28,36 @@ inline double Uniform(std::mt19937_64& rng) {
   return static_cast<double>(rng() >> 11) * 0x1.0p-53;
 }
 
+// The block draws are many (25 per frame, 400 frames per second per
+// sensor), so they use one 64-bit draw for several numbers:
+// a zero-mean unit-variance Irwin-Hall variable (the sum of four 16-bit
+// uniforms; bounded at +-3.46, close to normal) ...
+inline double IrwinHall4(std::uint64_t r) {
+  const double sum = static_cast<double>((r & 0xffff) + ((r >> 16) & 0xffff) +
+                                         ((r >> 32) & 0xffff) + (r >> 48));
+  return (sum * (1.0 / 65536.0) - 2.0) * 1.7320508075688772;
+}
+
+// ... and a Gamma(3, 1/3) variable (mean 1): the mean of three unit
+// exponentials from three 21-bit uniforms in (0, 1].
+inline double Gamma3(std::uint64_t r) {
+  constexpr double k = 1.0 / 2097152.0;
+  const double u1 = static_cast<double>((r & 0x1fffff) + 1) * k;
+  const double u2 = static_cast<double>(((r >> 21) & 0x1fffff) + 1) * k;
+  const double u3 = static_cast<double>(((r >> 42) & 0x1fffff) + 1) * k;
+  return -std::log(u1 * u2 * u3) * (1.0 / 3.0);
+}
+
+// 16-bit and 24-bit uniforms in [0, 1) from parts of a draw.
+inline double U16(std::uint64_t r, int shift) {
+  return static_cast<double>((r >> shift) & 0xffff) * (1.0 / 65536.0);
+}
+inline double U24(std::uint64_t r, int shift) {
+  return static_cast<double>((r >> shift) & 0xffffff) * (1.0 / 16777216.0);
+}
+
 // One standard normal by Box-Muller (one value per call, no cache, so the
-// generator's state is the whole state).
+// generator's state is the whole state): sonar and gyro noise.
 inline double Normal(std::mt19937_64& rng) {
   const double u1 = 1.0 - Uniform(rng);  // (0, 1]
   const double u2 = Uniform(rng);
@@ -38,8 +66,7 @@ inline double Normal(std::mt19937_64& rng) {
 
 inline double RoundHalf(double x) { return 0.5 * std::nearbyint(2.0 * x); }
 
-bool Inside(const models::Rect& r, double x, double y) {
-  const double c = std::cos(r.direction_rad), s = std::sin(r.direction_rad);
+bool Inside(const models::Rect& r, double c, double s, double x, double y) {
   const double dx = x - r.center_x_m, dy = y - r.center_y_m;
   const double along = dx * c + dy * s, across = -dx * s + dy * c;
   return std::abs(along) <= 0.5 * r.length_m && std::abs(across) <= 0.5 * r.width_m;
@@ -51,7 +78,10 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
     : cosim::Unit(kTypeName, std::move(name)), surfaces_(scene.surfaces), rng_(seed) {
   if (surfaces_.empty()) throw cosim::UnitError(Where() + ": the scene has no surfaces");
   floor_surface_ = scene.floor.surface;
-  for (const models::Belt& b : scene.belts) belts_.push_back({b.area, b.surface});
+  for (const models::Belt& b : scene.belts) {
+    belts_.push_back({b.area, b.surface, std::cos(b.area.direction_rad),
+                      std::sin(b.area.direction_rad)});
+  }
   const auto n_belts = belts_.size();
   position_.assign(2, 0.0);
   linear_velocity_.assign(2, 0.0);
@@ -174,6 +204,8 @@ std::vector<cosim::ParameterProblem> Px4FlowUnit::CheckParameters() const {
 }
 
 void Px4FlowUnit::CacheCamera() {
+  cos_mount_ = std::cos(mount_yaw_);
+  sin_mount_ = std::sin(mount_yaw_);
   cam_.focal_length_px = focal_length_px_;
   cam_.frame_rate_hz = frame_rate_;
   cam_.search_range_px = static_cast<int>(search_range_);
@@ -218,7 +250,7 @@ void Px4FlowUnit::TrueFlow(double& fx, double& fy, int& surface) const {
   double ux = 0.0, uy = 0.0;
   surface = floor_surface_;
   for (std::size_t b = 0; b < belts_.size(); ++b) {
-    if (Inside(belts_[b].area, px, py)) {
+    if (Inside(belts_[b].area, belts_[b].cos_dir, belts_[b].sin_dir, px, py)) {
       ux = belt_velocity_[2 * b];
       uy = belt_velocity_[2 * b + 1];
       surface = belts_[b].surface;
@@ -226,8 +258,8 @@ void Px4FlowUnit::TrueFlow(double& fx, double& fy, int& surface) const {
     }
   }
   const double rel_x = ux - vsx, rel_y = uy - vsy;
-  const double a = yaw_ + mount_yaw_;
-  const double ca = std::cos(a), sa = std::sin(a);
+  // cos and sin of yaw + mount_yaw by the angle sum.
+  const double ca = c * cos_mount_ - s * sin_mount_, sa = s * cos_mount_ + c * sin_mount_;
   const double scale = focal_length_px_ / (frame_rate_ * mount_height_);
   fx = (ca * rel_x + sa * rel_y) * scale;
   fy = (-sa * rel_x + ca * rel_y) * scale;
@@ -239,7 +271,7 @@ void Px4FlowUnit::Frame() {
   TrueFlow(fx, fy, surface);
   const models::Surface& surf = surfaces_[static_cast<std::size_t>(surface)];
   const Exposure e = AutoExposure(cam_, surf.illumination_lux + added_light_);
-  const double blur_px = std::hypot(fx, fy) * e.exposure_s * frame_rate_;
+  const double blur_px = std::sqrt(fx * fx + fy * fy) * e.exposure_s * frame_rate_;
   const double br = blur_px / kBlurScalePx;
   const double d = kNeighbourDiff * e.mean_dn * surf.texture_contrast *
                    std::sqrt(0.5 * (1.0 + 1.0 / (1.0 + br * br)));
@@ -259,30 +291,30 @@ void Px4FlowUnit::Frame() {
   double sum_x = 0.0, sum_y = 0.0;
   int used = 0;
   for (int k = 0; k < 25; ++k) {
-    // Gamma(3, 1/3) as the mean of three unit exponentials.
-    const double x =
-        -std::log((1.0 - Uniform(rng_)) * (1.0 - Uniform(rng_)) * (1.0 - Uniform(rng_))) /
-        kBlockShape;
-    const double m = kDiffPerSigma * (std::sqrt(d * d * x + n2) + kNoiseSpread * n * Normal(rng_));
+    const double x = Gamma3(rng_());
+    const double m = kDiffPerSigma * (std::sqrt(d * d * x + n2) + kNoiseSpread * n * IrwinHall4(rng_()));
     if (m < thr) continue;
     double ox, oy;
-    const double u = Uniform(rng_);
+    const std::uint64_t r = rng_();
+    const double u = U16(r, 48);
     if (u < p_true * p_edge) {
       // The true match (or, just beyond the window, its edge: the texture
       // is correlated over a few pixels), refined to half pixels.
-      ox = std::clamp(RoundHalf(fx + sigma_b * Normal(rng_)), -edge, edge);
-      oy = std::clamp(RoundHalf(fy + sigma_b * Normal(rng_)), -edge, edge);
+      const double zx = sigma_b > 0.0 ? IrwinHall4(rng_()) : 0.0;
+      const double zy = sigma_b > 0.0 ? IrwinHall4(rng_()) : 0.0;
+      ox = std::clamp(RoundHalf(fx + sigma_b * zx), -edge, edge);
+      oy = std::clamp(RoundHalf(fy + sigma_b * zy), -edge, edge);
     } else if (u < p_true) {
       // Aliased: the true match lies outside the window; the SAD minimum
       // is an unrelated patch anywhere in it (wrong, not flagged).
       const double cells = 4.0 * S + 3.0;
-      ox = -edge + 0.5 * std::floor(Uniform(rng_) * cells);
-      oy = -edge + 0.5 * std::floor(Uniform(rng_) * cells);
+      ox = -edge + 0.5 * std::floor(U24(r, 0) * cells);
+      oy = -edge + 0.5 * std::floor(U24(r, 24) * cells);
     } else {
       // A match on noise (dark or featureless image).
       const double cells = 4.0 * S - 1.0;
-      ox = -(S - 0.5) + 0.5 * std::floor(Uniform(rng_) * cells);
-      oy = -(S - 0.5) + 0.5 * std::floor(Uniform(rng_) * cells);
+      ox = -(S - 0.5) + 0.5 * std::floor(U24(r, 0) * cells);
+      oy = -(S - 0.5) + 0.5 * std::floor(U24(r, 24) * cells);
     }
     sum_x += ox;
     sum_y += oy;
@@ -300,7 +332,7 @@ void Px4FlowUnit::Frame() {
     acc_time_ += dt;
     // The board gyro, in the sensor frame (z down the optical axis is the
     // body z; the mount turns x, y by mount_yaw), saturating at its range.
-    const double cm = std::cos(mount_yaw_), sm = std::sin(mount_yaw_);
+    const double cm = cos_mount_, sm = sin_mount_;
     const double g[3] = {cm * angular_velocity_[0] + sm * angular_velocity_[1],
                          -sm * angular_velocity_[0] + cm * angular_velocity_[1],
                          angular_velocity_[2]};

@@ -30,22 +30,32 @@ namespace linesim::sensors {
 /// gives exposure time, gain, mean level and temporal noise for the
 /// surface's illumination plus `added_light`. Each of the 25 blocks draws
 /// the firmware's texture measure (compute_diff)
-///   M = 19.15 sqrt(D^2 X + N^2) + 3.83 N z,
+///   M = 19.15 (sqrt(D^2 X + N^2) + 0.2 N z),
 ///   D = 0.45 mean_dn contrast sqrt((1 + 1 / (1 + (blur_px / 1.8)^2)) / 2),
-///   N^2 = 2 noise_dn^2 + 1/6, X ~ Gamma(3, 1/3), z ~ N(0, 1),
-/// (19.15 = 24 sqrt(2/pi): 24 absolute differences of Gaussian variables;
-/// blur_px = |flow| * exposure * frame_rate; the constants 0.45, 1.8, 3 and
-/// the 0.2 noise-spread factor fitted to the image-level reference,
-/// px4flow_image.h) and is used when M >= feature_threshold. A used block
-/// matches the true offset with probability 1 / (1 + (0.18 / snr)^3),
-/// snr = D / noise_dn, plus N(0, (0.52 / snr)^2) per axis, quantized to
-/// half pixels; otherwise it matches noise (uniform over the search window).
-/// An axis whose true offset lies beyond search_range + 1/2 is aliased: the
-/// best SAD lies near the window's edge (S - 2 .. S + 1/2, uniform on the
-/// half-pixel grid), wrong and not flagged, as the image-level reference
-/// shows for a texture correlated over a few pixels. The frame's flow is
-/// the mean of the used blocks, valid when more than 10 are used; quality
-/// blocks * 255 / 25 (flow.c, compute_flow).
+///   N^2 = 2 noise_dn^2 + 1/6 (temporal noise and 8-bit rounding),
+///   X ~ Gamma(3, 1/3) (block-to-block texture), z of zero mean and unit
+///   variance (Irwin-Hall: a sum of four uniforms, close to normal, cheap),
+/// (19.15 = 24 sqrt(2/pi): the mean of 24 absolute differences of Gaussian
+/// variables; blur_px = |flow| * exposure * frame_rate) and is used when
+/// M >= feature_threshold. A used block matches the true offset with
+/// probability p = 1 / (1 + (0.18 / snr)^3), snr = D / noise_dn, plus
+/// min(0.42 / snr, 1) times such a z per axis, rounded to half pixels as the
+/// sub-pixel search does; otherwise it matches noise (uniform on the
+/// half-pixel grid within +-(S - 1/2)). Beyond the window (e = |flow| -
+/// (S + 1/2) > 0 on either axis) a block still finds the window's edge with
+/// probability exp(-(e / 2.3)^2) (the texture is correlated over a few
+/// pixels) and otherwise an unrelated patch anywhere in the window: the
+/// reading falls back towards 0 as the flow grows, wrong and not flagged.
+/// The frame's flow is the mean of the used blocks, valid when more than 10
+/// are used; quality = blocks * 255 / 25 (flow.c, compute_flow).
+///
+/// Calibration: 0.45, 1.8 and the Gamma shape come from the image-level
+/// reference's compute_diff mean and spread over contrast 0.02..0.3,
+/// 20..3000 lx, 0..0.7 m/s (texture lattice 1 mm, height 0.1841 m); 0.2 from
+/// its spread on a featureless image; 0.18, 0.42, 1 from its frame-flow
+/// bias and standard deviation at low light and contrast; 2.3 from its mean
+/// reading at 4.5..8 px/frame with S = 4. The agreement is checked by
+/// tests/units/sensors/px4flow_fast_vs_image_test.cc.
 ///
 /// Integration (main.c, OPTICAL_FLOW_RAD): over frames of quality > 0 only,
 /// integrated_x += flow_y / f, integrated_y -= flow_x / f, integration_time
@@ -83,6 +93,7 @@ class Px4FlowUnit : public cosim::Unit {
   struct BeltArea {
     models::Rect area;
     int surface;
+    double cos_dir, sin_dir;  // of area.direction_rad
   };
   std::vector<models::Surface> surfaces_;
   std::vector<BeltArea> belts_;
@@ -112,6 +123,7 @@ class Px4FlowUnit : public cosim::Unit {
 
   // Internal state.
   Px4FlowCamera cam_;
+  double cos_mount_ = 1.0, sin_mount_ = 0.0;  // of mount_yaw (CacheCamera)
   std::mt19937_64 rng_;
   cosim::TimeNs start_ = 0, next_frame_ = 0, next_publish_ = 0;
   std::int64_t frame_index_ = 0, publish_index_ = 0;

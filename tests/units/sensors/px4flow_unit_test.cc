@@ -76,8 +76,10 @@ TEST(Px4FlowUnit, TranslationFlowFollowsTheOpticsFormula) {
   EXPECT_EQ(surface, 0);
   EXPECT_NEAR(fx, 0.0, 1e-12);
   EXPECT_NEAR(fy, -0.1 * 0.0025 * 666.7 / kHeight, 1e-9);
-  // Sensor turned 90 deg on the robot: that motion is along the sensor's -x... +x.
+  // Sensor turned 90 deg on the robot (its x along base_link y): the
+  // surface's -y motion is along the sensor's -x.
   SetAll(u, "mount_yaw", std::numbers::pi / 2);
+  u.Initialize();  // a fixed parameter takes effect at initialization
   u.TrueFlow(fx, fy, surface);
   EXPECT_NEAR(fx, -0.1 * 0.0025 * 666.7 / kHeight, 1e-9);
   EXPECT_NEAR(fy, 0.0, 1e-9);
