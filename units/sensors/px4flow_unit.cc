@@ -229,7 +229,7 @@ void Px4FlowUnit::Initialize() {
   publish_index_ = 1;
   next_frame_ = start_ + static_cast<cosim::TimeNs>(std::llround(1e9 / frame_rate_));
   next_publish_ = start_ + static_cast<cosim::TimeNs>(std::llround(1e9 / publish_rate_));
-  acc_x_ = acc_y_ = acc_time_ = 0.0;
+  acc_x_ = acc_y_ = 0.0;
   acc_gyro_[0] = acc_gyro_[1] = acc_gyro_[2] = 0.0;
   acc_count_ = acc_quality_ = 0;
   integrated_x_ = integrated_y_ = integration_time_ = quality_ = frame_count_ = 0.0;
@@ -329,7 +329,6 @@ void Px4FlowUnit::Frame() {
     frame_flow_[1] = flow_y;
     acc_x_ += flow_y / focal_length_px_;
     acc_y_ -= flow_x / focal_length_px_;
-    acc_time_ += dt;
     // The board gyro, in the sensor frame (z down the optical axis is the
     // body z; the mount turns x, y by mount_yaw), saturating at its range.
     const double cm = cos_mount_, sm = sin_mount_;
@@ -352,22 +351,24 @@ void Px4FlowUnit::Frame() {
 void Px4FlowUnit::Publish() {
   integrated_x_ = acc_x_;
   integrated_y_ = acc_y_;
-  integration_time_ = acc_time_;
+  // Every counted frame adds one frame interval (main.c: deltatime since
+  // the previous frame): count / frame_rate, exact.
+  integration_time_ = static_cast<double>(acc_count_) / frame_rate_;
   frame_count_ = static_cast<double>(acc_count_);
   quality_ = acc_count_ > 0 ? static_cast<double>(acc_quality_ / acc_count_) : 0.0;
   for (int i = 0; i < 3; ++i) integrated_gyro_[static_cast<std::size_t>(i)] = acc_gyro_[i];
   double sonar = mount_height_;
   if (sonar_noise_ > 0.0) sonar += sonar_noise_ * Normal(rng_);
   distance_ = (sonar >= sonar_min_ && sonar <= sonar_max_) ? sonar : -1.0;
-  if (acc_count_ > 0 && acc_time_ > 0.0) {
+  if (acc_count_ > 0) {
     // Surface relative to the sensor: +flow / f / T * h; flow_x = -f * integrated_y.
-    velocity_[0] = -acc_y_ / acc_time_ * mount_height_;
-    velocity_[1] = acc_x_ / acc_time_ * mount_height_;
+    velocity_[0] = -acc_y_ / integration_time_ * mount_height_;
+    velocity_[1] = acc_x_ / integration_time_ * mount_height_;
     valid_ = 1.0;
   } else {
     valid_ = 0.0;
   }
-  acc_x_ = acc_y_ = acc_time_ = 0.0;
+  acc_x_ = acc_y_ = 0.0;
   acc_gyro_[0] = acc_gyro_[1] = acc_gyro_[2] = 0.0;
   acc_count_ = acc_quality_ = 0;
 }
@@ -399,21 +400,20 @@ void Px4FlowUnit::SaveInternal(cosim::UnitState& state) const {
   std::ostringstream rng;
   rng << rng_;
   state.strings = {rng.str()};
-  state.reals = {acc_x_, acc_y_, acc_time_, acc_gyro_[0], acc_gyro_[1], acc_gyro_[2]};
+  state.reals = {acc_x_, acc_y_, acc_gyro_[0], acc_gyro_[1], acc_gyro_[2]};
   state.integers = {start_,       next_frame_, next_publish_, frame_index_,
                     publish_index_, acc_count_, acc_quality_};
 }
 
 void Px4FlowUnit::RestoreInternal(const cosim::UnitState& state) {
-  if (state.strings.size() != 1 || state.reals.size() != 6 || state.integers.size() != 7) {
+  if (state.strings.size() != 1 || state.reals.size() != 5 || state.integers.size() != 7) {
     throw cosim::UnitError(Where() + ": saved state has the wrong shape");
   }
   std::istringstream rng(state.strings[0]);
   rng >> rng_;
   acc_x_ = state.reals[0];
   acc_y_ = state.reals[1];
-  acc_time_ = state.reals[2];
-  for (int i = 0; i < 3; ++i) acc_gyro_[i] = state.reals[static_cast<std::size_t>(3 + i)];
+  for (int i = 0; i < 3; ++i) acc_gyro_[i] = state.reals[static_cast<std::size_t>(2 + i)];
   start_ = state.integers[0];
   next_frame_ = state.integers[1];
   next_publish_ = state.integers[2];

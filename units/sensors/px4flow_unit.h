@@ -127,7 +127,7 @@ class Px4FlowUnit : public cosim::Unit {
   std::mt19937_64 rng_;
   cosim::TimeNs start_ = 0, next_frame_ = 0, next_publish_ = 0;
   std::int64_t frame_index_ = 0, publish_index_ = 0;
-  double acc_x_ = 0.0, acc_y_ = 0.0, acc_time_ = 0.0, acc_gyro_[3] = {0, 0, 0};
+  double acc_x_ = 0.0, acc_y_ = 0.0, acc_gyro_[3] = {0, 0, 0};
   std::int64_t acc_count_ = 0, acc_quality_ = 0;
 };
 
