@@ -1,0 +1,132 @@
+// The fast model of the px4flow unit against the image-level reference
+// (rendered frames + the firmware's compute_flow) over a grid of texture
+// contrast, light and speed: mean frame quality and flow noise (standard
+// deviation of the frame flow over many frames).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "tests/units/test_helpers.h"
+#include "units/sensors/px4flow_image.h"
+#include "units/sensors/px4flow_unit.h"
+
+namespace linesim::sensors {
+namespace {
+
+using cosim::TimeNs;
+constexpr double kHeight = 0.1841;  // paper 1
+
+struct Stats {
+  double quality = 0.0;  // mean frame quality over all frames
+  double mean = 0.0;     // mean frame flow x over frames of quality > 0
+  double std = 0.0;      // its standard deviation
+  int valid = 0;
+};
+
+Stats Summarize(const std::vector<double>& q, const std::vector<double>& f) {
+  Stats s;
+  double sum = 0.0, sq = 0.0;
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    s.quality += q[i];
+    if (q[i] > 0) {
+      sum += f[i];
+      sq += f[i] * f[i];
+      ++s.valid;
+    }
+  }
+  s.quality /= static_cast<double>(q.size());
+  if (s.valid > 1) {
+    s.mean = sum / s.valid;
+    s.std = std::sqrt(std::max(0.0, sq / s.valid - s.mean * s.mean));
+  }
+  return s;
+}
+
+Stats Image(double contrast, double lux, double v, int frames, std::uint64_t seed) {
+  Px4FlowCamera cam;
+  std::vector<double> q, f;
+  // Several textures (seeds), as the fast model's blocks are independent
+  // draws over many surface patches.
+  for (int k = 0; k < 4; ++k) {
+    Px4FlowImageModel m(cam, seed + static_cast<std::uint64_t>(k));
+    for (int i = 0; i < frames / 4; ++i) {
+      const FlowResult r = m.Step(v, 0.0, kHeight, contrast, lux);
+      q.push_back(r.quality);
+      f.push_back(r.flow_x_px);
+    }
+  }
+  return Summarize(q, f);
+}
+
+Stats Fast(double contrast, double lux, double v, int frames, std::uint64_t seed) {
+  models::Scene s;
+  s.surfaces.push_back({"floor", 0.8, contrast, lux});
+  s.floor = {-50, 50, -50, 50, 0};
+  Px4FlowUnit u("flow", s, seed);
+  test_helpers::SetAll(u, "mount_x", 0.0);
+  test_helpers::SetAll(u, "mount_y", 0.0);
+  test_helpers::SetAll(u, "mount_height", kHeight);
+  u.Setup(0, 1'000'000'000'000);
+  u.Initialize();
+  // The robot moving -x over the floor at rest: the surface moves +x.
+  test_helpers::SetArray(u, "linear_velocity", {-v, 0.0});
+  std::vector<double> q, f;
+  const TimeNs frame = 2'500'000;  // one frame per step at 400 Hz
+  for (int i = 0; i < frames; ++i) {
+    EXPECT_EQ(u.DoStep(i * frame, frame), cosim::StepResult::kOk);
+    q.push_back(test_helpers::Get(u, "frame_quality")[0]);
+    f.push_back(test_helpers::Get(u, "frame_flow")[0]);
+  }
+  return Summarize(q, f);
+}
+
+// Grid: contrast 0.02..0.3, light 20..1000 lx, speed 0..0.5 m/s (flow up
+// to 4.5 px/frame, inside the 2014 firmware's window). The figures of
+// agreement are printed; the assertions hold what the calibration reaches
+// (see the report in px4flow_unit.h): quality within one firmware step
+// (255/25 = 10.2) in most cells, noise within a factor given below.
+TEST(Px4FlowFastVsImage, QualityAndNoiseAgreeOverTheGrid) {
+  const double contrasts[] = {0.02, 0.05, 0.1, 0.3};
+  const double luxes[] = {20.0, 200.0, 1000.0};
+  const double speeds[] = {0.0, 0.25, 0.5};
+  constexpr int kImageFrames = 24, kFastFrames = 2000;
+  int cells = 0, quality_ok = 0, noise_ok = 0, noise_cells = 0, strict_ok = 0;
+  for (double c : contrasts) {
+    for (double lux : luxes) {
+      for (double v : speeds) {
+        const Stats im = Image(c, lux, v, kImageFrames, 100);
+        const Stats fa = Fast(c, lux, v, kFastFrames, 200);
+        ++cells;
+        const bool q_ok = std::abs(im.quality - fa.quality) <= 255.0 / 25.0;
+        quality_ok += q_ok;
+        // Noise compared where it is resolvable: the image reference's std
+        // over 24 frames is itself uncertain by ~15 %, and below 0.05 px
+        // it is dominated by the half-pixel quantization of a single texture.
+        bool n_ok = true;
+        if (im.std > 0.05 || fa.std > 0.05) {
+          ++noise_cells;
+          n_ok = std::abs(fa.std - im.std) <= 0.2 * std::max(im.std, 0.05) + 0.03;
+          noise_ok += n_ok;
+          strict_ok += std::abs(fa.std - im.std) <= 0.2 * im.std;
+        }
+        std::printf(
+            "c=%.2f lux=%6.0f v=%.2f | quality image %6.1f fast %6.1f %s | flow mean image "
+            "%6.3f fast %6.3f | std image %.3f fast %.3f %s\n",
+            c, lux, v, im.quality, fa.quality, q_ok ? "ok" : "--", im.mean, fa.mean, im.std,
+            fa.std, n_ok ? "ok" : "--");
+      }
+    }
+  }
+  std::printf(
+      "quality within one step: %d of %d cells; noise within 20 %% + 0.03 px: %d of %d cells, "
+      "within 20 %%: %d\n",
+      quality_ok, cells, noise_ok, noise_cells, strict_ok);
+  EXPECT_GE(quality_ok, cells * 3 / 4);
+  EXPECT_GE(noise_ok, noise_cells * 3 / 4);
+}
+
+}  // namespace
+}  // namespace linesim::sensors

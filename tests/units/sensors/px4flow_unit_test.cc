@@ -1,0 +1,394 @@
+#include "units/sensors/px4flow_unit.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "tests/units/test_helpers.h"
+#include "units/sensors/px4flow_image.h"
+
+namespace linesim::sensors {
+namespace {
+
+using cosim::TimeNs;
+using test_helpers::Get;
+using test_helpers::SetAll;
+using test_helpers::SetArray;
+
+constexpr TimeNs kMs = 1'000'000;
+constexpr double kHeight = 0.1841;  // paper 1: mount height of the four PX4Flow
+
+// A floor of one surface and one belt along x at y = 0 (10 m x 1 m).
+models::Scene Scene(double contrast, double lux) {
+  models::Scene s;
+  s.surfaces.push_back({"floor", 0.8, contrast, lux});
+  s.surfaces.push_back({"belt", 0.8, contrast, lux});
+  s.floor = {-50, 50, -50, 50, 0};
+  models::Belt b;
+  b.area = {0.0, 0.0, 10.0, 1.0, 0.0};
+  b.surface = 1;
+  s.belts.push_back(b);
+  return s;
+}
+
+void SetInt(Px4FlowUnit& u, const std::string& name, std::int64_t v) {
+  u.variables().SetValue(*u.variables().Find(name), cosim::Value{v});
+}
+
+void Mount(Px4FlowUnit& u, double mx = 0.0, double my = 0.0) {
+  SetAll(u, "mount_x", mx);
+  SetAll(u, "mount_y", my);
+  SetAll(u, "mount_height", kHeight);
+}
+
+void Start(Px4FlowUnit& u) {
+  u.Setup(0, 1000'000 * kMs);
+  u.Initialize();
+}
+
+void StepFor(Px4FlowUnit& u, TimeNs from, TimeNs to) {
+  for (TimeNs t = from; t < to; t += kMs) ASSERT_EQ(u.DoStep(t, kMs), cosim::StepResult::kOk);
+}
+
+// Optics: flow = v * dt * f / h px per frame (pinhole camera, flow.c's
+// focal_length_px). A belt at 0.2 m/s under a sensor at rest: 0.2 * 2.5 ms
+// * 666.7 / 0.1841 = 1.8106 px/frame along +x. With matching noise off
+// (texture strong, light bright: snr large) every block reads the true
+// flow rounded to half pixels: 2.0. TrueFlow gives the exact value.
+TEST(Px4FlowUnit, TranslationFlowFollowsTheOpticsFormula) {
+  Px4FlowUnit u("flow", Scene(0.3, 3000.0), 1);
+  Mount(u);
+  Start(u);
+  SetArray(u, "belt_velocity", {0.2, 0.0});
+  double fx, fy;
+  int surface;
+  u.TrueFlow(fx, fy, surface);
+  EXPECT_EQ(surface, 1);
+  EXPECT_NEAR(fx, 0.2 * 0.0025 * 666.7 / kHeight, 1e-9);
+  EXPECT_NEAR(fy, 0.0, 1e-12);
+  // Robot moving +y at 0.1 m/s over the floor: surface moves -y relative.
+  SetArray(u, "position", {0.0, 3.0});
+  SetArray(u, "linear_velocity", {0.0, 0.1});
+  u.TrueFlow(fx, fy, surface);
+  EXPECT_EQ(surface, 0);
+  EXPECT_NEAR(fx, 0.0, 1e-12);
+  EXPECT_NEAR(fy, -0.1 * 0.0025 * 666.7 / kHeight, 1e-9);
+  // Sensor turned 90 deg on the robot (its x along base_link y): the
+  // surface's -y motion is along the sensor's -x.
+  SetAll(u, "mount_yaw", std::numbers::pi / 2);
+  u.Initialize();  // a fixed parameter takes effect at initialization
+  u.TrueFlow(fx, fy, surface);
+  EXPECT_NEAR(fx, -0.1 * 0.0025 * 666.7 / kHeight, 1e-9);
+  EXPECT_NEAR(fy, 0.0, 1e-9);
+}
+
+// Rotation: a robot turning at omega about base_link moves a sensor at r by
+// omega x r; the surface (floor at rest) moves by -(omega x r) relative to
+// it. Sensor at (0.3, 0.2), yaw 0, omega = 0.5 rad/s: v_s = (-0.1, 0.15),
+// relative (0.1, -0.15) m/s. The integrated velocity output recovers it to
+// the half-pixel quantization averaged over 40 frames (texture strong, bright).
+TEST(Px4FlowUnit, RotationFlowIsOmegaCrossR) {
+  Px4FlowUnit u("flow", Scene(0.3, 3000.0), 2);
+  Mount(u, 0.3, 0.2);
+  Start(u);
+  SetArray(u, "position", {0.0, 5.0});
+  SetAll(u, "yaw_rate", 0.5);
+  double fx, fy;
+  int surface;
+  u.TrueFlow(fx, fy, surface);
+  const double k = 0.0025 * 666.7 / kHeight;
+  EXPECT_NEAR(fx, 0.1 * k, 1e-9);
+  EXPECT_NEAR(fy, -0.15 * k, 1e-9);
+  StepFor(u, 0, 100 * kMs);
+  EXPECT_EQ(Get(u, "valid")[0], 1.0);
+  // Half-pixel quantization of 0.905 and -1.358 px with block noise
+  // ~0.03 px: within 0.3 px / frame -> 0.3 / k m/s.
+  EXPECT_NEAR(Get(u, "velocity")[0], 0.1, 0.3 / k);
+  EXPECT_NEAR(Get(u, "velocity")[1], -0.15, 0.3 / k);
+}
+
+// At zero noise-free conditions the frame flow is the mean of blocks each
+// reading round_half(true + small noise): for a true flow on the half grid
+// (belt speed giving exactly 2.0 px/frame) every block reads 2.0.
+TEST(Px4FlowUnit, FrameFlowOnTheHalfPixelGridIsExact) {
+  Px4FlowUnit u("flow", Scene(0.3, 3000.0), 3);
+  Mount(u);
+  Start(u);
+  const double v = 2.0 * kHeight / (0.0025 * 666.7);
+  SetArray(u, "belt_velocity", {v, 0.0});
+  StepFor(u, 0, 10 * kMs);
+  EXPECT_EQ(Get(u, "frame_quality")[0], 255.0);
+  EXPECT_DOUBLE_EQ(Get(u, "frame_flow")[0], 2.0);
+  EXPECT_DOUBLE_EQ(Get(u, "frame_flow")[1], 0.0);
+}
+
+// Quality against light and texture: the firmware's validity needs more
+// than 10 of 25 blocks whose compute_diff reaches BFLOW_F_THLD (flow.c).
+// A featureless surface at low noise (contrast 0, bright: noise 1.13 DN
+// gives a noise-only measure 19.15 * sqrt(2 * 1.13^2 + 1/6) = 31.6 with
+// 20 % spread) against a threshold of 60: every frame fails, quality 0,
+// integration time 0, velocity held with valid 0. The same with a strong
+// texture passes every frame: quality 255.
+TEST(Px4FlowUnit, QualityFollowsTextureAndTheThreshold) {
+  for (double contrast : {0.0, 0.3}) {
+    Px4FlowUnit u("flow", Scene(contrast, 1000.0), 4);
+    Mount(u);
+    SetInt(u, "feature_threshold", 60);
+    Start(u);
+    StepFor(u, 0, 200 * kMs);
+    if (contrast == 0.0) {
+      EXPECT_EQ(Get(u, "quality")[0], 0.0);
+      EXPECT_EQ(Get(u, "integration_time")[0], 0.0);
+      EXPECT_EQ(Get(u, "valid")[0], 0.0);
+    } else {
+      // A strong texture: (almost) every block passes; a rare block whose
+      // patch happens to be flat fails (X ~ Gamma(3) near 0).
+      EXPECT_GE(Get(u, "quality")[0], 245.0);
+      EXPECT_NEAR(Get(u, "integration_time")[0], 0.1, 1e-9);
+      EXPECT_EQ(Get(u, "valid")[0], 1.0);
+    }
+  }
+}
+
+// Darkness: at 5 lx the AEC saturates (2.5 ms, gain 4): the mean level is
+// 42 * 5 * 0.0025 * 4 = 2.1 DN, the texture's neighbour difference
+// 0.45 * 2.1 * 0.1 = 0.09 DN against 2 DN of noise; the blocks that pass
+// the texture test on noise alone match noise, so the flow no longer
+// follows the belt (the firmware's "compute_diff is not appropriate for
+// low-light images"). With 3000 lx added light the same belt reads true.
+TEST(Px4FlowUnit, DarknessLosesTheFlowAndAddedLightRestoresIt) {
+  const double v = 0.2;
+  const double truth = v * 0.0025 * 666.7 / kHeight;
+  double mean_flow[2];
+  for (int lit = 0; lit < 2; ++lit) {
+    Px4FlowUnit u("flow", Scene(0.1, 5.0), 5);
+    Mount(u);
+    SetAll(u, "added_light", lit ? 3000.0 : 0.0);
+    Start(u);
+    SetArray(u, "belt_velocity", {v, 0.0});
+    double sum = 0.0;
+    int n = 0;
+    for (TimeNs t = 0; t < 500 * kMs; t += kMs) {
+      ASSERT_EQ(u.DoStep(t, kMs), cosim::StepResult::kOk);
+      if ((t / kMs) % 5 == 4 && Get(u, "frame_quality")[0] > 0) {
+        sum += Get(u, "frame_flow")[0];
+        ++n;
+      }
+    }
+    mean_flow[lit] = n > 0 ? sum / n : 0.0;
+  }
+  EXPECT_LT(mean_flow[0], 0.5 * truth);
+  EXPECT_NEAR(mean_flow[1], truth, 0.25);
+}
+
+// Search window: flow.c searches +-S integer pixels and refines by half a
+// pixel, so the largest measurable flow is S + 0.5 = 4.5 px/frame (S = 4),
+// 8.5 with S = 8. A belt at 6 px/frame reads, with full quality and no
+// flag, a wrong value inside the window: the image-level reference (the
+// firmware's search on rendered frames) reads 3.0 on average (some blocks
+// still find the window's edge, the others unrelated patches), and so must
+// the fast model, well below 6; with S = 8 it reads 6.
+TEST(Px4FlowUnit, FlowBeyondTheSearchWindowIsAliased) {
+  const double px = 6.0;
+  const double v = px * kHeight / (0.0025 * 666.7);
+  double image_mean = 0.0;
+  {
+    Px4FlowCamera cam;
+    int n = 0;
+    for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+      Px4FlowImageModel m(cam, seed);
+      for (int i = 0; i < 5; ++i) {
+        const FlowResult r = m.Step(v, 0.0, kHeight, 0.3, 3000.0);
+        EXPECT_EQ(r.quality, 255);
+        image_mean += r.flow_x_px;
+        ++n;
+      }
+    }
+    image_mean /= n;
+  }
+  EXPECT_LT(image_mean, 4.5);
+  EXPECT_GT(image_mean, 1.5);
+  for (std::int64_t s : {4, 8}) {
+    Px4FlowUnit u("flow", Scene(0.3, 3000.0), 6);
+    Mount(u);
+    SetInt(u, "search_range", s);
+    Start(u);
+    SetArray(u, "belt_velocity", {v, 0.0});
+    double sum = 0.0;
+    int n = 0;
+    for (TimeNs t = 0; t < 500 * kMs; t += kMs) {
+      ASSERT_EQ(u.DoStep(t, kMs), cosim::StepResult::kOk);
+      if ((t / kMs) % 5 == 4) {
+        EXPECT_EQ(Get(u, "frame_quality")[0], 255.0);
+        sum += Get(u, "frame_flow")[0];
+        ++n;
+      }
+    }
+    if (s == 4) {
+      EXPECT_NEAR(sum / n, image_mean, 0.5);
+    } else {
+      EXPECT_NEAR(sum / n, px, 0.05);
+    }
+  }
+}
+
+// OPTICAL_FLOW_RAD (main.c): integration over frames with quality > 0
+// only. The belt leaves the sensor's point half-way: on a textured belt
+// (contrast 0.3) for 50 ms, then on a featureless floor (contrast 0) with
+// a threshold the noise alone cannot reach: 20 frames of 2.5 ms count, the
+// other 20 do not: integration_time = 0.05 s, and integrated_y = -sum(flow_x)
+// / f = -20 * 2.0 / 666.7 for a flow of exactly 2 px/frame.
+TEST(Px4FlowUnit, IntegrationCountsOnlyFramesWithQuality) {
+  models::Scene s = Scene(0.3, 3000.0);
+  s.surfaces[0].texture_contrast = 0.0;
+  Px4FlowUnit u("flow", s, 7);
+  Mount(u);
+  SetInt(u, "feature_threshold", 60);
+  SetAll(u, "sonar_noise", 0.0);
+  Start(u);
+  const double v = 2.0 * kHeight / (0.0025 * 666.7);
+  SetArray(u, "belt_velocity", {v, 0.0});
+  SetArray(u, "position", {0.0, 0.0});
+  StepFor(u, 0, 50 * kMs);
+  SetArray(u, "position", {0.0, 3.0});  // over the floor now (at rest: flow 0)
+  StepFor(u, 50 * kMs, 100 * kMs);
+  EXPECT_NEAR(Get(u, "integration_time")[0], 0.05, 1e-12);
+  EXPECT_EQ(Get(u, "frame_count")[0], 20.0);
+  EXPECT_GE(Get(u, "quality")[0], 245.0);
+  EXPECT_NEAR(Get(u, "integrated_y")[0], -20 * 2.0 / 666.7, 1e-12);
+  EXPECT_NEAR(Get(u, "integrated_x")[0], 0.0, 1e-12);
+  EXPECT_NEAR(Get(u, "velocity")[0], v, 1e-9);
+  EXPECT_DOUBLE_EQ(Get(u, "distance")[0], kHeight);
+}
+
+// The sonar's valid window (sonar.c 0.12..3.5 m): a sensor mounted at
+// 0.1 m reports distance -1 (unknown).
+TEST(Px4FlowUnit, SonarOutsideItsRangeIsFlaggedInvalid) {
+  Px4FlowUnit u("flow", Scene(0.3, 3000.0), 8);
+  Mount(u);
+  SetAll(u, "mount_height", 0.1);
+  Start(u);
+  StepFor(u, 0, 100 * kMs);
+  EXPECT_EQ(Get(u, "distance")[0], -1.0);
+}
+
+// Integrated gyro: omega_z * integration time over the valid frames.
+TEST(Px4FlowUnit, IntegratedGyroIsRateTimesIntegrationTime) {
+  Px4FlowUnit u("flow", Scene(0.3, 3000.0), 9);
+  Mount(u);
+  SetAll(u, "gyro_noise", 0.0);
+  Start(u);
+  SetArray(u, "angular_velocity", {0.0, 0.0, 0.3});
+  StepFor(u, 0, 100 * kMs);
+  EXPECT_NEAR(Get(u, "integrated_gyro")[2], 0.3 * Get(u, "integration_time")[0], 1e-12);
+  EXPECT_NEAR(Get(u, "integration_time")[0], 0.1, 1e-12);
+}
+
+std::vector<double> Stream(std::uint64_t seed, TimeNs until) {
+  Px4FlowUnit u("flow", Scene(0.05, 300.0), seed);
+  Mount(u);
+  Start(u);
+  SetArray(u, "belt_velocity", {0.15, 0.02});
+  std::vector<double> out;
+  for (TimeNs t = 0; t < until; t += kMs) {
+    EXPECT_EQ(u.DoStep(t, kMs), cosim::StepResult::kOk);
+    const auto o = test_helpers::Outputs(u);
+    out.insert(out.end(), o.begin(), o.end());
+  }
+  return out;
+}
+
+// Determinism: the same seed gives the same bytes, another seed another
+// stream (contrast 0.05 at 300 lx: noisy flow).
+TEST(Px4FlowUnit, SameSeedSameBytesOtherSeedOtherStream) {
+  const auto a = Stream(11, 300 * kMs), b = Stream(11, 300 * kMs), c = Stream(12, 300 * kMs);
+  EXPECT_TRUE(test_helpers::SameBits(a, b));
+  EXPECT_FALSE(test_helpers::SameBits(a, c));
+}
+
+// Save/restore: a unit restored from a state saved mid-message continues
+// bit for bit like the original.
+TEST(Px4FlowUnit, RestoredUnitContinuesIdentically) {
+  Px4FlowUnit u("flow", Scene(0.05, 300.0), 21), w("flow", Scene(0.05, 300.0), 99);
+  for (auto* x : {&u, &w}) {
+    Mount(*x);
+    Start(*x);
+    SetArray(*x, "belt_velocity", {0.15, 0.02});
+  }
+  StepFor(u, 0, 137 * kMs);
+  const cosim::UnitState s = u.SaveState();
+  w.RestoreState(s);
+  for (TimeNs t = 137 * kMs; t < 400 * kMs; t += kMs) {
+    ASSERT_EQ(u.DoStep(t, kMs), cosim::StepResult::kOk);
+    ASSERT_EQ(w.DoStep(t, kMs), cosim::StepResult::kOk);
+    ASSERT_TRUE(test_helpers::SameBits(test_helpers::Outputs(u), test_helpers::Outputs(w)))
+        << cosim::FormatSeconds(t);
+  }
+}
+
+// Parameter errors: a missing mount, a bad range and inconsistent pairs
+// are each reported by name.
+TEST(Px4FlowUnit, ReportsParameterProblems) {
+  Px4FlowUnit u("flow", Scene(0.3, 500.0), 1);
+  SetInt(u, "search_range", 9);
+  SetAll(u, "sonar_min", 4.0);
+  SetAll(u, "publish_rate", 500.0);
+  const auto problems = u.CheckParameters();
+  std::string all;
+  for (const auto& p : problems) all += p.variable + ": " + p.message + "\n";
+  for (const char* name :
+       {"mount_x", "mount_y", "mount_height", "search_range", "sonar_max", "publish_rate"}) {
+    EXPECT_NE(all.find(std::string(name) + ":"), std::string::npos) << name << "\n" << all;
+  }
+  EXPECT_THROW(u.Initialize(), cosim::UnitError);
+}
+
+// The variable table: inputs, belt input only with belts, outputs.
+TEST(Px4FlowUnit, DeclaresBeltVelocityOnlyWithBelts) {
+  models::Scene s = Scene(0.3, 500.0);
+  s.belts.clear();
+  Px4FlowUnit u("flow", s, 1);
+  EXPECT_FALSE(u.variables().Find("belt_velocity"));
+  Px4FlowUnit w("flow", Scene(0.3, 500.0), 1);
+  EXPECT_TRUE(w.variables().Find("belt_velocity"));
+  for (const char* name : {"integrated_x", "integrated_y", "integration_time", "quality",
+                           "integrated_gyro", "distance", "velocity", "valid", "frame_quality",
+                           "frame_flow", "frame_count"}) {
+    EXPECT_TRUE(w.variables().Find(name)) << name;
+  }
+}
+
+// The firmware's texture measure on a known pattern: a 4x4 checkerboard
+// of 0 and 10 has 24 neighbour pairs each differing by 10: 240.
+TEST(Px4FlowImage, ComputeDiffOfACheckerboard) {
+  Image img{};
+  for (int y = 0; y < kImageSize; ++y) {
+    for (int x = 0; x < kImageSize; ++x) img[y * kImageSize + x] = ((x + y) % 2) ? 10 : 0;
+  }
+  EXPECT_EQ(ComputeDiff(img, 8, 8), 240);
+}
+
+// compute_flow on an image and its copy shifted by an integer (3, -2):
+// every textured block finds it exactly, quality 255.
+TEST(Px4FlowImage, ComputeFlowFindsAnIntegerShift) {
+  Px4FlowCamera cam;
+  Px4FlowImageModel m(cam, 5);
+  Image a{}, b{};
+  m.Render(0.0, 0.0, 0.0, 0.0, kHeight, 0.3, 3000.0, a);
+  for (int y = 0; y < kImageSize; ++y) {
+    for (int x = 0; x < kImageSize; ++x) {
+      const int sx = std::clamp(x - 3, 0, kImageSize - 1), sy = std::clamp(y + 2, 0, kImageSize - 1);
+      b[y * kImageSize + x] = a[sy * kImageSize + sx];
+    }
+  }
+  const FlowResult r = ComputeFlow(a, b, 4, 30);
+  EXPECT_EQ(r.quality, 255);
+  EXPECT_DOUBLE_EQ(r.flow_x_px, 3.0);
+  EXPECT_DOUBLE_EQ(r.flow_y_px, -2.0);
+}
+
+}  // namespace
+}  // namespace linesim::sensors

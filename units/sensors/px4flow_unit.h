@@ -1,0 +1,134 @@
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "cosim/time.h"
+#include "cosim/unit.h"
+#include "models/scene.h"
+#include "units/sensors/px4flow_image.h"
+
+namespace linesim::sensors {
+
+/// One PX4Flow optic-flow sensor looking straight down from a fixed height
+/// (paper 1, Unhelkar et al. ICRA 2014: four of them at 0.1841 m at the
+/// corners of the Rob@Work 3, with an added light).
+///
+/// Physics: the velocity of the surface under the sensor point (its belt's
+/// `belt_velocity` when the point lies on a scene belt, else 0) relative to
+/// the sensor point (v + omega x r), in the sensor frame; the true flow is
+/// that velocity * frame interval * focal_length_px / mount_height px per
+/// frame, positive along the surface's motion in the image, so that the
+/// firmware's velocity -flow/f/dt*distance is the sensor's velocity over
+/// the surface.
+///
+/// Fast model, per camera frame (frames at k / frame_rate from the start,
+/// computed inside the step that contains them): auto exposure (AutoExposure)
+/// gives exposure time, gain, mean level and temporal noise for the
+/// surface's illumination plus `added_light`. Each of the 25 blocks draws
+/// the firmware's texture measure (compute_diff)
+///   M = 19.15 (sqrt(D^2 X + N^2) + 0.2 N z),
+///   D = 0.45 mean_dn contrast sqrt((1 + 1 / (1 + (blur_px / 1.8)^2)) / 2),
+///   N^2 = 2 noise_dn^2 + 1/6 (temporal noise and 8-bit rounding),
+///   X ~ Gamma(3, 1/3) (block-to-block texture), z of zero mean and unit
+///   variance (Irwin-Hall: a sum of four uniforms, close to normal, cheap),
+/// (19.15 = 24 sqrt(2/pi): the mean of 24 absolute differences of Gaussian
+/// variables; blur_px = |flow| * exposure * frame_rate) and is used when
+/// M >= feature_threshold. A used block matches the true offset with
+/// probability p = 1 / (1 + (0.18 / snr)^3), snr = D / noise_dn, plus
+/// min(0.42 / snr, 1) times such a z per axis, rounded to half pixels as the
+/// sub-pixel search does; otherwise it matches noise (uniform on the
+/// half-pixel grid within +-(S - 1/2)). Beyond the window (e = |flow| -
+/// (S + 1/2) > 0 on either axis) a block still finds the window's edge with
+/// probability exp(-(e / 2.3)^2) (the texture is correlated over a few
+/// pixels) and otherwise an unrelated patch anywhere in the window: the
+/// reading falls back towards 0 as the flow grows, wrong and not flagged.
+/// The frame's flow is the mean of the used blocks, valid when more than 10
+/// are used; quality = blocks * 255 / 25 (flow.c, compute_flow).
+///
+/// Calibration: 0.45, 1.8 and the Gamma shape come from the image-level
+/// reference's compute_diff mean and spread over contrast 0.02..0.3,
+/// 20..3000 lx, 0..0.7 m/s (texture lattice 1 mm, height 0.1841 m); 0.2 from
+/// its spread on a featureless image; 0.18, 0.42, 1 from its frame-flow
+/// bias and standard deviation at low light and contrast; 2.3 from its mean
+/// reading at 4.5..8 px/frame with S = 4. The agreement is checked by
+/// tests/units/sensors/px4flow_fast_vs_image_test.cc.
+///
+/// Integration (main.c, OPTICAL_FLOW_RAD): over frames of quality > 0 only,
+/// integrated_x += flow_y / f, integrated_y -= flow_x / f, integration_time
+/// += frame interval, integrated_gyro += gyro * frame interval, quality sum;
+/// published and reset at publish_rate.
+class Px4FlowUnit : public cosim::Unit {
+ public:
+  static constexpr const char* kTypeName = "px4flow";
+
+  /// The scene gives the surfaces (texture contrast, illumination), the
+  /// floor's surface and the belts (area, surface); one `belt_velocity`
+  /// pair per scene belt is an input when the scene has belts.
+  Px4FlowUnit(std::string name, const models::Scene& scene, std::uint64_t seed);
+
+  std::vector<cosim::ParameterProblem> CheckParameters() const override;
+  void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
+  void Initialize() override;
+  cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
+
+  /// The camera/firmware settings the parameters make (valid after
+  /// Initialize).
+  const Px4FlowCamera& camera() const { return cam_; }
+  /// True flow (px per frame, sensor frame) at the current inputs.
+  void TrueFlow(double& fx, double& fy, int& surface) const;
+
+ protected:
+  void SaveInternal(cosim::UnitState& state) const override;
+  void RestoreInternal(const cosim::UnitState& state) override;
+
+ private:
+  void CacheCamera();
+  void Frame();
+  void Publish();
+
+  struct BeltArea {
+    models::Rect area;
+    int surface;
+    double cos_dir, sin_dir;  // of area.direction_rad
+  };
+  std::vector<models::Surface> surfaces_;
+  std::vector<BeltArea> belts_;
+  int floor_surface_ = 0;
+
+  // Parameters.
+  double mount_x_ = std::numeric_limits<double>::quiet_NaN();  // required
+  double mount_y_ = std::numeric_limits<double>::quiet_NaN();
+  double mount_height_ = std::numeric_limits<double>::quiet_NaN();
+  double mount_yaw_ = 0.0;
+  double focal_length_px_ = 666.7, frame_rate_ = 400.0, publish_rate_ = 10.0;
+  std::int64_t feature_threshold_ = 30, search_range_ = 4;
+  double max_exposure_ = 0.0025, max_gain_ = 4.0, target_brightness_ = 80.0;
+  double responsivity_ = 42.0, shot_noise_gain_ = 0.0128, read_noise_ = 0.5;
+  double added_light_ = 0.0;
+  double sonar_noise_ = 0.005, sonar_min_ = 0.12, sonar_max_ = 3.5;
+  double gyro_noise_ = 0.0, gyro_range_ = 4.363323129985824;  // 250 deg/s
+
+  // Inputs.
+  std::vector<double> position_, linear_velocity_, angular_velocity_, belt_velocity_;
+  double yaw_ = 0.0, yaw_rate_ = 0.0;
+
+  // Outputs.
+  double integrated_x_ = 0.0, integrated_y_ = 0.0, integration_time_ = 0.0, quality_ = 0.0;
+  std::vector<double> integrated_gyro_, velocity_, frame_flow_;
+  double distance_ = -1.0, valid_ = 0.0, frame_quality_ = 0.0, frame_count_ = 0.0;
+
+  // Internal state.
+  Px4FlowCamera cam_;
+  double cos_mount_ = 1.0, sin_mount_ = 0.0;  // of mount_yaw (CacheCamera)
+  std::mt19937_64 rng_;
+  cosim::TimeNs start_ = 0, next_frame_ = 0, next_publish_ = 0;
+  std::int64_t frame_index_ = 0, publish_index_ = 0;
+  double acc_x_ = 0.0, acc_y_ = 0.0, acc_gyro_[3] = {0, 0, 0};
+  std::int64_t acc_count_ = 0, acc_quality_ = 0;
+};
+
+}  // namespace linesim::sensors
