@@ -31,7 +31,7 @@ struct UnitBuildContext {
   /// models::OpenFloor() when the scenario names none.
   const models::Scene& scene;
   /// The unit's model file (`parameters.model`, read from the type's
-  /// model_folder), undefined when it names none; and its path, for
+  /// model_folder): a map, or a null node when it names none; and its path, for
   /// messages (YamlReader::InFile). A factory reads its structural keys
   /// from it when the parameters do not give them; the loader applies the
   /// file's other keys as parameters.

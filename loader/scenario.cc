@@ -249,7 +249,7 @@ class Builder {
 
     // Model file first, then the scenario's own values on top. The model's
     // structural keys were the factory's.
-    if (model.IsDefined()) {
+    if (model.IsMap()) {
       const YamlReader::InFile in_model(r_, model_file);
       std::vector<std::string> skipped = structural;
       skipped.insert(skipped.end(), {"source", "description"});

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <map>
 #include <set>
 
@@ -38,7 +39,8 @@ const std::map<std::string, KindWiring>& Wiring() {
          {"angular_velocity", "angular_velocity"}},
         {{"travel", "belt_travel"}, {"speed", "belt_speed"}},
         0}},
-      // 100 Hz: a typical output rate of a robot base's IMU driver.
+      // 100 Hz (a typical output rate of a robot base's IMU driver), as a
+      // whole number of master steps.
       {"imu",
        {{{"orientation", "orientation"},
          {"velocity_3d", "velocity_3d"},
@@ -49,6 +51,12 @@ const std::map<std::string, KindWiring>& Wiring() {
       {"wheel_encoder", {{}, {}, 0}},
   };
   return wiring;
+}
+
+// `period` rounded up to a whole number of master steps (at least one).
+cosim::TimeNs WholeMasterSteps(cosim::TimeNs period, cosim::TimeNs master_step) {
+  if (master_step <= 0) return period;
+  return std::max<cosim::TimeNs>(1, (period + master_step - 1) / master_step) * master_step;
 }
 
 // The mount's pose as the sensor unit's parameters.
@@ -118,7 +126,7 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
                          const std::vector<std::string>& extra_keys,
                          const std::set<std::string>& derived) {
     const std::string path = JoinPath("sensors", name);
-    if (c.node.IsDefined()) {
+    if (c.node.IsMap()) {
       std::vector<std::string> allowed = {"enabled", "step_s", "model", "parameters"};
       allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
       r.CheckKeys(c.node, path, allowed);
@@ -196,9 +204,21 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
         b.Connect(Signal(kBelt, from), Signal(m.name, to));
       }
     }
-    cosim::TimeNs step = wiring->second.default_step;
-    if (m.kind == "wheel_encoder") step = control_period;
-    if (m.step_s > 0) step = cosim::SecondsToNs(m.step_s);
+    // The step and where it comes from (a master-step problem with it is
+    // reported there): the mount's step_s, the control period (encoders),
+    // the kind's rate as a whole number of master steps, or the master's.
+    const std::string step_key = JoinPath(JoinPath("units", m.name), "step_s");
+    cosim::TimeNs step = 0;
+    if (m.step_s > 0) {
+      step = cosim::SecondsToNs(m.step_s);
+      b.Origin(step_key, {YAML::Node(), JoinPath(mount_path, "step_s"), robot.file});
+    } else if (m.kind == "wheel_encoder") {
+      step = control_period;
+      b.Derived(step_key, Child(b.root(), "control"), "control", "period_s");
+    } else if (wiring->second.default_step > 0) {
+      step = WholeMasterSteps(wiring->second.default_step, b.MasterStep());
+      b.Origin(step_key, {section, JoinPath(JoinPath("sensors", m.name), "step_s"), ""});
+    }
     apply(m.name, c, step, {}, derived);
     s.sensors.push_back({m.name, m.kind, m});
   }
@@ -209,20 +229,22 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
   if (gt.on && s.belt_count > 0) {
     const std::string path = JoinPath("sensors", kBeltGroundTruth);
     const std::int64_t belt =
-        gt.node.IsDefined()
+        gt.node.IsMap()
             ? r.Integer(gt.node, path, "belt", 0, 0, static_cast<std::int64_t>(s.belt_count) - 1)
             : 0;
     b.Unit(kBeltGroundTruth, "belt_encoder");
     b.Params(kBeltGroundTruth)["model"] = "belt_ground_truth_encoder";
     b.Connect(Element(kBelt, "travel", static_cast<std::size_t>(belt)),
               Signal(kBeltGroundTruth, "travel"));
-    // The Arduino of paper 1's sensor reports at 50 Hz (ASSUMPTION: the
-    // paper gives no rate; fast enough to show a belt start of ~0.5 s).
-    apply(kBeltGroundTruth, gt, cosim::kNsPerSecond / 50, {"belt"}, {});
+    // Sampled at the control period (ASSUMPTION: paper 1 gives no rate for
+    // its Arduino; the controllers' 50 Hz shows a belt start of ~1 s well).
+    b.Derived(JoinPath(JoinPath("units", kBeltGroundTruth), "step_s"), Child(b.root(), "control"),
+              "control", "period_s");
+    apply(kBeltGroundTruth, gt, control_period, {"belt"}, {});
     s.recorded.push_back(Signal(kBeltGroundTruth, "speed"));
     s.belt_ground_truth = Signal(kBeltGroundTruth, "speed");
     s.belt_ground_truth_belt = static_cast<int>(belt);
-  } else if (gt.node.IsDefined() && gt.on && s.belt_count == 0) {
+  } else if (gt.node.IsMap() && gt.on && s.belt_count == 0) {
     r.Error(gt.node, JoinPath("sensors", kBeltGroundTruth),
             "the scene has no belts for the belt's ground-truth sensor to measure");
   }

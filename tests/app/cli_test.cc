@@ -120,7 +120,7 @@ TEST(Cli, BadInputExitsTwoAndWritesNothing) {
 const std::string kCrossLine = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
 
 // Guards the README's main job, shortened: a robot scenario runs, prints its
-// metric and writes the three plots as PNG files (signature bytes) beside
+// metric and writes the four plots as PNG files (signature bytes) beside
 // the summary, which lists them.
 TEST(Cli, RobotRunWritesPlots) {
   const std::string out = Fresh("robot_run");
@@ -128,8 +128,8 @@ TEST(Cli, RobotRunWritesPlots) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("max_path_deviation_m"), std::string::npos) << r.out;
   const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
-  EXPECT_EQ(summary["plots"]["files"].size(), 3u) << summary.dump();
-  for (const char* png : {"top_view.png", "error.png", "belt.png"}) {
+  EXPECT_EQ(summary["plots"]["files"].size(), 4u) << summary.dump();
+  for (const char* png : {"top_view.png", "error.png", "belt.png", "optic_flow.png"}) {
     EXPECT_EQ(ReadFile(fs::path(out) / png).substr(0, 8), "\x89PNG\r\n\x1a\n") << png;
   }
   EXPECT_TRUE(fs::exists(fs::path(out) / "plots.gp"));

@@ -60,7 +60,10 @@ TEST(RobotFile, ShippedRobotsRead) {
   EXPECT_EQ(r.motor_groups[1].gear_ratio, 21.0);
   EXPECT_EQ(r.motor_groups[1].motor.at("gear_ratio"), 21.0);
   EXPECT_EQ(r.motor_groups[1].motor.at("torque_constant"), 0.0302);  // maxon RE 40 sheet
-  EXPECT_EQ(r.sensor_mounts.size(), 6u);
+  // 4 PX4Flow, 2 S300, an IMU, the joint encoders.
+  ASSERT_EQ(r.sensor_mounts.size(), 8u);
+  EXPECT_EQ(r.sensor_mounts[4].model, "sick_s300");
+  EXPECT_EQ(r.sensor_mounts[7].kind, "wheel_encoder");
 
   const Read husky = ReadModel("husky");
   ASSERT_TRUE(husky.file) << husky.issues;
@@ -71,6 +74,8 @@ TEST(RobotFile, ShippedRobotsRead) {
   EXPECT_EQ(h.wheels[0].drive_motor, h.wheels[1].drive_motor);  // belt-coupled side
   EXPECT_EQ(h.wheels[0].radius_m, 0.1651);
   EXPECT_EQ(h.Motors().size(), 2u);
+  ASSERT_EQ(h.sensor_mounts.size(), 3u);
+  EXPECT_EQ(h.sensor_mounts[0].model, "sick_lms151");
 }
 
 // Guards "no silent default": a description that leaves out a required

@@ -347,7 +347,7 @@ TEST(RobotScenario, MasterProblemsOfExpandedUnitsPointAtRobotLevelKeys) {
   const std::string f = WriteScenario("robot_own_step.yaml",
                                       text + "units:\n  wheel_controller:\n    step_s: 0.0153\n");
   const std::string g = Issues(f);
-  EXPECT_TRUE(Has(g, f + ":38: units.wheel_controller.step_s: unit 'wheel_controller' step 0.0153"))
+  EXPECT_TRUE(Has(g, f + ":43: units.wheel_controller.step_s: unit 'wheel_controller' step 0.0153"))
       << g;
   EXPECT_FALSE(Has(g, "control.period_s")) << g;
 }

@@ -76,11 +76,14 @@ TEST(SceneFile, FactoryLineLoads) {
   }
   EXPECT_EQ(pillars, 10);
   EXPECT_NEAR(s.obstacles[2].solid.yaw_rad, 0.5 * std::numbers::pi, 1e-15);  // west wall
-  ASSERT_EQ(s.carried.size(), 2u);
+  // Two car bodies, each on two skids.
+  ASSERT_EQ(s.carried.size(), 6u);
   EXPECT_EQ(s.carried[0].belt, 0);
   EXPECT_DOUBLE_EQ(s.carried[0].solid.x_m, -7.0);
   EXPECT_DOUBLE_EQ(s.carried[1].solid.x_m, 5.0);
   EXPECT_DOUBLE_EQ(s.carried[1].solid.bottom_m, 0.3);
+  EXPECT_DOUBLE_EQ(s.carried[2].solid.y_m, 0.6);
+  EXPECT_DOUBLE_EQ(s.carried[5].solid.height_m, 0.3);
   EXPECT_TRUE(s.terrain.empty());
 }
 
@@ -230,6 +233,10 @@ TEST(ScenarioScene, ProblemsAreReportedWhereTheyAreWritten) {
   carried:
     - {}
     - {}
+    - {}
+    - {}
+    - {}
+    - {}
     - {name: body_3, belt: line}
 )");
   const std::string issues = Issues(f);
@@ -237,7 +244,7 @@ TEST(ScenarioScene, ProblemsAreReportedWhereTheyAreWritten) {
   EXPECT_TRUE(Has(issues, f + ":17: scene.belts.0.speed_mp: unknown key; closest: "
                               "scene.belts.0.speed_mps"))
       << issues;
-  EXPECT_TRUE(Has(issues, f + ":21: scene.carried.2.box: missing required key")) << issues;
+  EXPECT_TRUE(Has(issues, f + ":25: scene.carried.6.box: missing required key")) << issues;
   EXPECT_FALSE(Has(issues, "factory_line.yaml")) << issues;
 
   const std::string typos = Issues(WriteScenario(

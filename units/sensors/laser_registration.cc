@@ -26,7 +26,7 @@ Source Find(const UnitBuildContext& c, const std::string& key) {
 }
 
 std::unique_ptr<cosim::Unit> MakeLaserScanner(const UnitBuildContext& c) {
-  const bool inspect = (!c.parameters.IsDefined() || c.parameters.IsNull()) && !c.model.IsDefined();
+  const bool inspect = (!c.parameters.IsDefined() || c.parameters.IsNull()) && !c.model.IsMap();
   const std::size_t issues_before = c.reader.issues().size();
   std::int64_t beams = 1;
   {
