@@ -86,6 +86,29 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
   spec.flow_columns = robot.flow_columns;
   spec.flow_labels = robot.flow_sensor_names;
   spec.flow_reference_column = robot.flow_reference_column;
+  if (!robot.scan_unit.empty()) {
+    // The beams' geometry is the laser unit's: read its parameters.
+    for (std::size_t u = 0; u < s.system->unit_count(); ++u) {
+      const cosim::Unit& unit = s.system->unit(u);
+      if (unit.name() != robot.scan_unit) continue;
+      const cosim::VariableTable& v = unit.variables();
+      const auto real = [&](const char* name) { return v.GetReal(*v.Find(name)); };
+      plots::RobotPlotSpec::Scan& scan = spec.scan;
+      scan.sensor = robot.scan_unit;
+      scan.time_s = robot.scan_time_s;
+      scan.mount_x_m = real("mount_x");
+      scan.mount_y_m = real("mount_y");
+      scan.mount_yaw_rad = real("mount_yaw");
+      scan.first_beam_rad = real("first_beam_angle");
+      scan.beam_step_rad = real("angular_step");
+      scan.no_return_m = real("no_return_value");
+      const std::size_t beams = v.info(*v.Find("ranges")).size;
+      for (std::size_t k = 0; k < beams; ++k) {
+        scan.range_columns.push_back(robot.scan_unit + ".ranges[" + std::to_string(k) + "]");
+      }
+      scan.scan_time_column = robot.scan_unit + ".scan_time";
+    }
+  }
   if (robot.body_length_m) spec.body_length_m = *robot.body_length_m;
   if (robot.body_width_m) spec.body_width_m = *robot.body_width_m;
   return spec;

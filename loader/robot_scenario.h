@@ -35,6 +35,10 @@ struct RobotInfo {
   /// and the ground-truth speed; empty without both.
   std::vector<std::string> flow_columns, flow_sensor_names;
   std::string flow_reference_column;
+  /// The laser unit whose completed scan at scan_time_s the plots draw
+  /// (sensors.NAME.snapshot_s; its ranges and scan_time are recorded), or "".
+  std::string scan_unit;
+  double scan_time_s = 0.0;
 };
 
 /// A robot scenario is written at the level of robot, scene, line, control,

@@ -186,6 +186,137 @@ std::vector<std::size_t> EvenlySpaced(std::size_t rows, int count) {
   return picks;
 }
 
+// One row of signals.csv, split (row_starts from a pass over the file).
+void ReadRow(Signals& signals, const std::vector<std::streamoff>& row_starts, std::size_t row,
+             std::string& line, std::vector<std::string_view>& fields) {
+  signals.in.clear();
+  signals.in.seekg(row_starts[row]);
+  if (!std::getline(signals.in, line)) {
+    throw std::runtime_error("cannot read " + signals.file.string() + " again at row " +
+                             std::to_string(row + 1));
+  }
+  SplitCsv(line, fields);
+}
+
+// scan.png: see RobotPlotSpec::Scan.
+std::string ScanPlot(const RobotPlotSpec& spec, Signals& signals,
+                     const std::vector<std::streamoff>& row_starts, int ix, int iy, int iyaw,
+                     const std::vector<int>& travels, const std::string& title_prefix,
+                     std::vector<std::string>* outputs) {
+  const RobotPlotSpec::Scan& scan = spec.scan;
+  ColumnFinder column(signals.header, signals.file);
+  std::vector<int> ranges;
+  for (const auto& name : scan.range_columns) ranges.push_back(column(name, "scan range"));
+  const int iscan = column(scan.scan_time_column, "scan start time");
+  column.ThrowIfUnknown();
+  if (iyaw == 0) throw std::runtime_error("the scan plot needs the robot's yaw column");
+  std::string line;
+  std::vector<std::string_view> fields;
+  // Row times are the first column; rows are in time order.
+  const auto row_at = [&](double t) {
+    std::size_t lo = 0, hi = row_starts.size() - 1;
+    while (lo < hi) {
+      const std::size_t mid = (lo + hi) / 2;
+      ReadRow(signals, row_starts, mid, line, fields);
+      const auto tm = Column(fields, 1);
+      if (tm && *tm < t) {
+        lo = mid + 1;
+      } else {
+        hi = mid;
+      }
+    }
+    return lo;
+  };
+  ReadRow(signals, row_starts, row_at(scan.time_s), line, fields);
+  std::vector<double> range(ranges.size(), scan.no_return_m);
+  for (std::size_t k = 0; k < ranges.size(); ++k) {
+    if (const auto r = Column(fields, ranges[k])) range[k] = *r;
+  }
+  const auto started = Column(fields, iscan);
+  const double start_s = started ? *started : scan.time_s;
+  ReadRow(signals, row_starts, row_at(start_s), line, fields);
+  const auto x = Column(fields, ix), y = Column(fields, iy), yaw = Column(fields, iyaw);
+  if (!x || !y || !yaw) throw std::runtime_error("no robot pose at the scan's start time");
+  std::vector<double> travel(travels.size(), 0.0);
+  for (std::size_t b = 0; b < travels.size(); ++b) {
+    if (const auto d = Column(fields, travels[b])) travel[b] = *d;
+  }
+
+  const double c = std::cos(*yaw), sn = std::sin(*yaw);
+  const double sx = *x + c * scan.mount_x_m - sn * scan.mount_y_m;
+  const double sy = *y + sn * scan.mount_x_m + c * scan.mount_y_m;
+  std::string rays, hits;
+  Bounds view;
+  view.Add(sx, sy);
+  for (std::size_t k = 0; k < range.size(); ++k) {
+    if (!(range[k] != scan.no_return_m) || !std::isfinite(range[k])) continue;
+    const double a = *yaw + scan.mount_yaw_rad + scan.first_beam_rad +
+                     static_cast<double>(k) * scan.beam_step_rad;
+    const double hx = sx + range[k] * std::cos(a), hy = sy + range[k] * std::sin(a);
+    hits += Num(hx) + "," + Num(hy) + "\n";
+    if (k % 4 == 0) rays += Num(sx) + "," + Num(sy) + "\n" + Num(hx) + "," + Num(hy) + "\n\n";
+    view.Add(hx, hy);
+  }
+  SolidLayer obstacles, carried;
+  for (const models::Obstacle& o : spec.scene.obstacles) AppendSolid(obstacles, o.solid, 0, 0);
+  for (const models::CarriedObject& o : spec.scene.carried) {
+    const auto b = static_cast<std::size_t>(o.belt);
+    if (b >= spec.scene.belts.size()) continue;
+    const double d = b < travel.size() ? travel[b] : 0.0;
+    const auto range_on = models::CarriedTravelRange(spec.scene.belts[b].area, o.solid);
+    if (d < range_on[0] || d > range_on[1]) continue;  // lifted off the line
+    const double heading = spec.scene.belts[b].area.direction_rad;
+    AppendSolid(carried, o.solid, d * std::cos(heading), d * std::sin(heading));
+  }
+  std::string belts, outline;
+  for (const models::Belt& b : spec.scene.belts) AppendPolygon(belts, BeltCorners(b));
+  AppendPolygon(outline, Rectangle(*x, *y, *yaw, spec.body_length_m, spec.body_width_m));
+
+  std::string s = "\n# One scan of " + scan.sensor + " (scan.png).\n";
+  AppendBlock(s, "scan_rays", rays.empty() ? "\n" : rays);
+  AppendBlock(s, "scan_hits", hits.empty() ? "nan,nan\n" : hits);
+  AppendBlock(s, "scan_outline", outline);
+  if (!belts.empty()) AppendBlock(s, "scan_belts", belts);
+  if (!obstacles.polygons.empty()) AppendBlock(s, "scan_obstacles", obstacles.polygons);
+  if (!obstacles.circles.empty()) AppendBlock(s, "scan_obstacles_circles", obstacles.circles);
+  if (!carried.polygons.empty()) AppendBlock(s, "scan_carried", carried.polygons);
+  outputs->push_back("scan.png");
+  s += "set output 'scan.png'\nset title " +
+       GnuplotQuote(title_prefix + scan.sensor + ", the scan started at t = " + Num(start_s) +
+                    " s (" + std::to_string(range.size()) + " beams, every 4th ray drawn)") +
+       "\nset xlabel 'x (m)'\nset ylabel 'y (m)'\nset size ratio -1\nset key outside bottom "
+       "center horizontal\n";
+  if (!view.empty()) {
+    const double m = 1.0;
+    s += "set xrange [" + Num(view.x_min - m) + ":" + Num(view.x_max + m) + "]\nset yrange [" +
+         Num(view.y_min - m) + ":" + Num(view.y_max + m) + "]\n";
+  }
+  std::vector<std::string> items;
+  if (!belts.empty()) {
+    items.push_back("$scan_belts using 1:2 with filledcurves closed fillcolor rgb '#dbe6f4' "
+                    "fillstyle solid 1.0 border lc rgb '#8fa9cc' title 'belt'");
+  }
+  if (!obstacles.polygons.empty()) {
+    items.push_back("$scan_obstacles using 1:2 with filledcurves closed fillcolor rgb '#d0d0d0' "
+                    "fillstyle solid 1.0 border lc rgb '#606060' title 'obstacle'");
+  }
+  if (!obstacles.circles.empty()) {
+    items.push_back("$scan_obstacles_circles using 1:2:3 with circles fillcolor rgb '#d0d0d0' "
+                    "fillstyle solid 1.0 border lc rgb '#606060' notitle");
+  }
+  if (!carried.polygons.empty()) {
+    items.push_back("$scan_carried using 1:2 with filledcurves closed fillcolor rgb '#f6d3a8' "
+                    "fillstyle solid 0.6 border lc rgb '#c07020' title 'carried (then)'");
+  }
+  items.push_back("$scan_rays using 1:2 with lines lw 0.5 lc rgb '#9ecae1' title 'rays'");
+  items.push_back("$scan_hits using 1:2 with points pt 7 ps 0.35 lc rgb '#d62728' title 'hits'");
+  items.push_back("$scan_outline using 1:2 with lines lw 2 lc rgb '#1f77b4' title 'robot'");
+  s += "plot ";
+  for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
+  s += "\nset size noratio\nset autoscale\nset key default\n";
+  return s;
+}
+
 std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std::string>* outputs) {
   if (spec.x_column.empty() || spec.y_column.empty()) {
     throw std::runtime_error("robot plots need the x and y columns of the robot position");
@@ -529,6 +660,9 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
                     " with lines lw 2.5 lc rgb 'black' title 'ground truth (encoder wheel)'");
     for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
     s += "\n";
+  }
+  if (!spec.scan.range_columns.empty()) {
+    s += ScanPlot(spec, signals, row_starts, ix, iy, iyaw, travels, title_prefix, outputs);
   }
   s += "unset output\n";
   return s;

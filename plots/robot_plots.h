@@ -47,6 +47,21 @@ struct RobotPlotSpec {
   /// and the belt's ground-truth speed; none when empty.
   std::vector<std::string> flow_columns, flow_labels;
   std::string flow_reference_column;
+  /// One laser scan over the scene (scan.png): the scan the scanner had
+  /// completed at `time_s`, its rays and hits drawn from the robot's pose
+  /// at the scan's start, with the carried objects where the belts had
+  /// moved them then. None when `range_columns` is empty.
+  struct Scan {
+    std::string sensor;
+    double time_s = 0.0;
+    std::vector<std::string> range_columns;  // one per beam
+    std::string scan_time_column;            // start time of the completed scan
+    /// Mount in base_link (x, y, yaw) and the beams' angles in the scanner
+    /// frame: first + k * step; a range equal to no_return is no echo.
+    double mount_x_m = 0.0, mount_y_m = 0.0, mount_yaw_rad = 0.0;
+    double first_beam_rad = 0.0, beam_step_rad = 0.0, no_return_m = 0.0;
+  };
+  Scan scan;
   /// Robot outlines and wheel footprints drawn at this many instants,
   /// evenly spaced over the recorded rows from first to last.
   int footprint_count = 5;
@@ -56,7 +71,7 @@ struct RobotPlotSpec {
   double body_width_m = 0.57;
 };
 
-/// Writes top_view.png, and error.png, belt.png and optic_flow.png when the spec asks for
+/// Writes top_view.png, and error.png, belt.png, optic_flow.png and scan.png when the spec asks for
 /// them, into `dir`, from `dir`/signals.csv. The gnuplot script is left in
 /// `dir`/plots.gp with paths relative to `dir`, so `gnuplot plots.gp` run in
 /// `dir` redraws the plots. Returns the paths of the PNG files written.

@@ -45,6 +45,9 @@ struct Signals {
   std::vector<Sensor> sensors;
   std::string belt_ground_truth;
   int belt_ground_truth_belt = 0;  // the scene belt it measures
+  /// The laser whose scan at scan_time_s the plots draw ("" for none).
+  std::string scan_unit;
+  double scan_time_s = 0.0;
 
   /// What each concern wants recorded, in order.
   std::vector<std::string> recorded;

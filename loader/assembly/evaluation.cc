@@ -106,6 +106,8 @@ void AddRecording(SystemBuilder& b, const Signals& s, RobotInfo& info) {
     info.wheel_columns.emplace_back(Element(kChassis, "wheel_contact", 2 * w),
                                     Element(kChassis, "wheel_contact", 2 * w + 1));
   }
+  info.scan_unit = s.scan_unit;
+  info.scan_time_s = s.scan_time_s;
   for (std::size_t k = 0; k < s.belt_count; ++k) {
     info.belt_speed_columns.push_back(Element(kBelt, "speed", k));
     info.belt_on_columns.push_back(Element(kBelt, "on", k));

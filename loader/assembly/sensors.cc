@@ -219,7 +219,18 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
       step = WholeMasterSteps(wiring->second.default_step, b.MasterStep());
       b.Origin(step_key, {section, JoinPath(JoinPath("sensors", m.name), "step_s"), ""});
     }
-    apply(m.name, c, step, {}, derived);
+    const bool laser = m.kind == "laser_scanner";
+    apply(m.name, c, step, laser ? std::vector<std::string>{"snapshot_s"} : std::vector<std::string>{},
+          derived);
+    if (laser && c.node.IsMap() && Child(c.node, "snapshot_s").IsDefined()) {
+      // The scan it has completed at this time is drawn (scan.png): its
+      // ranges are recorded with the rest.
+      s.scan_unit = m.name;
+      s.scan_time_s =
+          r.Real(c.node, JoinPath("sensors", m.name), "snapshot_s", std::nullopt, {0.0, 1e9});
+      s.recorded.push_back(Signal(m.name, "scan_time"));
+      s.recorded.push_back(Signal(m.name, "ranges"));
+    }
     s.sensors.push_back({m.name, m.kind, m});
   }
 
