@@ -63,7 +63,9 @@ namespace linesim::sensors {
 /// does not infringe (no restart interlock).
 ///
 /// Randomness: one std::mt19937_64 seeded with the constructor's seed: the
-/// bias first, then one normal per returning beam, beam after beam.
+/// bias first, then one normal per returning beam, beam after beam (normals
+/// by Marsaglia and Tsang's ziggurat: the generator's state is all there is
+/// to save).
 class LaserScannerUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "laser_scanner";
@@ -102,9 +104,9 @@ class LaserScannerUnit : public cosim::Unit {
   /// Casts beams [first, end) of the current scan, all inside the step
   /// starting at t (the inputs' time).
   void CastBeams(int first, int end, cosim::TimeNs t);
-  /// Beam i's ray, s seconds after the step's start; stores its in-plane
-  /// perpendicular.
-  Ray BeamRay(int i, double s);
+  /// Beam i's ray, s seconds after the step's start, into beam_rays_[i];
+  /// stores its in-plane perpendicular.
+  void BeamRay(int i, double s);
   /// The step's pose terms from the inputs (see the .cc).
   void PrepareStep();
   void RefineEdge(int i);  // the edge between beams i - 1 and i
@@ -150,8 +152,6 @@ class LaserScannerUnit : public cosim::Unit {
   cosim::TimeNs start_ = 0, scan_start_ = 0;
   int next_beam_ = 0;    // first beam not yet cast
   int finalized_ = 0;    // beams [0, finalized_) have their reported range
-  double spare_ = 0.0;       // Box-Muller's second normal
-  bool has_spare_ = false;
   double bias_draw_ = 0.0;  // N(0, 1), drawn in the constructor
   double bias_ = 0.0;       // bias_draw_ * bias_sigma clamped to +-bias_max
   std::int64_t infringing_scans_ = 0;  // consecutive
