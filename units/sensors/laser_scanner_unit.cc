@@ -95,6 +95,9 @@ LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene,
   samples_.resize(n);
   scan_ranges_.assign(n, 0.0);
   beam_perp_.resize(n);
+  step_s_.assign(n, 0.0);
+  step_sin_.assign(n, 0.0);
+  step_vers_.assign(n, 0.0);
 
   auto& v = variables();
   const auto mount = [&](const char* key, const char* unit, double* x, const char* what) {
@@ -237,6 +240,15 @@ void LaserScannerUnit::Derive() {
     cos_a_[k] = std::cos(a);
     sin_a_[k] = std::sin(a);
   }
+  // The field's reach along each beam: its corners' largest projection on
+  // the beam's direction (a point of the polygon lies in its corners'
+  // convex hull, so no farther along the beam than that).
+  field_reach_.assign(static_cast<std::size_t>(beam_count_), -kInf);
+  for (std::size_t k = 0; has_field_ && k < field_reach_.size(); ++k) {
+    for (const auto& c : field_) {
+      field_reach_[k] = std::max(field_reach_[k], c[0] * cos_a_[k] + c[1] * sin_a_[k]);
+    }
+  }
   q_mount_ = FromRpy(mount_roll_, mount_pitch_, mount_yaw_);
   PrepareStep();
   cos_max_incidence_ = std::cos(max_incidence_);
@@ -286,24 +298,7 @@ void LaserScannerUnit::PrepareStep() {
   }
 }
 
-void LaserScannerUnit::BeamRay(int i, double s) {
-  // sin(w s) and 1 - cos(w s); within a step the turn is small and the
-  // series are exact to double rounding for |w s| < 0.1 (the next terms are
-  // below 0.1^11 / 11! = 2.5e-19) and cheaper than sin and cos.
-  const double th = rate_ * s;
-  double sn, vc;
-  if (std::abs(th) < 0.1) {
-    const double t2 = th * th;
-    // Horner in t2 with the factorials' reciprocals (no divisions: they
-    // cost more than the rest of the beam's pose).
-    sn = th * (1.0 + t2 * (-1.0 / 6.0 + t2 * (1.0 / 120.0 + t2 * (-1.0 / 5040.0 +
-                                                                   t2 * (1.0 / 362880.0)))));
-    vc = t2 * (0.5 + t2 * (-1.0 / 24.0 + t2 * (1.0 / 720.0 + t2 * (-1.0 / 40320.0 +
-                                                                   t2 * (1.0 / 3628800.0)))));
-  } else {
-    sn = std::sin(th);
-    vc = 1.0 - std::cos(th);
-  }
+void LaserScannerUnit::BeamRay(int i, double s, double sn, double vc) {
   // The scanner's x, y axes and origin offset in map, in scalars (stored
   // and reloaded arrays stall store forwarding here).
   const auto& fx = frame_[0];
@@ -336,9 +331,38 @@ void LaserScannerUnit::BeamRay(int i, double s) {
 void LaserScannerUnit::CastBeams(int first, int end, cosim::TimeNs t) {
   step_t_ = t;
   const auto n = static_cast<std::size_t>(end - first);
+  // In three passes: the beams' times, their turn's sin(w s) and
+  // 1 - cos(w s), their poses (each pass without a dependency between
+  // beams: the series' chains of multiply-adds overlap).
   for (int i = first; i < end; ++i) {
-    const double s = cosim::NsToSeconds(scan_start_ + BeamOffset(i) - t);
-    BeamRay(i, s);
+    step_s_[static_cast<std::size_t>(i)] = cosim::NsToSeconds(scan_start_ + BeamOffset(i) - t);
+  }
+  const double th_max = rate_ * std::max(std::abs(step_s_[static_cast<std::size_t>(first)]),
+                                         std::abs(step_s_[static_cast<std::size_t>(end - 1)]));
+  if (th_max < 0.1) {
+    // Within a step the turn is small: the series of sin and 1 - cos to
+    // th^9 and th^10 are exact to double rounding for |th| < 0.1 (the next
+    // terms are below 0.1^11 / 11! = 2.5e-19) and cheaper than sin and cos.
+    // Horner in th^2 with the factorials' reciprocals (no divisions).
+    for (int i = first; i < end; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      const double th = rate_ * step_s_[k], t2 = th * th;
+      step_sin_[k] = th * (1.0 + t2 * (-1.0 / 6.0 + t2 * (1.0 / 120.0 + t2 * (-1.0 / 5040.0 +
+                                                                           t2 * (1.0 / 362880.0)))));
+      step_vers_[k] = t2 * (0.5 + t2 * (-1.0 / 24.0 + t2 * (1.0 / 720.0 + t2 * (-1.0 / 40320.0 +
+                                                                           t2 * (1.0 / 3628800.0)))));
+    }
+  } else {
+    for (int i = first; i < end; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      const double th = rate_ * step_s_[k];
+      step_sin_[k] = std::sin(th);
+      step_vers_[k] = 1.0 - std::cos(th);
+    }
+  }
+  for (int i = first; i < end; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    BeamRay(i, step_s_[k], step_sin_[k], step_vers_[k]);
   }
   rays_.Cast(std::span<const Ray>(beam_rays_.data() + first, n),
              std::span<RayHit>(centre_.data() + first, n), belt_travel_, belt_speed_);
@@ -441,7 +465,7 @@ void LaserScannerUnit::CompleteScan() {
     for (int i = 0; i < beam_count_ && !infringed; ++i) {
       const auto k = static_cast<std::size_t>(i);
       const double r = ranges_[k];
-      if (r == no_return_value_) continue;
+      if (r == no_return_value_ || r > field_reach_[k]) continue;
       infringed = InField(r * cos_a_[k], r * sin_a_[k]);
     }
     infringing_scans_ = infringed ? infringing_scans_ + 1 : 0;

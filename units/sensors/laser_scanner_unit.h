@@ -105,8 +105,8 @@ class LaserScannerUnit : public cosim::Unit {
   /// starting at t (the inputs' time).
   void CastBeams(int first, int end, cosim::TimeNs t);
   /// Beam i's ray, s seconds after the step's start, into beam_rays_[i];
-  /// stores its in-plane perpendicular.
-  void BeamRay(int i, double s);
+  /// stores its in-plane perpendicular. sn, vc: sin(w s), 1 - cos(w s).
+  void BeamRay(int i, double s, double sn, double vc);
   /// The step's pose terms from the inputs (see the .cc).
   void PrepareStep();
   void RefineEdge(int i);  // the edge between beams i - 1 and i
@@ -140,6 +140,7 @@ class LaserScannerUnit : public cosim::Unit {
   // Derived (Derive()).
   std::vector<cosim::TimeNs> beam_offset_ns_;
   std::vector<double> cos_a_, sin_a_;
+  std::vector<double> field_reach_;  // per beam: no point of the field farther along it
   cosim::TimeNs period_ns_ = 0;
   std::array<double, 4> q_mount_{};  // w x y z
   double cos_max_incidence_ = 0.0;
@@ -163,6 +164,9 @@ class LaserScannerUnit : public cosim::Unit {
   std::vector<double> scan_ranges_;
   // Per beam: the scan plane's direction of increasing beam angle (map).
   std::vector<std::array<double, 3>> beam_perp_;
+  // Per beam of the step being cast: its time after the step's start (s),
+  // sin and 1 - cos of the base's turn by then.
+  std::vector<double> step_s_, step_sin_, step_vers_;
   cosim::TimeNs step_t_ = 0;  // the inputs' time of the step being cast
 };
 
