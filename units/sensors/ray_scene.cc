@@ -308,7 +308,12 @@ int RayScene::CullCarried(std::span<const Ray> rays, std::span<const double> bel
   // widest ray from it, origins within rho of a, times in [s0, s1].
   double a[3] = {0.0, 0.0, 0.0}, ax[3] = {0.0, 0.0, 0.0};
   double s0 = rays[0].dt_s, s1 = rays[0].dt_s, t_far = 0.0;
+  // The heights the rays pass through within their reach.
+  double z_lo = kInf, z_hi = -kInf;
   for (const Ray& r : rays) {
+    const double z_end = r.origin[2] + r.max_range * r.direction[2];
+    z_lo = std::min(z_lo, std::min(r.origin[2], z_end));
+    z_hi = std::max(z_hi, std::max(r.origin[2], z_end));
     for (int c = 0; c < 3; ++c) {
       a[c] += r.origin[static_cast<std::size_t>(c)];
       ax[c] += r.direction[static_cast<std::size_t>(c)];
@@ -338,6 +343,11 @@ int RayScene::CullCarried(std::span<const Ray> rays, std::span<const double> bel
   int n = 0;
   for (std::size_t i = 0; i < carried_.size(); ++i) {
     const Carried& c = carried_[i];
+    // Above or below all the rays (a level scan under a car body).
+    const double z_pad = 1e-9 * (1.0 + std::abs(z_lo) + std::abs(z_hi));
+    if (c.solid.bottom_m > z_hi + z_pad || c.solid.bottom_m + c.solid.height_m < z_lo - z_pad) {
+      continue;
+    }
     const auto b = static_cast<std::size_t>(c.belt);
     const double travel = belt_travel[b] + belt_speed[b] * s_mid;
     const double sweep = std::abs(belt_speed[b]) * s_half;
@@ -354,8 +364,10 @@ int RayScene::CullCarried(std::span<const Ray> rays, std::span<const double> bel
         // axis) < cos(th + b) = (cos th sqrt(L^2 - r^2) - sin th r) / L.
         const double t = t_far + r;
         if (l2 > t * t) continue;
-        const double along = vx * ax[0] + vy * ax[1] + vz * ax[2];
-        if (along < cos_th * std::sqrt(l2 - r * r) - sin_th * r) continue;
+        // Without the square root: along + sin th r < cos th sqrt(L^2 - r^2)
+        // (both sides' signs known: cos th >= 0).
+        const double lhs = (vx * ax[0] + vy * ax[1] + vz * ax[2]) + sin_th * r;
+        if (lhs < 0.0 || lhs * lhs < cos_th * cos_th * (l2 - r * r)) continue;
       }
     }
     candidates_[static_cast<std::size_t>(n++)] = static_cast<int>(i);
