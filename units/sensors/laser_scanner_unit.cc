@@ -57,8 +57,25 @@ const Ziggurat& ZigguratTables() {
   return z;
 }
 
-// Uniform in [0, 1) from the top 53 bits.
-double Uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+// Uniform in [0, 1) from the top 53 bits (converted as signed: the unsigned
+// conversion costs a branch without AVX-512).
+double Uniform(std::mt19937_64& rng) {
+  return static_cast<double>(static_cast<std::int64_t>(rng() >> 11)) * 0x1.0p-53;
+}
+
+// std::nearbyint in the default rounding mode (to nearest, ties to even),
+// without the library call (which saves and restores the floating-point
+// environment): below 2^51 in magnitude, adding and subtracting 1.5 * 2^52
+// leaves the nearest integer (the sum's unit in the last place is 1). The
+// same value as nearbyint but for the sign of a zero (-0.4 gives +0), which
+// the reported range's max(0, .) makes moot.
+double RoundHalfEven(double x) {
+  constexpr double kMagic = 0x1.8p52;
+  if (!(std::abs(x) < 0x1.0p51)) return std::nearbyint(x);
+  // (Not folded away: without -ffast-math the compiler keeps IEEE sums.)
+  const double sum = x + kMagic;
+  return sum - kMagic;
+}
 
 }  // namespace
 
@@ -181,7 +198,7 @@ double LaserScannerUnit::Normal() {
     const std::uint64_t u = rng_();
     const auto i = static_cast<std::size_t>(u & 0xffu);
     const double sign = (u & 0x100u) ? -1.0 : 1.0;
-    const double z = static_cast<double>(u >> 11) * 0x1.0p-53 * zg.x[i];
+    const double z = static_cast<double>(static_cast<std::int64_t>(u >> 11)) * 0x1.0p-53 * zg.x[i];
     if (z < zg.x[i + 1]) return sign * z;
     if (i == 0) {
       // The tail beyond r (Marsaglia 1964): r + a with a = -ln(U1) / r,
@@ -431,7 +448,7 @@ void LaserScannerUnit::Finalize(int i) {
   double out = no_return_value_;
   if (r >= range_min_ && r <= range_max_ && cos_inc >= cos_max_incidence_) {
     const double m = r + bias_ + noise_sigma_ * Normal();
-    out = std::max(0.0, std::nearbyint(m / range_resolution_) * range_resolution_);
+    out = std::max(0.0, RoundHalfEven(m / range_resolution_) * range_resolution_);
   }
   scan_ranges_[k] = out;
 }
