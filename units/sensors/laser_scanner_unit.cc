@@ -115,6 +115,9 @@ LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene,
   step_s_.assign(n, 0.0);
   step_sin_.assign(n, 0.0);
   step_vers_.assign(n, 0.0);
+  edge_beam_.assign(n, 0);
+  edge_rays_.resize(4 * n);
+  edge_hits_.resize(4 * n);
 
   auto& v = variables();
   const auto mount = [&](const char* key, const char* unit, double* x, const char* what) {
@@ -390,21 +393,32 @@ void LaserScannerUnit::CastBeams(int first, int end, cosim::TimeNs t) {
     samples_[k].fill({h.range, e, h.cos_incidence});
   }
   // Edges between neighbours, each side sampled across its spot.
+  int edges = 0;
   if (spot_divergence_ > 0.0 || spot_offset_ > 0.0) {
     for (int i = std::max(first, 1); i < end; ++i) {
       const RayHit& a = centre_[static_cast<std::size_t>(i - 1)];
       const RayHit& b = centre_[static_cast<std::size_t>(i)];
       const bool edge = a.object != b.object ||
                         (a.object >= 0 && std::abs(a.range - b.range) > echo_separation_);
-      if (edge) RefineEdge(i);
+      if (edge) {
+        // Its four samples, cast with the batch's other edges' below.
+        PrepareEdge(i, &edge_rays_[4 * static_cast<std::size_t>(edges)]);
+        edge_beam_[static_cast<std::size_t>(edges++)] = i;
+      }
+    }
+  }
+  if (edges > 0) {
+    const auto m = 4 * static_cast<std::size_t>(edges);
+    rays_.Cast(std::span<const Ray>(edge_rays_.data(), m), std::span<RayHit>(edge_hits_.data(), m),
+               belt_travel_, belt_speed_);
+    for (int e = 0; e < edges; ++e) {
+      ApplyEdge(edge_beam_[static_cast<std::size_t>(e)], &edge_hits_[4 * static_cast<std::size_t>(e)]);
     }
   }
 }
 
-void LaserScannerUnit::RefineEdge(int i) {
+void LaserScannerUnit::PrepareEdge(int i, Ray* sub) const {
   // Beam i - 1 is sampled towards + (its +h/2 and +h), beam i towards -.
-  std::array<Ray, 4> sub;
-  std::array<RayHit, 4> hit;
   for (int side = 0; side < 2; ++side) {
     const auto k = static_cast<std::size_t>(i - 1 + side);
     const Ray& r = beam_rays_[k];
@@ -415,14 +429,16 @@ void LaserScannerUnit::RefineEdge(int i) {
     for (int j = 0; j < 2; ++j) {
       const double alpha = sgn * h * (j == 0 ? 0.5 : 1.0);
       const double ca = std::cos(alpha), sa = std::sin(alpha);
-      Ray& s = sub[static_cast<std::size_t>(2 * side + j)];
+      Ray& s = sub[2 * side + j];
       s = r;
       // The sample's time relative to this step's inputs.
       s.dt_s = cosim::NsToSeconds(scan_start_ + BeamOffset(i - 1 + side) - step_t_);
       for (std::size_t c = 0; c < 3; ++c) s.direction[c] = ca * r.direction[c] + sa * beam_perp_[k][c];
     }
   }
-  rays_.Cast(sub, hit, belt_travel_, belt_speed_);
+}
+
+void LaserScannerUnit::ApplyEdge(int i, const RayHit* hit) {
   // Sample slots: 0: -h, 1: -h/2, 2: centre, 3: +h/2, 4: +h.
   constexpr std::size_t kSlot[4] = {3, 4, 1, 0};
   for (std::size_t j = 0; j < 4; ++j) {

@@ -109,7 +109,10 @@ class LaserScannerUnit : public cosim::Unit {
   void BeamRay(int i, double s, double sn, double vc);
   /// The step's pose terms from the inputs (see the .cc).
   void PrepareStep();
-  void RefineEdge(int i);  // the edge between beams i - 1 and i
+  /// The edge between beams i - 1 and i: its four spot samples' rays
+  /// (sub[0..4)), then their hits into the two beams' samples.
+  void PrepareEdge(int i, Ray* sub) const;
+  void ApplyEdge(int i, const RayHit* hit);
   void Finalize(int i);
   /// The first echo of a spot's samples: its range and best incidence cosine.
   void MixEcho(const std::array<Sample, kSpotSamples>& samples, double& r, double& cos_inc) const;
@@ -167,6 +170,11 @@ class LaserScannerUnit : public cosim::Unit {
   // Per beam of the step being cast: its time after the step's start (s),
   // sin and 1 - cos of the base's turn by then.
   std::vector<double> step_s_, step_sin_, step_vers_;
+  // The step's edges: the beam after each, their samples' rays and hits
+  // (cast in one batch).
+  std::vector<int> edge_beam_;
+  std::vector<Ray> edge_rays_;
+  std::vector<RayHit> edge_hits_;
   cosim::TimeNs step_t_ = 0;  // the inputs' time of the step being cast
 };
 
