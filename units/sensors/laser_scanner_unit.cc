@@ -270,6 +270,8 @@ void LaserScannerUnit::Derive() {
     }
   }
   q_mount_ = FromRpy(mount_roll_, mount_pitch_, mount_yaw_);
+  mount_in_base_ = {Rotate(q_mount_, {1.0, 0.0, 0.0}), Rotate(q_mount_, {0.0, 1.0, 0.0}),
+                    std::array<double, 3>{mount_x_, mount_y_, mount_z_}};
   PrepareStep();
   cos_max_incidence_ = std::cos(max_incidence_);
   bias_ = std::clamp(bias_draw_ * bias_sigma_, -bias_max_, bias_max_);
@@ -297,24 +299,30 @@ void LaserScannerUnit::PrepareStep() {
   // y axes and its origin, in base_link) R0 v, R0 (k x v) and
   // R0 (k x (k x v)) are fixed over the step: a beam's pose is then two
   // scalars and a few multiply-adds.
-  const Quat q0{orientation_[0], orientation_[1], orientation_[2], orientation_[3]};
+  // Rotation preserves cross products: R0 (k x v) = (R0 k) x (R0 v), so
+  // one rotation matrix from q0 and three of its products do it all.
+  const double w = orientation_[0], x = orientation_[1], y = orientation_[2], z = orientation_[3];
+  const double m[3][3] = {
+      {1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)},
+      {2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)},
+      {2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)}};
+  const auto rotate = [&m](const std::array<double, 3>& v) {
+    return std::array<double, 3>{m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
+                                 m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
+                                 m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2]};
+  };
   const double wx = angular_velocity_[0], wy = angular_velocity_[1], wz = angular_velocity_[2];
   rate_ = std::sqrt(wx * wx + wy * wy + wz * wz);
   const std::array<double, 3> k =
-      rate_ > 0.0 ? std::array<double, 3>{wx / rate_, wy / rate_, wz / rate_}
-                  : std::array<double, 3>{0.0, 0.0, 0.0};
+      rate_ > 0.0 ? rotate({wx / rate_, wy / rate_, wz / rate_}) : std::array<double, 3>{0.0, 0.0, 0.0};
   const auto cross = [](const std::array<double, 3>& u, const std::array<double, 3>& v) {
     return std::array<double, 3>{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
                                  u[0] * v[1] - u[1] * v[0]};
   };
-  const std::array<std::array<double, 3>, 3> in_base = {
-      Rotate(q_mount_, {1.0, 0.0, 0.0}), Rotate(q_mount_, {0.0, 1.0, 0.0}),
-      std::array<double, 3>{mount_x_, mount_y_, mount_z_}};
   for (std::size_t j = 0; j < 3; ++j) {
-    const auto kv = cross(k, in_base[j]);
-    frame_[j][0] = Rotate(q0, in_base[j]);
-    frame_[j][1] = Rotate(q0, kv);
-    frame_[j][2] = Rotate(q0, cross(k, kv));
+    frame_[j][0] = rotate(mount_in_base_[j]);
+    frame_[j][1] = cross(k, frame_[j][0]);
+    frame_[j][2] = cross(k, frame_[j][1]);
   }
 }
 
