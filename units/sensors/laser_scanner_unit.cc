@@ -31,6 +31,52 @@ Quat FromRpy(double roll, double pitch, double yaw) {
           cr * cp * sy - sr * sp * cy};
 }
 
+// Marsaglia and Tsang's ziggurat for the normal distribution ("The
+// Ziggurat Method for Generating Random Variables", J. Stat. Softw. 5(8),
+// 2000), 256 layers of equal area v under f(x) = exp(-x^2 / 2): layer 0 is
+// the rectangle [0, r] x [0, f(r)] with the tail beyond r, layer i >= 1 the
+// rectangle of width x_i between heights f(x_i) and f(x_{i+1}).
+struct Ziggurat {
+  static constexpr double kR = 3.6541528853610088;  // x_1, the tail's start
+  static constexpr double kV = 4.92867323399e-3;    // each layer's area
+  std::array<double, 257> x{};  // x_0 = v / f(r) (layer 0's pseudo width) > x_1 = r > ... > x_256 = 0
+  std::array<double, 257> f{};  // f(x_i)
+  Ziggurat() {
+    x[0] = kV / std::exp(-0.5 * kR * kR);
+    x[1] = kR;
+    for (std::size_t i = 1; i < 255; ++i) {
+      x[i + 1] = std::sqrt(-2.0 * std::log(kV / x[i] + std::exp(-0.5 * x[i] * x[i])));
+    }
+    x[256] = 0.0;
+    for (std::size_t i = 0; i < 257; ++i) f[i] = std::exp(-0.5 * x[i] * x[i]);
+  }
+};
+
+const Ziggurat& ZigguratTables() {
+  static const Ziggurat z;
+  return z;
+}
+
+// Uniform in [0, 1) from the top 53 bits (converted as signed: the unsigned
+// conversion costs a branch without AVX-512).
+double Uniform(std::mt19937_64& rng) {
+  return static_cast<double>(static_cast<std::int64_t>(rng() >> 11)) * 0x1.0p-53;
+}
+
+// std::nearbyint in the default rounding mode (to nearest, ties to even),
+// without the library call (which saves and restores the floating-point
+// environment): below 2^51 in magnitude, adding and subtracting 1.5 * 2^52
+// leaves the nearest integer (the sum's unit in the last place is 1). The
+// same value as nearbyint but for the sign of a zero (-0.4 gives +0), which
+// the reported range's max(0, .) makes moot.
+double RoundHalfEven(double x) {
+  constexpr double kMagic = 0x1.8p52;
+  if (!(std::abs(x) < 0x1.0p51)) return std::nearbyint(x);
+  // (Not folded away: without -ffast-math the compiler keeps IEEE sums.)
+  const double sum = x + kMagic;
+  return sum - kMagic;
+}
+
 }  // namespace
 
 LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene, int beam_count,
@@ -66,6 +112,12 @@ LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene,
   samples_.resize(n);
   scan_ranges_.assign(n, 0.0);
   beam_perp_.resize(n);
+  step_s_.assign(n, 0.0);
+  step_sin_.assign(n, 0.0);
+  step_vers_.assign(n, 0.0);
+  edge_beam_.assign(n, 0);
+  edge_rays_.resize(4 * n);
+  edge_hits_.resize(4 * n);
 
   auto& v = variables();
   const auto mount = [&](const char* key, const char* unit, double* x, const char* what) {
@@ -140,22 +192,31 @@ LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene,
 }
 
 double LaserScannerUnit::Normal() {
-  // Marsaglia's polar method: two normals from a uniform point of the unit
-  // disc, the second kept for the next call (saved with the state).
-  if (has_spare_) {
-    has_spare_ = false;
-    return spare_;
+  // The ziggurat (see Ziggurat): one 64-bit draw gives the layer (8 bits),
+  // the sign (1 bit) and the abscissa (53 bits); 98.8 % of the draws end in
+  // a layer's rectangle, without log, sqrt or division. Nothing is cached
+  // between calls: the generator's state is the whole state.
+  const Ziggurat& zg = ZigguratTables();
+  while (true) {
+    const std::uint64_t u = rng_();
+    const auto i = static_cast<std::size_t>(u & 0xffu);
+    const double sign = (u & 0x100u) ? -1.0 : 1.0;
+    const double z = static_cast<double>(static_cast<std::int64_t>(u >> 11)) * 0x1.0p-53 * zg.x[i];
+    if (z < zg.x[i + 1]) return sign * z;
+    if (i == 0) {
+      // The tail beyond r (Marsaglia 1964): r + a with a = -ln(U1) / r,
+      // accepted when -2 ln(U2) > a^2.
+      double a, b;
+      do {
+        a = -std::log(1.0 - Uniform(rng_)) / Ziggurat::kR;
+        b = -std::log(1.0 - Uniform(rng_));
+      } while (b + b < a * a);
+      return sign * (Ziggurat::kR + a);
+    }
+    // The wedge: a uniform height in the layer, under the curve or not.
+    const double y = zg.f[i] + Uniform(rng_) * (zg.f[i + 1] - zg.f[i]);
+    if (y < std::exp(-0.5 * z * z)) return sign * z;
   }
-  double u, v, r2;
-  do {
-    u = static_cast<double>(rng_() >> 11) * 0x1.0p-52 - 1.0;
-    v = static_cast<double>(rng_() >> 11) * 0x1.0p-52 - 1.0;
-    r2 = u * u + v * v;
-  } while (r2 >= 1.0 || r2 == 0.0);
-  const double f = std::sqrt(-2.0 * std::log(r2) / r2);
-  spare_ = v * f;
-  has_spare_ = true;
-  return u * f;
 }
 
 std::vector<cosim::ParameterProblem> LaserScannerUnit::CheckParameters() const {
@@ -199,7 +260,18 @@ void LaserScannerUnit::Derive() {
     cos_a_[k] = std::cos(a);
     sin_a_[k] = std::sin(a);
   }
+  // The field's reach along each beam: its corners' largest projection on
+  // the beam's direction (a point of the polygon lies in its corners'
+  // convex hull, so no farther along the beam than that).
+  field_reach_.assign(static_cast<std::size_t>(beam_count_), -kInf);
+  for (std::size_t k = 0; has_field_ && k < field_reach_.size(); ++k) {
+    for (const auto& c : field_) {
+      field_reach_[k] = std::max(field_reach_[k], c[0] * cos_a_[k] + c[1] * sin_a_[k]);
+    }
+  }
   q_mount_ = FromRpy(mount_roll_, mount_pitch_, mount_yaw_);
+  mount_in_base_ = {Rotate(q_mount_, {1.0, 0.0, 0.0}), Rotate(q_mount_, {0.0, 1.0, 0.0}),
+                    std::array<double, 3>{mount_x_, mount_y_, mount_z_}};
   PrepareStep();
   cos_max_incidence_ = std::cos(max_incidence_);
   bias_ = std::clamp(bias_draw_ * bias_sigma_, -bias_max_, bias_max_);
@@ -227,67 +299,98 @@ void LaserScannerUnit::PrepareStep() {
   // y axes and its origin, in base_link) R0 v, R0 (k x v) and
   // R0 (k x (k x v)) are fixed over the step: a beam's pose is then two
   // scalars and a few multiply-adds.
-  const Quat q0{orientation_[0], orientation_[1], orientation_[2], orientation_[3]};
+  // Rotation preserves cross products: R0 (k x v) = (R0 k) x (R0 v), so
+  // one rotation matrix from q0 and three of its products do it all.
+  const double w = orientation_[0], x = orientation_[1], y = orientation_[2], z = orientation_[3];
+  const double m[3][3] = {
+      {1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)},
+      {2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)},
+      {2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)}};
+  const auto rotate = [&m](const std::array<double, 3>& v) {
+    return std::array<double, 3>{m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
+                                 m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
+                                 m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2]};
+  };
   const double wx = angular_velocity_[0], wy = angular_velocity_[1], wz = angular_velocity_[2];
   rate_ = std::sqrt(wx * wx + wy * wy + wz * wz);
   const std::array<double, 3> k =
-      rate_ > 0.0 ? std::array<double, 3>{wx / rate_, wy / rate_, wz / rate_}
-                  : std::array<double, 3>{0.0, 0.0, 0.0};
+      rate_ > 0.0 ? rotate({wx / rate_, wy / rate_, wz / rate_}) : std::array<double, 3>{0.0, 0.0, 0.0};
   const auto cross = [](const std::array<double, 3>& u, const std::array<double, 3>& v) {
     return std::array<double, 3>{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
                                  u[0] * v[1] - u[1] * v[0]};
   };
-  const std::array<std::array<double, 3>, 3> in_base = {
-      Rotate(q_mount_, {1.0, 0.0, 0.0}), Rotate(q_mount_, {0.0, 1.0, 0.0}),
-      std::array<double, 3>{mount_x_, mount_y_, mount_z_}};
   for (std::size_t j = 0; j < 3; ++j) {
-    const auto kv = cross(k, in_base[j]);
-    frame_[j][0] = Rotate(q0, in_base[j]);
-    frame_[j][1] = Rotate(q0, kv);
-    frame_[j][2] = Rotate(q0, cross(k, kv));
+    frame_[j][0] = rotate(mount_in_base_[j]);
+    frame_[j][1] = cross(k, frame_[j][0]);
+    frame_[j][2] = cross(k, frame_[j][1]);
   }
 }
 
-Ray LaserScannerUnit::BeamRay(int i, double s) {
-  // sin(w s) and 1 - cos(w s); within a step the turn is small and the
-  // series are exact to double rounding for |w s| < 0.1 (the next terms are
-  // below 0.1^11 / 11! = 2.5e-19) and cheaper than sin and cos.
-  const double th = rate_ * s;
-  double sn, vc;
-  if (std::abs(th) < 0.1) {
-    const double t2 = th * th;
-    sn = th * (1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0))));
-    vc = t2 / 2.0 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0))));
-  } else {
-    sn = std::sin(th);
-    vc = 1.0 - std::cos(th);
-  }
-  double e[3][3];  // the scanner's x, y axes and origin offset in map
-  for (std::size_t j = 0; j < 3; ++j) {
-    for (std::size_t c = 0; c < 3; ++c) {
-      e[j][c] = frame_[j][0][c] + sn * frame_[j][1][c] + vc * frame_[j][2][c];
-    }
-  }
+void LaserScannerUnit::BeamRay(int i, double s, double sn, double vc) {
+  // The scanner's x, y axes and origin offset in map, in scalars (stored
+  // and reloaded arrays stall store forwarding here).
+  const auto& fx = frame_[0];
+  const auto& fy = frame_[1];
+  const auto& fo = frame_[2];
+  const double x0 = fx[0][0] + sn * fx[1][0] + vc * fx[2][0];
+  const double x1 = fx[0][1] + sn * fx[1][1] + vc * fx[2][1];
+  const double x2 = fx[0][2] + sn * fx[1][2] + vc * fx[2][2];
+  const double y0 = fy[0][0] + sn * fy[1][0] + vc * fy[2][0];
+  const double y1 = fy[0][1] + sn * fy[1][1] + vc * fy[2][1];
+  const double y2 = fy[0][2] + sn * fy[1][2] + vc * fy[2][2];
   const auto k = static_cast<std::size_t>(i);
   const double ca = cos_a_[k], sa = sin_a_[k];
-  Ray r;
-  for (std::size_t c = 0; c < 3; ++c) {
-    r.origin[c] = position_[c] + velocity_[c] * s + e[2][c];
-    r.direction[c] = ca * e[0][c] + sa * e[1][c];
-    beam_perp_[k][c] = -sa * e[0][c] + ca * e[1][c];
-  }
+  Ray& r = beam_rays_[k];
+  r.origin[0] = position_[0] + velocity_[0] * s + (fo[0][0] + sn * fo[1][0] + vc * fo[2][0]);
+  r.origin[1] = position_[1] + velocity_[1] * s + (fo[0][1] + sn * fo[1][1] + vc * fo[2][1]);
+  r.origin[2] = position_[2] + velocity_[2] * s + (fo[0][2] + sn * fo[1][2] + vc * fo[2][2]);
+  r.direction[0] = ca * x0 + sa * y0;
+  r.direction[1] = ca * x1 + sa * y1;
+  r.direction[2] = ca * x2 + sa * y2;
+  auto& perp = beam_perp_[k];
+  perp[0] = -sa * x0 + ca * y0;
+  perp[1] = -sa * x1 + ca * y1;
+  perp[2] = -sa * x2 + ca * y2;
   // Far enough for a spot sample beyond range_max to still be met.
   r.max_range = range_max_ * 1.5;
   r.dt_s = s;
-  return r;
 }
 
 void LaserScannerUnit::CastBeams(int first, int end, cosim::TimeNs t) {
   step_t_ = t;
   const auto n = static_cast<std::size_t>(end - first);
+  // In three passes: the beams' times, their turn's sin(w s) and
+  // 1 - cos(w s), their poses (each pass without a dependency between
+  // beams: the series' chains of multiply-adds overlap).
   for (int i = first; i < end; ++i) {
-    const double s = cosim::NsToSeconds(scan_start_ + BeamOffset(i) - t);
-    beam_rays_[static_cast<std::size_t>(i)] = BeamRay(i, s);
+    step_s_[static_cast<std::size_t>(i)] = cosim::NsToSeconds(scan_start_ + BeamOffset(i) - t);
+  }
+  const double th_max = rate_ * std::max(std::abs(step_s_[static_cast<std::size_t>(first)]),
+                                         std::abs(step_s_[static_cast<std::size_t>(end - 1)]));
+  if (th_max < 0.1) {
+    // Within a step the turn is small: the series of sin and 1 - cos to
+    // th^9 and th^10 are exact to double rounding for |th| < 0.1 (the next
+    // terms are below 0.1^11 / 11! = 2.5e-19) and cheaper than sin and cos.
+    // Horner in th^2 with the factorials' reciprocals (no divisions).
+    for (int i = first; i < end; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      const double th = rate_ * step_s_[k], t2 = th * th;
+      step_sin_[k] = th * (1.0 + t2 * (-1.0 / 6.0 + t2 * (1.0 / 120.0 + t2 * (-1.0 / 5040.0 +
+                                                                           t2 * (1.0 / 362880.0)))));
+      step_vers_[k] = t2 * (0.5 + t2 * (-1.0 / 24.0 + t2 * (1.0 / 720.0 + t2 * (-1.0 / 40320.0 +
+                                                                           t2 * (1.0 / 3628800.0)))));
+    }
+  } else {
+    for (int i = first; i < end; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      const double th = rate_ * step_s_[k];
+      step_sin_[k] = std::sin(th);
+      step_vers_[k] = 1.0 - std::cos(th);
+    }
+  }
+  for (int i = first; i < end; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    BeamRay(i, step_s_[k], step_sin_[k], step_vers_[k]);
   }
   rays_.Cast(std::span<const Ray>(beam_rays_.data() + first, n),
              std::span<RayHit>(centre_.data() + first, n), belt_travel_, belt_speed_);
@@ -298,21 +401,32 @@ void LaserScannerUnit::CastBeams(int first, int end, cosim::TimeNs t) {
     samples_[k].fill({h.range, e, h.cos_incidence});
   }
   // Edges between neighbours, each side sampled across its spot.
+  int edges = 0;
   if (spot_divergence_ > 0.0 || spot_offset_ > 0.0) {
     for (int i = std::max(first, 1); i < end; ++i) {
       const RayHit& a = centre_[static_cast<std::size_t>(i - 1)];
       const RayHit& b = centre_[static_cast<std::size_t>(i)];
       const bool edge = a.object != b.object ||
                         (a.object >= 0 && std::abs(a.range - b.range) > echo_separation_);
-      if (edge) RefineEdge(i);
+      if (edge) {
+        // Its four samples, cast with the batch's other edges' below.
+        PrepareEdge(i, &edge_rays_[4 * static_cast<std::size_t>(edges)]);
+        edge_beam_[static_cast<std::size_t>(edges++)] = i;
+      }
+    }
+  }
+  if (edges > 0) {
+    const auto m = 4 * static_cast<std::size_t>(edges);
+    rays_.Cast(std::span<const Ray>(edge_rays_.data(), m), std::span<RayHit>(edge_hits_.data(), m),
+               belt_travel_, belt_speed_);
+    for (int e = 0; e < edges; ++e) {
+      ApplyEdge(edge_beam_[static_cast<std::size_t>(e)], &edge_hits_[4 * static_cast<std::size_t>(e)]);
     }
   }
 }
 
-void LaserScannerUnit::RefineEdge(int i) {
+void LaserScannerUnit::PrepareEdge(int i, Ray* sub) const {
   // Beam i - 1 is sampled towards + (its +h/2 and +h), beam i towards -.
-  std::array<Ray, 4> sub;
-  std::array<RayHit, 4> hit;
   for (int side = 0; side < 2; ++side) {
     const auto k = static_cast<std::size_t>(i - 1 + side);
     const Ray& r = beam_rays_[k];
@@ -323,14 +437,16 @@ void LaserScannerUnit::RefineEdge(int i) {
     for (int j = 0; j < 2; ++j) {
       const double alpha = sgn * h * (j == 0 ? 0.5 : 1.0);
       const double ca = std::cos(alpha), sa = std::sin(alpha);
-      Ray& s = sub[static_cast<std::size_t>(2 * side + j)];
+      Ray& s = sub[2 * side + j];
       s = r;
       // The sample's time relative to this step's inputs.
       s.dt_s = cosim::NsToSeconds(scan_start_ + BeamOffset(i - 1 + side) - step_t_);
       for (std::size_t c = 0; c < 3; ++c) s.direction[c] = ca * r.direction[c] + sa * beam_perp_[k][c];
     }
   }
-  rays_.Cast(sub, hit, belt_travel_, belt_speed_);
+}
+
+void LaserScannerUnit::ApplyEdge(int i, const RayHit* hit) {
   // Sample slots: 0: -h, 1: -h/2, 2: centre, 3: +h/2, 4: +h.
   constexpr std::size_t kSlot[4] = {3, 4, 1, 0};
   for (std::size_t j = 0; j < 4; ++j) {
@@ -356,7 +472,7 @@ void LaserScannerUnit::Finalize(int i) {
   double out = no_return_value_;
   if (r >= range_min_ && r <= range_max_ && cos_inc >= cos_max_incidence_) {
     const double m = r + bias_ + noise_sigma_ * Normal();
-    out = std::max(0.0, std::nearbyint(m / range_resolution_) * range_resolution_);
+    out = std::max(0.0, RoundHalfEven(m / range_resolution_) * range_resolution_);
   }
   scan_ranges_[k] = out;
 }
@@ -390,7 +506,7 @@ void LaserScannerUnit::CompleteScan() {
     for (int i = 0; i < beam_count_ && !infringed; ++i) {
       const auto k = static_cast<std::size_t>(i);
       const double r = ranges_[k];
-      if (r == no_return_value_) continue;
+      if (r == no_return_value_ || r > field_reach_[k]) continue;
       infringed = InField(r * cos_a_[k], r * sin_a_[k]);
     }
     infringing_scans_ = infringed ? infringing_scans_ + 1 : 0;
@@ -432,8 +548,8 @@ void LaserScannerUnit::SaveInternal(cosim::UnitState& state) const {
   std::ostringstream rng;
   rng << rng_;
   state.strings = {rng.str()};
-  state.integers = {start_, scan_start_, next_beam_, finalized_, infringing_scans_, has_spare_ ? 1 : 0};
-  state.reals = {bias_draw_, spare_};
+  state.integers = {start_, scan_start_, next_beam_, finalized_, infringing_scans_};
+  state.reals = {bias_draw_};
   state.reals.insert(state.reals.end(), scan_ranges_.begin(), scan_ranges_.end());
   for (int i = 0; i < next_beam_; ++i) {
     const auto k = static_cast<std::size_t>(i);
@@ -451,7 +567,7 @@ void LaserScannerUnit::SaveInternal(cosim::UnitState& state) const {
 
 void LaserScannerUnit::RestoreInternal(const cosim::UnitState& state) {
   const auto n = static_cast<std::size_t>(beam_count_);
-  if (state.strings.size() != 1 || state.integers.size() != 6 || state.reals.size() < 2 + n) {
+  if (state.strings.size() != 1 || state.integers.size() != 5 || state.reals.size() < 1 + n) {
     throw cosim::UnitError(Where() + ": saved state does not fit this unit");
   }
   std::istringstream rng(state.strings[0]);
@@ -461,17 +577,15 @@ void LaserScannerUnit::RestoreInternal(const cosim::UnitState& state) {
   next_beam_ = static_cast<int>(state.integers[2]);
   finalized_ = static_cast<int>(state.integers[3]);
   infringing_scans_ = state.integers[4];
-  has_spare_ = state.integers[5] != 0;
   const std::size_t per_beam = 14 + 3 * kSpotSamples;
   if (next_beam_ < 0 || next_beam_ > beam_count_ ||
-      state.reals.size() != 2 + n + per_beam * static_cast<std::size_t>(next_beam_)) {
+      state.reals.size() != 1 + n + per_beam * static_cast<std::size_t>(next_beam_)) {
     throw cosim::UnitError(Where() + ": saved state does not fit this unit");
   }
   bias_draw_ = state.reals[0];
-  spare_ = state.reals[1];
-  std::copy(state.reals.begin() + 2, state.reals.begin() + 2 + static_cast<std::ptrdiff_t>(n),
+  std::copy(state.reals.begin() + 1, state.reals.begin() + 1 + static_cast<std::ptrdiff_t>(n),
             scan_ranges_.begin());
-  std::size_t p = 2 + n;
+  std::size_t p = 1 + n;
   for (int i = 0; i < next_beam_; ++i) {
     const auto k = static_cast<std::size_t>(i);
     Ray& r = beam_rays_[k];

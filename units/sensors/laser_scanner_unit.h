@@ -63,7 +63,9 @@ namespace linesim::sensors {
 /// does not infringe (no restart interlock).
 ///
 /// Randomness: one std::mt19937_64 seeded with the constructor's seed: the
-/// bias first, then one normal per returning beam, beam after beam.
+/// bias first, then one normal per returning beam, beam after beam (normals
+/// by Marsaglia and Tsang's ziggurat: the generator's state is all there is
+/// to save).
 class LaserScannerUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "laser_scanner";
@@ -102,12 +104,15 @@ class LaserScannerUnit : public cosim::Unit {
   /// Casts beams [first, end) of the current scan, all inside the step
   /// starting at t (the inputs' time).
   void CastBeams(int first, int end, cosim::TimeNs t);
-  /// Beam i's ray, s seconds after the step's start; stores its in-plane
-  /// perpendicular.
-  Ray BeamRay(int i, double s);
+  /// Beam i's ray, s seconds after the step's start, into beam_rays_[i];
+  /// stores its in-plane perpendicular. sn, vc: sin(w s), 1 - cos(w s).
+  void BeamRay(int i, double s, double sn, double vc);
   /// The step's pose terms from the inputs (see the .cc).
   void PrepareStep();
-  void RefineEdge(int i);  // the edge between beams i - 1 and i
+  /// The edge between beams i - 1 and i: its four spot samples' rays
+  /// (sub[0..4)), then their hits into the two beams' samples.
+  void PrepareEdge(int i, Ray* sub) const;
+  void ApplyEdge(int i, const RayHit* hit);
   void Finalize(int i);
   /// The first echo of a spot's samples: its range and best incidence cosine.
   void MixEcho(const std::array<Sample, kSpotSamples>& samples, double& r, double& cos_inc) const;
@@ -138,8 +143,11 @@ class LaserScannerUnit : public cosim::Unit {
   // Derived (Derive()).
   std::vector<cosim::TimeNs> beam_offset_ns_;
   std::vector<double> cos_a_, sin_a_;
+  std::vector<double> field_reach_;  // per beam: no point of the field farther along it
   cosim::TimeNs period_ns_ = 0;
   std::array<double, 4> q_mount_{};  // w x y z
+  // The scanner's x and y axes and its origin in base_link.
+  std::array<std::array<double, 3>, 3> mount_in_base_{};
   double cos_max_incidence_ = 0.0;
   // PrepareStep(): |angular_velocity|, and per vector (scanner x, y axes,
   // mount offset) R0 v, R0 (k x v), R0 (k x (k x v)).
@@ -150,8 +158,6 @@ class LaserScannerUnit : public cosim::Unit {
   cosim::TimeNs start_ = 0, scan_start_ = 0;
   int next_beam_ = 0;    // first beam not yet cast
   int finalized_ = 0;    // beams [0, finalized_) have their reported range
-  double spare_ = 0.0;       // Box-Muller's second normal
-  bool has_spare_ = false;
   double bias_draw_ = 0.0;  // N(0, 1), drawn in the constructor
   double bias_ = 0.0;       // bias_draw_ * bias_sigma clamped to +-bias_max
   std::int64_t infringing_scans_ = 0;  // consecutive
@@ -163,6 +169,14 @@ class LaserScannerUnit : public cosim::Unit {
   std::vector<double> scan_ranges_;
   // Per beam: the scan plane's direction of increasing beam angle (map).
   std::vector<std::array<double, 3>> beam_perp_;
+  // Per beam of the step being cast: its time after the step's start (s),
+  // sin and 1 - cos of the base's turn by then.
+  std::vector<double> step_s_, step_sin_, step_vers_;
+  // The step's edges: the beam after each, their samples' rays and hits
+  // (cast in one batch).
+  std::vector<int> edge_beam_;
+  std::vector<Ray> edge_rays_;
+  std::vector<RayHit> edge_hits_;
   cosim::TimeNs step_t_ = 0;  // the inputs' time of the step being cast
 };
 

@@ -221,13 +221,16 @@ RayScene::RayScene(const models::Scene& scene)
     carried_.push_back({co.solid, co.belt, std::cos(belt.area.direction_rad),
                         std::sin(belt.area.direction_rad), range[0], range[1],
                         std::cos(co.solid.yaw_rad), std::sin(co.solid.yaw_rad),
-                        ObjectOfCarried(static_cast<int>(i)), 0.0});
+                        ObjectOfCarried(static_cast<int>(i)), 0.0, 0.0, 0.0});
     const models::Solid& s = co.solid;
     const double br = s.kind == models::Solid::Kind::kCylinder
                           ? s.radius_m
                           : 0.5 * std::hypot(s.length_m, s.width_m);
     carried_.back().bound_radius2 = (br + 1e-6) * (br + 1e-6);
+    carried_.back().center_z = s.bottom_m + 0.5 * s.height_m;
+    carried_.back().sphere_radius = std::hypot(br, 0.5 * s.height_m) + 1e-6;
   }
+  candidates_.assign(carried_.size(), 0);
 
   RTCGeometry mesh = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
@@ -299,9 +302,84 @@ void RayScene::AddBox(std::vector<float>& vertices, std::vector<unsigned>& indic
   }
 }
 
-void RayScene::CastCarried(const Ray& ray, std::span<const double> belt_travel,
-                           std::span<const double> belt_speed, RayHit& best) const {
-  for (const Carried& c : carried_) {
+int RayScene::CullCarried(std::span<const Ray> rays, std::span<const double> belt_travel,
+                          std::span<const double> belt_speed) {
+  // The bundle: mean origin a, axis the mean direction, half angle the
+  // widest ray from it, origins within rho of a, times in [s0, s1].
+  double a[3] = {0.0, 0.0, 0.0}, ax[3] = {0.0, 0.0, 0.0};
+  double s0 = rays[0].dt_s, s1 = rays[0].dt_s, t_far = 0.0;
+  // The heights the rays pass through within their reach.
+  double z_lo = kInf, z_hi = -kInf;
+  for (const Ray& r : rays) {
+    const double z_end = r.origin[2] + r.max_range * r.direction[2];
+    z_lo = std::min(z_lo, std::min(r.origin[2], z_end));
+    z_hi = std::max(z_hi, std::max(r.origin[2], z_end));
+    for (int c = 0; c < 3; ++c) {
+      a[c] += r.origin[static_cast<std::size_t>(c)];
+      ax[c] += r.direction[static_cast<std::size_t>(c)];
+    }
+    s0 = std::min(s0, r.dt_s);
+    s1 = std::max(s1, r.dt_s);
+    t_far = std::max(t_far, r.max_range);
+  }
+  const double inv_n = 1.0 / static_cast<double>(rays.size());
+  for (double& x : a) x *= inv_n;
+  const double axn = std::sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+  double cos_th = -1.0, rho = 0.0;
+  if (axn > 1e-6) {
+    for (double& x : ax) x /= axn;
+    cos_th = 1.0;
+    for (const Ray& r : rays) {
+      const double dx = r.origin[0] - a[0], dy = r.origin[1] - a[1], dz = r.origin[2] - a[2];
+      rho = std::max(rho, dx * dx + dy * dy + dz * dz);
+      cos_th = std::min(cos_th, ax[0] * r.direction[0] + ax[1] * r.direction[1] +
+                                    ax[2] * r.direction[2]);
+    }
+    rho = std::sqrt(rho);
+    cos_th -= 1e-6;  // rounding of the unit directions: only ever widens the cone
+  }
+  const double sin_th = std::sqrt(std::max(0.0, 1.0 - cos_th * cos_th));
+  const double s_mid = 0.5 * (s0 + s1), s_half = 0.5 * (s1 - s0);
+  int n = 0;
+  for (std::size_t i = 0; i < carried_.size(); ++i) {
+    const Carried& c = carried_[i];
+    // Above or below all the rays (a level scan under a car body).
+    const double z_pad = 1e-9 * (1.0 + std::abs(z_lo) + std::abs(z_hi));
+    if (c.solid.bottom_m > z_hi + z_pad || c.solid.bottom_m + c.solid.height_m < z_lo - z_pad) {
+      continue;
+    }
+    const auto b = static_cast<std::size_t>(c.belt);
+    const double travel = belt_travel[b] + belt_speed[b] * s_mid;
+    const double sweep = std::abs(belt_speed[b]) * s_half;
+    // Lifted off over all the bundle's times.
+    if (travel + sweep < c.travel_min || travel - sweep > c.travel_max) continue;
+    const double r = (c.sphere_radius + sweep + rho) * (1.0 + 1e-9) + 1e-9;
+    if (cos_th >= 0.0) {
+      const double vx = c.solid.x_m + travel * c.ux - a[0], vy = c.solid.y_m + travel * c.uy - a[1],
+                   vz = c.center_z - a[2];
+      const double l2 = vx * vx + vy * vy + vz * vz;
+      if (l2 > r * r) {
+        // Beyond the rays' reach, or off the cone by more than the
+        // sphere's angular radius b (sin b = r / L): cos(angle to the
+        // axis) < cos(th + b) = (cos th sqrt(L^2 - r^2) - sin th r) / L.
+        const double t = t_far + r;
+        if (l2 > t * t) continue;
+        // Without the square root: along + sin th r < cos th sqrt(L^2 - r^2)
+        // (both sides' signs known: cos th >= 0).
+        const double lhs = (vx * ax[0] + vy * ax[1] + vz * ax[2]) + sin_th * r;
+        if (lhs < 0.0 || lhs * lhs < cos_th * cos_th * (l2 - r * r)) continue;
+      }
+    }
+    candidates_[static_cast<std::size_t>(n++)] = static_cast<int>(i);
+  }
+  return n;
+}
+
+void RayScene::CastCarried(const Ray& ray, std::span<const int> candidates,
+                           std::span<const double> belt_travel, std::span<const double> belt_speed,
+                           RayHit& best) const {
+  for (const int ci : candidates) {
+    const Carried& c = carried_[static_cast<std::size_t>(ci)];
     const auto b = static_cast<std::size_t>(c.belt);
     const double travel = belt_travel[b] + belt_speed[b] * ray.dt_s;
     if (travel < c.travel_min || travel > c.travel_max) continue;  // lifted off
@@ -367,6 +445,8 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
       packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
     }
     rtcIntersect8(valid, scene_, &context, &packet);
+    const int candidates =
+        carried_.empty() ? 0 : CullCarried(rays.subspan(first, count), belt_travel, belt_speed);
     for (std::size_t k = 0; k < count; ++k) {
       const Ray& r = rays[first + k];
       RayHit& h = hits[first + k];
@@ -390,7 +470,10 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
                c.object};
         }
       }
-      if (!carried_.empty()) CastCarried(r, belt_travel, belt_speed, h);
+      if (candidates > 0) {
+        CastCarried(r, std::span<const int>(candidates_.data(), static_cast<std::size_t>(candidates)),
+                    belt_travel, belt_speed, h);
+      }
     }
   }
 }

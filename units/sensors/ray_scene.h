@@ -52,6 +52,9 @@ struct RayHit {
 /// its own frame at the ray's time (footprint moved along the belt's
 /// direction by the belt's travel then; absent once the travel leaves
 /// models::CarriedTravelRange, the object has been lifted off the line).
+/// Per packet of 8 rays, the objects whose bounding sphere (swept over the
+/// rays' times) lies off the cone holding the rays, or beyond their reach,
+/// are skipped for the whole packet (a conservative cull: exactness kept).
 ///
 /// One RayScene per unit: it owns its Embree device (created single-threaded
 /// with "threads=1") and is not shared between threads. Not copyable.
@@ -96,15 +99,25 @@ class RayScene {
     double cos_yaw, sin_yaw;
     int object;
     double bound_radius2;  // squared radius of the footprint's bounding circle
+    double center_z;       // the middle of its height
+    double sphere_radius;  // its bounding sphere's radius (about (x, y, center_z))
   };
 
  private:
   void AddBox(std::vector<float>& vertices, std::vector<unsigned>& indices,
               const std::array<double, 3>& center, const std::array<double, 3>& half,
               const std::array<std::array<double, 3>, 3>& axes, int object);
-  /// The carried objects met before `best` (updated in place).
-  void CastCarried(const Ray& ray, std::span<const double> belt_travel,
-                   std::span<const double> belt_speed, RayHit& best) const;
+  /// The carried objects (of `candidates`, indices into carried_) met
+  /// before `best` (updated in place).
+  void CastCarried(const Ray& ray, std::span<const int> candidates,
+                   std::span<const double> belt_travel, std::span<const double> belt_speed,
+                   RayHit& best) const;
+  /// The carried objects a bundle of rays may meet (into candidates_):
+  /// their bounding spheres, where their belts put them over the rays'
+  /// times, against the cone from the rays' mean origin that holds all
+  /// their directions, widened by the origins' spread. Returns the count.
+  int CullCarried(std::span<const Ray> rays, std::span<const double> belt_travel,
+                  std::span<const double> belt_speed);
 
   RTCDeviceTy* device_ = nullptr;
   RTCSceneTy* scene_ = nullptr;
@@ -113,6 +126,7 @@ class RayScene {
   std::vector<Face> faces_;  // per triangle
   std::vector<Cylinder> cylinders_;
   std::vector<Carried> carried_;
+  std::vector<int> candidates_;  // CullCarried's answer (carried_.size() long)
 };
 
 /// Exact first intersection (t > 1e-9, t < t_max) of a ray with a vertical
