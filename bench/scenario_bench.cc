@@ -52,9 +52,18 @@ void BM_Scenario(benchmark::State& state, const std::string& file,
 
 LINESIM_SCENARIO(motor_step, "motor_step.yaml");
 LINESIM_SCENARIO(cross_line, "cross_line.yaml");
+// Side by side: the same crossing without any sensor (the ground-truth loop
+// alone), and with the sensors but without the PX4Flow or the lasers.
+LINESIM_SCENARIO(cross_line_no_sensors, "cross_line.yaml", "sensors.default=false");
+LINESIM_SCENARIO(cross_line_no_lasers, "cross_line.yaml", "sensors.laser_front=false",
+                 "sensors.laser_rear=false");
+LINESIM_SCENARIO(cross_line_no_flow, "cross_line.yaml", "sensors.flow_front_left=false",
+                 "sensors.flow_rear_left=false", "sensors.flow_rear_right=false",
+                 "sensors.flow_front_right=false");
 LINESIM_SCENARIO(cross_line_nominal, "cross_line.yaml", "control.compensation=false");
 LINESIM_SCENARIO(hold_on_belt, "hold_on_belt.yaml");
 LINESIM_SCENARIO(hold_straddle, "hold_straddle.yaml");
 LINESIM_SCENARIO(husky_floor_path, "husky_floor_path.yaml");
+LINESIM_SCENARIO(optic_flow_profile, "optic_flow_profile.yaml");
 
 }  // namespace
