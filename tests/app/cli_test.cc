@@ -135,6 +135,18 @@ TEST(Cli, RobotRunWritesPlots) {
   EXPECT_TRUE(fs::exists(fs::path(out) / "plots.gp"));
 }
 
+// Guards scan.png: a laser with snapshot_s has its ranges recorded and one
+// of its scans drawn (a PNG) with the others.
+TEST(Cli, LaserSnapshotDrawsAScan) {
+  const std::string out = Fresh("scan_run");
+  const Result r = Linesim("run " LINESIM_SOURCE_DIR "/scenarios/scan_factory.yaml --out " + out +
+                           " --set duration_s=1 --set sensors.laser_front.snapshot_s=0.5");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(ReadFile(fs::path(out) / "scan.png").substr(0, 8), "\x89PNG\r\n\x1a\n");
+  const std::string header = ReadFile(fs::path(out) / "signals.csv").substr(0, 100000);
+  EXPECT_NE(header.find("laser_front.ranges[540]"), std::string::npos);
+}
+
 // Guards the bad-input contract for robot-level keys too: exit 2, file and
 // key path named, nothing written.
 TEST(Cli, RobotLevelBadInputExitsTwo) {
