@@ -413,13 +413,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     std::vector<std::string_view> fields;
     std::string line;
     for (std::size_t row : EvenlySpaced(row_starts.size(), spec.footprint_count)) {
-      signals.in.clear();
-      signals.in.seekg(row_starts[row]);
-      if (!std::getline(signals.in, line)) {
-        throw std::runtime_error("cannot read " + signals.file.string() + " again at row " +
-                                 std::to_string(row + 1));
-      }
-      SplitCsv(line, fields);
+      ReadRow(signals, row_starts, row, line, fields);
       const auto get = [&](int col) { return Column(fields, col); };
       const auto t = get(1), x = get(ix), y = get(iy), yaw = get(iyaw);
       if (!x || !y || !yaw || !std::isfinite(*x + *y + *yaw)) continue;

@@ -15,19 +15,13 @@ namespace linesim::loader {
 namespace {
 
 using testing::Has;
+using testing::Param;
 using testing::Issues;
 using testing::WriteScenario;
 
 const std::string kCross = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
 const std::string kHusky = LINESIM_SOURCE_DIR "/scenarios/husky_floor_path.yaml";
 
-double Param(const Scenario& s, const std::string& unit, const std::string& name,
-             std::size_t index = 0) {
-  const auto& v = s.system->unit(*s.system->FindUnit(unit)).variables();
-  const auto ref = *v.Find(name);
-  return v.info(ref).type == cosim::VarType::kRealArray ? v.GetRealElement(ref, index)
-                                                        : v.GetReal(ref);
-}
 
 bool BoolParam(const Scenario& s, const std::string& unit, const std::string& name) {
   const auto& v = s.system->unit(*s.system->FindUnit(unit)).variables();

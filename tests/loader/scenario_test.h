@@ -30,6 +30,16 @@ inline std::string Issues(const std::string& file, const std::vector<std::string
   return "(no error)";
 }
 
+/// A Real parameter of unit `unit` in the built system (element `index` of
+/// an array).
+inline double Param(const Scenario& s, const std::string& unit, const std::string& name,
+                    std::size_t index = 0) {
+  const auto& v = s.system->unit(*s.system->FindUnit(unit)).variables();
+  const auto ref = *v.Find(name);
+  return v.info(ref).type == cosim::VarType::kRealArray ? v.GetRealElement(ref, index)
+                                                        : v.GetReal(ref);
+}
+
 inline bool Has(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }

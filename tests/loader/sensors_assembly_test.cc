@@ -15,6 +15,7 @@ namespace linesim::loader {
 namespace {
 
 using testing::Has;
+using testing::Param;
 using testing::Issues;
 using testing::WriteScenario;
 
@@ -25,13 +26,6 @@ const cosim::VariableTable& Table(const Scenario& s, const std::string& unit) {
   return s.system->unit(*s.system->FindUnit(unit)).variables();
 }
 
-double Param(const Scenario& s, const std::string& unit, const std::string& name,
-             std::size_t index = 0) {
-  const auto& v = Table(s, unit);
-  const auto ref = *v.Find(name);
-  return v.info(ref).type == cosim::VarType::kRealArray ? v.GetRealElement(ref, index)
-                                                        : v.GetReal(ref);
-}
 
 bool Connected(const Scenario& s, const std::string& from, const std::string& to) {
   for (const auto& c : s.system->connections()) {
