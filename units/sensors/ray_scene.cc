@@ -422,6 +422,7 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   alignas(32) RTCRayHit8 packet;
   alignas(32) int valid[8];
+  int candidates = 0;
   for (std::size_t first = 0; first < rays.size(); first += 8) {
     const std::size_t count = std::min<std::size_t>(8, rays.size() - first);
     for (std::size_t k = 0; k < 8; ++k) {
@@ -445,8 +446,16 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
       packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
     }
     rtcIntersect8(valid, scene_, &context, &packet);
-    const int candidates =
-        carried_.empty() ? 0 : CullCarried(rays.subspan(first, count), belt_travel, belt_speed);
+    // The carried objects are culled once per group of kCullGroup rays (a
+    // 1 ms step's beams are one group): a group's cone is a few degrees
+    // wide, and the cull's fixed cost is paid once instead of per packet.
+    if (first % kCullGroup == 0) {
+      candidates = carried_.empty()
+                       ? 0
+                       : CullCarried(rays.subspan(first, std::min<std::size_t>(
+                                                             kCullGroup, rays.size() - first)),
+                                     belt_travel, belt_speed);
+    }
     for (std::size_t k = 0; k < count; ++k) {
       const Ray& r = rays[first + k];
       RayHit& h = hits[first + k];
