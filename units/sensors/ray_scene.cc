@@ -13,6 +13,8 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kTMin = 1e-9;
+// Rays per Embree packet (rtcIntersect16).
+constexpr std::size_t kPacket = 16;
 
 // Embree user-geometry callbacks for the cylinders.
 void CylinderBounds(const RTCBoundsFunctionArguments* args) {
@@ -71,6 +73,51 @@ void CylinderOccluded(const RTCOccludedFunctionNArguments* args) {
     if (IntersectCylinder(c, o, d, tfar, n) < tfar) {
       RTCRayN_tfar(ray, args->N, i) = -std::numeric_limits<float>::infinity();
     }
+  }
+}
+
+// What Cast needs of a packet's hits.
+struct PacketHits {
+  unsigned geom[kPacket], prim[kPacket];
+  float tfar[kPacket];
+};
+
+// Intersects up to N rays as one Embree packet of width N (8 or 16).
+template <class Packet, std::size_t N>
+void IntersectPacket(std::span<const Ray> rays, RTCScene scene, RTCIntersectContext* context,
+                     PacketHits& out) {
+  alignas(64) Packet packet;
+  alignas(64) int valid[N];
+  const std::size_t count = rays.size();
+  for (std::size_t k = 0; k < N; ++k) {
+    valid[k] = k < count ? -1 : 0;
+    const Ray& r = rays[std::min(k, count - 1)];
+    packet.ray.org_x[k] = static_cast<float>(r.origin[0]);
+    packet.ray.org_y[k] = static_cast<float>(r.origin[1]);
+    packet.ray.org_z[k] = static_cast<float>(r.origin[2]);
+    packet.ray.dir_x[k] = static_cast<float>(r.direction[0]);
+    packet.ray.dir_y[k] = static_cast<float>(r.direction[1]);
+    packet.ray.dir_z[k] = static_cast<float>(r.direction[2]);
+    packet.ray.tnear[k] = 0.0f;
+    // Beyond max_range by a margin: the exact distance is decided below.
+    packet.ray.tfar[k] = static_cast<float>(r.max_range * (1.0 + 1e-5) + 1e-4);
+    packet.ray.time[k] = 0.0f;
+    packet.ray.mask[k] = ~0u;
+    packet.ray.id[k] = 0;
+    packet.ray.flags[k] = 0;
+    packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+    packet.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+    packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+  }
+  if constexpr (N == 16) {
+    rtcIntersect16(valid, scene, context, &packet);
+  } else {
+    rtcIntersect8(valid, scene, context, &packet);
+  }
+  for (std::size_t k = 0; k < count; ++k) {
+    out.geom[k] = packet.hit.geomID[k];
+    out.prim[k] = packet.hit.primID[k];
+    out.tfar[k] = packet.ray.tfar[k];
   }
 }
 
@@ -418,72 +465,61 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
                     std::span<const double> belt_travel, std::span<const double> belt_speed) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  // The beams of a scan are neighbours: coherent packets of 8.
+  // The beams of a scan are neighbours: coherent packets of 16 while 16
+  // rays are left, then of 8 (a 1 ms step's 14 beams are cast faster as 8
+  // and 6 than as one packet of 16, measured).
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  alignas(32) RTCRayHit8 packet;
-  alignas(32) int valid[8];
+  PacketHits ph;
   int candidates = 0;
-  for (std::size_t first = 0; first < rays.size(); first += 8) {
-    const std::size_t count = std::min<std::size_t>(8, rays.size() - first);
-    for (std::size_t k = 0; k < 8; ++k) {
-      valid[k] = k < count ? -1 : 0;
-      const Ray& r = rays[first + std::min(k, count - 1)];
-      packet.ray.org_x[k] = static_cast<float>(r.origin[0]);
-      packet.ray.org_y[k] = static_cast<float>(r.origin[1]);
-      packet.ray.org_z[k] = static_cast<float>(r.origin[2]);
-      packet.ray.dir_x[k] = static_cast<float>(r.direction[0]);
-      packet.ray.dir_y[k] = static_cast<float>(r.direction[1]);
-      packet.ray.dir_z[k] = static_cast<float>(r.direction[2]);
-      packet.ray.tnear[k] = 0.0f;
-      // Beyond max_range by a margin: the exact distance is decided below.
-      packet.ray.tfar[k] = static_cast<float>(r.max_range * (1.0 + 1e-5) + 1e-4);
-      packet.ray.time[k] = 0.0f;
-      packet.ray.mask[k] = ~0u;
-      packet.ray.id[k] = 0;
-      packet.ray.flags[k] = 0;
-      packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-      packet.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
-      packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+  for (std::size_t first = 0; first < rays.size();) {
+    const std::size_t count =
+        rays.size() - first >= 16 ? 16 : std::min<std::size_t>(8, rays.size() - first);
+    const auto packet_rays = rays.subspan(first, count);
+    if (count == 16) {
+      IntersectPacket<RTCRayHit16, 16>(packet_rays, scene_, &context, ph);
+    } else {
+      IntersectPacket<RTCRayHit8, 8>(packet_rays, scene_, &context, ph);
     }
-    rtcIntersect8(valid, scene_, &context, &packet);
     // The carried objects are culled once per group of kCullGroup rays (a
     // 1 ms step's beams are one group): a group's cone is a few degrees
     // wide, and the cull's fixed cost is paid once instead of per packet.
     if (first % kCullGroup == 0) {
-      candidates = carried_.empty()
-                       ? 0
-                       : CullCarried(rays.subspan(first, std::min<std::size_t>(
-                                                             kCullGroup, rays.size() - first)),
-                                     belt_travel, belt_speed);
+      candidates =
+          carried_.empty()
+              ? 0
+              : CullCarried(
+                    rays.subspan(first, std::min<std::size_t>(kCullGroup, rays.size() - first)),
+                    belt_travel, belt_speed);
     }
     for (std::size_t k = 0; k < count; ++k) {
       const Ray& r = rays[first + k];
       RayHit& h = hits[first + k];
       h = {std::numeric_limits<double>::infinity(), 0.0, -1};
-      const unsigned geom = packet.hit.geomID[k];
+      const unsigned geom = ph.geom[k];
       if (geom == mesh_geom_) {
         // The exact distance to the face's plane.
-        const Face& f = faces_[packet.hit.primID[k]];
+        const Face& f = faces_[ph.prim[k]];
         const double dn = f.nx * r.direction[0] + f.ny * r.direction[1] + f.nz * r.direction[2];
         const double on = f.nx * r.origin[0] + f.ny * r.origin[1] + f.nz * r.origin[2];
-        const double t = dn != 0.0 ? (f.c - on) / dn : static_cast<double>(packet.ray.tfar[k]);
+        const double t = dn != 0.0 ? (f.c - on) / dn : static_cast<double>(ph.tfar[k]);
         if (t > 0.0 && t <= r.max_range) h = {t, std::abs(dn), f.object};
       } else if (geom == cylinder_geom_ && geom != RTC_INVALID_GEOMETRY_ID) {
-        const Cylinder& c = cylinders_[packet.hit.primID[k]];
+        const Cylinder& c = cylinders_[ph.prim[k]];
         double n[3];
         const double t = IntersectCylinder(c, r.origin.data(), r.direction.data(),
                                            r.max_range * 1.001 + 1e-3, n);
         if (t <= r.max_range) {
-          h = {t,
-               std::abs(n[0] * r.direction[0] + n[1] * r.direction[1] + n[2] * r.direction[2]),
+          h = {t, std::abs(n[0] * r.direction[0] + n[1] * r.direction[1] + n[2] * r.direction[2]),
                c.object};
         }
       }
       if (candidates > 0) {
-        CastCarried(r, std::span<const int>(candidates_.data(), static_cast<std::size_t>(candidates)),
+        CastCarried(r,
+                    std::span<const int>(candidates_.data(), static_cast<std::size_t>(candidates)),
                     belt_travel, belt_speed, h);
       }
     }
+    first += count;
   }
 }
 
