@@ -457,24 +457,36 @@ void LaserScannerUnit::ApplyEdge(int i, const RayHit* hit) {
   }
 }
 
-void LaserScannerUnit::Finalize(int i) {
-  const auto k = static_cast<std::size_t>(i);
-  const auto& sm = samples_[k];
-  bool uniform = true;
-  for (const Sample& x : sm) uniform = uniform && x.range == sm[2].range;
-  double r = kInf, cos_inc = 0.0;
-  if (uniform) {
-    r = sm[2].range;
-    cos_inc = sm[2].cos_incidence;
-  } else {
-    MixEcho(sm, r, cos_inc);
+void LaserScannerUnit::Finalize(int first, int end) {
+  // In two passes: each beam's echo and noise draw (the draws in beam
+  // order), then the reported ranges (the divisions of the second pass do
+  // not wait on one another or on the generator).
+  for (int i = first; i < end; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const auto& sm = samples_[k];
+    bool uniform = true;
+    for (const Sample& x : sm) uniform = uniform && x.range == sm[2].range;
+    double r = kInf, cos_inc = 0.0;
+    if (uniform) {
+      r = sm[2].range;
+      cos_inc = sm[2].cos_incidence;
+    } else {
+      MixEcho(sm, r, cos_inc);
+    }
+    // The measured range before rounding; NaN: no return.
+    double m = std::numeric_limits<double>::quiet_NaN();
+    if (r >= range_min_ && r <= range_max_ && cos_inc >= cos_max_incidence_) {
+      m = r + bias_ + noise_sigma_ * Normal();
+    }
+    scan_ranges_[k] = m;
   }
-  double out = no_return_value_;
-  if (r >= range_min_ && r <= range_max_ && cos_inc >= cos_max_incidence_) {
-    const double m = r + bias_ + noise_sigma_ * Normal();
-    out = std::max(0.0, RoundHalfEven(m / range_resolution_) * range_resolution_);
+  for (int i = first; i < end; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double m = scan_ranges_[k];
+    scan_ranges_[k] = std::isnan(m) ? no_return_value_
+                                    : std::max(0.0, RoundHalfEven(m / range_resolution_) *
+                                                        range_resolution_);
   }
-  scan_ranges_[k] = out;
 }
 
 void LaserScannerUnit::MixEcho(const std::array<Sample, kSpotSamples>& sm, double& r,
@@ -534,7 +546,10 @@ cosim::StepResult LaserScannerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     }
     // Every beam but the last cast one is final (its right edge is known).
     const int final_end = next_beam_ == beam_count_ ? beam_count_ : next_beam_ - 1;
-    for (; finalized_ < final_end; ++finalized_) Finalize(finalized_);
+    if (finalized_ < final_end) {
+      Finalize(finalized_, final_end);
+      finalized_ = final_end;
+    }
     if (next_beam_ == beam_count_) {
       CompleteScan();
       continue;
