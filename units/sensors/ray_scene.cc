@@ -351,40 +351,39 @@ void RayScene::AddBox(std::vector<float>& vertices, std::vector<unsigned>& indic
 
 int RayScene::CullCarried(std::span<const Ray> rays, std::span<const double> belt_travel,
                           std::span<const double> belt_speed) {
-  // The bundle: mean origin a, axis the mean direction, half angle the
-  // widest ray from it, origins within rho of a, times in [s0, s1].
-  double a[3] = {0.0, 0.0, 0.0}, ax[3] = {0.0, 0.0, 0.0};
+  // The bundle, in one pass over the rays: apex a the middle ray's origin,
+  // axis the bisector of the first and last rays' directions (any apex and
+  // axis bound the rays: the half angle is the widest ray from the axis and
+  // rho the farthest origin from a), times in [s0, s1].
+  const Ray& mid = rays[rays.size() / 2];
+  const double a[3] = {mid.origin[0], mid.origin[1], mid.origin[2]};
+  double ax[3] = {rays.front().direction[0] + rays.back().direction[0],
+                  rays.front().direction[1] + rays.back().direction[1],
+                  rays.front().direction[2] + rays.back().direction[2]};
+  const double axn = std::sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+  const bool cone = axn > 1e-6;
+  if (cone) {
+    for (double& x : ax) x /= axn;
+  }
   double s0 = rays[0].dt_s, s1 = rays[0].dt_s, t_far = 0.0;
   // The heights the rays pass through within their reach.
   double z_lo = kInf, z_hi = -kInf;
+  double cos_th = 1.0, rho = 0.0;
   for (const Ray& r : rays) {
     const double z_end = r.origin[2] + r.max_range * r.direction[2];
     z_lo = std::min(z_lo, std::min(r.origin[2], z_end));
     z_hi = std::max(z_hi, std::max(r.origin[2], z_end));
-    for (int c = 0; c < 3; ++c) {
-      a[c] += r.origin[static_cast<std::size_t>(c)];
-      ax[c] += r.direction[static_cast<std::size_t>(c)];
-    }
     s0 = std::min(s0, r.dt_s);
     s1 = std::max(s1, r.dt_s);
     t_far = std::max(t_far, r.max_range);
+    const double dx = r.origin[0] - a[0], dy = r.origin[1] - a[1], dz = r.origin[2] - a[2];
+    rho = std::max(rho, dx * dx + dy * dy + dz * dz);
+    cos_th = std::min(cos_th, ax[0] * r.direction[0] + ax[1] * r.direction[1] +
+                                  ax[2] * r.direction[2]);
   }
-  const double inv_n = 1.0 / static_cast<double>(rays.size());
-  for (double& x : a) x *= inv_n;
-  const double axn = std::sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
-  double cos_th = -1.0, rho = 0.0;
-  if (axn > 1e-6) {
-    for (double& x : ax) x /= axn;
-    cos_th = 1.0;
-    for (const Ray& r : rays) {
-      const double dx = r.origin[0] - a[0], dy = r.origin[1] - a[1], dz = r.origin[2] - a[2];
-      rho = std::max(rho, dx * dx + dy * dy + dz * dz);
-      cos_th = std::min(cos_th, ax[0] * r.direction[0] + ax[1] * r.direction[1] +
-                                    ax[2] * r.direction[2]);
-    }
-    rho = std::sqrt(rho);
-    cos_th -= 1e-6;  // rounding of the unit directions: only ever widens the cone
-  }
+  rho = std::sqrt(rho);
+  // Rounding of the unit directions: only ever widens the cone.
+  cos_th = cone ? cos_th - 1e-6 : -1.0;
   const double sin_th = std::sqrt(std::max(0.0, 1.0 - cos_th * cos_th));
   const double s_mid = 0.5 * (s0 + s1), s_half = 0.5 * (s1 - s0);
   int n = 0;

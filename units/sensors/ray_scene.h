@@ -116,8 +116,9 @@ class RayScene {
                    RayHit& best) const;
   /// The carried objects a bundle of rays may meet (into candidates_):
   /// their bounding spheres, where their belts put them over the rays'
-  /// times, against the cone from the rays' mean origin that holds all
-  /// their directions, widened by the origins' spread. Returns the count.
+  /// times, against a cone from the middle ray's origin about the first
+  /// and last rays' bisector that holds all their directions, widened by
+  /// the origins' spread. Returns the count.
   int CullCarried(std::span<const Ray> rays, std::span<const double> belt_travel,
                   std::span<const double> belt_speed);
 
