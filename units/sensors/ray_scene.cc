@@ -438,6 +438,17 @@ void RayScene::CastCarried(const Ray& ray, std::span<const int> candidates,
       const double cross = px * ray.direction[1] - py * ray.direction[0];
       const double h2 = ray.direction[0] * ray.direction[0] + ray.direction[1] * ray.direction[1];
       if (cross * cross > c.bound_radius2 * h2) continue;
+      if (c.solid.kind == models::Solid::Kind::kBox) {
+        // Tighter for a box: the horizontal line misses its footprint
+        // rectangle (the separating axis of the line's normal; cross is
+        // the same in the box's frame, where the direction's components
+        // are ld_x, ld_y). Padded: only a clear miss is dropped.
+        const double ldx = c.cos_yaw * ray.direction[0] + c.sin_yaw * ray.direction[1];
+        const double ldy = -c.sin_yaw * ray.direction[0] + c.cos_yaw * ray.direction[1];
+        const double reach =
+            0.5 * (c.solid.length_m * std::abs(ldy) + c.solid.width_m * std::abs(ldx));
+        if (std::abs(cross) > reach * (1.0 + 1e-9) + 1e-9) continue;
+      }
       if (px * ray.direction[0] + py * ray.direction[1] < -std::sqrt(c.bound_radius2 * h2)) continue;
     }
     double n[3] = {0.0, 0.0, 0.0};
