@@ -363,7 +363,10 @@ int RayScene::CullCarried(std::span<const Ray> rays, std::span<const double> bel
   const double axn = std::sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
   const bool cone = axn > 1e-6;
   if (cone) {
-    for (double& x : ax) x /= axn;
+    // (Not exactly unit after the reciprocal's rounding: the cone's 1e-6
+    // widening below covers that.)
+    const double inv = 1.0 / axn;
+    for (double& x : ax) x *= inv;
   }
   double s0 = rays[0].dt_s, s1 = rays[0].dt_s, t_far = 0.0;
   // The heights the rays pass through within their reach.
@@ -386,11 +389,11 @@ int RayScene::CullCarried(std::span<const Ray> rays, std::span<const double> bel
   cos_th = cone ? cos_th - 1e-6 : -1.0;
   const double sin_th = std::sqrt(std::max(0.0, 1.0 - cos_th * cos_th));
   const double s_mid = 0.5 * (s0 + s1), s_half = 0.5 * (s1 - s0);
+  const double z_pad = 1e-9 * (1.0 + std::abs(z_lo) + std::abs(z_hi));
   int n = 0;
   for (std::size_t i = 0; i < carried_.size(); ++i) {
     const Carried& c = carried_[i];
     // Above or below all the rays (a level scan under a car body).
-    const double z_pad = 1e-9 * (1.0 + std::abs(z_lo) + std::abs(z_hi));
     if (c.solid.bottom_m > z_hi + z_pad || c.solid.bottom_m + c.solid.height_m < z_lo - z_pad) {
       continue;
     }
