@@ -1,6 +1,7 @@
 #include "units/sensors/laser_scanner_unit.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -200,9 +201,14 @@ double LaserScannerUnit::Normal() {
   while (true) {
     const std::uint64_t u = rng_();
     const auto i = static_cast<std::size_t>(u & 0xffu);
-    const double sign = (u & 0x100u) ? -1.0 : 1.0;
+    // The sign as a bit flip: the same value as a product by -1 or 1, but
+    // without a branch on a random bit (mispredicted half the time).
+    const std::uint64_t sign_bit = (u & 0x100u) << 55;
+    const auto sign = [sign_bit](double v) {
+      return std::bit_cast<double>(std::bit_cast<std::uint64_t>(v) ^ sign_bit);
+    };
     const double z = static_cast<double>(static_cast<std::int64_t>(u >> 11)) * 0x1.0p-53 * zg.x[i];
-    if (z < zg.x[i + 1]) return sign * z;
+    if (z < zg.x[i + 1]) return sign(z);
     if (i == 0) {
       // The tail beyond r (Marsaglia 1964): r + a with a = -ln(U1) / r,
       // accepted when -2 ln(U2) > a^2.
@@ -211,11 +217,11 @@ double LaserScannerUnit::Normal() {
         a = -std::log(1.0 - Uniform(rng_)) / Ziggurat::kR;
         b = -std::log(1.0 - Uniform(rng_));
       } while (b + b < a * a);
-      return sign * (Ziggurat::kR + a);
+      return sign(Ziggurat::kR + a);
     }
     // The wedge: a uniform height in the layer, under the curve or not.
     const double y = zg.f[i] + Uniform(rng_) * (zg.f[i + 1] - zg.f[i]);
-    if (y < std::exp(-0.5 * z * z)) return sign * z;
+    if (y < std::exp(-0.5 * z * z)) return sign(z);
   }
 }
 
@@ -457,24 +463,36 @@ void LaserScannerUnit::ApplyEdge(int i, const RayHit* hit) {
   }
 }
 
-void LaserScannerUnit::Finalize(int i) {
-  const auto k = static_cast<std::size_t>(i);
-  const auto& sm = samples_[k];
-  bool uniform = true;
-  for (const Sample& x : sm) uniform = uniform && x.range == sm[2].range;
-  double r = kInf, cos_inc = 0.0;
-  if (uniform) {
-    r = sm[2].range;
-    cos_inc = sm[2].cos_incidence;
-  } else {
-    MixEcho(sm, r, cos_inc);
+void LaserScannerUnit::Finalize(int first, int end) {
+  // In two passes: each beam's echo and noise draw (the draws in beam
+  // order), then the reported ranges (the divisions of the second pass do
+  // not wait on one another or on the generator).
+  for (int i = first; i < end; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const auto& sm = samples_[k];
+    bool uniform = true;
+    for (const Sample& x : sm) uniform = uniform && x.range == sm[2].range;
+    double r = kInf, cos_inc = 0.0;
+    if (uniform) {
+      r = sm[2].range;
+      cos_inc = sm[2].cos_incidence;
+    } else {
+      MixEcho(sm, r, cos_inc);
+    }
+    // The measured range before rounding; NaN: no return.
+    double m = std::numeric_limits<double>::quiet_NaN();
+    if (r >= range_min_ && r <= range_max_ && cos_inc >= cos_max_incidence_) {
+      m = r + bias_ + noise_sigma_ * Normal();
+    }
+    scan_ranges_[k] = m;
   }
-  double out = no_return_value_;
-  if (r >= range_min_ && r <= range_max_ && cos_inc >= cos_max_incidence_) {
-    const double m = r + bias_ + noise_sigma_ * Normal();
-    out = std::max(0.0, RoundHalfEven(m / range_resolution_) * range_resolution_);
+  for (int i = first; i < end; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double m = scan_ranges_[k];
+    scan_ranges_[k] = std::isnan(m) ? no_return_value_
+                                    : std::max(0.0, RoundHalfEven(m / range_resolution_) *
+                                                        range_resolution_);
   }
-  scan_ranges_[k] = out;
 }
 
 void LaserScannerUnit::MixEcho(const std::array<Sample, kSpotSamples>& sm, double& r,
@@ -534,7 +552,10 @@ cosim::StepResult LaserScannerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     }
     // Every beam but the last cast one is final (its right edge is known).
     const int final_end = next_beam_ == beam_count_ ? beam_count_ : next_beam_ - 1;
-    for (; finalized_ < final_end; ++finalized_) Finalize(finalized_);
+    if (finalized_ < final_end) {
+      Finalize(finalized_, final_end);
+      finalized_ = final_end;
+    }
     if (next_beam_ == beam_count_) {
       CompleteScan();
       continue;

@@ -113,7 +113,8 @@ class LaserScannerUnit : public cosim::Unit {
   /// (sub[0..4)), then their hits into the two beams' samples.
   void PrepareEdge(int i, Ray* sub) const;
   void ApplyEdge(int i, const RayHit* hit);
-  void Finalize(int i);
+  /// The reported ranges of beams [first, end) into scan_ranges_.
+  void Finalize(int first, int end);
   /// The first echo of a spot's samples: its range and best incidence cosine.
   void MixEcho(const std::array<Sample, kSpotSamples>& samples, double& r, double& cos_inc) const;
   void CompleteScan();

@@ -52,9 +52,9 @@ struct RayHit {
 /// its own frame at the ray's time (footprint moved along the belt's
 /// direction by the belt's travel then; absent once the travel leaves
 /// models::CarriedTravelRange, the object has been lifted off the line).
-/// Per packet of 8 rays, the objects whose bounding sphere (swept over the
+/// Per group of 16 rays (kCullGroup), the objects whose bounding sphere (swept over the
 /// rays' times) lies off the cone holding the rays, or beyond their reach,
-/// are skipped for the whole packet (a conservative cull: exactness kept).
+/// are skipped for the whole group (a conservative cull: exactness kept).
 ///
 /// One RayScene per unit: it owns its Embree device (created single-threaded
 /// with "threads=1") and is not shared between threads. Not copyable.
@@ -63,6 +63,8 @@ class RayScene {
   static constexpr int kFloor = 0;
   /// Rays handed to Embree in one rtcIntersect1M stream.
   static constexpr int kStream = 64;
+  /// Rays culled together against the carried objects (two packets).
+  static constexpr std::size_t kCullGroup = 16;
 
   explicit RayScene(const models::Scene& scene);
   ~RayScene();
@@ -114,8 +116,9 @@ class RayScene {
                    RayHit& best) const;
   /// The carried objects a bundle of rays may meet (into candidates_):
   /// their bounding spheres, where their belts put them over the rays'
-  /// times, against the cone from the rays' mean origin that holds all
-  /// their directions, widened by the origins' spread. Returns the count.
+  /// times, against a cone from the middle ray's origin about the first
+  /// and last rays' bisector that holds all their directions, widened by
+  /// the origins' spread. Returns the count.
   int CullCarried(std::span<const Ray> rays, std::span<const double> belt_travel,
                   std::span<const double> belt_speed);
 
