@@ -61,8 +61,6 @@ struct RayHit {
 class RayScene {
  public:
   static constexpr int kFloor = 0;
-  /// Rays handed to Embree in one rtcIntersect1M stream.
-  static constexpr int kStream = 64;
   /// Rays culled together against the carried objects (two packets).
   static constexpr std::size_t kCullGroup = 16;
 
