@@ -590,35 +590,34 @@ void VariableTable::SetValue(ValueRef ref, const Value& v) {
 
 namespace {
 constexpr std::uint64_t kExponentBits = 0x7ff0000000000000ULL;
+constexpr std::uint64_t kExponentOne = std::uint64_t{1} << 52;
 }  // namespace
 
 std::optional<std::string> FirstNonFinite(const VariableTable& table,
                                           std::span<const ValueRef> refs) {
+  // The common case, all finite, in one branch-free pass that the compiler
+  // vectorizes with SSE2 (every unit's real inputs and outputs are checked
+  // every step, a laser's ranges among them): a value is inf or NaN exactly
+  // when its exponent bits are all set, and then adding one to the exponent
+  // carries into the sign bit.
+  std::uint64_t carries = 0;
+  for (ValueRef ref : refs) {
+    for (const double x : table.RealValues(ref)) {
+      carries |= (std::bit_cast<std::uint64_t>(x) & kExponentBits) + kExponentOne;
+    }
+  }
+  if ((carries >> 63) == 0) return std::nullopt;
   const auto describe = [&](const VariableInfo& info, std::string element, double v) {
     return std::string(ToString(info.causality)) + " '" + info.name + element + "' is " +
            FormatValue(v);
   };
   for (ValueRef ref : refs) {
     const VariableInfo& info = table.info(ref);
-    if (info.type == VarType::kReal) {
-      const double v = table.GetReal(ref);
-      if (!std::isfinite(v)) return describe(info, "", v);
-    } else {
-      const auto values = table.GetRealArray(ref);
-      // The common case, all finite, in one branch-free pass (a laser's
-      // ranges are checked every step): a value is inf or NaN exactly when
-      // its exponent bits are all set.
-      std::uint64_t all_ones = 0;
-      for (const double x : values) {
-        all_ones |= static_cast<std::uint64_t>(
-            (std::bit_cast<std::uint64_t>(x) & kExponentBits) == kExponentBits);
-      }
-      if (all_ones == 0) continue;
-      for (std::size_t k = 0; k < values.size(); ++k) {
-        if (!std::isfinite(values[k])) {
-          return describe(info, "[" + std::to_string(k) + "]", values[k]);
-        }
-      }
+    const auto values = table.RealValues(ref);
+    for (std::size_t k = 0; k < values.size(); ++k) {
+      if (std::isfinite(values[k])) continue;
+      return describe(info, info.type == VarType::kReal ? "" : "[" + std::to_string(k) + "]",
+                      values[k]);
     }
   }
   return std::nullopt;

@@ -218,6 +218,14 @@ class VariableTable {
   double GetReal(ValueRef ref) const { return *Slot<double>(ref, VarType::kReal); }
   void SetReal(ValueRef ref, double v) { *Writable<double>(ref, VarType::kReal) = v; }
   std::span<const double> GetRealArray(ValueRef ref) const;
+  /// The value(s) of a Real or Real[] variable as a span, for scans over
+  /// many variables (the master's finite checks); `ref` must name one of
+  /// those (real_inputs() and real_outputs() list them).
+  std::span<const double> RealValues(ValueRef ref) const {
+    if (infos_[ref].type == VarType::kReal) return {static_cast<const double*>(storage_[ref]), 1};
+    const auto* v = static_cast<const std::vector<double>*>(storage_[ref]);
+    return {v->data(), v->size()};
+  }
   void SetRealArray(ValueRef ref, std::span<const double> v);
   double GetRealElement(ValueRef ref, std::size_t index) const;
   void SetRealElement(ValueRef ref, std::size_t index, double v);
