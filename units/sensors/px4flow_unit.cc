@@ -10,6 +10,9 @@ namespace linesim::sensors {
 
 namespace {
 
+// Keeps the image mode's texture stream apart from the fast model's.
+constexpr std::uint64_t kImageSeedSalt = 0x9e3779b97f4a7c15ULL;
+
 // Fast-model constants fitted to the image-level reference (px4flow_image.h)
 // at texture_scale 1 mm, mount height 0.1841 m, over contrast 0.02..0.3,
 // 20..3000 lx, 0..0.7 m/s (see the class comment and the calibration test
@@ -75,7 +78,7 @@ bool Inside(const models::Rect& r, double c, double s, double x, double y) {
 }  // namespace
 
 Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint64_t seed)
-    : cosim::Unit(kTypeName, std::move(name)), surfaces_(scene.surfaces), rng_(seed) {
+    : cosim::Unit(kTypeName, std::move(name)), surfaces_(scene.surfaces), seed_(seed), rng_(seed) {
   if (surfaces_.empty()) throw cosim::UnitError(Where() + ": the scene has no surfaces");
   floor_surface_ = scene.floor.surface;
   for (const models::Belt& b : scene.belts) {
@@ -103,6 +106,10 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
   v.Parameter("mount_yaw", "rad", &mount_yaw_,
               "sensor x axis relative to base_link x, counter-clockwise in the floor plane",
               Rule::Finite());
+  v.Parameter("mode", &mode_,
+              "fast: the per-frame model of the firmware's block statistics; image: every frame "
+              "rendered and block-matched as the firmware does (the slow reference)",
+              Rule::OneOf({"fast", "image"}));
   v.Parameter("focal_length_px", "1", &focal_length_px_,
               "focal length in binned pixels (16 mm / (6 um * 4) = 666.7)", Rule::Positive());
   v.Parameter("frame_rate", "Hz", &frame_rate_, "camera frame rate (flow computations per s)",
@@ -223,6 +230,9 @@ void Px4FlowUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }
 void Px4FlowUnit::Initialize() {
   ThrowIfBadParameters();
   CacheCamera();
+  // Its own texture and noise stream, from the unit's seed.
+  image_ = mode_ == "image" ? std::make_unique<Px4FlowImageModel>(cam_, seed_ ^ kImageSeedSalt)
+                            : nullptr;
   // The first frame at the start has no previous frame; frames then follow
   // at k / frame_rate, messages at m / publish_rate.
   frame_index_ = 1;
@@ -270,6 +280,24 @@ void Px4FlowUnit::Frame() {
   int surface = 0;
   TrueFlow(fx, fy, surface);
   const models::Surface& surf = surfaces_[static_cast<std::size_t>(surface)];
+  int q = 0;
+  double flow_x = 0.0, flow_y = 0.0;
+  if (image_) {
+    // The surface's velocity relative to the sensor (m/s, sensor frame).
+    const double to_mps = frame_rate_ * mount_height_ / focal_length_px_;
+    const FlowResult r = image_->Step(fx * to_mps, fy * to_mps, mount_height_,
+                                      surf.texture_contrast, surf.illumination_lux + added_light_);
+    q = r.quality;
+    flow_x = r.flow_x_px;
+    flow_y = r.flow_y_px;
+  } else {
+    FastFrame(fx, fy, surf, q, flow_x, flow_y);
+  }
+  CommitFrame(q, flow_x, flow_y);
+}
+
+void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, int& q,
+                            double& flow_x, double& flow_y) {
   const Exposure e = AutoExposure(cam_, surf.illumination_lux + added_light_);
   const double blur_px = std::sqrt(fx * fx + fy * fy) * e.exposure_s * frame_rate_;
   const double br = blur_px / kBlurScalePx;
@@ -320,10 +348,16 @@ void Px4FlowUnit::Frame() {
     sum_y += oy;
     ++used;
   }
-  const double dt = 1.0 / frame_rate_;
   if (used > 10) {
-    const int q = used * 255 / 25;
-    const double flow_x = sum_x / used, flow_y = sum_y / used;
+    q = used * 255 / 25;
+    flow_x = sum_x / used;
+    flow_y = sum_y / used;
+  }
+}
+
+void Px4FlowUnit::CommitFrame(int q, double flow_x, double flow_y) {
+  const double dt = 1.0 / frame_rate_;
+  if (q > 0) {
     frame_quality_ = q;
     frame_flow_[0] = flow_x;
     frame_flow_[1] = flow_y;
@@ -397,6 +431,10 @@ cosim::StepResult Px4FlowUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
 }
 
 void Px4FlowUnit::SaveInternal(cosim::UnitState& state) const {
+  if (image_) {
+    throw cosim::UnitError(Where() + ": mode image cannot save its state (the rendered texture "
+                                     "and the last image are not kept); use mode fast");
+  }
   std::ostringstream rng;
   rng << rng_;
   state.strings = {rng.str()};

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -61,6 +62,14 @@ namespace linesim::sensors {
 /// integrated_x += flow_y / f, integrated_y -= flow_x / f, integration_time
 /// += frame interval, integrated_gyro += gyro * frame interval, quality sum;
 /// published and reset at publish_rate.
+///
+/// With `mode: image` each frame is rendered and matched instead
+/// (Px4FlowImageModel: the 64 x 64 binned image of the surface's procedural
+/// texture with its exposure, blur and noise, and the firmware's SAD search
+/// with half-pixel refinement); everything after the frame's flow and
+/// quality is the same. It is the slow reference (about 2-3 ms a frame);
+/// its state (the texture and the last image) is not saved, so SaveState
+/// refuses it.
 class Px4FlowUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "px4flow";
@@ -88,6 +97,12 @@ class Px4FlowUnit : public cosim::Unit {
  private:
   void CacheCamera();
   void Frame();
+  /// The fast model's frame: quality and flow (px) of the true flow (fx, fy)
+  /// over surface `surf`; q stays 0 with 10 or fewer blocks.
+  void FastFrame(double fx, double fy, const models::Surface& surf, int& q, double& flow_x,
+                 double& flow_y);
+  /// Integrates a frame of quality q (> 0: counted) into OPTICAL_FLOW_RAD.
+  void CommitFrame(int q, double flow_x, double flow_y);
   void Publish();
 
   struct BeltArea {
@@ -121,8 +136,15 @@ class Px4FlowUnit : public cosim::Unit {
   std::vector<double> integrated_gyro_, velocity_, frame_flow_;
   double distance_ = -1.0, valid_ = 0.0, frame_quality_ = 0.0, frame_count_ = 0.0;
 
+  // `mode`: "fast" (the per-frame model above) or "image" (every frame
+  // rendered and matched by Px4FlowImageModel: the reference, about 2-3 ms
+  // a frame, for checking the fast model inside a scenario).
+  std::string mode_ = "fast";
+
   // Internal state.
   Px4FlowCamera cam_;
+  std::uint64_t seed_;
+  std::unique_ptr<Px4FlowImageModel> image_;  // image mode only
   double cos_mount_ = 1.0, sin_mount_ = 0.0;  // of mount_yaw (CacheCamera)
   std::mt19937_64 rng_;
   cosim::TimeNs start_ = 0, next_frame_ = 0, next_publish_ = 0;
