@@ -1,8 +1,8 @@
 // Cost of one ClearanceUnit communication point (UpdateOutputs + DoStep,
 // inputs set as the master sets them) in the factory_line scene
-// (models/scenes/factory_line.yaml, built here in code: 30 x 20 m hall, 4
+// (models/scenes/factory_line.yaml, read by the loader: 30 x 20 m hall, 4
 // walls, 10 pillars, 3 carts, a rack, one 20 x 2 m belt at 0.10 m/s
-// carrying two car bodies), with the Rob@Work 3 body (models/robots/raw3.yaml:
+// carrying two car bodies on their skids), with the Rob@Work 3 body (models/robots/raw3.yaml:
 // 1.03 x 0.57 x 0.40 m box centred 0.13 m up, so its bottom is 0.07 m below
 // base_link). One step is 1 ms of simulated time (the chassis's step).
 //
@@ -42,6 +42,7 @@
 #include <vector>
 
 #include "cosim/time.h"
+#include "loader/scene_file.h"
 #include "models/scene.h"
 #include "units/evaluation/clearance.h"
 
@@ -51,62 +52,12 @@ namespace models = linesim::models;
 using linesim::cosim::TimeNs;
 using linesim::evaluation::ClearanceUnit;
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr TimeNs kStepNs = 1'000'000;
 constexpr double kStepS = 1e-3;
 
-models::Solid Box(double x, double y, double yaw_deg, double length, double width, double height,
-                  double bottom = 0.0) {
-  models::Solid s;
-  s.x_m = x;
-  s.y_m = y;
-  s.yaw_rad = yaw_deg * kDeg;
-  s.length_m = length;
-  s.width_m = width;
-  s.height_m = height;
-  s.bottom_m = bottom;
-  return s;
-}
-
-models::Solid Pillar(double x, double y) {
-  models::Solid s;
-  s.kind = models::Solid::Kind::kCylinder;
-  s.x_m = x;
-  s.y_m = y;
-  s.radius_m = 0.25;
-  s.height_m = 4.0;
-  return s;
-}
-
-// models/scenes/factory_line.yaml.
+// The hall, read as every scenario reads it.
 models::Scene FactoryLine() {
-  models::Scene s;
-  s.name = "factory_line";
-  s.surfaces.push_back({"concrete", 0.8, 0.2, 500.0});
-  s.surfaces.push_back({"belt", 0.8, 0.05, 500.0});
-  s.floor = {-15.0, 15.0, -10.0, 10.0, 0};
-  models::Belt line;
-  line.name = "line";
-  line.area = {0.0, 0.0, 20.0, 2.0, 0.0};
-  line.surface = 1;
-  line.nominal_speed_mps = 0.10;
-  s.belts.push_back(line);
-  s.obstacles.push_back({"wall_north", "wall", Box(0.0, 9.9, 0, 30.0, 0.2, 4.0)});
-  s.obstacles.push_back({"wall_south", "wall", Box(0.0, -9.9, 0, 30.0, 0.2, 4.0)});
-  s.obstacles.push_back({"wall_west", "wall", Box(-14.9, 0.0, 90, 19.6, 0.2, 4.0)});
-  s.obstacles.push_back({"wall_east", "wall", Box(14.9, 0.0, 90, 19.6, 0.2, 4.0)});
-  for (double y : {-7.5, 7.5}) {
-    for (double x : {-12.0, -6.0, 0.0, 6.0, 12.0}) {
-      s.obstacles.push_back({"pillar", "pillar", Pillar(x, y)});
-    }
-  }
-  s.obstacles.push_back({"cart_1", "cart", Box(-12.0, -4.0, 0, 1.2, 0.8, 1.0)});
-  s.obstacles.push_back({"cart_2", "cart", Box(-12.0, 4.0, 0, 1.2, 0.8, 1.0)});
-  s.obstacles.push_back({"cart_3", "cart", Box(12.0, 4.0, 90, 1.2, 0.8, 1.0)});
-  s.obstacles.push_back({"rack_1", "rack", Box(9.0, 8.8, 0, 2.7, 1.1, 2.5)});
-  s.carried.push_back({"body_1", 0, Box(-7.0, 0.0, 0, 4.6, 1.8, 1.2, 0.3)});
-  s.carried.push_back({"body_2", 0, Box(5.0, 0.0, 0, 4.6, 1.8, 1.2, 0.3)});
-  return s;
+  return linesim::loader::LoadSceneFile(LINESIM_SOURCE_DIR "/models/scenes/factory_line.yaml");
 }
 
 struct Pose {

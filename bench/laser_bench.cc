@@ -1,7 +1,7 @@
 // Cost of the laser scanner (units/sensors): one scan and one 1 ms step of a
 // SICK S300 / LMS151 in the factory_line scene (models/scenes/factory_line.yaml:
-// 4 walls, 10 pillars, 3 carts, a rack, 2 car bodies on the line), read here
-// with yaml-cpp (this program links the sensors family only, not the loader).
+// 4 walls, 10 pillars, 3 carts, a rack, 2 car bodies on their skids on the
+// line), read by the loader as a scenario reads it.
 #include <benchmark/benchmark.h>
 #include <yaml-cpp/yaml.h>
 
@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "loader/scene_file.h"
 #include "units/sensors/laser_scanner_unit.h"
 
 namespace linesim::sensors {
@@ -19,49 +20,9 @@ namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr cosim::TimeNs kMs = 1'000'000;
 
-models::Solid ReadSolid(const YAML::Node& item) {
-  models::Solid s;
-  const bool box = static_cast<bool>(item["box"]);
-  const YAML::Node n = box ? item["box"] : item["cylinder"];
-  s.kind = box ? models::Solid::Kind::kBox : models::Solid::Kind::kCylinder;
-  s.x_m = n["x_m"].as<double>();
-  s.y_m = n["y_m"].as<double>();
-  s.height_m = n["height_m"].as<double>();
-  s.bottom_m = n["bottom_m"] ? n["bottom_m"].as<double>() : 0.0;
-  if (box) {
-    s.yaw_rad = (n["yaw_deg"] ? n["yaw_deg"].as<double>() : 0.0) * kDeg;
-    s.length_m = n["length_m"].as<double>();
-    s.width_m = n["width_m"].as<double>();
-  } else {
-    s.radius_m = n["radius_m"].as<double>();
-  }
-  return s;
-}
-
-// The geometry of models/scenes/factory_line.yaml (what a laser sees).
+// The scene the laser sees, read as every scenario reads it.
 models::Scene FactoryLine() {
-  const YAML::Node f =
-      YAML::LoadFile(std::string(LINESIM_SOURCE_DIR) + "/models/scenes/factory_line.yaml");
-  models::Scene s;
-  s.name = "factory_line";
-  s.floor = {f["floor"]["min_x_m"].as<double>(), f["floor"]["max_x_m"].as<double>(),
-             f["floor"]["min_y_m"].as<double>(), f["floor"]["max_y_m"].as<double>(), 0};
-  for (const auto& b : f["belts"]) {
-    models::Belt belt;
-    belt.name = b["name"].as<std::string>();
-    belt.area = {b["center_x_m"].as<double>(), b["center_y_m"].as<double>(),
-                 b["length_m"].as<double>(), b["width_m"].as<double>(),
-                 b["direction_deg"].as<double>() * kDeg};
-    belt.nominal_speed_mps = b["speed_mps"].as<double>();
-    s.belts.push_back(belt);
-  }
-  for (const auto& o : f["obstacles"]) {
-    s.obstacles.push_back({o["name"].as<std::string>(), o["kind"].as<std::string>(), ReadSolid(o)});
-  }
-  for (const auto& c : f["carried"]) {
-    s.carried.push_back({c["name"].as<std::string>(), 0, ReadSolid(c)});
-  }
-  return s;
+  return linesim::loader::LoadSceneFile(LINESIM_SOURCE_DIR "/models/scenes/factory_line.yaml");
 }
 
 std::unique_ptr<LaserScannerUnit> FromModel(const std::string& name, const models::Scene& scene) {
