@@ -50,26 +50,15 @@ constexpr double kBeltMps = 0.2;
 models::Scene FactoryScene(bool furniture) {
   models::Scene s = robots::OneBelt({0.0, 4.5, 40.0, 3.0, 0.0});
   if (!furniture) return s;
+  // Argument order of the calls below: bottom before height.
   const auto box = [](double x, double y, double yaw, double length, double width, double bottom,
                       double height) {
-    models::Solid b;
-    b.x_m = x;
-    b.y_m = y;
-    b.yaw_rad = yaw;
-    b.length_m = length;
-    b.width_m = width;
-    b.bottom_m = bottom;
-    b.height_m = height;
-    return b;
+    return models::BoxSolid(x, y, yaw, length, width, height, bottom);
   };
   for (int i = 0; i < 12; ++i) {
-    models::Solid pillar;
-    pillar.kind = models::Solid::Kind::kCylinder;
-    pillar.x_m = -15.0 + 6.0 * (i % 6);
-    pillar.y_m = i < 6 ? -6.0 : 12.0;
-    pillar.radius_m = 0.3;
-    pillar.height_m = 6.0;
-    s.obstacles.push_back({"pillar", "pillar", pillar});
+    s.obstacles.push_back({"pillar", "pillar",
+                           models::CylinderSolid(-15.0 + 6.0 * (i % 6), i < 6 ? -6.0 : 12.0, 0.3,
+                                                 6.0)});
   }
   s.obstacles.push_back({"wall", "wall", box(0.0, -10.0, 0.0, 40.0, 0.2, 0.0, 4.0)});
   s.obstacles.push_back({"wall", "wall", box(0.0, 15.0, 0.0, 40.0, 0.2, 0.0, 4.0)});

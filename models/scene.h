@@ -82,6 +82,34 @@ struct Solid {
   double height_m = 0.0;  // top = bottom + height
 };
 
+/// A box footprint centred at (x, y), `length` along heading `yaw`.
+inline Solid BoxSolid(double x_m, double y_m, double yaw_rad, double length_m, double width_m,
+                      double height_m, double bottom_m = 0.0) {
+  Solid s;
+  s.kind = Solid::Kind::kBox;
+  s.x_m = x_m;
+  s.y_m = y_m;
+  s.yaw_rad = yaw_rad;
+  s.length_m = length_m;
+  s.width_m = width_m;
+  s.height_m = height_m;
+  s.bottom_m = bottom_m;
+  return s;
+}
+
+/// A vertical cylinder on the footprint centre (x, y).
+inline Solid CylinderSolid(double x_m, double y_m, double radius_m, double height_m,
+                           double bottom_m = 0.0) {
+  Solid s;
+  s.kind = Solid::Kind::kCylinder;
+  s.x_m = x_m;
+  s.y_m = y_m;
+  s.radius_m = radius_m;
+  s.height_m = height_m;
+  s.bottom_m = bottom_m;
+  return s;
+}
+
 /// A static obstacle: a wall, a pillar, a part cart, a rack.
 struct Obstacle {
   std::string name;

@@ -24,29 +24,8 @@ constexpr double kPi = std::numbers::pi;
 // at the origin, unrotated, it spans x -0.5..0.5, y -0.3..0.3, z 0.1..0.6.
 constexpr double kL = 1.0, kW = 0.6, kH = 0.5, kBottom = 0.1;
 
-models::Solid Box(double x, double y, double yaw, double length, double width, double height,
-                  double bottom = 0.0) {
-  models::Solid s;
-  s.kind = models::Solid::Kind::kBox;
-  s.x_m = x;
-  s.y_m = y;
-  s.yaw_rad = yaw;
-  s.length_m = length;
-  s.width_m = width;
-  s.height_m = height;
-  s.bottom_m = bottom;
-  return s;
-}
-
-models::Solid Cylinder(double x, double y, double radius, double height) {
-  models::Solid s;
-  s.kind = models::Solid::Kind::kCylinder;
-  s.x_m = x;
-  s.y_m = y;
-  s.radius_m = radius;
-  s.height_m = height;
-  return s;
-}
+using models::BoxSolid;
+using models::CylinderSolid;
 
 models::Scene SceneWith(const std::vector<models::Solid>& obstacles) {
   models::Scene scene = models::OpenFloor();
@@ -65,7 +44,7 @@ models::Scene LineScene() {
   belt.area = {0.0, 0.0, 20.0, 2.0, 0.0};
   belt.nominal_speed_mps = 0.1;
   scene.belts.push_back(belt);
-  scene.carried.push_back({"body_1", 0, Box(-7.0, 0.0, 0.0, 4.6, 1.8, 1.2, 0.3)});
+  scene.carried.push_back({"body_1", 0, BoxSolid(-7.0, 0.0, 0.0, 4.6, 1.8, 1.2, 0.3)});
   return scene;
 }
 
@@ -122,14 +101,14 @@ double DistanceTo(const models::Solid& obstacle, double x = 0.0, double y = 0.0,
 // the body's front face (x 0.5) across 1.0 m; both stand in z 0..1 and
 // 0.1..0.6, y overlapping.
 TEST(Clearance, AxisAlignedBoxesFaceToFace) {
-  EXPECT_NEAR(DistanceTo(Box(2.0, 0.0, 0.0, 1.0, 2.0, 1.0)), 1.0, kTol);
-  EXPECT_NEAR(DistanceTo(Box(2.0, 0.0, 0.0, 1.0, 2.0, 1.0), 0, 0, 0, 0, "full"), 1.0, kTol);
+  EXPECT_NEAR(DistanceTo(BoxSolid(2.0, 0.0, 0.0, 1.0, 2.0, 1.0)), 1.0, kTol);
+  EXPECT_NEAR(DistanceTo(BoxSolid(2.0, 0.0, 0.0, 1.0, 2.0, 1.0), 0, 0, 0, 0, "full"), 1.0, kTol);
 }
 
 // Guards the vertical extent (bottom_m, body_bottom, body_height): a box
 // hanging from 1.0 m over the body (top 0.1 + 0.5 = 0.6 m) is 0.4 m away.
 TEST(Clearance, BoxAboveTheBody) {
-  EXPECT_NEAR(DistanceTo(Box(0.0, 0.0, 0.0, 3.0, 3.0, 1.0, 1.0)), 0.4, kTol);
+  EXPECT_NEAR(DistanceTo(BoxSolid(0.0, 0.0, 0.0, 3.0, 3.0, 1.0, 1.0)), 0.4, kTol);
 }
 
 // Guards the edge and corner cases: a 1 x 1 box at (2, 2) has its corner
@@ -137,8 +116,8 @@ TEST(Clearance, BoxAboveTheBody) {
 // hypot(1.0, 1.2); lifted to start at 1.0 m (0.4 above the body's top), the
 // corner-to-corner distance in 3D, sqrt(1.0^2 + 1.2^2 + 0.4^2).
 TEST(Clearance, AxisAlignedEdgeAndCorner) {
-  EXPECT_NEAR(DistanceTo(Box(2.0, 2.0, 0.0, 1.0, 1.0, 1.0)), std::hypot(1.0, 1.2), kTol);
-  EXPECT_NEAR(DistanceTo(Box(2.0, 2.0, 0.0, 1.0, 1.0, 1.0, 1.0)),
+  EXPECT_NEAR(DistanceTo(BoxSolid(2.0, 2.0, 0.0, 1.0, 1.0, 1.0)), std::hypot(1.0, 1.2), kTol);
+  EXPECT_NEAR(DistanceTo(BoxSolid(2.0, 2.0, 0.0, 1.0, 1.0, 1.0, 1.0)),
               std::sqrt(1.0 * 1.0 + 1.2 * 1.2 + 0.4 * 0.4), kTol);
 }
 
@@ -151,10 +130,10 @@ TEST(Clearance, AxisAlignedEdgeAndCorner) {
 //   unrotated, so the gaps are sqrt 2 - 1.0 along x and sqrt 2 - 0.8 along y.
 TEST(Clearance, RotatedBoxes) {
   const double s2 = std::sqrt(2.0);
-  EXPECT_NEAR(DistanceTo(Box(2.0, 0.0, kPi / 4, 1.0, 1.0, 1.0)), 2.0 - s2 / 2 - 0.5, kTol);
-  EXPECT_NEAR(DistanceTo(Box(2.0, 0.0, 0.0, 1.0, 10.0, 1.0), 0, 0, kPi / 4),
+  EXPECT_NEAR(DistanceTo(BoxSolid(2.0, 0.0, kPi / 4, 1.0, 1.0, 1.0)), 2.0 - s2 / 2 - 0.5, kTol);
+  EXPECT_NEAR(DistanceTo(BoxSolid(2.0, 0.0, 0.0, 1.0, 10.0, 1.0), 0, 0, kPi / 4),
               1.5 - 0.8 * std::cos(kPi / 4), kTol);
-  EXPECT_NEAR(DistanceTo(Box(2.0, 0.0, kPi / 4, 1.0, 1.0, 1.0), 0, 0, kPi / 4),
+  EXPECT_NEAR(DistanceTo(BoxSolid(2.0, 0.0, kPi / 4, 1.0, 1.0, 1.0), 0, 0, kPi / 4),
               std::hypot(s2 - 1.0, s2 - 0.8), kTol);
 }
 
@@ -162,7 +141,7 @@ TEST(Clearance, RotatedBoxes) {
 // body's top edge (y 0.3, z 0.6) swings to y = 0.3 cos 0.1 + 0.6 sin 0.1,
 // toward a tall wall face at y = 1.0.
 TEST(Clearance, RolledBody) {
-  EXPECT_NEAR(DistanceTo(Box(0.0, 1.5, 0.0, 10.0, 1.0, 3.0), 0, 0, 0, -0.1),
+  EXPECT_NEAR(DistanceTo(BoxSolid(0.0, 1.5, 0.0, 10.0, 1.0, 3.0), 0, 0, 0, -0.1),
               1.0 - (0.3 * std::cos(0.1) + 0.6 * std::sin(0.1)), kTol);
 }
 
@@ -170,14 +149,14 @@ TEST(Clearance, RolledBody) {
 // face across 2 - 0.25 - 0.5; at (2, 2) the body's nearest point to its
 // axis is the corner (0.5, 0.3).
 TEST(Clearance, Cylinder) {
-  EXPECT_NEAR(DistanceTo(Cylinder(2.0, 0.0, 0.25, 4.0)), 1.25, kTol);
-  EXPECT_NEAR(DistanceTo(Cylinder(2.0, 2.0, 0.25, 4.0)), std::hypot(1.5, 1.7) - 0.25, kTol);
+  EXPECT_NEAR(DistanceTo(CylinderSolid(2.0, 0.0, 0.25, 4.0)), 1.25, kTol);
+  EXPECT_NEAR(DistanceTo(CylinderSolid(2.0, 2.0, 0.25, 4.0)), std::hypot(1.5, 1.7) - 0.25, kTol);
 }
 
 // Guards the nearest index and the minimum over several objects.
 TEST(Clearance, NearestOfSeveral) {
-  Rig r(SceneWith({Box(3.0, 0.0, 0.0, 1.0, 1.0, 1.0), Cylinder(0.0, -2.0, 0.25, 4.0),
-                   Box(-4.0, 0.0, 0.0, 1.0, 1.0, 1.0)}));
+  Rig r(SceneWith({BoxSolid(3.0, 0.0, 0.0, 1.0, 1.0, 1.0), CylinderSolid(0.0, -2.0, 0.25, 4.0),
+                   BoxSolid(-4.0, 0.0, 0.0, 1.0, 1.0, 1.0)}));
   r.Pose(0.0, 0.0);
   r.unit.Initialize();
   EXPECT_EQ(r.Int("nearest"), 1);  // 2 - 0.25 - 0.3 = 1.45 < 2.0 < 3.0
@@ -220,7 +199,7 @@ TEST(Clearance, CarBodyApproachesWithBeltTravel) {
 // no narrow-phase call; the values stay exact.
 TEST(Clearance, StandingRobotReusesDistances) {
   models::Scene scene = LineScene();
-  scene.obstacles.push_back({"box", "cart", Box(0.0, 3.0, 0.0, 1.0, 1.0, 1.0)});
+  scene.obstacles.push_back({"box", "cart", BoxSolid(0.0, 3.0, 0.0, 1.0, 1.0, 1.0)});
   Rig r(scene);
   r.Pose(0.0, 1.5);
   r.Travel(0.0);
@@ -278,7 +257,7 @@ TEST(Clearance, CarBodyLiftedOffAtTheBeltEnd) {
 // at 0.6 and 0.8, out at 0.3, inside again at 0.7: two collisions.
 TEST(Clearance, CollisionsCountContactEvents) {
   for (const char* query : {"pruned", "full"}) {
-    Rig r(SceneWith({Box(1.5, 0.0, 0.0, 1.0, 1.0, 1.0)}), query);
+    Rig r(SceneWith({BoxSolid(1.5, 0.0, 0.0, 1.0, 1.0, 1.0)}), query);
     r.Pose(0.0, 0.0);
     r.unit.Initialize();
     const std::vector<std::pair<double, std::int64_t>> path = {
@@ -300,7 +279,7 @@ TEST(Clearance, CollisionsCountContactEvents) {
 // collisions; starting in contact is one (nothing touched before the start).
 TEST(Clearance, TwoObjectsAtOnceAndContactAtTheStart) {
   // Boxes x 0.4..1.4 and -1.4..-0.4: the body (x -0.5..0.5) overlaps both.
-  Rig r(SceneWith({Box(0.9, 0.0, 0.0, 1.0, 1.0, 1.0), Box(-0.9, 0.0, 0.0, 1.0, 1.0, 1.0)}));
+  Rig r(SceneWith({BoxSolid(0.9, 0.0, 0.0, 1.0, 1.0, 1.0), BoxSolid(-0.9, 0.0, 0.0, 1.0, 1.0, 1.0)}));
   r.Pose(0.0, 0.0);
   r.unit.Initialize();
   EXPECT_EQ(r.Int("collisions"), 2);
@@ -317,7 +296,7 @@ TEST(Clearance, TwoObjectsAtOnceAndContactAtTheStart) {
 // Guards the metrics' outputs: the running minimum over the points passed,
 // and that UpdateOutputs alone (no step) does not commit a point.
 TEST(Clearance, MinimumOverTheRun) {
-  Rig r(SceneWith({Cylinder(3.0, 0.0, 0.5, 2.0)}));  // face at x = 2.5
+  Rig r(SceneWith({CylinderSolid(3.0, 0.0, 0.5, 2.0)}));  // face at x = 2.5
   r.Pose(0.0, 0.0);
   r.unit.Initialize();
   EXPECT_NEAR(r.Real("min_clearance"), 2.0, kTol);
@@ -339,9 +318,9 @@ TEST(Clearance, MinimumOverTheRun) {
 // body moving; the robot crossing the line and touching the body.
 models::Scene RunScene() {
   models::Scene scene = LineScene();
-  scene.obstacles.push_back({"wall", "wall", Box(0.0, 5.0, 0.0, 30.0, 0.2, 4.0)});
-  scene.obstacles.push_back({"pillar", "pillar", Cylinder(-3.0, 3.0, 0.25, 4.0)});
-  scene.obstacles.push_back({"cart", "cart", Box(3.0, -3.0, 0.3, 1.2, 0.8, 1.0)});
+  scene.obstacles.push_back({"wall", "wall", BoxSolid(0.0, 5.0, 0.0, 30.0, 0.2, 4.0)});
+  scene.obstacles.push_back({"pillar", "pillar", CylinderSolid(-3.0, 3.0, 0.25, 4.0)});
+  scene.obstacles.push_back({"cart", "cart", BoxSolid(3.0, -3.0, 0.3, 1.2, 0.8, 1.0)});
   return scene;
 }
 

@@ -86,18 +86,8 @@ double BeamAngle(int i) { return -135.0 * kDeg + i * 0.5 * kDeg; }
 models::Scene WithBox(double x, double y, double length, double width, double height,
                       double yaw = 0.0, double bottom = 0.0) {
   models::Scene s = models::OpenFloor();
-  models::Obstacle o;
-  o.name = "box";
-  o.kind = "cart";
-  o.solid.kind = models::Solid::Kind::kBox;
-  o.solid.x_m = x;
-  o.solid.y_m = y;
-  o.solid.yaw_rad = yaw;
-  o.solid.length_m = length;
-  o.solid.width_m = width;
-  o.solid.height_m = height;
-  o.solid.bottom_m = bottom;
-  s.obstacles.push_back(o);
+  s.obstacles.push_back(
+      {"box", "cart", models::BoxSolid(x, y, yaw, length, width, height, bottom)});
   return s;
 }
 
@@ -159,15 +149,7 @@ TEST(LaserScanner, BoxRangesAreAnalytic) {
 // the S300 file's 86.6 deg limit read 0.
 TEST(LaserScanner, CylinderRangesAreExact) {
   models::Scene scene = models::OpenFloor();
-  models::Obstacle pillar;
-  pillar.name = "pillar";
-  pillar.kind = "pillar";
-  pillar.solid.kind = models::Solid::Kind::kCylinder;
-  pillar.solid.x_m = 4.0;
-  pillar.solid.y_m = 1.0;
-  pillar.solid.radius_m = 0.3;
-  pillar.solid.height_m = 3.0;
-  scene.obstacles.push_back(pillar);
+  scene.obstacles.push_back({"pillar", "pillar", models::CylinderSolid(4.0, 1.0, 0.3, 3.0)});
   auto u = FromModel("sick_s300", scene);
   Exact(*u);
   SetAll(*u, "mount_z", 0.3);
@@ -296,15 +278,7 @@ models::Scene BodyOnBelt() {
   belt.area = {20.0, 0.0, 40.0, 4.0, 0.0};
   belt.nominal_speed_mps = 2.0;
   scene.belts.push_back(belt);
-  models::CarriedObject body;
-  body.name = "body";
-  body.belt = 0;
-  body.solid.kind = models::Solid::Kind::kBox;
-  body.solid.x_m = 5.0;
-  body.solid.length_m = 1.0;
-  body.solid.width_m = 4.0;
-  body.solid.height_m = 1.0;
-  scene.carried.push_back(body);
+  scene.carried.push_back({"body", 0, models::BoxSolid(5.0, 0.0, 0.0, 1.0, 4.0, 1.0)});
   return scene;
 }
 
@@ -464,14 +438,7 @@ TEST(LaserScanner, ProtectiveFieldNeedsTwoScansAndClears) {
   belt.name = "line";
   belt.area = {0.0, 0.0, 20.0, 4.0, std::numbers::pi / 2};  // along +y
   scene.belts.push_back(belt);
-  models::CarriedObject post;
-  post.name = "post";
-  post.solid.kind = models::Solid::Kind::kBox;
-  post.solid.x_m = 0.4;
-  post.solid.length_m = 0.1;
-  post.solid.width_m = 0.1;
-  post.solid.height_m = 1.0;
-  scene.carried.push_back(post);
+  scene.carried.push_back({"post", 0, models::BoxSolid(0.4, 0.0, 0.0, 0.1, 0.1, 1.0)});
   auto u = FromModel("sick_s300", scene);
   SetAll(*u, "mount_z", 0.2);
   Start(*u);
@@ -540,14 +507,7 @@ TEST(LaserScanner, MixedPixelsAtEdges) {
 // restored into a unit of another seed continues bit for bit.
 TEST(LaserScanner, DeterministicAndRestoresMidScan) {
   models::Scene scene = WithBox(3.0, 1.0, 1.0, 1.0, 1.0, 0.3);
-  models::Obstacle pillar;
-  pillar.name = "pillar";
-  pillar.solid.kind = models::Solid::Kind::kCylinder;
-  pillar.solid.x_m = -2.0;
-  pillar.solid.y_m = 2.0;
-  pillar.solid.radius_m = 0.25;
-  pillar.solid.height_m = 3.0;
-  scene.obstacles.push_back(pillar);
+  scene.obstacles.push_back({"pillar", "", models::CylinderSolid(-2.0, 2.0, 0.25, 3.0)});
   auto a = FromModel("sick_lms151", scene, 11);
   auto b = FromModel("sick_lms151", scene, 11);
   auto c = FromModel("sick_lms151", scene, 99);
