@@ -250,10 +250,6 @@ ClearanceUnit::ClearanceUnit(std::string name, const models::Scene& scene)
 
 ClearanceUnit::~ClearanceUnit() = default;
 
-std::vector<cosim::ParameterProblem> ClearanceUnit::CheckParameters() const {
-  return cosim::Unit::CheckParameters();
-}
-
 void ClearanceUnit::BuildBody() {
   fcl_->body = std::make_unique<fcl::CollisionObjectd>(
       std::make_shared<fcl::Boxd>(body_length_, body_width_, body_height_));

@@ -70,7 +70,6 @@ class ClearanceUnit : public cosim::Unit {
   ClearanceUnit(std::string name, const models::Scene& scene);
   ~ClearanceUnit() override;
 
-  std::vector<cosim::ParameterProblem> CheckParameters() const override;
   /// Validates the parameters (throws cosim::UnitError), builds the body
   /// and evaluates the start (no contact before it).
   void Initialize() override;

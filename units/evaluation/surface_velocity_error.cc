@@ -9,7 +9,9 @@ SurfaceVelocityErrorUnit::SurfaceVelocityErrorUnit(std::string name, int sensors
                                                    const models::Belt& belt)
     : cosim::Unit(kTypeName, std::move(name)),
       sensors_(static_cast<std::size_t>(sensors)),
-      belt_area_(belt.area) {
+      belt_area_(belt.area),
+      belt_x_(std::cos(belt.area.direction_rad)),
+      belt_y_(std::sin(belt.area.direction_rad)) {
   if (sensors < 1) {
     throw cosim::UnitError(Where() + ": sensors must be at least 1, got " +
                            std::to_string(sensors));
@@ -53,7 +55,7 @@ SurfaceVelocityErrorUnit::SurfaceVelocityErrorUnit(std::string name, int sensors
 
 void SurfaceVelocityErrorUnit::Evaluate() {
   const double c = std::cos(yaw_), s = std::sin(yaw_);
-  const double bx = std::cos(belt_area_.direction_rad), by = std::sin(belt_area_.direction_rad);
+  const double bx = belt_x_, by = belt_y_;
   for (std::size_t k = 0; k < sensors_; ++k) {
     // The sensor's point in map and its velocity (v + omega x r).
     const double rx = c * mount_x_[k] - s * mount_y_[k];

@@ -28,6 +28,9 @@ class SurfaceVelocityErrorUnit : public cosim::Unit {
   SurfaceVelocityErrorUnit(std::string name, int sensors, const models::Belt& belt);
 
   void Initialize() override;
+  /// surface_speed, error and over_belt follow the inputs at once (they
+  /// depend on them directly); rmse and samples move on in DoStep.
+  void UpdateOutputs() override { Evaluate(); }
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
 
  protected:
@@ -39,6 +42,7 @@ class SurfaceVelocityErrorUnit : public cosim::Unit {
 
   std::size_t sensors_;
   models::Rect belt_area_;
+  double belt_x_, belt_y_;  // unit vector of the belt's direction
 
   // Parameters, one element per sensor.
   std::vector<double> mount_x_, mount_y_, mount_yaw_;

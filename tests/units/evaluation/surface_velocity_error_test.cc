@@ -100,6 +100,21 @@ TEST(SurfaceVelocityError, RmseOverSensorsOverTheBelt) {
   EXPECT_EQ(Get(*u, "samples")[0], 2.0);
 }
 
+// Guards the declared feedthrough: surface_speed depends directly on the
+// inputs, so UpdateOutputs must show the inputs just set (the master reads
+// it before the step), not the previous step's. Expected as in the first
+// test: 0.2 m/s along the belt from a standing robot.
+TEST(SurfaceVelocityError, OutputsFollowTheInputsBeforeTheStep) {
+  auto u = TwoSensors();
+  u->Initialize();
+  EXPECT_EQ(Get(*u, "surface_speed")[0], 0.0);
+  SetArray(*u, "measured", {0.2, 0.0, 0.0, -0.2});
+  u->UpdateOutputs();
+  EXPECT_NEAR(Get(*u, "surface_speed")[0], 0.2, 1e-12);
+  EXPECT_NEAR(Get(*u, "surface_speed")[1], 0.2, 1e-12);
+  EXPECT_EQ(Get(*u, "samples")[0], 0.0);  // nothing counted before a step
+}
+
 TEST(SurfaceVelocityError, MountsAreRequired) {
   SurfaceVelocityErrorUnit u("e", 1, Treadmill());
   EXPECT_EQ(u.CheckParameters().size(), 3u);
