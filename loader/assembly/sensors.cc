@@ -107,7 +107,8 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
     bool on = false;
     YAML::Node node;  // the map, if one was given
   };
-  const auto choice = [&](const std::string& name) {
+  // A map's keys are checked whether the sensor ends up on or off.
+  const auto choice = [&](const std::string& name, const std::vector<std::string>& extra_keys) {
     Choice c{by_default, YAML::Node()};
     const YAML::Node entry = Child(section, name);
     const std::string path = JoinPath("sensors", name);
@@ -117,19 +118,18 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
       return c;
     }
     if (!r.ExpectMap(entry, path)) return c;
+    std::vector<std::string> allowed = {"enabled", "step_s", "model", "parameters"};
+    allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
+    r.CheckKeys(entry, path, allowed);
     c.on = r.Boolean(entry, path, "enabled", true);
     c.node = entry;
     return c;
   };
   // The scenario's step_s, model and parameters on top of the mount's.
   const auto apply = [&](const std::string& name, const Choice& c, cosim::TimeNs step,
-                         const std::vector<std::string>& extra_keys,
                          const std::set<std::string>& derived) {
     const std::string path = JoinPath("sensors", name);
     if (c.node.IsMap()) {
-      std::vector<std::string> allowed = {"enabled", "step_s", "model", "parameters"};
-      allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
-      r.CheckKeys(c.node, path, allowed);
       if (Child(c.node, "model").IsDefined()) {
         b.Params(name)["model"] = Child(c.node, "model");
         b.Derived(JoinPath(JoinPath(JoinPath("units", name), "parameters"), "model"), c.node, path,
@@ -166,7 +166,9 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
   const cosim::TimeNs control_period = b.ControlPeriod();
   for (std::size_t i = 0; i < robot.sensor_mounts.size(); ++i) {
     const models::SensorMount& m = robot.sensor_mounts[i];
-    const Choice c = choice(m.name);
+    const bool laser = m.kind == "laser_scanner";
+    const Choice c = choice(m.name, laser ? std::vector<std::string>{"snapshot_s"}
+                                          : std::vector<std::string>{});
     if (!c.on) continue;
     if (b.HasUnit(m.name)) {
       r.Error(Child(section, m.name).IsDefined() ? Child(section, m.name) : section,
@@ -219,9 +221,7 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
       step = WholeMasterSteps(wiring->second.default_step, b.MasterStep());
       b.Origin(step_key, {section, JoinPath(JoinPath("sensors", m.name), "step_s"), ""});
     }
-    const bool laser = m.kind == "laser_scanner";
-    apply(m.name, c, step, laser ? std::vector<std::string>{"snapshot_s"} : std::vector<std::string>{},
-          derived);
+    apply(m.name, c, step, derived);
     if (laser && c.node.IsMap() && Child(c.node, "snapshot_s").IsDefined()) {
       // The scan it has completed at this time is drawn (scan.png): its
       // ranges are recorded with the rest.
@@ -236,7 +236,7 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
 
   // Paper 1's ground truth of the line: a free wheel with a quadrature
   // encoder on the belt, mounted off the robot.
-  const Choice gt = choice(kBeltGroundTruth);
+  const Choice gt = choice(kBeltGroundTruth, {"belt"});
   if (gt.on && s.belt_count > 0) {
     const std::string path = JoinPath("sensors", kBeltGroundTruth);
     const std::int64_t belt =
@@ -251,12 +251,13 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
     // its Arduino; the controllers' 50 Hz shows a belt start of ~1 s well).
     b.Derived(JoinPath(JoinPath("units", kBeltGroundTruth), "step_s"), Child(b.root(), "control"),
               "control", "period_s");
-    apply(kBeltGroundTruth, gt, control_period, {"belt"}, {});
+    apply(kBeltGroundTruth, gt, control_period, {});
     s.recorded.push_back(Signal(kBeltGroundTruth, "speed"));
     s.belt_ground_truth = Signal(kBeltGroundTruth, "speed");
     s.belt_ground_truth_belt = static_cast<int>(belt);
-  } else if (gt.node.IsMap() && gt.on && s.belt_count == 0) {
-    r.Error(gt.node, JoinPath("sensors", kBeltGroundTruth),
+  } else if (const YAML::Node asked = Child(section, kBeltGroundTruth);
+             asked.IsDefined() && !asked.IsNull() && gt.on && s.belt_count == 0) {
+    r.Error(asked, JoinPath("sensors", kBeltGroundTruth),
             "the scene has no belts for the belt's ground-truth sensor to measure");
   }
 }

@@ -72,6 +72,8 @@ TEST(SensorsAssembly, EveryMountOfTheRobotIsAUnit) {
   EXPECT_EQ(Table(s, "laser_front").info(*Table(s, "laser_front").Find("ranges")).size, 541u);
   EXPECT_EQ(Param(s, "laser_front", "scan_period"), 0.04);
   EXPECT_EQ(Param(s, "laser_front", "range_resolution"), 0.01);
+  // models/robots/raw3.yaml: 0.1841 m (the authors' public code), its
+  // added light 500 lx (an assumption stated there).
   EXPECT_EQ(Param(s, "flow_front_left", "mount_height"), 0.1841);
   EXPECT_EQ(Param(s, "flow_front_left", "added_light"), 500.0);
   EXPECT_TRUE(Connected(s, "chassis.position_3d", "laser_front.position_3d"));
@@ -84,7 +86,8 @@ TEST(SensorsAssembly, EveryMountOfTheRobotIsAUnit) {
   EXPECT_EQ(s.master->decimation(*s.system->FindUnit("wheel_encoders")), 20);
   EXPECT_EQ(s.master->decimation(*s.system->FindUnit("imu")), 10);
   EXPECT_EQ(s.master->decimation(*s.system->FindUnit("laser_front")), 1);
-  EXPECT_EQ(Param(s, "wheel_encoders", "counts_per_revolution", 4), 86016.0);
+  // 4096 counts per motor turn x drive gear 21 (raw3.yaml).
+  EXPECT_EQ(Param(s, "wheel_encoders", "counts_per_revolution", 4), 4096.0 * 21);
   // The clearance body is the chassis's box: centred on com_height.
   EXPECT_NEAR(Param(s, "clearance", "body_bottom"), 0.13 - 0.2, 1e-15);
 }
@@ -137,6 +140,13 @@ TEST(SensorsAssembly, BadEntriesAreReportedAtTheirKeys) {
       kCross, "derived.yaml", "sensors:\n  laser_front: {parameters: {mount_x: 1.0}}\n");
   const std::string b = Issues(derived);
   EXPECT_TRUE(Has(b, "sensors.laser_front.parameters.mount_x: the assembly derives")) << b;
+
+  // A sensor turned off is still checked: its typo is reported.
+  const std::string off = WithSensors(
+      kCross, "off_typo.yaml", "sensors:\n  laser_front: {enabled: false, stepp_s: 0.002}\n");
+  const std::string d = Issues(off);
+  EXPECT_TRUE(Has(d, "sensors.laser_front.stepp_s: unknown key; closest: sensors.laser_front.step_s"))
+      << d;
 
   const std::string bad = WithSensors(
       kCross, "bad_value.yaml", "sensors:\n  laser_front: {parameters: {noise_sigma: -1}}\n");
