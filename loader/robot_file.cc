@@ -10,12 +10,13 @@
 #include "cosim/variable_table.h"
 #include "loader/scenario.h"
 #include "loader/yaml_files.h"
+#include "models/angle.h"
 
 namespace linesim::loader {
 
 namespace {
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
+using models::kDegToRad;
 // Sizes of anything that rolls on a factory floor: a wheel of 1 mm to 2 m,
 // a robot up to 10 m long and 10 t heavy.
 constexpr Range kPositionM{-10.0, 10.0};
@@ -334,7 +335,11 @@ class Reader {
       m.kind = r_.String(node, sp, "kind", std::nullopt, models::SensorKinds());
       const bool posed = models::SensorKindHasPose(m.kind);
       std::vector<std::string> keys = {"name", "kind", "model", "step_s", "parameters", "source"};
-      if (posed) keys.insert(keys.end(), {"x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg"});
+      // A PX4Flow looks straight down: only its heading about the vertical
+      // is free (a roll or pitch there would be silently dropped).
+      const bool downward = m.kind == "px4flow";
+      if (posed) keys.insert(keys.end(), {"x_m", "y_m", "z_m", "yaw_deg"});
+      if (posed && !downward) keys.insert(keys.end(), {"roll_deg", "pitch_deg"});
       r_.CheckKeys(node, sp, keys);
       m.name = r_.String(node, sp, "name", std::nullopt);
       if (!m.name.empty() && !cosim::IsIdentifier(m.name)) {
@@ -343,7 +348,7 @@ class Reader {
                  "names the sensor's unit)");
       }
       m.model = r_.String(node, sp, "model", "");
-      m.step_s = r_.Real(node, sp, "step_s", 0.0, {0.0, 10.0});
+      m.step_ns = r_.Time(node, sp, "step_s", 0.0, {0.0, 10.0});
       if (posed) {
         m.x_m = r_.Real(node, sp, "x_m", std::nullopt, kPositionM);
         m.y_m = r_.Real(node, sp, "y_m", std::nullopt, kPositionM);

@@ -6,12 +6,13 @@
 #include "cosim/variable_table.h"
 #include "loader/assembly/concerns.h"
 #include "loader/robot_file.h"
+#include "models/angle.h"
 
 namespace linesim::loader {
 
 namespace {
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
+using models::kDegToRad;
 
 // `units:` in a robot scenario adds to or overrides the expanded units, in
 // the system-level shape units.NAME.{type, step_s, parameters}; its

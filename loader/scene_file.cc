@@ -10,6 +10,7 @@
 
 #include "cosim/closest_names.h"
 #include "loader/yaml_files.h"
+#include "models/angle.h"
 
 namespace linesim::loader {
 
@@ -17,7 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
+using models::kDegToRad;
 
 // Positions on the floor: the same bound as robot scenarios' belts.
 constexpr Range kCoordinate{-1e6, 1e6};

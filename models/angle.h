@@ -5,6 +5,9 @@
 
 namespace linesim::models {
 
+/// Degrees (as files write angles) to radians.
+inline constexpr double kDegToRad = std::numbers::pi / 180.0;
+
 /// An angle wrapped to (-pi, pi]: remainder() gives [-pi, pi], and -pi is
 /// moved to +pi so that every heading has one value.
 inline double WrapAngle(double angle_rad) {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <optional>
@@ -78,8 +79,9 @@ struct SensorMount {
   std::string kind;
   /// The device's model file in models/sensors (sick_s300), or empty.
   std::string model;
-  /// The sensor's communication step (s); 0: the kind's default.
-  double step_s = 0.0;
+  /// The sensor's communication step (ns, as BeltSwitch times); 0: the
+  /// kind's default.
+  std::int64_t step_ns = 0;
   /// Pose in base_link (a wheel encoder has none: it reads the joints).
   double x_m = 0.0, y_m = 0.0, z_m = 0.0;
   double roll_rad = 0.0, pitch_rad = 0.0, yaw_rad = 0.0;

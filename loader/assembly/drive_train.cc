@@ -123,8 +123,6 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
   s.recorded.push_back(Signal(kMotors, "current"));
 
   info.wheel_count = static_cast<int>(robot.wheels.size());
-  info.body_length_m = robot.body.length_m;
-  info.body_width_m = robot.body.width_m;
   return s;
 }
 

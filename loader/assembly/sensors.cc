@@ -211,8 +211,8 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
     // the kind's rate as a whole number of master steps, or the master's.
     const std::string step_key = JoinPath(JoinPath("units", m.name), "step_s");
     cosim::TimeNs step = 0;
-    if (m.step_s > 0) {
-      step = cosim::SecondsToNs(m.step_s);
+    if (m.step_ns > 0) {
+      step = m.step_ns;
       b.Origin(step_key, {YAML::Node(), JoinPath(mount_path, "step_s"), robot.file});
     } else if (m.kind == "wheel_encoder") {
       step = control_period;

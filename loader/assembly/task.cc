@@ -2,11 +2,12 @@
 #include <numbers>
 
 #include "loader/assembly/concerns.h"
+#include "models/angle.h"
 
 namespace linesim::loader::assembly {
 
 namespace {
-constexpr double kDegToRad = std::numbers::pi / 180.0;
+using models::kDegToRad;
 }  // namespace
 
 void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Signals& s,

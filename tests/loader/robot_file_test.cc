@@ -111,10 +111,35 @@ TEST(RobotFile, TopologyProblemsAreNamed) {
       << ReadModel(steered).issues;
 
   const std::string typo = WriteScenario("robot_typo.yaml", Robot(kLeft) + "wheel: []\n");
-  EXPECT_TRUE(Has(ReadModel(typo).issues, "wheel")) << ReadModel(typo).issues;
+  EXPECT_TRUE(Has(ReadModel(typo).issues, "wheel: unknown key; closest: wheels"))
+      << ReadModel(typo).issues;
   EXPECT_FALSE(ReadModel(typo).file);
 
   EXPECT_TRUE(ReadModel(WriteScenario("robot_ok.yaml", Robot(kLeft))).file);
+}
+
+// Guards the sensor mounts' keys: a PX4Flow looks straight down (a roll or
+// pitch would be dropped, so it is refused), a wheel encoder has no pose,
+// and a step below 1 ns (which would round to "the default") is refused.
+TEST(RobotFile, SensorMountsTakeOnlyWhatTheirKindUses) {
+  const std::string pitched = WriteScenario(
+      "robot_pitched_flow.yaml",
+      Robot(kLeft) + "sensor_mounts:\n  - {name: f, kind: px4flow, x_m: 0.4, y_m: 0.2, "
+                     "z_m: 0.18, pitch_deg: 90}\n");
+  const Read a = ReadModel(pitched);
+  EXPECT_TRUE(Has(a.issues, "sensor_mounts.0.pitch_deg: unknown key")) << a.issues;
+
+  const std::string posed = WriteScenario(
+      "robot_posed_encoder.yaml",
+      Robot(kLeft) + "sensor_mounts:\n  - {name: e, kind: wheel_encoder, x_m: 0.1}\n");
+  EXPECT_TRUE(Has(ReadModel(posed).issues, "sensor_mounts.0.x_m: unknown key"))
+      << ReadModel(posed).issues;
+
+  const std::string tiny = WriteScenario(
+      "robot_tiny_step.yaml",
+      Robot(kLeft) + "sensor_mounts:\n  - {name: i, kind: imu, x_m: 0, y_m: 0, z_m: 0.2, "
+                     "step_s: 1.0e-10}\n");
+  EXPECT_TRUE(Has(ReadModel(tiny).issues, "sensor_mounts.0.step_s")) << ReadModel(tiny).issues;
 }
 
 // Guards what the chassis and the one motor unit need to be consistent:
