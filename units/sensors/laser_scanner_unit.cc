@@ -278,7 +278,6 @@ void LaserScannerUnit::Derive() {
   q_mount_ = FromRpy(mount_roll_, mount_pitch_, mount_yaw_);
   mount_in_base_ = {Rotate(q_mount_, {1.0, 0.0, 0.0}), Rotate(q_mount_, {0.0, 1.0, 0.0}),
                     std::array<double, 3>{mount_x_, mount_y_, mount_z_}};
-  PrepareStep();
   cos_max_incidence_ = std::cos(max_incidence_);
   bias_ = std::clamp(bias_draw_ * bias_sigma_, -bias_max_, bias_max_);
 }
@@ -307,11 +306,15 @@ void LaserScannerUnit::PrepareStep() {
   // scalars and a few multiply-adds.
   // Rotation preserves cross products: R0 (k x v) = (R0 k) x (R0 v), so
   // one rotation matrix from q0 and three of its products do it all.
+  // The rotation of q scaled by s = 2 / |q|^2: exact for any non-zero q
+  // (a quaternion off unit length by rounding or an FMU's output still
+  // gives unit ray directions; DoStep refuses a zero one).
   const double w = orientation_[0], x = orientation_[1], y = orientation_[2], z = orientation_[3];
+  const double sq = 2.0 / (w * w + x * x + y * y + z * z);
   const double m[3][3] = {
-      {1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)},
-      {2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)},
-      {2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)}};
+      {1.0 - sq * (y * y + z * z), sq * (x * y - w * z), sq * (x * z + w * y)},
+      {sq * (x * y + w * z), 1.0 - sq * (x * x + z * z), sq * (y * z - w * x)},
+      {sq * (x * z - w * y), sq * (y * z + w * x), 1.0 - sq * (x * x + y * y)}};
   const auto rotate = [&m](const std::array<double, 3>& v) {
     return std::array<double, 3>{m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
                                  m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
@@ -539,6 +542,12 @@ void LaserScannerUnit::CompleteScan() {
 cosim::StepResult LaserScannerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
   if (!InputsFinite(t)) return cosim::StepResult::kError;
+  const double q2 = orientation_[0] * orientation_[0] + orientation_[1] * orientation_[1] +
+                    orientation_[2] * orientation_[2] + orientation_[3] * orientation_[3];
+  if (!(q2 > 1e-12)) {
+    return Fail(Where() + ": input 'orientation' is a zero quaternion at t = " +
+                cosim::FormatSeconds(t) + " s: no attitude to cast the beams from");
+  }
   const cosim::TimeNs t_end = t + dt;
   PrepareStep();
   while (true) {

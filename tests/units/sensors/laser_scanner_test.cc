@@ -142,6 +142,30 @@ TEST(LaserScanner, BoxRangesAreAnalytic) {
   EXPECT_EQ(hits, 95);  // |a| < atan(2 / 4.5) = 23.96 deg: 47 + 1 + 47 beams
 }
 
+// Guards against ranges scaled by a quaternion off unit length (rounding,
+// an FMU's output): q and 3 q are the same rotation, so the box reads the
+// same; a zero quaternion is no attitude and fails the step by name.
+TEST(LaserScanner, OrientationIsARotationWhateverItsNorm) {
+  const double half = 0.25;  // a 0.5 rad turn about z
+  auto unit_q = FromModel("sick_s300", WithBox(5.0, 0.0, 1.0, 4.0, 2.0));
+  auto scaled_q = FromModel("sick_s300", WithBox(5.0, 0.0, 1.0, 4.0, 2.0));
+  for (auto* u : {unit_q.get(), scaled_q.get()}) {
+    Exact(*u);
+    SetAll(*u, "mount_z", 0.2);
+    Start(*u);
+  }
+  SetArray(*unit_q, "orientation", {std::cos(half), 0.0, 0.0, std::sin(half)});
+  SetArray(*scaled_q, "orientation", {3 * std::cos(half), 0.0, 0.0, 3 * std::sin(half)});
+  RunScans(*unit_q, 0, 1);
+  RunScans(*scaled_q, 0, 1);
+  const auto a = Get(*unit_q, "ranges"), b = Get(*scaled_q, "ranges");
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-9) << "beam " << i;
+
+  SetArray(*unit_q, "orientation", {0.0, 0.0, 0.0, 0.0});
+  EXPECT_EQ(unit_q->DoStep(0, kMs), cosim::StepResult::kError);
+  EXPECT_NE(unit_q->last_error().find("zero quaternion"), std::string::npos);
+}
+
 // Guards against a faceted or misplaced cylinder. Analytic: a ray from the
 // origin along (cos a, sin a) meets the circle |p - c| = R at
 // t = c.u - sqrt(R^2 - (|c|^2 - (c.u)^2)); the incidence cosine is
@@ -471,7 +495,9 @@ TEST(LaserScanner, ProtectiveFieldNeedsTwoScansAndClears) {
 // face at x = 5 covering y > 0, a wall behind it at x = 5 + gap. With a
 // 0.2 m gap (one echo) the beam whose spot straddles the edge reads between
 // the two surfaces; with a 2 m gap (two echoes, the first reported) every
-// beam reads one of the surfaces.
+// beam reads one of the surfaces. The spot at 5 m is 5 x 0.015 + 0.008 =
+// 0.083 m wide, 0.95 deg at that range: at most 2 beams (0.5 deg apart)
+// can straddle the edge.
 TEST(LaserScanner, MixedPixelsAtEdges) {
   for (const double gap : {0.2, 2.0}) {
     models::Scene scene = WithBox(5.5, 2.0, 1.0, 4.0, 2.0);
@@ -498,6 +524,7 @@ TEST(LaserScanner, MixedPixelsAtEdges) {
     }
     if (gap < 1.0) {
       EXPECT_GE(between, 1);
+      EXPECT_LE(between, 2);
     }
   }
 }
@@ -518,7 +545,9 @@ TEST(LaserScanner, DeterministicAndRestoresMidScan) {
     SetArray(*u, "angular_velocity", {0.0, 0.0, 0.4});
   }
   TimeNs t = 0;
-  for (; t < 57 * kMs; t += kMs) {
+  // Saved at 47 ms: 7 ms into the LMS151's third 20 ms scan, beam 252 of
+  // 541 (the beams span 15 ms), so the saved state holds a scan half cast.
+  for (; t < 47 * kMs; t += kMs) {
     for (auto* u : {a.get(), b.get(), c.get()}) {
       SetArray(*u, "position_3d", {0.3 * cosim::NsToSeconds(t), 0.1 * cosim::NsToSeconds(t), 0.0});
       ASSERT_EQ(u->DoStep(t, kMs), cosim::StepResult::kOk);
