@@ -111,6 +111,12 @@ void BeltEncoderUnit::RestoreInternal(const cosim::UnitState& state) {
                            std::to_string(5 + 2 * window) + " and 0");
   }
   const auto& s = state.integers;
+  if (s[3] < 0 || s[4] < 0 || static_cast<std::size_t>(s[3]) >= window ||
+      static_cast<std::size_t>(s[4]) > window) {
+    throw cosim::UnitError(Where() + ": saved ring position " + std::to_string(s[3]) +
+                           " and size " + std::to_string(s[4]) + " do not fit the window of " +
+                           std::to_string(window));
+  }
   count_ = s[0];
   start_ = s[1];
   sample_time_ = s[2];

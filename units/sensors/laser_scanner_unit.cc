@@ -600,18 +600,24 @@ void LaserScannerUnit::RestoreInternal(const cosim::UnitState& state) {
   if (state.strings.size() != 1 || state.integers.size() != 5 || state.reals.size() < 1 + n) {
     throw cosim::UnitError(Where() + ": saved state does not fit this unit");
   }
-  std::istringstream rng(state.strings[0]);
-  rng >> rng_;
-  start_ = state.integers[0];
-  scan_start_ = state.integers[1];
-  next_beam_ = static_cast<int>(state.integers[2]);
-  finalized_ = static_cast<int>(state.integers[3]);
-  infringing_scans_ = state.integers[4];
+  // Everything is checked before anything is assigned: a state that does
+  // not fit leaves the unit as it was.
+  const std::int64_t next_beam = state.integers[2], finalized = state.integers[3];
   const std::size_t per_beam = 14 + 3 * kSpotSamples;
-  if (next_beam_ < 0 || next_beam_ > beam_count_ ||
-      state.reals.size() != 1 + n + per_beam * static_cast<std::size_t>(next_beam_)) {
+  if (next_beam < 0 || next_beam > beam_count_ || finalized < 0 || finalized > next_beam ||
+      state.reals.size() != 1 + n + per_beam * static_cast<std::size_t>(next_beam)) {
     throw cosim::UnitError(Where() + ": saved state does not fit this unit");
   }
+  std::istringstream rng_text(state.strings[0]);
+  std::mt19937_64 rng;
+  rng_text >> rng;
+  if (!rng_text) throw cosim::UnitError(Where() + ": saved generator state is not readable");
+  rng_ = rng;
+  start_ = state.integers[0];
+  scan_start_ = state.integers[1];
+  next_beam_ = static_cast<int>(next_beam);
+  finalized_ = static_cast<int>(finalized);
+  infringing_scans_ = state.integers[4];
   bias_draw_ = state.reals[0];
   std::copy(state.reals.begin() + 1, state.reals.begin() + 1 + static_cast<std::ptrdiff_t>(n),
             scan_ranges_.begin());

@@ -84,8 +84,6 @@ class Px4FlowImageModel {
   /// velocity and returns the firmware's flow between the two frames.
   FlowResult Step(double vx_mps, double vy_mps, double height_m, double contrast, double lux);
 
-  const Image& current() const { return current_; }
-
  private:
   double Field(double x, double y) const;
 

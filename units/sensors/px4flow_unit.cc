@@ -447,8 +447,11 @@ void Px4FlowUnit::RestoreInternal(const cosim::UnitState& state) {
   if (state.strings.size() != 1 || state.reals.size() != 5 || state.integers.size() != 7) {
     throw cosim::UnitError(Where() + ": saved state has the wrong shape");
   }
-  std::istringstream rng(state.strings[0]);
-  rng >> rng_;
+  std::istringstream rng_text(state.strings[0]);
+  std::mt19937_64 rng;
+  rng_text >> rng;
+  if (!rng_text) throw cosim::UnitError(Where() + ": saved generator state is not readable");
+  rng_ = rng;
   acc_x_ = state.reals[0];
   acc_y_ = state.reals[1];
   for (int i = 0; i < 3; ++i) acc_gyro_[i] = state.reals[static_cast<std::size_t>(2 + i)];

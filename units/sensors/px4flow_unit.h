@@ -83,10 +83,6 @@ class Px4FlowUnit : public cosim::Unit {
   void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
   void Initialize() override;
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
-
-  /// The camera/firmware settings the parameters make (valid after
-  /// Initialize).
-  const Px4FlowCamera& camera() const { return cam_; }
   /// True flow (px per frame, sensor frame) at the current inputs.
   void TrueFlow(double& fx, double& fy, int& surface) const;
 

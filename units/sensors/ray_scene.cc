@@ -58,24 +58,6 @@ void CylinderIntersect(const RTCIntersectFunctionNArguments* args) {
   }
 }
 
-void CylinderOccluded(const RTCOccludedFunctionNArguments* args) {
-  const auto* cyl = static_cast<const RayScene::Cylinder*>(args->geometryUserPtr);
-  const RayScene::Cylinder& c = cyl[args->primID];
-  for (unsigned i = 0; i < args->N; ++i) {
-    if (!args->valid[i]) continue;
-    RTCRayN* ray = args->ray;
-    const double o[3] = {RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i),
-                         RTCRayN_org_z(ray, args->N, i)};
-    const double d[3] = {RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i),
-                         RTCRayN_dir_z(ray, args->N, i)};
-    double n[3] = {0.0, 0.0, 0.0};
-    const double tfar = RTCRayN_tfar(ray, args->N, i);
-    if (IntersectCylinder(c, o, d, tfar, n) < tfar) {
-      RTCRayN_tfar(ray, args->N, i) = -std::numeric_limits<float>::infinity();
-    }
-  }
-}
-
 // What Cast needs of a packet's hits.
 struct PacketHits {
   unsigned geom[kPacket], prim[kPacket];
@@ -296,7 +278,6 @@ RayScene::RayScene(const models::Scene& scene)
     rtcSetGeometryUserData(user, cylinders_.data());
     rtcSetGeometryBoundsFunction(user, CylinderBounds, nullptr);
     rtcSetGeometryIntersectFunction(user, CylinderIntersect);
-    rtcSetGeometryOccludedFunction(user, CylinderOccluded);
     rtcCommitGeometry(user);
     cylinder_geom_ = rtcAttachGeometry(scene_, user);
     rtcReleaseGeometry(user);

@@ -62,8 +62,6 @@ class WheelEncoderUnit : public cosim::Unit {
   void UpdateOutputs() override;
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
 
-  int channels() const { return static_cast<int>(angle_.size()); }
-
  protected:
   void SaveInternal(cosim::UnitState& state) const override;
   void RestoreInternal(const cosim::UnitState& state) override;

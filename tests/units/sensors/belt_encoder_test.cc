@@ -159,6 +159,11 @@ TEST(BeltEncoderUnit, RestoredUnitContinuesIdentically) {
     const auto rb = Sample(*b, k * dt, dt, travel(k));
     ASSERT_TRUE(test_helpers::SameBits(ra, rb)) << k;
   }
+  // A state whose ring position lies outside the 3-sample window is
+  // refused, not read out of bounds.
+  cosim::UnitState bad = saved;
+  bad.integers[3] = 3;
+  EXPECT_THROW(b->RestoreState(bad), cosim::UnitError);
 }
 
 }  // namespace
