@@ -245,6 +245,12 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   }
   steer_motor_count_ = MotorCount(steer_motor_);
   drive_motor_count_ = MotorCount(drive_motor_);
+  std::vector<char> motor_led(static_cast<std::size_t>(drive_motor_count_), 0);
+  for (const int m : drive_motor_) {
+    char& led = motor_led[static_cast<std::size_t>(m)];
+    leads_drive_motor_.push_back(led ? 0 : 1);
+    led = 1;
+  }
   const auto w = static_cast<std::size_t>(wheel_count_);
   const auto b = static_cast<std::size_t>(belt_count_);
   const auto ms = static_cast<std::size_t>(steer_motor_count_);
@@ -264,6 +270,7 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   steer_angle_.assign(ms, 0.0);
   steer_rate_.assign(ms, 0.0);
   drive_rate_.assign(md, 0.0);
+  drive_rate_before_.assign(md, 0.0);
   drive_angle_.assign(md, 0.0);
   position_.assign(2, 0.0);
   position_3d_.assign(3, 0.0);
@@ -470,14 +477,13 @@ void ChassisUnit::Build() {
   // drive motor. The axle is the wheel body's local y axis.
   const double axle[3] = {-s, c, 0.0};
   const double up[3] = {0.0, 0.0, 1.0};
-  std::vector<bool> motor_seen(static_cast<std::size_t>(drive_motor_count_), false);
   std::vector<int> first_wheel(static_cast<std::size_t>(drive_motor_count_), -1);
   for (std::size_t k = 0; k < static_cast<std::size_t>(wheel_count_); ++k) {
     const double radius = wheel_radius_[k];
     const double r2 = radius * radius;
     const bool steered = steer_motor_[k] >= 0;
     const auto motor = static_cast<std::size_t>(drive_motor_[k]);
-    const bool first = first_wheel[motor] < 0;
+    const bool first = leads_drive_motor_[k] != 0;
     const double i_axle = 0.5 * module_mass_ * r2 + (first ? drive_rotor_inertia_ : 0.0);
     const double i_perp = 0.25 * module_mass_ * r2 + (steered ? steer_rotor_inertia_ : 0.0);
     const double x = initial_x_ + c * wheel_x_[k] - s * wheel_y_[k];
@@ -562,9 +568,6 @@ void ChassisUnit::ApplyTorques() {
   Column(dBodyGetRotation(o.body), 2, up);
   const dReal* wb = dBodyGetAngularVel(o.body);
   // A drive motor's torque goes to the first wheel of its group only.
-  // Bit m: motor m's torque applied (m < wheel count <= kMaxWheels = 64).
-  std::uint64_t driven = 0;
-  static_assert(kMaxWheels <= 64, "one bit per drive motor in a 64-bit mask");
   for (std::size_t k = 0; k < o.wheels.size(); ++k) {
     const dBodyID w = o.wheels[k];
     Column(dBodyGetRotation(w), 1, axle);
@@ -576,10 +579,7 @@ void ChassisUnit::ApplyTorques() {
         sm >= 0 ? steer_torque_[static_cast<std::size_t>(sm)] - steer_friction_ * Dot(up, rel)
                 : 0.0;
     double drive = -drive_friction_ * Dot(axle, rel);
-    if ((driven & (std::uint64_t{1} << dm)) == 0) {
-      driven |= std::uint64_t{1} << dm;
-      drive = drive_torque_[dm] - drive_friction_ * Dot(axle, rel);
-    }
+    if (leads_drive_motor_[k]) drive = drive_torque_[dm] - drive_friction_ * Dot(axle, rel);
     // The motor turns the wheel and reacts on the body: equal and opposite.
     const double t[3] = {steer * up[0] + drive * axle[0], steer * up[1] + drive * axle[1],
                          steer * up[2] + drive * axle[2]};
@@ -745,8 +745,7 @@ void ChassisUnit::ComputeOutputs() {
   angular_velocity_[1] = Dot(ey, wb);
   angular_velocity_[2] = Dot(ez, wb);
   // drive_rate is the first wheel's of each motor (the others are coupled to
-  // it). Bit m: motor m seen (m < wheel count <= kMaxWheels = 64).
-  std::uint64_t seen = 0;
+  // it).
   for (std::size_t k = 0; k < o.wheels.size(); ++k) {
     const dBodyID w = o.wheels[k];
     Column(dBodyGetRotation(w), 1, axle);
@@ -758,10 +757,8 @@ void ChassisUnit::ComputeOutputs() {
       steer_angle_[m] = models::WrapAngle(std::atan2(-Dot(axle, ex), Dot(axle, ey)));
       steer_rate_[m] = Dot(ez, rel);
     }
-    const auto dm = static_cast<unsigned>(drive_motor_[k]);
-    if ((seen & (std::uint64_t{1} << dm)) == 0) {
-      seen |= std::uint64_t{1} << dm;
-      drive_rate_[dm] = Dot(axle, rel);
+    if (leads_drive_motor_[k]) {
+      drive_rate_[static_cast<std::size_t>(drive_motor_[k])] = Dot(axle, rel);
     }
     const GeomContact& gc = o.floor->contact(static_cast<int>(k));
     wheel_surface_[k] = gc.surface;
@@ -809,7 +806,7 @@ cosim::StepResult ChassisUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     return Fail(Where() + ": ODE state went non-finite" + at() + ": " + bad);
   }
   // FloorWorld::Step collided at the new positions already.
-  drive_rate_before_ = drive_rate_;  // same size: no allocation
+  drive_rate_before_ = drive_rate_;  // sized alike in the constructor: no allocation
   ComputeOutputs();
   const double dt_s = cosim::NsToSeconds(dt);
   for (std::size_t m = 0; m < drive_angle_.size(); ++m) {

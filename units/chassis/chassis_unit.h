@@ -63,10 +63,7 @@ namespace linesim::chassis {
 class ChassisUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "chassis";
-  /// Most wheels a chassis may have (wheel_count 1 to kMaxWheels). Motor
-  /// indices are below the wheel count (one wheel per steering motor, at
-  /// least one per drive motor), so a 64-bit mask holds one bit per drive
-  /// motor.
+  /// Most wheels a chassis may have (wheel_count 1 to kMaxWheels).
   static constexpr int kMaxWheels = 64;
 
   /// Checks a topology (steer_motor and drive_motor per wheel, as in the
@@ -137,6 +134,10 @@ class ChassisUnit : public cosim::Unit {
   int wheel_count_;
   int belt_count_;
   std::vector<int> steer_motor_, drive_motor_;
+  // Per wheel: 1 if it is the first wheel of its drive motor, the one the
+  // motor's torque goes to and whose spin is the motor's drive_rate (the
+  // others are coupled to it).
+  std::vector<char> leads_drive_motor_;
   int steer_motor_count_ = 0;
   int drive_motor_count_ = 0;
   models::Scene scene_;
