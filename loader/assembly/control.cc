@@ -130,7 +130,10 @@ void AddDifferential(SystemBuilder& b, const RobotFile& file, const YAML::Node& 
 void AddControl(SystemBuilder& b, const RobotFile& file, Signals& s) {
   const YAML::Node control = b.Section(b.root(), "", "control", {"compensation", "period_s"});
   YamlReader& r = b.reader();
-  const bool compensation = r.Boolean(control, "control", "compensation", true);
+  // Algorithm 1 needs steered wheels: on by default where the robot has
+  // them, off for a differential base (which refuses it when asked).
+  const bool steered = file.robot.controller == models::ControllerKind::kSwerve;
+  const bool compensation = r.Boolean(control, "control", "compensation", steered);
   // The Rob@Work 3 control cycle is 20 ms (IPA cob_control configuration).
   const cosim::TimeNs period = r.Time(control, "control", "period_s",
                                       cosim::NsToSeconds(kControlPeriod), {0.0, 10.0, true});
@@ -140,7 +143,7 @@ void AddControl(SystemBuilder& b, const RobotFile& file, Signals& s) {
     b.SetStep(name, period);
     b.Derived(JoinPath(JoinPath("units", name), "step_s"), control, "control", "period_s");
   }
-  if (file.robot.controller == models::ControllerKind::kSwerve) {
+  if (steered) {
     AddSwerve(b, file, compensation, s);
   } else {
     AddDifferential(b, file, control, compensation, s);

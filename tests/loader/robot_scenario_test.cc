@@ -132,6 +132,16 @@ TEST(RobotScenario, HuskyIsBuiltFromItsDescriptionOnTheSameUnits) {
   const std::string e = Issues(kHusky, {"control.compensation=true"});
   EXPECT_TRUE(Has(e, "control.compensation")) << e;
   EXPECT_TRUE(Has(e, "differential base")) << e;
+  // Left out, compensation defaults to what the robot can do: off here.
+  std::ifstream in(kHusky);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string line = "  compensation: false\n";
+  text.erase(text.find(line), line.size());
+  const auto scene = text.find("model: factory_line");
+  text.replace(scene, std::string("model: factory_line").size(),
+               "model: " LINESIM_SOURCE_DIR "/models/scenes/factory_line.yaml");
+  const std::string plain = WriteScenario("husky_default_compensation.yaml", text);
+  EXPECT_EQ(Issues(plain), "(no error)");
 }
 
 // Guards the plots' view of a robot run: every column they read is one the
