@@ -34,10 +34,11 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
     v->assign(n, 0.0);
   }
 
-  // Default gains, for the 20 ms period (sampled plant with zero-order
-  // hold, checked by simulation over the inertia ranges below, for
-  // Rob@Work 3 with its maxon RE 40 stand-in motors: they are design
-  // values for that plant, to be retuned for another):
+  // The gains have no default (robot-specific); the Rob@Work 3's, in
+  // models/robots/raw3.yaml, are designed for the 20 ms period (sampled
+  // plant with zero-order hold, checked by simulation over the inertia
+  // ranges below, with its maxon RE 40 stand-in motors; retune them for
+  // another plant):
   //  - drive: back-EMF damping at the wheel eta N^2 k_t k_e / R = 1.01
   //    N.m.s, so the loaded wheel (0.197 kg.m^2) has a 0.195 s time
   //    constant, but a wheel off the ground (about 0.01 kg.m^2) has 10 ms,
