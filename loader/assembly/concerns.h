@@ -36,13 +36,9 @@ struct Signals {
   std::size_t belt_count = 0;
 
   /// The sensor units on the robot, one per enabled mount (the unit is
-  /// named after the mount), and the belt's ground-truth speed ("" when
-  /// there is none).
-  struct Sensor {
-    std::string unit, kind;
-    models::SensorMount mount;
-  };
-  std::vector<Sensor> sensors;
+  /// named after the mount, its type is the mount's kind), and the belt's
+  /// ground-truth speed ("" when there is none).
+  std::vector<models::SensorMount> sensors;
   std::string belt_ground_truth;
   int belt_ground_truth_belt = 0;  // the scene belt it measures
   /// The laser whose scan at scan_time_s the plots draw ("" for none).

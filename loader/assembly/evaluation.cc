@@ -56,7 +56,7 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
 
   // Raw optic flow against the belt's ground truth (paper 1 Fig. 4), when
   // both are there.
-  std::vector<const Signals::Sensor*> flows;
+  std::vector<const models::SensorMount*> flows;
   for (const auto& sensor : s.sensors) {
     if (sensor.kind == "px4flow") flows.push_back(&sensor);
   }
@@ -67,11 +67,11 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     p["belt"] = s.belt_ground_truth_belt;
     std::vector<double> x, y, yaw;
     for (std::size_t k = 0; k < flows.size(); ++k) {
-      x.push_back(flows[k]->mount.x_m);
-      y.push_back(flows[k]->mount.y_m);
-      yaw.push_back(flows[k]->mount.yaw_rad);
+      x.push_back(flows[k]->x_m);
+      y.push_back(flows[k]->y_m);
+      yaw.push_back(flows[k]->yaw_rad);
       for (std::size_t i = 0; i < 2; ++i) {
-        b.Connect(Element(flows[k]->unit, "velocity", i), Element(kFlowError, "measured", 2 * k + i));
+        b.Connect(Element(flows[k]->name, "velocity", i), Element(kFlowError, "measured", 2 * k + i));
       }
     }
     p["mount_x"] = List(x);
@@ -86,10 +86,10 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     add("surface_velocity_rmse_raw_mps", Signal(kFlowError, "rmse"), "final");
     // The first sensor's quality (0..255, OPTICAL_FLOW_RAD's mean over its
     // publishing interval), over the run.
-    add("optic_flow_quality_mean", Signal(flows.front()->unit, "quality"), "mean");
+    add("optic_flow_quality_mean", Signal(flows.front()->name, "quality"), "mean");
     for (std::size_t k = 0; k < flows.size(); ++k) {
       info.flow_columns.push_back(Element(kFlowError, "surface_speed", k));
-      info.flow_sensor_names.push_back(flows[k]->unit);
+      info.flow_sensor_names.push_back(flows[k]->name);
     }
     info.flow_reference_column = s.belt_ground_truth;
   }

@@ -231,7 +231,7 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
       s.recorded.push_back(Signal(m.name, "scan_time"));
       s.recorded.push_back(Signal(m.name, "ranges"));
     }
-    s.sensors.push_back({m.name, m.kind, m});
+    s.sensors.push_back(m);
   }
 
   // Paper 1's ground truth of the line: a free wheel with a quadrature

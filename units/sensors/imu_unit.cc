@@ -221,9 +221,10 @@ cosim::StepResult ImuUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   // The biases of the sample at t + dt and its white noise.
   const double dt_s = cosim::NsToSeconds(dt);
   const double sqrt_dt = std::sqrt(dt_s);
-  const double walk_g = gyro_bias_instability_ * std::sqrt(3.0 / bias_instability_time_) * sqrt_dt;
-  const double walk_a =
-      accel_bias_instability_ * std::sqrt(3.0 / bias_instability_time_) * sqrt_dt;
+  // Rate random walk K = B sqrt(3 / tau) per sqrt(s) (see the header).
+  const double walk = std::sqrt(3.0 / bias_instability_time_) * sqrt_dt;
+  const double walk_g = gyro_bias_instability_ * walk;
+  const double walk_a = accel_bias_instability_ * walk;
   const double white_g = gyro_noise_density_ / sqrt_dt;
   const double white_a = accel_noise_density_ / sqrt_dt;
   double z[12];
