@@ -7,6 +7,8 @@
 #include <sstream>
 #include <utility>
 
+#include "models/rotation.h"
+
 namespace linesim::sensors {
 
 namespace {
@@ -14,7 +16,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 using Vec3 = std::array<double, 3>;
-using Mat3 = std::array<double, 9>;  // row-major
+using Mat3 = models::Matrix3;
 
 Vec3 Cross(const Vec3& a, const Vec3& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
@@ -132,13 +134,7 @@ void ImuUnit::NormalPair(double& a, double& b) {
 }
 
 void ImuUnit::CacheMount() {
-  const double cr = std::cos(mount_roll_), sr = std::sin(mount_roll_);
-  const double cp = std::cos(mount_pitch_), sp = std::sin(mount_pitch_);
-  const double cy = std::cos(mount_yaw_), sy = std::sin(mount_yaw_);
-  // Rz(yaw) Ry(pitch) Rx(roll).
-  mount_rotation_ = {cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr,
-                     sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr,
-                     -sp,     cp * sr,                cp * cr};
+  mount_rotation_ = models::RollPitchYawMatrix(mount_roll_, mount_pitch_, mount_yaw_);
 }
 
 void ImuUnit::Initialize() {
@@ -162,15 +158,10 @@ void ImuUnit::Initialize() {
 }
 
 void ImuUnit::UpdateOutputs() {
-  const double* q = orientation_.data();
-  const double norm2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
-  // A zero quaternion (unset) reads as identity; DoStep refuses it.
-  const double s = norm2 > 0.0 ? 2.0 / norm2 : 0.0;
-  const double w = q[0], x = q[1], y = q[2], zq = q[3];
-  // Rotation of base_link in the map (base vectors to map vectors).
-  const Mat3 rot = {1.0 - s * (y * y + zq * zq), s * (x * y - w * zq), s * (x * zq + w * y),
-                    s * (x * y + w * zq), 1.0 - s * (x * x + zq * zq), s * (y * zq - w * x),
-                    s * (x * zq - w * y), s * (y * zq + w * x), 1.0 - s * (x * x + y * y)};
+  // Rotation of base_link in the map (base vectors to map vectors); a zero
+  // quaternion (unset) reads as identity, and DoStep refuses it.
+  const Mat3 rot = models::QuaternionMatrix(orientation_[0], orientation_[1], orientation_[2],
+                                            orientation_[3]);
   const Vec3 omega = {angular_velocity_in_[0], angular_velocity_in_[1], angular_velocity_in_[2]};
   for (std::size_t i = 0; i < 3; ++i) {
     sampled_velocity_[i] = velocity_[i];

@@ -8,29 +8,12 @@
 #include <sstream>
 #include <utility>
 
+#include "models/rotation.h"
+
 namespace linesim::sensors {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-using Quat = std::array<double, 4>;  // w x y z
-
-// v rotated by the unit quaternion q.
-std::array<double, 3> Rotate(const Quat& q, const std::array<double, 3>& v) {
-  // v + 2 w (u x v) + 2 u x (u x v), u = (x, y, z).
-  const double ux = q[1], uy = q[2], uz = q[3], w = q[0];
-  const double cx = uy * v[2] - uz * v[1], cy = uz * v[0] - ux * v[2], cz = ux * v[1] - uy * v[0];
-  return {v[0] + 2.0 * (w * cx + uy * cz - uz * cy), v[1] + 2.0 * (w * cy + uz * cx - ux * cz),
-          v[2] + 2.0 * (w * cz + ux * cy - uy * cx)};
-}
-
-Quat FromRpy(double roll, double pitch, double yaw) {
-  const double cr = std::cos(0.5 * roll), sr = std::sin(0.5 * roll);
-  const double cp = std::cos(0.5 * pitch), sp = std::sin(0.5 * pitch);
-  const double cy = std::cos(0.5 * yaw), sy = std::sin(0.5 * yaw);
-  return {cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
-          cr * cp * sy - sr * sp * cy};
-}
 
 // Marsaglia and Tsang's ziggurat for the normal distribution ("The
 // Ziggurat Method for Generating Random Variables", J. Stat. Softw. 5(8),
@@ -275,8 +258,10 @@ void LaserScannerUnit::Derive() {
       field_reach_[k] = std::max(field_reach_[k], c[0] * cos_a_[k] + c[1] * sin_a_[k]);
     }
   }
-  q_mount_ = FromRpy(mount_roll_, mount_pitch_, mount_yaw_);
-  mount_in_base_ = {Rotate(q_mount_, {1.0, 0.0, 0.0}), Rotate(q_mount_, {0.0, 1.0, 0.0}),
+  // The scanner's x and y axes in base_link: the mount rotation's columns.
+  const models::Matrix3 mount = models::RollPitchYawMatrix(mount_roll_, mount_pitch_, mount_yaw_);
+  mount_in_base_ = {std::array<double, 3>{mount[0], mount[3], mount[6]},
+                    std::array<double, 3>{mount[1], mount[4], mount[7]},
                     std::array<double, 3>{mount_x_, mount_y_, mount_z_}};
   cos_max_incidence_ = std::cos(max_incidence_);
   bias_ = std::clamp(bias_draw_ * bias_sigma_, -bias_max_, bias_max_);
@@ -306,19 +291,15 @@ void LaserScannerUnit::PrepareStep() {
   // scalars and a few multiply-adds.
   // Rotation preserves cross products: R0 (k x v) = (R0 k) x (R0 v), so
   // one rotation matrix from q0 and three of its products do it all.
-  // The rotation of q scaled by s = 2 / |q|^2: exact for any non-zero q
-  // (a quaternion off unit length by rounding or an FMU's output still
-  // gives unit ray directions; DoStep refuses a zero one).
-  const double w = orientation_[0], x = orientation_[1], y = orientation_[2], z = orientation_[3];
-  const double sq = 2.0 / (w * w + x * x + y * y + z * z);
-  const double m[3][3] = {
-      {1.0 - sq * (y * y + z * z), sq * (x * y - w * z), sq * (x * z + w * y)},
-      {sq * (x * y + w * z), 1.0 - sq * (x * x + z * z), sq * (y * z - w * x)},
-      {sq * (x * z - w * y), sq * (y * z + w * x), 1.0 - sq * (x * x + y * y)}};
+  // The rotation of q whatever its norm (a quaternion off unit length by
+  // rounding or an FMU's output still gives unit ray directions; DoStep
+  // refuses a zero one).
+  const models::Matrix3 m =
+      models::QuaternionMatrix(orientation_[0], orientation_[1], orientation_[2], orientation_[3]);
   const auto rotate = [&m](const std::array<double, 3>& v) {
-    return std::array<double, 3>{m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
-                                 m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
-                                 m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2]};
+    return std::array<double, 3>{m[0] * v[0] + m[1] * v[1] + m[2] * v[2],
+                                 m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
+                                 m[6] * v[0] + m[7] * v[1] + m[8] * v[2]};
   };
   const double wx = angular_velocity_[0], wy = angular_velocity_[1], wz = angular_velocity_[2];
   rate_ = std::sqrt(wx * wx + wy * wy + wz * wz);

@@ -146,7 +146,6 @@ class LaserScannerUnit : public cosim::Unit {
   std::vector<double> cos_a_, sin_a_;
   std::vector<double> field_reach_;  // per beam: no point of the field farther along it
   cosim::TimeNs period_ns_ = 0;
-  std::array<double, 4> q_mount_{};  // w x y z
   // The scanner's x and y axes and its origin in base_link.
   std::array<std::array<double, 3>, 3> mount_in_base_{};
   double cos_max_incidence_ = 0.0;
