@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <set>
 
 #include "cosim/closest_names.h"
 #include "cosim/seed.h"
@@ -316,11 +317,14 @@ class Builder {
       }
       const YAML::Node vars = Child(rec, "variables");
       if (vars.IsDefined() && r_.ExpectSequence(vars, "recording.variables")) {
+        // A column is recorded once, however many items cover it.
+        std::set<std::string> labels;
         for (std::size_t i = 0; i < vars.size(); ++i) {
           if (auto v = r_.AsString(vars[i], "recording.variables." + std::to_string(i))) {
             try {
-              const auto resolved = cosim::ResolveProbes(*s_.system, {*v});
-              probes.insert(probes.end(), resolved.begin(), resolved.end());
+              for (auto& p : cosim::ResolveProbes(*s_.system, {*v})) {
+                if (labels.insert(p.label).second) probes.push_back(std::move(p));
+              }
             } catch (const cosim::ConfigError& e) {
               r_.Error(vars[i], "recording.variables." + std::to_string(i), e.what());
             }

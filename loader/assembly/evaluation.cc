@@ -114,8 +114,16 @@ void AddRecording(SystemBuilder& b, const Signals& s, RobotInfo& info) {
     info.belt_travel_columns.push_back(Element(kBelt, "travel", k));
   }
 
-  if (Child(b.root(), "recording").IsDefined()) {
-    b.out()["recording"] = Child(b.root(), "recording");
+  const YAML::Node own = Child(b.root(), "recording");
+  if (own.IsDefined()) {
+    // The scenario's recording, with the columns the plots read added to a
+    // list it gives (a column is recorded once); without a list it records
+    // everything anyway.
+    YAML::Node rec = YAML::Clone(own);
+    if (rec.IsMap() && Child(rec, "variables").IsSequence()) {
+      for (const auto& v : s.recorded) rec["variables"].push_back(v);
+    }
+    b.out()["recording"] = rec;
     return;
   }
   YAML::Node vars(YAML::NodeType::Sequence);

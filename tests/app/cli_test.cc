@@ -3,9 +3,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -133,6 +135,31 @@ TEST(Cli, RobotRunWritesPlots) {
     EXPECT_EQ(ReadFile(fs::path(out) / png).substr(0, 8), "\x89PNG\r\n\x1a\n") << png;
   }
   EXPECT_TRUE(fs::exists(fs::path(out) / "plots.gp"));
+}
+
+// Guards a robot scenario's own recording list: the columns the plots read
+// are added to it (the plots are drawn), and a column two items cover is
+// recorded once.
+TEST(Cli, OwnRecordingListStillDrawsThePlots) {
+  std::ifstream in(kCrossLine);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto scene = text.find("model: factory_line");
+  text.replace(scene, std::string("model: factory_line").size(),
+               "model: " LINESIM_SOURCE_DIR "/models/scenes/factory_line.yaml");
+  text += "recording:\n  variables: [chassis.position, \"chassis.position[0]\", chassis.yaw]\n";
+  const std::string out = Fresh("own_recording");
+  const std::string file = WriteScenario("own_recording.yaml", text);
+  const Result r = Linesim("run " + file + " --out " + out + " --set duration_s=1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(fs::path(out) / "top_view.png"));
+  std::istringstream header(ReadFile(fs::path(out) / "signals.csv"));
+  std::string line;
+  std::getline(header, line);
+  std::vector<std::string> columns;
+  std::istringstream fields(line);
+  for (std::string c; std::getline(fields, c, ',');) columns.push_back(c);
+  EXPECT_EQ(std::count(columns.begin(), columns.end(), "chassis.position[0]"), 1) << line;
+  EXPECT_EQ(std::count(columns.begin(), columns.end(), "chassis.wheel_contact[0]"), 1) << line;
 }
 
 // Guards scan.png: a laser with snapshot_s has its ranges recorded and one
