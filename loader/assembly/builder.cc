@@ -29,6 +29,13 @@ YAML::Node IntList(const std::vector<int>& values) {
   return list;
 }
 
+YAML::Node PointList(const std::vector<std::array<double, 2>>& points) {
+  YAML::Node list(YAML::NodeType::Sequence);
+  list.SetStyle(YAML::EmitterStyle::Flow);
+  for (const auto& p : points) list.push_back(List({p[0], p[1]}));
+  return list;
+}
+
 void MergeInto(YAML::Node to, const YAML::Node& from) {
   if (!from.IsMap()) return;
   for (const auto& kv : from) to[kv.first.Scalar()] = kv.second;

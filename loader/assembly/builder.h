@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <array>
 #include <map>
 #include <string>
 #include <vector>
@@ -38,6 +39,8 @@ std::string Element(const std::string& unit, const std::string& variable, std::s
 YAML::Node Num(double x);
 YAML::Node List(const std::vector<double>& values);
 YAML::Node IntList(const std::vector<int>& values);
+/// Points [x, y] as a flow list of flow pairs (a path).
+YAML::Node PointList(const std::vector<std::array<double, 2>>& points);
 /// Copies every key of `from` into `to` (both maps), the later one winning.
 void MergeInto(YAML::Node to, const YAML::Node& from);
 

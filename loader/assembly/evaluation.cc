@@ -8,10 +8,7 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
   // The deviation is measured on the ground truth, whatever the robot
   // believes.
   b.Unit(kDeviation, "path_deviation");
-  YAML::Node waypoints(YAML::NodeType::Sequence);
-  waypoints.SetStyle(YAML::EmitterStyle::Flow);
-  for (const auto& pt : info.path) waypoints.push_back(List({pt[0], pt[1]}));
-  b.Params(kDeviation)["path"] = waypoints;
+b.Params(kDeviation)["path"] = PointList(info.path);
   b.Connect(s.true_position, Signal(kDeviation, "position"));
   s.recorded.push_back(Signal(kDeviation, "deviation"));
 

@@ -70,10 +70,7 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
                        ? r.Real(task, "task", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad
                        : start.yaw_rad);
   }
-  YAML::Node waypoints(YAML::NodeType::Sequence);
-  waypoints.SetStyle(YAML::EmitterStyle::Flow);
-  for (const auto& pt : info.path) waypoints.push_back(List({pt[0], pt[1]}));
-  p["waypoints"] = waypoints;
+p["waypoints"] = PointList(info.path);
 
   b.RequireParameters(kPathFollower, file.follower_settings, file.robot.file, "path_follower");
 
