@@ -181,6 +181,8 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
            "flow and the known mount_height (paper 1); held when valid is 0",
            {});
   v.Output("valid", "1", &valid_, "1 if velocity is from the last message, 0 if held", {});
+  v.Output("message_count", "1", &message_count_,
+           "messages published so far (a new message: the count changed)", {});
   v.Output("frame_quality", "1", &frame_quality_, "quality of the last camera frame (0..255)",
            {});
   v.Output("frame_flow", "1", &frame_flow_,
@@ -246,7 +248,7 @@ void Px4FlowUnit::Initialize() {
   std::fill(integrated_gyro_.begin(), integrated_gyro_.end(), 0.0);
   std::fill(velocity_.begin(), velocity_.end(), 0.0);
   std::fill(frame_flow_.begin(), frame_flow_.end(), 0.0);
-  valid_ = frame_quality_ = 0.0;
+  valid_ = frame_quality_ = message_count_ = 0.0;
   distance_ = (mount_height_ >= sonar_min_ && mount_height_ <= sonar_max_) ? mount_height_ : -1.0;
 }
 
@@ -405,6 +407,7 @@ void Px4FlowUnit::Publish() {
   acc_x_ = acc_y_ = 0.0;
   acc_gyro_[0] = acc_gyro_[1] = acc_gyro_[2] = 0.0;
   acc_count_ = acc_quality_ = 0;
+  message_count_ += 1.0;
 }
 
 cosim::StepResult Px4FlowUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {

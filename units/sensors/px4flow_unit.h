@@ -131,6 +131,7 @@ class Px4FlowUnit : public cosim::Unit {
   double integrated_x_ = 0.0, integrated_y_ = 0.0, integration_time_ = 0.0, quality_ = 0.0;
   std::vector<double> integrated_gyro_, velocity_, frame_flow_;
   double distance_ = -1.0, valid_ = 0.0, frame_quality_ = 0.0, frame_count_ = 0.0;
+  double message_count_ = 0.0;
 
   // `mode`: "fast" (the per-frame model above) or "image" (every frame
   // rendered and matched by Px4FlowImageModel: the reference, about 2-3 ms

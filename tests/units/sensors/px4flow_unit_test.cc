@@ -262,6 +262,10 @@ TEST(Px4FlowUnit, IntegrationCountsOnlyFramesWithQuality) {
   EXPECT_NEAR(Get(u, "integrated_x")[0], 0.0, 1e-12);
   EXPECT_NEAR(Get(u, "velocity")[0], v, 1e-9);
   EXPECT_DOUBLE_EQ(Get(u, "distance")[0], kHeight);
+  // One message at 0.1 s (publish_rate 10 Hz), the next at 0.2 s.
+  EXPECT_EQ(Get(u, "message_count")[0], 1.0);
+  StepFor(u, 100 * kMs, 200 * kMs);
+  EXPECT_EQ(Get(u, "message_count")[0], 2.0);
 }
 
 // The sonar's valid window (sonar.c 0.12..3.5 m): a sensor mounted at
