@@ -2,6 +2,7 @@
 #include "config/unit_registry.h"
 #include "units/evaluation/clearance.h"
 #include "units/evaluation/path_deviation.h"
+#include "units/evaluation/pose_error.h"
 #include "units/evaluation/surface_velocity_error.h"
 
 namespace linesim::evaluation {
@@ -31,8 +32,10 @@ std::unique_ptr<cosim::Unit> MakeSurfaceVelocityError(const UnitBuildContext& c)
   }
   const auto belt = c.reader.Integer(c.parameters, c.path, "belt", 0, 0,
                                      static_cast<std::int64_t>(c.scene.belts.size()) - 1);
+  const bool estimated = c.reader.Boolean(c.parameters, c.path, "estimated", false);
   return std::make_unique<evaluation::SurfaceVelocityErrorUnit>(
-      c.name, static_cast<int>(sensors), c.scene.belts[static_cast<std::size_t>(belt)]);
+      c.name, static_cast<int>(sensors), c.scene.belts[static_cast<std::size_t>(belt)],
+      estimated);
 }
 
 const config::UnitTypeRegistrar kSurfaceVelocityError(
@@ -41,8 +44,21 @@ const config::UnitTypeRegistrar kSurfaceVelocityError(
      "belt's ground-truth speed, for the sensors over that belt; running RMSE",
      "",
      {{"sensors", "number of sensors compared (default 1)"},
-      {"belt", "index of the scene belt the reference measures (default 0)"}},
+      {"belt", "index of the scene belt the reference measures (default 0)"},
+      {"estimated", "also compare an estimator's absolute velocity per sensor (default false)"}},
      MakeSurfaceVelocityError});
+
+std::unique_ptr<cosim::Unit> MakePoseError(const UnitBuildContext& c) {
+  return std::make_unique<evaluation::PoseErrorUnit>(c.name);
+}
+
+const config::UnitTypeRegistrar kPoseError(
+    {evaluation::PoseErrorUnit::kTypeName,
+     "a localization's estimate against the true pose: position and yaw error, their maxima and "
+     "root mean squares",
+     "",
+     {},
+     MakePoseError});
 
 std::unique_ptr<cosim::Unit> MakeClearance(const UnitBuildContext& c) {
   for (std::size_t k = 0; k < c.scene.carried.size(); ++k) {

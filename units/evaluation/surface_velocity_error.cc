@@ -6,7 +6,7 @@
 namespace linesim::evaluation {
 
 SurfaceVelocityErrorUnit::SurfaceVelocityErrorUnit(std::string name, int sensors,
-                                                   const models::Belt& belt)
+                                                   const models::Belt& belt, bool estimated)
     : cosim::Unit(kTypeName, std::move(name)),
       sensors_(static_cast<std::size_t>(sensors)),
       belt_area_(belt.area),
@@ -51,6 +51,16 @@ SurfaceVelocityErrorUnit::SurfaceVelocityErrorUnit(std::string name, int sensors
   v.Output("rmse", "m/s", &rmse_,
            "root mean square of the error over every sensor and step compared so far", {});
   v.Output("samples", "1", &samples_out_, "how many (sensor, step) pairs rmse holds", {});
+  if (estimated) {
+    estimated_.assign(2 * n, 0.0);
+    estimated_speed_.assign(n, 0.0);
+    v.Input("estimated", "m/s", &estimated_,
+            "an estimator's absolute surface velocity at each sensor, in map: vx, vy per sensor");
+    v.Output("estimated_speed", "m/s", &estimated_speed_,
+             "each sensor's estimated absolute surface velocity along the belt", {"estimated"});
+    v.Output("rmse_estimated", "m/s", &rmse_estimated_,
+             "root mean square of estimated_speed - reference over the samples rmse holds", {});
+  }
 }
 
 void SurfaceVelocityErrorUnit::Evaluate() {
@@ -76,15 +86,18 @@ void SurfaceVelocityErrorUnit::Evaluate() {
                       std::abs(across) <= 0.5 * belt_area_.width_m;
     over_belt_[k] = over ? 1.0 : 0.0;
     error_[k] = over ? surface_speed_[k] - reference_ : 0.0;
+    if (!estimated_.empty()) {
+      estimated_speed_[k] = estimated_[2 * k] * bx + estimated_[2 * k + 1] * by;
+    }
   }
 }
 
 void SurfaceVelocityErrorUnit::Initialize() {
   ThrowIfBadParameters();
-  sum_squared_ = 0.0;
+  sum_squared_ = sum_squared_estimated_ = 0.0;
   samples_ = 0;
   samples_out_ = 0.0;
-  rmse_ = 0.0;
+  rmse_ = rmse_estimated_ = 0.0;
   Evaluate();
 }
 
@@ -96,25 +109,32 @@ cosim::StepResult SurfaceVelocityErrorUnit::DoStep(cosim::TimeNs t, cosim::TimeN
   for (std::size_t k = 0; k < sensors_; ++k) {
     if (over_belt_[k] == 0.0) continue;
     sum_squared_ += error_[k] * error_[k];
+    if (!estimated_.empty()) {
+      const double e = estimated_speed_[k] - reference_;
+      sum_squared_estimated_ += e * e;
+    }
     ++samples_;
   }
   samples_out_ = static_cast<double>(samples_);
-  rmse_ = samples_ > 0 ? std::sqrt(sum_squared_ / static_cast<double>(samples_)) : 0.0;
+  const double n = static_cast<double>(samples_);
+  rmse_ = samples_ > 0 ? std::sqrt(sum_squared_ / n) : 0.0;
+  rmse_estimated_ = samples_ > 0 ? std::sqrt(sum_squared_estimated_ / n) : 0.0;
   return cosim::StepResult::kOk;
 }
 
 void SurfaceVelocityErrorUnit::SaveInternal(cosim::UnitState& state) const {
-  state.reals = {sum_squared_};
+  state.reals = {sum_squared_, sum_squared_estimated_};
   state.integers = {samples_};
 }
 
 void SurfaceVelocityErrorUnit::RestoreInternal(const cosim::UnitState& state) {
-  if (state.reals.size() != 1 || state.integers.size() != 1) {
+  if (state.reals.size() != 2 || state.integers.size() != 1) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
-                           " integers, expected 1 and 1");
+                           " integers, expected 2 and 1");
   }
   sum_squared_ = state.reals[0];
+  sum_squared_estimated_ = state.reals[1];
   samples_ = state.integers[0];
 }
 

@@ -20,12 +20,19 @@ namespace linesim::evaluation {
 /// Only sensors whose point lies over the belt (true pose, scene geometry)
 /// are compared; `rmse` is the root mean square of the error over every
 /// (sensor, step) pair compared so far.
+///
+/// With `estimated`, the unit also compares an estimator's absolute
+/// surface velocity per sensor (map frame, e.g. the filtered value of
+/// paper 1's Kalman filter) with the same reference over the same samples:
+/// `estimated_speed` and `rmse_estimated`.
 class SurfaceVelocityErrorUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "surface_velocity_error";
 
-  /// `sensors` >= 1; `belt` is the scene belt the reference measures.
-  SurfaceVelocityErrorUnit(std::string name, int sensors, const models::Belt& belt);
+  /// `sensors` >= 1; `belt` is the scene belt the reference measures;
+  /// `estimated`: declare the estimate's input and outputs.
+  SurfaceVelocityErrorUnit(std::string name, int sensors, const models::Belt& belt,
+                           bool estimated = false);
 
   void Initialize() override;
   /// surface_speed, error and over_belt follow the inputs at once (they
@@ -48,14 +55,15 @@ class SurfaceVelocityErrorUnit : public cosim::Unit {
   std::vector<double> mount_x_, mount_y_, mount_yaw_;
   // Inputs.
   std::vector<double> measured_;
+  std::vector<double> estimated_;  // vx, vy per sensor in map (with `estimated`)
   std::vector<double> linear_velocity_ = std::vector<double>(2, 0.0);
   double yaw_ = 0.0, yaw_rate_ = 0.0, reference_ = 0.0;
   std::vector<double> position_ = std::vector<double>(2, 0.0);
   // Outputs.
-  std::vector<double> surface_speed_, error_, over_belt_;
-  double rmse_ = 0.0;
-  // Sum of squared errors and the number of samples in it.
-  double sum_squared_ = 0.0;
+  std::vector<double> surface_speed_, error_, over_belt_, estimated_speed_;
+  double rmse_ = 0.0, rmse_estimated_ = 0.0;
+  // Sums of squared errors (raw, estimated) and the number of samples in them.
+  double sum_squared_ = 0.0, sum_squared_estimated_ = 0.0;
   std::int64_t samples_ = 0;
   double samples_out_ = 0.0;
 };

@@ -115,6 +115,26 @@ TEST(SurfaceVelocityError, OutputsFollowTheInputsBeforeTheStep) {
   EXPECT_EQ(Get(*u, "samples")[0], 0.0);  // nothing counted before a step
 }
 
+// The estimate's error is counted over the same samples as the raw one.
+// Expected by hand: the belt runs along map x at 0.2 m/s (reference); both
+// sensors over it; estimates (0.25, 0) and (0.1, 7) in map give speeds
+// 0.25 and 0.1 along x, errors 0.05 and -0.1: rms = sqrt((0.0025 + 0.01) / 2).
+TEST(SurfaceVelocityError, EstimatedVelocityHasItsOwnRmse) {
+  SurfaceVelocityErrorUnit u("e", 2, Treadmill(), true);
+  SetArray(u, "mount_x", {0.5, -0.5});
+  SetArray(u, "mount_y", {0.25, -0.25});
+  SetArray(u, "mount_yaw", {0.0, kPi / 2});
+  Set(u, "reference", 0.2);
+  SetArray(u, "estimated", {0.25, 0.0, 0.1, 7.0});
+  u.Initialize();
+  ASSERT_EQ(u.DoStep(0, 1'000'000), cosim::StepResult::kOk);
+  EXPECT_NEAR(Get(u, "estimated_speed")[0], 0.25, 1e-15);
+  EXPECT_NEAR(Get(u, "estimated_speed")[1], 0.1, 1e-15);
+  EXPECT_NEAR(Get(u, "rmse_estimated")[0], std::sqrt((0.0025 + 0.01) / 2), 1e-15);
+  // Without `estimated` there is no such input.
+  EXPECT_FALSE(TwoSensors()->variables().Find("estimated").has_value());
+}
+
 TEST(SurfaceVelocityError, MountsAreRequired) {
   SurfaceVelocityErrorUnit u("e", 1, Treadmill());
   EXPECT_EQ(u.CheckParameters().size(), 3u);
