@@ -85,6 +85,7 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
   spec.belt_travel_columns = robot.belt_travel_columns;
   spec.flow_columns = robot.flow_columns;
   spec.flow_labels = robot.flow_sensor_names;
+  spec.flow_filtered_columns = robot.flow_filtered_columns;
   spec.flow_reference_column = robot.flow_reference_column;
   if (!robot.scan_unit.empty()) {
     // The beams' geometry is the laser unit's: read its parameters.

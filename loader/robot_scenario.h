@@ -34,6 +34,7 @@ struct RobotInfo {
   /// PX4Flow's absolute surface speed along the belt, its sensor's name,
   /// and the ground-truth speed; empty without both.
   std::vector<std::string> flow_columns, flow_sensor_names;
+  std::vector<std::string> flow_filtered_columns;  // the estimate's, if any
   std::string flow_reference_column;
   /// The laser unit whose completed scan at scan_time_s the plots draw
   /// (sensors.NAME.snapshot_s; its ranges and scan_time are recorded), or "".

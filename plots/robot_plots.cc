@@ -337,6 +337,10 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   for (const auto& name : spec.belt_travel_columns) travels.push_back(column(name, "belt travel"));
   std::vector<int> flows;
   for (const auto& name : spec.flow_columns) flows.push_back(column(name, "optic flow"));
+  std::vector<int> filtered;
+  for (const auto& name : spec.flow_filtered_columns) {
+    filtered.push_back(column(name, "filtered optic flow"));
+  }
   const int iref = spec.flow_reference_column.empty()
                        ? 0
                        : column(spec.flow_reference_column, "ground-truth surface speed");
@@ -638,7 +642,10 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   if (!flows.empty() && iref > 0) {
     outputs->push_back("optic_flow.png");
     s += "\nset output 'optic_flow.png'\nset title " +
-         GnuplotQuote(title_prefix + "raw optic flow against the belt's ground truth") +
+         GnuplotQuote(title_prefix + (filtered.empty()
+                                          ? "raw optic flow against the belt's ground truth"
+                                          : "raw and filtered optic flow against the belt's "
+                                            "ground truth")) +
          "\nset xlabel 'time (s)'\nset ylabel 'surface speed along the belt (m/s)'\n"
          "unset y2label\nunset y2tics\nset ytics mirror\nset autoscale y\n"
          "set offsets 0, 0, graph 0.05, graph 0.05\nplot ";
@@ -649,6 +656,14 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
       items.push_back(signals_file + " skip 1 using 1:" + std::to_string(flows[i]) +
                       " with lines lw 1 lc rgb '" + kColours[i % 4] + "' title " +
                       GnuplotQuote("raw optic flow, " + label));
+    }
+    // Paper 1 Fig. 4: the steady-state Kalman filter's output beside the raw.
+    static const char* kDark[] = {"#0b3c5d", "#a64d00", "#14601c", "#4b2a75"};
+    for (std::size_t i = 0; i < filtered.size(); ++i) {
+      const std::string label = i < spec.flow_labels.size() ? spec.flow_labels[i] : "sensor";
+      items.push_back(signals_file + " skip 1 using 1:" + std::to_string(filtered[i]) +
+                      " with lines lw 2 dt 2 lc rgb '" + kDark[i % 4] + "' title " +
+                      GnuplotQuote("filtered, " + label));
     }
     items.push_back(signals_file + " skip 1 using 1:" + std::to_string(iref) +
                     " with lines lw 2.5 lc rgb 'black' title 'ground truth (encoder wheel)'");

@@ -46,6 +46,8 @@ struct RobotPlotSpec {
   /// each sensor's raw surface speed along the belt (m/s) with its label,
   /// and the belt's ground-truth speed; none when empty.
   std::vector<std::string> flow_columns, flow_labels;
+  /// The filtered estimate per sensor (same order; empty without one).
+  std::vector<std::string> flow_filtered_columns;
   std::string flow_reference_column;
   /// One laser scan over the scene (scan.png): the scan the scanner had
   /// completed at `time_s`, its rays and hits drawn from the robot's pose

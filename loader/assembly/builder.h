@@ -23,6 +23,12 @@ inline constexpr const char* kPathFollower = "path_follower";
 inline constexpr const char* kDeviation = "deviation";
 inline constexpr const char* kClearance = "clearance";
 inline constexpr const char* kFlowError = "flow_error";
+/// The estimators (units/estimation) and the localization's evaluation.
+inline constexpr const char* kSurfaceEstimator = "surface_estimator";
+inline constexpr const char* kLaserLocalization = "laser_localization";
+inline constexpr const char* kOdometry = "odometry";
+inline constexpr const char* kPoseFusion = "pose_fusion";
+inline constexpr const char* kLocalizationError = "localization_error";
 /// The Rob@Work 3 control cycle (IPA cob_control configuration): the
 /// controllers' period unless control.period_s says otherwise.
 inline constexpr cosim::TimeNs kControlPeriod = cosim::kNsPerSecond / 50;

@@ -20,8 +20,15 @@ namespace linesim::loader::assembly {
 struct Signals {
   /// Ground truth of the robot: evaluation reads these, never estimates.
   std::string true_position, true_yaw, true_surface_velocity;
-  /// What the controllers use: localization's and sensing's choice.
-  std::string position, yaw, surface_velocity;
+  /// What the controllers use: localization's and sensing's choice (the
+  /// robot's velocity in map and yaw rate too: Eq. 2 needs them).
+  std::string position, yaw, velocity, yaw_rate, surface_velocity;
+  /// The estimators, when the scenario closes the loop through them: the
+  /// odometry unit ("" for none), the surface estimator's filtered value
+  /// per PX4Flow in map ("" for none), and each localization's source
+  /// output (which source it is using: the fallbacks).
+  std::string odometry, surface_estimate;
+  std::vector<std::string> localization_sources;
 
   /// Joints of the drive train: the chassis's index of each wheel's
   /// steering joint (-1: fixed wheel) and drive joint, and the dc_motor
@@ -73,8 +80,12 @@ void AddLine(SystemBuilder& b, const models::Scene& scene, Signals& s);
 void AddSensors(SystemBuilder& b, const RobotFile& robot, Signals& s);
 
 /// sensing.surface_velocity and localization.source: who tells the
-/// controllers the surface velocity under each wheel and the pose.
-void AddSensing(SystemBuilder& b, Signals& s);
+/// controllers the surface velocity under each wheel and the pose
+/// (ground truth, or the robot's own sensors through the estimators of
+/// units/estimation).
+void AddSensing(SystemBuilder& b, const RobotFile& robot, const StartPose& start, Signals& s);
+/// Whether the robot description mounts a sensor of `kind`.
+bool RobotHas(const models::RobotDescription& robot, const std::string& kind);
 
 /// control: the wheel controller of the robot's kind (swerve: Eq. 1 and
 /// Algorithm 1; differential), wired to the motors and the joints.

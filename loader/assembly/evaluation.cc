@@ -8,7 +8,7 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
   // The deviation is measured on the ground truth, whatever the robot
   // believes.
   b.Unit(kDeviation, "path_deviation");
-b.Params(kDeviation)["path"] = PointList(info.path);
+  b.Params(kDeviation)["path"] = PointList(info.path);
   b.Connect(s.true_position, Signal(kDeviation, "position"));
   s.recorded.push_back(Signal(kDeviation, "deviation"));
 
@@ -51,6 +51,27 @@ b.Params(kDeviation)["path"] = PointList(info.path);
   add("min_clearance_m", Signal(kClearance, "min_clearance"), "final");
   add("collisions", Signal(kClearance, "collisions"), "final");
 
+  // The localization the controllers use against the truth, when it is not
+  // the truth itself.
+  if (s.position != s.true_position) {
+    b.Unit(kLocalizationError, "pose_error");
+    b.Connect(s.true_position, Signal(kLocalizationError, "true_position"));
+    b.Connect(s.true_yaw, Signal(kLocalizationError, "true_yaw"));
+    b.Connect(s.position, Signal(kLocalizationError, "estimated_position"));
+    b.Connect(s.yaw, Signal(kLocalizationError, "estimated_yaw"));
+    s.recorded.push_back(Signal(kLocalizationError, "position_error"));
+    s.recorded.push_back(Signal(kLocalizationError, "yaw_error"));
+    add("localization_error_max_m", Signal(kLocalizationError, "max_position_error"), "final");
+    add("localization_error_rms_m", Signal(kLocalizationError, "rms_position_error"), "final");
+    add("localization_yaw_error_max_rad", Signal(kLocalizationError, "max_yaw_error"), "final");
+    add("localization_yaw_error_rms_rad", Signal(kLocalizationError, "rms_yaw_error"), "final");
+    // How long the localization ran on its fallback (a source code above 0).
+    for (const auto& source : s.localization_sources) {
+      const std::string unit = source.substr(0, source.find('.'));
+      add((unit + "_source_max").c_str(), source, "max");
+    }
+  }
+
   // Raw optic flow against the belt's ground truth (paper 1 Fig. 4), when
   // both are there.
   std::vector<const models::SensorMount*> flows;
@@ -62,6 +83,7 @@ b.Params(kDeviation)["path"] = PointList(info.path);
     YAML::Node p = b.Params(kFlowError);
     p["sensors"] = static_cast<int>(flows.size());
     p["belt"] = s.belt_ground_truth_belt;
+    if (!s.surface_estimate.empty()) p["estimated"] = true;
     std::vector<double> x, y, yaw;
     for (std::size_t k = 0; k < flows.size(); ++k) {
       x.push_back(flows[k]->x_m);
@@ -81,12 +103,21 @@ b.Params(kDeviation)["path"] = PointList(info.path);
     b.Connect(s.belt_ground_truth, Signal(kFlowError, "reference"));
     s.recorded.push_back(Signal(kFlowError, "surface_speed"));
     add("surface_velocity_rmse_raw_mps", Signal(kFlowError, "rmse"), "final");
+    if (!s.surface_estimate.empty()) {
+      // The surface estimator's filtered value per sensor, the same order.
+      b.Connect(s.surface_estimate, Signal(kFlowError, "estimated"));
+      s.recorded.push_back(Signal(kFlowError, "estimated_speed"));
+      add("surface_velocity_rmse_filtered_mps", Signal(kFlowError, "rmse_estimated"), "final");
+    }
     // The first sensor's quality (0..255, OPTICAL_FLOW_RAD's mean over its
     // publishing interval), over the run.
     add("optic_flow_quality_mean", Signal(flows.front()->name, "quality"), "mean");
     for (std::size_t k = 0; k < flows.size(); ++k) {
       info.flow_columns.push_back(Element(kFlowError, "surface_speed", k));
       info.flow_sensor_names.push_back(flows[k]->name);
+      if (!s.surface_estimate.empty()) {
+        info.flow_filtered_columns.push_back(Element(kFlowError, "estimated_speed", k));
+      }
     }
     info.flow_reference_column = s.belt_ground_truth;
   }

@@ -2,31 +2,272 @@
 #include <map>
 
 #include "loader/assembly/concerns.h"
+#include "loader/yaml_files.h"
 
 namespace linesim::loader::assembly {
 
 namespace {
 
-using Provider = std::function<void(SystemBuilder&, Signals&)>;
+// What a provider needs besides the builder: the robot, its start pose,
+// and where the scenario chose it (for errors).
+struct ProviderContext {
+  const RobotFile& file;
+  const StartPose& start;
+  YAML::Node at;     // the section the choice is in
+  std::string path;  // its key path
+};
+
+using Provider = std::function<void(SystemBuilder&, const ProviderContext&, Signals&)>;
+
+// The mounts of one kind the scenario left on.
+std::vector<const models::SensorMount*> Mounts(const Signals& s, const std::string& kind) {
+  std::vector<const models::SensorMount*> out;
+  for (const auto& m : s.sensors) {
+    if (m.kind == kind) out.push_back(&m);
+  }
+  return out;
+}
+
+// A provider that needs a kind of sensor the scenario turned off (or the
+// robot does not carry) says so at the key that chose it.
+bool Require(SystemBuilder& b, const ProviderContext& c, const Signals& s,
+             const std::string& kind, const std::string& choice) {
+  if (!Mounts(s, kind).empty()) return true;
+  b.reader().Error(c.at, c.path,
+                   "'" + choice + "' needs the robot's " + kind + " sensors, but " +
+                       (RobotHas(c.file.robot, kind) ? "the scenario's sensors: section turns "
+                                                       "them off"
+                                                     : c.file.robot.file + " mounts none"));
+  return false;
+}
+
+void SetStep(SystemBuilder& b, const std::string& unit) {
+  b.SetStep(unit, b.ControlPeriod());
+  b.Derived(JoinPath(JoinPath("units", unit), "step_s"), Child(b.root(), "control"), "control",
+            "period_s");
+}
+
+void SetInitialPose(YAML::Node p, const StartPose& start) {
+  p["initial_x"] = Num(start.x_m);
+  p["initial_y"] = Num(start.y_m);
+  p["initial_yaw"] = Num(start.yaw_rad);
+}
+
+// One value of a laser unit's parameter: the scenario's or the robot's
+// setting if the expansion has one, else the device's model file.
+double LaserValue(const YAML::Node& params, const YAML::Node& model, const std::string& key) {
+  const YAML::Node own = Child(params, key);
+  if (own.IsDefined() && own.IsScalar()) return own.as<double>();
+  const YAML::Node file = Child(model, key);
+  return file.IsDefined() && file.IsScalar() ? file.as<double>() : 0.0;
+}
+
+// hector_mapping on the robot's lasers (paper 1 Sec. IV-B): one
+// laser_localization unit matching every laser's scans against the scene.
+void AddLaserLocalization(SystemBuilder& b, const ProviderContext& c, Signals& s) {
+  const auto lasers = Mounts(s, "laser_scanner");
+  b.Unit(kLaserLocalization, "laser_localization");
+  YAML::Node p = b.Params(kLaserLocalization);
+  std::vector<int> beams;
+  std::vector<double> x, y, z, yaw, first, step, period;
+  for (std::size_t k = 0; k < lasers.size(); ++k) {
+    const models::SensorMount& m = *lasers[k];
+    const YAML::Node params = b.Params(m.name);
+    YAML::Node model;
+    if (!m.model.empty()) {
+      model = LoadModel(b.reader(), c.at, c.path, "laser model", m.model, "sensors",
+                        c.file.robot.file);
+    }
+    beams.push_back(static_cast<int>(LaserValue(params, model, "beam_count")));
+    x.push_back(m.x_m);
+    y.push_back(m.y_m);
+    z.push_back(m.z_m);
+    yaw.push_back(m.yaw_rad);
+    first.push_back(LaserValue(params, model, "first_beam_angle"));
+    step.push_back(LaserValue(params, model, "angular_step"));
+    period.push_back(LaserValue(params, model, "scan_period"));
+    const std::string suffix = "_" + std::to_string(k);
+    b.Connect(Signal(m.name, "ranges"), Signal(kLaserLocalization, "ranges" + suffix));
+    b.Connect(Signal(m.name, "scan_count"), Signal(kLaserLocalization, "scan_count" + suffix));
+    b.Connect(Signal(m.name, "scan_time"), Signal(kLaserLocalization, "scan_time" + suffix));
+  }
+  p["beam_counts"] = IntList(beams);
+  p["mount_x"] = List(x);
+  p["mount_y"] = List(y);
+  p["mount_z"] = List(z);
+  p["mount_yaw"] = List(yaw);
+  p["first_beam_angle"] = List(first);
+  p["angular_step"] = List(step);
+  p["scan_period"] = List(period);
+  SetInitialPose(p, c.start);
+  SetStep(b, kLaserLocalization);
+  s.recorded.push_back(Signal(kLaserLocalization, "source"));
+  s.recorded.push_back(Signal(kLaserLocalization, "laser_status"));
+  s.localization_sources.push_back(Signal(kLaserLocalization, "source"));
+}
+
+// Dead reckoning from the wheel encoders (swerve: the module kinematics;
+// differential: skid-steer with the controller's effective track), with
+// paper 1's Eq. 3 rectification by the surface velocity under each wheel.
+void AddOdometry(SystemBuilder& b, const ProviderContext& c, Signals& s) {
+  const models::RobotDescription& robot = c.file.robot;
+  const models::SensorMount& encoders = *Mounts(s, "wheel_encoder").front();
+  const YAML::Node enc = b.Params(encoders.name);
+  const std::size_t steer = s.steer_motor_element.size();
+  b.Unit(kOdometry, "wheel_odometry");
+  YAML::Node p = b.Params(kOdometry);
+  const bool swerve = robot.controller == models::ControllerKind::kSwerve;
+  p["kind"] = swerve ? "swerve" : "differential";
+  p["wheels"] = static_cast<int>(robot.wheels.size());
+  std::vector<double> x, y;
+  for (const auto& w : robot.wheels) {
+    x.push_back(w.x_m);
+    y.push_back(w.y_m);
+  }
+  p["wheel_x"] = List(x);
+  p["wheel_y"] = List(y);
+  p["wheel_radius"] = Num(robot.wheels.front().radius_m);
+  const YAML::Node cpr = Child(enc, "counts_per_revolution");
+  // The odometry's channels in its order: swerve, each wheel's steering
+  // joint then each wheel's drive joint; differential, the left side's
+  // drive joint then the right side's. The encoder counts every steering
+  // joint, then every drive joint.
+  std::vector<std::size_t> channels;
+  if (swerve) {
+    for (int j : s.wheel_steer_joint) channels.push_back(static_cast<std::size_t>(j));
+    for (int j : s.wheel_drive_joint) channels.push_back(steer + static_cast<std::size_t>(j));
+  } else {
+    int left = -1, right = -1;
+    for (std::size_t i = 0; i < robot.wheels.size(); ++i) {
+      (robot.wheels[i].y_m > 0.0 ? left : right) = s.wheel_drive_joint[i];
+    }
+    channels = {steer + static_cast<std::size_t>(left), steer + static_cast<std::size_t>(right)};
+    const YAML::Node track = Child(c.file.controller_settings, "effective_track");
+    if (track.IsDefined()) p["effective_track"] = track;
+    b.Origin(JoinPath(JoinPath(JoinPath("units", kOdometry), "parameters"), "effective_track"),
+             {YAML::Node(), "controller.effective_track", robot.file});
+  }
+  std::vector<double> counts;
+  for (std::size_t k = 0; k < channels.size(); ++k) {
+    if (cpr.IsSequence() && channels[k] < cpr.size()) {
+      counts.push_back(cpr[channels[k]].as<double>());
+    }
+    b.Connect(Element(encoders.name, "counts", channels[k]), Element(kOdometry, "counts", k));
+  }
+  if (counts.size() == channels.size()) p["counts_per_revolution"] = List(counts);
+  SetInitialPose(p, c.start);
+  SetStep(b, kOdometry);
+  s.odometry = kOdometry;
+}
 
 // Who measures the velocity of the surface under each wheel (base_link).
-// The sensing issue adds the PX4Flow chain and the belt-contact detection
-// here, each a provider that adds its units and sets s.surface_velocity.
 const std::map<std::string, Provider>& SurfaceVelocityProviders() {
   static const std::map<std::string, Provider> providers = {
-      {"ground_truth", [](SystemBuilder&, Signals& s) {
-         s.surface_velocity = s.true_surface_velocity;
+      {"ground_truth", [](SystemBuilder&, const ProviderContext&,
+                          Signals& s) { s.surface_velocity = s.true_surface_velocity; }},
+      // Paper 1 Sec. IV-A: the PX4Flow at the corners, made absolute with
+      // the localization's velocity (Eq. 2), filtered by the steady-state
+      // Kalman filter, assigned to the wheels the line map puts on a belt.
+      {"px4flow", [](SystemBuilder& b, const ProviderContext& c, Signals& s) {
+         if (!Require(b, c, s, "px4flow", "px4flow")) return;
+         const auto flows = Mounts(s, "px4flow");
+         const models::RobotDescription& robot = c.file.robot;
+         b.Unit(kSurfaceEstimator, "surface_velocity_estimator");
+         YAML::Node p = b.Params(kSurfaceEstimator);
+         p["sensors"] = static_cast<int>(flows.size());
+         p["wheels"] = static_cast<int>(robot.wheels.size());
+         std::vector<double> sx, sy, syaw, wx, wy;
+         for (std::size_t k = 0; k < flows.size(); ++k) {
+           const models::SensorMount& m = *flows[k];
+           sx.push_back(m.x_m);
+           sy.push_back(m.y_m);
+           syaw.push_back(m.yaw_rad);
+           for (std::size_t i = 0; i < 2; ++i) {
+             b.Connect(Element(m.name, "velocity", i),
+                       Element(kSurfaceEstimator, "sensor_velocity", 2 * k + i));
+           }
+           b.Connect(Signal(m.name, "valid"), Element(kSurfaceEstimator, "sensor_valid", k));
+           b.Connect(Signal(m.name, "quality"), Element(kSurfaceEstimator, "sensor_quality", k));
+           b.Connect(Signal(m.name, "message_count"),
+                     Element(kSurfaceEstimator, "sensor_message_count", k));
+         }
+         for (const auto& w : robot.wheels) {
+           wx.push_back(w.x_m);
+           wy.push_back(w.y_m);
+         }
+         p["sensor_x"] = List(sx);
+         p["sensor_y"] = List(sy);
+         p["sensor_yaw"] = List(syaw);
+         p["wheel_x"] = List(wx);
+         p["wheel_y"] = List(wy);
+         b.Connect(s.position, Signal(kSurfaceEstimator, "position"));
+         b.Connect(s.yaw, Signal(kSurfaceEstimator, "yaw"));
+         b.Connect(s.velocity, Signal(kSurfaceEstimator, "velocity"));
+         b.Connect(s.yaw_rate, Signal(kSurfaceEstimator, "yaw_rate"));
+         SetStep(b, kSurfaceEstimator);
+         s.surface_velocity = Signal(kSurfaceEstimator, "wheel_surface_velocity");
+         s.surface_estimate = Signal(kSurfaceEstimator, "filtered_surface_velocity");
+         s.recorded.push_back(Signal(kSurfaceEstimator, "wheel_source"));
+         s.recorded.push_back(Signal(kSurfaceEstimator, "sensor_status"));
        }}};
   return providers;
 }
 
-// Who tells the controllers where the robot is. Laser localization and
-// odometry fusion are further providers that set s.position and s.yaw.
+// Who tells the controllers where the robot is and how fast it moves.
 const std::map<std::string, Provider>& LocalizationProviders() {
   static const std::map<std::string, Provider> providers = {
-      {"ground_truth", [](SystemBuilder&, Signals& s) {
+      {"ground_truth",
+       [](SystemBuilder&, const ProviderContext&, Signals& s) {
          s.position = s.true_position;
          s.yaw = s.true_yaw;
+         s.velocity = Signal(kChassis, "linear_velocity");
+         s.yaw_rate = Signal(kChassis, "yaw_rate");
+       }},
+      // hector_mapping alone: the pose of the last match, its velocity
+      // from successive matches.
+      {"laser",
+       [](SystemBuilder& b, const ProviderContext& c, Signals& s) {
+         if (!Require(b, c, s, "laser_scanner", "laser")) return;
+         AddLaserLocalization(b, c, s);
+         s.position = Signal(kLaserLocalization, "position");
+         s.yaw = Signal(kLaserLocalization, "yaw");
+         s.velocity = Signal(kLaserLocalization, "velocity");
+         s.yaw_rate = Signal(kLaserLocalization, "yaw_rate");
+       }},
+      // Dead reckoning alone (rectified by Eq. 3).
+      {"odometry",
+       [](SystemBuilder& b, const ProviderContext& c, Signals& s) {
+         if (!Require(b, c, s, "wheel_encoder", "odometry")) return;
+         AddOdometry(b, c, s);
+         s.position = Signal(kOdometry, "position");
+         s.yaw = Signal(kOdometry, "yaw");
+         s.velocity = Signal(kOdometry, "velocity");
+         s.yaw_rate = Signal(kOdometry, "yaw_rate");
+       }},
+      // Odometry between scans, scan matches as corrections (an EKF).
+      {"fused", [](SystemBuilder& b, const ProviderContext& c, Signals& s) {
+         const bool lasers = Require(b, c, s, "laser_scanner", "fused");
+         const bool encoders = Require(b, c, s, "wheel_encoder", "fused");
+         if (!lasers || !encoders) return;
+         AddLaserLocalization(b, c, s);
+         AddOdometry(b, c, s);
+         b.Unit(kPoseFusion, "pose_fusion");
+         SetInitialPose(b.Params(kPoseFusion), c.start);
+         b.Connect(Signal(kOdometry, "body_velocity"), Signal(kPoseFusion, "odometry_velocity"));
+         b.Connect(Signal(kOdometry, "yaw_rate"), Signal(kPoseFusion, "odometry_yaw_rate"));
+         b.Connect(Signal(kLaserLocalization, "position"), Signal(kPoseFusion, "match_position"));
+         b.Connect(Signal(kLaserLocalization, "yaw"), Signal(kPoseFusion, "match_yaw"));
+         b.Connect(Signal(kLaserLocalization, "covariance"),
+                   Signal(kPoseFusion, "match_covariance"));
+         b.Connect(Signal(kLaserLocalization, "match_time"), Signal(kPoseFusion, "match_time"));
+         b.Connect(Signal(kLaserLocalization, "match_count"), Signal(kPoseFusion, "match_count"));
+         SetStep(b, kPoseFusion);
+         s.position = Signal(kPoseFusion, "position");
+         s.yaw = Signal(kPoseFusion, "yaw");
+         s.velocity = Signal(kPoseFusion, "velocity");
+         s.yaw_rate = Signal(kPoseFusion, "yaw_rate");
+         s.recorded.push_back(Signal(kPoseFusion, "source"));
+         s.localization_sources.push_back(Signal(kPoseFusion, "source"));
        }}};
   return providers;
 }
@@ -37,19 +278,43 @@ std::vector<std::string> Names(const std::map<std::string, Provider>& providers)
   return names;
 }
 
-void Apply(SystemBuilder& b, Signals& s, const std::string& section, const std::string& key,
-           const std::map<std::string, Provider>& providers) {
+// The provider `section.key` chooses, and where it was chosen.
+std::pair<std::string, YAML::Node> Choose(SystemBuilder& b, const std::string& section,
+                                          const std::string& key,
+                                          const std::map<std::string, Provider>& providers) {
   const YAML::Node node = b.Section(b.root(), "", section, {key});
-  const std::string choice =
-      b.reader().String(node, section, key, "ground_truth", Names(providers));
-  if (const auto it = providers.find(choice); it != providers.end()) it->second(b, s);
+  return {b.reader().String(node, section, key, "ground_truth", Names(providers)), node};
 }
 
 }  // namespace
 
-void AddSensing(SystemBuilder& b, Signals& s) {
-  Apply(b, s, "sensing", "surface_velocity", SurfaceVelocityProviders());
-  Apply(b, s, "localization", "source", LocalizationProviders());
+bool RobotHas(const models::RobotDescription& robot, const std::string& kind) {
+  for (const auto& m : robot.sensor_mounts) {
+    if (m.kind == kind) return true;
+  }
+  return false;
+}
+
+void AddSensing(SystemBuilder& b, const RobotFile& file, const StartPose& start, Signals& s) {
+  const auto [surface, surface_node] =
+      Choose(b, "sensing", "surface_velocity", SurfaceVelocityProviders());
+  const auto [localization, localization_node] =
+      Choose(b, "localization", "source", LocalizationProviders());
+  // The pose and velocity first: the surface velocity (Eq. 2) needs the
+  // robot's velocity; the odometry's rectification (Eq. 3) then takes the
+  // surface velocity, whoever provides it. Neither depends directly on the
+  // other's outputs, so the loop has a step's delay, not an algebraic loop.
+  if (const auto it = LocalizationProviders().find(localization);
+      it != LocalizationProviders().end()) {
+    it->second(b, {file, start, localization_node, "localization.source"}, s);
+  }
+  if (const auto it = SurfaceVelocityProviders().find(surface);
+      it != SurfaceVelocityProviders().end()) {
+    it->second(b, {file, start, surface_node, "sensing.surface_velocity"}, s);
+  }
+  if (!s.odometry.empty() && !s.surface_velocity.empty()) {
+    b.Connect(s.surface_velocity, Signal(s.odometry, "surface_velocity"));
+  }
 }
 
 }  // namespace linesim::loader::assembly

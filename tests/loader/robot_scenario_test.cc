@@ -281,12 +281,21 @@ TEST(RobotScenario, HoldScenariosHoldTheStartPose) {
 
 // Guards against sensing/localization choices a later capability adds being
 // silently accepted now: the message lists what exists.
-TEST(RobotScenario, ReservedChoicesNotYetBuiltAreRefused) {
-  const std::string a = Issues(kCross, {"sensing.surface_velocity=px4flow"});
+TEST(RobotScenario, ClosedLoopChoicesNeedTheirSensors) {
+  // The estimators need the sensors they read: turned off, the choice is
+  // refused at its key, naming what is missing.
+  const std::string a =
+      Issues(kCross, {"sensing.surface_velocity=px4flow", "sensors.default=false"});
   EXPECT_TRUE(Has(a, "sensing.surface_velocity")) << a;
-  EXPECT_TRUE(Has(a, "ground_truth")) << a;
-  const std::string b = Issues(kCross, {"localization.source=laser"});
+  EXPECT_TRUE(Has(a, "px4flow sensors")) << a;
+  const std::string b = Issues(kCross, {"localization.source=fused", "sensors.default=false"});
   EXPECT_TRUE(Has(b, "localization.source")) << b;
+  EXPECT_TRUE(Has(b, "laser_scanner sensors")) << b;
+  EXPECT_TRUE(Has(b, "wheel_encoder sensors")) << b;
+  // An unknown source lists the known ones.
+  const std::string c = Issues(kCross, {"localization.source=lidar"});
+  EXPECT_TRUE(Has(c, "localization.source")) << c;
+  EXPECT_TRUE(Has(c, "fused")) << c;
 }
 
 // Guards the robot-level checks: unknown keys name the closest, values out
