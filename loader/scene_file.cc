@@ -250,15 +250,69 @@ class SceneParser {
     }
   }
 
+  // A carried box, optionally on skids (runners under it, from the floor
+  // to its underside: what a scanner near the floor sees of a car body)
+  // and repeated upstream along its belt (a line of bodies, one key to
+  // sweep how many).
   void Carried(const YAML::Node& list, const std::string& path) {
     std::vector<std::string> names;
     for (const auto& [p, item] : Items(list, path)) {
-      r_.CheckKeys(item, p, {"name", "belt", "box"});
+      r_.CheckKeys(item, p, {"name", "belt", "box", "skids", "copies"});
       models::CarriedObject c;
       c.name = Name(item, p, names);
       c.belt = Reference(item, p, "belt", belt_names_, "belt");
-      if (auto solid = Shape(item, p, false)) c.solid = *solid;
-      s_.carried.push_back(c);
+      const auto solid = Shape(item, p, false);
+      if (solid) c.solid = *solid;
+      std::vector<models::CarriedObject> group = {c};
+      const YAML::Node skids = Child(item, "skids");
+      const std::string sp = JoinPath(p, "skids");
+      if (skids.IsDefined() && !skids.IsNull() && r_.ExpectMap(skids, sp) && solid) {
+        r_.CheckKeys(skids, sp, {"count", "width_m", "gauge_m", "length_m"});
+        const auto n = r_.Integer(skids, sp, "count", 2, 1, 16);
+        const double width = r_.Real(skids, sp, "width_m", std::nullopt, {0.0, 1e2, true});
+        const double gauge = r_.Real(skids, sp, "gauge_m", n > 1 ? std::nullopt
+                                                                  : std::optional<double>(0.0),
+                                     {0.0, 1e2});
+        const double length = r_.Real(skids, sp, "length_m", solid->length_m, {0.0, 1e3, true});
+        if (solid->bottom_m <= 0.0) {
+          r_.Error(skids, sp, "a box on skids needs bottom_m > 0 (the skids' height)");
+        }
+        const double cy = std::cos(solid->yaw_rad), sy = std::sin(solid->yaw_rad);
+        for (std::int64_t i = 0; i < n; ++i) {
+          // Evenly across the body, the outer ones gauge_m apart.
+          const double across = n > 1 ? gauge * (static_cast<double>(i) /
+                                                     static_cast<double>(n - 1) - 0.5)
+                                      : 0.0;
+          models::CarriedObject skid = c;
+          skid.name = c.name + "_skid_" + std::to_string(i + 1);
+          skid.solid = models::BoxSolid(solid->x_m - sy * across, solid->y_m + cy * across,
+                                        solid->yaw_rad, length, width, solid->bottom_m);
+          group.push_back(skid);
+        }
+      }
+      const YAML::Node copies = Child(item, "copies");
+      const std::string cp = JoinPath(p, "copies");
+      std::int64_t count = 1;
+      double pitch = 0.0;
+      if (copies.IsDefined() && !copies.IsNull() && r_.ExpectMap(copies, cp)) {
+        r_.CheckKeys(copies, cp, {"count", "pitch_m"});
+        count = r_.Integer(copies, cp, "count", 1, 0, 100);
+        pitch = r_.Real(copies, cp, "pitch_m", count > 1 ? std::nullopt
+                                                         : std::optional<double>(0.0),
+                        {0.0, 1e4});
+      }
+      if (c.belt < 0 || static_cast<std::size_t>(c.belt) >= s_.belts.size()) count = 0;
+      // Copy k sits k pitches upstream of the first, so they pass in turn.
+      const double dir =
+          count > 0 ? s_.belts[static_cast<std::size_t>(c.belt)].area.direction_rad : 0.0;
+      for (std::int64_t k = 0; k < count; ++k) {
+        for (models::CarriedObject o : group) {
+          if (k > 0) o.name += "_" + std::to_string(k + 1);
+          o.solid.x_m -= static_cast<double>(k) * pitch * std::cos(dir);
+          o.solid.y_m -= static_cast<double>(k) * pitch * std::sin(dir);
+          s_.carried.push_back(o);
+        }
+      }
     }
   }
 

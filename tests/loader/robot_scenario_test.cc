@@ -447,7 +447,7 @@ TEST(RobotScenario, StartPoseMustBeOnTheFloorAndOutsideSolids) {
   const std::string off = Issues(kCross, {"robot.pose.x_m=100"});
   EXPECT_TRUE(Has(off, "robot.pose: (100, -2) m is off the scene's floor")) << off;
   const std::string in_car = Issues(kCross, {"robot.pose.x_m=-7", "robot.pose.y_m=0"});
-  EXPECT_TRUE(Has(in_car, "inside carried object 'body_1'")) << in_car;
+  EXPECT_TRUE(Has(in_car, "inside carried object 'body_2'")) << in_car;  // the copy upstream
   const std::string f = WriteScenario("robot_no_scene.yaml", R"(name: bare
 duration_s: 1
 robot: {model: raw3, pose: {x_m: 100, y_m: 0, yaw_deg: 0}}

@@ -76,15 +76,44 @@ TEST(SceneFile, FactoryLineLoads) {
   }
   EXPECT_EQ(pillars, 10);
   EXPECT_NEAR(s.obstacles[2].solid.yaw_rad, 0.5 * std::numbers::pi, 1e-15);  // west wall
-  // Two car bodies, each on two skids.
+  // Two car bodies, each on two skids: one body with its skids, copied
+  // 12 m upstream (the belt runs along +x).
   ASSERT_EQ(s.carried.size(), 6u);
   EXPECT_EQ(s.carried[0].belt, 0);
-  EXPECT_DOUBLE_EQ(s.carried[0].solid.x_m, -7.0);
-  EXPECT_DOUBLE_EQ(s.carried[1].solid.x_m, 5.0);
-  EXPECT_DOUBLE_EQ(s.carried[1].solid.bottom_m, 0.3);
+  EXPECT_EQ(s.carried[0].name, "body");
+  EXPECT_DOUBLE_EQ(s.carried[0].solid.x_m, 5.0);
+  EXPECT_DOUBLE_EQ(s.carried[0].solid.bottom_m, 0.3);
+  EXPECT_EQ(s.carried[1].name, "body_skid_1");
+  EXPECT_DOUBLE_EQ(s.carried[1].solid.y_m, -0.6);
   EXPECT_DOUBLE_EQ(s.carried[2].solid.y_m, 0.6);
-  EXPECT_DOUBLE_EQ(s.carried[5].solid.height_m, 0.3);
+  EXPECT_DOUBLE_EQ(s.carried[2].solid.height_m, 0.3);
+  EXPECT_DOUBLE_EQ(s.carried[2].solid.bottom_m, 0.0);
+  EXPECT_DOUBLE_EQ(s.carried[2].solid.length_m, 4.4);
+  EXPECT_EQ(s.carried[3].name, "body_2");
+  EXPECT_DOUBLE_EQ(s.carried[3].solid.x_m, -7.0);
+  EXPECT_EQ(s.carried[5].name, "body_skid_2_2");
+  EXPECT_DOUBLE_EQ(s.carried[5].solid.x_m, -7.0);
+  EXPECT_DOUBLE_EQ(s.carried[5].solid.y_m, 0.6);
   EXPECT_TRUE(s.terrain.empty());
+}
+
+// Guards the line of bodies: copies.count sets how many ride on the line
+// (0 removes them), each pitch_m upstream of the one before; skids need a
+// raised box. Expected from the file's values: body at x = 5, pitch 12.
+TEST(SceneFile, CarriedCopiesAndSkids) {
+  for (int n : {0, 1, 4}) {
+    const std::string f = WriteScenario(
+        "copies_" + std::to_string(n) + ".yaml",
+        "name: c\nduration_s: 1\nscene: {model: factory_line, carried: [{copies: {count: " +
+            std::to_string(n) + ", pitch_m: 5.5}}]}\nunits: {}\n");
+    YamlReader r(f);
+    const auto scene = ReadScenarioScene(r, YAML::LoadFile(f)["scene"], f);
+    ASSERT_TRUE(r.issues().empty()) << r.issues().front().message;
+    ASSERT_EQ(scene.carried.size(), 3u * static_cast<std::size_t>(n));
+    for (int k = 0; k < n; ++k) {
+      EXPECT_DOUBLE_EQ(scene.carried[3 * static_cast<std::size_t>(k)].solid.x_m, 5.0 - 5.5 * k);
+    }
+  }
 }
 
 // Guards against a required value silently defaulting: a belt without its

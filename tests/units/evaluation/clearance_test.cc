@@ -36,7 +36,7 @@ models::Scene SceneWith(const std::vector<models::Solid>& obstacles) {
 }
 
 // A 20 x 2 m belt along x centred on the origin carrying a 4.6 x 1.8 x 1.2 m
-// car body on 0.3 m skids at x = -7 (the factory_line scene's body_1).
+// car body on 0.3 m skids at x = -7 (the factory_line scene's second body, body_2).
 models::Scene LineScene() {
   models::Scene scene = models::OpenFloor();
   models::Belt belt;
