@@ -105,10 +105,11 @@ SurfaceVelocityEstimator::SurfaceVelocityEstimator(std::string name, int sensors
               Rule::Range(1e-4, 10.0));
   v.Parameter("hold_time_constant", "s", &hold_time_constant_,
               "time constant of the decay toward 0 of a held value (a sensor without valid "
-              "messages)",
+              "messages); default 1 s, about the filter's own time constant (ASSUMPTION)",
               Rule::Positive());
   v.Parameter("stale_after", "s", &stale_after_,
-              "a sensor without a valid message for this long gives no estimate",
+              "a sensor without a valid message for this long gives no estimate (default 2 "
+              "hold time constants: ASSUMPTION)",
               Rule::Positive());
 
   v.Input("sensor_velocity", "m/s", &sensor_velocity_,

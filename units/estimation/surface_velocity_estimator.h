@@ -38,6 +38,11 @@ namespace linesim::estimation {
 /// to base_link with the estimated yaw (the controllers' input).
 ///
 /// Fallbacks: see the status and source codes of the outputs, and the .cc.
+///
+/// No output depends directly on an input: the outputs after DoStep(t, dt)
+/// come from the inputs set for t (one communication step of delay, 20 ms
+/// at the control period, against messages 100 ms apart), so the unit adds
+/// no algebraic loop to localization -> estimation -> control.
 class SurfaceVelocityEstimator : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "surface_velocity_estimator";
@@ -94,6 +99,13 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   double process_sigma_ = 0.01 / 3.0;
   double measurement_sigma_ = 0.03;
   double sample_period_ = 0.1;
+  // ASSUMPTION (no source gives them): 1 s is about the filter's own time
+  // constant at paper 1's figures, sample_period / -ln(1 - K) = 0.1 / 0.111
+  // = 0.90 s, so a held value fades no faster than the filter would have
+  // followed a real change (a line stopping: paper 1, Sec. II, factories
+  // give no reliable on/off signal) and keeps a stopped belt's speed little
+  // longer than the filter's lag would. stale_after = two of those (the held
+  // value down to e^-2 = 14 %, 20 missed messages).
   double hold_time_constant_ = 1.0;
   double stale_after_ = 2.0;
 
