@@ -152,8 +152,18 @@ TEST(WheelOdometryUnit, DeclaresItsVariables) {
 // vx = mean v_ix, vy = mean v_iy, omega = sum(x_i v_iy - y_i v_ix) /
 // sum rho_i^2: |vx|, |vy| errors below e and |omega| error below
 // sum rho_i e / sum rho_i^2.
+//
+// The heading, 33.7 deg, is put 0.9 of a steering count above an edge
+// (1533.9 counts): the middle of the count is 0.4 count off, the count's
+// floor would be 0.9 off. All wheels share that error, a rotation of every
+// wheel velocity (no yaw: the centroid is the origin), so the direction of
+// the dead-reckoned travel is off by at most pi / cpr_s plus the drive
+// quantization (one count of each wheel over the distance, and the yaw it
+// makes: the shared steering error turns no yaw, so only the drive counts
+// do, sum rho q / sum rho^2 for one count q of travel).
 TEST(WheelOdometryUnit, SwerveTranslationFromRealEncoderCounts) {
-  const double vx = 0.3, vy = 0.2, speed = std::hypot(vx, vy), heading = std::atan2(vy, vx);
+  const double heading = 1533.9 * kTwoPi / kSteerCpr, speed = 0.36;
+  const double vx = speed * std::cos(heading), vy = speed * std::sin(heading);
   Rig rig(Raw3Odometry(0.5), Raw3Cpr());
   const auto angles = [&](double t_s) {
     const double roll = speed * t_s / kRaw3Radius;
@@ -188,6 +198,11 @@ TEST(WheelOdometryUnit, SwerveTranslationFromRealEncoderCounts) {
   EXPECT_NEAR(Get(*rig.odometry, "yaw")[0], 0.5, e_yaw);
   EXPECT_NEAR(p[0], 1.0 + (c * vx - s * vy) * steps * dt, e_travel + distance * e_yaw);
   EXPECT_NEAR(p[1], -2.0 + (s * vx + c * vy) * steps * dt, e_travel + distance * e_yaw);
+  const double travel_direction = std::atan2(p[1] + 2.0, p[0] - 1.0) - 0.5;
+  const double drive_quantum = kRaw3Radius * kTwoPi / kDriveCpr;  // m of travel
+  const double e_yaw_drive = sum_rho * drive_quantum / sum_rho2;
+  EXPECT_NEAR(travel_direction, heading,
+              std::numbers::pi / kSteerCpr + drive_quantum / distance + e_yaw_drive);
   const auto vm = Get(*rig.odometry, "velocity");
   EXPECT_NEAR(vm[0], c * vx - s * vy, 2 * e);
   EXPECT_NEAR(vm[1], s * vx + c * vy, 2 * e);
