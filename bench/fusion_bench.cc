@@ -38,8 +38,8 @@ void BM_WheelOdometrySwerve8(benchmark::State& state) {
   Set(u, "wheel_x", std::vector<double>{0.368, -0.368, -0.368, 0.368});
   Set(u, "wheel_y", std::vector<double>{0.186, 0.134, -0.186, -0.134});
   Set(u, "wheel_radius", 0.08);
-  Set(u, "counts_per_revolution", std::vector<double>{16384, 16384, 16384, 16384, 86016, 86016,
-                                                      86016, 86016});
+  Set(u, "counts_per_revolution",
+      std::vector<double>{16384, 16384, 16384, 16384, 86016, 86016, 86016, 86016});
   Set(u, "initial_x", 0.0);
   Set(u, "initial_y", 0.0);
   Set(u, "initial_yaw", 0.0);
@@ -104,8 +104,7 @@ void FusionSteps(benchmark::State& state, bool match, TimeNs delay) {
   Rtf(state);
   // The share of matches the gate accepted (1: every correction was done).
   if (match) {
-    state.counters["accepted"] =
-        u.variables().GetReal(*u.variables().Find("accepted_matches")) / n;
+    state.counters["accepted"] = u.variables().GetReal(*u.variables().Find("accepted_matches")) / n;
   }
 }
 

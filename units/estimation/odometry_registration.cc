@@ -15,11 +15,11 @@ std::unique_ptr<cosim::Unit> MakeWheelOdometry(const UnitBuildContext& c) {
       c.reader.String(c.parameters, c.path, "kind", "swerve", {"swerve", "differential"});
   const auto wheels = c.reader.Integer(c.parameters, c.path, "wheels", 4, 2, 16);
   if (c.reader.issues().size() != issues) return nullptr;  // the reader reported them
-  return std::make_unique<WheelOdometryUnit>(
-      c.name,
-      kind == "differential" ? WheelOdometryUnit::Kind::kDifferential
-                             : WheelOdometryUnit::Kind::kSwerve,
-      static_cast<int>(wheels));
+  return std::make_unique<WheelOdometryUnit>(c.name,
+                                             kind == "differential"
+                                                 ? WheelOdometryUnit::Kind::kDifferential
+                                                 : WheelOdometryUnit::Kind::kSwerve,
+                                             static_cast<int>(wheels));
 }
 
 std::unique_ptr<cosim::Unit> MakePoseFusion(const UnitBuildContext& c) {
@@ -33,8 +33,9 @@ const config::UnitTypeRegistrar kWheelOdometry(
      "under each wheel, dead reckoning along exact arcs; robot-specific parameters have no "
      "default",
      "",
-     {{"kind", "swerve (2W channels: W steering, then W drive joints; default) or "
-               "differential (2 channels: left and right drive motor)"},
+     {{"kind",
+       "swerve (2W channels: W steering, then W drive joints; default) or "
+       "differential (2 channels: left and right drive motor)"},
       {"wheels", "number of wheels W (default 4, at least 2)"}},
      MakeWheelOdometry});
 

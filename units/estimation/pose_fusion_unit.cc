@@ -189,8 +189,7 @@ void PoseFusionUnit::Predict(double* xs, double* ps, double vx, double vy, doubl
   p(4, 4) += qb;
 }
 
-bool PoseFusionUnit::Correct(double* xs, double* ps, const double zs[3],
-                             const double rs[9]) const {
+bool PoseFusionUnit::Correct(double* xs, double* ps, const double zs[3], const double rs[9]) const {
   Eigen::Map<Vec5> x(xs);
   Eigen::Map<Mat5> p(ps);
   const Eigen::Map<const Eigen::Vector3d> z(zs);
@@ -301,8 +300,8 @@ void PoseFusionUnit::ComputeOutputs() {
   for (std::size_t a = 0; a < 3; ++a) {
     for (std::size_t b = 0; b < 3; ++b) covariance_[3 * a + b] = e.p[a + 5 * b];
   }
-  const bool fused = last_match_time_ != kNoMatch &&
-                     cosim::NsToSeconds(e.t - last_match_time_) <= timeout_;
+  const bool fused =
+      last_match_time_ != kNoMatch && cosim::NsToSeconds(e.t - last_match_time_) <= timeout_;
   source_ = fused ? 0.0 : 1.0;
 }
 
@@ -333,13 +332,11 @@ void PoseFusionUnit::SaveInternal(cosim::UnitState& state) const {
 
 void PoseFusionUnit::RestoreInternal(const cosim::UnitState& state) {
   const std::size_t n = state.integers.size() < 3 ? 0 : state.integers.size() - 3;
-  if (state.integers.size() < 4 || n > kHistory ||
-      state.reals.size() != n * kRealsPerEntry + 1) {
-    throw cosim::UnitError(Where() + ": saved state has " +
-                           std::to_string(state.integers.size()) + " integers and " +
-                           std::to_string(state.reals.size()) +
-                           " reals, expected 3 + n and 33 n + 1 for 1 <= n <= " +
-                           std::to_string(kHistory));
+  if (state.integers.size() < 4 || n > kHistory || state.reals.size() != n * kRealsPerEntry + 1) {
+    throw cosim::UnitError(
+        Where() + ": saved state has " + std::to_string(state.integers.size()) + " integers and " +
+        std::to_string(state.reals.size()) +
+        " reals, expected 3 + n and 33 n + 1 for 1 <= n <= " + std::to_string(kHistory));
   }
   first_ = 0;
   size_ = n;

@@ -207,8 +207,8 @@ void WheelOdometryUnit::ComputeSample() {
   // over the interval (an integer difference: exact).
   const auto rim_speed = [&](std::size_t c) {
     if (!rate_known) return 0.0;
-    const double turned = static_cast<double>(pending_counts_[c] - committed_counts_[c]) *
-                          kTwoPi / counts_per_revolution_[c];
+    const double turned = static_cast<double>(pending_counts_[c] - committed_counts_[c]) * kTwoPi /
+                          counts_per_revolution_[c];
     return wheel_radius_ * turned / interval_s;
   };
 
@@ -304,10 +304,9 @@ void WheelOdometryUnit::SaveInternal(cosim::UnitState& state) const {
 void WheelOdometryUnit::RestoreInternal(const cosim::UnitState& state) {
   const std::size_t ni = 2 * channels_ + 4;
   if (state.integers.size() != ni || state.reals.size() != 6) {
-    throw cosim::UnitError(Where() + ": saved state has " +
-                           std::to_string(state.integers.size()) + " integers and " +
-                           std::to_string(state.reals.size()) + " reals, expected " +
-                           std::to_string(ni) + " and 6");
+    throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.integers.size()) +
+                           " integers and " + std::to_string(state.reals.size()) +
+                           " reals, expected " + std::to_string(ni) + " and 6");
   }
   const auto mid = state.integers.begin() + static_cast<std::ptrdiff_t>(channels_);
   std::copy(state.integers.begin(), mid, committed_counts_.begin());

@@ -1,6 +1,4 @@
 // The pose_fusion unit (units/estimation/pose_fusion_unit.h).
-#include "units/estimation/pose_fusion_unit.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +8,7 @@
 
 #include "tests/units/test_helpers.h"
 #include "units/estimation/planar_arc.h"
+#include "units/estimation/pose_fusion_unit.h"
 
 namespace linesim::estimation {
 namespace {
@@ -83,38 +82,37 @@ double AngleError(double a, double b) { return std::remainder(a - b, 2.0 * std::
 TEST(PoseFusionUnit, DeclaresItsVariables) {
   PoseFusionUnit u("fusion");
   using cosim::Causality;
-  test_helpers::ExpectTable(
-      u, {{"yaw_rate_source", Causality::kParameter, "", 0},
-          {"velocity_noise", Causality::kParameter, "m/(s.Hz^0.5)", 0},
-          {"yaw_rate_noise", Causality::kParameter, "rad/(s.Hz^0.5)", 0},
-          {"offset_random_walk", Causality::kParameter, "m/(s2.Hz^0.5)", 0},
-          {"initial_position_sigma", Causality::kParameter, "m", 0},
-          {"initial_yaw_sigma", Causality::kParameter, "rad", 0},
-          {"initial_offset_sigma", Causality::kParameter, "m/s", 0},
-          {"position_floor", Causality::kParameter, "m", 0},
-          {"yaw_floor", Causality::kParameter, "rad", 0},
-          {"gate", Causality::kParameter, "1", 0},
-          {"timeout", Causality::kParameter, "s", 0},
-          {"initial_x", Causality::kParameter, "m", 0},
-          {"initial_y", Causality::kParameter, "m", 0},
-          {"initial_yaw", Causality::kParameter, "rad", 0},
-          {"odometry_velocity", Causality::kInput, "m/s", 2},
-          {"odometry_yaw_rate", Causality::kInput, "rad/s", 0},
-          {"imu_angular_velocity", Causality::kInput, "rad/s", 3},
-          {"match_position", Causality::kInput, "m", 2},
-          {"match_yaw", Causality::kInput, "rad", 0},
-          {"match_covariance", Causality::kInput, "1", 9},
-          {"match_time", Causality::kInput, "s", 0},
-          {"match_count", Causality::kInput, "1", 0},
-          {"position", Causality::kOutput, "m", 2},
-          {"yaw", Causality::kOutput, "rad", 0},
-          {"velocity", Causality::kOutput, "m/s", 2},
-          {"yaw_rate", Causality::kOutput, "rad/s", 0},
-          {"velocity_offset", Causality::kOutput, "m/s", 2},
-          {"covariance", Causality::kOutput, "1", 9},
-          {"source", Causality::kOutput, "1", 0},
-          {"rejected_matches", Causality::kOutput, "1", 0},
-          {"accepted_matches", Causality::kOutput, "1", 0}});
+  test_helpers::ExpectTable(u, {{"yaw_rate_source", Causality::kParameter, "", 0},
+                                {"velocity_noise", Causality::kParameter, "m/(s.Hz^0.5)", 0},
+                                {"yaw_rate_noise", Causality::kParameter, "rad/(s.Hz^0.5)", 0},
+                                {"offset_random_walk", Causality::kParameter, "m/(s2.Hz^0.5)", 0},
+                                {"initial_position_sigma", Causality::kParameter, "m", 0},
+                                {"initial_yaw_sigma", Causality::kParameter, "rad", 0},
+                                {"initial_offset_sigma", Causality::kParameter, "m/s", 0},
+                                {"position_floor", Causality::kParameter, "m", 0},
+                                {"yaw_floor", Causality::kParameter, "rad", 0},
+                                {"gate", Causality::kParameter, "1", 0},
+                                {"timeout", Causality::kParameter, "s", 0},
+                                {"initial_x", Causality::kParameter, "m", 0},
+                                {"initial_y", Causality::kParameter, "m", 0},
+                                {"initial_yaw", Causality::kParameter, "rad", 0},
+                                {"odometry_velocity", Causality::kInput, "m/s", 2},
+                                {"odometry_yaw_rate", Causality::kInput, "rad/s", 0},
+                                {"imu_angular_velocity", Causality::kInput, "rad/s", 3},
+                                {"match_position", Causality::kInput, "m", 2},
+                                {"match_yaw", Causality::kInput, "rad", 0},
+                                {"match_covariance", Causality::kInput, "1", 9},
+                                {"match_time", Causality::kInput, "s", 0},
+                                {"match_count", Causality::kInput, "1", 0},
+                                {"position", Causality::kOutput, "m", 2},
+                                {"yaw", Causality::kOutput, "rad", 0},
+                                {"velocity", Causality::kOutput, "m/s", 2},
+                                {"yaw_rate", Causality::kOutput, "rad/s", 0},
+                                {"velocity_offset", Causality::kOutput, "m/s", 2},
+                                {"covariance", Causality::kOutput, "1", 9},
+                                {"source", Causality::kOutput, "1", 0},
+                                {"rejected_matches", Causality::kOutput, "1", 0},
+                                {"accepted_matches", Causality::kOutput, "1", 0}});
 }
 
 // Guards the correction: a robot standing at (0.05, -0.03, 0.02) while the
@@ -257,6 +255,33 @@ TEST(PoseFusionUnit, RefusesOutOfOrderMatches) {
   f.Step(0.0, 0.0, 0.0, Match{truth, f.t - 50 * kMs});
   EXPECT_EQ(f.Scalar("accepted_matches"), 1.0);
   EXPECT_EQ(f.Scalar("rejected_matches"), 1.0);
+}
+
+// Guards the history's reach: after 300 steps of 20 ms (6 s) the buffer
+// holds the last 256 (5.12 s), so a match of t = 0.5 s is refused; one
+// that refers exactly to a buffered step (40 ms ago) is applied there and
+// carried to now: with a robot at 0.2 m/s and exact odometry the estimate
+// then equals the truth the match implies (the prediction is exact).
+TEST(PoseFusionUnit, MatchesOlderThanTheHistoryAreRefused) {
+  const Pose p0{0.0, 0.0, 0.0};
+  Fusion f(p0);
+  for (int k = 0; k < 300; ++k) f.Step(0.2, 0.0, 0.0);
+  f.Step(0.2, 0.0, 0.0, Match{ArcPose(p0, 0.2, 0.0, 0.0, 0.5), 500 * kMs});
+  EXPECT_EQ(f.Scalar("rejected_matches"), 1.0);
+  EXPECT_EQ(f.Scalar("accepted_matches"), 0.0);
+  const TimeNs tm = f.t - 40 * kMs;
+  Pose seen = ArcPose(p0, 0.2, 0.0, 0.0, cosim::NsToSeconds(tm));
+  seen.y += 0.01;  // the laser sees the robot 1 cm to the left
+  f.Step(0.2, 0.0, 0.0, Match{seen, tm});
+  EXPECT_EQ(f.Scalar("accepted_matches"), 1.0);
+  // After 6 s of dead reckoning P_yy (about 0.36 m^2, mostly the initial
+  // b's 0.1 m/s over 6 s) dwarfs the match's 1e-4: the gain is about 1, y
+  // moves to 0.01 at tm, and b_y (correlated with y by that growth) takes
+  // about 0.01 / 6 s; the 40 ms replay adds b_y x 0.04 s = 7e-5 m.
+  const double y = f.Estimate().y;
+  EXPECT_NEAR(y, 0.01 + 0.01 / 6.0 * 0.04, 5e-5);
+  EXPECT_NEAR(Get(f.u, "velocity_offset")[1], 0.01 / 6.0, 2e-4);
+  EXPECT_NEAR(f.Estimate().x, 0.2 * cosim::NsToSeconds(f.t), 1e-3);
 }
 
 // A restored unit continues bit for bit, including its history (delayed

@@ -1,7 +1,5 @@
 // The wheel_odometry unit (units/estimation/wheel_odometry_unit.h), driven
 // by the real wheel_encoder unit's counts where the counts matter.
-#include "units/estimation/wheel_odometry_unit.h"
-
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -15,6 +13,7 @@
 #include "config/yaml_reader.h"
 #include "models/scene.h"
 #include "tests/units/test_helpers.h"
+#include "units/estimation/wheel_odometry_unit.h"
 #include "units/sensors/wheel_encoder_unit.h"
 
 namespace linesim::estimation {
@@ -52,9 +51,9 @@ std::unique_ptr<WheelOdometryUnit> Raw3Odometry(double yaw0 = 0.0, bool rectify 
   SetArray(*u, "wheel_x", kRaw3X);
   SetArray(*u, "wheel_y", kRaw3Y);
   SetAll(*u, "wheel_radius", kRaw3Radius);
-  SetArray(*u, "counts_per_revolution",
-           {kSteerCpr, kSteerCpr, kSteerCpr, kSteerCpr, kDriveCpr, kDriveCpr, kDriveCpr,
-            kDriveCpr});
+  SetArray(
+      *u, "counts_per_revolution",
+      {kSteerCpr, kSteerCpr, kSteerCpr, kSteerCpr, kDriveCpr, kDriveCpr, kDriveCpr, kDriveCpr});
   SetAll(*u, "initial_x", 1.0);
   SetAll(*u, "initial_y", -2.0);
   SetAll(*u, "initial_yaw", yaw0);
@@ -115,25 +114,24 @@ std::vector<double> Raw3Cpr() {
 TEST(WheelOdometryUnit, DeclaresItsVariables) {
   WheelOdometryUnit s("odo", Kind::kSwerve, 4);
   const std::vector<std::string> both = {"counts", "surface_velocity"};
-  test_helpers::ExpectTable(s, {{"wheel_x", cosim::Causality::kParameter, "m", 4},
-                                {"wheel_y", cosim::Causality::kParameter, "m", 4},
-                                {"wheel_radius", cosim::Causality::kParameter, "m", 0},
-                                {"counts_per_revolution", cosim::Causality::kParameter, "1", 8},
-                                {"rectify", cosim::Causality::kParameter, "", 0},
-                                {"initial_x", cosim::Causality::kParameter, "m", 0},
-                                {"initial_y", cosim::Causality::kParameter, "m", 0},
-                                {"initial_yaw", cosim::Causality::kParameter, "rad", 0},
-                                {"counts", cosim::Causality::kInput, "1", 8},
-                                {"surface_velocity", cosim::Causality::kInput, "m/s", 8},
-                                {"body_velocity", cosim::Causality::kOutput, "m/s", 2, both},
-                                {"yaw_rate", cosim::Causality::kOutput, "rad/s", 0, both},
-                                {"raw_body_velocity", cosim::Causality::kOutput, "m/s", 2,
-                                 {"counts"}},
-                                {"raw_yaw_rate", cosim::Causality::kOutput, "rad/s", 0,
-                                 {"counts"}},
-                                {"position", cosim::Causality::kOutput, "m", 2, both},
-                                {"yaw", cosim::Causality::kOutput, "rad", 0, both},
-                                {"velocity", cosim::Causality::kOutput, "m/s", 2, both}});
+  test_helpers::ExpectTable(s,
+                            {{"wheel_x", cosim::Causality::kParameter, "m", 4},
+                             {"wheel_y", cosim::Causality::kParameter, "m", 4},
+                             {"wheel_radius", cosim::Causality::kParameter, "m", 0},
+                             {"counts_per_revolution", cosim::Causality::kParameter, "1", 8},
+                             {"rectify", cosim::Causality::kParameter, "", 0},
+                             {"initial_x", cosim::Causality::kParameter, "m", 0},
+                             {"initial_y", cosim::Causality::kParameter, "m", 0},
+                             {"initial_yaw", cosim::Causality::kParameter, "rad", 0},
+                             {"counts", cosim::Causality::kInput, "1", 8},
+                             {"surface_velocity", cosim::Causality::kInput, "m/s", 8},
+                             {"body_velocity", cosim::Causality::kOutput, "m/s", 2, both},
+                             {"yaw_rate", cosim::Causality::kOutput, "rad/s", 0, both},
+                             {"raw_body_velocity", cosim::Causality::kOutput, "m/s", 2, {"counts"}},
+                             {"raw_yaw_rate", cosim::Causality::kOutput, "rad/s", 0, {"counts"}},
+                             {"position", cosim::Causality::kOutput, "m", 2, both},
+                             {"yaw", cosim::Causality::kOutput, "rad", 0, both},
+                             {"velocity", cosim::Causality::kOutput, "m/s", 2, both}});
   WheelOdometryUnit d("odo", Kind::kDifferential, 4);
   EXPECT_EQ(d.variables().info(*d.variables().Find("counts")).size, 2u);
   EXPECT_EQ(d.variables().info(*d.variables().Find("surface_velocity")).size, 8u);
@@ -231,12 +229,13 @@ TEST(WheelOdometryUnit, SwerveRotationFromRealEncoderCounts) {
   const double t_end = steps * dt;
   for (std::size_t i = 0; i < 4; ++i) {
     const double rho = std::hypot(kRaw3X[i], kRaw3Y[i]);
-    const double e = kRaw3Radius * kTwoPi / kDriveCpr / dt + omega * rho * std::numbers::pi / kSteerCpr;
+    const double e =
+        kRaw3Radius * kTwoPi / kDriveCpr / dt + omega * rho * std::numbers::pi / kSteerCpr;
     sum_rho_e += rho * e;
     sum_rho2 += rho * rho;
     mean_e += e / 4.0;
-    sum_rho_travel +=
-        rho * (kRaw3Radius * kTwoPi / kDriveCpr + omega * rho * t_end * std::numbers::pi / kSteerCpr);
+    sum_rho_travel += rho * (kRaw3Radius * kTwoPi / kDriveCpr +
+                             omega * rho * t_end * std::numbers::pi / kSteerCpr);
   }
   for (int k = 1; k <= steps; ++k) {
     rig.Step(angles(k * dt));
@@ -440,8 +439,8 @@ TEST(WheelOdometryFactory, ReadsAndChecksStructuralKeys) {
   const models::Scene scene = models::OpenFloor();
   const auto make = [&](const std::string& params, std::vector<config::Issue>* issues) {
     config::YamlReader reader("scenario.yaml");
-    auto u = type->create({"odo", 1, reader, YAML::Load(params), "units.odo.parameters", scene,
-                           YAML::Node(), ""});
+    auto u = type->create(
+        {"odo", 1, reader, YAML::Load(params), "units.odo.parameters", scene, YAML::Node(), ""});
     *issues = reader.issues();
     return u;
   };
