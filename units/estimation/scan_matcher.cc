@@ -100,6 +100,7 @@ ScanMatcher::Result ScanMatcher::Match(std::span<const double> px, std::span<con
     res.solved = true;
     for (int it = 0; it < iterations; ++it) {
       Accumulate(level, px, py, res.pose, h, b, cost, on_map);
+      ++res.iterations;
       if (!SolveSymmetric3(h, b, d)) {
         res.solved = false;
         break;

@@ -50,6 +50,8 @@ class ScanMatcher {
     /// False when a Gauss-Newton system was singular (the pose is then the
     /// last one reached).
     bool solved = true;
+    /// Gauss-Newton iterations run over all levels (early exits included).
+    int iterations = 0;
   };
 
   ScanMatcher(const OccupancyGrid& grid, Options options) : grid_(grid), options_(options) {}
