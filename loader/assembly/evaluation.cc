@@ -65,10 +65,10 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     add("localization_error_rms_m", Signal(kLocalizationError, "rms_position_error"), "final");
     add("localization_yaw_error_max_rad", Signal(kLocalizationError, "max_yaw_error"), "final");
     add("localization_yaw_error_rms_rad", Signal(kLocalizationError, "rms_yaw_error"), "final");
-    // How long the localization ran on its fallback (a source code above 0).
+    // The share of the run the localization spent on its fallback (source 1).
     for (const auto& source : s.localization_sources) {
       const std::string unit = source.substr(0, source.find('.'));
-      add((unit + "_source_max").c_str(), source, "max");
+      add((unit + "_fallback_fraction").c_str(), source, "mean");
     }
   }
 

@@ -146,6 +146,12 @@ LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene,
               cosim::Rule::Positive().NoDefault());
   v.Parameter("no_return_value", "m", &no_return_value_,
               "the range the device reports for a beam without echo", cosim::Rule::Finite().NoDefault());
+  v.Parameter("blackout_from", "s", &blackout_from_,
+              "fault injection: beams measured from this time get no echo (a covered window) ...",
+              cosim::Rule::NonNegative());
+  v.Parameter("blackout_until", "s", &blackout_until_,
+              "... until this time (blackout_until <= blackout_from: never)",
+              cosim::Rule::NonNegative());
   if (has_field_) {
     v.Parameter("multiple_sampling", &multiple_sampling_,
                 "consecutive scans with an object in the protective field before field_clear "
@@ -465,7 +471,9 @@ void LaserScannerUnit::Finalize(int first, int end) {
     }
     // The measured range before rounding; NaN: no return.
     double m = std::numeric_limits<double>::quiet_NaN();
-    if (r >= range_min_ && r <= range_max_ && cos_inc >= cos_max_incidence_) {
+    const double beam_s = cosim::NsToSeconds(scan_start_ + BeamOffset(i));
+    const bool blackout = beam_s >= blackout_from_ && beam_s < blackout_until_;
+    if (!blackout && r >= range_min_ && r <= range_max_ && cos_inc >= cos_max_incidence_) {
       m = r + bias_ + noise_sigma_ * Normal();
     }
     scan_ranges_[k] = m;

@@ -132,6 +132,8 @@ class LaserScannerUnit : public cosim::Unit {
   double scan_period_, first_beam_angle_, angular_step_, range_min_, range_max_,
       range_resolution_, noise_sigma_, bias_sigma_ = 0.0, bias_max_ = 0.0, max_incidence_,
       spot_divergence_ = 0.0, spot_offset_ = 0.0, echo_separation_, no_return_value_;
+  // A fault to inject: no echo for beams measured in [blackout_from, blackout_until) s.
+  double blackout_from_ = 0.0, blackout_until_ = 0.0;
   std::int64_t multiple_sampling_ = 2;
 
   // Inputs.

@@ -138,6 +138,12 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
   v.Parameter("added_light", "lx", &added_light_,
               "illuminance the robot's own light adds at the floor under the sensor",
               Rule::NonNegative());
+  v.Parameter("dark_from", "s", &dark_from_,
+              "fault injection: from this time the surface gets no light at all (the hall's "
+              "lights and the sensor's own off) ...",
+              Rule::NonNegative());
+  v.Parameter("dark_until", "s", &dark_until_,
+              "... until this time (dark_until <= dark_from: never)", Rule::NonNegative());
   v.Parameter("sonar_noise", "m", &sonar_noise_, "standard deviation of the sonar distance",
               Rule::NonNegative());
   v.Parameter("sonar_min", "m", &sonar_min_, "shortest valid sonar distance", Rule::Positive());
@@ -288,7 +294,7 @@ void Px4FlowUnit::Frame() {
     // The surface's velocity relative to the sensor (m/s, sensor frame).
     const double to_mps = frame_rate_ * mount_height_ / focal_length_px_;
     const FlowResult r = image_->Step(fx * to_mps, fy * to_mps, mount_height_,
-                                      surf.texture_contrast, surf.illumination_lux + added_light_);
+                                      surf.texture_contrast, Illuminance(surf));
     q = r.quality;
     flow_x = r.flow_x_px;
     flow_y = r.flow_y_px;
@@ -300,7 +306,7 @@ void Px4FlowUnit::Frame() {
 
 void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, int& q,
                             double& flow_x, double& flow_y) {
-  const Exposure e = AutoExposure(cam_, surf.illumination_lux + added_light_);
+  const Exposure e = AutoExposure(cam_, Illuminance(surf));
   const double blur_px = std::sqrt(fx * fx + fy * fy) * e.exposure_s * frame_rate_;
   const double br = blur_px / kBlurScalePx;
   const double d = kNeighbourDiff * e.mean_dn * surf.texture_contrast *
@@ -419,6 +425,8 @@ cosim::StepResult Px4FlowUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   // same time as a message goes into it).
   while (next_frame_ <= t_end || next_publish_ <= t_end) {
     if (next_frame_ <= next_publish_) {
+      const double frame_s = cosim::NsToSeconds(next_frame_);
+      dark_ = frame_s >= dark_from_ && frame_s < dark_until_;
       Frame();
       ++frame_index_;
       next_frame_ = start_ + static_cast<cosim::TimeNs>(

@@ -100,6 +100,10 @@ class Px4FlowUnit : public cosim::Unit {
   /// Integrates a frame of quality q (> 0: counted) into OPTICAL_FLOW_RAD.
   void CommitFrame(int q, double flow_x, double flow_y);
   void Publish();
+  /// The light on `surf` under the sensor (0 in an injected dark spell).
+  double Illuminance(const models::Surface& surf) const {
+    return dark_ ? 0.0 : surf.illumination_lux + added_light_;
+  }
 
   struct BeltArea {
     models::Rect area;
@@ -120,6 +124,9 @@ class Px4FlowUnit : public cosim::Unit {
   double max_exposure_ = 0.0025, max_gain_ = 4.0, target_brightness_ = 80.0;
   double responsivity_ = 42.0, shot_noise_gain_ = 0.0128, read_noise_ = 0.5;
   double added_light_ = 0.0;
+  // A fault to inject: no light at all on the surface in [dark_from, dark_until) s.
+  double dark_from_ = 0.0, dark_until_ = 0.0;
+  bool dark_ = false;  // the frame being computed falls in it
   double sonar_noise_ = 0.005, sonar_min_ = 0.12, sonar_max_ = 3.5;
   double gyro_noise_ = 0.0, gyro_range_ = 4.363323129985824;  // 250 deg/s
 

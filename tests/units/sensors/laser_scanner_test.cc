@@ -96,6 +96,33 @@ constexpr double kHalfStep = 0.005 + 1e-9;
 
 // ---------------------------------------------------------------------------
 
+// Guards the injected blackout (a covered window): beams measured inside
+// [blackout_from, blackout_until) have no echo, the others are unchanged.
+// Beam times from the S300's 40 ms scan: beam i at i * 0.5 / 360 * 40 ms
+// after the scan's start, so the 10 ms of blackout from 45 ms cover the
+// beams of the second scan from 5 ms (beam 90) to 15 ms (beam 270).
+TEST(LaserScanner, BlackoutSilencesTheBeamsMeasuredInIt) {
+  auto u = FromModel("sick_s300", WithBox(5.0, 0.0, 1.0, 40.0, 2.0));
+  Exact(*u);
+  SetAll(*u, "mount_z", 0.2);
+  SetAll(*u, "blackout_from", 0.045);
+  SetAll(*u, "blackout_until", 0.055);
+  Start(*u);
+  RunScans(*u, RunScans(*u, 0, 1), 1);
+  const auto r = Get(*u, "ranges");
+  for (int i = 0; i < 541; ++i) {
+    const double beam_ms = i * 0.5 / 360.0 * 40.0;
+    const bool dark = beam_ms >= 5.0 - 1e-9 && beam_ms < 15.0 - 1e-9;
+    // Every beam ahead of the long box hits it (|a| < 84.3 deg).
+    const bool ahead = std::abs(BeamAngle(i)) < std::atan(20.0 / 4.5);
+    if (dark || !ahead) {
+      EXPECT_EQ(r[static_cast<std::size_t>(i)], 0.0) << "beam " << i;
+    } else {
+      EXPECT_GT(r[static_cast<std::size_t>(i)], 4.0) << "beam " << i;
+    }
+  }
+}
+
 // Guards against a wrong variable table or model file: the S300 file gives
 // 541 beams (270 deg / 0.5 deg + 1, 8010948) and a protective field; the
 // LMS151 file 541 beams and none. Beam 540 comes 540 * 0.5 / 360 of the

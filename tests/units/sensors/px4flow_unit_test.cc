@@ -268,6 +268,31 @@ TEST(Px4FlowUnit, IntegrationCountsOnlyFramesWithQuality) {
   EXPECT_EQ(Get(u, "message_count")[0], 2.0);
 }
 
+// Guards the injected dark spell: with no light on the surface the frame
+// is read noise at full gain, which passes compute_diff's threshold (the
+// firmware: "not appropriate for low-light images"), so the blocks match
+// noise anywhere in the window: the messages keep a quality above 0 but
+// their flow no longer follows the belt (the mean of offsets spread over
+// +-3.5 px: near 0). With the light back, the belt reads true again.
+// Expected flow: v / h * f / 400 Hz = 1.81 px/frame, as a velocity 0.2 m/s.
+TEST(Px4FlowUnit, DarkSpellLosesTheBeltUntilTheLightReturns) {
+  models::Scene s = Scene(0.3, 300.0);
+  Px4FlowUnit u("flow", s, 7);
+  Mount(u);
+  SetAll(u, "dark_from", 0.2);
+  SetAll(u, "dark_until", 0.5);
+  Start(u);
+  SetArray(u, "belt_velocity", {0.2, 0.0});
+  SetArray(u, "position", {0.0, 0.0});
+  StepFor(u, 0, 200 * kMs);
+  EXPECT_NEAR(Get(u, "velocity")[0], 0.2, 0.03);
+  StepFor(u, 200 * kMs, 400 * kMs);  // the messages of 0.3 s and 0.4 s are dark
+  EXPECT_GT(Get(u, "quality")[0], 0.0);
+  EXPECT_LT(std::abs(Get(u, "velocity")[0]), 0.1);
+  StepFor(u, 400 * kMs, 700 * kMs);  // light from 0.5 s: the 0.6 and 0.7 s messages
+  EXPECT_NEAR(Get(u, "velocity")[0], 0.2, 0.03);
+}
+
 // The sonar's valid window (sonar.c 0.12..3.5 m): a sensor mounted at
 // 0.1 m reports distance -1 (unknown).
 TEST(Px4FlowUnit, SonarOutsideItsRangeIsFlaggedInvalid) {
