@@ -251,6 +251,14 @@ const std::map<std::string, Provider>& LocalizationProviders() {
          if (!lasers || !encoders) return;
          AddLaserLocalization(b, c, s);
          AddOdometry(b, c, s);
+         // The matcher starts each match from its last pose moved by the
+         // odometry since then (hector alone has no motion model): through
+         // a blackout of both lasers it follows the odometry, so the first
+         // scans after it are within the matcher's reach.
+         b.Params(kLaserLocalization)["motion_prediction"] = "odometry";
+         b.Connect(Signal(kOdometry, "body_velocity"),
+                   Signal(kLaserLocalization, "odometry_velocity"));
+         b.Connect(Signal(kOdometry, "yaw_rate"), Signal(kLaserLocalization, "odometry_yaw_rate"));
          b.Unit(kPoseFusion, "pose_fusion");
          SetInitialPose(b.Params(kPoseFusion), c.start);
          b.Connect(Signal(kOdometry, "body_velocity"), Signal(kPoseFusion, "odometry_velocity"));
