@@ -217,16 +217,19 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
                              obj.name + "' is on belt " + std::to_string(obj.belt) +
                              ", not one of its " + std::to_string(belt_count_) + " belts");
     }
-    // It leaves the scene at its belt's end (FloorWorld), so it must start
-    // on the belt.
+    // It leaves the scene at its belt's end (FloorWorld), so it must not
+    // start past it; one upstream of the belt waits there and is put on
+    // the line once its footprint lies wholly on it (a line of bodies that
+    // enter in turn).
     const models::Belt& belt = scene_.belts[static_cast<std::size_t>(obj.belt)];
     const models::Rect& r = belt.area;
     const auto range = CarriedTravelRange(
         {r.center_x_m, r.center_y_m, r.length_m, r.width_m, r.direction_rad, 0.0}, obj.solid);
-    if (!(range[0] <= 0.0 && 0.0 <= range[1])) {
+    if (!(0.0 <= range[1] && range[0] <= range[1])) {
       throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': carried object '" +
-                             obj.name + "' overhangs an end of belt '" + belt.name +
-                             "' at time zero (its footprint must lie along the belt's length)");
+                             obj.name + "' overhangs the downstream end of belt '" + belt.name +
+                             "' at time zero, or is longer than the belt (its footprint must "
+                             "lie along the belt's length, or wait upstream of it)");
     }
   }
   // The wheels drive on the flat floor only (a later issue adds ramps):

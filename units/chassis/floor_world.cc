@@ -114,10 +114,10 @@ std::array<double, 2> CarriedTravelRange(const BeltPatch& b, const models::Solid
 void FloorWorld::AddCarried(const models::Solid& solid, int belt) {
   if (belt < 0 || belt >= belt_count()) throw std::out_of_range("FloorWorld: no such belt");
   const auto range = CarriedTravelRange(belts_[static_cast<std::size_t>(belt)], solid);
-  if (!(range[0] <= 0.0 && 0.0 <= range[1])) {
+  if (!(0.0 <= range[1] && range[0] <= range[1])) {
     throw std::invalid_argument(
-        "FloorWorld: a carried object's footprint overhangs an end of "
-        "its belt at zero travel");
+        "FloorWorld: a carried object's footprint overhangs the downstream end of its belt at "
+        "zero travel, or is longer than the belt");
   }
   Carried c;
   c.travel_min_m = range[0];

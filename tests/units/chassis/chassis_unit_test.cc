@@ -673,10 +673,15 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   car.width_m = 1.8;
   car.height_m = 1.2;
   bad.carried.push_back({"car", 0, car});
-  EXPECT_NE(scene_problem(bad).find("carried object 'car' overhangs an end of belt 'belt'"),
+  EXPECT_NE(scene_problem(bad).find(
+                "carried object 'car' overhangs the downstream end of belt 'belt'"),
             std::string::npos)
       << scene_problem(bad);
   bad.carried[0].solid.x_m = 2.75;  // its front exactly at the end: on the belt
+  EXPECT_EQ(scene_problem(bad), "");
+  // Upstream of the belt's start (-5 m), wholly or in part, it waits to be
+  // put on the line.
+  bad.carried[0].solid.x_m = -6.0;
   EXPECT_EQ(scene_problem(bad), "");
   // Terrain is not simulated yet: refused, naming the piece.
   bad = models::OpenFloor();

@@ -151,7 +151,8 @@ TEST(FloorWorld, SurfaceAtRotatedPatches) {
 // Guards against carried objects that ride past their belt's end: the
 // travel over which a footprint lies along a belt's length, for a belt
 // along map y and boxes turned on it, and a cylinder; AddCarried refuses
-// one that overhangs an end at zero travel.
+// one that overhangs the downstream end at zero travel (one upstream waits
+// to be put on the line).
 TEST(FloorWorld, CarriedTravelRangeEndsAtTheBeltsEnds) {
   // Belt along +y from y = -4 to 6 (centre (2, 1), 10 m long, 3 m wide).
   const BeltPatch belt{2.0, 1.0, 10.0, 3.0, std::numbers::pi / 2.0};
@@ -182,6 +183,9 @@ TEST(FloorWorld, CarriedTravelRangeEndsAtTheBeltsEnds) {
   EXPECT_NO_THROW(f.AddCarried(drum, 0));
   drum.y_m = 5.6;  // 0.1 m past the end
   EXPECT_THROW(f.AddCarried(drum, 0), std::invalid_argument);
+  drum.y_m = -5.0;  // 0.5 m before the start (y = -4): it enters after 1.5 m of travel
+  EXPECT_NO_THROW(f.AddCarried(drum, 0));
+  EXPECT_NEAR(CarriedTravelRange(belt, drum)[0], 1.5, 1e-12);
   EXPECT_THROW(f.AddCarried(drum, 1), std::out_of_range);
 }
 
