@@ -347,12 +347,23 @@ TEST(SweepFingerprint, ChangesWithTheSweepTheScenarioAndTheModelFiles) {
   EXPECT_NE(edited, base);
 }
 
+// Every shipped sweep passes the checks made before anything runs: its
+// base scenario loads with its fixed settings, each parameter path exists
+// and each metric is one the scenario then defines. Named after its file.
 TEST(SweepSpec, ShippedSweepsLoad) {
-  for (const std::string name : {"belt_speed_compensation", "master_step", "heading_monte_carlo"}) {
-    const SweepSpec spec = LoadSweepSpec(LINESIM_SOURCE_DIR "/scenarios/sweeps/" + name + ".yaml");
-    EXPECT_EQ(spec.name, name);
-    EXPECT_EQ(spec.scenario, LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml");
+  int count = 0;
+  for (const auto& e :
+       std::filesystem::directory_iterator(LINESIM_SOURCE_DIR "/scenarios/sweeps")) {
+    if (e.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(e.path().string());
+    const SweepSpec spec = LoadSweepSpec(e.path().string());
+    EXPECT_EQ(spec.name, e.path().stem().string());
+    ++count;
   }
+  EXPECT_GE(count, 7);
+  const SweepSpec speed =
+      LoadSweepSpec(LINESIM_SOURCE_DIR "/scenarios/sweeps/belt_speed_compensation.yaml");
+  EXPECT_EQ(speed.scenario, LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml");
 }
 
 // Guards the rules a unit declares reaching the sweep file: a unit parameter
