@@ -153,8 +153,7 @@ TEST(SwitchDetector, FalseAlarmRateOnWhiteInnovations) {
   // The innovations' variance is S (relative sampling sd sqrt(2 / n)).
   EXPECT_NEAR(sum2 / kN, f.innovation_variance(),
               5.0 * std::sqrt(2.0 / kN) * f.innovation_variance());
-  std::printf("alarms %lld, expected %.0f +- %.0f\n", static_cast<long long>(alarms), expected,
-              sd);
+  std::printf("alarms %lld, expected %.0f +- %.0f\n", static_cast<long long>(alarms), expected, sd);
 }
 
 }  // namespace

@@ -608,7 +608,8 @@ TEST(SurfaceVelocityEstimator, RestoredUnitContinuesBitForBit) {
 // (switch_gate 2.5: 0.0793 m/s).
 double Gain() { return SteadyStateKalman::Gain((0.01 / 3) * (0.01 / 3), 0.03 * 0.03); }
 double Gate() {
-  return 2.5 * std::sqrt(SteadyStateKalman::InnovationVariance((0.01 / 3) * (0.01 / 3), 0.03 * 0.03));
+  return 2.5 *
+         std::sqrt(SteadyStateKalman::InnovationVariance((0.01 / 3) * (0.01 / 3), 0.03 * 0.03));
 }
 
 // Runs `e` from 0 to `until` (inclusive) on a belt whose speed at time t is
@@ -620,7 +621,7 @@ struct Trace {
 };
 template <typename Speed>
 Trace RunBelt(SurfaceVelocityEstimator& e, Feed& feed, TimeNs until, Speed speed,
-          double sigma = 0.0, std::mt19937_64* rng = nullptr) {
+              double sigma = 0.0, std::mt19937_64* rng = nullptr) {
   Trace out;
   Motion m;
   for (TimeNs t = 0; t <= until; t += kStep) {
@@ -742,8 +743,7 @@ TEST(SurfaceVelocityEstimator, StepIsFollowedAtItsThirdMessage) {
     feed_b.Apply(*b, m, t);
     Step(*a, t);
     Step(*b, t);
-    ASSERT_TRUE(test_helpers::SameBits(test_helpers::Outputs(*a), test_helpers::Outputs(*b)))
-        << t;
+    ASSERT_TRUE(test_helpers::SameBits(test_helpers::Outputs(*a), test_helpers::Outputs(*b))) << t;
   }
   EXPECT_EQ(Get(*b, "switch_count")[0], 1.0);
   // The paper's filter alone.
@@ -806,8 +806,7 @@ TEST(SurfaceVelocityEstimator, RampIsTrackedWithOneRestart) {
   }
   EXPECT_NEAR(worst[1], worst_switch, 1e-12);
   EXPECT_NEAR(worst[0], worst_fixed, 1e-12);
-  std::printf("ramp: largest error %.4f m/s with the detector, %.4f without\n", worst[1],
-              worst[0]);
+  std::printf("ramp: largest error %.4f m/s with the detector, %.4f without\n", worst[1], worst[0]);
 }
 
 // Guards against the detector changing the paper's filter when it is off:
