@@ -31,6 +31,41 @@ namespace linesim::estimation {
 ///   frame, where a belt's velocity is constant; updated only from valid
 ///   messages of quality > 0.
 ///
+/// State switches (SwitchDetector in steady_state_kalman.h): the line runs
+/// in only two states, on and off (paper 1 Sec. II), and the filter's
+/// random walk models only the variation within one; a start or stop (a
+/// ramp of about 1 s) would lag by the fixed gain's time constant,
+/// sample_period / -ln(1 - K) = 0.9 s. Each innovation nu = raw - x (per
+/// map component) is compared with switch_gate sqrt(S), S = P- + r of the
+/// same Riccati solution (3.17 cm/s at paper 1's figures); switch_samples
+/// consecutive innovations beyond it on the same side restart the sensor's
+/// filter from that measurement, after which it goes on with the steady
+/// gain (switch_count counts the restarts). Per component, not the 2D
+/// normalized innovation squared: the filters are two independent scalar
+/// ones with the same S, and the sign of a run is what tells a change of
+/// the mean from noise, which the squared norm throws away (a belt at 45
+/// deg to the map axes is seen at 0.71 of its change in each component).
+/// Defaults switch_gate 2.5, switch_samples 3, from these numbers at
+/// paper 1's figures (K = 0.1051, sqrt(S) = 3.17 cm/s, 10 Hz):
+///  - false alarms: a run of 3 beyond 2.5 sigma on one side ends at a given
+///    message with probability Q(2.5)^3 = 2.4e-7 on white innovations;
+///    2 sides x 2 components: <= 9.6e-7 per message, one false restart per
+///    >= 29 h per sensor (2.5 sigma and 2 samples: one per 11 min; 2 sigma
+///    and 3: one per 35 min; 2 sigma and 4: 26 h but a step is followed a
+///    message later);
+///  - a 0 -> 0.2 m/s step (6.3 sigma): the innovations 0.2 (1 - K)^(n - 1)
+///    stay beyond the gate (0.079 m/s) for 9 messages; the filter restarts
+///    at the step's 3rd message, 0.2 to 0.3 s after it (the fixed gain: 2 s
+///    to within 10 %);
+///  - a 0 -> 0.2 m/s ramp over 1 s (0.02 m/s per message): the innovation
+///    0.02 (1 - (1 - K)^n) / K passes the gate at the ramp's 5th message and
+///    the filter restarts at its 7th; the estimate is at most 0.103 m/s
+///    behind the truth at a message (the innovation that restarts it; the
+///    fixed gain: 0.128 m/s, at the ramp's end), and the ramp's last three
+///    messages leave innovations under the gate (no second restart).
+/// switch_gate 0 turns the detector off: paper 1's filter alone, bit for
+/// bit.
+///
 /// Per wheel j (the paper's rule for a convex planform): the wheel point in
 /// map from the estimated pose; over scene belt k it takes belt k's estimate,
 /// the mean of the filtered values of the sensors the map puts over belt k
@@ -61,6 +96,7 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   int sensor_count() const { return static_cast<int>(n_); }
   int wheel_count() const { return static_cast<int>(w_); }
   const SteadyStateKalman& filter() const { return kf_; }
+  const SwitchDetector& switch_detector() const { return detector_; }
 
   /// Status codes (sensor_status).
   static constexpr int kFresh = 0, kHeld = 1, kNoEstimate = 2;
@@ -108,6 +144,9 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   // value down to e^-2 = 14 %, 20 missed messages).
   double hold_time_constant_ = 1.0;
   double stale_after_ = 2.0;
+  // The state-switch detector (see the class comment for the numbers).
+  double switch_gate_ = 2.5;
+  std::int64_t switch_samples_ = 3;
 
   // Inputs.
   std::vector<double> sensor_velocity_, sensor_valid_, sensor_quality_, sensor_message_count_;
@@ -117,10 +156,12 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   // Outputs.
   std::vector<double> raw_, filtered_, sensor_on_belt_, sensor_status_;
   std::vector<double> wheel_surface_velocity_, wheel_on_belt_, wheel_source_;
+  std::vector<double> switch_count_;
   double kalman_gain_ = 0.0;
 
   // Cached from the parameters (Cache).
   SteadyStateKalman kf_;
+  SwitchDetector detector_;
   std::vector<double> mount_cos_, mount_sin_;
   cosim::TimeNs sample_period_ns_ = 0, stale_after_ns_ = 0;
   // exp(-dt / hold_time_constant) for the last dt (a pure function of dt).
@@ -138,6 +179,9 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   // step (s), and the window (ns).
   std::vector<double> acc_vx_, acc_vy_, acc_c_, acc_s_;
   std::vector<cosim::TimeNs> acc_ns_;
+  // The switch detector's signed run per component (2 per sensor), and the
+  // restarts it made per sensor.
+  std::vector<std::int64_t> run_, switches_;
   // Per sensor: the surface the map puts it over at the last step (saved:
   // an output is written from it), and scratch flags of this step.
   std::vector<std::int64_t> map_surface_;

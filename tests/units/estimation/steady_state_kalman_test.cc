@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <vector>
 
 namespace linesim::estimation {
 namespace {
@@ -72,6 +73,87 @@ TEST(SteadyStateKalman, OutputVarianceMatchesTheory) {
   // Unbiased: the mean error within 4 standard errors (variance of the mean
   // of an AR(1): var (1 + a) / ((1 - a) n)).
   EXPECT_NEAR(mean, 0.0, 4.0 * std::sqrt(expected * (1.0 + a) / ((1.0 - a) * kN)));
+}
+
+// Guards against a gate in the wrong sigma: the innovation variance is
+// S = P- + r of the same Riccati solution, 1.0057e-3 m^2/s^2 at paper 1's
+// figures (sqrt(S) = 3.17 cm/s); a detector's threshold is g sqrt(S).
+TEST(SteadyStateKalman, InnovationVarianceIsPriorPlusMeasurement) {
+  const SteadyStateKalman f(kQ, kR);
+  EXPECT_DOUBLE_EQ(f.innovation_variance(), f.prior_variance() + kR);
+  EXPECT_DOUBLE_EQ(SteadyStateKalman::InnovationVariance(kQ, kR), f.innovation_variance());
+  EXPECT_NEAR(std::sqrt(f.innovation_variance()), 0.03171, 1e-5);
+  const SwitchDetector d(2.5, 3, f.innovation_variance());
+  EXPECT_NEAR(d.threshold(), 2.5 * 0.031713, 1e-6);
+  EXPECT_TRUE(d.enabled());
+  EXPECT_FALSE(SwitchDetector(0.0, 3, f.innovation_variance()).enabled());
+}
+
+// Guards against a run that counts the wrong thing (both sides together,
+// innovations inside the gate, a run not cleared by a sign change) and
+// against a gate 0 that still acts.
+TEST(SwitchDetector, CountsRunsOnOneSideBeyondTheGate) {
+  const SwitchDetector d(2.0, 3, 1.0);  // threshold 2
+  std::int64_t run = 0;
+  EXPECT_FALSE(d.Observe(2.5, run));
+  EXPECT_EQ(run, 1);
+  EXPECT_FALSE(d.Observe(-2.5, run));  // the other side: a new run
+  EXPECT_EQ(run, -1);
+  EXPECT_FALSE(d.Observe(-3.0, run));
+  EXPECT_FALSE(d.Observe(1.9, run));  // inside the gate: the run ends
+  EXPECT_EQ(run, 0);
+  EXPECT_FALSE(d.Observe(-2.1, run));
+  EXPECT_FALSE(d.Observe(-2.1, run));
+  EXPECT_TRUE(d.Observe(-2.1, run));
+  EXPECT_EQ(run, -3);
+  EXPECT_FALSE(d.Observe(2.0, run));  // exactly at the gate is inside
+  EXPECT_EQ(run, 0);
+  const SwitchDetector off(0.0, 3, 1.0);
+  run = 7;
+  for (double nu : {5.0, 5.0, 5.0, -5.0}) EXPECT_FALSE(off.Observe(nu, run));
+  EXPECT_EQ(run, 7);
+}
+
+// Guards against a false-alarm rate other than the one the gate was chosen
+// from: the filter runs on its own model (a random walk of variance q per
+// sample measured with variance r, started at its steady state), so its
+// innovations are white N(0, S); a run of N beyond g sqrt(S) on one side
+// then ends at a given sample with probability Q(g)^N, both sides 2 Q(g)^N.
+// A low gate (g = 1, N = 3: 2 Q(1)^3 = 7.99e-3) gives enough alarms in
+// 10^6 samples (7990 expected) to measure the rate; the run is not cleared
+// at an alarm here (every sample whose last N innovations qualify counts).
+// Tolerance: the counts come in clumps (a run of length L >= N counts
+// L - N + 1 times), clump sizes geometric with p = Q(1), so the count's
+// variance is about (number of clumps) E[C^2] = m (1 - p) (1 + p) / (1 -
+// p)^2 for m expected counts; 5 of its standard deviations. A gate in
+// sigmas of r instead of S (sqrt(S / r) = 1.057) would give 23 % fewer.
+TEST(SwitchDetector, FalseAlarmRateOnWhiteInnovations) {
+  const SteadyStateKalman f(kQ, kR);
+  const SwitchDetector d(1.0, 3, f.innovation_variance());
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> process(0.0, std::sqrt(kQ)), noise(0.0, std::sqrt(kR));
+  constexpr std::int64_t kN = 1'000'000;
+  double truth = 0.1;
+  // The estimate starts with the steady a posteriori error (variance P).
+  double x = truth + std::normal_distribution<double>(0.0, std::sqrt(f.posterior_variance()))(rng);
+  std::int64_t run = 0, alarms = 0;
+  double sum2 = 0.0;
+  for (std::int64_t k = 0; k < kN; ++k) {
+    truth += process(rng);
+    const double z = truth + noise(rng);
+    const double nu = z - x;
+    sum2 += nu * nu;
+    alarms += d.Observe(nu, run);
+    x = f.Update(x, z);
+  }
+  const double p = 0.5 * std::erfc(1.0 / std::sqrt(2.0));
+  const double expected = 2.0 * std::pow(p, 3) * static_cast<double>(kN - 2);
+  const double sd = std::sqrt(expected * (1.0 + p) / (1.0 - p));
+  EXPECT_NEAR(static_cast<double>(alarms), expected, 5.0 * sd);
+  // The innovations' variance is S (relative sampling sd sqrt(2 / n)).
+  EXPECT_NEAR(sum2 / kN, f.innovation_variance(),
+              5.0 * std::sqrt(2.0 / kN) * f.innovation_variance());
+  std::printf("alarms %lld, expected %.0f +- %.0f\n", static_cast<long long>(alarms), expected, sd);
 }
 
 }  // namespace
