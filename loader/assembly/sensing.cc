@@ -209,6 +209,7 @@ const std::map<std::string, Provider>& SurfaceVelocityProviders() {
          s.surface_estimate = Signal(kSurfaceEstimator, "filtered_surface_velocity");
          s.recorded.push_back(Signal(kSurfaceEstimator, "wheel_source"));
          s.recorded.push_back(Signal(kSurfaceEstimator, "sensor_status"));
+         s.recorded.push_back(Signal(kSurfaceEstimator, "switch_count"));
        }}};
   return providers;
 }

@@ -174,6 +174,7 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   std::vector<std::int64_t> status_;       // kFresh, kHeld, kNoEstimate
   std::vector<double> last_count_;         // message count last seen
   std::vector<cosim::TimeNs> last_valid_;  // time of the last valid message (or restart)
+  std::vector<cosim::TimeNs> entered_;  // when the map last moved it to another surface
   // Accumulated since the previous message: the sensor point's velocity in
   // the sensor frame times the step (m), the heading's unit vector times the
   // step (s), and the window (ns).
