@@ -200,6 +200,19 @@ const std::map<std::string, Provider>& SurfaceVelocityProviders() {
          p["sensor_yaw"] = List(syaw);
          p["wheel_x"] = List(wx);
          p["wheel_y"] = List(wy);
+         // The encoders' check of each message (a dark image passes the
+         // firmware's quality test with noise matches): with the wheel
+         // encoders on, the odometry's unrectified twist, and a gate of
+         // 3 x paper 1's measurement sigma (3 cm/s). The wheels' encoder
+         // velocities: those over the sensor's surface say how the robot
+         // moves relative to it.
+         if (s.odometry.empty() && !Mounts(s, "wheel_encoder").empty()) AddOdometry(b, c, s);
+         if (!s.odometry.empty()) {
+           b.Connect(Signal(s.odometry, "wheel_velocity"),
+                     Signal(kSurfaceEstimator, "odometry_wheel_velocity"));
+           p["odometry_gate"] = Num(0.09);
+           s.recorded.push_back(Signal(kSurfaceEstimator, "implausible_count"));
+         }
          b.Connect(s.position, Signal(kSurfaceEstimator, "position"));
          b.Connect(s.yaw, Signal(kSurfaceEstimator, "yaw"));
          b.Connect(s.velocity, Signal(kSurfaceEstimator, "velocity"));

@@ -123,6 +123,11 @@ PoseFusionUnit::PoseFusionUnit(std::string name) : cosim::Unit(kTypeName, std::m
   v.Output("rejected_matches", "1", &rejected_matches_,
            "matches refused so far (gate, older than the history, or out of order)", {});
   v.Output("accepted_matches", "1", &accepted_matches_, "matches applied so far", {});
+  v.Output("resets", "1", &resets_,
+           "restarts from a match: a match the gate refused while none had been accepted for "
+           "longer than timeout (the odometry alone drifted out of the gate; the matcher's own "
+           "checks passed it)",
+           {});
 }
 
 std::vector<cosim::ParameterProblem> PoseFusionUnit::CheckParameters() const {
@@ -149,6 +154,7 @@ void PoseFusionUnit::Initialize() {
   last_match_time_ = kNoMatch;
   rejected_matches_ = 0.0;
   accepted_matches_ = 0.0;
+  resets_ = 0.0;
   yaw_rate_ = 0.0;
   ComputeOutputs();
 }
@@ -212,7 +218,18 @@ bool PoseFusionUnit::Correct(double* xs, double* ps, const double zs[3], const d
   return true;
 }
 
-bool PoseFusionUnit::ApplyMatch(cosim::TimeNs time) {
+void PoseFusionUnit::Reset(double* xs, double* ps, const double zs[3], const double rs[9]) const {
+  Eigen::Map<Vec5> x(xs);
+  Eigen::Map<Mat5> p(ps);
+  x.head<3>() = Eigen::Map<const Eigen::Vector3d>(zs);
+  const double pb = initial_offset_sigma_ * initial_offset_sigma_;
+  p.setZero();
+  p.topLeftCorner<3, 3>() = Eigen::Map<const Eigen::Matrix3d>(rs);
+  p(3, 3) = pb;
+  p(4, 4) = pb;
+}
+
+bool PoseFusionUnit::ApplyMatch(cosim::TimeNs time, bool reset) {
   const Entry& newest = At(size_ - 1);
   if (time > newest.t) time = newest.t;  // not in the future
   if (time < At(0).t || time < last_match_time_) return false;
@@ -240,7 +257,11 @@ bool PoseFusionUnit::ApplyMatch(cosim::TimeNs time) {
     const Entry& next = At(j + 1);
     Predict(x, p, next.vx, next.vy, next.omega, cosim::NsToSeconds(time - At(j).t));
   }
-  if (!Correct(x, p, z, r)) return false;
+  if (reset) {
+    Reset(x, p, z, r);
+  } else if (!Correct(x, p, z, r)) {
+    return false;
+  }
   last_match_time_ = time;
   const auto store = [&](Entry& e) {
     std::copy(x, x + 5, e.x);
@@ -277,10 +298,18 @@ cosim::StepResult PoseFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   if (match_count_ != last_match_count_) {
     last_match_count_ = match_count_;
     const auto time = static_cast<cosim::TimeNs>(std::llround(match_time_ * 1e9));
+    // Fused up to now: the state predicts where the match should be.
+    const bool fused = last_match_time_ != kNoMatch &&
+                       cosim::NsToSeconds(e.t - last_match_time_) <= timeout_;
     if (ApplyMatch(time)) {
       accepted_matches_ += 1.0;
     } else {
       rejected_matches_ += 1.0;
+      // On the odometry alone for longer than timeout and refused again:
+      // the odometry drifted (a wrong surface velocity in Eq. 3, slip), and
+      // waiting for a match inside the gate would never end. The matcher
+      // passed its own tests, so the pose restarts from it.
+      if (!fused && last_match_time_ != kNoMatch && ApplyMatch(time, true)) resets_ += 1.0;
     }
   }
   ComputeOutputs();

@@ -90,8 +90,12 @@ class PoseFusionUnit : public cosim::Unit {
   /// Whether the match (z, column-major covariance r) passes the gate at
   /// (x, P); if so corrects them.
   bool Correct(double* x, double* p, const double z[3], const double r[9]) const;
+  /// Restarts the pose from a match (its covariance; the offset's kept, its
+  /// variance back to the initial one).
+  void Reset(double* x, double* p, const double z[3], const double r[9]) const;
   /// Applies the match at `time` through the history; false if refused.
-  bool ApplyMatch(cosim::TimeNs time);
+  /// `reset`: restart from the match instead of correcting with it.
+  bool ApplyMatch(cosim::TimeNs time, bool reset = false);
   Entry& At(std::size_t k) { return history_[(first_ + k) % kHistory]; }
   const Entry& At(std::size_t k) const { return history_[(first_ + k) % kHistory]; }
   void Push(const Entry& e);
@@ -124,7 +128,7 @@ class PoseFusionUnit : public cosim::Unit {
   // Outputs.
   std::vector<double> position_, velocity_, velocity_offset_, covariance_;
   double yaw_ = 0.0, yaw_rate_ = 0.0, source_ = 1.0;
-  double rejected_matches_ = 0.0, accepted_matches_ = 0.0;
+  double rejected_matches_ = 0.0, accepted_matches_ = 0.0, resets_ = 0.0;
 
   // State. The history (oldest first from first_, size_ entries; the
   // newest is the current estimate), the last match_count seen, the time of

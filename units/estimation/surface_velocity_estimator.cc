@@ -58,6 +58,7 @@ SurfaceVelocityEstimator::SurfaceVelocityEstimator(std::string name, int sensors
   sensor_on_belt_.assign(n_, 0.0);
   sensor_status_.assign(n_, kNoEstimate);
   wheel_surface_velocity_.assign(2 * w_, 0.0);
+  odometry_wheel_velocity_.assign(2 * w_, 0.0);
   wheel_on_belt_.assign(w_, 0.0);
   wheel_source_.assign(w_, kFloor);
 
@@ -70,6 +71,11 @@ SurfaceVelocityEstimator::SurfaceVelocityEstimator(std::string name, int sensors
   last_valid_.assign(n_, 0);
   entered_.assign(n_, 0);
   acc_vx_.assign(n_, 0.0);
+  acc_ox_.assign(n_, 0.0);
+  acc_checked_ns_.assign(n_, 0);
+  acc_oy_.assign(n_, 0.0);
+  implausible_.assign(n_, 0);
+  implausible_count_.assign(n_, 0.0);
   acc_vy_.assign(n_, 0.0);
   acc_c_.assign(n_, 0.0);
   acc_s_.assign(n_, 0.0);
@@ -126,6 +132,13 @@ SurfaceVelocityEstimator::SurfaceVelocityEstimator(std::string name, int sensors
               "state-switch detector: this many consecutive innovations beyond the gate on the "
               "same side restart the sensor's filter from its latest measurement",
               Rule::Range(1, 100));
+  v.Parameter("odometry_gate", "m/s", &odometry_gate_,
+              "the encoders' check of each message: the sensor must read minus the robot's "
+              "motion relative to the surface under it at its point, which the encoders of the "
+              "wheels the map puts over the same surface measure; a message farther off than "
+              "this is refused as implausible (a dark image: the firmware matches noise and "
+              "keeps its quality). 0 (default): off, odometry_wheel_velocity unused",
+              Rule::NonNegative());
 
   v.Input("sensor_velocity", "m/s", &sensor_velocity_,
           "each PX4Flow's velocity output: the surface relative to the sensor, sensor frame, vx "
@@ -139,6 +152,9 @@ SurfaceVelocityEstimator::SurfaceVelocityEstimator(std::string name, int sensors
   v.Input("yaw", "rad", &yaw_, "estimated yaw of base_link in map");
   v.Input("velocity", "m/s", &velocity_, "estimated vx, vy of base_link's origin in map");
   v.Input("yaw_rate", "rad/s", &yaw_rate_, "estimated yaw rate of base_link");
+  v.Input("odometry_wheel_velocity", "m/s", &odometry_wheel_velocity_,
+          "each wheel's velocity relative to the surface under it by its encoders, base_link, "
+          "vx vy per wheel (the wheel odometry's wheel_velocity): for odometry_gate");
 
   v.Output("raw_surface_velocity", "m/s", &raw_,
            "per sensor, map frame, vx vy: paper 1 Eq. 2 at its last valid message (the "
@@ -177,6 +193,8 @@ SurfaceVelocityEstimator::SurfaceVelocityEstimator(std::string name, int sensors
            "(the surface under it switched on or off, or sped up or slowed down beyond the "
            "gate)",
            {});
+  v.Output("implausible_count", "1", &implausible_count_,
+           "per sensor: messages refused by the encoders' check (odometry_gate) so far", {});
   v.Output("kalman_gain", "1", &kalman_gain_,
            "the steady-state gain K solved from process_sigma^2 and measurement_sigma^2", {});
 }
@@ -222,6 +240,10 @@ void SurfaceVelocityEstimator::ResetState() {
   std::fill(last_valid_.begin(), last_valid_.end(), start_);
   std::fill(entered_.begin(), entered_.end(), start_);
   std::fill(acc_vx_.begin(), acc_vx_.end(), 0.0);
+  std::fill(acc_ox_.begin(), acc_ox_.end(), 0.0);
+  std::fill(acc_checked_ns_.begin(), acc_checked_ns_.end(), 0);
+  std::fill(acc_oy_.begin(), acc_oy_.end(), 0.0);
+  std::fill(implausible_.begin(), implausible_.end(), 0);
   std::fill(acc_vy_.begin(), acc_vy_.end(), 0.0);
   std::fill(acc_c_.begin(), acc_c_.end(), 0.0);
   std::fill(acc_s_.begin(), acc_s_.end(), 0.0);
@@ -267,6 +289,25 @@ bool SurfaceVelocityEstimator::SurfaceMean(int surface, int status, char skip, d
   return true;
 }
 
+bool SurfaceVelocityEstimator::RelativeAt(std::int64_t surface, double px, double py, double c,
+                                          double s, double& vx, double& vy) const {
+  double sx = 0.0, sy = 0.0;
+  int count = 0;
+  for (std::size_t j = 0; j < w_; ++j) {
+    const double wx = position_[0] + c * wheel_x_[j] - s * wheel_y_[j];
+    const double wy = position_[1] + s * wheel_x_[j] + c * wheel_y_[j];
+    if (SurfaceAt(wx, wy) != surface) continue;
+    // Rigid body: v(p) = v(r_j) + omega x (p - r_j).
+    sx += odometry_wheel_velocity_[2 * j] - yaw_rate_ * (py - wheel_y_[j]);
+    sy += odometry_wheel_velocity_[2 * j + 1] + yaw_rate_ * (px - wheel_x_[j]);
+    ++count;
+  }
+  if (count == 0) return false;
+  vx = sx / count;
+  vy = sy / count;
+  return true;
+}
+
 void SurfaceVelocityEstimator::WriteOutputs(double c, double s) {
   const double px = position_[0], py = position_[1];
   for (std::size_t i = 0; i < n_; ++i) {
@@ -276,6 +317,7 @@ void SurfaceVelocityEstimator::WriteOutputs(double c, double s) {
     filtered_[2 * i] = has ? x_[2 * i] : 0.0;
     filtered_[2 * i + 1] = has ? x_[2 * i + 1] : 0.0;
     switch_count_[i] = static_cast<double>(switches_[i]);
+    implausible_count_[i] = static_cast<double>(implausible_[i]);
   }
   // The paper's wheel rule: a wheel over belt k takes belt k's estimate,
   // the mean over the sensors the map puts over belt k (a rigid belt has
@@ -357,7 +399,19 @@ cosim::StepResult SurfaceVelocityEstimator::DoStep(cosim::TimeNs t, cosim::TimeN
     // the two (the window is 100 ms: 3 cm at 0.3 m/s): only messages whose
     // whole window lies over the surface the map now puts it on count.
     const bool one_surface = t - acc_ns_[i] >= entered_[i];
-    const bool measured = sensor_valid_[i] != 0.0 && sensor_quality_[i] > 0.0 && one_surface;
+    bool measured = sensor_valid_[i] != 0.0 && sensor_quality_[i] > 0.0 && one_surface;
+    if (measured && odometry_gate_ > 0.0 && acc_ns_[i] > 0 && acc_checked_ns_[i] == acc_ns_[i]) {
+      // The surface relative to the sensor is minus the robot's motion
+      // relative to the surface at the sensor point, which the encoders of
+      // the wheels on the same surface measure (over the whole window).
+      const double inv_t = 1e9 / static_cast<double>(acc_ns_[i]);
+      const double ex = sensor_velocity_[2 * i] + acc_ox_[i] * inv_t;
+      const double ey = sensor_velocity_[2 * i + 1] + acc_oy_[i] * inv_t;
+      if (std::hypot(ex, ey) > odometry_gate_) {
+        measured = false;
+        ++implausible_[i];
+      }
+    }
     if (measured) {
       // The sensor point's mean velocity over the window in the sensor
       // frame, and the mean heading; at the very first step (no window
@@ -387,8 +441,8 @@ cosim::StepResult SurfaceVelocityEstimator::DoStep(cosim::TimeNs t, cosim::TimeN
       raw_[2 * i + 1] = hs * bx + hc * by;
       flags_[i] |= kMeasured;
     }
-    acc_vx_[i] = acc_vy_[i] = acc_c_[i] = acc_s_[i] = 0.0;
-    acc_ns_[i] = 0;
+    acc_vx_[i] = acc_vy_[i] = acc_c_[i] = acc_s_[i] = acc_ox_[i] = acc_oy_[i] = 0.0;
+    acc_ns_[i] = acc_checked_ns_[i] = 0;
     if (status_[i] == kNoEstimate) continue;  // started in 3
     if (measured) {
       // The state-switch detector on the innovations (both components
@@ -481,6 +535,13 @@ cosim::StepResult SurfaceVelocityEstimator::DoStep(cosim::TimeNs t, cosim::TimeN
     const double pbx = vbx - w * sensor_y_[i], pby = vby + w * sensor_x_[i];
     acc_vx_[i] += (mount_cos_[i] * pbx + mount_sin_[i] * pby) * h;
     acc_vy_[i] += (-mount_sin_[i] * pbx + mount_cos_[i] * pby) * h;
+    double obx = 0.0, oby = 0.0;
+    if (odometry_gate_ > 0.0 &&
+        RelativeAt(map_surface_[i], sensor_x_[i], sensor_y_[i], c, s, obx, oby)) {
+      acc_ox_[i] += (mount_cos_[i] * obx + mount_sin_[i] * oby) * h;
+      acc_oy_[i] += (-mount_sin_[i] * obx + mount_cos_[i] * oby) * h;
+      acc_checked_ns_[i] += dt;
+    }
     acc_c_[i] += c * h;
     acc_s_[i] += s * h;
     acc_ns_[i] += dt;
@@ -494,34 +555,34 @@ cosim::StepResult SurfaceVelocityEstimator::DoStep(cosim::TimeNs t, cosim::TimeN
 // rest is here. The scratch (map_surface_, flags_) is recomputed every step.
 void SurfaceVelocityEstimator::SaveInternal(cosim::UnitState& state) const {
   state.reals = x_;
-  for (const auto* v : {&acc_vx_, &acc_vy_, &acc_c_, &acc_s_, &last_count_}) {
+  for (const auto* v : {&acc_vx_, &acc_vy_, &acc_c_, &acc_s_, &acc_ox_, &acc_oy_, &last_count_}) {
     state.reals.insert(state.reals.end(), v->begin(), v->end());
   }
   state.integers = {start_};
-  for (const auto* v : {&surface_, &status_, &last_valid_, &entered_, &acc_ns_, &map_surface_, &switches_}) {
+  for (const auto* v : {&surface_, &status_, &last_valid_, &entered_, &acc_ns_, &acc_checked_ns_, &map_surface_, &switches_, &implausible_}) {
     state.integers.insert(state.integers.end(), v->begin(), v->end());
   }
   state.integers.insert(state.integers.end(), run_.begin(), run_.end());
 }
 
 void SurfaceVelocityEstimator::RestoreInternal(const cosim::UnitState& state) {
-  if (state.reals.size() != 7 * n_ || state.integers.size() != 1 + 9 * n_) {
+  if (state.reals.size() != 9 * n_ || state.integers.size() != 1 + 11 * n_) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
-                           " integers, expected " + std::to_string(7 * n_) + " and " +
-                           std::to_string(1 + 9 * n_));
+                           " integers, expected " + std::to_string(9 * n_) + " and " +
+                           std::to_string(1 + 11 * n_));
   }
   auto r = state.reals.begin();
   const auto n = static_cast<std::ptrdiff_t>(n_);
   std::copy(r, r + 2 * n, x_.begin());
   r += 2 * n;
-  for (auto* v : {&acc_vx_, &acc_vy_, &acc_c_, &acc_s_, &last_count_}) {
+  for (auto* v : {&acc_vx_, &acc_vy_, &acc_c_, &acc_s_, &acc_ox_, &acc_oy_, &last_count_}) {
     std::copy(r, r + n, v->begin());
     r += n;
   }
   auto k = state.integers.begin();
   start_ = *k++;
-  for (auto* v : {&surface_, &status_, &last_valid_, &entered_, &acc_ns_, &map_surface_, &switches_}) {
+  for (auto* v : {&surface_, &status_, &last_valid_, &entered_, &acc_ns_, &acc_checked_ns_, &map_surface_, &switches_, &implausible_}) {
     std::copy(k, k + n, v->begin());
     k += n;
   }

@@ -115,6 +115,11 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   /// 0 over the floor, k + 1 over scene belt k (the first that holds the
   /// point, as the px4flow and the chassis take it).
   int SurfaceAt(double x, double y) const;
+  /// The robot's velocity relative to `surface` at base_link point (px, py)
+  /// in base_link by the encoders of the wheels the map puts over it (the
+  /// yaw rate: the localization's, a belt does not turn); false when none is.
+  bool RelativeAt(std::int64_t surface, double px, double py, double c, double s, double& vx,
+                  double& vy) const;
   /// Mean filtered value (map) of the sensors whose filter belongs to
   /// `surface` (the one the map puts them over) and whose status is
   /// `status`, skipping those with any of the flags `skip` this step; false
@@ -147,16 +152,19 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   // The state-switch detector (see the class comment for the numbers).
   double switch_gate_ = 2.5;
   std::int64_t switch_samples_ = 3;
+  // The encoders' check of each message (m/s; 0: off).
+  double odometry_gate_ = 0.0;
 
   // Inputs.
   std::vector<double> sensor_velocity_, sensor_valid_, sensor_quality_, sensor_message_count_;
   std::vector<double> position_, velocity_;
   double yaw_ = 0.0, yaw_rate_ = 0.0;
+  std::vector<double> odometry_wheel_velocity_;
 
   // Outputs.
   std::vector<double> raw_, filtered_, sensor_on_belt_, sensor_status_;
   std::vector<double> wheel_surface_velocity_, wheel_on_belt_, wheel_source_;
-  std::vector<double> switch_count_;
+  std::vector<double> switch_count_, implausible_count_;
   double kalman_gain_ = 0.0;
 
   // Cached from the parameters (Cache).
@@ -180,6 +188,11 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   // step (s), and the window (ns).
   std::vector<double> acc_vx_, acc_vy_, acc_c_, acc_s_;
   std::vector<cosim::TimeNs> acc_ns_;
+  // The same window: the sensor point's velocity relative to the surface
+  // under the wheels by the encoders, in the sensor frame, times the step.
+  std::vector<double> acc_ox_, acc_oy_;
+  std::vector<cosim::TimeNs> acc_checked_ns_;  // the part of the window they cover
+  std::vector<std::int64_t> implausible_;  // messages the encoders refuted
   // The switch detector's signed run per component (2 per sensor), and the
   // restarts it made per sensor.
   std::vector<std::int64_t> run_, switches_;

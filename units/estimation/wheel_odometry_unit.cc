@@ -30,6 +30,7 @@ WheelOdometryUnit::WheelOdometryUnit(std::string name, Kind kind, int wheels)
   surface_velocity_.assign(2 * w, 0.0);
   body_velocity_.assign(2, 0.0);
   raw_body_velocity_.assign(2, 0.0);
+  wheel_velocity_.assign(2 * static_cast<std::size_t>(wheels), 0.0);
   position_.assign(2, 0.0);
   velocity_.assign(2, 0.0);
   solve_.assign(3 * 2 * w, 0.0);
@@ -95,6 +96,10 @@ WheelOdometryUnit::WheelOdometryUnit(std::string name, Kind kind, int wheels)
            {"counts"});
   v.Output("raw_yaw_rate", "rad/s", &raw_yaw_rate_,
            "yaw rate from the encoders alone (relative to the surface)", {"counts"});
+  v.Output("wheel_velocity", "m/s", &wheel_velocity_,
+           "each wheel's velocity relative to the surface under it from the encoders alone, in "
+           "base_link, vx vy per wheel (differential: its side's rim speed along x)",
+           {"counts"});
   v.Output("position", "m", &position_, "dead-reckoned x, y of base_link in map", both);
   v.Output("yaw", "rad", &yaw_, "dead-reckoned yaw of base_link in map, in (-pi, pi]", both);
   v.Output("velocity", "m/s", &velocity_,
@@ -242,6 +247,11 @@ void WheelOdometryUnit::ComputeSample() {
       surf[2 * s] += share * surface_velocity_[2 * i];
       surf[2 * s + 1] += share * surface_velocity_[2 * i + 1];
     }
+  }
+  for (std::size_t i = 0; i < w; ++i) {
+    const std::size_t k = kind_ == Kind::kSwerve ? i : static_cast<std::size_t>(side_[i]);
+    wheel_velocity_[2 * i] = raw[2 * k];
+    wheel_velocity_[2 * i + 1] = raw[2 * k + 1];
   }
   double raw_twist[3];
   Solve(raw, raw_twist);

@@ -108,6 +108,7 @@ class WheelOdometryUnit : public cosim::Unit {
 
   // Outputs.
   std::vector<double> body_velocity_, raw_body_velocity_, position_, velocity_;
+  std::vector<double> wheel_velocity_;  // per wheel, from the encoders alone
   double yaw_rate_ = 0.0, raw_yaw_rate_ = 0.0, yaw_ = 0.0;
 
   // Derived in Precompute (from parameters only): the 3 x 2W least-squares

@@ -112,7 +112,8 @@ TEST(PoseFusionUnit, DeclaresItsVariables) {
                                 {"covariance", Causality::kOutput, "1", 9},
                                 {"source", Causality::kOutput, "1", 0},
                                 {"rejected_matches", Causality::kOutput, "1", 0},
-                                {"accepted_matches", Causality::kOutput, "1", 0}});
+                                {"accepted_matches", Causality::kOutput, "1", 0},
+                                {"resets", Causality::kOutput, "1", 0}});
 }
 
 // Guards the correction: a robot standing at (0.05, -0.03, 0.02) while the
@@ -233,6 +234,28 @@ TEST(PoseFusionUnit, SourceFallsBackToOdometryAfterTimeout) {
   EXPECT_EQ(f.Scalar("source"), 1.0);
   f.Step(0.0, 0.0, 0.0, Match{truth, f.t});
   EXPECT_EQ(f.Scalar("source"), 0.0);
+}
+
+// Guards the recovery: the odometry alone carried the estimate 1 m off
+// (its surface velocity wrong for a while: here it reports 0.5 m/s for 2 s
+// of a robot at rest, with no match). A match at the truth then lies beyond
+// the gate; refused while the fusion is fused, after timeout without an
+// accepted match the pose restarts from it (resets 1) instead of waiting
+// forever for a match inside the gate, and the next matches are accepted.
+TEST(PoseFusionUnit, RestartsFromTheMatchesWhenTheOdometryDriftedOutOfTheGate) {
+  const Pose truth{0.0, 0.0, 0.0};
+  Fusion f(truth);
+  for (int k = 0; k < 10; ++k) f.Step(0.0, 0.0, 0.0, Match{truth, f.t});
+  for (int k = 0; k < 100; ++k) f.Step(0.5, 0.0, 0.0);  // 2 s: 1 m of drift
+  EXPECT_NEAR(f.Estimate().x, 1.0, 0.05);
+  EXPECT_EQ(f.Scalar("source"), 1.0);
+  f.Step(0.0, 0.0, 0.0, Match{truth, f.t});
+  EXPECT_EQ(f.Scalar("resets"), 1.0);
+  EXPECT_NEAR(f.Estimate().x, 0.0, 1e-9);
+  EXPECT_EQ(f.Scalar("source"), 0.0);
+  for (int k = 0; k < 5; ++k) f.Step(0.0, 0.0, 0.0, Match{truth, f.t});
+  EXPECT_EQ(f.Scalar("resets"), 1.0);
+  EXPECT_EQ(f.Scalar("accepted_matches"), 15.0);
 }
 
 // Guards yaw_rate_source = imu: the odometry's yaw rate (here wrong) is

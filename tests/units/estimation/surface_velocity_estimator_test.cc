@@ -570,6 +570,66 @@ TEST(SurfaceVelocityEstimator, SensorReachingTheBeltStartsFromTheOthers) {
   }
 }
 
+// Guards the encoders' check (odometry_gate): a robot driving at 0.3 m/s
+// along x on a belt running at 0.1 m/s, every wheel and sensor over it. Its
+// wheels roll at 0.3 - 0.1 = 0.2 m/s relative to the belt, so a working
+// sensor reads -0.2 m/s; a dark one (the firmware matching noise) reads
+// about 0 while its quality stays high. Expected: the working messages pass
+// (|error| 0 < 0.09), the dark ones are refused (|error| 0.2 > 0.09) and
+// counted; the sensors are held, then stale, and the wheels say so.
+TEST(SurfaceVelocityEstimator, EncodersRefuteADarkSensor) {
+  auto e = Estimator(Scene(4.0), {0, 0, 0, 0});
+  SetAll(*e, "odometry_gate", 0.09);
+  Motion m;
+  m.vx = 0.3;
+  std::vector<double> wheels;
+  for (std::size_t j = 0; j < 4; ++j) {
+    wheels.push_back(0.3 - 0.1);
+    wheels.push_back(0.0);
+  }
+  SetArray(*e, "odometry_wheel_velocity", wheels);
+  Feed feed;
+  feed.half_width = 2.0;
+  TimeNs t = 0;
+  for (; t <= 1000 * kMs; t += kStep) {
+    m.x = 0.3 * cosim::NsToSeconds(t);
+    feed.Apply(*e, m, t);
+    Step(*e, t);
+  }
+  for (double s : Get(*e, "sensor_status")) EXPECT_EQ(s, 0.0);
+  for (double n : Get(*e, "implausible_count")) EXPECT_EQ(n, 0.0);
+  EXPECT_NEAR(Get(*e, "filtered_surface_velocity")[0], 0.1, 1e-9);
+  // Dark from 1.0 s: every message reads 0 (valid, quality 200).
+  for (t = 1000 * kMs + kStep; t <= 1500 * kMs; t += kStep) {
+    m.x = 0.3 * cosim::NsToSeconds(t);
+    feed.Apply(*e, m, t);
+    std::fill(feed.velocity.begin(), feed.velocity.end(), 0.0);
+    SetArray(*e, "sensor_velocity", feed.velocity);
+    Step(*e, t);
+  }
+  for (double n : Get(*e, "implausible_count")) EXPECT_EQ(n, 5.0);  // 1.1 ... 1.5 s
+  for (double s : Get(*e, "sensor_status")) EXPECT_EQ(s, 1.0);
+  for (double s : Get(*e, "wheel_source")) EXPECT_EQ(s, 2.0);
+  // Held with the decay: 0.1 exp(-(1.5 - 1.0) / 1 s) at most (held from
+  // the overdue time on).
+  EXPECT_LT(Get(*e, "filtered_surface_velocity")[0], 0.1);
+  // Without the check the same messages would be filtered in.
+  auto off = Estimator(Scene(4.0), {0, 0, 0, 0});
+  Feed feed2;
+  feed2.half_width = 2.0;
+  for (t = 0; t <= 1500 * kMs; t += kStep) {
+    m.x = 0.3 * cosim::NsToSeconds(t);
+    feed2.Apply(*off, m, t);
+    if (t > 1000 * kMs) {
+      std::fill(feed2.velocity.begin(), feed2.velocity.end(), 0.0);
+      SetArray(*off, "sensor_velocity", feed2.velocity);
+    }
+    Step(*off, t);
+  }
+  for (double s : Get(*off, "sensor_status")) EXPECT_EQ(s, 0.0);
+  for (double n : Get(*off, "implausible_count")) EXPECT_EQ(n, 0.0);
+}
+
 // Guards against state SaveState misses (filter states, message counts,
 // timers, the Eq. 2 windows): a unit restored mid-run, with the robot
 // turning and driving across the belt's edge, noisy measurements and one

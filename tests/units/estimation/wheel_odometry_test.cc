@@ -129,6 +129,7 @@ TEST(WheelOdometryUnit, DeclaresItsVariables) {
                              {"yaw_rate", cosim::Causality::kOutput, "rad/s", 0, both},
                              {"raw_body_velocity", cosim::Causality::kOutput, "m/s", 2, {"counts"}},
                              {"raw_yaw_rate", cosim::Causality::kOutput, "rad/s", 0, {"counts"}},
+                             {"wheel_velocity", cosim::Causality::kOutput, "m/s", 8, {"counts"}},
                              {"position", cosim::Causality::kOutput, "m", 2, both},
                              {"yaw", cosim::Causality::kOutput, "rad", 0, both},
                              {"velocity", cosim::Causality::kOutput, "m/s", 2, both}});
@@ -182,6 +183,13 @@ TEST(WheelOdometryUnit, SwerveTranslationFromRealEncoderCounts) {
     EXPECT_NEAR(v[0], vx, e) << k;
     EXPECT_NEAR(v[1], vy, e) << k;
     EXPECT_NEAR(Get(*rig.odometry, "yaw_rate")[0], 0.0, sum_rho * e / sum_rho2) << k;
+    // Each wheel's own velocity (what the surface estimator's check reads):
+    // the same translation, within the same one-wheel bound e.
+    const auto wv = Get(*rig.odometry, "wheel_velocity");
+    for (std::size_t i = 0; i < 4; ++i) {
+      EXPECT_NEAR(wv[2 * i], vx, e) << k;
+      EXPECT_NEAR(wv[2 * i + 1], vy, e) << k;
+    }
   }
   // Dead reckoning: the count differences telescope, so each wheel's
   // travel is off by less than one drive count plus the steering error
