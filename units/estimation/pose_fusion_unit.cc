@@ -47,10 +47,16 @@ PoseFusionUnit::PoseFusionUnit(std::string name) : cosim::Unit(kTypeName, std::m
               "white-noise density of the yaw rate: theta's variance grows by "
               "yaw_rate_noise^2 dt",
               cosim::Rule::Positive());
-  // Paper 1's surface-velocity KF takes the surface velocity as a random
-  // walk with 3 sigma = 1 cm/s per 0.1 s sample: sigma 3.33 mm/s per
-  // sqrt(0.1 s) = 0.0105 m/s/sqrt(s). b is that surface motion when it is
-  // not rectified.
+  // b is what the odometry misses: the surface's motion while it is not
+  // (yet) rectified, as when a line starts under the robot before the
+  // surface estimator follows it. Paper 1's figure for the surface's
+  // variation in the on state (3 sigma = 1 cm/s per 0.1 s sample: 0.0105
+  // m/s/sqrt(s)) leaves b a second and more behind such a start (hold_on_belt
+  // closed loop: 0.19 m of drift); a line reaches 0.2 m/s in 0.4 s (its
+  // 0.5 m/s^2), which a random walk covers at one sigma in that time with
+  // about 0.2 / sqrt(0.4) = 0.3 m/s/sqrt(s). ASSUMPTION: 0.1 m/s/sqrt(s), the
+  // smallest of 0.0105, 0.05, 0.1, 0.3 that took the drift under 0.1 m
+  // (0.19, 0.11, 0.093, 0.081 m; the crossing 4.8, 5.0, 5.3, 5.0 mm).
   v.Parameter("offset_random_walk", "m/(s2.Hz^0.5)", &offset_random_walk_,
               "random-walk intensity of the velocity offset b: each coordinate's variance grows "
               "by offset_random_walk^2 dt",

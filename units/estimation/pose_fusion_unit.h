@@ -105,7 +105,7 @@ class PoseFusionUnit : public cosim::Unit {
   std::string yaw_rate_source_ = "odometry";
   double velocity_noise_ = 0.02;
   double yaw_rate_noise_ = 0.01;
-  double offset_random_walk_ = 0.0105;
+  double offset_random_walk_ = 0.1;
   double initial_position_sigma_ = 0.1;
   double initial_yaw_sigma_ = 0.1;
   double initial_offset_sigma_ = 0.1;

@@ -297,13 +297,15 @@ TEST(PoseFusionUnit, MatchesOlderThanTheHistoryAreRefused) {
   seen.y += 0.01;  // the laser sees the robot 1 cm to the left
   f.Step(0.2, 0.0, 0.0, Match{seen, tm});
   EXPECT_EQ(f.Scalar("accepted_matches"), 1.0);
-  // After 6 s of dead reckoning P_yy (about 0.36 m^2, mostly the initial
-  // b's 0.1 m/s over 6 s) dwarfs the match's 1e-4: the gain is about 1, y
-  // moves to 0.01 at tm, and b_y (correlated with y by that growth) takes
-  // about 0.01 / 6 s; the 40 ms replay adds b_y x 0.04 s = 7e-5 m.
-  const double y = f.Estimate().y;
-  EXPECT_NEAR(y, 0.01 + 0.01 / 6.0 * 0.04, 5e-5);
-  EXPECT_NEAR(Get(f.u, "velocity_offset")[1], 0.01 / 6.0, 2e-4);
+  // After T = 6 s of dead reckoning P_yy dwarfs the match's 1e-4: b_y is
+  // the initial offset (sigma0 = 0.1 m/s) plus a random walk (q = 0.1
+  // m/s/sqrt(s)), so var y = sigma0^2 T^2 + q^2 T^3 / 3 = 1.08 m^2 and
+  // cov(y, b_y) = sigma0^2 T + q^2 T^2 / 2 = 0.24 m^2/s: the gain on y is
+  // about 1 (y moves to 0.01 at tm) and b_y takes 0.01 x 0.24 / 1.08; the
+  // 40 ms replay then adds b_y x 0.04 s.
+  const double b_y = 0.01 * 0.24 / 1.08;
+  EXPECT_NEAR(Get(f.u, "velocity_offset")[1], b_y, 2e-4);
+  EXPECT_NEAR(f.Estimate().y, 0.01 + b_y * 0.04, 5e-5);
   EXPECT_NEAR(f.Estimate().x, 0.2 * cosim::NsToSeconds(f.t), 1e-3);
 }
 
