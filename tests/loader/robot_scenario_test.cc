@@ -39,7 +39,9 @@ TEST(RobotScenario, CrossLineExpandsIntoTheRobotUnits) {
        {"belt", "chassis", "motors", "wheel_controller", "path_follower", "deviation"}) {
     EXPECT_TRUE(s.system->FindUnit(unit)) << unit;
   }
-  EXPECT_EQ(s.master->decimation(*s.system->FindUnit("wheel_controller")), 20);
+  // The 20 ms cycle in master steps (cross_line's 5 ms).
+  EXPECT_EQ(s.master->decimation(*s.system->FindUnit("wheel_controller")),
+            20'000'000 / s.master->options().base_step);
   EXPECT_EQ(s.master->decimation(*s.system->FindUnit("chassis")), 1);
   EXPECT_EQ(s.robot->task, "path");
   ASSERT_EQ(s.robot->path.size(), 2u);

@@ -83,8 +83,10 @@ TEST(SensorsAssembly, EveryMountOfTheRobotIsAUnit) {
   EXPECT_TRUE(Connected(s, "chassis.steer_angle[0]", "wheel_encoders.angle[0]"));
   EXPECT_TRUE(Connected(s, "chassis.drive_angle[3]", "wheel_encoders.angle[7]"));
   EXPECT_TRUE(Connected(s, "belt.travel[0]", "belt_ground_truth.travel"));
-  EXPECT_EQ(s.master->decimation(*s.system->FindUnit("wheel_encoders")), 20);
-  EXPECT_EQ(s.master->decimation(*s.system->FindUnit("imu")), 10);
+  // The control period and the IMU's 100 Hz, in master steps.
+  const auto step = s.master->options().base_step;
+  EXPECT_EQ(s.master->decimation(*s.system->FindUnit("wheel_encoders")), 20'000'000 / step);
+  EXPECT_EQ(s.master->decimation(*s.system->FindUnit("imu")), 10'000'000 / step);
   EXPECT_EQ(s.master->decimation(*s.system->FindUnit("laser_front")), 1);
   // 4096 counts per motor turn x drive gear 21 (raw3.yaml).
   EXPECT_EQ(Param(s, "wheel_encoders", "counts_per_revolution", 4), 4096.0 * 21);
@@ -120,11 +122,12 @@ TEST(SensorsAssembly, TheScenarioChoosesSensorsAndTheirOptions) {
 
   const Scenario tuned = LoadScenario(WithSensors(
       kCross, "tuned.yaml",
-      "sensors:\n  laser_rear: false\n  laser_front: {step_s: 0.002, parameters: "
+      "sensors:\n  laser_rear: false\n  laser_front: {step_s: 0.01, parameters: "
       "{noise_sigma: 0.03}}\n"));
   EXPECT_FALSE(tuned.system->FindUnit("laser_rear"));
   EXPECT_EQ(Param(tuned, "laser_front", "noise_sigma"), 0.03);
-  EXPECT_EQ(tuned.master->decimation(*tuned.system->FindUnit("laser_front")), 2);
+  EXPECT_EQ(tuned.master->decimation(*tuned.system->FindUnit("laser_front")),
+            10'000'000 / tuned.master->options().base_step);
 }
 
 // Guards the errors: an unknown sensor name (with the closest), a value the
