@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 #include <numbers>
+#include <sstream>
 
 #include "loader/scenario.h"
 #include "scenario_test.h"
@@ -352,17 +353,30 @@ TEST(RobotScenario, ControlPeriodMustBeAMultipleOfTheMasterStep) {
 // line), not at an expanded unit the file does not have; a unit step the
 // file sets itself under units: is reported there.
 TEST(RobotScenario, MasterProblemsOfExpandedUnitsPointAtRobotLevelKeys) {
-  const std::string e = Issues(kCross, {"duration_s=20.01"});
-  EXPECT_TRUE(Has(e, kCross + ":27: control.period_s: unit 'wheel_controller' step 0.02 s does "
-                              "not divide the duration 20.01 s"))
-      << e;
-  EXPECT_FALSE(Has(e, "units.")) << e;
   std::ifstream in(kCross);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string f = WriteScenario("robot_own_step.yaml",
-                                      text + "units:\n  wheel_controller:\n    step_s: 0.0153\n");
+  // The 1-based line of the first line starting with `prefix`.
+  const auto line_of = [&](const std::string& body, const std::string& prefix) {
+    std::istringstream lines(body);
+    std::string line;
+    for (int n = 1; std::getline(lines, line); ++n) {
+      if (line.rfind(prefix, 0) == 0) return n;
+    }
+    return 0;
+  };
+  const int period_line = line_of(text, "  period_s:");
+  ASSERT_GT(period_line, 0);
+  const std::string e = Issues(kCross, {"duration_s=20.01"});
+  EXPECT_TRUE(Has(e, kCross + ":" + std::to_string(period_line) +
+                         ": control.period_s: unit 'wheel_controller' step 0.02 s does "
+                         "not divide the duration 20.01 s"))
+      << e;
+  EXPECT_FALSE(Has(e, "units.")) << e;
+  const std::string own = text + "units:\n  wheel_controller:\n    step_s: 0.0153\n";
+  const std::string f = WriteScenario("robot_own_step.yaml", own);
   const std::string g = Issues(f);
-  EXPECT_TRUE(Has(g, f + ":43: units.wheel_controller.step_s: unit 'wheel_controller' step 0.0153"))
+  EXPECT_TRUE(Has(g, f + ":" + std::to_string(line_of(own, "    step_s: 0.0153")) +
+                         ": units.wheel_controller.step_s: unit 'wheel_controller' step 0.0153"))
       << g;
   EXPECT_FALSE(Has(g, "control.period_s")) << g;
 }
