@@ -58,5 +58,24 @@ TEST(OpticFlowScenario, AFeaturelessBeltDefeatsTheSensor) {
             textured.metrics.at("optic_flow_quality_mean"));
 }
 
+// Guards the filtered estimate the robot holds with (paper 1 Sec. IV-A).
+// Expected: its error against the encoder wheel within paper 1's in-house
+// measurement sigma, 3 cm/s (the filter's lag over the 1 s ramps is most
+// of it, see the note below); and the hold: the treadmill reaches 0.2 m/s
+// in 1 s and the state-switch detector restarts the filter at the 7th
+// message of that ramp (a 0.7 s lag, units/estimation tests), so the belt
+// carries the robot at most about half the speed for that long before the
+// compensation has it: 0.1 m/s x 0.7 s = 0.07 m.
+// Not asserted, because it does not hold: a filtered RMSE a third of the
+// raw. The raw error here (about 1 cm/s) is not white noise a low-pass
+// filter removes but the firmware's half-pixel quantization bias and the
+// Eq. 2 window; the filter can only add its lag to it.
+TEST(OpticFlowScenario, TheRobotHoldsOnTheTreadmillWithItsFilteredFlow) {
+  const ProfileRun run = RunProfile({});
+  EXPECT_LT(run.metrics.at("surface_velocity_rmse_filtered_mps"), 0.03);
+  EXPECT_GT(run.metrics.at("surface_velocity_rmse_filtered_mps"), 0.0);
+  EXPECT_LT(run.metrics.at("max_position_drift_m"), 0.07);
+}
+
 }  // namespace
 }  // namespace linesim
