@@ -50,13 +50,7 @@ void AddSwerve(SystemBuilder& b, const RobotFile& file, bool compensation, Signa
   YAML::Node p = b.Params(kWheelController);
   const std::size_t n = robot.wheels.size();
   p["wheel_count"] = n;
-  std::vector<double> x, y;
-  for (const auto& w : robot.wheels) {
-    x.push_back(w.x_m);
-    y.push_back(w.y_m);
-  }
-  p["wheel_x"] = List(x);
-  p["wheel_y"] = List(y);
+  SetWheelPositions(p, robot);
   const models::WheelDescription& w0 = robot.wheels.front();
   p["wheel_radius"] = Num(w0.radius_m);
   // Feedforwards from the motor files: the steering module's own inertia,

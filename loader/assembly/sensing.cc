@@ -119,13 +119,7 @@ void AddOdometry(SystemBuilder& b, const ProviderContext& c, Signals& s) {
   const bool swerve = robot.controller == models::ControllerKind::kSwerve;
   p["kind"] = swerve ? "swerve" : "differential";
   p["wheels"] = static_cast<int>(robot.wheels.size());
-  std::vector<double> x, y;
-  for (const auto& w : robot.wheels) {
-    x.push_back(w.x_m);
-    y.push_back(w.y_m);
-  }
-  p["wheel_x"] = List(x);
-  p["wheel_y"] = List(y);
+  SetWheelPositions(p, robot);
   p["wheel_radius"] = Num(robot.wheels.front().radius_m);
   const YAML::Node cpr = Child(enc, "counts_per_revolution");
   // The odometry's channels in its order: swerve, each wheel's steering
@@ -176,7 +170,7 @@ const std::map<std::string, Provider>& SurfaceVelocityProviders() {
          YAML::Node p = b.Params(kSurfaceEstimator);
          p["sensors"] = static_cast<int>(flows.size());
          p["wheels"] = static_cast<int>(robot.wheels.size());
-         std::vector<double> sx, sy, syaw, wx, wy;
+         std::vector<double> sx, sy, syaw;
          for (std::size_t k = 0; k < flows.size(); ++k) {
            const models::SensorMount& m = *flows[k];
            sx.push_back(m.x_m);
@@ -191,15 +185,10 @@ const std::map<std::string, Provider>& SurfaceVelocityProviders() {
            b.Connect(Signal(m.name, "message_count"),
                      Element(kSurfaceEstimator, "sensor_message_count", k));
          }
-         for (const auto& w : robot.wheels) {
-           wx.push_back(w.x_m);
-           wy.push_back(w.y_m);
-         }
          p["sensor_x"] = List(sx);
          p["sensor_y"] = List(sy);
          p["sensor_yaw"] = List(syaw);
-         p["wheel_x"] = List(wx);
-         p["wheel_y"] = List(wy);
+         SetWheelPositions(p, robot);
          // The encoders' check of each message (a dark image passes the
          // firmware's quality test with noise matches): with the wheel
          // encoders on, the odometry's unrectified twist, and a gate of
@@ -309,6 +298,16 @@ std::pair<std::string, YAML::Node> Choose(SystemBuilder& b, const std::string& s
 }
 
 }  // namespace
+
+void SetWheelPositions(YAML::Node params, const models::RobotDescription& robot) {
+  std::vector<double> x, y;
+  for (const auto& w : robot.wheels) {
+    x.push_back(w.x_m);
+    y.push_back(w.y_m);
+  }
+  params["wheel_x"] = List(x);
+  params["wheel_y"] = List(y);
+}
 
 bool RobotHas(const models::RobotDescription& robot, const std::string& kind) {
   for (const auto& m : robot.sensor_mounts) {

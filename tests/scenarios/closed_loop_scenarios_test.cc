@@ -14,33 +14,16 @@
 #include <string>
 #include <vector>
 
-#include "cosim/observers.h"
-#include "loader/scenario.h"
+#include "tests/scenarios/run_scenario.h"
 
 namespace linesim {
 namespace {
 
+using test_scenarios::RunFile;
+using test_scenarios::Shipped;
+
 const std::vector<std::string> kClosedLoop = {"sensing.surface_velocity=px4flow",
                                               "localization.source=fused"};
-
-std::map<std::string, double> RunFile(const std::string& file, std::vector<std::string> sets) {
-  loader::Scenario s = loader::LoadScenario(file, sets);
-  cosim::MetricsObserver metrics(s.metrics);
-  s.master->AddObserver(&metrics);
-  const cosim::RunResult result = s.master->Run();
-  EXPECT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors.front());
-  std::map<std::string, double> out;
-  for (const auto& [metric, value] : metrics.Results()) out[metric] = value;
-  std::cout << file;
-  for (const auto& set : sets) std::cout << " --set " << set;
-  for (const auto& [metric, value] : out) std::cout << "\n  " << metric << " = " << value;
-  std::cout << "\n";
-  return out;
-}
-
-std::string Shipped(const std::string& name) {
-  return std::string(LINESIM_SOURCE_DIR "/scenarios/") + name + ".yaml";
-}
 
 // A shipped scenario with `add` written under its `sensors:` section (the
 // faults a test injects), saved beside the test's other files.

@@ -11,26 +11,14 @@
 #include <string>
 #include <vector>
 
-#include "cosim/observers.h"
-#include "loader/scenario.h"
+#include "tests/scenarios/run_scenario.h"
 
 namespace linesim {
 namespace {
 
-std::map<std::string, double> RunScenario(const std::string& name, std::vector<std::string> sets) {
-  const std::string file = std::string(LINESIM_SOURCE_DIR "/scenarios/") + name + ".yaml";
-  loader::Scenario s = loader::LoadScenario(file, sets);
-  cosim::MetricsObserver metrics(s.metrics);
-  s.master->AddObserver(&metrics);
-  const cosim::RunResult result = s.master->Run();
-  EXPECT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors.front());
-  std::map<std::string, double> out;
-  for (const auto& [metric, value] : metrics.Results()) out[metric] = value;
-  std::cout << name;
-  for (const auto& set : sets) std::cout << " --set " << set;
-  for (const auto& [metric, value] : out) std::cout << "\n  " << metric << " = " << value;
-  std::cout << "\n";
-  return out;
+std::map<std::string, double> RunScenario(const std::string& name,
+                                          const std::vector<std::string>& sets) {
+  return test_scenarios::RunFile(test_scenarios::Shipped(name), sets);
 }
 
 // The path follower's gains (units/control defaults): cross-track and
