@@ -137,7 +137,7 @@ YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
     assembly::Signals s = assembly::AddDriveTrain(b, *file, start, info);
     assembly::AddLine(b, scene, s);
     assembly::AddSensors(b, *file, s);
-    assembly::AddSensing(b, *file, start, s);
+    assembly::AddSensing(b, *file, start, scene, s);
     assembly::AddControl(b, *file, s);
     assembly::AddTask(b, *file, start, s, info);
     assembly::AddEvaluation(b, file->robot, s, info);

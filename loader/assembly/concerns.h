@@ -83,7 +83,8 @@ void AddSensors(SystemBuilder& b, const RobotFile& robot, Signals& s);
 /// controllers the surface velocity under each wheel and the pose
 /// (ground truth, or the robot's own sensors through the estimators of
 /// units/estimation).
-void AddSensing(SystemBuilder& b, const RobotFile& robot, const StartPose& start, Signals& s);
+void AddSensing(SystemBuilder& b, const RobotFile& robot, const StartPose& start,
+                const models::Scene& scene, Signals& s);
 /// The robot's wheel positions in base_link as a unit's list parameters
 /// wheel_x and wheel_y (the controller's, the odometry's and the surface
 /// estimator's wheels).

@@ -1,5 +1,7 @@
+#include <cmath>
 #include <functional>
 #include <map>
+#include <optional>
 
 #include "loader/assembly/concerns.h"
 #include "loader/yaml_files.h"
@@ -13,6 +15,7 @@ namespace {
 struct ProviderContext {
   const RobotFile& file;
   const StartPose& start;
+  const models::Scene& scene;
   YAML::Node at;     // the section the choice is in
   std::string path;  // its key path
 };
@@ -53,18 +56,57 @@ void SetInitialPose(YAML::Node p, const StartPose& start) {
   p["initial_yaw"] = Num(start.yaw_rad);
 }
 
-// One value of a laser unit's parameter: the scenario's or the robot's
-// setting if the expansion has one, else the device's model file.
-double LaserValue(const YAML::Node& params, const YAML::Node& model, const std::string& key) {
-  const YAML::Node own = Child(params, key);
-  if (own.IsDefined() && own.IsScalar()) return own.as<double>();
-  const YAML::Node file = Child(model, key);
-  return file.IsDefined() && file.IsScalar() ? file.as<double>() : 0.0;
+// One number of a sensor unit's parameters as the unit will get it: the
+// scenario's or the robot's setting if the expansion has one, else the
+// device's model file (the mount's or the scenario's `model`); nullopt when
+// neither gives it, or (reported at the key) when it is not a number.
+std::optional<double> DeviceValue(SystemBuilder& b, const ProviderContext& c,
+                                  const models::SensorMount& m, const std::string& key) {
+  const YAML::Node params = b.Params(m.name);
+  YAML::Node value = Child(params, key);
+  if (!value.IsDefined()) {
+    const YAML::Node model_name = Child(params, "model");
+    if (model_name.IsDefined() && model_name.IsScalar()) {
+      const YAML::Node model = LoadModel(b.reader(), c.at, c.path, "sensor model",
+                                         model_name.Scalar(), "sensors", c.file.robot.file);
+      value = Child(model, key);
+    }
+  }
+  if (!value.IsDefined() || value.IsNull()) return std::nullopt;
+  double x = 0.0;
+  if (!value.IsScalar() || !YAML::convert<double>::decode(value, x) || !std::isfinite(x)) {
+    b.reader().Error(c.at, c.path,
+                     "sensor '" + m.name + "': its parameter " + key +
+                         " is not a number (sensors." + m.name + ".parameters." + key +
+                         " or its model file)");
+    return std::nullopt;
+  }
+  return x;
+}
+
+// A device number the estimator cannot do without.
+double RequiredDeviceValue(SystemBuilder& b, const ProviderContext& c,
+                           const models::SensorMount& m, const std::string& key) {
+  if (const auto x = DeviceValue(b, c, m, key)) return *x;
+  b.reader().Error(c.at, c.path,
+                   "sensor '" + m.name + "' has no " + key + " (its model file or sensors." +
+                       m.name + ".parameters." + key + "), which the localization needs");
+  return 0.0;
 }
 
 // hector_mapping on the robot's lasers (paper 1 Sec. IV-B): one
 // laser_localization unit matching every laser's scans against the scene.
 void AddLaserLocalization(SystemBuilder& b, const ProviderContext& c, Signals& s) {
+  // The map is a grid over the scene's floor: an unbounded floor (no scene)
+  // has nothing to match against and no grid to hold it.
+  const models::Floor& f = c.scene.floor;
+  constexpr double kMaxFloorSide = 1000.0;  // m: 40,000 cells of 0.025 m a side
+  if (!(f.max_x_m - f.min_x_m <= kMaxFloorSide && f.max_y_m - f.min_y_m <= kMaxFloorSide)) {
+    b.reader().Error(c.at, c.path,
+                     "laser localization matches scans against the scene's map: it needs a "
+                     "scene (scene: {model: ...}) whose floor is at most 1000 m a side");
+    return;
+  }
   const auto lasers = Mounts(s, "laser_scanner");
   b.Unit(kLaserLocalization, "laser_localization");
   YAML::Node p = b.Params(kLaserLocalization);
@@ -72,20 +114,14 @@ void AddLaserLocalization(SystemBuilder& b, const ProviderContext& c, Signals& s
   std::vector<double> x, y, z, yaw, first, step, period;
   for (std::size_t k = 0; k < lasers.size(); ++k) {
     const models::SensorMount& m = *lasers[k];
-    const YAML::Node params = b.Params(m.name);
-    YAML::Node model;
-    if (!m.model.empty()) {
-      model = LoadModel(b.reader(), c.at, c.path, "laser model", m.model, "sensors",
-                        c.file.robot.file);
-    }
-    beams.push_back(static_cast<int>(LaserValue(params, model, "beam_count")));
+    beams.push_back(static_cast<int>(RequiredDeviceValue(b, c, m, "beam_count")));
     x.push_back(m.x_m);
     y.push_back(m.y_m);
     z.push_back(m.z_m);
     yaw.push_back(m.yaw_rad);
-    first.push_back(LaserValue(params, model, "first_beam_angle"));
-    step.push_back(LaserValue(params, model, "angular_step"));
-    period.push_back(LaserValue(params, model, "scan_period"));
+    first.push_back(RequiredDeviceValue(b, c, m, "first_beam_angle"));
+    step.push_back(RequiredDeviceValue(b, c, m, "angular_step"));
+    period.push_back(RequiredDeviceValue(b, c, m, "scan_period"));
     const std::string suffix = "_" + std::to_string(k);
     b.Connect(Signal(m.name, "ranges"), Signal(kLaserLocalization, "ranges" + suffix));
     b.Connect(Signal(m.name, "scan_count"), Signal(kLaserLocalization, "scan_count" + suffix));
@@ -135,20 +171,34 @@ void AddOdometry(SystemBuilder& b, const ProviderContext& c, Signals& s) {
     for (std::size_t i = 0; i < robot.wheels.size(); ++i) {
       (robot.wheels[i].y_m > 0.0 ? left : right) = s.wheel_drive_joint[i];
     }
+    if (left < 0 || right < 0) {
+      b.reader().Error(c.at, c.path,
+                       "differential odometry needs a driven wheel on each side of " +
+                           robot.file + " (wheels with y_m > 0 and y_m < 0)");
+      return;
+    }
     channels = {steer + static_cast<std::size_t>(left), steer + static_cast<std::size_t>(right)};
     const YAML::Node track = Child(c.file.controller_settings, "effective_track");
     if (track.IsDefined()) p["effective_track"] = track;
     b.Origin(JoinPath(JoinPath(JoinPath("units", kOdometry), "parameters"), "effective_track"),
              {YAML::Node(), "controller.effective_track", robot.file});
   }
+  // The encoder's counts per revolution, one number for every channel or
+  // one per channel (the encoder unit checks them at its own key).
   std::vector<double> counts;
   for (std::size_t k = 0; k < channels.size(); ++k) {
-    if (cpr.IsSequence() && channels[k] < cpr.size()) {
-      counts.push_back(cpr[channels[k]].as<double>());
-    }
+    const YAML::Node one =
+        cpr.IsSequence() && channels[k] < cpr.size() ? cpr[channels[k]] : cpr;
+    double x = 0.0;
+    if (one.IsScalar() && YAML::convert<double>::decode(one, x)) counts.push_back(x);
     b.Connect(Element(encoders.name, "counts", channels[k]), Element(kOdometry, "counts", k));
   }
-  if (counts.size() == channels.size()) p["counts_per_revolution"] = List(counts);
+  if (counts.size() == channels.size()) {
+    p["counts_per_revolution"] = List(counts);
+    b.Origin(JoinPath(JoinPath(JoinPath("units", kOdometry), "parameters"),
+                      "counts_per_revolution"),
+             {YAML::Node(), JoinPath(JoinPath("sensors", encoders.name), "parameters"), ""});
+  }
   SetInitialPose(p, c.start);
   SetStep(b, kOdometry);
   s.odometry = kOdometry;
@@ -188,6 +238,21 @@ const std::map<std::string, Provider>& SurfaceVelocityProviders() {
          p["sensor_x"] = List(sx);
          p["sensor_y"] = List(sy);
          p["sensor_yaw"] = List(syaw);
+         // The filter's sample is the sensors' message period, when their
+         // settings or model file say (else both units' default, 10 Hz).
+         std::optional<double> rate;
+         for (const auto* m : flows) {
+           const auto r = DeviceValue(b, c, *m, "publish_rate");
+           if (!r) continue;
+           if (rate && *rate != *r) {
+             b.reader().Error(c.at, c.path,
+                              "the PX4Flow publish at different rates (" + Num(*rate).Scalar() +
+                                  " and " + Num(*r).Scalar() +
+                                  " Hz): the surface estimator needs one message period");
+           }
+           rate = r;
+         }
+         if (rate && *rate > 0.0) p["sample_period"] = Num(1.0 / *rate);
          SetWheelPositions(p, robot);
          // The encoders' check of each message (a dark image passes the
          // firmware's quality test with noise matches): with the wheel
@@ -316,7 +381,8 @@ bool RobotHas(const models::RobotDescription& robot, const std::string& kind) {
   return false;
 }
 
-void AddSensing(SystemBuilder& b, const RobotFile& file, const StartPose& start, Signals& s) {
+void AddSensing(SystemBuilder& b, const RobotFile& file, const StartPose& start,
+                const models::Scene& scene, Signals& s) {
   const auto [surface, surface_node] =
       Choose(b, "sensing", "surface_velocity", SurfaceVelocityProviders());
   const auto [localization, localization_node] =
@@ -327,11 +393,11 @@ void AddSensing(SystemBuilder& b, const RobotFile& file, const StartPose& start,
   // other's outputs, so the loop has a step's delay, not an algebraic loop.
   if (const auto it = LocalizationProviders().find(localization);
       it != LocalizationProviders().end()) {
-    it->second(b, {file, start, localization_node, "localization.source"}, s);
+    it->second(b, {file, start, scene, localization_node, "localization.source"}, s);
   }
   if (const auto it = SurfaceVelocityProviders().find(surface);
       it != SurfaceVelocityProviders().end()) {
-    it->second(b, {file, start, surface_node, "sensing.surface_velocity"}, s);
+    it->second(b, {file, start, scene, surface_node, "sensing.surface_velocity"}, s);
   }
   if (!s.odometry.empty() && !s.surface_velocity.empty()) {
     b.Connect(s.surface_velocity, Signal(s.odometry, "surface_velocity"));

@@ -360,7 +360,7 @@ TEST(SweepSpec, ShippedSweepsLoad) {
     EXPECT_EQ(spec.name, e.path().stem().string());
     ++count;
   }
-  EXPECT_GE(count, 7);
+  EXPECT_GE(count, 7);  // the seven sweeps scenarios/sweeps ships (README)
   const SweepSpec speed =
       LoadSweepSpec(LINESIM_SOURCE_DIR "/scenarios/sweeps/belt_speed_compensation.yaml");
   EXPECT_EQ(speed.scenario, LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml");

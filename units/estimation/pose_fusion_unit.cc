@@ -315,7 +315,11 @@ cosim::StepResult PoseFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
       // the odometry drifted (a wrong surface velocity in Eq. 3, slip), and
       // waiting for a match inside the gate would never end. The matcher
       // passed its own tests, so the pose restarts from it.
-      if (!fused && last_match_time_ != kNoMatch && ApplyMatch(time, true)) resets_ += 1.0;
+      // The same when the first match is refused (a start pose off by more
+      // than the gate) once the history reaches back timeout.
+      const bool waited = last_match_time_ != kNoMatch ||
+                          cosim::NsToSeconds(e.t - At(0).t) > timeout_;
+      if (!fused && waited && ApplyMatch(time, true)) resets_ += 1.0;
     }
   }
   ComputeOutputs();

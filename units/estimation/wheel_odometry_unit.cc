@@ -98,7 +98,8 @@ WheelOdometryUnit::WheelOdometryUnit(std::string name, Kind kind, int wheels)
            "yaw rate from the encoders alone (relative to the surface)", {"counts"});
   v.Output("wheel_velocity", "m/s", &wheel_velocity_,
            "each wheel's velocity relative to the surface under it from the encoders alone, in "
-           "base_link, vx vy per wheel (differential: its side's rim speed along x)",
+           "base_link, vx vy per wheel (differential: the body's velocity at the wheel from the "
+           "encoders' twist, since a skid-steer wheel scrubs)",
            {"counts"});
   v.Output("position", "m", &position_, "dead-reckoned x, y of base_link in map", both);
   v.Output("yaw", "rad", &yaw_, "dead-reckoned yaw of base_link in map, in (-pi, pi]", both);
@@ -248,13 +249,20 @@ void WheelOdometryUnit::ComputeSample() {
       surf[2 * s + 1] += share * surface_velocity_[2 * i + 1];
     }
   }
-  for (std::size_t i = 0; i < w; ++i) {
-    const std::size_t k = kind_ == Kind::kSwerve ? i : static_cast<std::size_t>(side_[i]);
-    wheel_velocity_[2 * i] = raw[2 * k];
-    wheel_velocity_[2 * i + 1] = raw[2 * k + 1];
-  }
   double raw_twist[3];
   Solve(raw, raw_twist);
+  for (std::size_t i = 0; i < w; ++i) {
+    if (kind_ == Kind::kSwerve) {
+      // A steered wheel rolls without side slip: its own velocity.
+      wheel_velocity_[2 * i] = raw[2 * i];
+      wheel_velocity_[2 * i + 1] = raw[2 * i + 1];
+    } else {
+      // A skid-steer wheel scrubs: its rim speed is not the body's speed at
+      // it; the body's twist (through the effective track) is.
+      wheel_velocity_[2 * i] = raw_twist[0] - raw_twist[2] * wheel_y_[i];
+      wheel_velocity_[2 * i + 1] = raw_twist[1] + raw_twist[2] * wheel_x_[i];
+    }
+  }
   double twist[3] = {raw_twist[0], raw_twist[1], raw_twist[2]};
   if (rectify_) {
     // Eq. 3 per wheel, and the solve is linear: solve(raw + surface) =

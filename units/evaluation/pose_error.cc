@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <utility>
+
+#include "models/angle.h"
 
 namespace linesim::evaluation {
 
@@ -29,10 +30,7 @@ PoseErrorUnit::PoseErrorUnit(std::string name) : cosim::Unit(kTypeName, std::mov
 void PoseErrorUnit::Evaluate() {
   position_error_ = std::hypot(estimated_position_[0] - true_position_[0],
                                estimated_position_[1] - true_position_[1]);
-  // remainder gives [-pi, pi]; -pi becomes pi so the wrap is one-sided.
-  double d = std::remainder(estimated_yaw_ - true_yaw_, 2.0 * std::numbers::pi);
-  if (d <= -std::numbers::pi) d += 2.0 * std::numbers::pi;
-  yaw_error_ = d;
+  yaw_error_ = models::WrapAngle(estimated_yaw_ - true_yaw_);
 }
 
 void PoseErrorUnit::Initialize() {
