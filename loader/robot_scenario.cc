@@ -100,7 +100,14 @@ void CheckStartPose(assembly::SystemBuilder& b, const models::Scene& scene,
     if (inside(o.solid)) refuse("the robot would start inside obstacle '" + o.name + "'");
   }
   for (const auto& o : scene.carried) {
-    if (inside(o.solid)) refuse("the robot would start inside carried object '" + o.name + "'");
+    // One waiting upstream of its belt is not there yet.
+    const bool on_line =
+        o.belt >= 0 && static_cast<std::size_t>(o.belt) < scene.belts.size() &&
+        models::CarriedTravelRange(scene.belts[static_cast<std::size_t>(o.belt)].area,
+                                   o.solid)[0] <= 0.0;
+    if (on_line && inside(o.solid)) {
+      refuse("the robot would start inside carried object '" + o.name + "'");
+    }
   }
 }
 

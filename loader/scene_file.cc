@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <numbers>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "cosim/closest_names.h"
+#include "cosim/variable_table.h"
 #include "loader/yaml_files.h"
 #include "models/angle.h"
 
@@ -277,6 +279,16 @@ class SceneParser {
         if (solid->bottom_m <= 0.0) {
           r_.Error(skids, sp, "a box on skids needs bottom_m > 0 (the skids' height)");
         }
+        if (gauge + width > solid->width_m) {
+          r_.Error(Child(skids, "gauge_m"), JoinPath(sp, "gauge_m"),
+                   "the skids must fit under the box: gauge_m + width_m at most its width " +
+                       cosim::FormatValue(solid->width_m) + " m");
+        }
+        if (length > solid->length_m) {
+          r_.Error(Child(skids, "length_m"), JoinPath(sp, "length_m"),
+                   "the skids must fit under the box: at most its length " +
+                       cosim::FormatValue(solid->length_m) + " m");
+        }
         const double cy = std::cos(solid->yaw_rad), sy = std::sin(solid->yaw_rad);
         for (std::int64_t i = 0; i < n; ++i) {
           // Evenly across the body, the outer ones gauge_m apart.
@@ -300,6 +312,20 @@ class SceneParser {
         pitch = r_.Real(copies, cp, "pitch_m", count > 1 ? std::nullopt
                                                          : std::optional<double>(0.0),
                         {0.0, 1e4});
+        // Copies must not overlap: the pitch at least the box's extent
+        // along its belt.
+        if (count > 1 && solid && c.belt >= 0 &&
+            static_cast<std::size_t>(c.belt) < s_.belts.size()) {
+          const double d =
+              solid->yaw_rad - s_.belts[static_cast<std::size_t>(c.belt)].area.direction_rad;
+          const double extent = solid->length_m * std::abs(std::cos(d)) +
+                                solid->width_m * std::abs(std::sin(d));
+          if (pitch < extent) {
+            r_.Error(copies, JoinPath(cp, "pitch_m"),
+                     "copies " + cosim::FormatValue(pitch) + " m apart overlap: the box is " +
+                         cosim::FormatValue(extent) + " m long along its belt");
+          }
+        }
       }
       if (c.belt < 0 || static_cast<std::size_t>(c.belt) >= s_.belts.size()) count = 0;
       // Copy k sits k pitches upstream of the first, so they pass in turn.
@@ -308,6 +334,14 @@ class SceneParser {
       for (std::int64_t k = 0; k < count; ++k) {
         for (models::CarriedObject o : group) {
           if (k > 0) o.name += "_" + std::to_string(k + 1);
+          // A generated name must not be one the file gives another object.
+          if (o.name != c.name) {
+            if (std::find(names.begin(), names.end(), o.name) != names.end()) {
+              r_.Error(item, p, "the copy or skid it makes, '" + o.name +
+                                    "', has the name of another carried object");
+            }
+            names.push_back(o.name);
+          }
           o.solid.x_m -= static_cast<double>(k) * pitch * std::cos(dir);
           o.solid.y_m -= static_cast<double>(k) * pitch * std::sin(dir);
           s_.carried.push_back(o);

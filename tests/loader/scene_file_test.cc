@@ -116,6 +116,37 @@ TEST(SceneFile, CarriedCopiesAndSkids) {
   }
 }
 
+// Guards the bad inputs of the line of bodies, each at its key: copies that
+// overlap (pitch below the 4.6 m body), a pitch missing with more than one
+// copy, skids wider than the 1.8 m body, skids under a box on the floor, a
+// generated name another object already has, and copies not a map.
+TEST(SceneFile, CarriedCopiesAndSkidsRefuseWhatCannotBe) {
+  const auto issues = [](const std::string& name, const std::string& carried) {
+    const std::string f = WriteScenario(
+        name + ".yaml",
+        "name: c\nduration_s: 1\nscene: {model: factory_line, carried: " + carried + "}\n");
+    YamlReader r(f);
+    (void)ReadScenarioScene(r, YAML::LoadFile(f)["scene"], f);
+    std::string all;
+    for (const auto& i : r.issues()) all += i.ToString() + "\n";
+    return all;
+  };
+  EXPECT_NE(issues("overlap", "[{copies: {count: 3, pitch_m: 4.0}}]")
+                .find("scene.carried.0.copies.pitch_m"),
+            std::string::npos);
+  EXPECT_NE(issues("no_pitch", "[{copies: {count: 3, pitch_m: null}}]")
+                .find("scene.carried.0.copies.pitch_m"),
+            std::string::npos);
+  EXPECT_NE(issues("wide", "[{skids: {gauge_m: 1.8}}]").find("scene.carried.0.skids.gauge_m"),
+            std::string::npos);
+  EXPECT_NE(issues("floor", "[{box: {bottom_m: 0}}]").find("bottom_m > 0"), std::string::npos);
+  EXPECT_NE(issues("clash", "[{}, {name: body_2, belt: line, box: {x_m: -3, y_m: 0, length_m: 1, "
+                            "width_m: 1, height_m: 1}}]")
+                .find("body_2"),
+            std::string::npos);
+  EXPECT_NE(issues("scalar", "[{copies: 3}]").find("scene.carried.0.copies"), std::string::npos);
+}
+
 // Guards against a required value silently defaulting: a belt without its
 // speed is refused at the belt's line, naming the key.
 TEST(SceneFile, MissingRequiredValueIsNamed) {
