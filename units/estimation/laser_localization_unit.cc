@@ -167,8 +167,11 @@ LaserLocalizationUnit::LaserLocalizationUnit(std::string name, const models::Sce
   v.Output("position", "m", &position_, "base_link x, y in map (latest accepted match)", {});
   v.Output("yaw", "rad", &yaw_, "base_link yaw in map (latest accepted match)", {});
   v.Output("velocity", "m/s", &velocity_,
-           "base_link velocity in map from the last two accepted matches", {});
-  v.Output("yaw_rate", "rad/s", &yaw_rate_, "yaw rate from the last two accepted matches", {});
+           "base_link velocity in map: the pose change over the accepted matches of the last "
+           "velocity_window", {});
+  v.Output("yaw_rate", "rad/s", &yaw_rate_,
+           "yaw rate: the heading change over the accepted matches of the last velocity_window",
+           {});
   v.Output("covariance", "1", &covariance_,
            "row-major 3 x 3 of x (m), y (m), yaw (rad): sigma_r^2 H^-1 + floor", {});
   v.Output("hessian", "1", &hessian_,

@@ -43,9 +43,10 @@ namespace linesim::estimation {
 ///    max_jump_yaw from its start (left the coarse level's basin);
 ///  - else accepted: position, yaw, hessian, match_cost, match_time,
 ///    covariance, laser_status 0, match_count + 1, and velocity and yaw_rate
-///    as the difference to the previous accepted match over their match
-///    times (no smoothing: about +-0.1 m/s of noise from mm-level match
-///    noise at 50 matches per second).
+///    as the pose change from the oldest accepted match of the last
+///    velocity_window (0.2 s) over their match times (between two matches,
+///    as hector would, mm-level match noise at 50 matches per second is
+///    about +-0.1 m/s).
 ///
 /// Covariance (row-major 3 x 3, x, y, yaw, SI): sigma_r^2 H^-1 with
 /// sigma_r^2 = sum (1 - M)^2 / (n - 3) (the Gauss-Newton estimate of the
