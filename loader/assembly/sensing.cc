@@ -195,9 +195,15 @@ void AddOdometry(SystemBuilder& b, const ProviderContext& c, Signals& s) {
   }
   if (counts.size() == channels.size()) {
     p["counts_per_revolution"] = List(counts);
-    b.Origin(JoinPath(JoinPath(JoinPath("units", kOdometry), "parameters"),
-                      "counts_per_revolution"),
-             {YAML::Node(), JoinPath(JoinPath("sensors", encoders.name), "parameters"), ""});
+    // A problem with them is reported where the encoder's came from.
+    const auto& origins = b.origins();
+    const auto from = origins.find(JoinPath(
+        JoinPath(JoinPath("units", encoders.name), "parameters"), "counts_per_revolution"));
+    if (from != origins.end()) {
+      b.Origin(JoinPath(JoinPath(JoinPath("units", kOdometry), "parameters"),
+                        "counts_per_revolution"),
+               from->second);
+    }
   }
   SetInitialPose(p, c.start);
   SetStep(b, kOdometry);

@@ -299,6 +299,17 @@ TEST(RobotScenario, ClosedLoopChoicesNeedTheirSensors) {
   const std::string c = Issues(kCross, {"localization.source=lidar"});
   EXPECT_TRUE(Has(c, "localization.source")) << c;
   EXPECT_TRUE(Has(c, "fused")) << c;
+  // Matching needs a map: a robot scenario without a scene (an unbounded
+  // floor) is refused at the choice, not at run time.
+  const std::string f = WriteScenario("robot_laser_no_scene.yaml", R"(name: bare
+duration_s: 1
+robot: {model: raw3, pose: {x_m: 0, y_m: 0, yaw_deg: 0}}
+task: {type: hold}
+localization: {source: laser}
+)");
+  const std::string d = Issues(f);
+  EXPECT_TRUE(Has(d, "localization.source")) << d;
+  EXPECT_TRUE(Has(d, "at most 1000 m a side")) << d;
 }
 
 // Guards the robot-level checks: unknown keys name the closest, values out
