@@ -142,6 +142,12 @@ void AddLaserLocalization(SystemBuilder& b, const ProviderContext& c, Signals& s
   s.localization_sources.push_back(Signal(kLaserLocalization, "source"));
 }
 
+// The odometry's twist into the matcher (for motion_prediction: odometry).
+void ConnectOdometryToMatcher(SystemBuilder& b) {
+  b.Connect(Signal(kOdometry, "body_velocity"), Signal(kLaserLocalization, "odometry_velocity"));
+  b.Connect(Signal(kOdometry, "yaw_rate"), Signal(kLaserLocalization, "odometry_yaw_rate"));
+}
+
 // Dead reckoning from the wheel encoders (swerve: the module kinematics;
 // differential: skid-steer with the controller's effective track), with
 // paper 1's Eq. 3 rectification by the surface velocity under each wheel.
@@ -303,6 +309,13 @@ const std::map<std::string, Provider>& LocalizationProviders() {
        [](SystemBuilder& b, const ProviderContext& c, Signals& s) {
          if (!Require(b, c, s, "laser_scanner", "laser")) return;
          AddLaserLocalization(b, c, s);
+         // hector alone starts each match from the last pose; with the
+         // wheel encoders on, their odometry is wired for the option
+         // motion_prediction: odometry (off unless the scenario sets it).
+         if (!Mounts(s, "wheel_encoder").empty()) {
+           AddOdometry(b, c, s);
+           ConnectOdometryToMatcher(b);
+         }
          s.position = Signal(kLaserLocalization, "position");
          s.yaw = Signal(kLaserLocalization, "yaw");
          s.velocity = Signal(kLaserLocalization, "velocity");
@@ -330,9 +343,7 @@ const std::map<std::string, Provider>& LocalizationProviders() {
          // a blackout of both lasers it follows the odometry, so the first
          // scans after it are within the matcher's reach.
          b.Params(kLaserLocalization)["motion_prediction"] = "odometry";
-         b.Connect(Signal(kOdometry, "body_velocity"),
-                   Signal(kLaserLocalization, "odometry_velocity"));
-         b.Connect(Signal(kOdometry, "yaw_rate"), Signal(kLaserLocalization, "odometry_yaw_rate"));
+         ConnectOdometryToMatcher(b);
          b.Unit(kPoseFusion, "pose_fusion");
          SetInitialPose(b.Params(kPoseFusion), c.start);
          b.Connect(Signal(kOdometry, "body_velocity"), Signal(kPoseFusion, "odometry_velocity"));
