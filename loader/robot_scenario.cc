@@ -63,8 +63,8 @@ void Passthrough(assembly::SystemBuilder& b) {
 // A positive number the chassis will get, for the plots; nothing otherwise
 // (the chassis unit reports a bad one).
 std::optional<double> PositiveChassisValue(assembly::SystemBuilder& b, const std::string& key) {
-  const YAML::Node n = Child(Child(Child(Child(b.out(), "units"), assembly::kChassis), "parameters"),
-                             key);
+  const YAML::Node n =
+      Child(Child(Child(Child(b.out(), "units"), assembly::kChassis), "parameters"), key);
   const auto value = YamlReader::DecodeReal(n);
   if (value && std::isfinite(*value) && *value > 0.0) return value;
   return std::nullopt;
@@ -101,10 +101,9 @@ void CheckStartPose(assembly::SystemBuilder& b, const models::Scene& scene,
   }
   for (const auto& o : scene.carried) {
     // One waiting upstream of its belt is not there yet.
-    const bool on_line =
-        o.belt >= 0 && static_cast<std::size_t>(o.belt) < scene.belts.size() &&
-        models::CarriedTravelRange(scene.belts[static_cast<std::size_t>(o.belt)].area,
-                                   o.solid)[0] <= 0.0;
+    const bool on_line = o.belt >= 0 && static_cast<std::size_t>(o.belt) < scene.belts.size() &&
+                         models::CarriedTravelRange(
+                             scene.belts[static_cast<std::size_t>(o.belt)].area, o.solid)[0] <= 0.0;
     if (on_line && inside(o.solid)) {
       refuse("the robot would start inside carried object '" + o.name + "'");
     }
@@ -120,8 +119,8 @@ bool IsRobotScenario(const YAML::Node& root) {
 YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
   r.CheckKeys(root, "",
               {"name", "description", "duration_s", "seed", "master", "robot", "scene", "line",
-               "control", "task", "sensors", "sensing", "localization", "units", "connections", "recording",
-               "metrics"});
+               "control", "task", "sensors", "sensing", "localization", "units", "connections",
+               "recording", "metrics"});
   assembly::SystemBuilder b(root, r);
   for (const char* key : {"name", "description", "duration_s", "seed", "master"}) {
     if (Child(root, key).IsDefined()) b.out()[key] = Child(root, key);

@@ -158,9 +158,8 @@ class SceneParser {
       models::Belt belt;
       // A belt without a name is "belt_<index>"; without a surface its top
       // is the floor's covering.
-      belt.name = Child(b, "name").IsDefined()
-                      ? Name(b, p, belt_names_)
-                      : "belt_" + std::to_string(s_.belts.size());
+      belt.name = Child(b, "name").IsDefined() ? Name(b, p, belt_names_)
+                                               : "belt_" + std::to_string(s_.belts.size());
       belt.surface = Child(b, "surface").IsDefined()
                          ? Reference(b, p, "surface", surface_names_, "surface")
                          : s_.floor.surface;
@@ -272,9 +271,8 @@ class SceneParser {
         r_.CheckKeys(skids, sp, {"count", "width_m", "gauge_m", "length_m"});
         const auto n = r_.Integer(skids, sp, "count", 2, 1, 16);
         const double width = r_.Real(skids, sp, "width_m", std::nullopt, {0.0, 1e2, true});
-        const double gauge = r_.Real(skids, sp, "gauge_m", n > 1 ? std::nullopt
-                                                                  : std::optional<double>(0.0),
-                                     {0.0, 1e2});
+        const double gauge = r_.Real(skids, sp, "gauge_m",
+                                     n > 1 ? std::nullopt : std::optional<double>(0.0), {0.0, 1e2});
         const double length = r_.Real(skids, sp, "length_m", solid->length_m, {0.0, 1e3, true});
         if (solid->bottom_m <= 0.0) {
           r_.Error(skids, sp, "a box on skids needs bottom_m > 0 (the skids' height)");
@@ -292,9 +290,8 @@ class SceneParser {
         const double cy = std::cos(solid->yaw_rad), sy = std::sin(solid->yaw_rad);
         for (std::int64_t i = 0; i < n; ++i) {
           // Evenly across the body, the outer ones gauge_m apart.
-          const double across = n > 1 ? gauge * (static_cast<double>(i) /
-                                                     static_cast<double>(n - 1) - 0.5)
-                                      : 0.0;
+          const double across =
+              n > 1 ? gauge * (static_cast<double>(i) / static_cast<double>(n - 1) - 0.5) : 0.0;
           models::CarriedObject skid = c;
           skid.name = c.name + "_skid_" + std::to_string(i + 1);
           skid.solid = models::BoxSolid(solid->x_m - sy * across, solid->y_m + cy * across,
@@ -309,17 +306,16 @@ class SceneParser {
       if (copies.IsDefined() && !copies.IsNull() && r_.ExpectMap(copies, cp)) {
         r_.CheckKeys(copies, cp, {"count", "pitch_m"});
         count = r_.Integer(copies, cp, "count", 1, 0, 100);
-        pitch = r_.Real(copies, cp, "pitch_m", count > 1 ? std::nullopt
-                                                         : std::optional<double>(0.0),
-                        {0.0, 1e4});
+        pitch = r_.Real(copies, cp, "pitch_m",
+                        count > 1 ? std::nullopt : std::optional<double>(0.0), {0.0, 1e4});
         // Copies must not overlap: the pitch at least the box's extent
         // along its belt.
         if (count > 1 && solid && c.belt >= 0 &&
             static_cast<std::size_t>(c.belt) < s_.belts.size()) {
           const double d =
               solid->yaw_rad - s_.belts[static_cast<std::size_t>(c.belt)].area.direction_rad;
-          const double extent = solid->length_m * std::abs(std::cos(d)) +
-                                solid->width_m * std::abs(std::sin(d));
+          const double extent =
+              solid->length_m * std::abs(std::cos(d)) + solid->width_m * std::abs(std::sin(d));
           if (pitch < extent) {
             r_.Error(copies, JoinPath(cp, "pitch_m"),
                      "copies " + cosim::FormatValue(pitch) + " m apart overlap: the box is " +
@@ -337,8 +333,9 @@ class SceneParser {
           // A generated name must not be one the file gives another object.
           if (o.name != c.name) {
             if (std::find(names.begin(), names.end(), o.name) != names.end()) {
-              r_.Error(item, p, "the copy or skid it makes, '" + o.name +
-                                    "', has the name of another carried object");
+              r_.Error(item, p,
+                       "the copy or skid it makes, '" + o.name +
+                           "', has the name of another carried object");
             }
             names.push_back(o.name);
           }
@@ -551,7 +548,8 @@ models::Scene ReadScenarioScene(YamlReader& r, const YAML::Node& scene,
     if (kv.second.IsSequence() && kv.second.size() == 0 && own.IsSequence() && own.size() > 0) {
       r.Error(kv.second, JoinPath("scene", kv.first.Scalar()),
               "an empty list removes nothing: lists merge item by item onto the scene file's " +
-                  std::to_string(own.size()) + " items; to leave them out, write the scene "
+                  std::to_string(own.size()) +
+                  " items; to leave them out, write the scene "
                   "without model");
     }
   }
@@ -599,8 +597,8 @@ void ExposeSceneModelToOverrides(YAML::Node& root, const std::vector<Override>& 
     if (key.empty() || key == rest || Child(scene, key).IsDefined()) continue;
     if (!file_scene) {
       YamlReader quiet(scenario_file);
-      file_scene = LoadModel(quiet, model, "scene.model", "scene", model.Scalar(), "scenes",
-                             scenario_file);
+      file_scene =
+          LoadModel(quiet, model, "scene.model", "scene", model.Scalar(), "scenes", scenario_file);
     }
     if (const YAML::Node value = Child(*file_scene, key); value.IsDefined()) {
       scene[key] = YAML::Clone(value);

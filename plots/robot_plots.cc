@@ -293,20 +293,24 @@ std::string ScanPlot(const RobotPlotSpec& spec, Signals& signals,
   }
   std::vector<std::string> items;
   if (!belts.empty()) {
-    items.push_back("$scan_belts using 1:2 with filledcurves closed fillcolor rgb '#dbe6f4' "
-                    "fillstyle solid 1.0 border lc rgb '#8fa9cc' title 'belt'");
+    items.push_back(
+        "$scan_belts using 1:2 with filledcurves closed fillcolor rgb '#dbe6f4' "
+        "fillstyle solid 1.0 border lc rgb '#8fa9cc' title 'belt'");
   }
   if (!obstacles.polygons.empty()) {
-    items.push_back("$scan_obstacles using 1:2 with filledcurves closed fillcolor rgb '#d0d0d0' "
-                    "fillstyle solid 1.0 border lc rgb '#606060' title 'obstacle'");
+    items.push_back(
+        "$scan_obstacles using 1:2 with filledcurves closed fillcolor rgb '#d0d0d0' "
+        "fillstyle solid 1.0 border lc rgb '#606060' title 'obstacle'");
   }
   if (!obstacles.circles.empty()) {
-    items.push_back("$scan_obstacles_circles using 1:2:3 with circles fillcolor rgb '#d0d0d0' "
-                    "fillstyle solid 1.0 border lc rgb '#606060' notitle");
+    items.push_back(
+        "$scan_obstacles_circles using 1:2:3 with circles fillcolor rgb '#d0d0d0' "
+        "fillstyle solid 1.0 border lc rgb '#606060' notitle");
   }
   if (!carried.polygons.empty()) {
-    items.push_back("$scan_carried using 1:2 with filledcurves closed fillcolor rgb '#f6d3a8' "
-                    "fillstyle solid 0.6 border lc rgb '#c07020' title 'carried (then)'");
+    items.push_back(
+        "$scan_carried using 1:2 with filledcurves closed fillcolor rgb '#f6d3a8' "
+        "fillstyle solid 0.6 border lc rgb '#c07020' title 'carried (then)'");
   }
   items.push_back("$scan_rays using 1:2 with lines lw 0.5 lc rgb '#9ecae1' title 'rays'");
   items.push_back("$scan_hits using 1:2 with points pt 7 ps 0.35 lc rgb '#d62728' title 'hits'");

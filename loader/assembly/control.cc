@@ -55,7 +55,8 @@ void AddSwerve(SystemBuilder& b, const RobotFile& file, bool compensation, Signa
   p["wheel_radius"] = Num(w0.radius_m);
   // Feedforwards from the motor files: the steering module's own inertia,
   // and for a drive wheel its share of the robot's mass at the rim.
-  const Feedforward steer = JointFeedforward(GroupOf(robot, *w0.steer_motor), w0.steer_inertia_kgm2);
+  const Feedforward steer =
+      JointFeedforward(GroupOf(robot, *w0.steer_motor), w0.steer_inertia_kgm2);
   const double share_kg = robot.body.mass_kg / static_cast<double>(n);
   const Feedforward drive =
       JointFeedforward(GroupOf(robot, w0.drive_motor), share_kg * w0.radius_m * w0.radius_m);
@@ -88,9 +89,10 @@ void AddDifferential(SystemBuilder& b, const RobotFile& file, const YAML::Node& 
   const models::RobotDescription& robot = file.robot;
   if (compensation) {
     b.reader().Error(Child(control, "compensation"), "control.compensation",
-                     "robot '" + robot.name + "' is a differential base: its fixed wheels cannot "
-                     "cancel the surface's cross velocity (Algorithm 1 needs steered wheels); "
-                     "set control.compensation: false");
+                     "robot '" + robot.name +
+                         "' is a differential base: its fixed wheels cannot "
+                         "cancel the surface's cross velocity (Algorithm 1 needs steered wheels); "
+                         "set control.compensation: false");
   }
   b.Unit(kWheelController, "diff_drive_controller");
   YAML::Node p = b.Params(kWheelController);
@@ -104,8 +106,9 @@ void AddDifferential(SystemBuilder& b, const RobotFile& file, const YAML::Node& 
   }
   p["wheel_radius"] = Num(left->radius_m);
   // Each side's motor moves half the robot (its wheels' share at the rim).
-  const Feedforward drive = JointFeedforward(
-      GroupOf(robot, left->drive_motor), 0.5 * robot.body.mass_kg * left->radius_m * left->radius_m);
+  const Feedforward drive =
+      JointFeedforward(GroupOf(robot, left->drive_motor),
+                       0.5 * robot.body.mass_kg * left->radius_m * left->radius_m);
   p["drive_feedforward"] = Num(drive.rate_v_per_rad_s);
   p["drive_acceleration_feedforward"] = Num(drive.acceleration_v_per_rad_s2);
   b.MergeSettings(kWheelController, file.controller_settings, robot.file, "controller");
@@ -129,8 +132,8 @@ void AddControl(SystemBuilder& b, const RobotFile& file, Signals& s) {
   const bool steered = file.robot.controller == models::ControllerKind::kSwerve;
   const bool compensation = r.Boolean(control, "control", "compensation", steered);
   // The Rob@Work 3 control cycle is 20 ms (IPA cob_control configuration).
-  const cosim::TimeNs period = r.Time(control, "control", "period_s",
-                                      cosim::NsToSeconds(kControlPeriod), {0.0, 10.0, true});
+  const cosim::TimeNs period =
+      r.Time(control, "control", "period_s", cosim::NsToSeconds(kControlPeriod), {0.0, 10.0, true});
   // The master checks the controllers' step against its own; its problems
   // are reported here, where the step comes from.
   for (const char* name : {kWheelController, kPathFollower}) {

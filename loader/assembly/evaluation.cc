@@ -90,7 +90,8 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
       y.push_back(flows[k]->y_m);
       yaw.push_back(flows[k]->yaw_rad);
       for (std::size_t i = 0; i < 2; ++i) {
-        b.Connect(Element(flows[k]->name, "velocity", i), Element(kFlowError, "measured", 2 * k + i));
+        b.Connect(Element(flows[k]->name, "velocity", i),
+                  Element(kFlowError, "measured", 2 * k + i));
       }
     }
     p["mount_x"] = List(x);

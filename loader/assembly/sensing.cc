@@ -33,8 +33,8 @@ std::vector<const models::SensorMount*> Mounts(const Signals& s, const std::stri
 
 // A provider that needs a kind of sensor the scenario turned off (or the
 // robot does not carry) says so at the key that chose it.
-bool Require(SystemBuilder& b, const ProviderContext& c, const Signals& s,
-             const std::string& kind, const std::string& choice) {
+bool Require(SystemBuilder& b, const ProviderContext& c, const Signals& s, const std::string& kind,
+             const std::string& choice) {
   if (!Mounts(s, kind).empty()) return true;
   b.reader().Error(c.at, c.path,
                    "'" + choice + "' needs the robot's " + kind + " sensors, but " +
@@ -85,8 +85,8 @@ std::optional<double> DeviceValue(SystemBuilder& b, const ProviderContext& c,
 }
 
 // A device number the estimator cannot do without.
-double RequiredDeviceValue(SystemBuilder& b, const ProviderContext& c,
-                           const models::SensorMount& m, const std::string& key) {
+double RequiredDeviceValue(SystemBuilder& b, const ProviderContext& c, const models::SensorMount& m,
+                           const std::string& key) {
   if (const auto x = DeviceValue(b, c, m, key)) return *x;
   b.reader().Error(c.at, c.path,
                    "sensor '" + m.name + "' has no " + key + " (its model file or sensors." +
@@ -179,8 +179,8 @@ void AddOdometry(SystemBuilder& b, const ProviderContext& c, Signals& s) {
     }
     if (left < 0 || right < 0) {
       b.reader().Error(c.at, c.path,
-                       "differential odometry needs a driven wheel on each side of " +
-                           robot.file + " (wheels with y_m > 0 and y_m < 0)");
+                       "differential odometry needs a driven wheel on each side of " + robot.file +
+                           " (wheels with y_m > 0 and y_m < 0)");
       return;
     }
     channels = {steer + static_cast<std::size_t>(left), steer + static_cast<std::size_t>(right)};
@@ -193,8 +193,7 @@ void AddOdometry(SystemBuilder& b, const ProviderContext& c, Signals& s) {
   // one per channel (the encoder unit checks them at its own key).
   std::vector<double> counts;
   for (std::size_t k = 0; k < channels.size(); ++k) {
-    const YAML::Node one =
-        cpr.IsSequence() && channels[k] < cpr.size() ? cpr[channels[k]] : cpr;
+    const YAML::Node one = cpr.IsSequence() && channels[k] < cpr.size() ? cpr[channels[k]] : cpr;
     double x = 0.0;
     if (one.IsScalar() && YAML::convert<double>::decode(one, x)) counts.push_back(x);
     b.Connect(Element(encoders.name, "counts", channels[k]), Element(kOdometry, "counts", k));
@@ -206,9 +205,9 @@ void AddOdometry(SystemBuilder& b, const ProviderContext& c, Signals& s) {
     const auto from = origins.find(JoinPath(
         JoinPath(JoinPath("units", encoders.name), "parameters"), "counts_per_revolution"));
     if (from != origins.end()) {
-      b.Origin(JoinPath(JoinPath(JoinPath("units", kOdometry), "parameters"),
-                        "counts_per_revolution"),
-               from->second);
+      b.Origin(
+          JoinPath(JoinPath(JoinPath("units", kOdometry), "parameters"), "counts_per_revolution"),
+          from->second);
     }
   }
   SetInitialPose(p, c.start);

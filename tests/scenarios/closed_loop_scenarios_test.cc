@@ -27,8 +27,7 @@ const std::vector<std::string> kClosedLoop = {"sensing.surface_velocity=px4flow"
 
 // A shipped scenario with `add` written under its `sensors:` section (the
 // faults a test injects), saved beside the test's other files.
-std::string WithSensors(const std::string& name, const std::string& add,
-                        const std::string& tag) {
+std::string WithSensors(const std::string& name, const std::string& add, const std::string& tag) {
   std::ifstream in(Shipped(name));
   std::stringstream text;
   text << in.rdbuf();
@@ -67,11 +66,11 @@ TEST(ClosedLoopScenarios, CrossLineWithItsOwnSensorsStaysWithin4cm) {
 // share of the run on the fallback is about (4 - 0.5) s / 20 s = 0.175.
 // Meanwhile the Eq. 3 odometry keeps the robot within the paper's 4 cm.
 TEST(ClosedLoopScenarios, LasersBlackedOutTheFusionFallsBackToOdometryAndReturns) {
-  const std::string file = WithSensors(
-      "cross_line",
-      "  laser_front: {parameters: {blackout_from: 5, blackout_until: 9}}\n"
-      "  laser_rear: {parameters: {blackout_from: 5, blackout_until: 9}}\n",
-      "blackout");
+  const std::string file =
+      WithSensors("cross_line",
+                  "  laser_front: {parameters: {blackout_from: 5, blackout_until: 9}}\n"
+                  "  laser_rear: {parameters: {blackout_from: 5, blackout_until: 9}}\n",
+                  "blackout");
   const auto m = RunFile(file, kClosedLoop);
   EXPECT_GT(m.at("pose_fusion_fallback_fraction"), 0.17);
   // At most: the 3.5 s, one scan period (40 ms) and one control period
@@ -93,13 +92,13 @@ TEST(ClosedLoopScenarios, LasersBlackedOutTheFusionFallsBackToOdometryAndReturns
 // loop of gain k = 1/s against a belt at v = 0.10 m/s (+10 % variation):
 // bounded by 0.11 m, never carried away.
 TEST(ClosedLoopScenarios, DarkFlowSensorsAreRefusedAndTheRobotStaysBounded) {
-  std::string file = WithSensors(
-      "cross_line",
-      "  flow_front_left: {parameters: {dark_from: 4, dark_until: 100}}\n"
-      "  flow_rear_left: {parameters: {dark_from: 4, dark_until: 100}}\n"
-      "  flow_rear_right: {parameters: {dark_from: 4, dark_until: 100}}\n"
-      "  flow_front_right: {parameters: {dark_from: 4, dark_until: 100}}\n",
-      "dark");
+  std::string file =
+      WithSensors("cross_line",
+                  "  flow_front_left: {parameters: {dark_from: 4, dark_until: 100}}\n"
+                  "  flow_rear_left: {parameters: {dark_from: 4, dark_until: 100}}\n"
+                  "  flow_rear_right: {parameters: {dark_from: 4, dark_until: 100}}\n"
+                  "  flow_front_right: {parameters: {dark_from: 4, dark_until: 100}}\n",
+                  "dark");
   std::ofstream(file, std::ios::app)
       << "metrics:\n  - {name: refused_front_left, of: 'surface_estimator.implausible_count[0]', "
          "reduce: final}\n  - {name: wheel_source_max, of: "

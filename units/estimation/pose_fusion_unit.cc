@@ -305,8 +305,8 @@ cosim::StepResult PoseFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     last_match_count_ = match_count_;
     const auto time = static_cast<cosim::TimeNs>(std::llround(match_time_ * 1e9));
     // Fused up to now: the state predicts where the match should be.
-    const bool fused = last_match_time_ != kNoMatch &&
-                       cosim::NsToSeconds(e.t - last_match_time_) <= timeout_;
+    const bool fused =
+        last_match_time_ != kNoMatch && cosim::NsToSeconds(e.t - last_match_time_) <= timeout_;
     if (ApplyMatch(time)) {
       accepted_matches_ += 1.0;
     } else {
@@ -317,8 +317,8 @@ cosim::StepResult PoseFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
       // passed its own tests, so the pose restarts from it.
       // The same when the first match is refused (a start pose off by more
       // than the gate) once the history reaches back timeout.
-      const bool waited = last_match_time_ != kNoMatch ||
-                          cosim::NsToSeconds(e.t - At(0).t) > timeout_;
+      const bool waited =
+          last_match_time_ != kNoMatch || cosim::NsToSeconds(e.t - At(0).t) > timeout_;
       if (!fused && waited && ApplyMatch(time, true)) resets_ += 1.0;
     }
   }

@@ -481,8 +481,7 @@ cosim::StepResult SurfaceVelocityEstimator::DoStep(cosim::TimeNs t, cosim::TimeN
   for (std::size_t i = 0; i < n_; ++i) {
     if (status_[i] != kNoEstimate || (flags_[i] & (kMoved | kMeasured)) == 0) continue;
     double bx = 0.0, by = 0.0;
-    const bool borrowed =
-        SurfaceMean(static_cast<int>(surface_[i]), kFresh, kStarted, bx, by);
+    const bool borrowed = SurfaceMean(static_cast<int>(surface_[i]), kFresh, kStarted, bx, by);
     if (borrowed) {
       x_[2 * i] = bx;
       x_[2 * i + 1] = by;
@@ -559,7 +558,8 @@ void SurfaceVelocityEstimator::SaveInternal(cosim::UnitState& state) const {
     state.reals.insert(state.reals.end(), v->begin(), v->end());
   }
   state.integers = {start_};
-  for (const auto* v : {&surface_, &status_, &last_valid_, &entered_, &acc_ns_, &acc_checked_ns_, &map_surface_, &switches_, &implausible_}) {
+  for (const auto* v : {&surface_, &status_, &last_valid_, &entered_, &acc_ns_, &acc_checked_ns_,
+                        &map_surface_, &switches_, &implausible_}) {
     state.integers.insert(state.integers.end(), v->begin(), v->end());
   }
   state.integers.insert(state.integers.end(), run_.begin(), run_.end());
@@ -582,7 +582,8 @@ void SurfaceVelocityEstimator::RestoreInternal(const cosim::UnitState& state) {
   }
   auto k = state.integers.begin();
   start_ = *k++;
-  for (auto* v : {&surface_, &status_, &last_valid_, &entered_, &acc_ns_, &acc_checked_ns_, &map_surface_, &switches_, &implausible_}) {
+  for (auto* v : {&surface_, &status_, &last_valid_, &entered_, &acc_ns_, &acc_checked_ns_,
+                  &map_surface_, &switches_, &implausible_}) {
     std::copy(k, k + n, v->begin());
     k += n;
   }

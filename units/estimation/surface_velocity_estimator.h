@@ -182,7 +182,7 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   std::vector<std::int64_t> status_;       // kFresh, kHeld, kNoEstimate
   std::vector<double> last_count_;         // message count last seen
   std::vector<cosim::TimeNs> last_valid_;  // time of the last valid message (or restart)
-  std::vector<cosim::TimeNs> entered_;  // when the map last moved it to another surface
+  std::vector<cosim::TimeNs> entered_;     // when the map last moved it to another surface
   // Accumulated since the previous message: the sensor point's velocity in
   // the sensor frame times the step (m), the heading's unit vector times the
   // step (s), and the window (ns).
@@ -192,7 +192,7 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   // under the wheels by the encoders, in the sensor frame, times the step.
   std::vector<double> acc_ox_, acc_oy_;
   std::vector<cosim::TimeNs> acc_checked_ns_;  // the part of the window they cover
-  std::vector<std::int64_t> implausible_;  // messages the encoders refuted
+  std::vector<std::int64_t> implausible_;      // messages the encoders refuted
   // The switch detector's signed run per component (2 per sensor), and the
   // restarts it made per sensor.
   std::vector<std::int64_t> run_, switches_;

@@ -28,7 +28,7 @@ using test_helpers::SetAll;
 using test_helpers::SetArray;
 
 constexpr TimeNs kMs = 1'000'000;
-constexpr TimeNs kStep = 20 * kMs;     // the control period the estimator runs at
+constexpr TimeNs kStep = 20 * kMs;      // the control period the estimator runs at
 constexpr TimeNs kMessage = 100 * kMs;  // px4flow publish_rate 10 Hz
 constexpr double kPi = std::numbers::pi;
 
@@ -966,8 +966,8 @@ TEST(SurfaceVelocityEstimator, ParameterProblemsAreReported) {
   EXPECT_EQ(static_cast<SurfaceVelocityEstimator*>(ok.get())->wheel_count(), 2);
   EXPECT_TRUE(issues.empty());
 
-  EXPECT_FALSE(make("{sensors: 4, wheels: 4, sensor_yaw: [0, 1, 2], wheel_x: [1, 2, 3, 4, 5]}",
-                    issues));
+  EXPECT_FALSE(
+      make("{sensors: 4, wheels: 4, sensor_yaw: [0, 1, 2], wheel_x: [1, 2, 3, 4, 5]}", issues));
   ASSERT_EQ(issues.size(), 2u);
   EXPECT_EQ(issues[0].key_path, "units.est.parameters.sensor_yaw");
   EXPECT_NE(issues[0].message.find("sensors: 4"), std::string::npos) << issues[0].message;
