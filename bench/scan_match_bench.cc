@@ -1,5 +1,6 @@
 // Cost of the laser-only localization (units/estimation): one hector-style
-// scan match of a 541-beam S300 scan over 3 levels, and the map's build, on
+// scan match of a 541-beam S300 scan over 3 levels, the map's build, and
+// (map: mapping) a match plus a map update, on
 // the factory_line scene (models/scenes/factory_line.yaml) read by the
 // loader as a scenario reads it. The scan comes from the real laser_scanner
 // unit (units/sensors) on that scene.
@@ -112,6 +113,46 @@ void BM_ScanMatch541Factory(benchmark::State& state) {
   state.counters["iterations"] = r.iterations;
 }
 BENCHMARK(BM_ScanMatch541Factory)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+
+// map: mapping: one match of the 541-beam scan against a learned map (the
+// map built by entering the same scan at the truth, as the unit's first
+// scan does) and one map update with it (every level: Bresenham misses and
+// the hit of each beam). The match starts where the unit's would, from the
+// last estimate: one S300 scan (40 ms) of 0.3 m/s and 0.3 rad/s off (12 mm,
+// 12 mrad); the learned map's peaked cells have a narrower basin than the
+// scene map's profile (from the 5 cm, 3 cm, 2 deg start above it ends
+// about 6 cm off). Argument 0: the match only; 1: match + update.
+// Counters: the cells of the map, and the match's error (mm, mrad).
+void BM_ScanMatchAndMapUpdate541Factory(benchmark::State& state) {
+  const models::Scene scene = FactoryLine();
+  OccupancyGrid g(scene.floor, {}, {});
+  const ScanMatcher m(g, {});
+  const double tx = 1.0, ty = -2.5, tyaw = 0.0;
+  const Scan s = FrontScan(scene, tx, ty, tyaw);
+  // The laser at its mount (0.465, -0.232) in base_link.
+  g.UpdateByScan(s.x, s.y, 0.465, -0.232, tx, ty, tyaw);
+  const OccupancyGrid start = g;
+  ScanMatcher::Result r;
+  std::int64_t updates = 0;
+  for (auto _ : state) {
+    r = m.Match(s.x, s.y, {tx + 0.012, ty, tyaw + 0.012});
+    if (state.range(0) == 1) {
+      g.UpdateByScan(s.x, s.y, 0.465, -0.232, r.pose.x, r.pose.y, r.pose.yaw);
+      ++updates;
+    }
+    benchmark::DoNotOptimize(r);
+    benchmark::DoNotOptimize(g.level(0).value.data());
+  }
+  std::size_t cells = 0;
+  for (int i = 0; i < start.levels(); ++i) cells += start.level(i).value.size();
+  state.counters["cells"] = static_cast<double>(cells);
+  state.counters["points"] = r.points;
+  state.counters["err_mm"] = 1e3 * std::hypot(r.pose.x - tx, r.pose.y - ty);
+  state.counters["err_mrad"] = 1e3 * std::abs(r.pose.yaw - tyaw);
+  state.counters["iterations"] = r.iterations;
+}
+BENCHMARK(BM_ScanMatchAndMapUpdate541Factory)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace linesim::estimation

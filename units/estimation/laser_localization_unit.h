@@ -56,6 +56,27 @@ namespace linesim::estimation {
 /// and the map as exact (about 1 mm for a 541-beam scan), which a fusion
 /// filter would take at face value.
 ///
+/// Map (`map`): `scene` (default) builds the grid from the scene's solids
+/// before time zero, as above. `mapping` learns it from the scans as
+/// hector_mapping does (OccupancyGrid's learned map: log-odds per cell and
+/// level, hits and Bresenham misses, update_factor_occupied /
+/// update_factor_free): the grid covers the same floor rectangle + margin,
+/// every cell unknown at Initialize. Its frame is the scene's map frame
+/// (hector's map frame is its start pose; here the start pose is known:
+/// initial_x, initial_y, initial_yaw). Per laser k: while no match has been
+/// accepted, laser k's first usable scan enters the map at the current
+/// estimate without matching (hector maps its first scan without matching;
+/// every laser its own first, since each sees its own side); after that
+/// each scan is matched against the current map, and an accepted match
+/// enters the map when laser k has not entered it yet or the pose moved
+/// more than map_update_distance_thresh (0.4 m) or turned more than
+/// map_update_angle_thresh (0.06 rad) since laser k last entered it
+/// (hector_mapping's parameters of those names, values of its
+/// mapping_default.launch; per laser, where hector has one scan stream).
+/// Beams without return or outside [range_min, usable_range_max] enter
+/// nothing (hector: no miss for out-of-range beams). The map is saved with
+/// the state (log-odds of every level, 4 bytes per cell).
+///
 /// laser_status per laser: 0 ok, 1 no new scan within scan_timeout, 2
 /// blacked out (fewer than min_points returns in its last scan), 3 its last
 /// match was rejected. source: 0 the pose is from a match within
@@ -98,6 +119,8 @@ class LaserLocalizationUnit : public cosim::Unit {
   void ProcessScan(int k);
   /// `p` moved by the odometry inputs over `seconds` (may be < 0).
   Pose Predict(const Pose& p, double seconds) const;
+  /// Enters laser k's points (px_, py_, n of them) into the learned map at `p`.
+  void UpdateMap(int k, std::size_t n, const Pose& p);
   void SetStatus(int k, int status) { laser_status_[static_cast<std::size_t>(k)] = status; }
 
   std::vector<int> beam_counts_;
@@ -110,6 +133,8 @@ class LaserLocalizationUnit : public cosim::Unit {
   std::vector<double> grid_heights_;
   double grid_resolution_ = 0.0;
   std::int64_t grid_levels_ = 0;
+  std::string grid_map_;
+  double grid_occupied_ = 0.0, grid_free_ = 0.0;
 
   // Parameters (lists: one element per laser).
   std::vector<double> mount_x_, mount_y_, mount_z_, mount_yaw_, first_beam_angle_, angular_step_,
@@ -127,6 +152,9 @@ class LaserLocalizationUnit : public cosim::Unit {
   double velocity_window_ = 0.2;
   std::int64_t min_points_ = 50;
   double covariance_floor_position_ = 0.01, covariance_floor_yaw_ = 0.0087;
+  std::string map_ = "scene";
+  double map_update_distance_thresh_ = 0.4, map_update_angle_thresh_ = 0.06;
+  double update_factor_occupied_ = 0.9, update_factor_free_ = 0.4;
 
   // Inputs.
   std::vector<std::vector<double>> ranges_;
@@ -137,13 +165,14 @@ class LaserLocalizationUnit : public cosim::Unit {
   // Outputs.
   std::vector<double> position_, velocity_, covariance_, hessian_, laser_status_;
   double yaw_ = 0.0, yaw_rate_ = 0.0, match_time_ = 0.0, match_count_ = 0.0, match_cost_ = 0.0,
-         source_ = 1.0;
+         source_ = 1.0, map_updates_ = 0.0;
 
   // Derived (Derive()): per laser and beam, cos and sin of the beam's
   // direction in base_link, and its time after the scan's start (s).
   std::vector<std::vector<double>> beam_cos_, beam_sin_, beam_dt_;
   std::vector<cosim::TimeNs> mid_offset_ns_;  // the match time after the scan's start
   bool odometry_prediction_ = false;
+  bool mapping_ = false;
 
   // Scratch (sized in the constructor): the points of one scan.
   std::vector<double> px_, py_;
@@ -168,6 +197,10 @@ class LaserLocalizationUnit : public cosim::Unit {
   Pose odom_;                     // estimate_ moved by odometry up to odom_ns_
   cosim::TimeNs odom_ns_ = 0;
   cosim::TimeNs step_end_ns_ = 0;
+  // map: mapping: per laser, whether its scans have entered the map and the
+  // pose it last entered at.
+  std::vector<char> mapped_;
+  std::vector<Pose> last_map_pose_;
 };
 
 }  // namespace linesim::estimation

@@ -46,6 +46,147 @@ OccupancyGrid::OccupancyGrid(const std::vector<models::Solid>& solids, const mod
   Build(floor, options);
 }
 
+OccupancyGrid::OccupancyGrid(const models::Floor& floor, Options options, UpdateFactors factors)
+    : learned_(true) {
+  if (!(factors.occupied > 0.0 && factors.occupied < 1.0 && factors.free > 0.0 &&
+        factors.free < 1.0)) {
+    throw std::invalid_argument("occupancy grid: update factors must be in (0, 1)");
+  }
+  // hector's probToLogOdds, in float as hector keeps them.
+  log_odds_occupied_ = static_cast<float>(std::log(factors.occupied / (1.0 - factors.occupied)));
+  log_odds_free_ = static_cast<float>(std::log(factors.free / (1.0 - factors.free)));
+  Build(floor, options);
+  for (Level& l : levels_) {
+    l.log_odds.assign(l.value.size(), 0.0f);
+    l.stamp.assign(l.value.size(), 0u);
+  }
+  Clear();
+}
+
+void OccupancyGrid::Clear() {
+  if (!learned_) throw std::logic_error("occupancy grid: Clear on a map built from the scene");
+  for (Level& l : levels_) {
+    std::fill(l.log_odds.begin(), l.log_odds.end(), 0.0f);
+    std::fill(l.value.begin(), l.value.end(), Probability(0.0f));
+    std::fill(l.stamp.begin(), l.stamp.end(), 0u);
+  }
+  update_index_ = 0;
+}
+
+void OccupancyGrid::SetLogOdds(int i, std::span<const float> log_odds) {
+  if (!learned_) throw std::logic_error("occupancy grid: SetLogOdds on a map built from the scene");
+  Level& l = levels_.at(static_cast<std::size_t>(i));
+  if (log_odds.size() != l.log_odds.size()) {
+    throw std::invalid_argument("occupancy grid: level " + std::to_string(i) + " holds " +
+                                std::to_string(l.log_odds.size()) + " cells, got " +
+                                std::to_string(log_odds.size()));
+  }
+  for (std::size_t k = 0; k < log_odds.size(); ++k) {
+    l.log_odds[k] = log_odds[k];
+    l.value[k] = Probability(log_odds[k]);
+  }
+  std::fill(l.stamp.begin(), l.stamp.end(), 0u);
+}
+
+bool OccupancyGrid::CellOf(int i, double x, double y, int& ix, int& iy) const {
+  const Level& l = level(i);
+  const double fx = std::floor((x - l.origin_x) * l.inv_cell);
+  const double fy = std::floor((y - l.origin_y) * l.inv_cell);
+  // Compare before converting: NaN or far away never indexes.
+  if (!(fx >= 0.0 && fy >= 0.0 && fx < l.nx && fy < l.ny)) return false;
+  ix = static_cast<int>(fx);
+  iy = static_cast<int>(fy);
+  return true;
+}
+
+// Update marks of one scan (update_index_ + ...): 1 a miss skipped at the
+// bound, 2 a miss applied, 3 a hit. A cell whose stamp is below 1 is
+// untouched by this scan.
+namespace {
+constexpr std::uint32_t kMissSkipped = 1, kMissApplied = 2, kHit = 3, kMarks = 4;
+}  // namespace
+
+void OccupancyGrid::Free(Level& l, std::size_t k) const {
+  std::uint32_t& st = l.stamp[k];
+  if (st > update_index_) return;  // already missed or hit in this scan
+  float& lo = l.log_odds[k];
+  if (lo > -kLogOddsBound) {
+    lo += log_odds_free_;
+    l.value[k] = Probability(lo);
+    st = update_index_ + kMissApplied;
+  } else {
+    st = update_index_ + kMissSkipped;
+  }
+}
+
+void OccupancyGrid::Occupy(Level& l, std::size_t k) const {
+  std::uint32_t& st = l.stamp[k];
+  if (st >= update_index_ + kHit) return;  // already hit in this scan
+  float& lo = l.log_odds[k];
+  // A miss of this scan undone (hector's updateUnsetFree): the cell counts
+  // once, as a hit.
+  if (st == update_index_ + kMissApplied) lo -= log_odds_free_;
+  if (lo < kLogOddsBound) lo += log_odds_occupied_;
+  l.value[k] = Probability(lo);
+  st = update_index_ + kHit;
+}
+
+void OccupancyGrid::UpdateLevel(Level& l, std::span<const double> px, std::span<const double> py,
+                                double ox, double oy, double x, double y, double c, double s) {
+  const auto cell = [&l](double wx, double wy, int& ix, int& iy) {
+    const double fx = std::floor((wx - l.origin_x) * l.inv_cell);
+    const double fy = std::floor((wy - l.origin_y) * l.inv_cell);
+    if (!(fx >= 0.0 && fy >= 0.0 && fx < l.nx && fy < l.ny)) return false;
+    ix = static_cast<int>(fx);
+    iy = static_cast<int>(fy);
+    return true;
+  };
+  int x0 = 0, y0 = 0;
+  if (!cell(x + c * ox - s * oy, y + s * ox + c * oy, x0, y0)) return;  // laser off the map
+  const std::ptrdiff_t nx = l.nx;
+  const std::ptrdiff_t start = static_cast<std::ptrdiff_t>(y0) * nx + x0;
+  const std::size_t n = std::min(px.size(), py.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    int x1 = 0, y1 = 0;
+    if (!cell(x + c * px[i] - s * py[i], y + s * px[i] + c * py[i], x1, y1)) continue;
+    if (x1 == x0 && y1 == y0) continue;
+    const int dx = x1 - x0, dy = y1 - y0;
+    const int adx = std::abs(dx), ady = std::abs(dy);
+    const std::ptrdiff_t sx = dx > 0 ? 1 : (dx < 0 ? -1 : 0);
+    const std::ptrdiff_t sy = dy > 0 ? nx : (dy < 0 ? -nx : 0);
+    // Bresenham along the dominant axis a: the start cell and the next
+    // |da| - 1 cells are misses; the end cell (|da| steps on) is the hit.
+    const int da = adx >= ady ? adx : ady, db = adx >= ady ? ady : adx;
+    const std::ptrdiff_t step_a = adx >= ady ? sx : sy, step_b = adx >= ady ? sy : sx;
+    int err = da / 2;
+    std::ptrdiff_t k = start;
+    Free(l, static_cast<std::size_t>(k));
+    for (int j = 1; j < da; ++j) {
+      k += step_a;
+      err += db;
+      if (err >= da) {
+        k += step_b;
+        err -= da;
+      }
+      Free(l, static_cast<std::size_t>(k));
+    }
+    Occupy(l, static_cast<std::size_t>(static_cast<std::ptrdiff_t>(y1) * nx + x1));
+  }
+}
+
+void OccupancyGrid::UpdateByScan(std::span<const double> px, std::span<const double> py, double ox,
+                                 double oy, double x, double y, double yaw) {
+  if (!learned_) throw std::logic_error("occupancy grid: UpdateByScan on a map built from the scene");
+  // Before the marks could wrap: every stamp back below the next scan's.
+  if (update_index_ > std::numeric_limits<std::uint32_t>::max() - 2 * kMarks) {
+    for (Level& l : levels_) std::fill(l.stamp.begin(), l.stamp.end(), 0u);
+    update_index_ = 0;
+  }
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  for (Level& l : levels_) UpdateLevel(l, px, py, ox, oy, x, y, c, s);
+  update_index_ += kMarks;
+}
+
 double OccupancyGrid::SignedDistance(double x, double y) const {
   double d = -std::numeric_limits<double>::infinity();
   for (const models::Solid& s : solids_) d = std::max(d, SolidSignedDistance(s, x, y));

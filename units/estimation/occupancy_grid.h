@@ -1,6 +1,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cmath>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -42,6 +44,27 @@ namespace linesim::estimation {
 /// (0.6 mm for the scene's 0.25 m pillars at 0.025 m cells). The residual is what peaks
 /// (at zero) on the outline. Stored as float (the values are O(1) and
 /// interpolated; float halves the memory the lookups touch).
+///
+/// Learned map (the other constructor, `map: mapping` of laser_localization):
+/// the same levels over the same rectangle, every cell unknown, learned from
+/// scans as hector_mapping does (tu-darmstadt hector_slam: MapRepMultiMap
+/// updates every level with every scan; OccGridMapBase::updateByScan,
+/// GridMapLogOdds.h). Per cell a log-odds L (0 = unknown); a scan adds
+/// log_odds_occupied (log(0.9 / 0.1) = 2.197 for hector's launch file's
+/// update_factor_occupied 0.9) to the cell holding each beam's end point
+/// and log_odds_free (log(0.4 / 0.6) = -0.405, update_factor_free 0.4) to
+/// every cell a Bresenham line from the laser's cell passes before it (the
+/// end cell skipped). Each cell counts once per scan (hector's update
+/// index: a per-cell stamp; a cell first marked free and then hit has its
+/// free update undone, hector's updateUnsetFree). A beam whose start or end
+/// cell leaves the grid, or that ends in its start cell, updates nothing
+/// (hector). L is bounded: a hit only while L < 50 (hector's bound), a miss
+/// only while L > -50 (ours, the mirror: hector's stablize uses +-50 as
+/// "very occupied / very free"). The matcher reads `value` = the cell's
+/// probability 1 / (1 + exp(-L)) (hector's getGridProbability; unknown 0.5),
+/// kept in step with L at each update: the peaked profile this comment's
+/// first part warns about (the hit cell's centre is where the map peaks),
+/// which is hector's.
 class OccupancyGrid {
  public:
   struct Options {
@@ -56,7 +79,17 @@ class OccupancyGrid {
     int nx = 0, ny = 0;
     double w = 0.0;  // profile width (m)
     std::vector<float> value;  // nx * ny, row-major in y
+    // Learned maps only (empty otherwise): log-odds and update stamps per cell.
+    std::vector<float> log_odds;
+    std::vector<std::uint32_t> stamp;
   };
+  /// hector_mapping's default launch file (mapping_default.launch):
+  /// update_factor_occupied 0.9, update_factor_free 0.4.
+  struct UpdateFactors {
+    double occupied = 0.9;
+    double free = 0.4;
+  };
+  static constexpr float kLogOddsBound = 50.0f;
 
   /// Builds every level (throws std::invalid_argument for a resolution <= 0,
   /// levels < 1, or a grid beyond 2^28 cells).
@@ -64,6 +97,29 @@ class OccupancyGrid {
                 Options options);
   OccupancyGrid(const std::vector<models::Solid>& solids, const models::Floor& floor,
                 Options options);
+  /// A learned map over the floor rectangle + margin, every cell unknown
+  /// (log-odds 0, value 0.5). Throws std::invalid_argument for factors
+  /// outside (0, 1).
+  OccupancyGrid(const models::Floor& floor, Options options, UpdateFactors factors);
+
+  bool learned() const { return learned_; }
+  float log_odds_occupied() const { return log_odds_occupied_; }
+  float log_odds_free() const { return log_odds_free_; }
+  /// The probability a log-odds value stands for (what `value` holds).
+  static float Probability(float log_odds) { return 1.0f / (1.0f + std::exp(-log_odds)); }
+  /// Learned maps: every cell back to unknown.
+  void Clear();
+  /// Learned maps: the scan's beams (points px, py in the robot's frame, the
+  /// laser at (ox, oy) in that frame) entered into every level with the
+  /// robot at (x, y, yaw) in map. Allocation-free.
+  void UpdateByScan(std::span<const double> px, std::span<const double> py, double ox, double oy,
+                    double x, double y, double yaw);
+  /// Learned maps: level i's log-odds replaced by `log_odds` (nx * ny
+  /// values), the values recomputed, the stamps reset (a stamp only matters
+  /// within one update). Throws std::invalid_argument on a size mismatch.
+  void SetLogOdds(int i, std::span<const float> log_odds);
+  /// The cell (ix, iy) of level i holding (x, y); false outside the grid.
+  bool CellOf(int i, double x, double y, int& ix, int& iy) const;
 
   /// Whether a solid is in the map for these scan plane heights.
   static bool CoversPlane(const models::Solid& s, std::span<const double> plane_heights);
@@ -113,9 +169,18 @@ class OccupancyGrid {
  private:
   void Build(const models::Floor& floor, const Options& options);
   void Rasterise(Level& l, const models::Solid& s) const;
+  void UpdateLevel(Level& l, std::span<const double> px, std::span<const double> py, double ox,
+                   double oy, double x, double y, double c, double s);
+  void Free(Level& l, std::size_t k) const;
+  void Occupy(Level& l, std::size_t k) const;
 
   std::vector<models::Solid> solids_;
   std::vector<Level> levels_;
+  bool learned_ = false;
+  float log_odds_occupied_ = 0.0f, log_odds_free_ = 0.0f;
+  // hector's update index: a scan's free mark is update_index_ + 1, its
+  // occupied mark update_index_ + 2; + 3 per scan.
+  std::uint32_t update_index_ = 0;
 };
 
 }  // namespace linesim::estimation

@@ -152,5 +152,138 @@ TEST(OccupancyGrid, OutsideTheGridReadsZero) {
   EXPECT_NEAR(g.Value(0, 0.0, 0.0), 2.0, 1e-6);  // deep inside the box
 }
 
+
+// The learned map (map: mapping). Grid over Floor(2, 1) + 0.5 m: 5 x 3 m,
+// 200 x 120 cells of 0.025 m, origin (-2.5, -1.5); the cell of x is
+// floor((x + 2.5) / 0.025), of y floor((y + 1.5) / 0.025). The robot at the
+// origin, heading +x, the laser at (0.01, 0.01) in its frame: cell (100, 60).
+struct Learned {
+  OccupancyGrid g{Floor(2.0, 1.0), {}, {}};
+  double P(int i, double x, double y) const {
+    int ix = 0, iy = 0;
+    EXPECT_TRUE(g.CellOf(i, x, y, ix, iy));
+    return g.level(i).value[static_cast<std::size_t>(iy) * static_cast<std::size_t>(g.level(i).nx) +
+                            static_cast<std::size_t>(ix)];
+  }
+  float L(int i, double x, double y) const {
+    int ix = 0, iy = 0;
+    EXPECT_TRUE(g.CellOf(i, x, y, ix, iy));
+    return g.level(i).log_odds[static_cast<std::size_t>(iy) * static_cast<std::size_t>(g.level(i).nx) +
+                               static_cast<std::size_t>(ix)];
+  }
+  void Scan(const std::vector<double>& px, const std::vector<double>& py) {
+    g.UpdateByScan(px, py, 0.01, 0.01, 0.0, 0.0, 0.0);
+  }
+};
+
+// Guards against a learned map that does not start unknown or whose cells
+// are not where CellOf says.
+TEST(OccupancyGridLearned, StartsUnknown) {
+  const Learned m;
+  ASSERT_TRUE(m.g.learned());
+  EXPECT_EQ(m.g.level(0).nx, 200);
+  EXPECT_EQ(m.g.level(0).ny, 120);
+  for (int i = 0; i < 3; ++i) {
+    for (const float v : m.g.level(i).value) ASSERT_EQ(v, 0.5f);
+    for (const float v : m.g.level(i).log_odds) ASSERT_EQ(v, 0.0f);
+  }
+  int ix = 0, iy = 0;
+  ASSERT_TRUE(m.g.CellOf(0, 0.01, 0.01, ix, iy));
+  EXPECT_EQ(ix, 100);
+  EXPECT_EQ(iy, 60);
+  EXPECT_FALSE(m.g.CellOf(0, 2.6, 0.0, ix, iy));
+  // hector's probToLogOdds of its launch file's 0.9 and 0.4.
+  EXPECT_NEAR(m.g.log_odds_occupied(), 2.1972246, 1e-6);
+  EXPECT_NEAR(m.g.log_odds_free(), -0.4054651, 1e-6);
+  // A map built from the scene is not learned.
+  EXPECT_FALSE(OccupancyGrid({}, Floor(2.0, 1.0), {}).learned());
+}
+
+// Guards against the log-odds update of one beam against a wall at
+// x = 1.01 (cell 140): one hit gives the end cell p = 0.9 (log-odds
+// log 9), not decremented by its own beam; the 40 cells from the laser's
+// (100) to the one before the wall (139) read 0.4 (log-odds log(2/3));
+// the cell behind the wall and the cells beside the beam stay 0.5. The
+// same on level 1 (cells 0.05 m: laser cell 50, wall cell 70).
+TEST(OccupancyGridLearned, OneBeamAgainstAWall) {
+  Learned m;
+  m.Scan({1.01}, {0.01});
+  EXPECT_NEAR(m.P(0, 1.01, 0.01), 0.9, 1e-6);
+  for (int ix = 100; ix < 140; ++ix) {
+    ASSERT_NEAR(m.P(0, -2.5 + (ix + 0.5) * 0.025, 0.01), 0.4, 1e-6) << ix;
+  }
+  EXPECT_EQ(m.P(0, 1.04, 0.01), 0.5);   // behind the wall
+  EXPECT_EQ(m.P(0, 0.5, 0.04), 0.5);    // beside the beam
+  EXPECT_EQ(m.P(0, -0.02, 0.01), 0.5);  // behind the laser
+  EXPECT_NEAR(m.P(1, 1.01, 0.01), 0.9, 1e-6);
+  for (int ix = 50; ix < 70; ++ix) {
+    ASSERT_NEAR(m.P(1, -2.5 + (ix + 0.5) * 0.05, 0.01), 0.4, 1e-6) << ix;
+  }
+  // The level's value is the probability of its log-odds.
+  EXPECT_EQ(m.P(0, 1.01, 0.01), OccupancyGrid::Probability(m.L(0, 1.01, 0.01)));
+  // A second scan: odds multiply, 9^2 = 81 -> 81 / 82; (2/3)^2 = 4/9 -> 4 / 13.
+  m.Scan({1.01}, {0.01});
+  EXPECT_NEAR(m.P(0, 1.01, 0.01), 81.0 / 82.0, 1e-6);
+  EXPECT_NEAR(m.P(0, 0.5, 0.01), 4.0 / 13.0, 1e-6);
+}
+
+// Guards against a cell counted more than once in one scan (hector's update
+// index): 41 beams fanning from the laser to a wall at x = 1.01 share the
+// cells near the laser, which still read 0.4 after the scan; a beam whose
+// end cell another beam of the same scan passes reads 0.9 whichever comes
+// first (hector's updateUnsetFree).
+TEST(OccupancyGridLearned, EachCellOncePerScan) {
+  Learned m;
+  std::vector<double> px, py;
+  for (int j = -20; j <= 20; ++j) {
+    px.push_back(1.01);
+    py.push_back(0.01 + j * 0.0125);
+  }
+  m.Scan(px, py);
+  EXPECT_NEAR(m.P(0, 0.01, 0.01), 0.4, 1e-6);  // the laser's cell, on every beam
+  EXPECT_NEAR(m.P(0, 0.04, 0.01), 0.4, 1e-6);
+  for (int j = -20; j <= 20; ++j) ASSERT_NEAR(m.P(0, 1.01, 0.01 + j * 0.0125), 0.9, 1e-6) << j;
+  for (const bool short_first : {true, false}) {
+    Learned o;
+    if (short_first) {
+      o.Scan({0.51, 1.01}, {0.01, 0.01});
+    } else {
+      o.Scan({1.01, 0.51}, {0.01, 0.01});
+    }
+    EXPECT_NEAR(o.P(0, 0.51, 0.01), 0.9, 1e-6) << short_first;
+    EXPECT_NEAR(o.P(0, 0.26, 0.01), 0.4, 1e-6) << short_first;
+    EXPECT_NEAR(o.P(0, 0.76, 0.01), 0.4, 1e-6) << short_first;
+  }
+}
+
+// Guards against beams leaving the grid updating anything (hector skips a
+// beam whose end cell is off the map), against an unbounded log-odds (a hit
+// only while L < 50: at most 50 + log 9) and against Clear and SetLogOdds
+// not restoring what they promise.
+TEST(OccupancyGridLearned, OffMapBeamsBoundsClearAndRestore) {
+  Learned m;
+  m.Scan({3.0, 0.01}, {0.01, 5.0});
+  for (int i = 0; i < 3; ++i) {
+    for (const float v : m.g.level(i).value) ASSERT_EQ(v, 0.5f);
+  }
+  for (int s = 0; s < 40; ++s) m.Scan({1.01}, {0.01});
+  // 23 hits: 22 log 9 = 48.3 < 50, 23 log 9 = 50.5, then no more.
+  EXPECT_NEAR(m.L(0, 1.01, 0.01), 23 * std::log(9.0), 1e-3);
+  EXPECT_LT(m.L(0, 0.5, 0.01), -15.0);  // 40 misses: -16.2
+  EXPECT_EQ(m.P(0, 1.01, 0.01), 1.0f);
+  // Restore level 0's log-odds into a fresh map: the same values.
+  Learned r;
+  for (int i = 0; i < 3; ++i) r.g.SetLogOdds(i, m.g.level(i).log_odds);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(r.g.level(i).value, m.g.level(i).value) << i;
+  // A further scan gives the same map in both.
+  m.Scan({0.51}, {0.3});
+  r.Scan({0.51}, {0.3});
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(r.g.level(i).log_odds, m.g.level(i).log_odds) << i;
+  EXPECT_THROW(r.g.SetLogOdds(0, std::vector<float>(5, 0.0f)), std::invalid_argument);
+  m.g.Clear();
+  for (const float v : m.g.level(0).value) ASSERT_EQ(v, 0.5f);
+  EXPECT_THROW(OccupancyGrid(Floor(2.0, 1.0), {}, {1.0, 0.4}), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace linesim::estimation
