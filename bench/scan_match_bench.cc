@@ -35,7 +35,8 @@ struct Scan {
 };
 
 Scan FrontScan(const models::Scene& scene, double rx, double ry, double ryaw) {
-  const YAML::Node m = YAML::LoadFile(std::string(LINESIM_SOURCE_DIR) + "/models/sensors/sick_s300.yaml");
+  const YAML::Node m =
+      YAML::LoadFile(std::string(LINESIM_SOURCE_DIR) + "/models/sensors/sick_s300.yaml");
   sensors::LaserScannerUnit u("laser", scene, 541, {}, 42);
   for (const auto& kv : m) {
     const auto ref = u.variables().Find(kv.first.as<std::string>());
@@ -113,7 +114,6 @@ void BM_ScanMatch541Factory(benchmark::State& state) {
   state.counters["iterations"] = r.iterations;
 }
 BENCHMARK(BM_ScanMatch541Factory)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
-
 
 // map: mapping: one match of the 541-beam scan against a learned map (the
 // map built by entering the same scan at the truth, as the unit's first

@@ -47,7 +47,8 @@ LaserLocalizationUnit::LaserLocalizationUnit(std::string name, const models::Sce
   angular_step_.assign(L, nan);
   scan_period_.assign(L, nan);
   ranges_.resize(L);
-  for (std::size_t k = 0; k < L; ++k) ranges_[k].assign(static_cast<std::size_t>(beam_counts_[k]), 0.0);
+  for (std::size_t k = 0; k < L; ++k)
+    ranges_[k].assign(static_cast<std::size_t>(beam_counts_[k]), 0.0);
   scan_count_.assign(L, 0.0);
   scan_time_.assign(L, 0.0);
   odometry_velocity_.assign(2, 0.0);
@@ -130,7 +131,8 @@ LaserLocalizationUnit::LaserLocalizationUnit(std::string name, const models::Sce
               "match for this long the source is 1",
               Rule::Positive());
   v.Parameter("max_cost", "1", &max_cost_,
-              "a match whose mean squared residual exceeds this is rejected", Rule::Range(0, false, 4, true));
+              "a match whose mean squared residual exceeds this is rejected",
+              Rule::Range(0, false, 4, true));
   v.Parameter("max_position_sigma", "m", &max_position_sigma_,
               "a match whose own position sigma (unfloored covariance) exceeds this is rejected "
               "(near-singular Hessian)",
@@ -192,7 +194,8 @@ LaserLocalizationUnit::LaserLocalizationUnit(std::string name, const models::Sce
   v.Output("yaw", "rad", &yaw_, "base_link yaw in map (latest accepted match)", {});
   v.Output("velocity", "m/s", &velocity_,
            "base_link velocity in map: the pose change over the accepted matches of the last "
-           "velocity_window", {});
+           "velocity_window",
+           {});
   v.Output("yaw_rate", "rad/s", &yaw_rate_,
            "yaw rate: the heading change over the accepted matches of the last velocity_window",
            {});
@@ -202,8 +205,8 @@ LaserLocalizationUnit::LaserLocalizationUnit(std::string name, const models::Sce
            "row-major 3 x 3 Gauss-Newton Hessian of the latest accepted match (1/m^2, 1/(m rad), "
            "1/rad^2)",
            {});
-  v.Output("match_time", "s", &match_time_,
-           "time the pose refers to (middle of the matched scan)", {});
+  v.Output("match_time", "s", &match_time_, "time the pose refers to (middle of the matched scan)",
+           {});
   v.Output("match_count", "1", &match_count_, "accepted matches so far", {});
   v.Output("match_cost", "1", &match_cost_,
            "mean squared residual (1 - M)^2 of the latest accepted match", {});
@@ -236,8 +239,8 @@ std::vector<cosim::ParameterProblem> LaserLocalizationUnit::CheckParameters() co
     }
     if (scan_period_[k] >= scan_timeout_) {
       problems.push_back({"scan_timeout", std::nullopt,
-                          "must be > every laser's scan_period (laser " + std::to_string(k) +
-                              ": " + cosim::FormatValue(scan_period_[k]) + " s), got " +
+                          "must be > every laser's scan_period (laser " + std::to_string(k) + ": " +
+                              cosim::FormatValue(scan_period_[k]) + " s), got " +
                               cosim::FormatValue(scan_timeout_)});
     }
   }
@@ -391,8 +394,8 @@ void LaserLocalizationUnit::ProcessScan(int k) {
     return;
   }
   const ScanMatcher::Result res =
-      matcher_->Match(std::span<const double>(px_.data(), n), std::span<const double>(py_.data(), n),
-                      {start.x, start.y, start.yaw});
+      matcher_->Match(std::span<const double>(px_.data(), n),
+                      std::span<const double>(py_.data(), n), {start.x, start.y, start.yaw});
   last_result_ = res;
   // Divergence tests.
   const std::array<double, 6> h{res.hessian[0], res.hessian[1], res.hessian[2],
@@ -430,8 +433,8 @@ void LaserLocalizationUnit::ProcessScan(int k) {
     --history_size_;
   }
   if (history_size_ > 0) {
-    const std::size_t from = window_ns > 0 ? history_begin_
-                                           : (history_begin_ + history_size_ - 1) % kHistory;
+    const std::size_t from =
+        window_ns > 0 ? history_begin_ : (history_begin_ + history_size_ - 1) % kHistory;
     const Pose& old_pose = history_[from];
     const cosim::TimeNs old_ns = history_ns_[from];
     if (match_ns > old_ns) {
@@ -475,8 +478,9 @@ void LaserLocalizationUnit::ProcessScan(int k) {
 
 void LaserLocalizationUnit::UpdateMap(int k, std::size_t n, const Pose& p) {
   const auto kk = static_cast<std::size_t>(k);
-  grid_->UpdateByScan(std::span<const double>(px_.data(), n), std::span<const double>(py_.data(), n),
-                      mount_x_[kk], mount_y_[kk], p.x, p.y, p.yaw);
+  grid_->UpdateByScan(std::span<const double>(px_.data(), n),
+                      std::span<const double>(py_.data(), n), mount_x_[kk], mount_y_[kk], p.x, p.y,
+                      p.yaw);
   mapped_[kk] = 1;
   last_map_pose_[kk] = p;
   map_updates_ += 1.0;

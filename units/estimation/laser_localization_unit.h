@@ -1,8 +1,8 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
-#include <array>
 #include <string>
 #include <vector>
 
@@ -91,8 +91,8 @@ class LaserLocalizationUnit : public cosim::Unit {
   /// One entry of `beam_counts` per laser (1..kMaxLasers lasers, each
   /// 1..100000 beams); throws cosim::UnitError otherwise. The scene's
   /// obstacles and floor are copied (the map is built in Initialize).
-  LaserLocalizationUnit(std::string name, const models::Scene& scene,
-                        std::vector<int> beam_counts, std::uint64_t seed);
+  LaserLocalizationUnit(std::string name, const models::Scene& scene, std::vector<int> beam_counts,
+                        std::uint64_t seed);
   ~LaserLocalizationUnit() override;
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
@@ -191,10 +191,10 @@ class LaserLocalizationUnit : public cosim::Unit {
   std::array<Pose, kHistory> history_{};
   std::array<cosim::TimeNs, kHistory> history_ns_{};
   std::size_t history_begin_ = 0, history_size_ = 0;
-  Pose estimate_;                 // the latest accepted match (or the initial pose)
+  Pose estimate_;                  // the latest accepted match (or the initial pose)
   cosim::TimeNs estimate_ns_ = 0;  // its time
   bool have_match_ = false;
-  Pose odom_;                     // estimate_ moved by odometry up to odom_ns_
+  Pose odom_;  // estimate_ moved by odometry up to odom_ns_
   cosim::TimeNs odom_ns_ = 0;
   cosim::TimeNs step_end_ns_ = 0;
   // map: mapping: per laser, whether its scans have entered the map and the

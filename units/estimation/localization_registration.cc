@@ -31,8 +31,8 @@ std::unique_ptr<cosim::Unit> MakeLaserLocalization(const UnitBuildContext& c) {
     }
     bool ok = true;
     for (std::size_t i = 0; i < list.size(); ++i) {
-      const auto n = c.reader.AsInteger(list[i], config::JoinPath(path, std::to_string(i)), 1,
-                                        100000);
+      const auto n =
+          c.reader.AsInteger(list[i], config::JoinPath(path, std::to_string(i)), 1, 100000);
       if (!n) {
         ok = false;
         continue;

@@ -176,7 +176,8 @@ void OccupancyGrid::UpdateLevel(Level& l, std::span<const double> px, std::span<
 
 void OccupancyGrid::UpdateByScan(std::span<const double> px, std::span<const double> py, double ox,
                                  double oy, double x, double y, double yaw) {
-  if (!learned_) throw std::logic_error("occupancy grid: UpdateByScan on a map built from the scene");
+  if (!learned_)
+    throw std::logic_error("occupancy grid: UpdateByScan on a map built from the scene");
   // Before the marks could wrap: every stamp back below the next scan's.
   if (update_index_ > std::numeric_limits<std::uint32_t>::max() - 2 * kMarks) {
     for (Level& l : levels_) std::fill(l.stamp.begin(), l.stamp.end(), 0u);

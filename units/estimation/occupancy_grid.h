@@ -1,7 +1,7 @@
 #pragma once
 
-#include <cstddef>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -68,16 +68,16 @@ namespace linesim::estimation {
 class OccupancyGrid {
  public:
   struct Options {
-    double resolution = 0.025;  // finest cell (m): hector's map_resolution default
-    int levels = 3;             // hector's map_multi_res_levels default
-    double margin = 0.5;        // m beyond the floor rectangle
-    double profile_cells = 2.0; // w in cells of each level (see above)
+    double resolution = 0.025;   // finest cell (m): hector's map_resolution default
+    int levels = 3;              // hector's map_multi_res_levels default
+    double margin = 0.5;         // m beyond the floor rectangle
+    double profile_cells = 2.0;  // w in cells of each level (see above)
   };
   struct Level {
     double cell = 0.0, inv_cell = 0.0;
     double origin_x = 0.0, origin_y = 0.0;  // corner of cell (0, 0)
     int nx = 0, ny = 0;
-    double w = 0.0;  // profile width (m)
+    double w = 0.0;            // profile width (m)
     std::vector<float> value;  // nx * ny, row-major in y
     // Learned maps only (empty otherwise): log-odds and update stamps per cell.
     std::vector<float> log_odds;
@@ -93,8 +93,7 @@ class OccupancyGrid {
 
   /// Builds every level (throws std::invalid_argument for a resolution <= 0,
   /// levels < 1, or a grid beyond 2^28 cells).
-  OccupancyGrid(const models::Scene& scene, std::span<const double> plane_heights,
-                Options options);
+  OccupancyGrid(const models::Scene& scene, std::span<const double> plane_heights, Options options);
   OccupancyGrid(const std::vector<models::Solid>& solids, const models::Floor& floor,
                 Options options);
   /// A learned map over the floor rectangle + margin, every cell unknown
@@ -156,7 +155,8 @@ class OccupancyGrid {
     }
     const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
     const double tx = fx - ix, ty = fy - iy;
-    const float* p = l.value.data() + static_cast<std::size_t>(iy) * static_cast<std::size_t>(l.nx) +
+    const float* p = l.value.data() +
+                     static_cast<std::size_t>(iy) * static_cast<std::size_t>(l.nx) +
                      static_cast<std::size_t>(ix);
     const double v00 = p[0], v10 = p[1], v01 = p[l.nx], v11 = p[l.nx + 1];
     const double a = v00 + tx * (v10 - v00);  // along x at y = iy

@@ -35,7 +35,8 @@ bool InverseSymmetric3(const std::array<double, 6>& h, std::array<double, 9>& in
     std::array<double, 3> e{}, col{};
     e[static_cast<std::size_t>(c)] = 1.0;
     if (!SolveSymmetric3(h, e, col)) return false;
-    for (int r = 0; r < 3; ++r) inv[static_cast<std::size_t>(3 * r + c)] = col[static_cast<std::size_t>(r)];
+    for (int r = 0; r < 3; ++r)
+      inv[static_cast<std::size_t>(3 * r + c)] = col[static_cast<std::size_t>(r)];
   }
   // Exactly symmetric (the column solves round differently).
   for (const auto& [a, b] : {std::pair{1, 3}, std::pair{2, 6}, std::pair{5, 7}}) {
@@ -109,8 +110,8 @@ ScanMatcher::Result ScanMatcher::Match(std::span<const double> px, std::span<con
       res.pose.x += d[0];
       res.pose.y += d[1];
       res.pose.yaw += d[2];
-      if (std::abs(d[0]) < options_.min_step_position && std::abs(d[1]) < options_.min_step_position &&
-          std::abs(d[2]) < options_.min_step_yaw) {
+      if (std::abs(d[0]) < options_.min_step_position &&
+          std::abs(d[1]) < options_.min_step_position && std::abs(d[2]) < options_.min_step_yaw) {
         break;
       }
     }

@@ -27,9 +27,9 @@ namespace linesim::estimation {
 class ScanMatcher {
  public:
   struct Options {
-    int coarse_iterations = 3;  // hector: 3 on each coarser level
-    int fine_iterations = 5;    // hector: 5 on the finest
-    double max_angle_step = 0.2;  // rad, hector's clamp
+    int coarse_iterations = 3;        // hector: 3 on each coarser level
+    int fine_iterations = 5;          // hector: 5 on the finest
+    double max_angle_step = 0.2;      // rad, hector's clamp
     double min_step_position = 1e-4;  // m
     double min_step_yaw = 1e-4;       // rad
   };

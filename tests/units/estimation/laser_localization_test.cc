@@ -1,8 +1,6 @@
 // The laser_localization unit (units/estimation/laser_localization_unit.h),
 // driven by hand with synthetic scans of two Rob@Work 3 S300 lasers,
 // ray-cast analytically against the test room (scan_matcher_test.cc).
-#include "units/estimation/laser_localization_unit.h"
-
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -15,6 +13,7 @@
 #include "config/unit_registry.h"
 #include "config/yaml_reader.h"
 #include "tests/units/test_helpers.h"
+#include "units/estimation/laser_localization_unit.h"
 
 namespace linesim::estimation {
 
@@ -83,9 +82,7 @@ std::vector<double> ScanRanges(int k, double start, Trajectory truth,
 
 std::unique_ptr<LaserLocalizationUnit> MakeUnit(const models::Scene& scene, Pose initial) {
   auto u = std::make_unique<LaserLocalizationUnit>("loc", scene, std::vector<int>{541, 541}, 7);
-  auto set2 = [&](const char* key, int j) {
-    SetArray(*u, key, {kMount[0][j], kMount[1][j]});
-  };
+  auto set2 = [&](const char* key, int j) { SetArray(*u, key, {kMount[0][j], kMount[1][j]}); };
   set2("mount_x", 0);
   set2("mount_y", 1);
   set2("mount_z", 2);
@@ -324,8 +321,8 @@ TEST(LaserLocalization, NamesParameterProblems) {
   auto v = std::make_unique<LaserLocalizationUnit>("loc", scene, std::vector<int>{541, 541}, 7);
   names.clear();
   for (const auto& p : v->CheckParameters()) names.push_back(p.variable);
-  for (const char* required : {"mount_x", "mount_yaw", "first_beam_angle", "scan_period", "initial_x",
-                               "initial_yaw"}) {
+  for (const char* required :
+       {"mount_x", "mount_yaw", "first_beam_angle", "scan_period", "initial_x", "initial_yaw"}) {
     EXPECT_NE(std::find(names.begin(), names.end(), required), names.end()) << required;
   }
   EXPECT_THROW(LaserLocalizationUnit("x", scene, {}, 1), cosim::UnitError);
@@ -413,8 +410,8 @@ TEST(LaserLocalizationMapping, TracksAndLearnsTheRoom) {
       d.Step();
       if (Get(*u, "match_count")[0] < 1.0) continue;
       const Pose truth = Drive(Get(*u, "match_time")[0]);
-      emax = std::max(emax, std::hypot(Get(*u, "position")[0] - truth.x,
-                                       Get(*u, "position")[1] - truth.y));
+      emax = std::max(
+          emax, std::hypot(Get(*u, "position")[0] - truth.x, Get(*u, "position")[1] - truth.y));
       ymax = std::max(ymax, std::abs(Get(*u, "yaw")[0] - truth.yaw));
     }
     // 12 s, 50 scans per second, the first two mapped unmatched.

@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include <array>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -46,15 +46,16 @@ TEST(OccupancyGrid, HoldsTheStaticSolidsAtTheScanPlane) {
   models::Scene scene;
   scene.floor = Floor(5.0, 5.0);
   scene.obstacles.push_back({"cart", "cart", models::BoxSolid(1.0, 1.0, 0.0, 1.2, 0.8, 1.0)});
-  scene.obstacles.push_back({"shelf", "rack", models::BoxSolid(-2.0, 1.0, 0.0, 1.0, 1.0, 0.3, 0.5)});
+  scene.obstacles.push_back(
+      {"shelf", "rack", models::BoxSolid(-2.0, 1.0, 0.0, 1.0, 1.0, 0.3, 0.5)});
   scene.obstacles.push_back({"pillar", "pillar", models::CylinderSolid(2.0, -2.0, 0.25, 4.0)});
   scene.carried.push_back({"body", 0, models::BoxSolid(0.0, -3.0, 0.0, 4.6, 1.8, 1.2, 0.3)});
   const std::vector<double> planes{0.178};
   const OccupancyGrid g(scene, planes, {});
   EXPECT_EQ(g.solid_count(), 2u);
-  EXPECT_NEAR(g.Value(0, 1.6, 1.0), 1.0, 1e-6);   // the cart's face at x = 1.6
-  EXPECT_EQ(g.Value(0, -2.5, 1.0), 0.0);          // the shelf's face: not in the map
-  EXPECT_EQ(g.Value(0, 0.0, -3.9), 0.0);          // the car body's side: not in the map
+  EXPECT_NEAR(g.Value(0, 1.6, 1.0), 1.0, 1e-6);  // the cart's face at x = 1.6
+  EXPECT_EQ(g.Value(0, -2.5, 1.0), 0.0);         // the shelf's face: not in the map
+  EXPECT_EQ(g.Value(0, 0.0, -3.9), 0.0);         // the car body's side: not in the map
   const std::vector<double> high{0.6};
   EXPECT_EQ(OccupancyGrid(scene, high, {}).solid_count(), 3u);
 }
@@ -152,7 +153,6 @@ TEST(OccupancyGrid, OutsideTheGridReadsZero) {
   EXPECT_NEAR(g.Value(0, 0.0, 0.0), 2.0, 1e-6);  // deep inside the box
 }
 
-
 // The learned map (map: mapping). Grid over Floor(2, 1) + 0.5 m: 5 x 3 m,
 // 200 x 120 cells of 0.025 m, origin (-2.5, -1.5); the cell of x is
 // floor((x + 2.5) / 0.025), of y floor((y + 1.5) / 0.025). The robot at the
@@ -168,8 +168,9 @@ struct Learned {
   float L(int i, double x, double y) const {
     int ix = 0, iy = 0;
     EXPECT_TRUE(g.CellOf(i, x, y, ix, iy));
-    return g.level(i).log_odds[static_cast<std::size_t>(iy) * static_cast<std::size_t>(g.level(i).nx) +
-                               static_cast<std::size_t>(ix)];
+    return g.level(i)
+        .log_odds[static_cast<std::size_t>(iy) * static_cast<std::size_t>(g.level(i).nx) +
+                  static_cast<std::size_t>(ix)];
   }
   void Scan(const std::vector<double>& px, const std::vector<double>& py) {
     g.UpdateByScan(px, py, 0.01, 0.01, 0.0, 0.0, 0.0);

@@ -23,8 +23,10 @@ models::Floor RoomFloor() { return {-5.0, 5.0, -4.0, 4.0, 0}; }
 
 // A 10 x 8 m room: walls 0.2 m thick on its edges.
 std::vector<models::Solid> EmptyRoom() {
-  return {models::BoxSolid(0.0, 3.9, 0.0, 10.0, 0.2, 3.0), models::BoxSolid(0.0, -3.9, 0.0, 10.0, 0.2, 3.0),
-          models::BoxSolid(-4.9, 0.0, 0.0, 0.2, 8.0, 3.0), models::BoxSolid(4.9, 0.0, 0.0, 0.2, 8.0, 3.0)};
+  return {models::BoxSolid(0.0, 3.9, 0.0, 10.0, 0.2, 3.0),
+          models::BoxSolid(0.0, -3.9, 0.0, 10.0, 0.2, 3.0),
+          models::BoxSolid(-4.9, 0.0, 0.0, 0.2, 8.0, 3.0),
+          models::BoxSolid(4.9, 0.0, 0.0, 0.2, 8.0, 3.0)};
 }
 
 // The room with pillars (r 0.25 m) and carts, placed without symmetry.
@@ -58,7 +60,8 @@ double Cast(const std::vector<models::Solid>& solids, double x, double y, double
     const double o[2] = {c * ox + sn * oy, -sn * ox + c * oy};
     const double d[2] = {c * dx + sn * dy, -sn * dx + c * dy};
     const double half[2] = {0.5 * s.length_m, 0.5 * s.width_m};
-    double t0 = -std::numeric_limits<double>::infinity(), t1 = std::numeric_limits<double>::infinity();
+    double t0 = -std::numeric_limits<double>::infinity(),
+           t1 = std::numeric_limits<double>::infinity();
     for (int a = 0; a < 2; ++a) {
       if (d[a] == 0.0) {
         if (std::abs(o[a]) > half[a]) t0 = std::numeric_limits<double>::infinity();
