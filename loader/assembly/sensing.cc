@@ -135,6 +135,14 @@ void AddLaserLocalization(SystemBuilder& b, const ProviderContext& c, Signals& s
   p["first_beam_angle"] = List(first);
   p["angular_step"] = List(step);
   p["scan_period"] = List(period);
+  // localization.map: the scene's map (default) or one learned while
+  // driving, as hector_mapping does.
+  const YAML::Node map = Child(c.at, "map");
+  if (map.IsDefined()) {
+    p["map"] = b.reader().String(c.at, "localization", "map", "scene", {"scene", "mapping"});
+    b.Derived(JoinPath(JoinPath(JoinPath("units", kLaserLocalization), "parameters"), "map"),
+              c.at, "localization", "map");
+  }
   SetInitialPose(p, c.start);
   SetStep(b, kLaserLocalization);
   s.recorded.push_back(Signal(kLaserLocalization, "source"));
@@ -373,8 +381,11 @@ std::vector<std::string> Names(const std::map<std::string, Provider>& providers)
 // The provider `section.key` chooses, and where it was chosen.
 std::pair<std::string, YAML::Node> Choose(SystemBuilder& b, const std::string& section,
                                           const std::string& key,
-                                          const std::map<std::string, Provider>& providers) {
-  const YAML::Node node = b.Section(b.root(), "", section, {key});
+                                          const std::map<std::string, Provider>& providers,
+                                          const std::vector<std::string>& other_keys = {}) {
+  std::vector<std::string> keys = {key};
+  keys.insert(keys.end(), other_keys.begin(), other_keys.end());
+  const YAML::Node node = b.Section(b.root(), "", section, keys);
   return {b.reader().String(node, section, key, "ground_truth", Names(providers)), node};
 }
 
@@ -402,7 +413,7 @@ void AddSensing(SystemBuilder& b, const RobotFile& file, const StartPose& start,
   const auto [surface, surface_node] =
       Choose(b, "sensing", "surface_velocity", SurfaceVelocityProviders());
   const auto [localization, localization_node] =
-      Choose(b, "localization", "source", LocalizationProviders());
+      Choose(b, "localization", "source", LocalizationProviders(), {"map"});
   // The pose and velocity first: the surface velocity (Eq. 2) needs the
   // robot's velocity; the odometry's rectification (Eq. 3) then takes the
   // surface velocity, whoever provides it. Neither depends directly on the
@@ -414,6 +425,10 @@ void AddSensing(SystemBuilder& b, const RobotFile& file, const StartPose& start,
   if (const auto it = SurfaceVelocityProviders().find(surface);
       it != SurfaceVelocityProviders().end()) {
     it->second(b, {file, start, scene, surface_node, "sensing.surface_velocity"}, s);
+  }
+  if (Child(localization_node, "map").IsDefined() && !b.HasUnit(kLaserLocalization)) {
+    b.reader().Error(Child(localization_node, "map"), "localization.map",
+                     "a map is matched against only with localization.source laser or fused");
   }
   if (!s.odometry.empty() && !s.surface_velocity.empty()) {
     b.Connect(s.surface_velocity, Signal(s.odometry, "surface_velocity"));

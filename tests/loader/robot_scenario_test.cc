@@ -310,6 +310,17 @@ localization: {source: laser}
   const std::string d = Issues(f);
   EXPECT_TRUE(Has(d, "localization.source")) << d;
   EXPECT_TRUE(Has(d, "at most 1000 m a side")) << d;
+  // localization.map: scene or mapping, and only where scans are matched.
+  const std::string m = Issues(kCross, {"localization.source=laser", "localization.map=learned"});
+  EXPECT_TRUE(Has(m, "localization.map")) << m;
+  EXPECT_TRUE(Has(m, "mapping")) << m;
+  const std::string g = Issues(kCross, {"localization.map=mapping"});
+  EXPECT_TRUE(Has(g, "only with localization.source laser or fused")) << g;
+  const Scenario learned =
+      LoadScenario(kCross, {"localization.source=laser", "localization.map=mapping"});
+  const auto& table =
+      learned.system->unit(*learned.system->FindUnit("laser_localization")).variables();
+  EXPECT_EQ(table.GetString(*table.Find("map")), "mapping");
 }
 
 // Guards the robot-level checks: unknown keys name the closest, values out
