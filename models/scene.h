@@ -164,6 +164,15 @@ struct Scene {
   }
 };
 
+/// Whether map point (x, y) lies in the rotated rectangle `r` (edges count
+/// as inside); `cos_dir`, `sin_dir`: cosine and sine of r.direction_rad, which
+/// callers testing many points cache.
+inline bool InsideRect(const Rect& r, double cos_dir, double sin_dir, double x, double y) {
+  const double dx = x - r.center_x_m, dy = y - r.center_y_m;
+  const double along = dx * cos_dir + dy * sin_dir, across = -dx * sin_dir + dy * cos_dir;
+  return std::abs(along) <= 0.5 * r.length_m && std::abs(across) <= 0.5 * r.width_m;
+}
+
 /// The belt travel over which an object a belt carries (its footprint at
 /// zero travel: `solid`) lies along the belt's length (`belt_area`): its
 /// footprint's extent along the belt axis within the belt's two ends.

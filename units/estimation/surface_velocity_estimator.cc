@@ -11,16 +11,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Inside the rotated rectangle (the same test as the px4flow's and the
-// chassis' belt patches: edges count as inside).
-bool Inside(const models::Rect& r, double c, double s, double x, double y) {
-  const double dx = x - r.center_x_m, dy = y - r.center_y_m;
-  const double along = dx * c + dy * s, across = -dx * s + dy * c;
-  return std::abs(along) <= 0.5 * r.length_m && std::abs(across) <= 0.5 * r.width_m;
-}
-
-cosim::TimeNs SecondsToNs(double s) { return static_cast<cosim::TimeNs>(std::llround(s * 1e9)); }
-
 // Flags of a sensor within one step (scratch).
 constexpr char kMoved = 1;     // the map moved it to another surface this step
 constexpr char kMeasured = 2;  // a new valid message of quality > 0 this step
@@ -224,8 +214,8 @@ void SurfaceVelocityEstimator::Cache() {
     mount_cos_[i] = std::cos(sensor_yaw_[i]);
     mount_sin_[i] = std::sin(sensor_yaw_[i]);
   }
-  sample_period_ns_ = SecondsToNs(sample_period_);
-  stale_after_ns_ = SecondsToNs(stale_after_);
+  sample_period_ns_ = cosim::SecondsToNs(sample_period_);
+  stale_after_ns_ = cosim::SecondsToNs(stale_after_);
   decay_dt_ = -1;
   decay_factor_ = 1.0;
 }
@@ -266,7 +256,7 @@ void SurfaceVelocityEstimator::Initialize() {
 
 int SurfaceVelocityEstimator::SurfaceAt(double x, double y) const {
   for (std::size_t b = 0; b < belts_.size(); ++b) {
-    if (Inside(belts_[b].area, belts_[b].cos_dir, belts_[b].sin_dir, x, y)) {
+    if (models::InsideRect(belts_[b].area, belts_[b].cos_dir, belts_[b].sin_dir, x, y)) {
       return static_cast<int>(b) + 1;
     }
   }

@@ -79,11 +79,7 @@ void SurfaceVelocityErrorUnit::Evaluate() {
     const double ux = ca * mx - sa * my + vx;
     const double uy = sa * mx + ca * my + vy;
     surface_speed_[k] = ux * bx + uy * by;
-    // Over the belt: inside its rectangle.
-    const double dx = px - belt_area_.center_x_m, dy = py - belt_area_.center_y_m;
-    const double along = dx * bx + dy * by, across = -dx * by + dy * bx;
-    const bool over = std::abs(along) <= 0.5 * belt_area_.length_m &&
-                      std::abs(across) <= 0.5 * belt_area_.width_m;
+    const bool over = models::InsideRect(belt_area_, bx, by, px, py);
     over_belt_[k] = over ? 1.0 : 0.0;
     error_[k] = over ? surface_speed_[k] - reference_ : 0.0;
     if (!estimated_.empty()) {

@@ -17,27 +17,25 @@ constexpr std::uint64_t kImageSeedSalt = 0x9e3779b97f4a7c15ULL;
 // at texture_scale 1 mm, mount height 0.1841 m, over contrast 0.02..0.3,
 // 20..3000 lx, 0..0.7 m/s (see the class comment and the calibration test
 // tests/units/sensors/px4flow_fast_vs_image_test.cc).
-constexpr double kDiffPerSigma = 19.1492;   // 24 * sqrt(2 / pi)
-constexpr double kNeighbourDiff = 0.45;     // std of a neighbour difference / (mean * contrast)
-constexpr double kBlurScalePx = 1.8;        // blur length halving the along-motion part
-constexpr double kBlockShape = 3.0;         // Gamma shape of the block-to-block texture variance
-constexpr double kNoiseSpread = 0.2;        // relative spread of a noise-only measure
-constexpr double kLostSnr = 0.18;           // snr at which half the blocks match noise
-constexpr double kMatchNoise = 0.42;        // block offset std * snr (px)
-constexpr double kMatchNoiseMax = 1.0;      // its limit at low snr (px)
-constexpr double kAliasScalePx = 2.3;       // beyond the window: P(edge match) = exp(-(e/2.3)^2)
+constexpr double kDiffPerSigma = 19.1492;  // 24 * sqrt(2 / pi)
+constexpr double kNeighbourDiff = 0.45;    // std of a neighbour difference / (mean * contrast)
+constexpr double kBlurScalePx = 1.8;       // blur length halving the along-motion part
+constexpr double kBlockShape = 3.0;        // Gamma shape of the block-to-block texture variance
+constexpr double kNoiseSpread = 0.2;       // relative spread of a noise-only measure
+constexpr double kLostSnr = 0.18;          // snr at which half the blocks match noise
+constexpr double kMatchNoise = 0.42;       // block offset std * snr (px)
+constexpr double kMatchNoiseMax = 1.0;     // its limit at low snr (px)
+constexpr double kAliasScalePx = 2.3;      // beyond the window: P(edge match) = exp(-(e/2.3)^2)
 
-inline double Uniform(std::mt19937_64& rng) {
-  return static_cast<double>(rng() >> 11) * 0x1.0p-53;
-}
+inline double Uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
 // The block draws are many (25 per frame, 400 frames per second per
 // sensor), so they use one 64-bit draw for several numbers:
 // a zero-mean unit-variance Irwin-Hall variable (the sum of four 16-bit
 // uniforms; bounded at +-3.46, close to normal) ...
 inline double IrwinHall4(std::uint64_t r) {
-  const double sum = static_cast<double>((r & 0xffff) + ((r >> 16) & 0xffff) +
-                                         ((r >> 32) & 0xffff) + (r >> 48));
+  const double sum =
+      static_cast<double>((r & 0xffff) + ((r >> 16) & 0xffff) + ((r >> 32) & 0xffff) + (r >> 48));
   return (sum * (1.0 / 65536.0) - 2.0) * 1.7320508075688772;
 }
 
@@ -69,12 +67,6 @@ inline double Normal(std::mt19937_64& rng) {
 
 inline double RoundHalf(double x) { return 0.5 * std::nearbyint(2.0 * x); }
 
-bool Inside(const models::Rect& r, double c, double s, double x, double y) {
-  const double dx = x - r.center_x_m, dy = y - r.center_y_m;
-  const double along = dx * c + dy * s, across = -dx * s + dy * c;
-  return std::abs(along) <= 0.5 * r.length_m && std::abs(across) <= 0.5 * r.width_m;
-}
-
 }  // namespace
 
 Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint64_t seed)
@@ -82,8 +74,8 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
   if (surfaces_.empty()) throw cosim::UnitError(Where() + ": the scene has no surfaces");
   floor_surface_ = scene.floor.surface;
   for (const models::Belt& b : scene.belts) {
-    belts_.push_back({b.area, b.surface, std::cos(b.area.direction_rad),
-                      std::sin(b.area.direction_rad)});
+    belts_.push_back(
+        {b.area, b.surface, std::cos(b.area.direction_rad), std::sin(b.area.direction_rad)});
   }
   const auto n_belts = belts_.size();
   position_.assign(2, 0.0);
@@ -189,8 +181,7 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
   v.Output("valid", "1", &valid_, "1 if velocity is from the last message, 0 if held", {});
   v.Output("message_count", "1", &message_count_,
            "messages published so far (a new message: the count changed)", {});
-  v.Output("frame_quality", "1", &frame_quality_, "quality of the last camera frame (0..255)",
-           {});
+  v.Output("frame_quality", "1", &frame_quality_, "quality of the last camera frame (0..255)", {});
   v.Output("frame_flow", "1", &frame_flow_,
            "flow of the last camera frame, x and y, pixels per frame (0 when quality is 0)", {});
 }
@@ -268,7 +259,7 @@ void Px4FlowUnit::TrueFlow(double& fx, double& fy, int& surface) const {
   double ux = 0.0, uy = 0.0;
   surface = floor_surface_;
   for (std::size_t b = 0; b < belts_.size(); ++b) {
-    if (Inside(belts_[b].area, belts_[b].cos_dir, belts_[b].sin_dir, px, py)) {
+    if (models::InsideRect(belts_[b].area, belts_[b].cos_dir, belts_[b].sin_dir, px, py)) {
       ux = belt_velocity_[2 * b];
       uy = belt_velocity_[2 * b + 1];
       surface = belts_[b].surface;
@@ -328,7 +319,8 @@ void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, i
   int used = 0;
   for (int k = 0; k < 25; ++k) {
     const double x = Gamma3(rng_());
-    const double m = kDiffPerSigma * (std::sqrt(d * d * x + n2) + kNoiseSpread * n * IrwinHall4(rng_()));
+    const double m =
+        kDiffPerSigma * (std::sqrt(d * d * x + n2) + kNoiseSpread * n * IrwinHall4(rng_()));
     if (m < thr) continue;
     double ox, oy;
     const std::uint64_t r = rng_();
@@ -443,15 +435,16 @@ cosim::StepResult Px4FlowUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
 
 void Px4FlowUnit::SaveInternal(cosim::UnitState& state) const {
   if (image_) {
-    throw cosim::UnitError(Where() + ": mode image cannot save its state (the rendered texture "
-                                     "and the last image are not kept); use mode fast");
+    throw cosim::UnitError(Where() +
+                           ": mode image cannot save its state (the rendered texture "
+                           "and the last image are not kept); use mode fast");
   }
   std::ostringstream rng;
   rng << rng_;
   state.strings = {rng.str()};
   state.reals = {acc_x_, acc_y_, acc_gyro_[0], acc_gyro_[1], acc_gyro_[2]};
-  state.integers = {start_,       next_frame_, next_publish_, frame_index_,
-                    publish_index_, acc_count_, acc_quality_};
+  state.integers = {start_,         next_frame_, next_publish_, frame_index_,
+                    publish_index_, acc_count_,  acc_quality_};
 }
 
 void Px4FlowUnit::RestoreInternal(const cosim::UnitState& state) {
