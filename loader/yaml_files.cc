@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
+#include <optional>
+#include <set>
+#include <vector>
 
 #include "cosim/closest_names.h"
 #include "models/models_dir.h"
@@ -9,6 +13,44 @@
 namespace linesim::loader {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// The first key a map of `node`'s tree gives twice (yaml-cpp keeps both
+// pairs and a lookup finds the first, so the second would be silently
+// ignored): its text and the lines of both. Nodes reached again through an
+// alias (the same position in the file) are scanned once.
+struct DuplicateKey {
+  std::string key;
+  int line = 0, first_line = 0;
+};
+
+std::optional<DuplicateKey> FindDuplicateKey(const YAML::Node& node,
+                                             std::set<std::size_t>& visited) {
+  if (!node.IsMap() && !node.IsSequence()) return std::nullopt;
+  const YAML::Mark mark = node.Mark();
+  if (!mark.is_null() && !visited.insert(static_cast<std::size_t>(mark.pos)).second) {
+    return std::nullopt;
+  }
+  if (node.IsSequence()) {
+    for (const auto& item : node) {
+      if (auto d = FindDuplicateKey(item, visited)) return d;
+    }
+    return std::nullopt;
+  }
+  std::map<std::string, int> seen;
+  for (const auto& kv : node) {
+    if (kv.first.IsScalar()) {
+      const int line = kv.first.Mark().is_null() ? 0 : kv.first.Mark().line + 1;
+      const auto [it, fresh] = seen.emplace(kv.first.Scalar(), line);
+      if (!fresh) return DuplicateKey{kv.first.Scalar(), line, it->second};
+    }
+    if (auto d = FindDuplicateKey(kv.second, visited)) return d;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
 
 YamlFile LoadYamlFile(const std::string& file) {
   YamlFile out;
@@ -22,7 +64,27 @@ YamlFile LoadYamlFile(const std::string& file) {
     return out;
   }
   try {
-    out.root = YAML::LoadFile(file);
+    // Every document of the file: a second one (after "---", or after a
+    // "..." end marker) would be silently dropped by a single-document read.
+    const std::vector<YAML::Node> documents = YAML::LoadAllFromFile(file);
+    if (documents.size() > 1) {
+      out.problem = YamlFile::Problem::kInvalid;
+      out.detail =
+          "a second YAML document (after '---' or '...'): linesim reads one document per file, "
+          "so the rest would be ignored";
+      const YAML::Mark m = documents[1].Mark();
+      out.line = m.is_null() ? 0 : m.line + 1;
+      return out;
+    }
+    if (!documents.empty()) out.root = documents.front();
+    std::set<std::size_t> visited;
+    if (const auto d = FindDuplicateKey(out.root, visited)) {
+      out.problem = YamlFile::Problem::kInvalid;
+      out.detail = "key '" + d->key + "' appears twice in one map (first at line " +
+                   std::to_string(d->first_line) + "): one of them would be ignored";
+      out.line = d->line;
+      out.root = YAML::Node();
+    }
   } catch (const YAML::BadFile&) {
     out.problem = YamlFile::Problem::kUnreadable;
     out.detail = "not readable";

@@ -383,6 +383,37 @@ units:
   EXPECT_EQ(first("gear_ratio"), 1.0);
 }
 
+// Guards YAML that parses but would mean something else: a key written
+// twice in one map (a lookup finds the first, the second would be ignored),
+// a second document after "---" and content after a "..." end marker (a
+// single-document read drops it). Each is refused at its line. An alias
+// used twice is one node, not a duplicate; a file ending in "..." is fine.
+TEST(LoadScenario, DuplicateKeysAndSecondDocumentsAreRefused) {
+  const std::string twice = WriteScenario(
+      "twice.yaml", "name: t\nduration_s: 1\nunits: {}\nduration_s: 2\n");
+  const std::string a = Issues(twice);
+  EXPECT_TRUE(Has(a, twice + ":4: not valid YAML: key 'duration_s' appears twice in one map "
+                          "(first at line 2)"))
+      << a;
+  const std::string nested = WriteScenario(
+      "nested_twice.yaml",
+      "name: t\nduration_s: 1\nunits:\n  m: {type: dc_motor, parameters: {resistance: 1, "
+      "resistance: 2}}\n");
+  EXPECT_TRUE(Has(Issues(nested), "key 'resistance' appears twice")) << Issues(nested);
+  const std::string second =
+      WriteScenario("second.yaml", "name: t\nduration_s: 1\nunits: {}\n---\nseed: 3\n");
+  EXPECT_TRUE(Has(Issues(second), second + ":5: not valid YAML: a second YAML document"))
+      << Issues(second);
+  const std::string ended =
+      WriteScenario("ended.yaml", "name: t\nduration_s: 1\nunits: {}\n...\nseed: 3\n");
+  EXPECT_TRUE(Has(Issues(ended), "a second YAML document")) << Issues(ended);
+  const std::string fine = WriteScenario(
+      "aliases.yaml",
+      "name: t\nduration_s: 1\nunits:\n  a: {type: dc_motor, parameters: &p {resistance: 1}}\n"
+      "  b: {type: dc_motor, parameters: *p}\n...\n");
+  EXPECT_EQ(Issues(fine), "(no error)");
+}
+
 // Guards file-level failures: a missing file and malformed YAML.
 TEST(LoadScenario, UnreadableAndMalformedFiles) {
   EXPECT_TRUE(Has(Issues("/nonexistent/x.yaml"), "cannot read the file"));
