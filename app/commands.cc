@@ -157,6 +157,12 @@ int RunCommand(const std::string& file, const std::string& out_dir,
                              " (disk full or not writable): the signals are incomplete");
   }
 
+  // A metric that overflowed fails the run, naming the metric.
+  for (const auto& e : metrics.NonFiniteResults()) {
+    outcome.ok = false;
+    outcome.errors.push_back(e);
+  }
+
   const cosim::MasterOptions& options = s.master->options();
   const double simulated_s = cosim::NsToSeconds(result.end_time - options.start);
   Json summary;

@@ -144,6 +144,18 @@ void MetricsObserver::OnSample(TimeNs, const System& system) {
   ++samples_;
 }
 
+std::vector<std::string> MetricsObserver::NonFiniteResults() const {
+  std::vector<std::string> out;
+  for (const auto& [name, value] : Results()) {
+    if (std::isfinite(value)) continue;
+    out.push_back("metric '" + name + "' is " + (std::isnan(value) ? "NaN" : "infinite") +
+                  (samples_ == 0 ? " (no sample was taken)"
+                                 : " (its reduction overflowed): the run's numbers are not "
+                                   "trustworthy"));
+  }
+  return out;
+}
+
 std::vector<std::pair<std::string, double>> MetricsObserver::Results() const {
   std::vector<std::pair<std::string, double>> out;
   const double n = static_cast<double>(samples_);

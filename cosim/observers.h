@@ -66,6 +66,10 @@ class MetricsObserver : public Observer {
   void OnSample(TimeNs t, const System& system) override;
   /// Name and value of each metric, in the order given.
   std::vector<std::pair<std::string, double>> Results() const;
+  /// One message per metric whose value is not finite (a reduction that
+  /// overflowed, e.g. a mean of huge values, or no sample at all): a run
+  /// with such a metric has failed, its numbers are not to be trusted.
+  std::vector<std::string> NonFiniteResults() const;
 
  private:
   struct Accumulator {

@@ -64,6 +64,10 @@ RunOutcome ExecuteRun(const SweepSpec& spec, const RunSpec& run, const std::atom
     }
     const auto values = metrics.Results();
     for (std::size_t i = 0; i < values.size(); ++i) out.metrics[i] = values[i].second;
+    // A metric that overflowed fails the run, naming the metric.
+    std::string overflow;
+    for (const auto& e : metrics.NonFiniteResults()) overflow += (overflow.empty() ? "" : "; ") + e;
+    if (!overflow.empty()) return finish(RunStatus::kFailed, overflow);
     return finish(RunStatus::kOk, "");
   } catch (const std::exception& e) {
     return finish(RunStatus::kFailed, e.what());

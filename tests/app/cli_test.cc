@@ -250,6 +250,27 @@ connections:
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 11) << csv;
 }
 
+// Guards against a metric that overflowed passing for a good run: the mean
+// of 1e308 over the 101 samples of 0.1 s at 1 ms sums past the largest
+// double (1.8e308), so the metric is inf; the run fails (exit 1) naming it,
+// status failed, while the signal itself stays finite (no unit fails).
+TEST(Cli, AMetricThatOverflowsFailsTheRun) {
+  const std::string file = WriteScenario("overflow.yaml", R"(duration_s: 0.1
+units:
+  supply:
+    type: step_signal
+    parameters: {unit: V, initial: 1.0e308, steps: [{time_s: 0.05, value: 1.0e308}]}
+metrics:
+  - {name: mean_supply, of: supply.value, reduce: mean}
+)");
+  const std::string out = Fresh("overflow");
+  const Result r = Linesim("run " + file + " --out " + out);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("metric 'mean_supply' is infinite"), std::string::npos) << r.err;
+  const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
+  EXPECT_EQ(summary["status"], "failed");
+}
+
 // Guards against a lost signals.csv passing for a good run: when its writes
 // fail (here a full disk: the file is /dev/full) the run fails, exit 1, and
 // the summary and the message name the file.
