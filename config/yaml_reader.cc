@@ -269,6 +269,12 @@ std::string YamlReader::String(const YAML::Node& map, const std::string& path,
   const std::string p = JoinPath(path, key);
   const auto s = AsString(node, p);
   if (!s) return fallback.value_or("");
+  // A required text left empty would make its item silently disappear (a
+  // unit without a type, a connection or a metric without an end).
+  if (!fallback && s->empty()) {
+    Error(node, p, "is empty: expected a non-empty text");
+    return "";
+  }
   if (!allowed.empty()) {
     bool found = false;
     for (const auto& a : allowed) found |= (a == *s);

@@ -414,6 +414,24 @@ TEST(LoadScenario, DuplicateKeysAndSecondDocumentsAreRefused) {
   EXPECT_EQ(Issues(fine), "(no error)");
 }
 
+// Guards required texts left empty, which would make their item silently
+// disappear: a unit type, a connection's end and a metric's signal are each
+// refused at their key.
+TEST(LoadScenario, EmptyRequiredTextsAreRefusedAtTheirKeys) {
+  const std::string type = WriteScenario(
+      "empty_type.yaml", "name: t\nduration_s: 1\nunits:\n  m: {type: \"\"}\n");
+  EXPECT_TRUE(Has(Issues(type), "units.m.type: is empty")) << Issues(type);
+  const std::string base =
+      "name: t\nduration_s: 0.01\nunits:\n  supply: {type: step_signal, parameters: {unit: V, "
+      "steps: [{time_s: 0.002, value: 12}]}}\n  motor: {type: dc_motor}\n";
+  const std::string connection = WriteScenario(
+      "empty_connection.yaml", base + "connections:\n  - {from: \"\", to: motor.voltage}\n");
+  EXPECT_TRUE(Has(Issues(connection), "connections.0.from: is empty")) << Issues(connection);
+  const std::string metric = WriteScenario(
+      "empty_metric.yaml", base + "metrics:\n  - {name: m, of: \"\", reduce: max}\n");
+  EXPECT_TRUE(Has(Issues(metric), "metrics.0.of: is empty")) << Issues(metric);
+}
+
 // Guards file-level failures: a missing file and malformed YAML.
 TEST(LoadScenario, UnreadableAndMalformedFiles) {
   EXPECT_TRUE(Has(Issues("/nonexistent/x.yaml"), "cannot read the file"));
