@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <map>
 #include <optional>
 #include <string_view>
 
@@ -55,6 +56,68 @@ Override ParseOverride(const std::string& text) {
         {{"", 0, "--set " + text, "expected dotted.path=value (for example master.step_s=0.002)"}});
   }
   return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+namespace {
+
+// Positions in the file of the nodes the tree reaches more than once: an
+// anchored value and its aliases are one node in yaml-cpp, so writing into
+// it through one path changes it at every other. Each node is entered once.
+void CountVisits(const YAML::Node& node, std::map<std::size_t, int>& visits) {
+  const YAML::Mark mark = node.Mark();
+  if (!mark.is_null() && ++visits[static_cast<std::size_t>(mark.pos)] > 1) return;
+  if (node.IsMap()) {
+    for (const auto& kv : node) CountVisits(kv.second, visits);
+  } else if (node.IsSequence()) {
+    for (const auto& item : node) CountVisits(item, visits);
+  }
+}
+
+bool Shared(const YAML::Node& node, const std::map<std::size_t, int>& visits) {
+  if (!node.IsDefined() || node.Mark().is_null()) return false;
+  const auto it = visits.find(static_cast<std::size_t>(node.Mark().pos));
+  return it != visits.end() && it->second > 1;
+}
+
+}  // namespace
+
+void RefuseOverridesThroughAliases(const YAML::Node& root, const std::vector<Override>& overrides,
+                                   const std::string& file, std::vector<Issue>& issues) {
+  if (overrides.empty()) return;
+  std::map<std::size_t, int> visits;
+  CountVisits(root, visits);
+  for (const Override& o : overrides) {
+    YAML::Node node = root;
+    std::string walked;
+    for (const std::string& key : Split(o.path)) {
+      const YAML::Node& cnode = node;
+      const auto child_of = [&]() -> YAML::Node {
+        if (cnode.IsSequence()) {
+          if (const auto index = IndexBelow(key, cnode.size())) return cnode[*index];
+        } else if (cnode.IsMap()) {
+          return cnode[key];
+        }
+        return YAML::Node();
+      };
+      const YAML::Node child = child_of();
+      if (!child.IsDefined()) break;  // ApplyOverrides reports a bad path
+      walked = JoinPath(walked, key);
+      if (Shared(child, visits)) {
+        issues.push_back(
+            {file, 0, o.path,
+             "'" + walked +
+                 "' is a value the file uses again through a YAML alias (its anchor "
+                 "at line " +
+                 std::to_string(child.Mark().line + 1) +
+                 "): setting it would change every place the alias stands; write the value "
+                 "out where it is meant to differ (in --set " +
+                 o.path + "=" + o.value + ")",
+             true, false});
+        break;
+      }
+      node.reset(child);
+    }
+  }
 }
 
 void ApplyOverrides(YAML::Node& root, const std::vector<Override>& overrides,

@@ -394,6 +394,7 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
     }
   }
   YAML::Node tree = LoadYamlOrThrow(file);
+  RefuseOverridesThroughAliases(tree, s.overrides, file, issues);
   ExposeSceneModelToOverrides(tree, s.overrides, file);
   ApplyOverrides(tree, s.overrides, file, issues);
   std::set<std::string> overridden;

@@ -389,11 +389,11 @@ units:
 // single-document read drops it). Each is refused at its line. An alias
 // used twice is one node, not a duplicate; a file ending in "..." is fine.
 TEST(LoadScenario, DuplicateKeysAndSecondDocumentsAreRefused) {
-  const std::string twice = WriteScenario(
-      "twice.yaml", "name: t\nduration_s: 1\nunits: {}\nduration_s: 2\n");
+  const std::string twice =
+      WriteScenario("twice.yaml", "name: t\nduration_s: 1\nunits: {}\nduration_s: 2\n");
   const std::string a = Issues(twice);
   EXPECT_TRUE(Has(a, twice + ":4: not valid YAML: key 'duration_s' appears twice in one map "
-                          "(first at line 2)"))
+                             "(first at line 2)"))
       << a;
   const std::string nested = WriteScenario(
       "nested_twice.yaml",
@@ -418,8 +418,8 @@ TEST(LoadScenario, DuplicateKeysAndSecondDocumentsAreRefused) {
 // disappear: a unit type, a connection's end and a metric's signal are each
 // refused at their key.
 TEST(LoadScenario, EmptyRequiredTextsAreRefusedAtTheirKeys) {
-  const std::string type = WriteScenario(
-      "empty_type.yaml", "name: t\nduration_s: 1\nunits:\n  m: {type: \"\"}\n");
+  const std::string type =
+      WriteScenario("empty_type.yaml", "name: t\nduration_s: 1\nunits:\n  m: {type: \"\"}\n");
   EXPECT_TRUE(Has(Issues(type), "units.m.type: is empty")) << Issues(type);
   const std::string base =
       "name: t\nduration_s: 0.01\nunits:\n  supply: {type: step_signal, parameters: {unit: V, "
@@ -427,9 +427,28 @@ TEST(LoadScenario, EmptyRequiredTextsAreRefusedAtTheirKeys) {
   const std::string connection = WriteScenario(
       "empty_connection.yaml", base + "connections:\n  - {from: \"\", to: motor.voltage}\n");
   EXPECT_TRUE(Has(Issues(connection), "connections.0.from: is empty")) << Issues(connection);
-  const std::string metric = WriteScenario(
-      "empty_metric.yaml", base + "metrics:\n  - {name: m, of: \"\", reduce: max}\n");
+  const std::string metric =
+      WriteScenario("empty_metric.yaml", base + "metrics:\n  - {name: m, of: \"\", reduce: max}\n");
   EXPECT_TRUE(Has(Issues(metric), "metrics.0.of: is empty")) << Issues(metric);
+}
+
+// Guards --set through a YAML alias: the anchored value and its alias are
+// one node, so setting it through either path would change both; refused
+// at the path, naming the anchor's line. A value outside the alias is set
+// as written.
+TEST(LoadScenario, SetThroughAnAliasIsRefused) {
+  const std::string f = WriteScenario("aliased.yaml",
+                                      "name: t\nduration_s: 0.01\nunits:\n"
+                                      "  a: {type: dc_motor, parameters: &p {resistance: 1.0}}\n"
+                                      "  b: {type: dc_motor, parameters: *p}\n");
+  const std::string via_alias = Issues(f, {"units.b.parameters.resistance=2"});
+  EXPECT_TRUE(Has(via_alias,
+                  "units.b.parameters' is a value the file uses again through a YAML "
+                  "alias (its anchor at line 4)"))
+      << via_alias;
+  const std::string via_anchor = Issues(f, {"units.a.parameters.resistance=2"});
+  EXPECT_TRUE(Has(via_anchor, "through a YAML alias")) << via_anchor;
+  EXPECT_EQ(Issues(f, {"duration_s=0.02"}), "(no error)");
 }
 
 // Guards file-level failures: a missing file and malformed YAML.
