@@ -130,6 +130,21 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   // Everything is checked: only now is anything written.
   const fs::path dir(out_dir);
   if (!CreateOutputFolder(out_dir)) return kExitBadInput;
+  // A previous run's outputs go first: the folder never holds files of two
+  // runs (a summary that fails to write must not leave the old one behind).
+  {
+    std::vector<std::string> previous = plots::RobotPlotFiles();
+    previous.push_back("summary.json");
+    for (const auto& name : previous) {
+      std::error_code ec;
+      fs::remove(dir / name, ec);
+      if (ec) {
+        std::cerr << "linesim: cannot remove the previous run's " << (dir / name).string() << ": "
+                  << ec.message() << "\n";
+        return kExitBadInput;
+      }
+    }
+  }
   const fs::path csv_path = dir / "signals.csv";
   std::ofstream csv(csv_path, std::ios::binary | std::ios::trunc);
   if (!csv) {

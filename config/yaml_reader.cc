@@ -1,6 +1,7 @@
 #include "config/yaml_reader.h"
 
 #include <cmath>
+#include <cstdint>
 
 #include "cosim/closest_names.h"
 
@@ -167,9 +168,54 @@ std::optional<double> YamlReader::AsReal(const YAML::Node& node, const std::stri
   return v;
 }
 
+namespace {
+
+// Whether `s` is valid UTF-8 (RFC 3629: no overlong forms, no surrogates,
+// nothing above U+10FFFF): the outputs (summary.json) can carry only that.
+bool ValidUtf8(const std::string& s) {
+  std::size_t i = 0;
+  const std::size_t n = s.size();
+  while (i < n) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    std::size_t len = 0;
+    std::uint32_t cp = 0;
+    if (c < 0x80) {
+      ++i;
+      continue;
+    } else if ((c & 0xE0) == 0xC0) {
+      len = 2;
+      cp = c & 0x1F;
+    } else if ((c & 0xF0) == 0xE0) {
+      len = 3;
+      cp = c & 0x0F;
+    } else if ((c & 0xF8) == 0xF0) {
+      len = 4;
+      cp = c & 0x07;
+    } else {
+      return false;
+    }
+    if (i + len > n) return false;
+    for (std::size_t k = 1; k < len; ++k) {
+      const auto cc = static_cast<unsigned char>(s[i + k]);
+      if ((cc & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (cc & 0x3F);
+    }
+    const std::uint32_t min = len == 2 ? 0x80 : len == 3 ? 0x800 : 0x10000;
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return false;
+    i += len;
+  }
+  return true;
+}
+
+}  // namespace
+
 std::optional<std::string> YamlReader::AsString(const YAML::Node& node, const std::string& path) {
   if (!node.IsScalar()) {
     Error(node, path, "expected a text value, got " + Describe(node));
+    return std::nullopt;
+  }
+  if (!ValidUtf8(node.Scalar())) {
+    Error(node, path, "is not valid UTF-8 text (the outputs can only carry UTF-8)");
     return std::nullopt;
   }
   return node.Scalar();

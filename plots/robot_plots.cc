@@ -683,6 +683,12 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
 
 }  // namespace
 
+const std::vector<std::string>& RobotPlotFiles() {
+  static const std::vector<std::string> files = {kScript,    "top_view.png",   "error.png",
+                                                 "belt.png", "optic_flow.png", "scan.png"};
+  return files;
+}
+
 std::vector<std::string> WriteRobotPlots(const std::string& dir, const RobotPlotSpec& spec) {
   const fs::path folder(dir);
   const fs::path csv = folder / kSignals;

@@ -82,4 +82,8 @@ struct RobotPlotSpec {
 /// gnuplot is missing or fails (with gnuplot's error text).
 std::vector<std::string> WriteRobotPlots(const std::string& dir, const RobotPlotSpec& spec);
 
+/// Every file WriteRobotPlots may write (the script and each picture), so
+/// that a new run can clear a previous run's before it starts.
+const std::vector<std::string>& RobotPlotFiles();
+
 }  // namespace linesim::plots

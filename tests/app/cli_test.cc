@@ -271,6 +271,21 @@ metrics:
   EXPECT_EQ(summary["status"], "failed");
 }
 
+// Guards against files of two runs in one folder: a robot run draws its
+// plots; a system run (no plots) into the same folder then leaves only its
+// own outputs, not the previous pictures beside its summary.
+TEST(Cli, ARunClearsThePreviousRunsOutputs) {
+  const std::string out = Fresh("two_runs");
+  ASSERT_EQ(Linesim("run " + kCrossLine + " --out " + out + " --set duration_s=1").status, 0);
+  ASSERT_TRUE(fs::exists(fs::path(out) / "top_view.png"));
+  ASSERT_EQ(Linesim("run " + kMotorStep + " --out " + out).status, 0);
+  for (const char* stale : {"top_view.png", "error.png", "belt.png", "plots.gp"}) {
+    EXPECT_FALSE(fs::exists(fs::path(out) / stale)) << stale;
+  }
+  const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
+  EXPECT_EQ(summary["file"], kMotorStep);
+}
+
 // Guards against a lost signals.csv passing for a good run: when its writes
 // fail (here a full disk: the file is /dev/full) the run fails, exit 1, and
 // the summary and the message name the file.

@@ -451,6 +451,21 @@ TEST(LoadScenario, SetThroughAnAliasIsRefused) {
   EXPECT_EQ(Issues(f, {"duration_s=0.02"}), "(no error)");
 }
 
+// Guards text the outputs cannot carry: a name or description that is not
+// valid UTF-8 (here a lone 0xFF byte, and 0xE9, Latin-1's e-acute, without
+// its UTF-8 continuation) is refused at its key; real UTF-8 (U+00E9 as
+// 0xC3 0xA9) is accepted.
+TEST(LoadScenario, TextThatIsNotUtf8IsRefusedAtItsKey) {
+  const std::string rest = "duration_s: 0.01\nunits:\n  s: {type: step_signal}\n";
+  const std::string bad =
+      WriteScenario("latin1.yaml", "name: \"caf\xe9\"\ndescription: \"bad \xff\"\n" + rest);
+  const std::string e = Issues(bad);
+  EXPECT_TRUE(Has(e, bad + ":1: name: is not valid UTF-8 text")) << e;
+  EXPECT_TRUE(Has(e, bad + ":2: description: is not valid UTF-8 text")) << e;
+  const std::string good = WriteScenario("utf8.yaml", "name: \"caf\xc3\xa9\"\n" + rest);
+  EXPECT_EQ(Issues(good), "(no error)");
+}
+
 // Guards file-level failures: a missing file and malformed YAML.
 TEST(LoadScenario, UnreadableAndMalformedFiles) {
   EXPECT_TRUE(Has(Issues("/nonexistent/x.yaml"), "cannot read the file"));
