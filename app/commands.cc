@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -157,8 +158,21 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   s.master->AddObserver(&recorder);
   s.master->AddObserver(&metrics);
 
+  // Ctrl-C or SIGTERM: stop at the next communication point, keep what was
+  // recorded and write the summary (status interrupted); again to quit.
+  std::atomic<bool>& stop = InstallStopSignals(
+      "\nlinesim: interrupted: stopping at the next communication point (again to quit at "
+      "once)\n");
   const auto wall0 = std::chrono::steady_clock::now();
-  const cosim::RunResult result = s.master->Run();
+  s.master->Start();
+  bool interrupted = false;
+  while (s.master->Step()) {
+    if (stop.load(std::memory_order_relaxed)) {
+      interrupted = true;
+      break;
+    }
+  }
+  const cosim::RunResult result = s.master->Finish();
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   csv.close();
@@ -183,7 +197,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   Json summary;
   summary["scenario"] = s.name;
   summary["file"] = file;
-  summary["status"] = outcome.ok ? "ok" : "failed";
+  summary["status"] = interrupted ? "interrupted" : outcome.ok ? "ok" : "failed";
   summary["errors"] = outcome.errors;
   Json settings;
   settings["duration_s"] = s.duration_s;
@@ -249,8 +263,11 @@ int RunCommand(const std::string& file, const std::string& out_dir,
     return kExitRunFailed;
   }
 
-  std::cout << s.name << ": " << (outcome.ok ? "ok" : "FAILED") << ", "
-            << cosim::FormatSeconds(result.end_time - options.start) << " s simulated in "
+  std::cout << s.name << ": "
+            << (interrupted  ? "INTERRUPTED"
+                : outcome.ok ? "ok"
+                             : "FAILED")
+            << ", " << cosim::FormatSeconds(result.end_time - options.start) << " s simulated in "
             << std::setprecision(3) << wall_s << " s wall (" << std::setprecision(4)
             << simulated_s / wall_s << "x real time)\n";
   std::size_t name_width = 0;
@@ -265,6 +282,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   for (const auto& p : pictures) std::cout << ", " << p;
   std::cout << "\n";
   for (const auto& e : outcome.errors) std::cerr << "linesim: " << e << "\n";
+  if (interrupted) return kExitInterrupted;
   return outcome.ok ? kExitOk : kExitRunFailed;
 }
 

@@ -1,5 +1,9 @@
 #include "app/console.h"
 
+#include <unistd.h>
+
+#include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <system_error>
@@ -19,6 +23,31 @@ bool CreateOutputFolder(const std::string& dir) {
   std::cerr << "linesim: cannot create the output folder " << dir << ": "
             << (ec ? ec.message() : "a file of that name exists") << "\n";
   return false;
+}
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "used from a signal handler");
+std::atomic<const char*> g_stop_message{""};
+
+extern "C" void OnStopSignal(int sig) {
+  if (g_stop.exchange(true)) {
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+    return;
+  }
+  const char* text = g_stop_message.load();
+  [[maybe_unused]] const auto n = write(STDERR_FILENO, text, std::strlen(text));
+}
+
+}  // namespace
+
+std::atomic<bool>& InstallStopSignals(const char* message) {
+  g_stop_message.store(message);
+  std::signal(SIGINT, OnStopSignal);
+  std::signal(SIGTERM, OnStopSignal);
+  return g_stop;
 }
 
 }  // namespace linesim::app

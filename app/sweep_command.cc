@@ -30,23 +30,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr int kExitInterrupted = 130;  // the shell's code for Ctrl-C
-
-// Set by Ctrl-C (SIGINT) or SIGTERM: no new run starts, running ones stop at
-// their next step and leave no row. A second signal ends the process at once.
-std::atomic<bool> g_stop{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "used from a signal handler");
-
-extern "C" void OnSignal(int sig) {
-  if (g_stop.exchange(true)) {
-    std::signal(sig, SIG_DFL);
-    std::raise(sig);
-    return;
-  }
-  const char text[] = "\nlinesim: interrupted: stopping the running runs (again to quit at once)\n";
-  [[maybe_unused]] const auto n = write(STDERR_FILENO, text, sizeof text - 1);
-}
-
 // The sweep folder made ready on rank 0: results.csv started or resumed and
 // sweep.json saying which sweep it holds. Prints why not and returns nothing
 // when the folder cannot take this sweep.
@@ -139,10 +122,12 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
   if (leader && !results) status = kExitBadInput;
   if (share(status) != kExitOk) return kExitBadInput;
 
-  std::signal(SIGINT, OnSignal);
-  std::signal(SIGTERM, OnSignal);
+  // Ctrl-C or SIGTERM: no new run starts, running ones stop at their next
+  // step and leave no row; a second signal ends the process at once.
+  std::atomic<bool>& stop = InstallStopSignals(
+      "\nlinesim: interrupted: stopping the running runs (again to quit at once)\n");
   if (!leader) {
-    sweep::ServeRuns(spec, g_stop);
+    sweep::ServeRuns(spec, stop);
     return kExitOk;
   }
 
@@ -194,9 +179,9 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
   const auto wall0 = std::chrono::steady_clock::now();
   try {
     if (mpi) {
-      sweep::DispatchRuns(spec, pending, g_stop, on_done);
+      sweep::DispatchRuns(spec, pending, stop, on_done);
     } else {
-      sweep::RunOnThreads(spec, pending, args.jobs, g_stop, on_done);
+      sweep::RunOnThreads(spec, pending, args.jobs, stop, on_done);
     }
   } catch (const std::exception& e) {
     ticker = {};

@@ -277,6 +277,33 @@ TEST(SweepCli, CtrlCStopsCleanlyAndResumeFinishes) {
   EXPECT_EQ(Rows(dir), Rows(whole));
 }
 
+// `linesim run` under Ctrl-C, as the sweep: it stops at the next
+// communication point, keeps the rows recorded so far (whole lines) and
+// writes summary.json with status interrupted and the metrics so far; exit
+// 130. A 600 s crossing (several seconds of wall time) is stopped once its
+// first 100 rows (1 s at 100 Hz) are on disk: well before its 60,001.
+TEST(RunCli, CtrlCWritesAnInterruptedSummary) {
+  const std::string dir = Fresh("run_interrupted");
+  const std::string log = Temp("run_int_log");
+  const pid_t pid = Spawn({LINESIM_CLI, "run", kCrossLine, "--out", dir, "--set",
+                           "duration_s=600"},
+                          log);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline &&
+         LineCount(fs::path(dir) / "signals.csv") < 101) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  kill(pid, SIGINT);
+  EXPECT_EQ(Wait(pid), 130) << ReadFile(log + ".err");
+  const auto summary = nlohmann::json::parse(ReadFile(fs::path(dir) / "summary.json"));
+  EXPECT_EQ(summary["status"], "interrupted");
+  EXPECT_TRUE(summary["metrics"].contains("max_path_deviation_m")) << summary.dump();
+  const std::string csv = ReadFile(fs::path(dir) / "signals.csv");
+  ASSERT_FALSE(csv.empty());
+  EXPECT_EQ(csv.back(), '\n');
+  EXPECT_LT(LineCount(fs::path(dir) / "signals.csv"), 60001u);
+}
+
 TEST(SweepCli, AnInterruptedMpiSweepResumesToTheSameFile) {
   const std::string file = WriteSweep(
       "mpiint.yaml", "scenario: " + kCrossLine +
