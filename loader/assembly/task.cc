@@ -28,8 +28,16 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
     if (!waypoints.IsDefined()) {
       r.Error(task, "task.waypoints", "missing required key: a list of points [x, y] (m)");
     } else if (r.ExpectSequence(waypoints, "task.waypoints")) {
+      // A stated limit: the follower and the deviation unit each keep the
+      // path (and the plots draw it), a few kB per point in all.
+      constexpr std::size_t kMaxWaypoints = 10000;
       if (waypoints.size() < 2) {
         r.Error(waypoints, "task.waypoints", "expected at least two points [x, y]");
+      } else if (waypoints.size() > kMaxWaypoints) {
+        r.Error(waypoints, "task.waypoints",
+                std::to_string(waypoints.size()) + " points: at most " +
+                    std::to_string(kMaxWaypoints) + " (a path of 10 km at 1 m spacing)");
+        return;
       }
       for (std::size_t i = 0; i < waypoints.size(); ++i) {
         if (auto pt = r.AsPoint(waypoints[i], JoinPath("task.waypoints", std::to_string(i)),

@@ -284,6 +284,18 @@ TEST(RobotScenario, HoldScenariosHoldTheStartPose) {
 
 // Guards against sensing/localization choices a later capability adds being
 // silently accepted now: the message lists what exists.
+// Guards the stated limit on a path's size (a few kB per waypoint in the
+// follower, the deviation unit and the plots): 10,000 points are refused
+// before anything is built, naming the key and the limit.
+TEST(RobotScenario, AHugeWaypointListIsRefusedWithItsLimit) {
+  std::string points = "[";
+  for (int i = 0; i <= 10000; ++i) points += (i ? ", [" : "[") + std::to_string(i) + ", 0]";
+  points += "]";
+  const std::string e = Issues(kCross, {"task.waypoints=" + points});
+  EXPECT_TRUE(Has(e, "task.waypoints")) << e.substr(0, 300);
+  EXPECT_TRUE(Has(e, "10001 points: at most 10000")) << e.substr(0, 300);
+}
+
 TEST(RobotScenario, ClosedLoopChoicesNeedTheirSensors) {
   // The estimators need the sensors they read: turned off, the choice is
   // refused at its key, naming what is missing.
