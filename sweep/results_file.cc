@@ -199,6 +199,21 @@ ResultsFile ResultsFile::Create(const std::string& path, const SweepSpec& spec) 
 
 ResultsFile ResultsFile::Resume(const std::string& path, const SweepSpec& spec) {
   const std::string header = JoinCsvLine(ResultsHeader(spec));
+  // Read only a regular file of bounded size: a link to a device (/dev/zero)
+  // would be read for ever. 1 GiB holds ten million rows of 100 bytes, the
+  // most runs a sweep may plan.
+  constexpr std::uintmax_t kMaxResultsBytes = std::uintmax_t{1} << 30;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw std::runtime_error(path +
+                             " is not a regular file (a device or a folder?): it cannot "
+                             "be this sweep's results; choose another --out");
+  }
+  if (const auto size = std::filesystem::file_size(path, ec); !ec && size > kMaxResultsBytes) {
+    throw std::runtime_error(path + " is " + std::to_string(size) +
+                             " bytes, more than the 1 GiB a sweep's results can be: it is not "
+                             "this sweep's; choose another --out");
+  }
   const std::string text = ReadWhole(path);
   if (text.compare(0, header.size(), header) != 0) {
     throw std::runtime_error(path + " has other columns than this sweep writes (expected " +

@@ -50,8 +50,8 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
     // Up to the robot's top speed (its description's path_follower.max_speed).
     const double top_mps =
         YamlReader::DecodeReal(Child(file.follower_settings, "max_speed")).value_or(0.0);
-    p["speed"] = Num(r.Real(task, "task", "speed_mps", std::min(0.3, top_mps),
-                            {0.0, top_mps, true}));
+    p["speed"] =
+        Num(r.Real(task, "task", "speed_mps", std::min(0.3, top_mps), {0.0, top_mps, true}));
   } else if (info.task == "hold") {
     std::array<double, 2> point{start.x_m, start.y_m};
     if (Child(task, "point").IsDefined()) {
@@ -69,16 +69,17 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
     p["base"] = "differential";
     if (Child(task, "yaw_deg").IsDefined()) {
       r.Error(Child(task, "yaw_deg"), "task.yaw_deg",
-              "robot '" + file.robot.name + "' is a differential base: it cannot hold a heading "
-              "while it moves; leave task.yaw_deg out");
+              "robot '" + file.robot.name +
+                  "' is a differential base: it cannot hold a heading "
+                  "while it moves; leave task.yaw_deg out");
     }
   } else {
     // An omnidirectional base keeps this heading while it moves.
     p["heading"] = Num(Child(task, "yaw_deg").IsDefined()
-                       ? r.Real(task, "task", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad
-                       : start.yaw_rad);
+                           ? r.Real(task, "task", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad
+                           : start.yaw_rad);
   }
-p["waypoints"] = PointList(info.path);
+  p["waypoints"] = PointList(info.path);
 
   b.RequireParameters(kPathFollower, file.follower_settings, file.robot.file, "path_follower");
 

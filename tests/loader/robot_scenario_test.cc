@@ -16,13 +16,12 @@ namespace linesim::loader {
 namespace {
 
 using testing::Has;
-using testing::Param;
 using testing::Issues;
+using testing::Param;
 using testing::WriteScenario;
 
 const std::string kCross = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
 const std::string kHusky = LINESIM_SOURCE_DIR "/scenarios/husky_floor_path.yaml";
-
 
 bool BoolParam(const Scenario& s, const std::string& unit, const std::string& name) {
   const auto& v = s.system->unit(*s.system->FindUnit(unit)).variables();
@@ -128,9 +127,9 @@ TEST(RobotScenario, HuskyIsBuiltFromItsDescriptionOnTheSameUnits) {
   // The robot's follower settings are defaults the task overrides
   // (husky.yaml: acceleration 0.5 m/s^2).
   EXPECT_EQ(Param(s, "path_follower", "acceleration"), 0.5);
-  EXPECT_EQ(Param(LoadScenario(kHusky, {"task.acceleration_mps2=0.4"}), "path_follower",
-                  "acceleration"),
-            0.4);
+  EXPECT_EQ(
+      Param(LoadScenario(kHusky, {"task.acceleration_mps2=0.4"}), "path_follower", "acceleration"),
+      0.4);
   // A differential base cannot run Algorithm 1, nor hold a heading.
   const std::string e = Issues(kHusky, {"control.compensation=true"});
   EXPECT_TRUE(Has(e, "control.compensation")) << e;
@@ -534,17 +533,19 @@ TEST(RobotScenario, DeclaredRulesRefuseOutOfRangeValuesAtTheirKeys) {
   YAML::Emitter out;
   out << robot.expanded;
   const std::string f = WriteScenario("expanded_rules.yaml", out.c_str());
-  const std::string e = Issues(
-      f, {"units.belt.parameters={speed_variation: 0.9}", "units.chassis.parameters.mass=-1",
-          "units.motors.parameters.gear_efficiency.5=1.5",
-          "units.wheel_controller.parameters.steer_kp=-1", "units.path_follower.parameters.speed=0"});
+  const std::string e =
+      Issues(f, {"units.belt.parameters={speed_variation: 0.9}", "units.chassis.parameters.mass=-1",
+                 "units.motors.parameters.gear_efficiency.5=1.5",
+                 "units.wheel_controller.parameters.steer_kp=-1",
+                 "units.path_follower.parameters.speed=0"});
   for (const char* expected :
        {"units.belt.parameters.speed_variation.0 (set on the command line): must be in [0, 0.5], "
         "got 0.9",
         "units.chassis.parameters.mass (set on the command line): must be > 0, got -1",
         "units.motors.parameters.gear_efficiency.5 (set on the command line): must be in (0, 1], "
         "got 1.5",
-        "units.wheel_controller.parameters.steer_kp (set on the command line): must be >= 0, got -1",
+        "units.wheel_controller.parameters.steer_kp (set on the command line): must be >= 0, got "
+        "-1",
         "units.path_follower.parameters.speed (set on the command line): must be > 0, got 0"}) {
     EXPECT_TRUE(Has(e, expected)) << expected << "\n" << e;
   }
@@ -553,8 +554,9 @@ TEST(RobotScenario, DeclaredRulesRefuseOutOfRangeValuesAtTheirKeys) {
   husky_out << husky.expanded;
   const std::string g = WriteScenario("expanded_husky_rules.yaml", husky_out.c_str());
   const std::string h = Issues(g, {"units.wheel_controller.parameters.effective_track=0"});
-  EXPECT_TRUE(Has(h, "units.wheel_controller.parameters.effective_track (set on the command "
-                     "line): must be > 0, got 0"))
+  EXPECT_TRUE(Has(h,
+                  "units.wheel_controller.parameters.effective_track (set on the command "
+                  "line): must be > 0, got 0"))
       << h;
 }
 
@@ -573,8 +575,9 @@ TEST(RobotScenario, YawInRadiansConnectsOnlyToRadianInputs) {
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string f = WriteScenario(
       "robot_yaw_to_metres.yaml",
-      text + "units:\n  probe:\n    type: path_deviation\n    parameters: {path: [[0, 0]]}\n"
-             "connections:\n  - {from: chassis.yaw, to: \"probe.position[0]\"}\n");
+      text +
+          "units:\n  probe:\n    type: path_deviation\n    parameters: {path: [[0, 0]]}\n"
+          "connections:\n  - {from: chassis.yaw, to: \"probe.position[0]\"}\n");
   const std::string e = Issues(f);
   EXPECT_TRUE(Has(e, "connections.0")) << e;
   EXPECT_TRUE(Has(e, "rad")) << e;

@@ -277,6 +277,23 @@ TEST(SweepCli, CtrlCStopsCleanlyAndResumeFinishes) {
   EXPECT_EQ(Rows(dir), Rows(whole));
 }
 
+// Guards --resume against a results file that never ends: a link to a
+// device (/dev/zero) is refused at once (exit 2, naming the file) instead
+// of being read for ever.
+TEST(SweepCli, ResumeRefusesAResultsFileThatIsADevice) {
+  const std::string file =
+      WriteSweep("device.yaml", "scenario: " + kCrossLine +
+                                    "\nset: {duration_s: 1}\nparameters:\n"
+                                    "  - {path: control.compensation, values: [true, false]}\n");
+  const std::string dir = Fresh("device");
+  ASSERT_EQ(Sweep(file, dir).status, 0);
+  fs::remove(fs::path(dir) / "results.csv");
+  fs::create_symlink("/dev/zero", fs::path(dir) / "results.csv");
+  const Result r = Sweep(file, dir, {"--resume"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("results.csv is not a regular file"), std::string::npos) << r.err;
+}
+
 // `linesim run` under Ctrl-C, as the sweep: it stops at the next
 // communication point, keeps the rows recorded so far (whole lines) and
 // writes summary.json with status interrupted and the metrics so far; exit
@@ -285,9 +302,8 @@ TEST(SweepCli, CtrlCStopsCleanlyAndResumeFinishes) {
 TEST(RunCli, CtrlCWritesAnInterruptedSummary) {
   const std::string dir = Fresh("run_interrupted");
   const std::string log = Temp("run_int_log");
-  const pid_t pid = Spawn({LINESIM_CLI, "run", kCrossLine, "--out", dir, "--set",
-                           "duration_s=600"},
-                          log);
+  const pid_t pid =
+      Spawn({LINESIM_CLI, "run", kCrossLine, "--out", dir, "--set", "duration_s=600"}, log);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (std::chrono::steady_clock::now() < deadline &&
          LineCount(fs::path(dir) / "signals.csv") < 101) {
