@@ -9,6 +9,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -156,6 +157,61 @@ void Step(SurfaceVelocityEstimator& e, TimeNs t, TimeNs dt = kStep) {
   ASSERT_EQ(e.DoStep(t, dt), cosim::StepResult::kOk) << e.last_error();
 }
 
+// Four REAL px4flow units at the corners, stepped at 1 ms with the true
+// motion, and their outputs handed to the estimator as the assembly wires
+// them.
+struct RealFlows {
+  std::vector<std::unique_ptr<sensors::Px4FlowUnit>> units;
+  std::vector<double> velocity = std::vector<double>(8), valid = std::vector<double>(4),
+                      quality = std::vector<double>(4), count = std::vector<double>(4);
+
+  RealFlows(const models::Scene& scene, const std::array<double, 4>& mounts, std::uint64_t seed) {
+    for (std::size_t i = 0; i < 4; ++i) {
+      auto u = std::make_unique<sensors::Px4FlowUnit>("flow" + std::to_string(i), scene,
+                                                      seed + i);
+      SetAll(*u, "mount_x", kCorners[i][0]);
+      SetAll(*u, "mount_y", kCorners[i][1]);
+      SetAll(*u, "mount_height", kHeight);
+      SetAll(*u, "mount_yaw", mounts[i]);
+      u->Setup(0, 1000'000 * kMs);
+      u->Initialize();
+      units.push_back(std::move(u));
+    }
+  }
+
+  // One control period from t; `belt` (m/s along x) when the scene has one.
+  template <typename Truth>
+  void Advance(TimeNs t, const Truth& truth, std::optional<double> belt = std::nullopt) {
+    for (TimeNs tf = t; tf < t + kStep; tf += kMs) {
+      const Motion m = truth(tf);
+      for (auto& u : units) {
+        SetArray(*u, "position", {m.x, m.y});
+        SetAll(*u, "yaw", m.yaw);
+        SetArray(*u, "linear_velocity", {m.vx, m.vy});
+        SetAll(*u, "yaw_rate", m.w);
+        SetArray(*u, "angular_velocity", {0.0, 0.0, m.w});
+        if (belt) SetArray(*u, "belt_velocity", {*belt, 0.0});
+        ASSERT_EQ(u->DoStep(tf, kMs), cosim::StepResult::kOk);
+      }
+    }
+  }
+
+  void Feed(SurfaceVelocityEstimator& e) {
+    for (std::size_t i = 0; i < 4; ++i) {
+      const auto v = Get(*units[i], "velocity");
+      velocity[2 * i] = v[0];
+      velocity[2 * i + 1] = v[1];
+      valid[i] = Get(*units[i], "valid")[0];
+      quality[i] = Get(*units[i], "quality")[0];
+      count[i] = Get(*units[i], "message_count")[0];
+    }
+    SetArray(e, "sensor_velocity", velocity);
+    SetArray(e, "sensor_valid", valid);
+    SetArray(e, "sensor_quality", quality);
+    SetArray(e, "sensor_message_count", count);
+  }
+};
+
 // ---------------------------------------------------------------------------
 
 // Guards against a gain typed in or solved from the wrong variances: the
@@ -186,17 +242,7 @@ TEST(SurfaceVelocityEstimator, Eq2GivesZeroOnAStillFloorWhileTurning) {
   const models::Scene scene = Scene(1.0, /*belt=*/false);
   const std::array<double, 4> mounts = {0.0, kPi / 2, kPi, -kPi / 4};
   auto e = Estimator(scene, mounts);
-  std::vector<std::unique_ptr<sensors::Px4FlowUnit>> flows;
-  for (std::size_t i = 0; i < 4; ++i) {
-    auto u = std::make_unique<sensors::Px4FlowUnit>("flow" + std::to_string(i), scene, 20 + i);
-    SetAll(*u, "mount_x", kCorners[i][0]);
-    SetAll(*u, "mount_y", kCorners[i][1]);
-    SetAll(*u, "mount_height", kHeight);
-    SetAll(*u, "mount_yaw", mounts[i]);
-    u->Setup(0, 1000'000 * kMs);
-    u->Initialize();
-    flows.push_back(std::move(u));
-  }
+  RealFlows flows(scene, mounts, 20);
   const double f = 666.7, frame_rate = 400.0;  // the px4flow's defaults (px4flow_unit.h)
   const double quantum = 0.5 * kHeight / f * frame_rate;
   EXPECT_NEAR(quantum, 0.0552, 1e-4);
@@ -206,42 +252,20 @@ TEST(SurfaceVelocityEstimator, Eq2GivesZeroOnAStillFloorWhileTurning) {
     const double ts = cosim::NsToSeconds(t);
     return Motion{vx * ts, vy * ts + 5.0, 0.3 + w * ts, vx, vy, w};
   };
-  std::vector<double> velocity(8), valid(4), quality(4), count(4);
   int checked = 0;
   double worst = 0.0;
   for (TimeNs t = 0; t < 6000 * kMs; t += kStep) {
     // The sensors step at 1 ms with the truth at each step's start.
-    for (TimeNs tf = t; tf < t + kStep; tf += kMs) {
-      const Motion m = truth(tf);
-      for (auto& u : flows) {
-        SetArray(*u, "position", {m.x, m.y});
-        SetAll(*u, "yaw", m.yaw);
-        SetArray(*u, "linear_velocity", {m.vx, m.vy});
-        SetAll(*u, "yaw_rate", m.w);
-        SetArray(*u, "angular_velocity", {0.0, 0.0, m.w});
-        ASSERT_EQ(u->DoStep(tf, kMs), cosim::StepResult::kOk);
-      }
-    }
+    flows.Advance(t, truth);
     const TimeNs te = t + kStep;
-    for (std::size_t i = 0; i < 4; ++i) {
-      const auto v = Get(*flows[i], "velocity");
-      velocity[2 * i] = v[0];
-      velocity[2 * i + 1] = v[1];
-      valid[i] = Get(*flows[i], "valid")[0];
-      quality[i] = Get(*flows[i], "quality")[0];
-      count[i] = Get(*flows[i], "message_count")[0];
-    }
-    SetArray(*e, "sensor_velocity", velocity);
-    SetArray(*e, "sensor_valid", valid);
-    SetArray(*e, "sensor_quality", quality);
-    SetArray(*e, "sensor_message_count", count);
+    flows.Feed(*e);
     SetPose(*e, truth(te));
     Step(*e, te);
     if (te % kMessage != 0 || te < 2 * kMessage) continue;  // from the 2nd message on
     const auto raw = Get(*e, "raw_surface_velocity");
     const auto status = Get(*e, "sensor_status");
     for (std::size_t i = 0; i < 4; ++i) {
-      ASSERT_EQ(valid[i], 1.0) << "sensor " << i << " at " << te;
+      ASSERT_EQ(flows.valid[i], 1.0) << "sensor " << i << " at " << te;
       EXPECT_EQ(status[i], 0.0);
       EXPECT_NEAR(raw[2 * i], 0.0, quantum) << "sensor " << i << " at " << te;
       EXPECT_NEAR(raw[2 * i + 1], 0.0, quantum) << "sensor " << i << " at " << te;
@@ -325,49 +349,16 @@ TEST(SurfaceVelocityEstimator, BeltVelocityAfterTheFilterSettles) {
   const models::Scene scene = Scene(1.4);
   const std::array<double, 4> mounts = {0.0, kPi / 2, kPi, -kPi / 4};
   auto e = Estimator(scene, mounts);
-  std::vector<std::unique_ptr<sensors::Px4FlowUnit>> flows;
-  for (std::size_t i = 0; i < 4; ++i) {
-    auto u = std::make_unique<sensors::Px4FlowUnit>("flow" + std::to_string(i), scene, 40 + i);
-    SetAll(*u, "mount_x", kCorners[i][0]);
-    SetAll(*u, "mount_y", kCorners[i][1]);
-    SetAll(*u, "mount_height", kHeight);
-    SetAll(*u, "mount_yaw", mounts[i]);
-    u->Setup(0, 1000'000 * kMs);
-    u->Initialize();
-    flows.push_back(std::move(u));
-  }
+  RealFlows flows(scene, mounts, 40);
   const double belt = 0.15, bound = 0.25 * kHeight / 666.7 * 400.0;
   const auto truth = [&](TimeNs t) {
     const double ts = cosim::NsToSeconds(t);
     return Motion{-2.0 + 0.1 * ts, 0.0, 0.1 * ts, 0.1, 0.0, 0.1};
   };
-  std::vector<double> velocity(8), valid(4), quality(4), count(4);
   for (TimeNs t = 0; t < 6000 * kMs; t += kStep) {
-    for (TimeNs tf = t; tf < t + kStep; tf += kMs) {
-      const Motion m = truth(tf);
-      for (auto& u : flows) {
-        SetArray(*u, "position", {m.x, m.y});
-        SetAll(*u, "yaw", m.yaw);
-        SetArray(*u, "linear_velocity", {m.vx, m.vy});
-        SetAll(*u, "yaw_rate", m.w);
-        SetArray(*u, "angular_velocity", {0.0, 0.0, m.w});
-        SetArray(*u, "belt_velocity", {belt, 0.0});
-        ASSERT_EQ(u->DoStep(tf, kMs), cosim::StepResult::kOk);
-      }
-    }
+    flows.Advance(t, truth, belt);
     const TimeNs te = t + kStep;
-    for (std::size_t i = 0; i < 4; ++i) {
-      const auto v = Get(*flows[i], "velocity");
-      velocity[2 * i] = v[0];
-      velocity[2 * i + 1] = v[1];
-      valid[i] = Get(*flows[i], "valid")[0];
-      quality[i] = Get(*flows[i], "quality")[0];
-      count[i] = Get(*flows[i], "message_count")[0];
-    }
-    SetArray(*e, "sensor_velocity", velocity);
-    SetArray(*e, "sensor_valid", valid);
-    SetArray(*e, "sensor_quality", quality);
-    SetArray(*e, "sensor_message_count", count);
+    flows.Feed(*e);
     const Motion m = truth(te);
     SetPose(*e, m);
     Step(*e, te);
