@@ -141,6 +141,22 @@ struct Driver {
   }
 };
 
+// A restored unit's driver `b` continues where `a`'s is (time, scan counts,
+// noise draws); both drivers step `steps` control periods and the two
+// units' outputs must stay bit for bit alike.
+void ExpectSameContinuation(Driver& a, Driver& b, int steps) {
+  b.rng = a.rng;
+  b.t = a.t;
+  b.count[0] = a.count[0];
+  b.count[1] = a.count[1];
+  for (int i = 0; i < steps; ++i) {
+    a.Step();
+    b.Step();
+    ASSERT_TRUE(test_helpers::SameBits(test_helpers::Outputs(a.u), test_helpers::Outputs(b.u)))
+        << i;
+  }
+}
+
 // Guards against the unit not localizing from an initial pose off by 5 cm,
 // 3 cm, 2 deg with two lasers: the matcher's bound (1 mm, 1 mrad; see
 // scan_matcher_test.cc), 50 matches per second, the match time at the
@@ -286,15 +302,8 @@ TEST(LaserLocalization, RestoredUnitContinuesBitForBit) {
   b->Initialize();
   b->RestoreState(saved);
   Driver db{*b, Moving, testscene::Room()};
-  db.t = da.t;
-  db.count[0] = da.count[0];
-  db.count[1] = da.count[1];
   const double before = Get(*b, "match_count")[0];
-  for (int i = 0; i < 15; ++i) {
-    da.Step();
-    db.Step();
-    ASSERT_TRUE(test_helpers::SameBits(test_helpers::Outputs(*a), test_helpers::Outputs(*b))) << i;
-  }
+  ExpectSameContinuation(da, db, 15);
   // The steps compared include new matches (not only a held pose).
   EXPECT_GT(Get(*b, "match_count")[0], before);
 }
@@ -487,16 +496,8 @@ TEST(LaserLocalizationMapping, RestoredUnitContinuesBitForBit) {
   for (int i = 0; i < 3; ++i) ASSERT_EQ(b->grid()->level(i).value, a->grid()->level(i).value);
   Driver db{*b, Drive, testscene::Room()};
   db.noise = 0.015;
-  db.rng = da.rng;
-  db.t = da.t;
-  db.count[0] = da.count[0];
-  db.count[1] = da.count[1];
   const double before = Get(*b, "map_updates")[0];
-  for (int i = 0; i < 40; ++i) {
-    da.Step();
-    db.Step();
-    ASSERT_TRUE(test_helpers::SameBits(test_helpers::Outputs(*a), test_helpers::Outputs(*b))) << i;
-  }
+  ExpectSameContinuation(da, db, 40);
   EXPECT_GT(Get(*b, "map_updates")[0], before);
   for (int i = 0; i < 3; ++i) EXPECT_EQ(b->grid()->level(i).log_odds, a->grid()->level(i).log_odds);
   // A scene-map state does not restore into a mapping unit.
