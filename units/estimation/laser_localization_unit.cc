@@ -18,9 +18,8 @@ double WrapAngle(double a) {
 }  // namespace
 
 LaserLocalizationUnit::LaserLocalizationUnit(std::string name, const models::Scene& scene,
-                                             std::vector<int> beam_counts, std::uint64_t seed)
+                                             std::vector<int> beam_counts)
     : cosim::Unit(kTypeName, std::move(name)), beam_counts_(std::move(beam_counts)) {
-  (void)seed;  // deterministic: no randomness
   if (beam_counts_.empty() || beam_counts_.size() > static_cast<std::size_t>(kMaxLasers)) {
     throw cosim::UnitError(Where() + ": beam_counts must list 1 to " + std::to_string(kMaxLasers) +
                            " lasers, got " + std::to_string(beam_counts_.size()));

@@ -91,8 +91,7 @@ class LaserLocalizationUnit : public cosim::Unit {
   /// One entry of `beam_counts` per laser (1..kMaxLasers lasers, each
   /// 1..100000 beams); throws cosim::UnitError otherwise. The scene's
   /// obstacles and floor are copied (the map is built in Initialize).
-  LaserLocalizationUnit(std::string name, const models::Scene& scene, std::vector<int> beam_counts,
-                        std::uint64_t seed);
+  LaserLocalizationUnit(std::string name, const models::Scene& scene, std::vector<int> beam_counts);
   ~LaserLocalizationUnit() override;
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
@@ -111,9 +110,7 @@ class LaserLocalizationUnit : public cosim::Unit {
   void RestoreInternal(const cosim::UnitState& state) override;
 
  private:
-  struct Pose {
-    double x = 0.0, y = 0.0, yaw = 0.0;
-  };
+  using Pose = ScanMatcher::Pose;
   void Derive();
   /// Matches laser k's current scan; true when accepted.
   void ProcessScan(int k);

@@ -41,7 +41,7 @@ std::unique_ptr<cosim::Unit> MakeLaserLocalization(const UnitBuildContext& c) {
     }
     if (!ok) return nullptr;
   }
-  return std::make_unique<LaserLocalizationUnit>(c.name, c.scene, std::move(beams), c.seed);
+  return std::make_unique<LaserLocalizationUnit>(c.name, c.scene, std::move(beams));
 }
 
 const config::UnitTypeRegistrar kLaserLocalization(

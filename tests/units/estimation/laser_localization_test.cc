@@ -81,7 +81,7 @@ std::vector<double> ScanRanges(int k, double start, Trajectory truth,
 }
 
 std::unique_ptr<LaserLocalizationUnit> MakeUnit(const models::Scene& scene, Pose initial) {
-  auto u = std::make_unique<LaserLocalizationUnit>("loc", scene, std::vector<int>{541, 541}, 7);
+  auto u = std::make_unique<LaserLocalizationUnit>("loc", scene, std::vector<int>{541, 541});
   auto set2 = [&](const char* key, int j) { SetArray(*u, key, {kMount[0][j], kMount[1][j]}); };
   set2("mount_x", 0);
   set2("mount_y", 1);
@@ -327,15 +327,15 @@ TEST(LaserLocalization, NamesParameterProblems) {
   EXPECT_NE(std::find(names.begin(), names.end(), "scan_timeout"), names.end());
   EXPECT_NE(std::find(names.begin(), names.end(), "usable_range_max"), names.end());
 
-  auto v = std::make_unique<LaserLocalizationUnit>("loc", scene, std::vector<int>{541, 541}, 7);
+  auto v = std::make_unique<LaserLocalizationUnit>("loc", scene, std::vector<int>{541, 541});
   names.clear();
   for (const auto& p : v->CheckParameters()) names.push_back(p.variable);
   for (const char* required :
        {"mount_x", "mount_yaw", "first_beam_angle", "scan_period", "initial_x", "initial_yaw"}) {
     EXPECT_NE(std::find(names.begin(), names.end(), required), names.end()) << required;
   }
-  EXPECT_THROW(LaserLocalizationUnit("x", scene, {}, 1), cosim::UnitError);
-  EXPECT_THROW(LaserLocalizationUnit("x", scene, {541, 0}, 1), cosim::UnitError);
+  EXPECT_THROW(LaserLocalizationUnit("x", scene, {}), cosim::UnitError);
+  EXPECT_THROW(LaserLocalizationUnit("x", scene, {541, 0}), cosim::UnitError);
 }
 
 // Guards against the factory accepting bad beam_counts or sizing the
