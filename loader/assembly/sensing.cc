@@ -275,15 +275,15 @@ const std::map<std::string, Provider>& SurfaceVelocityProviders() {
          SetWheelPositions(p, robot);
          // The encoders' check of each message (a dark image passes the
          // firmware's quality test with noise matches): with the wheel
-         // encoders on, the odometry's unrectified twist, and a gate of
-         // 3 x paper 1's measurement sigma (3 cm/s). The wheels' encoder
+         // encoders on, their wheel velocities, and a gate of 3 measurement
+         // sigmas (0.09 m/s with paper 1's 3 cm/s). The wheels' encoder
          // velocities: those over the sensor's surface say how the robot
          // moves relative to it.
          if (s.odometry.empty() && !Mounts(s, "wheel_encoder").empty()) AddOdometry(b, c, s);
          if (!s.odometry.empty()) {
            b.Connect(Signal(s.odometry, "wheel_velocity"),
                      Signal(kSurfaceEstimator, "odometry_wheel_velocity"));
-           p["odometry_gate"] = Num(0.09);
+           p["odometry_gate"] = 3;
            s.recorded.push_back(Signal(kSurfaceEstimator, "implausible_count"));
          }
          b.Connect(s.position, Signal(kSurfaceEstimator, "position"));

@@ -122,12 +122,13 @@ SurfaceVelocityEstimator::SurfaceVelocityEstimator(std::string name, int sensors
               "state-switch detector: this many consecutive innovations beyond the gate on the "
               "same side restart the sensor's filter from its latest measurement",
               Rule::Range(1, 100));
-  v.Parameter("odometry_gate", "m/s", &odometry_gate_,
-              "the encoders' check of each message: the sensor must read minus the robot's "
-              "motion relative to the surface under it at its point, which the encoders of the "
-              "wheels the map puts over the same surface measure; a message farther off than "
-              "this is refused as implausible (a dark image: the firmware matches noise and "
-              "keeps its quality). 0 (default): off, odometry_wheel_velocity unused",
+  v.Parameter("odometry_gate", "1", &odometry_gate_,
+              "the encoders' check of each message, in measurement sigmas: the sensor must read "
+              "minus the robot's motion relative to the surface under it at its point, which the "
+              "encoders of the wheels the map puts over the same surface measure; a message "
+              "farther off than odometry_gate x measurement_sigma is refused as implausible (a "
+              "dark image: the firmware matches noise and keeps its quality). 0 (default): off, "
+              "odometry_wheel_velocity unused",
               Rule::NonNegative());
 
   v.Input("sensor_velocity", "m/s", &sensor_velocity_,
@@ -397,7 +398,7 @@ cosim::StepResult SurfaceVelocityEstimator::DoStep(cosim::TimeNs t, cosim::TimeN
       const double inv_t = 1e9 / static_cast<double>(acc_ns_[i]);
       const double ex = sensor_velocity_[2 * i] + acc_ox_[i] * inv_t;
       const double ey = sensor_velocity_[2 * i + 1] + acc_oy_[i] * inv_t;
-      if (std::hypot(ex, ey) > odometry_gate_) {
+      if (std::hypot(ex, ey) > odometry_gate_ * measurement_sigma_) {
         measured = false;
         ++implausible_[i];
       }

@@ -152,7 +152,7 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   // The state-switch detector (see the class comment for the numbers).
   double switch_gate_ = 2.5;
   std::int64_t switch_samples_ = 3;
-  // The encoders' check of each message (m/s; 0: off).
+  // The encoders' check of each message (in measurement sigmas; 0: off).
   double odometry_gate_ = 0.0;
 
   // Inputs.
