@@ -56,43 +56,51 @@ void SetInitialPose(YAML::Node p, const StartPose& start) {
   p["initial_yaw"] = Num(start.yaw_rad);
 }
 
-// One number of a sensor unit's parameters as the unit will get it: the
-// scenario's or the robot's setting if the expansion has one, else the
-// device's model file (the mount's or the scenario's `model`); nullopt when
-// neither gives it, or (reported at the key) when it is not a number.
-std::optional<double> DeviceValue(SystemBuilder& b, const ProviderContext& c,
-                                  const models::SensorMount& m, const std::string& key) {
-  const YAML::Node params = b.Params(m.name);
-  YAML::Node value = Child(params, key);
-  if (!value.IsDefined()) {
-    const YAML::Node model_name = Child(params, "model");
+// The numbers of one sensor unit's parameters as the unit will get them:
+// the scenario's or the robot's setting if the expansion has one, else the
+// device's model file (the mount's or the scenario's `model`, read once).
+class DeviceNumbers {
+ public:
+  DeviceNumbers(SystemBuilder& b, const ProviderContext& c, const models::SensorMount& m)
+      : b_(b), c_(c), m_(m), params_(b.Params(m.name)) {
+    const YAML::Node model_name = Child(params_, "model");
     if (model_name.IsDefined() && model_name.IsScalar()) {
-      const YAML::Node model = LoadModel(b.reader(), c.at, c.path, "sensor model",
-                                         model_name.Scalar(), "sensors", c.file.robot.file);
-      value = Child(model, key);
+      model_ = LoadModel(b.reader(), c.at, c.path, "sensor model", model_name.Scalar(), "sensors",
+                         c.file.robot.file);
     }
   }
-  if (!value.IsDefined() || value.IsNull()) return std::nullopt;
-  double x = 0.0;
-  if (!value.IsScalar() || !YAML::convert<double>::decode(value, x) || !std::isfinite(x)) {
-    b.reader().Error(c.at, c.path,
-                     "sensor '" + m.name + "': its parameter " + key +
-                         " is not a number (sensors." + m.name + ".parameters." + key +
-                         " or its model file)");
-    return std::nullopt;
-  }
-  return x;
-}
 
-// A device number the estimator cannot do without.
-double RequiredDeviceValue(SystemBuilder& b, const ProviderContext& c, const models::SensorMount& m,
-                           const std::string& key) {
-  if (const auto x = DeviceValue(b, c, m, key)) return *x;
-  b.reader().Error(c.at, c.path,
-                   "sensor '" + m.name + "' has no " + key + " (its model file or sensors." +
-                       m.name + ".parameters." + key + "), which the localization needs");
-  return 0.0;
-}
+  // nullopt when neither gives it, or (reported) when it is not a number.
+  std::optional<double> Get(const std::string& key) const {
+    YAML::Node value = Child(params_, key);
+    if (!value.IsDefined()) value = Child(model_, key);
+    if (!value.IsDefined() || value.IsNull()) return std::nullopt;
+    double x = 0.0;
+    if (!value.IsScalar() || !YAML::convert<double>::decode(value, x) || !std::isfinite(x)) {
+      b_.reader().Error(c_.at, c_.path,
+                        "sensor '" + m_.name + "': its parameter " + key +
+                            " is not a number (sensors." + m_.name + ".parameters." + key +
+                            " or its model file)");
+      return std::nullopt;
+    }
+    return x;
+  }
+
+  // A number the estimator cannot do without.
+  double Required(const std::string& key) const {
+    if (const auto x = Get(key)) return *x;
+    b_.reader().Error(c_.at, c_.path,
+                      "sensor '" + m_.name + "' has no " + key + " (its model file or sensors." +
+                          m_.name + ".parameters." + key + "), which the localization needs");
+    return 0.0;
+  }
+
+ private:
+  SystemBuilder& b_;
+  const ProviderContext& c_;
+  const models::SensorMount& m_;
+  YAML::Node params_, model_;
+};
 
 // hector_mapping on the robot's lasers (paper 1 Sec. IV-B): one
 // laser_localization unit matching every laser's scans against the scene.
@@ -114,14 +122,15 @@ void AddLaserLocalization(SystemBuilder& b, const ProviderContext& c, Signals& s
   std::vector<double> x, y, z, yaw, first, step, period;
   for (std::size_t k = 0; k < lasers.size(); ++k) {
     const models::SensorMount& m = *lasers[k];
-    beams.push_back(static_cast<int>(RequiredDeviceValue(b, c, m, "beam_count")));
+    const DeviceNumbers device(b, c, m);
+    beams.push_back(static_cast<int>(device.Required("beam_count")));
     x.push_back(m.x_m);
     y.push_back(m.y_m);
     z.push_back(m.z_m);
     yaw.push_back(m.yaw_rad);
-    first.push_back(RequiredDeviceValue(b, c, m, "first_beam_angle"));
-    step.push_back(RequiredDeviceValue(b, c, m, "angular_step"));
-    period.push_back(RequiredDeviceValue(b, c, m, "scan_period"));
+    first.push_back(device.Required("first_beam_angle"));
+    step.push_back(device.Required("angular_step"));
+    period.push_back(device.Required("scan_period"));
     const std::string suffix = "_" + std::to_string(k);
     b.Connect(Signal(m.name, "ranges"), Signal(kLaserLocalization, "ranges" + suffix));
     b.Connect(Signal(m.name, "scan_count"), Signal(kLaserLocalization, "scan_count" + suffix));
@@ -140,8 +149,8 @@ void AddLaserLocalization(SystemBuilder& b, const ProviderContext& c, Signals& s
   const YAML::Node map = Child(c.at, "map");
   if (map.IsDefined()) {
     p["map"] = b.reader().String(c.at, "localization", "map", "scene", {"scene", "mapping"});
-    b.Derived(JoinPath(JoinPath(JoinPath("units", kLaserLocalization), "parameters"), "map"),
-              c.at, "localization", "map");
+    b.Derived(JoinPath(JoinPath(JoinPath("units", kLaserLocalization), "parameters"), "map"), c.at,
+              "localization", "map");
   }
   SetInitialPose(p, c.start);
   SetStep(b, kLaserLocalization);
@@ -261,7 +270,7 @@ const std::map<std::string, Provider>& SurfaceVelocityProviders() {
          // settings or model file say (else both units' default, 10 Hz).
          std::optional<double> rate;
          for (const auto* m : flows) {
-           const auto r = DeviceValue(b, c, *m, "publish_rate");
+           const auto r = DeviceNumbers(b, c, *m).Get("publish_rate");
            if (!r) continue;
            if (rate && *rate != *r) {
              b.reader().Error(c.at, c.path,
