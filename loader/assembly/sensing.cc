@@ -72,8 +72,7 @@ class DeviceNumbers {
 
   // nullopt when neither gives it, or (reported) when it is not a number.
   std::optional<double> Get(const std::string& key) const {
-    YAML::Node value = Child(params_, key);
-    if (!value.IsDefined()) value = Child(model_, key);
+    const YAML::Node value = Find(key);
     if (!value.IsDefined() || value.IsNull()) return std::nullopt;
     double x = 0.0;
     if (!value.IsScalar() || !YAML::convert<double>::decode(value, x) || !std::isfinite(x)) {
@@ -88,7 +87,8 @@ class DeviceNumbers {
 
   // A number the estimator cannot do without.
   double Required(const std::string& key) const {
-    if (const auto x = Get(key)) return *x;
+    const YAML::Node value = Find(key);
+    if (value.IsDefined() && !value.IsNull()) return Get(key).value_or(0.0);
     b_.reader().Error(c_.at, c_.path,
                       "sensor '" + m_.name + "' has no " + key + " (its model file or sensors." +
                           m_.name + ".parameters." + key + "), which the localization needs");
@@ -96,6 +96,11 @@ class DeviceNumbers {
   }
 
  private:
+  YAML::Node Find(const std::string& key) const {
+    const YAML::Node own = Child(params_, key);
+    return own.IsDefined() ? own : Child(model_, key);
+  }
+
   SystemBuilder& b_;
   const ProviderContext& c_;
   const models::SensorMount& m_;

@@ -332,6 +332,16 @@ localization: {source: laser}
   const auto& table =
       learned.system->unit(*learned.system->FindUnit("laser_localization")).variables();
   EXPECT_EQ(table.GetString(*table.Find("map")), "mapping");
+  // A laser number the matcher needs that is not a number: said once, at the
+  // sensor's key.
+  std::ifstream in(kCross);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("sensors:\n  default: true\n"), 25,
+               "sensors:\n  default: true\n  laser_front: {parameters: {scan_period: fast}}\n");
+  const std::string bad =
+      Issues(WriteScenario("laser_period.yaml", text), {"localization.source=laser"});
+  EXPECT_TRUE(Has(bad, "sensors.laser_front.parameters.scan_period")) << bad;
+  EXPECT_FALSE(Has(bad, "has no scan_period")) << bad;
 }
 
 // Guards the robot-level checks: unknown keys name the closest, values out
