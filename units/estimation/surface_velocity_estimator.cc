@@ -48,6 +48,7 @@ SurfaceVelocityEstimator::SurfaceVelocityEstimator(std::string name, int sensors
   sensor_on_belt_.assign(n_, 0.0);
   sensor_status_.assign(n_, kNoEstimate);
   wheel_surface_velocity_.assign(2 * w_, 0.0);
+  wheel_map_surface_.assign(w_, 0);
   odometry_wheel_velocity_.assign(2 * w_, 0.0);
   wheel_on_belt_.assign(w_, 0.0);
   wheel_source_.assign(w_, kFloor);
@@ -280,14 +281,12 @@ bool SurfaceVelocityEstimator::SurfaceMean(int surface, int status, char skip, d
   return true;
 }
 
-bool SurfaceVelocityEstimator::RelativeAt(std::int64_t surface, double px, double py, double c,
-                                          double s, double& vx, double& vy) const {
+bool SurfaceVelocityEstimator::RelativeAt(std::int64_t surface, double px, double py, double& vx,
+                                          double& vy) const {
   double sx = 0.0, sy = 0.0;
   int count = 0;
   for (std::size_t j = 0; j < w_; ++j) {
-    const double wx = position_[0] + c * wheel_x_[j] - s * wheel_y_[j];
-    const double wy = position_[1] + s * wheel_x_[j] + c * wheel_y_[j];
-    if (SurfaceAt(wx, wy) != surface) continue;
+    if (wheel_map_surface_[j] != surface) continue;
     // Rigid body: v(p) = v(r_j) + omega x (p - r_j).
     sx += odometry_wheel_velocity_[2 * j] - yaw_rate_ * (py - wheel_y_[j]);
     sy += odometry_wheel_velocity_[2 * j + 1] + yaw_rate_ * (px - wheel_x_[j]);
@@ -300,7 +299,6 @@ bool SurfaceVelocityEstimator::RelativeAt(std::int64_t surface, double px, doubl
 }
 
 void SurfaceVelocityEstimator::WriteOutputs(double c, double s) {
-  const double px = position_[0], py = position_[1];
   for (std::size_t i = 0; i < n_; ++i) {
     sensor_on_belt_[i] = static_cast<double>(map_surface_[i]);
     sensor_status_[i] = static_cast<double>(status_[i]);
@@ -320,9 +318,7 @@ void SurfaceVelocityEstimator::WriteOutputs(double c, double s) {
   // (Near a belt's end, or on a narrower line, a wheel can be over a belt
   // no sensor sees: source 3.)
   for (std::size_t j = 0; j < w_; ++j) {
-    const double wx = px + c * wheel_x_[j] - s * wheel_y_[j];
-    const double wy = py + s * wheel_x_[j] + c * wheel_y_[j];
-    const int k = SurfaceAt(wx, wy);
+    const auto k = static_cast<int>(wheel_map_surface_[j]);
     double vx = 0.0, vy = 0.0;
     int source = kFloor;
     if (k > 0) {
@@ -344,11 +340,12 @@ void SurfaceVelocityEstimator::WriteOutputs(double c, double s) {
 }
 
 void SurfaceVelocityEstimator::MapSurfaces(double c, double s) {
-  for (std::size_t i = 0; i < n_; ++i) {
-    const double mx = position_[0] + c * sensor_x_[i] - s * sensor_y_[i];
-    const double my = position_[1] + s * sensor_x_[i] + c * sensor_y_[i];
-    map_surface_[i] = SurfaceAt(mx, my);
-  }
+  // base_link point (x, y) in map, and the surface there.
+  const auto at = [&](double x, double y) {
+    return SurfaceAt(position_[0] + c * x - s * y, position_[1] + s * x + c * y);
+  };
+  for (std::size_t i = 0; i < n_; ++i) map_surface_[i] = at(sensor_x_[i], sensor_y_[i]);
+  for (std::size_t j = 0; j < w_; ++j) wheel_map_surface_[j] = at(wheel_x_[j], wheel_y_[j]);
 }
 
 cosim::StepResult SurfaceVelocityEstimator::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
@@ -526,8 +523,7 @@ cosim::StepResult SurfaceVelocityEstimator::DoStep(cosim::TimeNs t, cosim::TimeN
     acc_vx_[i] += (mount_cos_[i] * pbx + mount_sin_[i] * pby) * h;
     acc_vy_[i] += (-mount_sin_[i] * pbx + mount_cos_[i] * pby) * h;
     double obx = 0.0, oby = 0.0;
-    if (odometry_gate_ > 0.0 &&
-        RelativeAt(map_surface_[i], sensor_x_[i], sensor_y_[i], c, s, obx, oby)) {
+    if (odometry_gate_ > 0.0 && RelativeAt(map_surface_[i], sensor_x_[i], sensor_y_[i], obx, oby)) {
       acc_ox_[i] += (mount_cos_[i] * obx + mount_sin_[i] * oby) * h;
       acc_oy_[i] += (-mount_sin_[i] * obx + mount_cos_[i] * oby) * h;
       acc_checked_ns_[i] += dt;

@@ -116,16 +116,17 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   /// point, as the px4flow and the chassis take it).
   int SurfaceAt(double x, double y) const;
   /// The robot's velocity relative to `surface` at base_link point (px, py)
-  /// in base_link by the encoders of the wheels the map puts over it (the
-  /// yaw rate: the localization's, a belt does not turn); false when none is.
-  bool RelativeAt(std::int64_t surface, double px, double py, double c, double s, double& vx,
-                  double& vy) const;
+  /// in base_link by the encoders of the wheels the map puts over it
+  /// (wheel_map_surface_; the yaw rate: the localization's, a belt does not
+  /// turn); false when none is.
+  bool RelativeAt(std::int64_t surface, double px, double py, double& vx, double& vy) const;
   /// Mean filtered value (map) of the sensors whose filter belongs to
   /// `surface` (the one the map puts them over) and whose status is
   /// `status`, skipping those with any of the flags `skip` this step; false
   /// if there is none.
   bool SurfaceMean(int surface, int status, char skip, double& vx, double& vy) const;
-  /// map_surface_ from the pose inputs (c, s: cos and sin of yaw).
+  /// map_surface_ and wheel_map_surface_ from the pose inputs (c, s: cos
+  /// and sin of yaw).
   void MapSurfaces(double c, double s);
   /// Per-sensor outputs from the state, and the wheel outputs.
   void WriteOutputs(double c, double s);
@@ -199,6 +200,8 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   // Per sensor: the surface the map puts it over at the last step (saved:
   // an output is written from it), and scratch flags of this step.
   std::vector<std::int64_t> map_surface_;
+  // The same for each wheel (scratch: from the pose each step).
+  std::vector<std::int64_t> wheel_map_surface_;
   std::vector<char> flags_;
 
   cosim::TimeNs start_ = 0;
