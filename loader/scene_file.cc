@@ -245,7 +245,7 @@ class SceneParser {
       r_.CheckKeys(item, p, {"name", "kind", "box", "cylinder"});
       models::Obstacle o;
       o.name = Name(item, p, names);
-      o.kind = r_.String(item, p, "kind", std::nullopt, {"wall", "pillar", "cart", "rack"});
+      o.kind = r_.String(item, p, "kind", std::nullopt, {"wall", "pillar", "cart", "rack", "vehicle", "beacon"});
       if (auto solid = Shape(item, p, true)) o.solid = *solid;
       s_.obstacles.push_back(o);
     }

@@ -113,7 +113,7 @@ inline Solid CylinderSolid(double x_m, double y_m, double radius_m, double heigh
 /// A static obstacle: a wall, a pillar, a part cart, a rack.
 struct Obstacle {
   std::string name;
-  std::string kind;  // wall, pillar, cart, rack: for plots and reports
+  std::string kind;  // wall, pillar, cart, rack, vehicle (a van), beacon (a reflector)
   Solid solid;
 };
 
