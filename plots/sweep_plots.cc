@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <optional>
 #include <set>
 #include <stdexcept>
@@ -31,6 +32,10 @@ bool IsSafeFileName(const std::string& name) {
 void CheckChart(const SweepChart& chart) {
   if (!IsSafeFileName(chart.file) || !chart.file.ends_with(".png")) {
     Refuse(chart, "the file name must be made of [A-Za-z0-9._-] and end in .png");
+  }
+  if (chart.histogram) {
+    if (chart.series.size() != 1) Refuse(chart, "a histogram has exactly one series of samples");
+    return;
   }
   for (const SweepSeries& s : chart.series) {
     const std::size_t n = s.x.size();
@@ -93,8 +98,62 @@ std::vector<Point> Points(const SweepChart& chart, const SweepSeries& s,
   return points;
 }
 
+// The script lines of a histogram chart: counts per bin as boxes and the
+// normal density N(mean, std) times n x bin width over them; empty without
+// finite samples.
+std::string HistogramScript(const SweepChart& chart, std::size_t index) {
+  std::vector<double> v;
+  for (double x : chart.series[0].mean) {
+    if (std::isfinite(x)) v.push_back(x);
+  }
+  if (v.empty()) return {};
+  const double n = static_cast<double>(v.size());
+  double mean = 0.0;
+  for (double x : v) mean += x / n;
+  double var = 0.0;
+  for (double x : v) var += (x - mean) * (x - mean);
+  const double sd = v.size() > 1 ? std::sqrt(var / (n - 1.0)) : 0.0;
+  const auto [lo_it, hi_it] = std::minmax_element(v.begin(), v.end());
+  double lo = *lo_it, hi = *hi_it;
+  // Square-root choice of the bin count (at least 5, at most 30); a single
+  // value gets one bin of a width that shows it.
+  const int bins = std::clamp(static_cast<int>(std::ceil(std::sqrt(n))), 5, 30);
+  if (hi - lo <= 0.0) {
+    const double half = std::max(std::abs(lo) * 1e-3, 1e-12);
+    lo -= half;
+    hi += half;
+  }
+  const double width = (hi - lo) / bins;
+  std::vector<int> counts(static_cast<std::size_t>(bins), 0);
+  for (double x : v) {
+    const int b = std::min(bins - 1, static_cast<int>((x - lo) / width));
+    ++counts[static_cast<std::size_t>(b)];
+  }
+  const std::string block = "$hist" + std::to_string(index);
+  std::string s = "\n" + block + " << EOD\n";
+  for (int b = 0; b < bins; ++b) {
+    s += Num(lo + (b + 0.5) * width) + " " + std::to_string(counts[static_cast<std::size_t>(b)]) +
+         "\n";
+  }
+  s += "EOD\nset output " + GnuplotQuote(chart.file) + "\nset title " +
+       GnuplotQuote(chart.title) + "\nset xlabel " + GnuplotQuote(chart.x_label) +
+       "\nset ylabel 'runs'\nset autoscale x\nset xtics autofreq\nset key title ''\n"
+       "set boxwidth " + Num(width) + " absolute\nset style fill solid 0.5 border -1\n";
+  s += "plot " + block + " using 1:2 with boxes lt 1 title " +
+       GnuplotQuote(std::to_string(v.size()) + " runs, bins of " + Num(width));
+  if (sd > 0.0) {
+    const std::string k = Num(n * width / (sd * std::sqrt(2.0 * std::numbers::pi)));
+    s += ", \\\n     [" + Num(mean - 4.0 * sd) + ":" + Num(mean + 4.0 * sd) + "] " + k +
+         " * exp(-0.5 * ((x - " + Num(mean) + ") / " + Num(sd) +
+         ") ** 2) with lines lw 2 lt 2 title " +
+         GnuplotQuote("normal: mean " + Num(mean) + ", std " + Num(sd));
+  }
+  return s + "\n";
+}
+
 // The script lines of one chart; empty when it has nothing to draw.
 std::string ChartScript(const SweepChart& chart, std::size_t index) {
+  if (chart.histogram) return HistogramScript(chart, index);
   const std::vector<std::string> categories =
       chart.categorical_x ? Categories(chart) : std::vector<std::string>{};
   const std::size_t count = chart.series.size();

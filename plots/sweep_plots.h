@@ -28,6 +28,11 @@ struct SweepChart {
   bool categorical_x = false;
   std::vector<std::string> categories;
   bool scatter = false;
+  /// A histogram of the samples in series[0].mean (x, min and max unused),
+  /// with the normal density of their mean and sample standard deviation
+  /// scaled to counts over it (as paper 2's Figs. 6-11 show a histogram and
+  /// its normal distribution). `x_label` names the sample's quantity.
+  bool histogram = false;
   std::vector<SweepSeries> series;
 };
 

@@ -186,6 +186,8 @@ std::string Label(const SweepTable& t, const std::vector<std::size_t>& which,
 }
 
 std::string ValuesText(const SweepTable& t, const Row& r) {
+  // Repeats of one scenario differ only by their seed.
+  if (t.parameters.empty()) return "seed " + std::to_string(r.seed);
   return Label(t, AllParameters(t), r.values);
 }
 
@@ -287,6 +289,53 @@ void PrintPoints(const SweepTable& t, const Rows& all, std::ostream& out) {
   PrintColumns(rows, right, out);
 }
 
+// Index of metric `name` in t.metrics (the sweep spec checked it is there).
+std::size_t MetricIndex(const SweepTable& t, const std::string& name) {
+  const auto it = std::find(t.metrics.begin(), t.metrics.end(), name);
+  if (it == t.metrics.end()) {
+    throw std::invalid_argument("sweep table '" + t.name + "': the reference names metric '" +
+                                name + "', which it does not hold");
+  }
+  return static_cast<std::size_t>(it - t.metrics.begin());
+}
+
+// Each metric over all runs (a sweep without parameters): mean ± std
+// [min, max], the largest and the mean absolute value.
+void PrintOverall(const SweepTable& t, const Rows& all, std::ostream& out) {
+  out << "\nover all runs:\n";
+  std::vector<std::vector<std::string>> rows{
+      {"metric", "n", "mean", "", "[min, max]", "max |x|", "mean |x|"}};
+  for (std::size_t m = 0; m < t.metrics.size(); ++m) {
+    const Stats s = StatsOf(OkValues(all, m));
+    rows.push_back({t.metrics[m], std::to_string(s.n), Sig4(s.mean), "± " + Sig4(s.std),
+                    "[" + Sig4(s.min) + ", " + Sig4(s.max) + "]", Sig4(s.max_abs),
+                    Sig4(s.mean_abs)});
+  }
+  PrintColumns(rows, {false, true, true, false, false, true, true}, out);
+}
+
+// The reference's table: a row per figure, a column per metric, ours beside
+// the source's.
+void PrintReference(const SweepTable& t, const Rows& all, std::ostream& out) {
+  out << "\n" << t.reference_title << " (this sweep | reference):\n";
+  std::vector<std::vector<std::string>> rows{{""}};
+  std::vector<std::string> max_row{"maximum absolute error"}, std_row{"standard deviation"},
+      mean_row{"mean absolute error"};
+  for (const auto& ref : t.reference) {
+    const Stats s = StatsOf(OkValues(all, MetricIndex(t, ref.metric)));
+    rows[0].push_back(ref.label);
+    max_row.push_back(Sig4(s.max_abs) + " | " + Sig4(ref.max_abs));
+    std_row.push_back(Sig4(s.std) + " | " + Sig4(ref.std));
+    mean_row.push_back(Sig4(s.mean_abs) + " | " + Sig4(ref.mean_abs));
+  }
+  rows.push_back(std::move(max_row));
+  rows.push_back(std::move(std_row));
+  rows.push_back(std::move(mean_row));
+  std::vector<bool> right(rows[0].size(), true);
+  right[0] = false;
+  PrintColumns(rows, right, out);
+}
+
 void PrintRandom(const SweepTable& t, std::size_t p, std::ostream& out) {
   const RandomParameter r = DescribeRandom(t, p);
   out << "\n"
@@ -348,17 +397,21 @@ std::string UniqueFile(const std::string& name, std::set<std::string>& taken) {
 Stats StatsOf(std::span<const double> values) {
   Stats s;
   double sum = 0.0;
+  double sum_abs = 0.0;
   s.min = INFINITY;
   s.max = -INFINITY;
   for (double v : values) {
     if (!std::isfinite(v)) continue;
     ++s.n;
     sum += v;
+    sum_abs += std::abs(v);
     s.min = std::min(s.min, v);
     s.max = std::max(s.max, v);
   }
-  if (s.n == 0) return {0, kNaN, kNaN, kNaN, kNaN};
+  if (s.n == 0) return {0, kNaN, kNaN, kNaN, kNaN, kNaN, kNaN};
   s.mean = sum / static_cast<double>(s.n);
+  s.mean_abs = sum_abs / static_cast<double>(s.n);
+  s.max_abs = std::max(std::abs(s.min), std::abs(s.max));
   // Squares of deviations from the mean (second pass): no cancellation for
   // large values with a small spread.
   double squares = 0.0;
@@ -444,6 +497,31 @@ nlohmann::ordered_json Summarize(const SweepTable& t) {
                         {"error", r.error}});
   }
   s["failures"] = std::move(failures);
+
+  Json overall = Json::object();
+  for (std::size_t m = 0; m < t.metrics.size(); ++m) {
+    const Stats st = StatsOf(OkValues(all, m));
+    Json one = StatsJson(st);
+    one["max_abs"] = Number(st.max_abs);
+    one["mean_abs"] = Number(st.mean_abs);
+    overall[t.metrics[m]] = std::move(one);
+  }
+  s["overall"] = std::move(overall);
+  if (!t.reference_title.empty()) {
+    Json metrics = Json::object();
+    for (const auto& ref : t.reference) {
+      const Stats st = StatsOf(OkValues(all, MetricIndex(t, ref.metric)));
+      metrics[ref.metric] = {
+          {"label", ref.label},
+          {"ours",
+           {{"max_abs", Number(st.max_abs)}, {"std", Number(st.std)},
+            {"mean_abs", Number(st.mean_abs)}}},
+          {"reference",
+           {{"max_abs", Number(ref.max_abs)}, {"std", Number(ref.std)},
+            {"mean_abs", Number(ref.mean_abs)}}}};
+    }
+    s["reference"] = {{"title", t.reference_title}, {"metrics", std::move(metrics)}};
+  }
   return s;
 }
 
@@ -461,6 +539,8 @@ void PrintSummary(const SweepTable& t, std::ostream& out) {
     }
   }
   if (t.grid && t.parameters.size() > 1) PrintPoints(t, all, out);
+  if (t.parameters.empty()) PrintOverall(t, all, out);
+  if (!t.reference_title.empty()) PrintReference(t, all, out);
   if (failed == 0) return;
   out << "\nfailed runs:\n";
   std::size_t printed = 0;
@@ -484,6 +564,23 @@ std::vector<plots::SweepChart> SweepCharts(const SweepTable& t) {
   for (std::size_t p = 0; p < t.parameters.size(); ++p) series_rows.push_back(SeriesOf(t, p, all));
   std::vector<plots::SweepChart> charts;
   std::set<std::string> taken;
+  if (t.parameters.empty()) {
+    // Repeats of one scenario: how each metric is distributed over them.
+    for (std::size_t m = 0; m + 1 < t.metrics.size(); ++m) {
+      plots::SweepChart chart;
+      chart.histogram = true;
+      chart.title = (t.name.empty() ? "" : t.name + ": ") + t.metrics[m] + " over " +
+                    std::to_string(t.rows.size()) + " runs";
+      chart.x_label = t.metrics[m];
+      plots::SweepSeries samples;
+      samples.mean = OkValues(all, m);
+      if (StatsOf(samples.mean).n == 0) continue;
+      chart.series.push_back(std::move(samples));
+      chart.file = UniqueFile(plots::SafeFileName(t.metrics[m] + "_histogram.png"), taken);
+      charts.push_back(std::move(chart));
+    }
+    return charts;
+  }
   for (std::size_t m = 0; m < t.metrics.size(); ++m) {
     for (std::size_t p = 0; p < t.parameters.size(); ++p) {
       const std::string& path = t.parameters[p];

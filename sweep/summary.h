@@ -18,6 +18,9 @@ namespace linesim::sweep {
 struct Stats {
   std::int64_t n = 0;
   double mean = 0.0, std = 0.0, min = 0.0, max = 0.0;
+  /// Largest and mean absolute value (paper 2's Table 1 reports signed
+  /// errors by these and the standard deviation).
+  double max_abs = 0.0, mean_abs = 0.0;
 };
 
 /// Stats of the finite values among `values` (the others are not counted).
@@ -32,7 +35,11 @@ double Correlation(std::span<const double> x, std::span<const double> y);
 ///    "by_parameter": {path: [{"value", "runs", "failed", "metrics": {metric:
 ///      {"n", "mean", "std", "min", "max"}}}, ...]},
 ///    "by_point": [{"values": {path: value}, "runs", "failed", "metrics"}, ...],
-///    "failures": [{"id", "seed", "values", "error"}, ...]}
+///    "failures": [{"id", "seed", "values", "error"}, ...],
+///    "overall": {metric: {"n", "mean", "std", "min", "max", "max_abs",
+///      "mean_abs"}},
+///    "reference": {"title", "metrics": {metric: {"label", "ours": {"max_abs",
+///      "std", "mean_abs"}, "reference": {...}}}} (only with a reference)}
 /// Statistics are over the ok runs; "failed" counts the others. Groups of
 /// by_parameter follow the parameter's levels; a parameter drawn at random
 /// (no levels) has instead {"min", "max", "correlation": {metric: r}}: its
@@ -44,11 +51,14 @@ double Correlation(std::span<const double> x, std::span<const double> y);
 nlohmann::ordered_json Summarize(const SweepTable& table);
 
 /// The summary as an aligned terminal table: per parameter, per value, each
-/// metric's mean ± std [min, max] (4 significant digits); then the failed
-/// runs (at most 10).
+/// metric's mean ± std [min, max] (4 significant digits); for a sweep
+/// without parameters each metric over all runs with its largest and mean
+/// absolute value; the reference's table, ours beside the source's; then
+/// the failed runs (at most 10).
 void PrintSummary(const SweepTable& table, std::ostream& out);
 
-/// One chart per (metric, varied parameter), wall_s included, of the ok
+/// A sweep without parameters: one histogram per metric (wall_s left out)
+/// of the ok runs. Otherwise one chart per (metric, varied parameter), wall_s included, of the ok
 /// runs. In a grid with several parameters each combination of the other
 /// parameters' values is its own series when there are at most 8 of them
 /// (else one series pools them); each point is the mean, min and max of the

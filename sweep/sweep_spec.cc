@@ -334,6 +334,38 @@ std::vector<std::string> FixedOverrides(const SweepSpec& spec) {
   return args;
 }
 
+// `reference: {title, metrics: {NAME: {label, max_abs, std, mean_abs}}}`;
+// a figure the source does not give is left out (NaN).
+void ReadReference(const YAML::Node& node, YamlReader& r, SweepSpec& spec) {
+  if (!node.IsDefined() || !r.ExpectMap(node, "reference")) return;
+  r.CheckKeys(node, "reference", {"title", "metrics"});
+  spec.reference_title = r.String(node, "reference", "title", std::nullopt);
+  const YAML::Node metrics = Child(node, "metrics");
+  if (!metrics.IsDefined()) {
+    r.Error(node, "reference.metrics",
+            "missing required key: a map from metric name to {label, max_abs, std, mean_abs}");
+    return;
+  }
+  if (!r.ExpectMap(metrics, "reference.metrics")) return;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& kv : metrics) {
+    SweepTable::ReferenceMetric m;
+    m.metric = kv.first.IsScalar() ? kv.first.Scalar() : "";
+    const std::string path = JoinPath("reference.metrics", m.metric);
+    if (!r.ExpectMap(kv.second, path)) continue;
+    r.CheckKeys(kv.second, path, {"label", "max_abs", "std", "mean_abs"});
+    m.label = r.String(kv.second, path, "label", m.metric);
+    const auto figure = [&](const char* key) {
+      return Child(kv.second, key).IsDefined() ? r.Real(kv.second, path, key, 0.0, {0.0, 1e300})
+                                               : kNaN;
+    };
+    m.max_abs = figure("max_abs");
+    m.std = figure("std");
+    m.mean_abs = figure("mean_abs");
+    spec.reference.push_back(m);
+  }
+}
+
 SweepSpec LoadSweepSpec(const std::string& file) {
   SweepSpec spec;
   spec.file = file;
@@ -342,7 +374,7 @@ SweepSpec LoadSweepSpec(const std::string& file) {
   if (!r.ExpectMap(root, "")) throw ScenarioError(r.issues());
   r.CheckKeys(root, "",
               {"name", "description", "scenario", "set", "parameters", "combine", "samples",
-               "repeats", "seed", "seeds", "metrics"});
+               "repeats", "seed", "seeds", "metrics", "reference"});
   spec.name = r.String(root, "", "name", fs::path(file).stem().string());
   spec.description = r.String(root, "", "description", "");
   const std::string scenario = r.String(root, "", "scenario", std::nullopt);
@@ -365,11 +397,10 @@ SweepSpec LoadSweepSpec(const std::string& file) {
       }
     }
   }
+  // Without parameters a sweep repeats the scenario as it is (repeats: N,
+  // N >= 2, checked below): a repeatability study such as paper 2's 20 runs.
   const YAML::Node parameters = Child(root, "parameters");
-  if (!parameters.IsDefined()) {
-    r.Error(root, "parameters", "missing required key: the list of parameters to vary");
-  } else if (r.ExpectSequence(parameters, "parameters")) {
-    if (parameters.size() == 0) r.Error(parameters, "parameters", "expected at least one");
+  if (parameters.IsDefined() && r.ExpectSequence(parameters, "parameters")) {
     for (std::size_t i = 0; i < parameters.size(); ++i) {
       ReadParameter(parameters[i], "parameters." + std::to_string(i), r, spec);
     }
@@ -391,6 +422,12 @@ SweepSpec LoadSweepSpec(const std::string& file) {
     }
   }
   spec.repeats = r.Integer(root, "", "repeats", 1, 1, 1000000);
+  if (spec.parameters.empty() && spec.repeats < 2 &&
+      (!parameters.IsDefined() || parameters.IsSequence())) {
+    r.Error(parameters.IsDefined() ? parameters : root, "parameters",
+            "expected at least one parameter to vary, or repeats: N (N >= 2) to run the "
+            "scenario as it is N times");
+  }
   // Points x samples x repeats, refused above kMaxRuns before it could
   // overflow: each run is a row, and the ids of the runs to do are held.
   double runs = static_cast<double>(spec.samples) * static_cast<double>(spec.repeats);
@@ -417,6 +454,7 @@ SweepSpec LoadSweepSpec(const std::string& file) {
       }
     }
   }
+  ReadReference(Child(root, "reference"), r, spec);
   if (!r.ok()) throw ScenarioError(r.issues());
 
   // The base scenario with the fixed settings must load by itself.
@@ -454,6 +492,14 @@ SweepSpec LoadSweepSpec(const std::string& file) {
               "'" + m +
                   "' is also the name of another column of results.csv; rename the metric "
                   "in the scenario");
+    }
+  }
+  for (const auto& ref : spec.reference) {
+    if (std::find(spec.metrics.begin(), spec.metrics.end(), ref.metric) == spec.metrics.end()) {
+      const YAML::Node key = Child(Child(Child(root, "reference"), "metrics"), ref.metric);
+      r.Error(key, "reference.metrics." + ref.metric,
+              "'" + ref.metric + "' is not a metric this sweep collects; it collects: " +
+                  config::JoinNames(spec.metrics));
     }
   }
   if (spec.metrics.empty() && r.ok()) {

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "sweep/sweep_table.h"
+
 namespace linesim::sweep {
 
 /// How a parameter's values are chosen.
@@ -61,6 +63,11 @@ struct SweepSpec {
   /// Metrics of the base scenario to collect; all of them when the file
   /// names none.
   std::vector<std::string> metrics;
+  /// `reference: {title, metrics: {NAME: {label, max_abs, std, mean_abs}}}`:
+  /// published figures the report prints beside the sweep's (empty title:
+  /// none). Each NAME is one of `metrics`.
+  std::string reference_title;
+  std::vector<SweepTable::ReferenceMetric> reference;
 };
 
 /// The `set:` entries as `--set` arguments ("path=value"), in file order.

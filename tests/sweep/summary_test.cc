@@ -90,6 +90,16 @@ TEST(StatsOf, MeanSampleStdAndExtremes) {
   EXPECT_EQ(s.max, 4.0);
 }
 
+// Guards paper 2's Table 1 figures: the largest and the mean absolute
+// value of signed errors (worked by hand: |-3| is the largest, (1+2+3)/3).
+TEST(StatsOf, LargestAndMeanAbsoluteValue) {
+  const std::vector<double> values{1, -3, 2};
+  const Stats s = StatsOf(values);
+  EXPECT_EQ(s.max_abs, 3.0);
+  EXPECT_DOUBLE_EQ(s.mean_abs, 2.0);
+  EXPECT_TRUE(std::isnan(StatsOf({}).max_abs));
+}
+
 // Guards the edge cases: one value has std 0 (not NaN from 0/0), none has
 // NaN everywhere, and non-finite values are not counted.
 TEST(StatsOf, OneValueNoValueAndNonFinite) {
@@ -470,6 +480,67 @@ TEST_F(WriteSweepReportTest, PlotFailureKeepsTheSummary) {
   EXPECT_NE(summary["plots"]["error"].get<std::string>().find("cannot run gnuplot"),
             std::string::npos)
       << summary["plots"];
+}
+
+// Five repeats of one scenario (no parameters) with a reference, as paper 2's
+// Table 1: signed errors -2, -1, 0, 1, 2 (mean 0, sample std sqrt(10/4),
+// max |x| 2, mean |x| 6/5); run 5 failed and does not count.
+SweepTable Repeats() {
+  SweepTable t;
+  t.name = "van_entry";
+  t.metrics = {"error_x_m", "wall_s"};
+  for (int i = 0; i < 5; ++i) t.rows.push_back(Ok(i, {}, {i - 2.0, 1.0}));
+  t.rows.push_back(Failed(5, {}, "follower: did not reach the route's end", {NAN, 1.0}));
+  t.reference_title = "paper 2, Table 1";
+  t.reference = {{"error_x_m", "X (m)", 0.019, 0.005, 0.004}};
+  return t;
+}
+
+// Guards the repeatability report: summary.json's overall statistics and
+// the reference beside ours.
+TEST(Summarize, RepeatsWithoutParametersAndAReference) {
+  const auto s = Summarize(Repeats());
+  EXPECT_EQ(s["ok"], 5);
+  const auto& x = s["overall"]["error_x_m"];
+  EXPECT_EQ(x["n"], 5);
+  EXPECT_DOUBLE_EQ(x["std"].get<double>(), std::sqrt(10.0 / 4.0));
+  EXPECT_EQ(x["max_abs"], 2.0);
+  EXPECT_DOUBLE_EQ(x["mean_abs"].get<double>(), 1.2);
+  const auto& ref = s["reference"]["metrics"]["error_x_m"];
+  EXPECT_EQ(s["reference"]["title"], "paper 2, Table 1");
+  EXPECT_EQ(ref["label"], "X (m)");
+  EXPECT_EQ(ref["ours"]["max_abs"], 2.0);
+  EXPECT_EQ(ref["reference"]["max_abs"], 0.019);
+  EXPECT_EQ(ref["reference"]["mean_abs"], 0.004);
+}
+
+// Guards the terminal table: each figure's row with ours | the reference's.
+TEST(PrintSummary, RepeatsPrintOverallAndTheReferenceTable) {
+  std::ostringstream out;
+  PrintSummary(Repeats(), out);
+  const std::string text = out.str();
+  EXPECT_NE(text.find("over all runs:"), std::string::npos) << text;
+  EXPECT_NE(text.find("paper 2, Table 1 (this sweep | reference):"), std::string::npos) << text;
+  EXPECT_NE(text.find("maximum absolute error      2 | 0.019"), std::string::npos) << text;
+  EXPECT_NE(text.find("mean absolute error       1.2 | 0.004"), std::string::npos) << text;
+  EXPECT_NE(text.find("run 5 (seed 105): follower"), std::string::npos) << text;
+}
+
+// Guards the histograms: one per metric but wall_s, of the ok runs only.
+TEST(SweepCharts, RepeatsGiveOneHistogramPerMetric) {
+  const auto charts = SweepCharts(Repeats());
+  ASSERT_EQ(charts.size(), 1u);
+  EXPECT_TRUE(charts[0].histogram);
+  EXPECT_EQ(charts[0].file, "error_x_m_histogram.png");
+  EXPECT_EQ(charts[0].series[0].mean, (std::vector<double>{-2, -1, 0, 1, 2}));
+}
+
+// Guards that gnuplot draws the histogram with its normal curve.
+TEST_F(WriteSweepReportTest, WritesHistograms) {
+  const auto files = WriteSweepReport(dir_.string(), Repeats());
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(ReadAll(files[1]).substr(0, 8), "\x89PNG\r\n\x1a\n");
+  EXPECT_NE(ReadAll(dir_ / "sweep_plots.gp").find("exp(-0.5 *"), std::string::npos);
 }
 
 }  // namespace

@@ -248,6 +248,35 @@ TEST(SweepSpec, BadSweepFilesNameFileKeyPathAndWhatWasExpected) {
   EXPECT_TRUE(AnyContains(IssueTexts("/nonexistent/sweep.yaml"), "cannot read the sweep file"));
 }
 
+// Guards the repeatability sweep (paper 2's 20 runs): no parameters but
+// repeats, each run its own seed, a reference beside the metrics; refused
+// without repeats, or with a reference to a metric it does not collect.
+TEST(SweepSpec, RepeatsWithoutParametersAndAReference) {
+  const std::string head = "scenario: " + kCrossLine + "\nset: {duration_s: 2}\n";
+  const SweepSpec spec = LoadSweepSpec(WriteFile(
+      "repeats.yaml", head + "repeats: 3\nseeds: per_run\nmetrics: [max_path_deviation_m]\n"
+                             "reference: {title: 'paper 1', metrics: {max_path_deviation_m: "
+                             "{label: 'max (m)', max_abs: 0.04}}}\n"));
+  EXPECT_EQ(RunCount(spec), 3);
+  EXPECT_TRUE(spec.parameters.empty());
+  EXPECT_NE(PlanRun(spec, 0).seed, PlanRun(spec, 1).seed);
+  ASSERT_EQ(spec.reference.size(), 1u);
+  EXPECT_EQ(spec.reference_title, "paper 1");
+  EXPECT_EQ(spec.reference[0].label, "max (m)");
+  EXPECT_EQ(spec.reference[0].max_abs, 0.04);
+  EXPECT_TRUE(std::isnan(spec.reference[0].std));
+  EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("once.yaml", head)), "parameters",
+                          "repeats: N (N >= 2)"));
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(WriteFile("refbad.yaml",
+                           head + "repeats: 2\nreference: {title: t, metrics: {nope: {std: 1}}}\n")),
+      "reference.metrics.nope", "not a metric this sweep collects"));
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(WriteFile("refkey.yaml", head + "repeats: 2\nreference: {title: t, metrics: "
+                                                 "{max_path_deviation_m: {maxabs: 1}}}\n")),
+      "reference.metrics.max_path_deviation_m", "unknown key"));
+}
+
 TEST(SweepSpec, MalformedPathsDuplicatesAndHugeSweepsAreRefused) {
   const std::string head = "scenario: " + kCrossLine + "\n";
   EXPECT_TRUE(AnyContains(
