@@ -137,6 +137,38 @@ struct TerrainPiece {
   int surface = 0;  // index into Scene::surfaces
 };
 
+/// The axes of terrain piece `t` in map: the columns of R = Rz(yaw)
+/// Ry(-pitch) Rx(roll) (+ pitch raises the far, + length, end): along its
+/// length, across its width, and along its thickness (the top face's
+/// outward normal).
+inline std::array<std::array<double, 3>, 3> TerrainAxes(const TerrainPiece& t) {
+  const double cy = std::cos(t.yaw_rad), sy = std::sin(t.yaw_rad);
+  const double cp = std::cos(-t.pitch_rad), sp = std::sin(-t.pitch_rad);
+  const double cr = std::cos(t.roll_rad), sr = std::sin(t.roll_rad);
+  return {{{cy * cp, sy * cp, -sp},
+           {cy * sp * sr - sy * cr, sy * sp * sr + cy * cr, cp * sr},
+           {cy * sp * cr + sy * sr, sy * sp * cr - cy * sr, cp * cr}}};
+}
+
+/// Height of terrain piece `t`'s top face over map point (x, y), or nothing
+/// when the vertical through it misses the top face.
+inline std::optional<double> TerrainTopAt(const TerrainPiece& t, double x, double y) {
+  const auto axes = TerrainAxes(t);
+  const auto& n = axes[2];
+  if (n[2] <= 0.0) return std::nullopt;  // tilts are within +-89 degrees
+  const double h = 0.5 * t.thickness_m;
+  const double px = t.center_x_m + h * n[0], py = t.center_y_m + h * n[1],
+               pz = t.center_z_m + h * n[2];
+  const double z = pz - (n[0] * (x - px) + n[1] * (y - py)) / n[2];
+  const double dx = x - px, dy = y - py, dz = z - pz;
+  const double along = axes[0][0] * dx + axes[0][1] * dy + axes[0][2] * dz;
+  const double across = axes[1][0] * dx + axes[1][1] * dy + axes[1][2] * dz;
+  if (std::abs(along) > 0.5 * t.length_m || std::abs(across) > 0.5 * t.width_m) {
+    return std::nullopt;
+  }
+  return z;
+}
+
 /// The hall: the floor's extent and its covering.
 struct Floor {
   double min_x_m = 0.0, max_x_m = 0.0, min_y_m = 0.0, max_y_m = 0.0;

@@ -231,16 +231,8 @@ RayScene::RayScene(const models::Scene& scene)
   }
   for (int i = 0; i < terrain_count_; ++i) {
     const models::TerrainPiece& t = scene.terrain[static_cast<std::size_t>(i)];
-    // R = Rz(yaw) Ry(-pitch) Rx(roll): + pitch raises the far (+length)
-    // end, as models::TerrainPiece says; its columns are the piece's axes.
-    const double cy = std::cos(t.yaw_rad), sy = std::sin(t.yaw_rad);
-    const double cp = std::cos(-t.pitch_rad), sp = std::sin(-t.pitch_rad);
-    const double cr = std::cos(t.roll_rad), sr = std::sin(t.roll_rad);
-    const std::array<double, 3> ax = {cy * cp, sy * cp, -sp};
-    const std::array<double, 3> ay = {cy * sp * sr - sy * cr, sy * sp * sr + cy * cr, cp * sr};
-    const std::array<double, 3> az = {cy * sp * cr + sy * sr, sy * sp * cr - cy * sr, cp * cr};
     AddBox(vertices, indices, {t.center_x_m, t.center_y_m, t.center_z_m},
-           {0.5 * t.length_m, 0.5 * t.width_m, 0.5 * t.thickness_m}, {{ax, ay, az}},
+           {0.5 * t.length_m, 0.5 * t.width_m, 0.5 * t.thickness_m}, models::TerrainAxes(t),
            ObjectOfTerrain(i));
   }
   for (std::size_t i = 0; i < scene.carried.size(); ++i) {
