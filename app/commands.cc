@@ -77,6 +77,7 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
   spec.x_column = robot.x_column;
   spec.y_column = robot.y_column;
   spec.yaw_column = robot.yaw_column;
+  spec.z_column = robot.z_column;
   spec.wheel_columns = robot.wheel_columns;
   spec.error_column = robot.error_column;
   spec.error_label =

@@ -27,6 +27,8 @@ struct RobotInfo {
   /// (x, y), the deviation or drift, and each belt's speed, on state and
   /// travel (which moves the objects it carries).
   std::string x_column, y_column, yaw_column;
+  /// base_link's height, over a scene with terrain ("" otherwise).
+  std::string z_column;
   std::vector<std::pair<std::string, std::string>> wheel_columns;
   std::string error_column;
   std::vector<std::string> belt_speed_columns, belt_on_columns, belt_travel_columns;

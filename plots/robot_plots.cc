@@ -321,6 +321,50 @@ std::string ScanPlot(const RobotPlotSpec& spec, Signals& signals,
   return s;
 }
 
+// Height of the ground at map point (x, y): the highest terrain top face
+// over it, else the floor (0).
+double GroundAt(const models::Scene& scene, double x, double y) {
+  double z = 0.0;
+  for (const models::TerrainPiece& t : scene.terrain) {
+    if (const auto top = models::TerrainTopAt(t, x, y)) z = std::max(z, *top);
+  }
+  return z;
+}
+
+// side_view.png: base_link's height and the ground under it against the
+// distance travelled in the plane.
+std::string SideView(const RobotPlotSpec& spec, Signals& signals,
+                     const std::vector<std::streamoff>& row_starts, int ix, int iy, int iz,
+                     const std::string& title_prefix, std::vector<std::string>* outputs) {
+  std::string data;
+  std::vector<std::string_view> fields;
+  std::string line;
+  double travelled_m = 0.0;
+  std::optional<Point> last;
+  for (std::size_t row = 0; row < row_starts.size(); ++row) {
+    ReadRow(signals, row_starts, row, line, fields);
+    const auto x = Column(fields, ix), y = Column(fields, iy), z = Column(fields, iz);
+    if (!x || !y || !z) continue;
+    if (last) travelled_m += std::hypot(*x - last->x, *y - last->y);
+    last = Point{*x, *y};
+    data += Num(travelled_m) + "," + Num(*z) + "," + Num(GroundAt(spec.scene, *x, *y)) + "\n";
+  }
+  if (data.empty()) return {};
+  outputs->push_back("side_view.png");
+  std::string s;
+  AppendBlock(s, "side", data);
+  return s + "set output 'side_view.png'\nset title " +
+         GnuplotQuote(title_prefix + "side view: height along the track") +
+         "\nset xlabel 'distance travelled in the plane (m)'\nset ylabel 'height (m)'\n"
+         "unset y2label\nunset y2tics\nset ytics mirror\n"
+         "set autoscale\nset offsets 0, 0, graph 0.1, graph 0.05\nset key top left\n"
+         "plot $side using 1:3 with filledcurves y1=0 lc rgb '#c8c8c8' title "
+         "'ground under the track (floor, ramp, van floor)', \\\n"
+         "     $side using 1:2 with lines lw 2 lc rgb '#d62728' title " +
+         GnuplotQuote("robot base_link height (" + spec.z_column + ")") +
+         "\n";
+}
+
 std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std::string>* outputs) {
   if (spec.x_column.empty() || spec.y_column.empty()) {
     throw std::runtime_error("robot plots need the x and y columns of the robot position");
@@ -334,6 +378,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     wheels.emplace_back(column(wx, "wheel x"), column(wy, "wheel y"));
   }
   const int ierr = spec.error_column.empty() ? 0 : column(spec.error_column, "error");
+  const int iz = spec.z_column.empty() ? 0 : column(spec.z_column, "robot height");
   std::vector<int> speeds, ons;
   for (const auto& name : spec.belt_speed_columns) speeds.push_back(column(name, "belt speed"));
   for (const auto& name : spec.belt_on_columns) ons.push_back(column(name, "belt on"));
@@ -677,6 +722,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   if (!spec.scan.range_columns.empty()) {
     s += ScanPlot(spec, signals, row_starts, ix, iy, iyaw, travels, title_prefix, outputs);
   }
+  if (iz > 0) s += SideView(spec, signals, row_starts, ix, iy, iz, title_prefix, outputs);
   s += "unset output\n";
   return s;
 }
@@ -684,8 +730,9 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
 }  // namespace
 
 const std::vector<std::string>& RobotPlotFiles() {
-  static const std::vector<std::string> files = {kScript,    "top_view.png",   "error.png",
-                                                 "belt.png", "optic_flow.png", "scan.png"};
+  static const std::vector<std::string> files = {
+      kScript, "top_view.png", "error.png", "belt.png", "optic_flow.png", "scan.png",
+      "side_view.png"};
   return files;
 }
 

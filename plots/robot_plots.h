@@ -32,6 +32,11 @@ struct RobotPlotSpec {
   /// Robot position (m) and yaw (rad) in the map frame. x and y are
   /// required; without yaw no outlines are drawn.
   std::string x_column, y_column, yaw_column;
+  /// Height of base_link above the map's z = 0 (m): with it, side_view.png
+  /// draws the height profile along the track (distance travelled in the
+  /// plane) over the ground under the track (the floor, or the highest
+  /// terrain top face), as a climb into a van shows it.
+  std::string z_column;
   /// x and y columns (map frame, m) of each wheel's contact point, drawn as
   /// footprints with the outlines.
   std::vector<std::pair<std::string, std::string>> wheel_columns;
@@ -73,7 +78,7 @@ struct RobotPlotSpec {
   double body_width_m = 0.57;
 };
 
-/// Writes top_view.png, and error.png, belt.png, optic_flow.png and scan.png when the spec asks for
+/// Writes top_view.png, and error.png, belt.png, optic_flow.png, scan.png and side_view.png when the spec asks for
 /// them, into `dir`, from `dir`/signals.csv. The gnuplot script is left in
 /// `dir`/plots.gp with paths relative to `dir`, so `gnuplot plots.gp` run in
 /// `dir` redraws the plots. Returns the paths of the PNG files written.

@@ -41,6 +41,8 @@ struct Signals {
 
   /// Belts of the scene: how many, and the belt unit's outputs.
   std::size_t belt_count = 0;
+  /// Whether the scene has terrain pieces (the robot's height varies).
+  bool terrain = false;
 
   /// The sensor units on the robot, one per enabled mount (the unit is
   /// named after the mount, its type is the mount's kind), and the belt's

@@ -131,6 +131,7 @@ void AddRecording(SystemBuilder& b, const Signals& s, RobotInfo& info) {
   info.x_column = Element(kChassis, "position", 0);
   info.y_column = Element(kChassis, "position", 1);
   info.yaw_column = Signal(kChassis, "yaw");
+  if (s.terrain) info.z_column = Element(kChassis, "position_3d", 2);
   for (std::size_t w = 0; w < static_cast<std::size_t>(info.wheel_count); ++w) {
     info.wheel_columns.emplace_back(Element(kChassis, "wheel_contact", 2 * w),
                                     Element(kChassis, "wheel_contact", 2 * w + 1));

@@ -62,6 +62,10 @@ models::Scene AddScene(SystemBuilder& b) {
 }
 
 void AddLine(SystemBuilder& b, const models::Scene& scene, Signals& s) {
+  // Over terrain (a ramp, a van floor) the height is part of the story:
+  // recorded for the side view.
+  s.terrain = !scene.terrain.empty();
+  if (s.terrain) s.recorded.push_back(Signal(kChassis, "position_3d"));
   s.belt_count = scene.belts.size();
   if (s.belt_count == 0) return;
   // The belt unit drives every belt of the scene; it takes them from there.

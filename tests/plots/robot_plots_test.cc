@@ -120,6 +120,42 @@ TEST_F(RobotPlotsTest, WritesTheThreePngsAndTheScript) {
   EXPECT_EQ(lines, 20);
 }
 
+// Guards the side view of a climb: a robot driving along +x over a ramp
+// whose top face rises 0.54 m over 2 m from x = 2 (the van bay's), its
+// base_link 0.1 m above the ground: side_view.png is drawn with the ground
+// under the track from the scene's terrain (0 on the floor, 0.27 m at the
+// ramp's middle x = 3, the 1-D interpolation of the top face).
+TEST_F(RobotPlotsTest, SideViewDrawsTheHeightOverTheGround) {
+  {
+    std::ofstream out(dir_ / "signals.csv");
+    out << "time,chassis.position_3d[0],chassis.position_3d[1],chassis.position_3d[2]\n";
+    for (int k = 0; k <= 50; ++k) {
+      const double x = 0.1 * k, ground = std::clamp((x - 2.0) * 0.27, 0.0, 0.54);
+      out << 0.5 * k << "," << x << ",0," << ground + 0.1 << "\n";
+    }
+  }
+  RobotPlotSpec spec;
+  spec.x_column = "chassis.position_3d[0]";
+  spec.y_column = "chassis.position_3d[1]";
+  spec.z_column = "chassis.position_3d[2]";
+  models::TerrainPiece ramp;
+  ramp.pitch_rad = std::atan2(0.54, 2.0);
+  ramp.length_m = std::hypot(2.0, 0.54);
+  ramp.width_m = 1.2;
+  ramp.thickness_m = 0.0;
+  ramp.center_x_m = 3.0;
+  ramp.center_z_m = 0.27;
+  spec.scene.terrain = {ramp};
+  const auto files = WriteRobotPlots(dir_.string(), spec);
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(fs::path(files[1]).filename(), "side_view.png");
+  EXPECT_TRUE(IsPng(files[1]));
+  const std::string script = ReadAll(dir_ / "plots.gp");
+  // Row 30: 3 m travelled, base_link at 0.37 m over ground at 0.27 m.
+  EXPECT_NE(script.find("\n3,0.37,0.27"), std::string::npos) << script.substr(0, 400);
+  EXPECT_NE(script.find("\n1,0.1,0\n"), std::string::npos);
+}
+
 // Guards against output that changes from run to run (timestamps, map
 // order): the same input gives the same script and the same PNG bytes.
 TEST_F(RobotPlotsTest, IsDeterministic) {
