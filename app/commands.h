@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -28,13 +29,20 @@ struct SweepArgs {
   bool jobs_given = false;  // --jobs on the command line (it means nothing under mpirun)
   bool resume = false;
   bool force = false;
+  /// `linesim run FILE --runs N`: N > 0 makes `file` a scenario run N times
+  /// with its own seed each (sweep::RepeatSweepSpec) with `sets` applied;
+  /// afterwards the first run is run once more as `linesim run` into
+  /// DIR/run_0 for its signals and plots.
+  std::int64_t repeats = 0;
+  std::vector<std::string> sets;
 };
 
 /// `linesim sweep FILE --out DIR [--jobs N] [--resume|--force]`; under
 /// mpirun `mpi` is the MPI session (rank 0 dispatches and writes, the other
 /// ranks run), otherwise null and the runs go on `jobs` threads. Exits 0
 /// when every run is ok, 1 when a run failed (it has a row with its error),
-/// 2 on bad input with nothing written, 130 when interrupted.
+/// 2 on bad input with nothing written, 130 when interrupted. With
+/// `repeats`, the same for `linesim run FILE --runs N`.
 int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi);
 
 }  // namespace linesim::app

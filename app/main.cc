@@ -19,6 +19,16 @@ int main(int argc, char** argv) {
   run->add_option("--out,-o", out_dir, "output folder (created if missing)")->required();
   run->add_option("--set", run_sets, "override a value: dotted.path=value (repeatable)")
       ->take_all();
+  std::int64_t runs = 1;
+  CLI::Option* runs_option = run->add_option("--runs", runs,
+                  "run the scenario N times, each with its own seed, as a sweep (results.csv, "
+                  "summary.json with the statistics and the scenario's reference, histograms), "
+                  "then the first run again into DIR/run_0")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1000000}));
+  int run_jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  CLI::Option* run_jobs_option =
+      run->add_option("--jobs,-j", run_jobs, "with --runs: runs at a time (default: the cores)");
+  run_jobs_option->check(CLI::Range(1, 4096))->needs(runs_option);
 
   std::string what;
   std::vector<std::string> inspect_sets;
@@ -57,6 +67,22 @@ int main(int argc, char** argv) {
   // The commands report what they expect; anything else escaping is still
   // answered with a message and an exit status, never an abort.
   try {
+    if (run->parsed() && runs > 1) {
+      // Repeats are a sweep without parameters, on threads or MPI ranks.
+      if (linesim::sweep::LaunchedByMpi()) {
+        mpi = std::make_unique<linesim::sweep::MpiSession>(&argc, &argv);
+      }
+      SweepArgs repeats;
+      repeats.file = run_file;
+      repeats.out_dir = out_dir;
+      repeats.jobs = run_jobs;
+      repeats.jobs_given = run_jobs_option->count() > 0;
+      // As `linesim run` does, a new run replaces the folder's last one.
+      repeats.force = true;
+      repeats.repeats = runs;
+      repeats.sets = run_sets;
+      return SweepCommand(repeats, mpi.get());
+    }
     if (run->parsed()) return RunCommand(run_file, out_dir, run_sets);
     if (sweep->parsed()) {
       if (linesim::sweep::LaunchedByMpi()) {

@@ -99,10 +99,11 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
   std::string fingerprint;
   int status = kExitOk;
   try {
-    spec = sweep::LoadSweepSpec(args.file);
+    spec = args.repeats > 0 ? sweep::RepeatSweepSpec(args.file, args.sets, args.repeats)
+                            : sweep::LoadSweepSpec(args.file);
     fingerprint = sweep::SweepFingerprint(spec);
   } catch (const config::ScenarioError& e) {
-    PrintIssues(e, "sweep", problems);
+    PrintIssues(e, args.repeats > 0 ? "scenario" : "sweep", problems);
     status = kExitBadInput;
   }
   if (share(status) != kExitOk) return kExitBadInput;
@@ -220,7 +221,19 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
   std::cout << "  wrote " << (dir / "results.csv").string();
   for (const auto& f : written) std::cout << ", " << fs::path(f).filename().string();
   std::cout << "\n";
-  return results->failed_count() == 0 ? kExitOk : kExitRunFailed;
+  int one_run = kExitOk;
+  if (args.repeats > 0) {
+    // One run's signals and plots (top view, side view, ...): the first
+    // run's seed again, as `linesim run` writes them.
+    std::vector<std::string> sets = args.sets;
+    sets.push_back("seed=" + std::to_string(sweep::PlanRun(spec, 0).seed));
+    std::cout << "\nthe first run again, with its signals and plots, into "
+              << (dir / "run_0").string() << ":\n"
+              << std::flush;
+    one_run = RunCommand(args.file, (dir / "run_0").string(), sets);
+  }
+  if (one_run == kExitInterrupted) return kExitInterrupted;
+  return results->failed_count() == 0 && one_run == kExitOk ? kExitOk : kExitRunFailed;
 }
 
 }  // namespace linesim::app

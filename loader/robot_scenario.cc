@@ -120,9 +120,9 @@ YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
   r.CheckKeys(root, "",
               {"name", "description", "duration_s", "seed", "master", "robot", "scene", "line",
                "control", "task", "sensors", "sensing", "localization", "units", "connections",
-               "recording", "metrics"});
+               "recording", "metrics", "reference"});
   assembly::SystemBuilder b(root, r);
-  for (const char* key : {"name", "description", "duration_s", "seed", "master"}) {
+  for (const char* key : {"name", "description", "duration_s", "seed", "master", "reference"}) {
     if (Child(root, key).IsDefined()) b.out()[key] = Child(root, key);
   }
 

@@ -113,7 +113,7 @@ class Builder {
     if (!r_.ExpectMap(root, "(top)")) return;
     r_.CheckKeys(root, "",
                  {"name", "description", "duration_s", "seed", "master", "units", "connections",
-                  "recording", "metrics", "scene"});
+                  "recording", "metrics", "scene", "reference"});
     s_.name = r_.String(root, "", "name", fs::path(s_.file).stem().string());
     s_.description = r_.String(root, "", "description", "");
     cosim::MasterOptions options;
@@ -183,6 +183,10 @@ class Builder {
     }
     BuildRecording(Child(root, "recording"), options);
     BuildMetrics(Child(root, "metrics"));
+    s_.reference = ReadReference(Child(root, "reference"), r_);
+    std::vector<std::string> names;
+    for (const auto& m : s_.metrics) names.push_back(m.name);
+    CheckReferenceMetrics(s_.reference, names, root, "of this scenario", r_);
   }
 
  private:

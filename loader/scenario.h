@@ -12,6 +12,7 @@
 #include "cosim/observers.h"
 #include "cosim/system.h"
 #include "loader/config_names.h"
+#include "loader/reference.h"
 #include "loader/overrides.h"
 #include "loader/robot_scenario.h"
 #include "models/scene.h"
@@ -38,6 +39,8 @@ struct Scenario {
   std::vector<cosim::Probe> recorded;
   cosim::TimeNs record_interval = 0;
   std::vector<cosim::MetricSpec> metrics;
+  /// Published figures repeated runs print beside their own (`reference:`).
+  Reference reference;
 
   /// Robot scenarios only: the system-level tree they expanded into (what
   /// `linesim inspect` prints) and the geometry for the plots.

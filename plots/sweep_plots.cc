@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <locale>
 #include <numbers>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include "cosim/variable_table.h"
@@ -20,6 +23,14 @@ constexpr int kWidthPx = 800, kHeightPx = 500;
 // Shortest text that reads back to the same double, independent of the
 // locale.
 std::string Num(double x) { return cosim::FormatValue(x); }
+
+// A number for a legend: 4 significant digits, independent of the locale.
+std::string Short(double x) {
+  std::ostringstream out;
+  out.imbue(std::locale::classic());
+  out << std::setprecision(4) << x;
+  return out.str();
+}
 
 bool IsSafeFileName(const std::string& name) {
   return !name.empty() && name != "." && name != ".." && SafeFileName(name) == name;
@@ -138,17 +149,19 @@ std::string HistogramScript(const SweepChart& chart, std::size_t index) {
   s += "EOD\nset output " + GnuplotQuote(chart.file) + "\nset title " +
        GnuplotQuote(chart.title) + "\nset xlabel " + GnuplotQuote(chart.x_label) +
        "\nset ylabel 'runs'\nset autoscale x\nset xtics autofreq\nset key title ''\n"
+       "set yrange [0:*]\nset ytics 1\n"
        "set boxwidth " + Num(width) + " absolute\nset style fill solid 0.5 border -1\n";
   s += "plot " + block + " using 1:2 with boxes lt 1 title " +
-       GnuplotQuote(std::to_string(v.size()) + " runs, bins of " + Num(width));
+       GnuplotQuote(std::to_string(v.size()) + " runs, bins of " + Short(width));
   if (sd > 0.0) {
     const std::string k = Num(n * width / (sd * std::sqrt(2.0 * std::numbers::pi)));
     s += ", \\\n     [" + Num(mean - 4.0 * sd) + ":" + Num(mean + 4.0 * sd) + "] " + k +
          " * exp(-0.5 * ((x - " + Num(mean) + ") / " + Num(sd) +
          ") ** 2) with lines lw 2 lt 2 title " +
-         GnuplotQuote("normal: mean " + Num(mean) + ", std " + Num(sd));
+         GnuplotQuote("normal: mean " + Short(mean) + ", std " + Short(sd));
   }
-  return s + "\n";
+  // The next chart scales its own axes.
+  return s + "\nset autoscale y\nset ytics autofreq\n";
 }
 
 // The script lines of one chart; empty when it has nothing to draw.

@@ -275,7 +275,6 @@ SweepTable ResultsFile::Table(const SweepSpec& spec) const {
   }
   t.metrics = spec.metrics;
   t.metrics.push_back("wall_s");
-  t.reference_title = spec.reference_title;
   t.reference = spec.reference;
   const std::size_t np = spec.parameters.size();
   const std::size_t nm = spec.metrics.size();

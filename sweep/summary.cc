@@ -317,11 +317,11 @@ void PrintOverall(const SweepTable& t, const Rows& all, std::ostream& out) {
 // The reference's table: a row per figure, a column per metric, ours beside
 // the source's.
 void PrintReference(const SweepTable& t, const Rows& all, std::ostream& out) {
-  out << "\n" << t.reference_title << " (this sweep | reference):\n";
+  out << "\n" << t.reference.title << " (this sweep | reference):\n";
   std::vector<std::vector<std::string>> rows{{""}};
   std::vector<std::string> max_row{"maximum absolute error"}, std_row{"standard deviation"},
       mean_row{"mean absolute error"};
-  for (const auto& ref : t.reference) {
+  for (const auto& ref : t.reference.metrics) {
     const Stats s = StatsOf(OkValues(all, MetricIndex(t, ref.metric)));
     rows[0].push_back(ref.label);
     max_row.push_back(Sig4(s.max_abs) + " | " + Sig4(ref.max_abs));
@@ -507,9 +507,9 @@ nlohmann::ordered_json Summarize(const SweepTable& t) {
     overall[t.metrics[m]] = std::move(one);
   }
   s["overall"] = std::move(overall);
-  if (!t.reference_title.empty()) {
+  if (!t.reference.title.empty()) {
     Json metrics = Json::object();
-    for (const auto& ref : t.reference) {
+    for (const auto& ref : t.reference.metrics) {
       const Stats st = StatsOf(OkValues(all, MetricIndex(t, ref.metric)));
       metrics[ref.metric] = {
           {"label", ref.label},
@@ -520,7 +520,7 @@ nlohmann::ordered_json Summarize(const SweepTable& t) {
            {{"max_abs", Number(ref.max_abs)}, {"std", Number(ref.std)},
             {"mean_abs", Number(ref.mean_abs)}}}};
     }
-    s["reference"] = {{"title", t.reference_title}, {"metrics", std::move(metrics)}};
+    s["reference"] = {{"title", t.reference.title}, {"metrics", std::move(metrics)}};
   }
   return s;
 }
@@ -540,7 +540,7 @@ void PrintSummary(const SweepTable& t, std::ostream& out) {
   }
   if (t.grid && t.parameters.size() > 1) PrintPoints(t, all, out);
   if (t.parameters.empty()) PrintOverall(t, all, out);
-  if (!t.reference_title.empty()) PrintReference(t, all, out);
+  if (!t.reference.title.empty()) PrintReference(t, all, out);
   if (failed == 0) return;
   out << "\nfailed runs:\n";
   std::size_t printed = 0;

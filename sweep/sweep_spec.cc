@@ -334,36 +334,32 @@ std::vector<std::string> FixedOverrides(const SweepSpec& spec) {
   return args;
 }
 
-// `reference: {title, metrics: {NAME: {label, max_abs, std, mean_abs}}}`;
-// a figure the source does not give is left out (NaN).
-void ReadReference(const YAML::Node& node, YamlReader& r, SweepSpec& spec) {
-  if (!node.IsDefined() || !r.ExpectMap(node, "reference")) return;
-  r.CheckKeys(node, "reference", {"title", "metrics"});
-  spec.reference_title = r.String(node, "reference", "title", std::nullopt);
-  const YAML::Node metrics = Child(node, "metrics");
-  if (!metrics.IsDefined()) {
-    r.Error(node, "reference.metrics",
-            "missing required key: a map from metric name to {label, max_abs, std, mean_abs}");
-    return;
+SweepSpec RepeatSweepSpec(const std::string& scenario, const std::vector<std::string>& set_args,
+                          std::int64_t runs) {
+  if (runs < 2 || runs > 1000000) {
+    throw std::invalid_argument("--runs " + std::to_string(runs) + ": expected 2 to 1000000");
   }
-  if (!r.ExpectMap(metrics, "reference.metrics")) return;
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  for (const auto& kv : metrics) {
-    SweepTable::ReferenceMetric m;
-    m.metric = kv.first.IsScalar() ? kv.first.Scalar() : "";
-    const std::string path = JoinPath("reference.metrics", m.metric);
-    if (!r.ExpectMap(kv.second, path)) continue;
-    r.CheckKeys(kv.second, path, {"label", "max_abs", "std", "mean_abs"});
-    m.label = r.String(kv.second, path, "label", m.metric);
-    const auto figure = [&](const char* key) {
-      return Child(kv.second, key).IsDefined() ? r.Real(kv.second, path, key, 0.0, {0.0, 1e300})
-                                               : kNaN;
-    };
-    m.max_abs = figure("max_abs");
-    m.std = figure("std");
-    m.mean_abs = figure("mean_abs");
-    spec.reference.push_back(m);
+  const loader::Scenario base = loader::LoadScenario(scenario, set_args);
+  SweepSpec spec;
+  spec.file = scenario;
+  spec.scenario = scenario;
+  spec.name = base.name;
+  spec.description = base.description;
+  for (const std::string& a : set_args) {
+    const auto eq = a.find('=');
+    spec.fixed.emplace_back(a.substr(0, eq), eq == std::string::npos ? "" : a.substr(eq + 1));
   }
+  spec.repeats = runs;
+  spec.seed = base.seed;
+  spec.seeds = SeedPolicy::kPerRun;
+  for (const auto& m : base.metrics) spec.metrics.push_back(m.name);
+  if (spec.metrics.empty()) {
+    throw ScenarioError({{scenario, 0, "metrics",
+                          "the scenario defines no metrics, so repeated runs have nothing to "
+                          "collect"}});
+  }
+  spec.reference = base.reference;
+  return spec;
 }
 
 SweepSpec LoadSweepSpec(const std::string& file) {
@@ -454,7 +450,7 @@ SweepSpec LoadSweepSpec(const std::string& file) {
       }
     }
   }
-  ReadReference(Child(root, "reference"), r, spec);
+  spec.reference = loader::ReadReference(Child(root, "reference"), r);
   if (!r.ok()) throw ScenarioError(r.issues());
 
   // The base scenario with the fixed settings must load by itself.
@@ -494,13 +490,17 @@ SweepSpec LoadSweepSpec(const std::string& file) {
                   "in the scenario");
     }
   }
-  for (const auto& ref : spec.reference) {
-    if (std::find(spec.metrics.begin(), spec.metrics.end(), ref.metric) == spec.metrics.end()) {
-      const YAML::Node key = Child(Child(Child(root, "reference"), "metrics"), ref.metric);
-      r.Error(key, "reference.metrics." + ref.metric,
-              "'" + ref.metric + "' is not a metric this sweep collects; it collects: " +
-                  config::JoinNames(spec.metrics));
+  if (spec.reference.title.empty()) {
+    // The base scenario's reference, for the metrics this sweep collects.
+    spec.reference.title = base.reference.title;
+    for (const auto& m : base.reference.metrics) {
+      if (std::find(spec.metrics.begin(), spec.metrics.end(), m.metric) != spec.metrics.end()) {
+        spec.reference.metrics.push_back(m);
+      }
     }
+    if (spec.reference.metrics.empty()) spec.reference.title.clear();
+  } else {
+    loader::CheckReferenceMetrics(spec.reference, spec.metrics, root, "this sweep collects", r);
   }
   if (spec.metrics.empty() && r.ok()) {
     r.Error(root, "metrics",

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "sweep/sweep_table.h"
+#include "loader/reference.h"
 
 namespace linesim::sweep {
 
@@ -63,11 +63,10 @@ struct SweepSpec {
   /// Metrics of the base scenario to collect; all of them when the file
   /// names none.
   std::vector<std::string> metrics;
-  /// `reference: {title, metrics: {NAME: {label, max_abs, std, mean_abs}}}`:
-  /// published figures the report prints beside the sweep's (empty title:
-  /// none). Each NAME is one of `metrics`.
-  std::string reference_title;
-  std::vector<SweepTable::ReferenceMetric> reference;
+  /// Published figures the report prints beside the sweep's: the sweep
+  /// file's `reference:`, else the base scenario's (empty title: none).
+  /// Each of its metrics is one of `metrics`.
+  loader::Reference reference;
 };
 
 /// The `set:` entries as `--set` arguments ("path=value"), in file order.
@@ -78,5 +77,13 @@ std::vector<std::string> FixedOverrides(const SweepSpec& spec);
 /// one it defines. Throws config::ScenarioError listing every problem (file,
 /// line, key path, what was expected).
 SweepSpec LoadSweepSpec(const std::string& file);
+
+/// The sweep `linesim run FILE --runs N` makes: the scenario as it is with
+/// `set_args` ("dotted.path=value", as --set takes them), run N times, each
+/// run with its own seed derived from the scenario's seed, collecting every
+/// metric, with the scenario's reference. Throws config::ScenarioError as
+/// loader::LoadScenario does; N must be in [2, 1e6].
+SweepSpec RepeatSweepSpec(const std::string& scenario, const std::vector<std::string>& set_args,
+                          std::int64_t runs);
 
 }  // namespace linesim::sweep

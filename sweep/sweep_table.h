@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "loader/reference.h"
+
 namespace linesim::sweep {
 
 /// The finished runs of a sweep, as the report (summary.json, the terminal
@@ -22,17 +24,9 @@ struct SweepTable {
   /// True for `combine: grid`; false for Monte-Carlo draws.
   bool grid = true;
 
-  /// Published figures to print beside the sweep's own (the sweep file's
-  /// `reference:`): per metric the maximum absolute value, the sample
-  /// standard deviation and the mean absolute value over the runs, as
-  /// paper 2's Table 1 reports its 20 runs. NaN where the source gives none.
-  struct ReferenceMetric {
-    std::string metric;  // one of `metrics`
-    std::string label;   // the column's heading, e.g. "X (m)"
-    double max_abs = 0.0, std = 0.0, mean_abs = 0.0;
-  };
-  std::string reference_title;  // empty: no reference
-  std::vector<ReferenceMetric> reference;
+  /// Published figures to print beside the sweep's own (empty title:
+  /// none); each of its metrics is one of `metrics`.
+  loader::Reference reference;
 
   struct Row {
     std::int64_t id = 0;

@@ -137,6 +137,49 @@ TEST(Cli, RobotRunWritesPlots) {
   EXPECT_TRUE(fs::exists(fs::path(out) / "plots.gp"));
 }
 
+// Guards `run --runs N`: N runs with their own seeds as a sweep without
+// parameters (results.csv with N rows, summary.json with the statistics
+// over all runs and the scenario's reference beside them, a histogram per
+// metric), then the first run again with its plots into DIR/run_0 (the
+// same seed: the same metric as its row). --jobs needs --runs.
+TEST(Cli, RunRepeatsWritesStatisticsReferenceHistogramsAndOneRun) {
+  std::ifstream in(kCrossLine);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text += "\nreference:\n  title: 'paper 1, Sec. VI-B'\n  metrics:\n"
+          "    max_path_deviation_m: {label: 'deviation (m)', max_abs: 0.04}\n";
+  const std::string file = WriteScenario("cross_line_reference.yaml", text);
+  const std::string out = Fresh("run_repeats");
+  const Result r = Linesim("run " + file + " --out " + out + " --set duration_s=1 --runs 3 -j 2");
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("paper 1, Sec. VI-B (this sweep | reference):"), std::string::npos)
+      << r.out;
+  const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
+  EXPECT_EQ(summary["runs"], 3);
+  EXPECT_EQ(summary["overall"]["max_path_deviation_m"]["n"], 3);
+  EXPECT_EQ(summary["reference"]["metrics"]["max_path_deviation_m"]["reference"]["max_abs"], 0.04);
+  EXPECT_EQ(ReadFile(fs::path(out) / "max_path_deviation_m_histogram.png").substr(0, 8),
+            "\x89PNG\r\n\x1a\n");
+  const auto one = nlohmann::json::parse(ReadFile(fs::path(out) / "run_0" / "summary.json"));
+  EXPECT_EQ(one["status"], "ok");
+  const std::string rows = ReadFile(fs::path(out) / "results.csv");
+  const std::string first = rows.substr(rows.find('\n') + 1);
+  EXPECT_EQ(first.substr(0, 2), "0,");
+  // Both write numbers in their shortest round-trip form.
+  EXPECT_NE(first.find("," + one["metrics"]["max_path_deviation_m"].dump() + ","),
+            std::string::npos)
+      << first << one["metrics"];
+  EXPECT_EQ(Linesim("run " + kCrossLine + " --out " + out + " -j 2").status, 2);
+  // A reference to a metric the scenario does not define is bad input.
+  std::string bad = text;
+  bad.replace(bad.find("    max_path_deviation_m: {label"), 24, "    max_path_deviaton_m:");
+  const Result refused =
+      Linesim("run " + WriteScenario("bad_reference.yaml", bad) + " --out " + out + "_bad");
+  EXPECT_EQ(refused.status, 2);
+  EXPECT_NE(refused.err.find("reference.metrics.max_path_deviaton_m"), std::string::npos)
+      << refused.err;
+  EXPECT_NE(refused.err.find("is not a metric of this scenario"), std::string::npos) << refused.err;
+}
+
 // Guards a robot scenario's own recording list: the columns the plots read
 // are added to it (the plots are drawn), and a column two items cover is
 // recorded once.

@@ -491,8 +491,7 @@ SweepTable Repeats() {
   t.metrics = {"error_x_m", "wall_s"};
   for (int i = 0; i < 5; ++i) t.rows.push_back(Ok(i, {}, {i - 2.0, 1.0}));
   t.rows.push_back(Failed(5, {}, "follower: did not reach the route's end", {NAN, 1.0}));
-  t.reference_title = "paper 2, Table 1";
-  t.reference = {{"error_x_m", "X (m)", 0.019, 0.005, 0.004}};
+  t.reference = {"paper 2, Table 1", {{"error_x_m", "X (m)", 0.019, 0.005, 0.004}}};
   return t;
 }
 

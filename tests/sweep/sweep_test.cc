@@ -260,11 +260,11 @@ TEST(SweepSpec, RepeatsWithoutParametersAndAReference) {
   EXPECT_EQ(RunCount(spec), 3);
   EXPECT_TRUE(spec.parameters.empty());
   EXPECT_NE(PlanRun(spec, 0).seed, PlanRun(spec, 1).seed);
-  ASSERT_EQ(spec.reference.size(), 1u);
-  EXPECT_EQ(spec.reference_title, "paper 1");
-  EXPECT_EQ(spec.reference[0].label, "max (m)");
-  EXPECT_EQ(spec.reference[0].max_abs, 0.04);
-  EXPECT_TRUE(std::isnan(spec.reference[0].std));
+  ASSERT_EQ(spec.reference.metrics.size(), 1u);
+  EXPECT_EQ(spec.reference.title, "paper 1");
+  EXPECT_EQ(spec.reference.metrics[0].label, "max (m)");
+  EXPECT_EQ(spec.reference.metrics[0].max_abs, 0.04);
+  EXPECT_TRUE(std::isnan(spec.reference.metrics[0].std));
   EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("once.yaml", head)), "parameters",
                           "repeats: N (N >= 2)"));
   EXPECT_TRUE(AnyContains(
