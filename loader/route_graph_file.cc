@@ -43,9 +43,8 @@ std::vector<std::pair<std::string, YAML::Node>> Items(YamlReader& r, const YAML:
 }
 
 // A name at `key` of `item` that must be one of `names`.
-std::optional<std::size_t> Reference(YamlReader& r, const YAML::Node& item,
-                                     const std::string& path, const std::string& key,
-                                     const std::vector<std::string>& names,
+std::optional<std::size_t> Reference(YamlReader& r, const YAML::Node& item, const std::string& path,
+                                     const std::string& key, const std::vector<std::string>& names,
                                      const std::string& what) {
   const std::string name = r.String(item, path, key, std::nullopt);
   if (name.empty()) return std::nullopt;  // reported (missing or not text)
@@ -95,8 +94,9 @@ std::optional<RouteGraph> ReadRouteGraph(YamlReader& r, const YAML::Node& root,
   // Maps: names, in the order of their map_index.
   const YAML::Node maps = Child(root, "maps");
   if (!maps.IsDefined() || maps.IsNull()) {
-    r.Error(root, "maps", "missing required key: a list of map names (a map's index is its "
-                          "map_index)");
+    r.Error(root, "maps",
+            "missing required key: a list of map names (a map's index is its "
+            "map_index)");
   } else if (r.ExpectSequence(maps, "maps")) {
     for (std::size_t i = 0; i < maps.size(); ++i) {
       const std::string path = JoinPath("maps", std::to_string(i));
@@ -212,16 +212,17 @@ std::optional<RouteGraph> ReadRouteGraphModel(YamlReader& r, const YAML::Node& a
                                               const std::string& path, const std::string& value,
                                               const std::string& relative_to) {
   std::string file;
-  const YAML::Node root = LoadModel(r, at, path, "route graph", value, "graphs", relative_to, &file);
+  const YAML::Node root =
+      LoadModel(r, at, path, "route graph", value, "graphs", relative_to, &file);
   if (!root.IsDefined()) return std::nullopt;
   YamlReader::InFile in(r, file);
   return ReadRouteGraph(r, root, file);
 }
 
 std::optional<std::vector<models::PolynomialSegment>> RouteSegments(YamlReader& r,
-                                                                     const RouteGraph& graph,
-                                                                     const YAML::Node& route,
-                                                                     const std::string& path) {
+                                                                    const RouteGraph& graph,
+                                                                    const YAML::Node& route,
+                                                                    const std::string& path) {
   if (!route.IsDefined() || route.IsNull()) {
     r.Error(route, path, "missing required key: a list of node names");
     return std::nullopt;

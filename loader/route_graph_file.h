@@ -61,8 +61,8 @@ std::optional<RouteGraph> ReadRouteGraphModel(YamlReader& r, const YAML::Node& a
 /// from, to). Problems at `path`.i: an unknown node (with the closest
 /// names), a pair without an edge (naming both nodes and the graph file).
 std::optional<std::vector<models::PolynomialSegment>> RouteSegments(YamlReader& r,
-                                                                     const RouteGraph& graph,
-                                                                     const YAML::Node& route,
-                                                                     const std::string& path);
+                                                                    const RouteGraph& graph,
+                                                                    const YAML::Node& route,
+                                                                    const std::string& path);
 
 }  // namespace linesim::loader

@@ -15,10 +15,14 @@ using models::kDegToRad;
 const std::vector<std::string> kRouteKeys = {"graph", "route", "gains", "deceleration_mps2"};
 const std::vector<std::string> kPathKeys = {"waypoints", "point", "acceleration_mps2", "yaw_deg"};
 // task.gains: the route follower's parameters a scenario may set there.
-const std::vector<std::string> kRouteGains = {
-    "k_p_distance",   "k_i_distance",       "k_p_orientation",
-    "k_i_orientation", "distance_integral", "max_distance_integral_rate",
-    "max_orientation_integral_rate", "stop_tolerance"};
+const std::vector<std::string> kRouteGains = {"k_p_distance",
+                                              "k_i_distance",
+                                              "k_p_orientation",
+                                              "k_i_orientation",
+                                              "distance_integral",
+                                              "max_distance_integral_rate",
+                                              "max_orientation_integral_rate",
+                                              "stop_tolerance"};
 
 // task.type route: paper 2's parametric trajectory controller (the
 // `route_follower` unit, under the follower's unit name) along a route
@@ -121,10 +125,9 @@ void AddRoute(SystemBuilder& b, const RobotFile& file, const YAML::Node& task, S
 void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Signals& s,
              RobotInfo& info) {
   YamlReader& r = b.reader();
-  const YAML::Node task =
-      b.Section(b.root(), "", "task",
-                {"type", "waypoints", "point", "speed_mps", "acceleration_mps2", "yaw_deg", "graph",
-                 "route", "gains", "deceleration_mps2"});
+  const YAML::Node task = b.Section(b.root(), "", "task",
+                                    {"type", "waypoints", "point", "speed_mps", "acceleration_mps2",
+                                     "yaw_deg", "graph", "route", "gains", "deceleration_mps2"});
   info.task = r.String(task, "task", "type", std::nullopt, {"path", "hold", "route"});
   if (info.task == "route") {
     AddRoute(b, file, task, s, info);

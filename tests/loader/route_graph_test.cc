@@ -1,12 +1,11 @@
 // The route graph files (loader/route_graph_file.h) and the `route` task
 // (loader/assembly/task.cc).
-#include "loader/route_graph_file.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
+#include "loader/route_graph_file.h"
 #include "loader/scenario.h"
 #include "models/models_dir.h"
 #include "scenario_test.h"
@@ -105,8 +104,9 @@ edges:
 // the first one's edges go); a graph that does not exist; keys of the path
 // task refused with a reason, and the route keys refused for a path task.
 TEST(RouteGraph, RouteErrorsNameTheNodeAndTheMissingEdge) {
-  const std::string unknown = RouteScenario(
-      "route_unknown.yaml", "  type: route\n  graph: van_bay\n  route: [start, ramp_foot, ramp_tp]\n");
+  const std::string unknown =
+      RouteScenario("route_unknown.yaml",
+                    "  type: route\n  graph: van_bay\n  route: [start, ramp_foot, ramp_tp]\n");
   std::string e = Issues(unknown);
   EXPECT_TRUE(Has(e, unknown + ":12: task.route.2: no node 'ramp_tp' in route graph")) << e;
   EXPECT_TRUE(Has(e, "(closest: ramp_top)")) << e;
@@ -121,9 +121,9 @@ TEST(RouteGraph, RouteErrorsNameTheNodeAndTheMissingEdge) {
   e = Issues(nograph);
   EXPECT_TRUE(Has(e, "task.graph: no route graph file")) << e;
   EXPECT_TRUE(Has(e, "(closest: van_bay)")) << e;
-  const std::string heading = RouteScenario(
-      "route_heading.yaml",
-      "  type: route\n  graph: van_bay\n  route: [start, ramp_foot]\n  yaw_deg: 0\n");
+  const std::string heading =
+      RouteScenario("route_heading.yaml",
+                    "  type: route\n  graph: van_bay\n  route: [start, ramp_foot]\n  yaw_deg: 0\n");
   e = Issues(heading);
   EXPECT_TRUE(Has(e, "task.yaw_deg: a route steers the robot's heading")) << e;
   const std::string path = RouteScenario(
@@ -134,8 +134,7 @@ TEST(RouteGraph, RouteErrorsNameTheNodeAndTheMissingEdge) {
       "route_gains.yaml",
       "  type: route\n  graph: van_bay\n  route: [start, ramp_foot]\n  gains: {k_p_distanc: 1}\n");
   e = Issues(gains);
-  EXPECT_TRUE(Has(e, "task.gains.k_p_distanc: unknown key; closest: task.gains.k_p_distance"))
-      << e;
+  EXPECT_TRUE(Has(e, "task.gains.k_p_distanc: unknown key; closest: task.gains.k_p_distance")) << e;
 }
 
 // Guards the route task's expansion: the route_follower (under the
@@ -145,10 +144,10 @@ TEST(RouteGraph, RouteErrorsNameTheNodeAndTheMissingEdge) {
 // gains say otherwise; the path the plots and the deviation use is the
 // sampled route, from the start node to the last node.
 TEST(RouteGraph, RouteTaskExpandsIntoTheFollower) {
-  const std::string f = RouteScenario(
-      "route_ok.yaml",
-      "  type: route\n  graph: van_bay\n  route: [start, ramp_foot, ramp_top, work]\n"
-      "  speed_mps: 0.25\n  gains: {k_p_orientation: 2.5}\n");
+  const std::string f =
+      RouteScenario("route_ok.yaml",
+                    "  type: route\n  graph: van_bay\n  route: [start, ramp_foot, ramp_top, work]\n"
+                    "  speed_mps: 0.25\n  gains: {k_p_orientation: 2.5}\n");
   const Scenario s = LoadScenario(f);
   const YAML::Node unit = s.expanded["units"]["path_follower"];
   EXPECT_EQ(unit["type"].as<std::string>(), "route_follower");
@@ -166,9 +165,9 @@ TEST(RouteGraph, RouteTaskExpandsIntoTheFollower) {
   EXPECT_NEAR(s.robot->path.front()[1], -1.0, 1e-12);
   EXPECT_NEAR(s.robot->path.back()[0], 5.9, 1e-12);
   // A bad gain is reported at the key the user wrote.
-  const std::string bad = RouteScenario(
-      "route_bad_gain.yaml",
-      "  type: route\n  graph: van_bay\n  route: [start, ramp_foot]\n  gains: {k_p_orientation: -1}\n");
+  const std::string bad = RouteScenario("route_bad_gain.yaml",
+                                        "  type: route\n  graph: van_bay\n  route: [start, "
+                                        "ramp_foot]\n  gains: {k_p_orientation: -1}\n");
   const std::string e = Issues(bad);
   EXPECT_TRUE(Has(e, "task.gains.k_p_orientation")) << e;
 }

@@ -55,9 +55,9 @@ std::unique_ptr<cosim::Unit> MakeRouteFollower(const UnitBuildContext& c) {
   // A stated limit, as for the path follower's waypoints.
   constexpr std::size_t kMaxSegments = 10000;
   if (list.size() == 0 || list.size() > kMaxSegments) {
-    c.reader.Error(list, path,
-                   std::to_string(list.size()) + " segments: expected 1 to " +
-                       std::to_string(kMaxSegments));
+    c.reader.Error(
+        list, path,
+        std::to_string(list.size()) + " segments: expected 1 to " + std::to_string(kMaxSegments));
     return nullptr;
   }
   for (std::size_t k = 0; k < list.size(); ++k) {
@@ -77,7 +77,8 @@ std::unique_ptr<cosim::Unit> MakeRouteFollower(const UnitBuildContext& c) {
 const config::UnitTypeRegistrar kRouteFollower(
     {RouteFollowerUnit::kTypeName,
      "paper 2's parametric trajectory controller (Sobreira et al. 2019, Sec. 5, Eqs. 1-17): "
-     "a differential base follows polynomial segments at a constant speed, yaw rate from the "
+     "a unicycle-steered base (differential; a swerve base with vy = 0) follows polynomial "
+     "segments at a constant speed, yaw rate from the "
      "distance and orientation errors (PI, switched by T_theta) plus the curvature "
      "feed-forward; stops on the final point; outputs the current segment's map index",
      "",

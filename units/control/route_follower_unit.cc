@@ -158,7 +158,7 @@ RouteFollowerUnit::Sample RouteFollowerUnit::Evaluate() const {
   s.t = t;
   const models::SegmentPoint p = models::EvaluateSegment(segments_[k], t);
   const double ex = p.x - x, ey = p.y - y;
-  s.distance = std::hypot(ex, ey);                                        // Eq. 6
+  s.distance = std::hypot(ex, ey);                                               // Eq. 6
   s.orientation = models::WrapAngle(models::SegmentHeading(p) - yaw_measured_);  // Eq. 10
   const double t_theta = models::WrapAngle(std::atan2(ey, ex) - yaw_measured_);  // Eq. 11
   s.side = t_theta > 0.0 ? 1.0 : -1.0;

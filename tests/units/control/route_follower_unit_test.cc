@@ -76,10 +76,10 @@ TEST(RouteFollowerUnit, VariableTable) {
   RouteFollowerUnit u("route", {Line(0, 0, 1, 0)});
   EXPECT_EQ(u.type_name(), "route_follower");
   const auto& v = u.variables();
-  for (const char* p : {"speed", "k_p_distance", "k_i_distance", "k_p_orientation",
-                        "k_i_orientation", "distance_integral", "max_distance_integral_rate",
-                        "max_orientation_integral_rate", "max_yaw_rate", "deceleration",
-                        "stop_tolerance"}) {
+  for (const char* p :
+       {"speed", "k_p_distance", "k_i_distance", "k_p_orientation", "k_i_orientation",
+        "distance_integral", "max_distance_integral_rate", "max_orientation_integral_rate",
+        "max_yaw_rate", "deceleration", "stop_tolerance"}) {
     ASSERT_TRUE(v.Find(p)) << p;
     EXPECT_EQ(v.info(*v.Find(p)).causality, cosim::Causality::kParameter) << p;
   }
@@ -295,8 +295,8 @@ TEST(RouteFollowerUnit, YawRateIsClampedWithoutWindup) {
 // Guards save/restore: a restored unit (segment, integrals, done) continues
 // bit for bit.
 TEST(RouteFollowerUnit, RestoredUnitContinuesIdentically) {
-  const std::vector<PolynomialSegment> route = {
-      models::HermiteSegment(0, 0, 0, 2, 1, 0.5, 0.0, 0), models::HermiteSegment(2, 1, 0.5, 3, 1, 0, 0.0, 1)};
+  const std::vector<PolynomialSegment> route = {models::HermiteSegment(0, 0, 0, 2, 1, 0.5, 0.0, 0),
+                                                models::HermiteSegment(2, 1, 0.5, 3, 1, 0, 0.0, 1)};
   RouteFollowerUnit u("route", route);
   SetParam(u, "k_i_distance", 0.5);
   SetParam(u, "k_i_orientation", 0.5);
