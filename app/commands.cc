@@ -81,7 +81,7 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
   spec.wheel_columns = robot.wheel_columns;
   spec.error_column = robot.error_column;
   spec.error_label =
-      robot.task == "path" ? "deviation from the path (m)" : "drift from the held position (m)";
+      robot.task != "hold" ? "deviation from the path (m)" : "drift from the held position (m)";
   spec.belt_speed_columns = robot.belt_speed_columns;
   spec.belt_on_columns = robot.belt_on_columns;
   spec.belt_travel_columns = robot.belt_travel_columns;

@@ -25,7 +25,7 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     metrics.push_back(m);
   };
   const std::string deviation = Signal(kDeviation, "deviation");
-  if (info.task == "path") {
+  if (info.task != "hold") {  // a path or a route
     add("max_path_deviation_m", deviation, "max");
     add("final_path_deviation_m", deviation, "final");
     add("final_progress_m", Signal(kDeviation, "progress"), "final");
