@@ -104,7 +104,7 @@ task:
   EXPECT_NEAR(route.x, 5.9, 0.019);
   EXPECT_NEAR(route.y, 0.0, 0.014);
   EXPECT_NEAR(route.yaw, 0.0, 2.216 * M_PI / 180);
-  EXPECT_LT(m.at("max_position_drift_m"), 0.014);  // the deviation from the sampled route
+  EXPECT_LT(m.at("max_path_deviation_m"), 0.014);  // the deviation from the sampled route
 }
 
 }  // namespace
