@@ -144,6 +144,11 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
   }
   std::cout << "sweep " << spec.name << ": " << total << " runs";
   if (done_before > 0) std::cout << " (" << done_before << " already have rows)";
+  if (results->dropped_count() > 0) {
+    std::cout << " (" << results->dropped_count()
+              << " rows did not match the plan (values, seed, status or numbers) and are run "
+                 "again)";
+  }
   std::cout << " of " << spec.scenario << ", ";
   if (!mpi) {
     std::cout << args.jobs << " job(s)\n";

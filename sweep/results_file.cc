@@ -65,6 +65,27 @@ double ParseNumber(const std::string& text) {
   return cosim::ParseFiniteValue(text).value_or(std::numeric_limits<double>::quiet_NaN());
 }
 
+// Whether a results row (split, with every column) is what run `run` of the
+// plan writes: its values and seed as planned, a known status, and numbers
+// where numbers belong (an ok run's metrics are all finite: a run with a
+// non-finite metric fails).
+bool RowMatchesPlan(const SweepSpec& spec, const RunSpec& run,
+                    const std::vector<std::string>& f) {
+  const std::size_t np = spec.parameters.size(), nm = spec.metrics.size();
+  for (std::size_t i = 0; i < np; ++i) {
+    if (f[1 + i] != run.values[i]) return false;
+  }
+  if (f[1 + np] != std::to_string(run.seed)) return false;
+  const std::string& status = f[2 + np + nm];
+  if (status != "ok" && status != "failed") return false;
+  for (std::size_t m = 0; m < nm; ++m) {
+    const std::string& text = f[2 + np + m];
+    if (text.empty() && status == "failed") continue;
+    if (!cosim::ParseFiniteValue(text)) return false;
+  }
+  return cosim::ParseFiniteValue(f[4 + np + nm]).has_value();
+}
+
 }  // namespace
 
 std::vector<std::string> ResultsHeader(const SweepSpec& spec) {
@@ -223,7 +244,7 @@ ResultsFile ResultsFile::Resume(const std::string& path, const SweepSpec& spec) 
   const std::size_t columns = ResultsHeader(spec).size();
   const std::int64_t count = RunCount(spec);
   std::map<std::int64_t, std::string> rows;
-  std::int64_t failed = 0;
+  std::int64_t failed = 0, dropped = 0;
   std::size_t start = header.size();
   while (start < text.size()) {
     const std::size_t end = text.find('\n', start);
@@ -235,10 +256,17 @@ ResultsFile ResultsFile::Resume(const std::string& path, const SweepSpec& spec) 
     if (!fields || fields->size() != columns) continue;
     const auto id = ParseId(fields->front());
     if (!id || *id < 0 || *id >= count) continue;
-    if (rows.emplace(*id, line).second && (*fields)[columns - 3] != "ok") ++failed;
+    if (rows.count(*id) != 0) continue;  // the first of duplicates stands
+    if (!RowMatchesPlan(spec, PlanRun(spec, *id), *fields)) {
+      ++dropped;
+      continue;
+    }
+    rows.emplace(*id, line);
+    if ((*fields)[columns - 3] != "ok") ++failed;
   }
   ResultsFile f(path, header, nullptr, std::move(rows));
   f.failed_ = failed;
+  f.dropped_ = dropped;
   f.Rewrite();
   return f;
 }

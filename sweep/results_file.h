@@ -51,8 +51,12 @@ class ResultsFile {
   static ResultsFile Create(const std::string& path, const SweepSpec& spec);
   /// Continues `path`: keeps every complete row of a planned run (the first
   /// of duplicates) and drops a line cut off by a kill, rewriting the file
-  /// through a temporary and a rename. Throws std::runtime_error when the
-  /// header is not this sweep's.
+  /// through a temporary and a rename. A row is checked, not trusted: one
+  /// whose parameter values or seed are not the plan's for its run id,
+  /// whose status is neither ok nor failed, whose ok metrics or wall time
+  /// do not read as finite numbers (a failed run's may be empty) is dropped
+  /// (its run is done again) and counted in dropped_count(). Throws
+  /// std::runtime_error when the header is not this sweep's.
   static ResultsFile Resume(const std::string& path, const SweepSpec& spec);
 
   ResultsFile(ResultsFile&& other) noexcept;
@@ -66,6 +70,8 @@ class ResultsFile {
   void Append(std::int64_t id, const std::string& line, bool ok);
   /// Rows whose run failed.
   std::int64_t failed_count() const { return failed_; }
+  /// Rows Resume dropped because they did not match the plan.
+  std::int64_t dropped_count() const { return dropped_; }
   /// Rewrites the file with its rows sorted by run id (temporary and rename).
   void SortByRunId();
   /// The rows parsed for the report, sorted by run id.
@@ -81,6 +87,7 @@ class ResultsFile {
   std::FILE* file_ = nullptr;
   std::map<std::int64_t, std::string> rows_;  // run id -> line with its newline
   std::int64_t failed_ = 0;
+  std::int64_t dropped_ = 0;
 };
 
 }  // namespace linesim::sweep

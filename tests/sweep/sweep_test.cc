@@ -572,6 +572,38 @@ TEST(ResultsFile, ResumeKeepsCompleteRowsAndDropsACutOffLine) {
   EXPECT_EQ(ReadFile(path), full);  // and left as it was
 }
 
+// Guards --resume against rows that are not the plan's (issue: results are
+// checked, not trusted): a row with another parameter value, another seed,
+// an unknown status or an ok metric that does not parse is dropped and its
+// run done again; a well-formed row stays.
+TEST(ResultsFile, ResumeDropsRowsThatDoNotMatchThePlan) {
+  const SweepSpec spec = LoadSweepSpec(WriteFile("check.yaml", BeltSweep()));
+  const std::string dir = FreshDir("check");
+  const std::string full = RunSweep(spec, 2, dir);
+  std::istringstream in(full);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line + "\n");
+  const auto field_replaced = [](std::string line, int field, const std::string& text) {
+    std::size_t begin = 0;
+    for (int i = 0; i < field; ++i) begin = line.find(',', begin) + 1;
+    const std::size_t end = line.find(',', begin);
+    return line.replace(begin, end - begin, text);
+  };
+  // Columns: run_id, speed, compensation, seed, 8 metrics..., status, error, wall_s.
+  const std::string path = dir + "/results.csv";
+  std::ofstream(path, std::ios::trunc)
+      << lines[0] << lines[1]                          // run 0 as it was
+      << field_replaced(lines[2], 1, "0.3")            // run 1: a value not planned
+      << field_replaced(lines[3], 3, "12345")          // run 2: another seed
+      << field_replaced(lines[4], 4, "lots")           // run 3: a metric that is no number
+      << field_replaced(lines[5], 12, "fine");         // run 4: an unknown status
+  ResultsFile resumed = ResultsFile::Resume(path, spec);
+  EXPECT_EQ(resumed.row_count(), 1u);
+  EXPECT_TRUE(resumed.HasRow(0));
+  EXPECT_EQ(resumed.dropped_count(), 4);
+  EXPECT_EQ(ReadFile(path), lines[0] + lines[1]);
+}
+
 TEST(ResultsFile, TableParsesRowsBack) {
   const SweepSpec spec = LoadSweepSpec(WriteFile("table.yaml", BeltSweep()));
   const std::string dir = FreshDir("table");
