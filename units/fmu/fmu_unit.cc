@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <set>
 
 #include "units/fmu/fmi_api.h"
@@ -313,7 +314,7 @@ void FmuUnit::DeclareVariables() {
   string_buffer_.resize(count[3]);
 
   std::set<std::string> used;
-  std::map<std::uint32_t, std::string> input_names;  // vr -> table name
+  std::map<std::size_t, std::string> input_names;  // variable index -> table name
   std::vector<std::string> all_inputs;
   const auto unique_name = [&](const std::string& fmi_name) {
     std::string n = Identifier(fmi_name);
@@ -352,8 +353,8 @@ void FmuUnit::DeclareVariables() {
           if (!v.dependencies) {
             deps = all_inputs;
           } else {
-            for (auto vr : *v.dependencies) {
-              if (auto it = input_names.find(vr); it != input_names.end()) deps.push_back(it->second);
+            for (auto index : *v.dependencies) {
+              if (auto it = input_names.find(index); it != input_names.end()) deps.push_back(it->second);
             }
           }
           if (!deps.empty()) has_feedthrough_ = true;
@@ -434,7 +435,7 @@ void FmuUnit::DeclareVariables() {
           }
         }
         if (d == kInputs) {
-          input_names[v.value_reference] = name;
+          input_names[i] = name;
           all_inputs.push_back(name);
         }
       }

@@ -436,8 +436,8 @@ class Parser {
           Fail(u, "dependency index " + std::to_string(d) + " names no variable");
         }
         if (index2_[d - 1] < 0) continue;
-        const FmiVariable& dep = md.variables[static_cast<std::size_t>(index2_[d - 1])];
-        if (dep.causality == "input") refs.push_back(dep.value_reference);
+        const auto dep = static_cast<std::size_t>(index2_[d - 1]);
+        if (md.variables[dep].causality == "input") refs.push_back(static_cast<std::uint32_t>(dep));
       }
       out.dependencies = refs;
     }
@@ -456,7 +456,9 @@ class Parser {
       for (std::uint32_t d : UnsignedList(o, "dependencies")) {
         const auto dep = std::find_if(md.variables.begin(), md.variables.end(),
                                       [&](const FmiVariable& v) { return v.value_reference == d; });
-        if (dep != md.variables.end() && dep->causality == "input") refs.push_back(d);
+        if (dep != md.variables.end() && dep->causality == "input") {
+          refs.push_back(static_cast<std::uint32_t>(dep - md.variables.begin()));
+        }
       }
       it->dependencies = refs;
     }

@@ -46,8 +46,9 @@ struct FmiVariable {
   /// linesim's spelling: "m", "rad/s", "N.m", "1"), see LinesimUnit.
   std::string fmi_unit;
   std::string unit;
-  /// Outputs: the value references of the inputs the output depends on
-  /// directly (ModelStructure); nothing when the FMU does not say (then
+  /// Outputs: the inputs the output depends on directly (ModelStructure),
+  /// as indices into ModelDescription::variables (FMI 2.0 value references
+  /// are unique per type only); nothing when the FMU does not say (then
   /// every input is assumed).
   std::optional<std::vector<std::uint32_t>> dependencies;
   int line = 0;  // in modelDescription.xml
