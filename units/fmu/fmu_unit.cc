@@ -347,6 +347,13 @@ void FmuUnit::DeclareVariables() {
                 std::to_string(v.value_reference);
         if (!v.fmi_unit.empty() && v.fmi_unit != v.unit) text += ", unit '" + v.fmi_unit + "'";
         if (v.causality == "calculatedParameter") text += ", calculated parameter";
+        if (v.dimensions.size() > 1) {
+          text += ", ";
+          for (std::size_t k = 0; k < v.dimensions.size(); ++k) {
+            text += (k ? "x" : "") + std::to_string(v.dimensions[k]);
+          }
+          text += " row-major";
+        }
         text += ")";
         std::vector<std::string> deps;
         if (d == kOutputs) {
@@ -794,7 +801,8 @@ StepResult FmuUnit::DoStep(TimeNs t, TimeNs dt) {
           last_time = t_ok;
         }
       }
-      Fail(Where() + ": " + why + " for the step from t = " + cosim::FormatSeconds(t) + " s to " +
+      // No unit name in front: the master's message names it, around this.
+      Fail(why + " for the step from t = " + cosim::FormatSeconds(t) + " s to " +
            cosim::FormatSeconds(t + dt) + " s (last successful time " + cosim::FormatValue(last_time) +
            " s)" + RecentMessages(call_messages_));
       return StepResult::kDiscard;
