@@ -688,11 +688,11 @@ void FmuUnit::Setup(TimeNs start, TimeNs stop) {
     const std::string uri = "file://" + resources;
     instance_ = binary_->f2.Instantiate(name().c_str(), fmi2::kCoSimulation,
                                         description_.token.c_str(), uri.c_str(), &callbacks2_,
-                                        fmi2::kFalse, fmi2::kTrue);
+                                        fmi2::kFalse, /*loggingOn=*/fmi2::kFalse);
   } else {
     const std::string path = resources + "/";
     instance_ = binary_->f3.InstantiateCoSimulation(
-        name().c_str(), description_.token.c_str(), path.c_str(), false, true,
+        name().c_str(), description_.token.c_str(), path.c_str(), false, /*loggingOn=*/false,
         /*eventModeUsed=*/false, /*earlyReturnAllowed=*/true, nullptr, 0, this, Logger3, nullptr);
   }
   if (!instance_) {

@@ -58,7 +58,11 @@ class FmuUnit : public cosim::Unit {
   const std::string& file() const { return file_; }
   const std::vector<MappedVariable>& mapping() const { return mapping_; }
   /// The FMU's log (logger / logMessage callbacks), oldest first, as
-  /// "status [category] message"; at most kMaxMessages are kept.
+  /// "status [category] message"; at most kMaxMessages are kept. The FMU is
+  /// instantiated with loggingOn = false (no debug logging, which would
+  /// cost every step): it still reports warnings and errors. linesim has no
+  /// channel for a unit's messages during a run: they stay here, and the
+  /// ones logged during a failed call are added to its error.
   const std::vector<std::string>& messages() const { return messages_; }
   static constexpr std::size_t kMaxMessages = 1000;
 

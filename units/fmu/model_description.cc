@@ -153,14 +153,9 @@ class Parser {
     md.can_return_early = cs.attribute("mightReturnEarlyFromDoStep").as_bool();
     md.needs_execution_tool = cs.attribute("needsExecutionTool").as_bool();
     md.only_once_per_process = cs.attribute("canBeInstantiatedOnlyOncePerProcess").as_bool();
-    if (md.fmi_major == 2 && cs.attribute("canRunAsynchronuously").as_bool()) {
-      // Asynchronous doStep is optional for the FMU too: nothing to refuse.
-    }
     if (const auto a = cs.attribute("fixedInternalStepSize")) md.fixed_internal_step = Real(cs, a);
-    if (md.fmi_major == 3 && cs.attribute("hasEventMode").as_bool()) {
-      // Event mode is offered, not required: linesim instantiates with
-      // eventModeUsed = false.
-    }
+    // FMI 3.0 event mode (hasEventMode) is offered, not required: linesim
+    // instantiates with eventModeUsed = false.
 
     if (const pugi::xml_node de = root.child("DefaultExperiment")) {
       if (const auto a = de.attribute("startTime")) md.default_start = Real(de, a);

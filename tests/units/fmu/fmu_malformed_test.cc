@@ -211,6 +211,26 @@ TEST(FmuMalformed, UnsupportedVersionAndTypes) {
   EXPECT_NE(e.find("dimension set by a structural parameter"), std::string::npos) << e;
 }
 
+// The FMU refuses to instantiate (its GUID is not the model description's):
+// named at Setup, with the FMU's log.
+TEST(FmuMalformed, InstantiationRefusedIsNamedWithTheLog) {
+  Scratch s("guid");
+  std::string xml = Dahlquist2Xml();
+  const std::string from = "guid=\"{linesim-test-dahlquist-2}\"";
+  xml.replace(xml.find(from), from.size(), "guid=\"{other}\"");
+  MakeZip(s / "g.fmu", {{"modelDescription.xml", xml},
+                        {"binaries/linux64/dahlquist.so", ReadFile(LINESIM_DAHLQUIST_SO)}});
+  FmuUnit u("g", s / "g.fmu");
+  try {
+    u.Setup(0, 1'000'000'000);
+    FAIL() << "instantiated with a wrong GUID";
+  } catch (const cosim::UnitError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("the FMU refused to instantiate"), std::string::npos) << what;
+    EXPECT_NE(what.find("wrong guid {other}"), std::string::npos) << what;
+  }
+}
+
 // The folder an FMU unpacks into is private and goes with the unit.
 TEST(FmuArchive, UnpacksIntoAPrivateFolderRemovedAfterwards) {
   std::string folder;

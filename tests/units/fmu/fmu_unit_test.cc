@@ -318,6 +318,21 @@ TEST(FmuUnit, DiscardBecomesTheStepResultDiscard) {
   }
 }
 
+// An error status from doStep is named with the call, the step and the
+// FMU's own log line (the Dahlquist FMU refuses h <= 0).
+TEST(FmuUnit, AnErrorStatusIsNamedWithTheFmuLog) {
+  FmuUnit u("d", Fmu("dahlquist"));
+  u.Setup(0, 100 * kMs);
+  u.Initialize();
+  EXPECT_EQ(u.DoStep(0, 0), StepResult::kError);
+  const std::string& e = u.last_error();
+  EXPECT_NE(e.find("fmi2DoStep returned fmi2Error for the step of 0 s at t = 0 s"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("does the FMU refuse this step size?"), std::string::npos) << e;
+  EXPECT_NE(e.find("step size 0 refused: must be > 0"), std::string::npos) << e;
+}
+
 // The unit made without an FMU (`linesim inspect fmu`) says what is missing.
 TEST(FmuUnit, WithoutAnFmuReportsPath) {
   FmuUnit u("f");
