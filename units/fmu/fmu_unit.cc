@@ -212,7 +212,7 @@ std::atomic<std::int64_t> next_id{1};
 
 void FmuUnit::Log(int status, const char* category, const char* message) {
   ++message_count_;
-  if (messages_.size() >= kMaxMessages) return;
+  if (messages_.size() >= kMaxMessages) messages_.pop_front();
   messages_.push_back(std::string(StatusName(description_.fmi_major, status)) + " [" +
                       (category ? category : "") + "] " + message);
 }
@@ -310,7 +310,6 @@ void FmuUnit::DeclareVariables() {
   strings_.resize(count[3]);
   arrays_.reserve(array_count);  // never grows after: the table keeps addresses
   int_buffer_.resize(std::max(count[1], count[2]));
-  bool_buffer_.resize(count[2]);
   string_buffer_.resize(count[3]);
 
   std::set<std::string> used;
@@ -467,10 +466,12 @@ std::vector<cosim::ParameterProblem> FmuUnit::CheckParameters() const {
 // Calls.
 
 std::string FmuUnit::RecentMessages(std::size_t since) const {
+  // The messages logged since message number `since`, as far as kept.
   std::string text;
-  // messages_ holds the first kMaxMessages only: the recent ones are those
-  // past `since` that were kept.
-  for (std::size_t i = since; i < messages_.size(); ++i) text += "; FMU log: " + messages_[i];
+  const std::size_t recent = std::min(message_count_ - since, messages_.size());
+  for (std::size_t i = messages_.size() - recent; i < messages_.size(); ++i) {
+    text += "; FMU log: " + messages_[i];
+  }
   return text;
 }
 
@@ -675,7 +676,7 @@ void FmuUnit::Setup(TimeNs start, TimeNs stop) {
   start_ = start;
   stop_ = stop;
   first_dt_ = 0;
-  call_messages_ = messages_.size();
+  call_messages_ = message_count_;
   const std::string resources = (fs::path(folder_->path()) / "resources").string();
   if (description_.fmi_major == 2) {
     static const fmi2::CallbackFunctions* callbacks = [] {
@@ -712,7 +713,7 @@ void FmuUnit::Initialize() {
   if (!binary_) throw UnitError(Where() + ": no FMU: parameters.path must name one");
   ThrowIfBadParameters();
   if (mode_ == Mode::kNone || mode_ == Mode::kTerminated) Setup(start_, stop_);
-  call_messages_ = messages_.size();
+  call_messages_ = message_count_;
   if (mode_ == Mode::kInstantiated) {
     // Start values of parameters and inputs go in before initialization.
     SetGroups(groups_[kParameters], "initialize");
@@ -738,7 +739,7 @@ void FmuUnit::Initialize() {
 
 void FmuUnit::UpdateOutputs() {
   if (!has_feedthrough_ || !instance_) return;
-  call_messages_ = messages_.size();
+  call_messages_ = message_count_;
   SetGroups(groups_[kInputs], "updating outputs");
   GetGroups(groups_[kOutputs], "updating outputs");
 }
@@ -749,7 +750,7 @@ StepResult FmuUnit::DoStep(TimeNs t, TimeNs dt) {
     return Fail(Where() + ": the FMU is not initialized (or was terminated) at t = " +
                 cosim::FormatSeconds(t) + " s");
   }
-  call_messages_ = messages_.size();
+  call_messages_ = message_count_;
   if (!InputsFinite(t)) return StepResult::kError;
   // Step sizes the FMU cannot take, named before it is asked.
   if (first_dt_ == 0) first_dt_ = dt;
@@ -833,7 +834,7 @@ StepResult FmuUnit::DoStep(TimeNs t, TimeNs dt) {
 void FmuUnit::Terminate() {
   if (!instance_ || mode_ == Mode::kBroken || mode_ == Mode::kTerminated) return;
   if (mode_ != Mode::kInitialization && mode_ != Mode::kStep) return;
-  call_messages_ = messages_.size();
+  call_messages_ = message_count_;
   const int status = description_.fmi_major == 2 ? static_cast<int>(binary_->f2.Terminate(instance_))
                                                  : static_cast<int>(binary_->f3.Terminate(instance_));
   mode_ = Mode::kTerminated;

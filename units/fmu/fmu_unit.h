@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -58,12 +59,15 @@ class FmuUnit : public cosim::Unit {
   const std::string& file() const { return file_; }
   const std::vector<MappedVariable>& mapping() const { return mapping_; }
   /// The FMU's log (logger / logMessage callbacks), oldest first, as
-  /// "status [category] message"; at most kMaxMessages are kept. The FMU is
+  /// "status [category] message"; the last kMaxMessages are kept. The FMU is
   /// instantiated with loggingOn = false (no debug logging, which would
   /// cost every step): it still reports warnings and errors. linesim has no
   /// channel for a unit's messages during a run: they stay here, and the
   /// ones logged during a failed call are added to its error.
-  const std::vector<std::string>& messages() const { return messages_; }
+  const std::deque<std::string>& messages() const { return messages_; }
+  /// How many messages the FMU logged in all (the oldest beyond
+  /// kMaxMessages are dropped).
+  std::size_t message_count() const { return message_count_; }
   static constexpr std::size_t kMaxMessages = 1000;
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
@@ -133,7 +137,6 @@ class FmuUnit : public cosim::Unit {
   // passed as pointers), sized once.
   std::vector<int> int_buffer_;
   std::vector<const char*> string_buffer_;
-  std::vector<char> bool_buffer_;
   // Tunable parameters: the values last given to the FMU.
   std::vector<double> sent_reals_;
   std::vector<std::int64_t> sent_integers_;
@@ -152,9 +155,9 @@ class FmuUnit : public cosim::Unit {
   mutable std::vector<void*> kept_states_;
   std::int64_t id_ = 0;
 
-  std::vector<std::string> messages_;
+  std::deque<std::string> messages_;
   std::size_t message_count_ = 0;  // all ever logged
-  std::size_t call_messages_ = 0;  // messages_.size() when the current call began
+  std::size_t call_messages_ = 0;  // message_count_ when the current call began
   fmi2::CallbackFunctions callbacks2_{};
   double placeholder_ = 0;
 };
