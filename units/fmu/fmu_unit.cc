@@ -679,13 +679,9 @@ void FmuUnit::Setup(TimeNs start, TimeNs stop) {
   call_messages_ = message_count_;
   const std::string resources = (fs::path(folder_->path()) / "resources").string();
   if (description_.fmi_major == 2) {
-    static const fmi2::CallbackFunctions* callbacks = [] {
-      static fmi2::CallbackFunctions c{Logger2, Allocate2, Free2, nullptr, nullptr};
-      return &c;
-    }();
-    // The environment is per instance: a copy with this unit in it.
-    callbacks2_ = *callbacks;
-    callbacks2_.componentEnvironment = this;
+    // The FMU keeps a pointer to the callbacks: they live in the unit, with
+    // the unit as the environment the logger gets back.
+    callbacks2_ = {Logger2, Allocate2, Free2, nullptr, this};
     const std::string uri = "file://" + resources;
     instance_ = binary_->f2.Instantiate(name().c_str(), fmi2::kCoSimulation,
                                         description_.token.c_str(), uri.c_str(), &callbacks2_,
