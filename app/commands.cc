@@ -17,6 +17,7 @@
 #include "cosim/observers.h"
 #include "loader/scenario.h"
 #include "plots/robot_plots.h"
+#include "units/fmu/fmu_unit.h"
 
 namespace linesim::app {
 
@@ -287,7 +288,64 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   return outcome.ok ? kExitOk : kExitRunFailed;
 }
 
+// `linesim inspect X.fmu`: what the FMU declares and what the `fmu` unit
+// makes of it.
+static int InspectFmu(const std::string& file) {
+  std::unique_ptr<fmu::FmuUnit> unit;
+  try {
+    unit = std::make_unique<fmu::FmuUnit>("fmu", file);
+  } catch (const std::exception& e) {
+    std::cerr << "linesim: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  const fmu::ModelDescription& md = unit->description();
+  const auto yes = [](bool b) { return b ? "yes" : "no"; };
+  const auto seconds = [](const std::optional<double>& v) {
+    return v ? cosim::FormatValue(*v) + " s" : std::string("-");
+  };
+  std::cout << "FMU " << file << ": FMI " << md.fmi_version << " co-simulation, model '"
+            << md.model_name << "' (modelIdentifier " << md.model_identifier << ")\n";
+  if (!md.description.empty()) std::cout << "  description:      " << md.description << "\n";
+  std::cout << "  generation tool:  " << (md.generation_tool.empty() ? "-" : md.generation_tool);
+  if (!md.generation_date.empty()) std::cout << " (" << md.generation_date << ")";
+  std::cout << "\n  token:            " << md.token << "\n";
+  std::cout << "  capabilities:     canGetAndSetFMUstate " << yes(md.can_get_and_set_state)
+            << ", canSerializeFMUstate " << yes(md.can_serialize_state)
+            << ", canHandleVariableCommunicationStepSize " << yes(md.can_handle_variable_step);
+  if (md.fmi_major == 2) {
+    std::cout << ", canInterpolateInputs " << yes(md.can_interpolate_inputs);
+  } else {
+    std::cout << ", mightReturnEarlyFromDoStep " << yes(md.can_return_early)
+              << ", fixedInternalStepSize " << seconds(md.fixed_internal_step);
+  }
+  std::cout << ", needsExecutionTool " << yes(md.needs_execution_tool)
+            << ", canBeInstantiatedOnlyOncePerProcess " << yes(md.only_once_per_process);
+  if (md.has_model_exchange) std::cout << " (also model exchange: not used)";
+  std::cout << "\n  default experiment: start " << seconds(md.default_start) << ", stop "
+            << seconds(md.default_stop) << ", step " << seconds(md.default_step)
+            << ", tolerance "
+            << (md.default_tolerance ? cosim::FormatValue(*md.default_tolerance) : "-") << "\n";
+  std::cout << "variables, as a unit `type: fmu` with `parameters: {path: ...}` declares them:\n";
+  PrintTable(*unit, std::cout);
+  std::string left_out;
+  for (const auto& m : unit->mapping()) {
+    if (!m.mapped) left_out += (left_out.empty() ? "" : ", ") + m.fmi_name;
+  }
+  if (!left_out.empty()) {
+    std::cout << "left out (inside the FMU only: the independent time, non-Real locals): "
+              << left_out << "\n";
+  }
+  return kExitOk;
+}
+
 int InspectCommand(const std::string& what, const std::vector<std::string>& set_args) {
+  if (what.ends_with(".fmu") && config::FindUnitType(what) == nullptr) {
+    if (!set_args.empty()) {
+      std::cerr << "linesim: --set applies to a scenario file, not to an FMU\n";
+      return kExitBadInput;
+    }
+    return InspectFmu(what);
+  }
   // A type name first: a file or folder of that name where linesim runs
   // (inspect chassis from inside units/) does not hide the type.
   const config::UnitType* type = config::FindUnitType(what);

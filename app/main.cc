@@ -33,8 +33,8 @@ int main(int argc, char** argv) {
   std::string what;
   std::vector<std::string> inspect_sets;
   CLI::App* inspect =
-      cli.add_subcommand("inspect", "print the variables of a unit type or of a scenario's units");
-  inspect->add_option("what", what, "unit type name, or a scenario YAML file")->required();
+      cli.add_subcommand("inspect", "print the variables of a unit type, of a scenario's units or of an FMU");
+  inspect->add_option("what", what, "unit type name, a scenario YAML file, or an FMU (.fmu)")->required();
   inspect->add_option("--set", inspect_sets, "override a value: dotted.path=value (repeatable)")
       ->take_all();
 

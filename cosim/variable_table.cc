@@ -450,6 +450,11 @@ ValueRef VariableTable::Output(std::string name, bool* s, std::string d,
   return Bind(std::move(name), Causality::kOutput, Variability::kDiscrete, "1", s, std::move(d),
               deps);
 }
+ValueRef VariableTable::Output(std::string name, std::string* s, std::string d,
+                               const std::vector<std::string>& deps) {
+  return Bind(std::move(name), Causality::kOutput, Variability::kDiscrete, "", s, std::move(d),
+              deps);
+}
 
 ValueRef VariableTable::Local(std::string name, std::string unit, double* s, std::string d) {
   return Bind(std::move(name), Causality::kLocal, Variability::kContinuous, std::move(unit), s,

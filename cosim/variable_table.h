@@ -190,6 +190,8 @@ class VariableTable {
                   const std::vector<std::string>& depends_on);
   ValueRef Output(std::string name, bool* storage, std::string description,
                   const std::vector<std::string>& depends_on);
+  ValueRef Output(std::string name, std::string* storage, std::string description,
+                  const std::vector<std::string>& depends_on);
 
   ValueRef Local(std::string name, std::string unit, double* storage, std::string description);
   ValueRef Local(std::string name, std::string unit, std::vector<double>* storage,

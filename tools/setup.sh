@@ -9,6 +9,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libtbb-dev
   libopenmpi-dev openmpi-bin gnuplot-nox
+  libzip-dev libpugixml-dev
 )
 
 missing=()

@@ -1,0 +1,250 @@
+// The malformed-FMU corpus, made at run time with libzip: each archive is
+// refused with a named error, and nothing lands outside the unit's folder.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <zip.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "tests/units/fmu/fmu_test_support.h"
+#include "units/fmu/fmu_archive.h"
+#include "units/fmu/fmu_unit.h"
+
+namespace linesim::fmu {
+namespace {
+
+namespace fs = std::filesystem;
+using test::Scratch;
+
+struct Entry {
+  std::string name;
+  std::string content;
+  bool symlink = false;
+};
+
+void MakeZip(const std::string& file, const std::vector<Entry>& entries) {
+  int error = 0;
+  zip_t* z = zip_open(file.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &error);
+  ASSERT_NE(z, nullptr);
+  for (const auto& e : entries) {
+    zip_source_t* src = zip_source_buffer(z, e.content.data(), e.content.size(), 0);
+    ASSERT_NE(src, nullptr);
+    const zip_int64_t index = zip_file_add(z, e.name.c_str(), src, ZIP_FL_ENC_UTF_8);
+    ASSERT_GE(index, 0) << e.name << ": " << zip_strerror(z);
+    if (e.symlink) {
+      const zip_uint32_t mode = S_IFLNK | 0777;
+      ASSERT_EQ(zip_file_set_external_attributes(z, static_cast<zip_uint64_t>(index), 0,
+                                                 ZIP_OPSYS_UNIX, mode << 16),
+                0);
+    }
+  }
+  ASSERT_EQ(zip_close(z), 0);
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The error loading `fmu` gives ("" when it loads).
+std::string LoadError(const std::string& fmu) {
+  try {
+    FmuUnit u("bad", fmu);
+  } catch (const FmuError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string Dahlquist2Xml() {
+  return ReadFile(std::string(LINESIM_SOURCE_DIR) + "/tests/units/fmu/fmus/dahlquist.xml");
+}
+
+std::string Fmi3Xml(const std::string& variables, const std::string& cs_extra = "") {
+  return "<?xml version=\"1.0\"?>\n<fmiModelDescription fmiVersion=\"3.0\" modelName=\"m\" "
+         "instantiationToken=\"t\">\n  <CoSimulation modelIdentifier=\"m\"" + cs_extra +
+         "/>\n  <ModelVariables>\n" + variables + "  </ModelVariables>\n</fmiModelDescription>\n";
+}
+
+TEST(FmuMalformed, MissingFile) {
+  const auto e = LoadError("/nonexistent/none.fmu");
+  EXPECT_NE(e.find("no such FMU file"), std::string::npos) << e;
+}
+
+TEST(FmuMalformed, NotAZipArchive) {
+  Scratch s("notzip");
+  std::ofstream(s / "x.fmu") << "plain text";
+  const auto e = LoadError(s / "x.fmu");
+  EXPECT_NE(e.find("not a readable FMU (zip archive)"), std::string::npos) << e;
+}
+
+// Zip-slip: a '..' entry would land beside the unit's folder; it is refused
+// before anything is written, and no file appears there.
+TEST(FmuMalformed, ZipSlipEntriesAreRefused) {
+  Scratch s("slip");
+  const std::string escaped = "linesim-zip-slip-" + std::to_string(::getpid()) + ".txt";
+  for (const std::string& name : {"../" + escaped, "binaries/../../" + escaped, "a/../../" + escaped}) {
+    MakeZip(s / "slip.fmu", {{"modelDescription.xml", Dahlquist2Xml()}, {name, "pwned"}});
+    const auto e = LoadError(s / "slip.fmu");
+    EXPECT_NE(e.find("refused: entry '" + name + "' has a '..' component"), std::string::npos)
+        << e;
+    EXPECT_FALSE(fs::exists(fs::temp_directory_path() / escaped));
+  }
+}
+
+TEST(FmuMalformed, AbsolutePathsAreRefused) {
+  Scratch s("abs");
+  const std::string target = (fs::temp_directory_path() /
+                              ("linesim-abs-" + std::to_string(::getpid()) + ".txt")).string();
+  MakeZip(s / "abs.fmu", {{"modelDescription.xml", Dahlquist2Xml()}, {target, "pwned"}});
+  auto e = LoadError(s / "abs.fmu");
+  EXPECT_NE(e.find("has an absolute path"), std::string::npos) << e;
+  EXPECT_FALSE(fs::exists(target));
+  MakeZip(s / "abs.fmu", {{"C:/x.txt", "pwned"}});
+  e = LoadError(s / "abs.fmu");
+  EXPECT_NE(e.find("drive letter"), std::string::npos) << e;
+  MakeZip(s / "abs.fmu", {{"binaries\\..\\x.txt", "pwned"}});
+  e = LoadError(s / "abs.fmu");
+  EXPECT_NE(e.find("backslash"), std::string::npos) << e;
+}
+
+TEST(FmuMalformed, SymbolicLinksAreRefused) {
+  Scratch s("link");
+  MakeZip(s / "link.fmu", {{"modelDescription.xml", Dahlquist2Xml()},
+                           {"resources/passwd", "/etc/passwd", true}});
+  const auto e = LoadError(s / "link.fmu");
+  EXPECT_NE(e.find("entry 'resources/passwd' is a symbolic link"), std::string::npos) << e;
+}
+
+TEST(FmuMalformed, MissingModelDescription) {
+  Scratch s("nomd");
+  MakeZip(s / "nomd.fmu", {{"binaries/linux64/x.so", "x"}});
+  const auto e = LoadError(s / "nomd.fmu");
+  EXPECT_NE(e.find("no modelDescription.xml"), std::string::npos) << e;
+}
+
+// Invalid XML is named with the file inside the FMU and the line (pugixml's
+// offset turned into a line): the unclosed element is on line 3.
+TEST(FmuMalformed, InvalidXmlNamesFileAndLine) {
+  Scratch s("xml");
+  MakeZip(s / "xml.fmu", {{"modelDescription.xml",
+                           "<?xml version=\"1.0\"?>\n<fmiModelDescription fmiVersion=\"2.0\">\n"
+                           "  <CoSimulation modelIdentifier=\"m\"\n</fmiModelDescription>\n"}});
+  const auto e = LoadError(s / "xml.fmu");
+  EXPECT_NE(e.find(s / "xml.fmu" + "/modelDescription.xml:"), std::string::npos) << e;
+  EXPECT_NE(e.find("invalid XML"), std::string::npos) << e;
+  EXPECT_NE(e.find(":4: invalid XML"), std::string::npos) << e;
+}
+
+TEST(FmuMalformed, WrongPlatform) {
+  Scratch s("platform");
+  MakeZip(s / "p.fmu", {{"modelDescription.xml", Dahlquist2Xml()},
+                        {"binaries/win64/dahlquist.dll", "MZ"}});
+  const auto e = LoadError(s / "p.fmu");
+  EXPECT_NE(e.find("no binary for this platform: binaries/linux64/dahlquist.so is missing "
+                   "(binaries for: win64)"),
+            std::string::npos)
+      << e;
+}
+
+TEST(FmuMalformed, MissingSymbols) {
+  Scratch s("symbols");
+  std::string xml = Dahlquist2Xml();
+  const std::string from = "modelIdentifier=\"dahlquist\"";
+  xml.replace(xml.find(from), from.size(), "modelIdentifier=\"missing_symbols\"");
+  MakeZip(s / "sym.fmu", {{"modelDescription.xml", xml},
+                          {"binaries/linux64/missing_symbols.so", ReadFile(LINESIM_MISSING_SYMBOLS_SO)}});
+  const auto e = LoadError(s / "sym.fmu");
+  EXPECT_NE(e.find("does not export fmi2FreeInstance (missing symbol)"), std::string::npos) << e;
+}
+
+TEST(FmuMalformed, ModelExchangeOnly) {
+  Scratch s("me");
+  MakeZip(s / "me.fmu",
+          {{"modelDescription.xml",
+            "<?xml version=\"1.0\"?>\n<fmiModelDescription fmiVersion=\"2.0\" modelName=\"m\" "
+            "guid=\"g\">\n  <ModelExchange modelIdentifier=\"m\"/>\n  <ModelVariables/>\n"
+            "</fmiModelDescription>\n"}});
+  const auto e = LoadError(s / "me.fmu");
+  EXPECT_NE(e.find("model exchange only"), std::string::npos) << e;
+}
+
+TEST(FmuMalformed, ClocksAreRefused) {
+  Scratch s("clock");
+  MakeZip(s / "c.fmu", {{"modelDescription.xml",
+                         Fmi3Xml("    <Clock name=\"tick\" valueReference=\"1\" causality=\"input\"/>\n")}});
+  const auto e = LoadError(s / "c.fmu");
+  EXPECT_NE(e.find("modelDescription.xml:5: variable 'tick' is a clock: FMI 3.0 clocks are not "
+                   "supported"),
+            std::string::npos)
+      << e;
+}
+
+TEST(FmuMalformed, TerminalsAreRefused) {
+  Scratch s("terminals");
+  MakeZip(s / "t.fmu", {{"modelDescription.xml", Fmi3Xml("")},
+                        {"terminalsAndIcons/terminalsAndIcons.xml", "<fmiTerminalsAndIcons/>"}});
+  const auto e = LoadError(s / "t.fmu");
+  EXPECT_NE(e.find("terminals are not supported"), std::string::npos) << e;
+}
+
+TEST(FmuMalformed, UnsupportedVersionAndTypes) {
+  Scratch s("version");
+  MakeZip(s / "v.fmu", {{"modelDescription.xml",
+                         "<?xml version=\"1.0\"?>\n<fmiModelDescription fmiVersion=\"1.0\"/>\n"}});
+  auto e = LoadError(s / "v.fmu");
+  EXPECT_NE(e.find("unsupported FMI version '1.0'"), std::string::npos) << e;
+  MakeZip(s / "v.fmu",
+          {{"modelDescription.xml",
+            Fmi3Xml("    <Float32 name=\"f\" valueReference=\"1\" causality=\"output\"/>\n")}});
+  e = LoadError(s / "v.fmu");
+  EXPECT_NE(e.find("variable 'f' (output) has type Float32"), std::string::npos) << e;
+  MakeZip(s / "v.fmu",
+          {{"modelDescription.xml",
+            Fmi3Xml("    <Float64 name=\"a\" valueReference=\"1\" causality=\"output\">"
+                    "<Dimension valueReference=\"2\"/></Float64>\n")}});
+  e = LoadError(s / "v.fmu");
+  EXPECT_NE(e.find("dimension set by a structural parameter"), std::string::npos) << e;
+}
+
+// The FMU refuses to instantiate (its GUID is not the model description's):
+// named at Setup, with the FMU's log.
+TEST(FmuMalformed, InstantiationRefusedIsNamedWithTheLog) {
+  Scratch s("guid");
+  std::string xml = Dahlquist2Xml();
+  const std::string from = "guid=\"{linesim-test-dahlquist-2}\"";
+  xml.replace(xml.find(from), from.size(), "guid=\"{other}\"");
+  MakeZip(s / "g.fmu", {{"modelDescription.xml", xml},
+                        {"binaries/linux64/dahlquist.so", ReadFile(LINESIM_DAHLQUIST_SO)}});
+  FmuUnit u("g", s / "g.fmu");
+  try {
+    u.Setup(0, 1'000'000'000);
+    FAIL() << "instantiated with a wrong GUID";
+  } catch (const cosim::UnitError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("the FMU refused to instantiate"), std::string::npos) << what;
+    EXPECT_NE(what.find("wrong guid {other}"), std::string::npos) << what;
+  }
+}
+
+// The folder an FMU unpacks into is private and goes with the unit.
+TEST(FmuArchive, UnpacksIntoAPrivateFolderRemovedAfterwards) {
+  std::string folder;
+  {
+    TempFolder t;
+    folder = t.path();
+    struct stat st {};
+    ASSERT_EQ(::stat(folder.c_str(), &st), 0);
+    EXPECT_EQ(st.st_mode & 0777, 0700u);
+    Unpack(test::Fmu("dahlquist"), folder);
+    EXPECT_TRUE(fs::exists(fs::path(folder) / "binaries/linux64/dahlquist.so"));
+  }
+  EXPECT_FALSE(fs::exists(folder));
+}
+
+}  // namespace
+}  // namespace linesim::fmu

@@ -1,0 +1,368 @@
+// The test FMUs (tests/units/fmu/fmus/*.c, zipped by CMake) through the fmu
+// unit, each against its analytic result.
+#include "units/fmu/fmu_unit.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "tests/units/fmu/fmu_test_support.h"
+
+namespace linesim::fmu {
+namespace {
+
+using cosim::Causality;
+using cosim::StepResult;
+using cosim::TimeNs;
+using cosim::VarType;
+using test::Fmu;
+
+constexpr TimeNs kMs = 1'000'000;
+
+const cosim::VariableInfo& Info(const cosim::Unit& u, const std::string& name) {
+  const auto ref = u.variables().Find(name);
+  EXPECT_TRUE(ref) << name;
+  return u.variables().info(*ref);
+}
+double Real(const cosim::Unit& u, const std::string& name) {
+  return u.variables().GetReal(*u.variables().Find(name));
+}
+void SetReal(cosim::Unit& u, const std::string& name, double v) {
+  u.variables().SetReal(*u.variables().Find(name), v);
+}
+bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Guards the mapping of an FMI 2.0 model description: names made
+// identifiers, causality, units from the variable, its declaredType and
+// UnitDefinitions ("s-1" with base unit s^-1 is linesim's "1/s"), the
+// independent time left out, and ModelStructure's (empty) dependencies.
+TEST(FmuUnit, MapsTheDahlquistModelDescription) {
+  FmuUnit u("d", Fmu("dahlquist"));
+  EXPECT_EQ(u.description().fmi_major, 2);
+  EXPECT_EQ(u.description().generation_tool, "linesim tests (hand-written C)");
+  EXPECT_TRUE(u.description().can_serialize_state);
+  ASSERT_TRUE(u.description().default_step);
+  EXPECT_EQ(*u.description().default_step, 0.01);
+  EXPECT_EQ(Info(u, "x").causality, Causality::kOutput);
+  EXPECT_EQ(Info(u, "x").unit, "m");  // declaredType Position
+  EXPECT_TRUE(Info(u, "x").depends_on.empty());
+  EXPECT_EQ(Info(u, "k").causality, Causality::kParameter);
+  EXPECT_EQ(Info(u, "k").unit, "1/s");
+  EXPECT_EQ(Info(u, "k").variability, cosim::Variability::kFixed);
+  EXPECT_EQ(Info(u, "x0").unit, "m");
+  EXPECT_EQ(Info(u, "u").causality, Causality::kInput);
+  EXPECT_EQ(Info(u, "u").unit, "m/s");
+  EXPECT_EQ(Info(u, "der_x_").causality, Causality::kLocal);
+  EXPECT_NE(Info(u, "der_x_").description.find("FMI 'der(x)'"), std::string::npos);
+  EXPECT_FALSE(u.variables().Find("time"));
+  EXPECT_EQ(Real(u, "k"), 1.0);  // start values
+  EXPECT_EQ(Real(u, "x0"), 1.0);
+}
+
+// x' = -k x stepped exactly: after n steps of h, x = x0 e^{-k t_n} to
+// rounding (analytic solution of Dahlquist's test equation); and the same
+// bits as the per-step recurrence x <- x e^{-k h}, which shows that every
+// step got exactly h and the time start + k h.
+TEST(FmuUnit, DahlquistFollowsTheClosedForm) {
+  FmuUnit u("d", Fmu("dahlquist"));
+  const double k = 2.0, x0 = 1.5;
+  SetReal(u, "k", k);
+  SetReal(u, "x0", x0);
+  const TimeNs h = 10 * kMs;
+  u.Setup(0, 2000 * kMs);
+  u.Initialize();
+  EXPECT_EQ(Real(u, "x"), x0);
+  double recurrence = x0;
+  const double factor = std::exp(-k * cosim::NsToSeconds(h));
+  for (int n = 0; n < 200; ++n) {
+    ASSERT_EQ(u.DoStep(n * h, h), StepResult::kOk) << u.last_error();
+    recurrence *= factor;
+    const double t = cosim::NsToSeconds((n + 1) * h);
+    const double exact = x0 * std::exp(-k * t);
+    ASSERT_TRUE(SameBits(Real(u, "x"), recurrence)) << n;
+    ASSERT_NEAR(Real(u, "x"), exact, 1e-13 * exact) << "t = " << t;
+  }
+  EXPECT_NEAR(Real(u, "der_x_"), -k * Real(u, "x"), 1e-15);
+  u.Terminate();
+  // The FMU's log reached the unit.
+  ASSERT_FALSE(u.messages().empty());
+  EXPECT_NE(u.messages()[0].find("instantiated {linesim-test-dahlquist-2}"), std::string::npos)
+      << u.messages()[0];
+}
+
+// With a constant input u: x(t) = u/k + (x0 - u/k) e^{-k t} (the closed form
+// of x' = -k x + u).
+TEST(FmuUnit, DahlquistWithAConstantInput) {
+  FmuUnit u("d", Fmu("dahlquist"));
+  const double k = 0.5, x0 = -1.0, in = 0.3;
+  SetReal(u, "k", k);
+  SetReal(u, "x0", x0);
+  u.Setup(0, 1000 * kMs);
+  u.Initialize();
+  SetReal(u, "u", in);
+  for (int n = 0; n < 100; ++n) ASSERT_EQ(u.DoStep(n * 7 * kMs, 7 * kMs), StepResult::kOk);
+  const double t = 0.7;
+  const double exact = in / k + (x0 - in / k) * std::exp(-k * t);
+  EXPECT_NEAR(Real(u, "x"), exact, 1e-14);
+}
+
+// Save, run, restore, run again: the same bits (the FMU state serialized
+// into the UnitState, canSerializeFMUstate); and the state restores into a
+// second unit of the same FMU, which then continues identically.
+TEST(FmuUnit, SaveAndRestoreContinueBitForBit) {
+  FmuUnit a("d", Fmu("dahlquist"));
+  SetReal(a, "k", 3.0);
+  a.Setup(0, 1000 * kMs);
+  a.Initialize();
+  SetReal(a, "u", 0.25);
+  for (int n = 0; n < 30; ++n) ASSERT_EQ(a.DoStep(n * kMs, kMs), StepResult::kOk);
+  const cosim::UnitState saved = a.SaveState();
+  ASSERT_EQ(saved.strings.size(), 1u);  // the serialized FMU state
+  std::vector<double> first;
+  for (int n = 30; n < 60; ++n) {
+    SetReal(a, "u", 0.01 * n);
+    ASSERT_EQ(a.DoStep(n * kMs, kMs), StepResult::kOk);
+    first.push_back(Real(a, "x"));
+  }
+  a.RestoreState(saved);
+  FmuUnit b("d", Fmu("dahlquist"));
+  b.Setup(0, 1000 * kMs);
+  b.Initialize();
+  b.RestoreState(saved);
+  EXPECT_EQ(Real(b, "k"), 3.0);
+  for (int n = 30; n < 60; ++n) {
+    SetReal(a, "u", 0.01 * n);
+    SetReal(b, "u", 0.01 * n);
+    ASSERT_EQ(a.DoStep(n * kMs, kMs), StepResult::kOk);
+    ASSERT_EQ(b.DoStep(n * kMs, kMs), StepResult::kOk);
+    EXPECT_TRUE(SameBits(Real(a, "x"), first[static_cast<std::size_t>(n - 30)])) << n;
+    EXPECT_TRUE(SameBits(Real(b, "x"), first[static_cast<std::size_t>(n - 30)])) << n;
+  }
+}
+
+// Every FMI 2.0 type through: outputs equal inputs after UpdateOutputs (no
+// step: direct feedthrough) and after a step; the tunable offset changes
+// between steps; units and dependencies as declared.
+TEST(FmuUnit, Fmi2FeedthroughOfEveryType) {
+  FmuUnit u("f", Fmu("feedthrough2"));
+  auto& t = u.variables();
+  EXPECT_EQ(Info(u, "in_a").unit, "rad/s");
+  EXPECT_EQ(Info(u, "in_b").unit, "N.m");  // m2.kg.s-2 in linesim's spelling
+  EXPECT_EQ(Info(u, "in_count").type, VarType::kInteger);
+  EXPECT_EQ(Info(u, "in_flag").type, VarType::kBoolean);
+  EXPECT_EQ(Info(u, "out_text").type, VarType::kString);
+  EXPECT_EQ(Info(u, "offset").variability, cosim::Variability::kTunable);
+  ASSERT_EQ(Info(u, "out_a").depends_on.size(), 1u);
+  EXPECT_EQ(t.info(Info(u, "out_a").depends_on[0]).name, "in_a");
+  EXPECT_EQ(t.GetInteger(*t.Find("in_count")), 3);  // start values
+  EXPECT_EQ(t.GetBoolean(*t.Find("in_flag")), true);
+  EXPECT_EQ(t.GetString(*t.Find("in_text")), "start");
+
+  u.Setup(0, kMs * 100);
+  u.Initialize();
+  EXPECT_EQ(Real(u, "out_a"), 0.5);
+  EXPECT_EQ(t.GetString(*t.Find("out_text")), "start");
+  SetReal(u, "in_a", 1.25);
+  SetReal(u, "in_b", -2.5);
+  t.SetInteger(*t.Find("in_count"), -123456);
+  t.SetBoolean(*t.Find("in_flag"), false);
+  t.SetString(*t.Find("in_text"), "hello FMU");
+  u.UpdateOutputs();
+  EXPECT_EQ(Real(u, "out_a"), 1.25);
+  EXPECT_EQ(Real(u, "out_b"), -2.5);
+  EXPECT_EQ(t.GetInteger(*t.Find("out_count")), -123456);
+  EXPECT_EQ(t.GetBoolean(*t.Find("out_flag")), false);
+  EXPECT_EQ(t.GetString(*t.Find("out_text")), "hello FMU");
+  ASSERT_EQ(u.DoStep(0, kMs), StepResult::kOk);
+  EXPECT_EQ(Real(u, "out_a"), 1.25);
+  SetReal(u, "offset", 0.5);  // tunable: given to the FMU before the next step
+  ASSERT_EQ(u.DoStep(kMs, kMs), StepResult::kOk);
+  EXPECT_EQ(Real(u, "out_a"), 1.75);
+  // An Integer beyond the FMI 2.0 range is named, not wrapped.
+  t.SetInteger(*t.Find("in_count"), std::int64_t{1} << 40);
+  EXPECT_EQ(u.DoStep(2 * kMs, kMs), StepResult::kError);
+  EXPECT_NE(u.last_error().find("outside the FMI 2.0 Integer range"), std::string::npos)
+      << u.last_error();
+}
+
+// The same for FMI 3.0: Float64 (declaredType unit), Int32, Boolean, String.
+TEST(FmuUnit, Fmi3FeedthroughOfEveryType) {
+  FmuUnit u("f", Fmu("feedthrough3"));
+  auto& t = u.variables();
+  EXPECT_EQ(u.description().fmi_major, 3);
+  EXPECT_EQ(Info(u, "speed_in").unit, "m/s");
+  EXPECT_EQ(Info(u, "speed_out").unit, "m/s");
+  EXPECT_EQ(t.GetInteger(*t.Find("count_in")), -7);
+  EXPECT_EQ(t.GetString(*t.Find("text_in")), "start");
+  u.Setup(0, 100 * kMs);
+  u.Initialize();
+  EXPECT_EQ(t.GetInteger(*t.Find("count_out")), -7);
+  SetReal(u, "speed_in", -0.125);
+  t.SetInteger(*t.Find("count_in"), 2147483647);
+  t.SetBoolean(*t.Find("flag_in"), true);
+  t.SetString(*t.Find("text_in"), "drei");
+  ASSERT_EQ(u.DoStep(0, kMs), StepResult::kOk) << u.last_error();
+  EXPECT_EQ(Real(u, "speed_out"), -0.125);
+  EXPECT_EQ(t.GetInteger(*t.Find("count_out")), 2147483647);
+  EXPECT_EQ(t.GetBoolean(*t.Find("flag_out")), true);
+  EXPECT_EQ(t.GetString(*t.Find("text_out")), "drei");
+  ASSERT_FALSE(u.messages().empty());
+  EXPECT_NE(u.messages()[0].find("fmi3OK [logEvents] instantiated"), std::string::npos);
+}
+
+// A 2 x 3 Float64 array output and a fixed parameter array (FMI 3.0):
+// y[i][j] = scale p[j] (i + 1) t, row-major, against that formula.
+TEST(FmuUnit, Fmi3ArrayOutput) {
+  FmuUnit u("a", Fmu("array3"));
+  auto& t = u.variables();
+  EXPECT_EQ(Info(u, "y").type, VarType::kRealArray);
+  EXPECT_EQ(Info(u, "y").size, 6u);
+  EXPECT_EQ(Info(u, "y").unit, "m");
+  EXPECT_EQ(Info(u, "p").size, 3u);
+  EXPECT_EQ(t.GetRealElement(*t.Find("p"), 2), 3.0);  // start "1 2 3"
+  const std::vector<double> p = {2.0, -4.0, 0.5};
+  t.SetRealArray(*t.Find("p"), p);
+  u.Setup(0, 1000 * kMs);
+  u.Initialize();
+  SetReal(u, "scale", 0.75);
+  const TimeNs h = 10 * kMs;
+  for (int n = 0; n < 25; ++n) ASSERT_EQ(u.DoStep(n * h, h), StepResult::kOk) << u.last_error();
+  const double time = cosim::NsToSeconds(24 * h) + cosim::NsToSeconds(h);  // as the FMU adds them
+  const auto y = t.GetRealArray(*t.Find("y"));
+  for (int i = 0; i < 2; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      EXPECT_DOUBLE_EQ(y[static_cast<std::size_t>(3 * i + j)], 0.75 * p[static_cast<std::size_t>(j)] * (i + 1) * time)
+          << i << "," << j;
+    }
+  }
+  // y depends directly on scale (ModelStructure): UpdateOutputs follows it.
+  SetReal(u, "scale", 1.5);
+  u.UpdateOutputs();
+  EXPECT_DOUBLE_EQ(t.GetRealElement(*t.Find("y"), 0), 1.5 * 2.0 * time);
+}
+
+// fixedInternalStepSize = 1 ms: a 1.5 ms communication step is refused as
+// such, before the FMU is called.
+TEST(FmuUnit, RefusesAStepSizeTheFmuCannotTake) {
+  FmuUnit u("a", Fmu("array3"));
+  u.Setup(0, 100 * kMs);
+  u.Initialize();
+  EXPECT_EQ(u.DoStep(0, 3 * kMs / 2), StepResult::kError);
+  EXPECT_NE(u.last_error().find("step size refused"), std::string::npos) << u.last_error();
+  EXPECT_NE(u.last_error().find("fixedInternalStepSize 0.001 s"), std::string::npos);
+
+  // canHandleVariableCommunicationStepSize = false: a changed step is refused.
+  FmuUnit d("d", Fmu("discard2"));
+  d.Setup(0, 100 * kMs);
+  d.Initialize();
+  ASSERT_EQ(d.DoStep(0, 10 * kMs), StepResult::kOk);
+  EXPECT_EQ(d.DoStep(10 * kMs, 5 * kMs), StepResult::kError);
+  EXPECT_NE(d.last_error().find("cannot handle a variable communication step size"),
+            std::string::npos)
+      << d.last_error();
+}
+
+// Without canSerializeFMUstate the FMU keeps the state: it restores into the
+// unit that saved it (bit for bit), and into another unit with a named error.
+TEST(FmuUnit, StateKeptByTheFmuRestoresIntoItsOwnUnitOnly) {
+  FmuUnit a("a", Fmu("array3"));
+  a.Setup(0, 1000 * kMs);
+  a.Initialize();
+  for (int n = 0; n < 5; ++n) ASSERT_EQ(a.DoStep(n * kMs, kMs), StepResult::kOk);
+  const auto saved = a.SaveState();
+  EXPECT_TRUE(saved.strings.empty());
+  ASSERT_EQ(a.DoStep(5 * kMs, kMs), StepResult::kOk);
+  const auto y1 = a.variables().GetRealArray(*a.variables().Find("y"));
+  const std::vector<double> after(y1.begin(), y1.end());
+  a.RestoreState(saved);
+  ASSERT_EQ(a.DoStep(5 * kMs, kMs), StepResult::kOk);
+  const auto y2 = a.variables().GetRealArray(*a.variables().Find("y"));
+  EXPECT_EQ(std::memcmp(after.data(), y2.data(), after.size() * sizeof(double)), 0);
+
+  FmuUnit b("a", Fmu("array3"));
+  b.Setup(0, 1000 * kMs);
+  b.Initialize();
+  try {
+    b.RestoreState(saved);
+    FAIL() << "restored a kept state into another unit";
+  } catch (const cosim::UnitError& e) {
+    EXPECT_NE(std::string(e.what()).find("canSerializeFMUstate"), std::string::npos) << e.what();
+  }
+}
+
+// fmi2Discard at a known time: t_discard = 0.35 s with 0.1 s steps, so the
+// step from 0.3 s is discarded; the result names the call, the step and the
+// FMU's own log line. Its state cannot be saved: named.
+TEST(FmuUnit, DiscardBecomesTheStepResultDiscard) {
+  FmuUnit u("d", Fmu("discard2"));
+  SetReal(u, "t_discard", 0.35);
+  u.Setup(0, 1000 * kMs);
+  u.Initialize();
+  const TimeNs h = 100 * kMs;
+  for (int n = 0; n < 3; ++n) {
+    ASSERT_EQ(u.DoStep(n * h, h), StepResult::kOk);
+    EXPECT_EQ(Real(u, "x"), cosim::NsToSeconds(n * h) + cosim::NsToSeconds(h));
+  }
+  EXPECT_EQ(u.DoStep(3 * h, h), StepResult::kDiscard);
+  const std::string& e = u.last_error();
+  EXPECT_NE(e.find("fmi2DoStep returned fmi2Discard"), std::string::npos) << e;
+  EXPECT_NE(e.find("from t = 0.3 s to 0.4 s"), std::string::npos) << e;
+  EXPECT_NE(e.find("last successful time 0.35 s"), std::string::npos) << e;
+  EXPECT_NE(e.find("cannot pass t_discard = 0.35"), std::string::npos) << e;
+  try {
+    (void)u.SaveState();
+    FAIL() << "saved the state of an FMU that cannot";
+  } catch (const cosim::UnitError& ex) {
+    EXPECT_NE(std::string(ex.what()).find("canGetAndSetFMUstate"), std::string::npos);
+  }
+}
+
+// An error status from doStep is named with the call, the step and the
+// FMU's own log line (the Dahlquist FMU refuses h <= 0).
+TEST(FmuUnit, AnErrorStatusIsNamedWithTheFmuLog) {
+  FmuUnit u("d", Fmu("dahlquist"));
+  u.Setup(0, 100 * kMs);
+  u.Initialize();
+  EXPECT_EQ(u.DoStep(0, 0), StepResult::kError);
+  const std::string& e = u.last_error();
+  EXPECT_NE(e.find("fmi2DoStep returned fmi2Error for the step of 0 s at t = 0 s"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("does the FMU refuse this step size?"), std::string::npos) << e;
+  EXPECT_NE(e.find("step size 0 refused: must be > 0"), std::string::npos) << e;
+}
+
+// The unit made without an FMU (`linesim inspect fmu`) says what is missing.
+TEST(FmuUnit, WithoutAnFmuReportsPath) {
+  FmuUnit u("f");
+  EXPECT_EQ(u.variables().size(), 1u);
+  const auto problems = u.CheckParameters();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].variable, "path");
+  EXPECT_THROW(u.Initialize(), cosim::UnitError);
+}
+
+// LinesimUnit: SI spellings, base units, and units with a factor kept as
+// they are (so that they connect only to the same unit).
+TEST(FmuUnits, MapsToLinesimSpellings) {
+  std::map<std::string, FmiUnit> defs;
+  FmiUnit deg;
+  deg.name = "deg";
+  deg.has_base_unit = true;
+  deg.exponents[7] = 1;
+  deg.factor = 0.017453292519943295;
+  defs["deg"] = deg;
+  EXPECT_EQ(LinesimUnit("", defs), "1");
+  EXPECT_EQ(LinesimUnit("m/s", defs), "m/s");
+  EXPECT_EQ(LinesimUnit("m.s-1", defs), "m/s");
+  EXPECT_EQ(LinesimUnit("m/s2", defs), "m/s2");
+  EXPECT_EQ(LinesimUnit("kg.m2/s2", defs), "N.m");
+  EXPECT_EQ(LinesimUnit("J", defs), "J");
+  EXPECT_EQ(LinesimUnit("V.s/rad", defs), "V.s/rad");
+  EXPECT_EQ(LinesimUnit("deg", defs), "deg");
+  EXPECT_EQ(LinesimUnit("furlong", defs), "furlong");
+}
+
+}  // namespace
+}  // namespace linesim::fmu

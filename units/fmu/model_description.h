@@ -1,0 +1,112 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace linesim::fmu {
+
+/// Every refusal of an FMU (its archive, its model description, its binary,
+/// a call that failed), worded for the user: what is wrong and where.
+class FmuError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The variable types linesim maps (FMI 2.0 Real / Integer / Boolean /
+/// String; FMI 3.0 Float64 (also arrays of fixed dimensions) / Int32 /
+/// Boolean / String).
+enum class FmiType { kFloat64, kInt32, kBoolean, kString };
+
+struct FmiVariable {
+  std::string name;
+  std::uint32_t value_reference = 0;
+  FmiType type = FmiType::kFloat64;
+  /// As in the model description: parameter, calculatedParameter,
+  /// structuralParameter, input, output, local, independent.
+  std::string causality = "local";
+  /// constant, fixed, tunable, discrete, continuous.
+  std::string variability = "continuous";
+  std::string description;
+  /// FMI 3.0 arrays: the fixed dimensions (empty for a scalar); `size` is
+  /// their product (1 for a scalar).
+  std::vector<std::size_t> dimensions;
+  std::size_t size = 1;
+  bool has_start = false;
+  std::vector<double> start_reals;  // Float64 (one per element)
+  std::int64_t start_integer = 0;
+  bool start_boolean = false;
+  std::string start_string;
+  /// The unit as the FMU declares it (on the variable or its declared
+  /// type), "" when none; and the unit string linesim compares (SI, in
+  /// linesim's spelling: "m", "rad/s", "N.m", "1"), see LinesimUnit.
+  std::string fmi_unit;
+  std::string unit;
+  /// Outputs: the inputs the output depends on directly (ModelStructure),
+  /// as indices into ModelDescription::variables (FMI 2.0 value references
+  /// are unique per type only); nothing when the FMU does not say (then
+  /// every input is assumed).
+  std::optional<std::vector<std::uint32_t>> dependencies;
+  int line = 0;  // in modelDescription.xml
+};
+
+/// One <Unit> of UnitDefinitions: its SI base-unit exponents (kg, m, s, A,
+/// K, mol, cd, rad), factor and offset (value_SI = factor * value + offset).
+struct FmiUnit {
+  std::string name;
+  bool has_base_unit = false;
+  int exponents[8] = {};
+  double factor = 1.0;
+  double offset = 0.0;
+};
+
+struct ModelDescription {
+  int fmi_major = 0;  // 2 or 3
+  std::string fmi_version;
+  std::string model_name;
+  std::string token;  // FMI 2.0 guid, FMI 3.0 instantiationToken
+  std::string description;
+  std::string generation_tool;
+  std::string generation_date;
+  bool has_co_simulation = false;
+  bool has_model_exchange = false;
+  bool has_scheduled_execution = false;
+  std::string model_identifier;  // of <CoSimulation>
+  bool can_get_and_set_state = false;
+  bool can_serialize_state = false;
+  bool can_handle_variable_step = false;
+  bool can_interpolate_inputs = false;
+  bool can_return_early = false;         // FMI 3.0 mightReturnEarlyFromDoStep
+  bool needs_execution_tool = false;
+  bool only_once_per_process = false;
+  std::optional<double> fixed_internal_step;  // FMI 3.0 fixedInternalStepSize
+  std::optional<double> default_start, default_stop, default_tolerance, default_step;
+  std::vector<FmiVariable> variables;
+  std::map<std::string, FmiUnit> units;
+};
+
+/// Reads and checks a modelDescription.xml: FMI 2.0 or 3.0, with a
+/// co-simulation interface, variables of the mapped types. Throws FmuError
+/// naming `file` and the line of the problem: invalid XML, an FMI version
+/// other than 2.0 or 3.0, model exchange only, clocks, a variable type or
+/// array dimension linesim does not map.
+ModelDescription ParseModelDescription(const std::string& file);
+/// The same from text already read; `file` names it in messages.
+ModelDescription ParseModelDescriptionText(const std::string& text, const std::string& file);
+
+/// The unit linesim compares for a declared FMI unit: "" (no unit) gives
+/// "1" for a Float64; a name whose base units (from UnitDefinitions, or
+/// from the name's own SI symbols) match one of linesim's spellings takes
+/// that spelling ("m.s-1" -> "m/s"); a unit with factor != 1 or offset != 0
+/// (deg, rpm, degC) keeps its own name, so that it connects only to the
+/// same name (linesim converts no units).
+std::string LinesimUnit(const std::string& fmi_unit, const std::map<std::string, FmiUnit>& units);
+
+/// "Float64", "Int32", "Boolean", "String" (FMI 3.0 names).
+const char* ToString(FmiType type);
+
+}  // namespace linesim::fmu
