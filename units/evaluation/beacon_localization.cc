@@ -791,6 +791,8 @@ void BeaconLocalizationUnit::ProcessScan() {
   }
   valid_ = recent >= min_beacons_;
   PublishOutputs();
+  // Lost (nothing associated for valid_scans scans): from geometry again.
+  if (recent == 0) started_ = false;
 }
 
 cosim::StepResult BeaconLocalizationUnit::DoStep(cosim::TimeNs t, cosim::TimeNs) {
