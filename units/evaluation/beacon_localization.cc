@@ -151,6 +151,11 @@ BeaconLocalizationUnit::BeaconLocalizationUnit(std::string name, std::vector<Bea
               "last processed scans (a single scan may miss a beacon to noise; 5: 0.1 s at the "
               "LMS151's 50 Hz)",
               Rule::Range(1, 1000));
+  v.Parameter("uncover_delay", "s", &uncover_delay_,
+              "scans starting earlier than this after `active` rose are not used (ASSUMPTION 1 "
+              "s: paper 2 uncovered the beacons by hand once the robot stood inside; the filter "
+              "assumes a robot that no longer moves)",
+              Rule::NonNegative());
   v.Parameter("heading_hint", "rad", &heading_hint_,
               "decides between hypotheses a symmetric layout fits equally (the van's rectangle: "
               "a pose and its half-turn): the one whose yaw is nearer wins; nothing else",
@@ -243,6 +248,7 @@ void BeaconLocalizationUnit::Initialize() {
   last_scan_time_ = scan_time_;
   was_active_ = false;
   started_ = false;
+  active_since_ns_ = start_;
   x_ = {0.0, 0.0, 0.0};
   p_ = {};
   g_ = {};
@@ -802,18 +808,23 @@ cosim::StepResult BeaconLocalizationUnit::DoStep(cosim::TimeNs t, cosim::TimeNs)
     // Uncovered (again): the robot may have moved meanwhile.
     started_ = false;
     scans_used_ = 0;
+    active_since_ns_ = t;
   }
   was_active_ = active_;
   if (scan_count_ != last_count_) {
     last_count_ = scan_count_;
-    if (active_) ProcessScan();
+    if (active_ && cosim::SecondsToNs(scan_time_) >=
+                       active_since_ns_ + cosim::SecondsToNs(uncover_delay_)) {
+      ProcessScan();
+    }
   }
   if (!active_) valid_ = false;
   return cosim::StepResult::kOk;
 }
 
 void BeaconLocalizationUnit::SaveInternal(cosim::UnitState& state) const {
-  state.integers = {start_, was_active_ ? 1 : 0, started_ ? 1 : 0, scan_index_};
+  state.integers = {start_, was_active_ ? 1 : 0, started_ ? 1 : 0, scan_index_,
+                    active_since_ns_};
   state.integers.insert(state.integers.end(), beacon_last_scan_.begin(), beacon_last_scan_.end());
   state.reals = {last_count_, last_scan_time_};
   state.reals.insert(state.reals.end(), x_.begin(), x_.end());
@@ -822,14 +833,15 @@ void BeaconLocalizationUnit::SaveInternal(cosim::UnitState& state) const {
 }
 
 void BeaconLocalizationUnit::RestoreInternal(const cosim::UnitState& state) {
-  const std::size_t ni = 4 + beacon_last_scan_.size();
+  const std::size_t ni = 5 + beacon_last_scan_.size();
   if (state.integers.size() != ni || state.reals.size() != 17) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
                            " integers, expected 17 and " + std::to_string(ni));
   }
   scan_index_ = state.integers[3];
-  std::copy(state.integers.begin() + 4, state.integers.end(), beacon_last_scan_.begin());
+  active_since_ns_ = state.integers[4];
+  std::copy(state.integers.begin() + 5, state.integers.end(), beacon_last_scan_.begin());
   start_ = state.integers[0];
   was_active_ = state.integers[1] != 0;
   started_ = state.integers[2] != 0;

@@ -23,7 +23,8 @@ namespace linesim::evaluation {
 /// taken level (3-DoF, as laser_localization): a beacon is a circle of its
 /// radius around its axis.
 ///
-/// Per new scan (scan_count changed) while `active`:
+/// Per new scan (scan_count changed) while `active`, from the first scan
+/// that starts uncover_delay after `active` rose:
 ///  1. detection: the beams with a range in [range_min, range_max] as
 ///     points of the laser frame. A beacon candidate is seeded at every
 ///     beam nearest within a beacon's angular half width at its range
@@ -32,10 +33,13 @@ namespace linesim::evaluation {
 ///     range_sigma (+ flank_margin); the run must end on both sides within
 ///     a beacon's full width (a beacon stands free of its background, a
 ///     wall's nearest point does not). Not a segmentation by range jumps:
-///     the van's beacons stand 9 cm before the wall, and the LMS151's
-///     spot (15 mrad + 8 mm, SICK 8012471) makes a mixed pixel between
-///     them, so beacon and wall differ by steps of 4-6 cm, 3 sigma of the
-///     difference of two 12 mm ranges. The run less edge_trim beams at
+///     a jump threshold must exceed 3 sigma of the difference of two 12 mm
+///     ranges (5 cm) plus the up to 2.5 cm a 4 cm cylinder recedes between
+///     beams near its edge at 1 m, while the van's beacons stand 9 cm
+///     before the wall and the LMS151's spot (15 mrad + 8 mm, SICK
+///     8012471) puts a mixed pixel between them: in the simulated scans
+///     the steps from beacon to wall were 1.6-9 cm, and an 8 cm threshold
+///     merged the rear beacons with the wall. The run less edge_trim beams at
 ///     either edge (mixed pixels, grazing returns) is fitted with a circle
 ///     of the known radius: least squares for the centre c on sum
 ///     ((|p_i - c| - R) / range_sigma)^2 plus ((bearing(c) - b_s) /
@@ -178,6 +182,7 @@ class BeaconLocalizationUnit : public cosim::Unit {
   double max_fit_rms_ = 0.03, outlier_sigmas_ = 3.0;
   double pair_tolerance_ = 0.06, match_distance_ = 0.1, gate_ = 13.8;
   double heading_hint_ = 0.0;
+  double uncover_delay_ = 1.0;
   double process_noise_position_ = 0.001, process_noise_yaw_ = 0.001;
   double initial_sigma_position_ = 0.1, initial_sigma_yaw_ = 0.1;
 
@@ -208,6 +213,7 @@ class BeaconLocalizationUnit : public cosim::Unit {
   double last_count_ = 0.0;
   double last_scan_time_ = 0.0;
   bool was_active_ = false;
+  cosim::TimeNs active_since_ns_ = 0;  // the last rising edge of `active`
   bool started_ = false;
   std::array<double, 3> x_{};
   std::array<double, 9> p_{};

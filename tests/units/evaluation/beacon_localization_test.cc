@@ -91,6 +91,7 @@ std::unique_ptr<BeaconLocalizationUnit> Beacons(std::vector<BeaconLocalizationUn
   SetAll(*u, "mount_yaw", 0.0);
   SetAll(*u, "first_beam_angle", -135.0 * kDeg);  // LMS151 (SICK 8012471)
   SetAll(*u, "angular_step", 0.5 * kDeg);
+  SetAll(*u, "uncover_delay", 0.0);  // the robot stands from the start
   return u;
 }
 
@@ -405,6 +406,20 @@ TEST(BeaconLocalization, TrackingWithTwoBeaconsIsNotValid) {
   EXPECT_FALSE(two.valid());
   EXPECT_EQ(two.seen(), 2);
   EXPECT_LT(PositionError(two.pose(), truth), 0.03);
+}
+
+// Guards uncover_delay: scans that start earlier than 0.3 s after `active`
+// rose are not used (15 LMS151 scans of 20 ms), the next ones are.
+TEST(BeaconLocalization, ScansBeforeTheUncoverDelayAreNotUsed) {
+  auto l = Beacons();
+  SetAll(*l, "uncover_delay", 0.3);
+  Rig rig(Van(), 15, {5.9, 0.0, 0.0}, std::move(l));
+  rig.Run(14);
+  EXPECT_EQ(rig.used(), 0);
+  EXPECT_FALSE(rig.valid());
+  rig.Run(3);
+  EXPECT_GE(rig.used(), 1);
+  EXPECT_TRUE(rig.valid());
 }
 
 // Guards Save/Restore: a restored unit continues bit for bit.
