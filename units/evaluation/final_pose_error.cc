@@ -25,7 +25,8 @@ FinalPoseErrorUnit::FinalPoseErrorUnit(std::string name)
   v.Parameter("target_yaw", "rad", &target_yaw_, "the work pose in map, yaw", Rule::Required());
   v.Parameter("settle_time", "s", &settle_time_,
               "the pose is taken this long after `done` (ASSUMPTION 2 s: the Husky's stop and "
-              "its suspension's settling, and 100 LMS151 scans for the beacons' filter)",
+              "its suspension's settling; with the beacons uncovered at `done` and their "
+              "uncover_delay of 1 s, 50 LMS151 scans in their filter)",
               Rule::NonNegative());
   v.Parameter("fail_if_unmeasured", &fail_if_unmeasured_,
               "the step reaching the run's stop time fails when the final pose (or the "
@@ -49,6 +50,10 @@ FinalPoseErrorUnit::FinalPoseErrorUnit(std::string name)
            "the beacons' final yaw - target_yaw, wrapped, in degrees (0 until measured)", {});
   v.Output("beacon_self_error_position", "m", &beacon_self_error_position_,
            "distance between the beacons' and the true final position (0 until measured)", {});
+  v.Output("beacon_self_error_x", "m", &beacon_self_error_x_,
+           "the beacons' x - the true x at that time (0 until measured)", {});
+  v.Output("beacon_self_error_y", "m", &beacon_self_error_y_,
+           "the beacons' y - the true y at that time (0 until measured)", {});
   v.Output("beacon_self_error_yaw", "deg", &beacon_self_error_yaw_,
            "the beacons' yaw - the true yaw at that time, wrapped, in degrees (0 until "
            "measured)",
@@ -68,6 +73,7 @@ void FinalPoseErrorUnit::Initialize() {
   error_x_ = error_y_ = error_yaw_ = 0.0;
   beacon_error_x_ = beacon_error_y_ = beacon_error_yaw_ = 0.0;
   beacon_self_error_position_ = beacon_self_error_yaw_ = 0.0;
+  beacon_self_error_x_ = beacon_self_error_y_ = 0.0;
   done_time_ = 0.0;
   measured_ = beacon_measured_ = false;
   seen_done_ = false;
@@ -94,8 +100,9 @@ cosim::StepResult FinalPoseErrorUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) 
     beacon_error_x_ = beacon_position_[0] - target_x_;
     beacon_error_y_ = beacon_position_[1] - target_y_;
     beacon_error_yaw_ = models::WrapAngle(beacon_yaw_ - target_yaw_) * kRadToDeg;
-    beacon_self_error_position_ =
-        std::hypot(beacon_position_[0] - position_[0], beacon_position_[1] - position_[1]);
+    beacon_self_error_x_ = beacon_position_[0] - position_[0];
+    beacon_self_error_y_ = beacon_position_[1] - position_[1];
+    beacon_self_error_position_ = std::hypot(beacon_self_error_x_, beacon_self_error_y_);
     beacon_self_error_yaw_ = models::WrapAngle(beacon_yaw_ - yaw_) * kRadToDeg;
     beacon_measured_ = true;
   }

@@ -58,6 +58,7 @@ class FinalPoseErrorUnit : public cosim::Unit {
   double error_x_ = 0.0, error_y_ = 0.0, error_yaw_ = 0.0;
   double beacon_error_x_ = 0.0, beacon_error_y_ = 0.0, beacon_error_yaw_ = 0.0;
   double beacon_self_error_position_ = 0.0, beacon_self_error_yaw_ = 0.0;
+  double beacon_self_error_x_ = 0.0, beacon_self_error_y_ = 0.0;
   double done_time_ = 0.0;
   bool measured_ = false, beacon_measured_ = false;
   // State.

@@ -74,6 +74,8 @@ TEST(FinalPoseError, SignedErrorsOnceSettled) {
   EXPECT_NEAR(Get(u, "beacon_error_y")[0], -0.001, 1e-12);
   EXPECT_NEAR(Get(u, "beacon_error_yaw")[0], 1.2, 1e-12);
   EXPECT_NEAR(Get(u, "beacon_self_error_position")[0], std::hypot(0.003, 0.003), 1e-12);
+  EXPECT_NEAR(Get(u, "beacon_self_error_x")[0], 0.003, 1e-12);
+  EXPECT_NEAR(Get(u, "beacon_self_error_y")[0], 0.003, 1e-12);
   EXPECT_NEAR(Get(u, "beacon_self_error_yaw")[0], 0.2, 1e-12);
   // Later the robot is pushed: the final pose stays.
   SetArray(u, "position", {6.5, 0.3});
