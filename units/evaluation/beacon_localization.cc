@@ -376,6 +376,9 @@ void BeaconLocalizationUnit::Detect() {
     while (lo > i - limit && foreground(lo - 1)) --lo;
     while (hi < i + limit && foreground(hi + 1)) ++hi;
     if (foreground(lo - 1) || foreground(hi + 1)) continue;
+    // Cut by the field of view's edge (its bearing unknown), or wider than
+    // a beacon (2 w + 1 beams) and a mixed pixel on either side.
+    if (lo == 0 || hi == n - 1 || hi - lo + 1 > 2 * w + 3) continue;
     // The fit: the run less edge_trim beams at either edge (the mixed
     // pixels and grazing returns at the silhouette).
     const int a = lo + static_cast<int>(edge_trim_), b = hi + 1 - static_cast<int>(edge_trim_);

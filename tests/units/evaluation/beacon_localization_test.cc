@@ -380,6 +380,30 @@ TEST(BeaconLocalization, GeometryNeedsNoPrior) {
   }
 }
 
+// Guards against distractors: a stray pole of the beacons' radius (4 cm)
+// at (6.95, 0.2), not in the beacons' map, and a 10 cm pillar at (6.85,
+// -0.3) inside the van. The pole is a candidate but joins no hypothesis
+// (no beacon within 0.1 m of it at the right pose) nor passes the gate; the
+// pillar is wider than a beacon. The pose comes out right.
+TEST(BeaconLocalization, DistractorsAreNotBeacons) {
+  const Pose truth{5.9, 0.0, 0.0};
+  models::Scene scene = Van();
+  scene.obstacles.push_back({"pole", "pillar", models::CylinderSolid(6.95, 0.2, 0.04, 0.8, kFloor)});
+  scene.obstacles.push_back(
+      {"pillar", "pillar", models::CylinderSolid(6.85, -0.3, 0.1, 0.8, kFloor)});
+  Rig rig(scene, 16, truth);
+  rig.Run(1);
+  ASSERT_TRUE(rig.valid());
+  EXPECT_EQ(rig.loc->detection_count(), 5);  // four beacons and the pole
+  EXPECT_EQ(rig.seen(), 4);
+  EXPECT_LT(PositionError(rig.pose(), truth), 0.02);
+  rig.Run(20);
+  ASSERT_TRUE(rig.valid());
+  EXPECT_EQ(rig.seen(), 4);
+  EXPECT_LT(PositionError(rig.pose(), truth), 0.005);
+  EXPECT_LT(std::abs(YawError(rig.pose(), truth)), 0.2 * kDeg);
+}
+
 // Guards `valid`: with two of the four beacons gone from the van (the
 // laser sees two), no pose from geometry (it needs three) and not valid.
 TEST(BeaconLocalization, FewerThanThreeBeaconsIsNotValid) {
