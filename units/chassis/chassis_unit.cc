@@ -56,8 +56,14 @@ bool AllFinite(const dReal* v, int n) {
 struct ChassisUnit::Ode {
   std::unique_ptr<FloorWorld> floor;
   dBodyID body = nullptr;
-  // The body's collision box (obstacles and carried objects only).
+  // The body's collision box and the payload's (obstacles, carried objects
+  // and terrain only; nullptr: none).
   dGeomID body_geom = nullptr;
+  dGeomID payload_geom = nullptr;
+  // base_link's origin relative to the body's origin (the centre of mass of
+  // body box and payload), in the body's frame: -c with c the centre of
+  // mass in base_link.
+  double base_from_com[3] = {0.0, 0.0, 0.0};
   std::vector<dBodyID> wheels;
   // Per wheel: its joint to the body, hinge2 when steered, else hinge.
   std::vector<dJointID> joints;
@@ -83,7 +89,9 @@ struct ChassisUnit::Ode {
     floor->SetBodyGeom(nullptr, 0.0);
     for (dGeomID g : geoms) dGeomDestroy(g);
     if (body_geom) dGeomDestroy(body_geom);
+    if (payload_geom) dGeomDestroy(payload_geom);
     body_geom = nullptr;
+    payload_geom = nullptr;
     geoms.clear();
     wheels.clear();
     joints.clear();
@@ -232,11 +240,17 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
                              "lie along the belt's length, or wait upstream of it)");
     }
   }
-  // The wheels drive on the flat floor only (a later issue adds ramps):
-  // a terrain piece would be driven through, not on.
-  if (!scene_.terrain.empty()) {
-    throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': terrain '" +
-                           scene_.terrain.front().name + "' is not simulated by the chassis yet");
+  for (const auto& piece : scene_.terrain) {
+    if (!surface_ok(piece.surface)) {
+      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': terrain '" + piece.name +
+                             "' has surface " + std::to_string(piece.surface) +
+                             ", not one of its " + std::to_string(scene_.surfaces.size()) +
+                             " surfaces");
+    }
+    if (!(piece.length_m > 0.0 && piece.width_m > 0.0 && piece.thickness_m > 0.0)) {
+      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': terrain '" + piece.name +
+                             "' needs a positive length, width and thickness");
+    }
   }
   if (!(scene_.floor.min_x_m < scene_.floor.max_x_m &&
         scene_.floor.min_y_m < scene_.floor.max_y_m)) {
@@ -283,6 +297,8 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   angular_velocity_.assign(3, 0.0);
   linear_velocity_.assign(2, 0.0);
   body_linear_velocity_.assign(2, 0.0);
+  payload_position_.assign(3, 0.0);
+  payload_size_.assign(3, 0.0);
   wheel_surface_.assign(w, -1.0);
   wheel_surface_velocity_.assign(2 * w, 0.0);
   wheel_contact_.assign(2 * w, 0.0);
@@ -322,6 +338,18 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
               "drive motor rotor inertia seen at the wheel (eta N^2 J_rotor), added once per "
               "drive motor about the axle of its first wheel",
               cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("payload_mass", "kg", &payload_mass_,
+              "mass of a payload fixed rigidly on the body (an arm and its mount), on top of "
+              "mass (default 0: none)",
+              cosim::Rule::NonNegative());
+  v.Parameter("payload_position", "m", &payload_position_,
+              "x, y, z in base_link of the payload's centre of mass (default 0, 0, 0)",
+              cosim::Rule::Finite());
+  v.Parameter("payload_size", "m", &payload_size_,
+              "length, width, height of the payload's box about its centre of mass: its "
+              "inertia (a uniform box) and its collision with obstacles, carried objects and "
+              "terrain (default 0, 0, 0: a point mass that collides with nothing)",
+              cosim::Rule::NonNegative());
   v.Parameter("steer_friction", "N.m.s/rad", &steer_friction_,
               "viscous friction of the steering joint (default 0.01: small against the motor "
               "torques, it only damps a free joint)",
@@ -398,9 +426,9 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   v.Output("body_linear_velocity", "m/s", &body_linear_velocity_,
            "vx, vy of base_link in base_link", {});
   v.Output("position_3d", "m", &position_3d_,
-           "x, y, z in map of base_link's origin: on the floor under the body's centre at rest "
-           "(the body's centre of mass minus com_height along the body's z axis), the point "
-           "sensor mounts refer to",
+           "x, y, z in map of base_link's origin: on the wheels' contact plane under the body "
+           "box's centre (com_height below it along the body's z axis; on a ramp, on the "
+           "ramp), the point sensor mounts refer to",
            {});
   v.Output("orientation", "1", &orientation_,
            "attitude of base_link in map as a unit quaternion w, x, y, z", {});
@@ -410,7 +438,9 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
            "what a gyro on it measures",
            {});
   v.Output("wheel_surface", "1", &wheel_surface_,
-           "surface under each wheel: -1 no contact, 0 floor, k + 1 scene belt k", {});
+           "surface under each wheel (its deepest contact point): -1 no contact, 0 floor, "
+           "k + 1 scene belt k, belt count + 1 + j scene terrain piece j",
+           {});
   v.Output("wheel_surface_velocity", "m/s", &wheel_surface_velocity_,
            "velocity of the surface under each wheel in base_link: vx, vy per wheel (zero on "
            "the floor or without contact)",
@@ -453,6 +483,7 @@ void ChassisUnit::Build() {
   f.SetSurface({mu_of(scene_.floor.surface), contact_stiffness_, contact_damping_, slip_damping_});
   for (const models::Obstacle& obstacle : scene_.obstacles) f.AddObstacle(obstacle.solid);
   for (const models::CarriedObject& obj : scene_.carried) f.AddCarried(obj.solid, obj.belt);
+  for (const models::TerrainPiece& piece : scene_.terrain) f.AddTerrain(piece, mu_of(piece.surface));
 
   // Start with the contacts pressed in by equal shares of the weight, so
   // that the settle has little to do. The suspension starts unloaded (its
@@ -464,15 +495,53 @@ void ChassisUnit::Build() {
   dMatrix3 rot;
   dRFromAxisAndAngle(rot, 0.0, 0.0, 1.0, initial_yaw_);
 
+  // The body: the body box (centre of mass at (0, 0, com_height) in
+  // base_link) and the payload as one rigid body, whose origin ODE wants at
+  // their joint centre of mass c; each part's inertia moved to c by the
+  // parallel-axis theorem (dMassTranslate). Without a payload c is the box
+  // centre and nothing is offset.
   o.body = dBodyCreate(f.world());
   dMass m;
   dMassSetBoxTotal(&m, body_mass, body_length_, body_width_, body_height_);
+  double com[3] = {0.0, 0.0, com_height_};
+  const bool payload = payload_mass_ > 0.0;
+  if (payload) {
+    const double total = body_mass + payload_mass_;
+    for (int d = 0; d < 3; ++d) {
+      const double box_d = d == 2 ? com_height_ : 0.0;
+      com[d] = (body_mass * box_d + payload_mass_ * payload_position_[static_cast<std::size_t>(d)]) /
+               total;
+    }
+    dMassTranslate(&m, -com[0], -com[1], com_height_ - com[2]);
+    dMass mp;
+    const double* size = payload_size_.data();
+    if (size[0] > 0.0 && size[1] > 0.0 && size[2] > 0.0) {
+      dMassSetBoxTotal(&mp, payload_mass_, size[0], size[1], size[2]);
+    } else {
+      dMassSetParameters(&mp, payload_mass_, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    }
+    dMassTranslate(&mp, payload_position_[0] - com[0], payload_position_[1] - com[1],
+                   payload_position_[2] - com[2]);
+    dMassAdd(&m, &mp);
+    // The sum's centre is 0 up to rounding; ODE requires it exactly there.
+    for (int d = 0; d < 3; ++d) m.c[d] = 0.0;
+  }
+  for (int d = 0; d < 3; ++d) o.base_from_com[d] = -com[d];
   dBodySetMass(o.body, &m);
-  dBodySetPosition(o.body, initial_x_, initial_y_, com_height_ - drop_m);
+  dBodySetPosition(o.body, initial_x_ + c * com[0] - s * com[1],
+                   initial_y_ + s * com[0] + c * com[1], com[2] - drop_m);
   dBodySetRotation(o.body, rot);
   o.body_geom = dCreateBox(nullptr, body_length_, body_width_, body_height_);
   dGeomSetBody(o.body_geom, o.body);
+  if (payload) dGeomSetOffsetPosition(o.body_geom, -com[0], -com[1], com_height_ - com[2]);
   f.SetBodyGeom(o.body_geom, body_friction_);
+  if (payload && payload_size_[0] > 0.0 && payload_size_[1] > 0.0 && payload_size_[2] > 0.0) {
+    o.payload_geom = dCreateBox(nullptr, payload_size_[0], payload_size_[1], payload_size_[2]);
+    dGeomSetBody(o.payload_geom, o.body);
+    dGeomSetOffsetPosition(o.payload_geom, payload_position_[0] - com[0],
+                           payload_position_[1] - com[1], payload_position_[2] - com[2]);
+    f.AddBodyGeom(o.payload_geom);
+  }
 
   // Wheel inertia: a thin disc of the wheel radius (axial m r^2 / 2,
   // diametral m r^2 / 4) plus the reflected rotor inertias: the steering
@@ -593,6 +662,20 @@ void ChassisUnit::ApplyTorques() {
 
 void ChassisUnit::Settle() {
   FloorWorld& f = *ode_->floor;
+  // Built on the floor plane: a wheel deep in a terrain piece would be
+  // thrown out of it.
+  f.Probe();
+  for (int k = 0; k < wheel_count_; ++k) {
+    const GeomContact& gc = f.contact(k);
+    if (gc.surface > belt_count_ && gc.depth_m > kMaxStartDepthM) {
+      const auto& piece = scene_.terrain[static_cast<std::size_t>(gc.surface - belt_count_ - 1)];
+      throw cosim::UnitError(Where() + ": at the initial pose, wheel " + std::to_string(k) +
+                             " is " + cosim::FormatValue(gc.depth_m) +
+                             " m deep in terrain piece '" + piece.name +
+                             "' (the robot starts on the floor plane: start it clear of the "
+                             "terrain)");
+    }
+  }
   for (int k = 0; k < f.belt_count(); ++k) f.SetBeltVelocity(k, 0.0, 0.0);
   SetSuspension(kSettleStepS);
   SetJointMotors(true, kSettleHoldTorqueNm);
@@ -605,8 +688,11 @@ void ChassisUnit::Settle() {
   }
   // Move every body rigidly so that base_link is exactly at the initial
   // pose, and stop everything.
-  const dReal* p0 = dBodyGetPosition(ode_->body);
-  const double bx = p0[0], by = p0[1];
+  // base_link's origin: the body's origin plus base_from_com in its frame.
+  double origin[3];
+  dBodyGetRelPointPos(ode_->body, ode_->base_from_com[0], ode_->base_from_com[1],
+                      ode_->base_from_com[2], origin);
+  const double bx = origin[0], by = origin[1];
   const double turn = initial_yaw_ - Yaw(dBodyGetRotation(ode_->body));
   const double c = std::cos(turn), s = std::sin(turn);
   dQuaternion q_turn;
@@ -723,27 +809,31 @@ void ChassisUnit::ComputeOutputs() {
   const dReal* wb = dBodyGetAngularVel(o.body);
   const double yaw = Yaw(rb);
   const double c = std::cos(yaw), s = std::sin(yaw);
-  position_[0] = pb[0];
-  position_[1] = pb[1];
   yaw_ = models::WrapAngle(yaw);
-  linear_velocity_[0] = vb[0];
-  linear_velocity_[1] = vb[1];
   yaw_rate_ = wb[2];
-  body_linear_velocity_[0] = c * vb[0] + s * vb[1];
-  body_linear_velocity_[1] = -s * vb[0] + c * vb[1];
 
   double ex[3], ey[3], ez[3], axle[3];
   Column(rb, 0, ex);
   Column(rb, 1, ey);
   Column(rb, 2, ez);
-  // base_link's origin: com_height below the body's centre along its z axis;
-  // its velocity v + w x (-com_height ez).
+  // base_link's origin: the body's origin (the centre of mass) plus
+  // r = R base_from_com (without a payload -com_height ez); its velocity
+  // v + w x r.
   const dReal* q = dBodyGetQuaternion(o.body);
-  for (int i = 0; i < 3; ++i) position_3d_[i] = pb[i] - com_height_ * ez[i];
+  const double* bc = o.base_from_com;
+  double r[3];
+  for (int i = 0; i < 3; ++i) r[i] = bc[0] * ex[i] + bc[1] * ey[i] + bc[2] * ez[i];
+  for (int i = 0; i < 3; ++i) position_3d_[i] = pb[i] + r[i];
   for (int i = 0; i < 4; ++i) orientation_[i] = q[i];
-  const double wxez[3] = {wb[1] * ez[2] - wb[2] * ez[1], wb[2] * ez[0] - wb[0] * ez[2],
-                          wb[0] * ez[1] - wb[1] * ez[0]};
-  for (int i = 0; i < 3; ++i) velocity_3d_[i] = vb[i] - com_height_ * wxez[i];
+  const double wxr[3] = {wb[1] * r[2] - wb[2] * r[1], wb[2] * r[0] - wb[0] * r[2],
+                         wb[0] * r[1] - wb[1] * r[0]};
+  for (int i = 0; i < 3; ++i) velocity_3d_[i] = vb[i] + wxr[i];
+  position_[0] = position_3d_[0];
+  position_[1] = position_3d_[1];
+  linear_velocity_[0] = velocity_3d_[0];
+  linear_velocity_[1] = velocity_3d_[1];
+  body_linear_velocity_[0] = c * velocity_3d_[0] + s * velocity_3d_[1];
+  body_linear_velocity_[1] = -s * velocity_3d_[0] + c * velocity_3d_[1];
   angular_velocity_[0] = Dot(ex, wb);
   angular_velocity_[1] = Dot(ey, wb);
   angular_velocity_[2] = Dot(ez, wb);

@@ -683,11 +683,18 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   // put on the line.
   bad.carried[0].solid.x_m = -6.0;
   EXPECT_EQ(scene_problem(bad), "");
-  // Terrain is not simulated yet: refused, naming the piece.
+  // A terrain piece without a size, or on a surface the scene lacks:
+  // refused, naming the piece.
   bad = models::OpenFloor();
   bad.terrain.push_back({});
   bad.terrain.back().name = "ramp";
-  EXPECT_NE(scene_problem(bad).find("terrain 'ramp' is not simulated by the chassis yet"),
+  EXPECT_NE(scene_problem(bad).find("terrain 'ramp' needs a positive length, width and thickness"),
+            std::string::npos)
+      << scene_problem(bad);
+  bad.terrain.back().length_m = bad.terrain.back().width_m = bad.terrain.back().thickness_m = 1.0;
+  EXPECT_EQ(scene_problem(bad), "");
+  bad.terrain.back().surface = 1;
+  EXPECT_NE(scene_problem(bad).find("terrain 'ramp' has surface 1, not one of its 1 surfaces"),
             std::string::npos)
       << scene_problem(bad);
   // A floor with no area: every wheel would be off it.
@@ -866,6 +873,9 @@ std::vector<Expected> Parameters(std::size_t wheels) {
           {"wheel_y", C::kParameter, "m", wheels},
           {"steer_rotor_inertia", C::kParameter, "kg.m2", 0},
           {"drive_rotor_inertia", C::kParameter, "kg.m2", 0},
+          {"payload_mass", C::kParameter, "kg", 0},
+          {"payload_position", C::kParameter, "m", 3},
+          {"payload_size", C::kParameter, "m", 3},
           {"steer_friction", C::kParameter, "N.m.s/rad", 0},
           {"drive_friction", C::kParameter, "N.m.s/rad", 0},
           {"body_friction", C::kParameter, "1", 0},
