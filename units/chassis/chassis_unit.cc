@@ -64,6 +64,9 @@ struct ChassisUnit::Ode {
   // body box and payload), in the body's frame: -c with c the centre of
   // mass in base_link.
   double base_from_com[3] = {0.0, 0.0, 0.0};
+  // Slope (dz/dx, dz/dy in map) of the ground plane PlaceOnTerrain put the
+  // robot on; 0 on the floor.
+  double ground_slope[2] = {0.0, 0.0};
   std::vector<dBodyID> wheels;
   // Per wheel: its joint to the body, hinge2 when steered, else hinge.
   std::vector<dJointID> joints;
@@ -100,6 +103,7 @@ struct ChassisUnit::Ode {
     body = nullptr;
     floor.reset();
     suspension_h_s = 0.0;
+    ground_slope[0] = ground_slope[1] = 0.0;
     motor_fmax_nm = std::numeric_limits<double>::quiet_NaN();
   }
 
@@ -604,6 +608,112 @@ void ChassisUnit::Build() {
   }
 }
 
+void ChassisUnit::PlaceOnTerrain() {
+  Ode& o = *ode_;
+  const FloorWorld& f = *o.floor;
+  if (f.terrain_count() == 0) return;
+  // The ground under each wheel's contact point at the initial pose: the
+  // highest terrain top face there, else the floor.
+  const auto n = static_cast<std::size_t>(wheel_count_);
+  const double c = std::cos(initial_yaw_), s = std::sin(initial_yaw_);
+  std::vector<double> h(n);
+  bool raised = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double x = initial_x_ + c * wheel_x_[k] - s * wheel_y_[k];
+    const double y = initial_y_ + s * wheel_x_[k] + c * wheel_y_[k];
+    h[k] = std::max(0.0, f.TerrainTopAt(x, y));
+    raised = raised || h[k] > 0.0;
+  }
+  if (!raised) return;
+  // The plane z = a + b x + c y (base_link x, y) through those heights, by
+  // least squares (exact for wheels on one plane); a level lift by the
+  // highest one when the wheels do not span a plane.
+  double a = *std::max_element(h.begin(), h.end()), b = 0.0, cy = 0.0;
+  if (n >= 3) {
+    double m[3][4] = {};
+    for (std::size_t k = 0; k < n; ++k) {
+      const double row[3] = {1.0, wheel_x_[k], wheel_y_[k]};
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) m[i][j] += row[i] * row[j];
+        m[i][3] += row[i] * h[k];
+      }
+    }
+    // Gauss-Jordan with partial pivoting on the 3 x 3 normal equations.
+    bool ok = true;
+    for (int col = 0; col < 3 && ok; ++col) {
+      int piv = col;
+      for (int i = col + 1; i < 3; ++i) {
+        if (std::abs(m[i][col]) > std::abs(m[piv][col])) piv = i;
+      }
+      if (std::abs(m[piv][col]) < 1e-9) {
+        ok = false;
+        break;
+      }
+      for (int j = 0; j < 4; ++j) std::swap(m[col][j], m[piv][j]);
+      for (int i = 0; i < 3; ++i) {
+        if (i == col) continue;
+        const double ratio = m[i][col] / m[col][col];
+        for (int j = 0; j < 4; ++j) m[i][j] -= ratio * m[col][j];
+      }
+    }
+    if (ok) {
+      a = m[0][3] / m[0][0];
+      b = m[1][3] / m[1][1];
+      cy = m[2][3] / m[2][2];
+    }
+  }
+  // The tilt in the heading frame (x forward, y left): x' along (1, 0, b),
+  // y' (0, 1, cy) made orthogonal to it, z' = x' x y'; in map
+  // T = Rz(yaw) [x' y' z'] Rz(-yaw). Every body moves rigidly about the
+  // initial base_link origin and up by a; the joints keep their anchors in
+  // the bodies' frames.
+  double ex[3] = {1.0, 0.0, b};
+  const double lx = std::sqrt(1.0 + b * b);
+  for (double& e : ex) e /= lx;
+  double ey[3] = {0.0, 1.0, cy};
+  const double dot = ey[1] * ex[1] + ey[2] * ex[2];
+  for (int i = 0; i < 3; ++i) ey[i] -= dot * ex[i];
+  const double ly = std::sqrt(ey[0] * ey[0] + ey[1] * ey[1] + ey[2] * ey[2]);
+  for (double& e : ey) e /= ly;
+  const double ez[3] = {ex[1] * ey[2] - ex[2] * ey[1], ex[2] * ey[0] - ex[0] * ey[2],
+                        ex[0] * ey[1] - ex[1] * ey[0]};
+  // Heading-frame tilt matrix (columns ex, ey, ez), then conjugated by yaw.
+  const double th[3][3] = {{ex[0], ey[0], ez[0]}, {ex[1], ey[1], ez[1]}, {ex[2], ey[2], ez[2]}};
+  const double rz[3][3] = {{c, -s, 0.0}, {s, c, 0.0}, {0.0, 0.0, 1.0}};
+  double tmp[3][3] = {}, t[3][3] = {};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      for (int k = 0; k < 3; ++k) tmp[i][j] += rz[i][k] * th[k][j];
+    }
+  }
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      for (int k = 0; k < 3; ++k) t[i][j] += tmp[i][k] * rz[j][k];
+    }
+  }
+  dMatrix3 tr;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) tr[4 * i + j] = t[i][j];
+    tr[4 * i + 3] = 0.0;
+  }
+  dQuaternion qt;
+  dRtoQ(tr, qt);
+  // The ground's gradient in map: (b, cy) turned by the yaw.
+  o.ground_slope[0] = c * b - s * cy;
+  o.ground_slope[1] = s * b + c * cy;
+  for (std::size_t i = 0; i < o.BodyCount(); ++i) {
+    const dBodyID body = o.Body(i);
+    const dReal* p = dBodyGetPosition(body);
+    const double d[3] = {p[0] - initial_x_, p[1] - initial_y_, p[2]};
+    double moved[3];
+    for (int r = 0; r < 3; ++r) moved[r] = t[r][0] * d[0] + t[r][1] * d[1] + t[r][2] * d[2];
+    dBodySetPosition(body, initial_x_ + moved[0], initial_y_ + moved[1], a + moved[2]);
+    dQuaternion q;
+    dQMultiply0(q, qt, dBodyGetQuaternion(body));
+    dBodySetQuaternion(body, q);
+  }
+}
+
 void ChassisUnit::SetSuspension(double h_s) {
   if (h_s == ode_->suspension_h_s) return;
   const auto [erp, cfm] = ErpCfm(h_s, suspension_stiffness_, suspension_damping_);
@@ -693,6 +803,10 @@ void ChassisUnit::Settle() {
   dBodyGetRelPointPos(ode_->body, ode_->base_from_com[0], ode_->base_from_com[1],
                       ode_->base_from_com[2], origin);
   const double bx = origin[0], by = origin[1];
+  // On terrain the ground rises along its slope: moved back to the initial
+  // x, y, the robot moves up or down with it (0 on the floor).
+  const double lift = ode_->ground_slope[0] * (initial_x_ - bx) +
+                      ode_->ground_slope[1] * (initial_y_ - by);
   const double turn = initial_yaw_ - Yaw(dBodyGetRotation(ode_->body));
   const double c = std::cos(turn), s = std::sin(turn);
   dQuaternion q_turn;
@@ -701,7 +815,7 @@ void ChassisUnit::Settle() {
     const dBodyID b = ode_->Body(i);
     const dReal* p = dBodyGetPosition(b);
     const double dx = p[0] - bx, dy = p[1] - by;
-    dBodySetPosition(b, initial_x_ + c * dx - s * dy, initial_y_ + s * dx + c * dy, p[2]);
+    dBodySetPosition(b, initial_x_ + c * dx - s * dy, initial_y_ + s * dx + c * dy, p[2] + lift);
     dQuaternion q;
     dQMultiply0(q, q_turn, dBodyGetQuaternion(b));
     dBodySetQuaternion(b, q);
@@ -728,6 +842,7 @@ void ChassisUnit::Initialize() {
     ThrowIfBadParameters();
     initialized_ = false;
     Build();
+    PlaceOnTerrain();
     Settle();
     settled_parameters_ = std::move(parameters);
     stepped_since_settle_ = false;

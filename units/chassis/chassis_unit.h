@@ -63,8 +63,11 @@ namespace linesim::chassis {
 /// and terrain pieces (rigid tilted boxes the wheels drive on with the
 /// friction of the piece's surface, and the body and payload boxes collide
 /// with; units/chassis/floor_world.h). The robot is built on the floor
-/// plane: Initialize refuses an initial pose whose wheels would start
-/// sunk into a terrain piece (more than kMaxStartDepthM).
+/// plane, or, when a terrain top face lies under a wheel at the initial
+/// pose, tilted and lifted onto the plane through the ground heights under
+/// its wheels (PlaceOnTerrain); Initialize refuses an initial pose whose
+/// wheels would still start sunk into a terrain piece (more than
+/// kMaxStartDepthM: against its side).
 ///
 /// Initialize builds the robot at the initial pose with every wheel
 /// pressed in by its share of the weight, then settles it for 0.3 s with
@@ -132,6 +135,10 @@ class ChassisUnit : public cosim::Unit {
 
   /// Creates a fresh world with the robot at the initial pose (no settle).
   void Build();
+  /// Before settling: when terrain lies under a wheel at the initial pose,
+  /// tilts and lifts the robot (rigidly, about base_link's origin) onto the
+  /// plane through the ground heights under its wheels.
+  void PlaceOnTerrain();
   void Settle();
   /// Suspension ERP/CFM for internal step h_s (only when h_s changes).
   void SetSuspension(double h_s);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -139,6 +140,30 @@ void FloorWorld::AddTerrain(const models::TerrainPiece& t, double mu) {
   terrain_.push_back(piece);
   near_region_ = {1.0, -1.0, 1.0, -1.0, 1.0, -1.0};  // list again
   collided_ = false;
+}
+
+double FloorWorld::TerrainTopAt(double x_m, double y_m) const {
+  double top = -std::numeric_limits<double>::infinity();
+  for (const Terrain& t : terrain_) {
+    const dReal* c = dGeomGetPosition(t.geom);
+    const dReal* r = dGeomGetRotation(t.geom);
+    dVector3 size;
+    dGeomBoxGetLengths(t.geom, size);
+    // The piece's axes (columns of R) and its top face's centre.
+    const double ax[3] = {r[0], r[4], r[8]}, ay[3] = {r[1], r[5], r[9]}, az[3] = {r[2], r[6], r[10]};
+    if (az[2] <= 0.0) continue;  // never for a tilt within +-89 deg
+    const double tc[3] = {c[0] + 0.5 * size[2] * az[0], c[1] + 0.5 * size[2] * az[1],
+                          c[2] + 0.5 * size[2] * az[2]};
+    // The top face's plane above (x, y), and that point in the piece's axes.
+    const double z = tc[2] - (az[0] * (x_m - tc[0]) + az[1] * (y_m - tc[1])) / az[2];
+    const double d[3] = {x_m - tc[0], y_m - tc[1], z - tc[2]};
+    const double along = ax[0] * d[0] + ax[1] * d[1] + ax[2] * d[2];
+    const double across = ay[0] * d[0] + ay[1] * d[1] + ay[2] * d[2];
+    if (std::abs(along) <= 0.5 * size[0] && std::abs(across) <= 0.5 * size[1]) {
+      top = std::max(top, z);
+    }
+  }
+  return top;
 }
 
 std::array<double, 2> CarriedTravelRange(const BeltPatch& b, const models::Solid& solid) {

@@ -202,6 +202,9 @@ class FloorWorld {
   /// size that is not positive.
   void AddTerrain(const models::TerrainPiece& piece, double mu);
   int terrain_count() const { return static_cast<int>(terrain_.size()); }
+  /// Height of the highest terrain top face above map point (x, y) (its
+  /// edges included), or -infinity when no piece's top face is above it.
+  double TerrainTopAt(double x_m, double y_m) const;
   /// Adds an object carried by belt `belt` (0-based, < belt_count()), at
   /// `solid` when the belt has travelled 0 m; it leaves the scene when its
   /// footprint passes an end of the belt (see the class comment). Throws
