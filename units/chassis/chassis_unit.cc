@@ -457,13 +457,24 @@ ChassisUnit::~ChassisUnit() = default;
 
 std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
   // The rules of single parameters are declared with them; here only what
-  // relates several: the wheels weigh less than the whole robot.
+  // relates several: the wheels weigh less than the whole robot, and the
+  // payload's box.
   auto problems = cosim::Unit::CheckParameters();
   if (mass_ > 0.0 && module_mass_ > 0.0 && !(wheel_count_ * module_mass_ < mass_)) {
     problems.push_back({"module_mass", std::nullopt,
                         "times " + std::to_string(wheel_count_) +
                             " wheels must be less than mass " + cosim::FormatValue(mass_) +
                             ", got " + cosim::FormatValue(module_mass_)});
+  }
+  // The payload's box: all three sizes (a box) or none (a point mass).
+  const auto boxed = std::count_if(payload_size_.begin(), payload_size_.end(),
+                                   [](double d) { return d > 0.0; });
+  if (boxed != 0 && boxed != 3) {
+    problems.push_back({"payload_size", std::nullopt,
+                        "give all three sizes (a box) or none (a point mass), got " +
+                            cosim::FormatValue(payload_size_[0]) + ", " +
+                            cosim::FormatValue(payload_size_[1]) + ", " +
+                            cosim::FormatValue(payload_size_[2])});
   }
   return problems;
 }

@@ -563,6 +563,7 @@ TEST(ChassisUnit, CheckParametersRejectsBadValues) {
   Set(u, "substeps", std::int64_t{0});
   u.variables().SetRealElement(*u.variables().Find("wheel_x"), 2, std::nan(""));
   Set(u, "contact_stiffness", -1.0);
+  Set(u, "payload_size", std::vector<double>{0.5, 0.0, 0.3});  // a box needs all three
   const auto problems = u.CheckParameters();
   std::vector<std::string> names;
   for (const auto& p : problems) {
@@ -571,10 +572,12 @@ TEST(ChassisUnit, CheckParametersRejectsBadValues) {
   // The declared rules in declaration order, then the rule between
   // parameters.
   EXPECT_EQ(names, (std::vector<std::string>{"wheel_radius[1]", "wheel_x[2]", "contact_stiffness",
-                                             "substeps", "module_mass"}));
+                                             "substeps", "module_mass", "payload_size"}));
   EXPECT_EQ(problems[2].message, "must be > 0, got -1");
   EXPECT_EQ(problems[3].message, "must be in [1, 1000], got 0");
   EXPECT_EQ(problems[4].message, "times 4 wheels must be less than mass 15, got 5");
+  EXPECT_EQ(problems[5].message,
+            "give all three sizes (a box) or none (a point mass), got 0.5, 0, 0.3");
   try {
     u.Initialize();
     ADD_FAILURE() << "Initialize accepted bad parameters";
