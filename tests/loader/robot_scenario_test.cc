@@ -646,5 +646,20 @@ TEST(RobotScenario, PayloadReachesTheChassis) {
   EXPECT_EQ(Param(bare, "chassis", "payload_mass"), 0.0);
 }
 
+// Guards the van bay's header: one key sets the bump's height (its top is
+// center_m.2 + 0.01, 6 mm above the 0.54 m van floor by default).
+TEST(RobotScenario, VanBayBumpHeightIsOneKey) {
+  const std::string file = WriteScenario("van_entry_bump.yaml", kVanEntry);
+  const Scenario s = LoadScenario(file);
+  ASSERT_EQ(s.scene.terrain.size(), 3u);
+  EXPECT_EQ(s.scene.terrain[2].name, "floor_bump");
+  EXPECT_NEAR(s.scene.terrain[2].center_z_m + 0.5 * s.scene.terrain[2].thickness_m - 0.54, 0.006,
+              1e-12);
+  const Scenario cm = LoadScenario(file, {"scene.terrain.2.center_m.2=0.54"});
+  EXPECT_NEAR(cm.scene.terrain[2].center_z_m + 0.5 * cm.scene.terrain[2].thickness_m - 0.54, 0.01,
+              1e-12);
+  EXPECT_EQ(cm.scene.terrain[2].center_x_m, 5.9);  // the rest of the piece kept
+}
+
 }  // namespace
 }  // namespace linesim::loader

@@ -166,6 +166,39 @@ TEST(Terrain, StartAgainstAPiecesSideIsRefused) {
   }
 }
 
+// Guards the body's collision with terrain (a belly or bumper meeting a
+// piece the wheels pass beside): a Husky driven at 0.3 m/s towards a beam
+// 0.2 m high and 0.3 m wide on its centre line (its wheels, inner faces at
+// |y| = 0.2854 - 0.1143 / 2 = 0.228 m, pass either side) stops with its body
+// box's front face (x + 0.9874 / 2) on the beam's near face (x = 1.2), to
+// the contact springs (the traction, at most mu m g = 490 N, over the
+// face's contact points of 1e6 N/m: below 0.5 mm; 2 mm tolerance).
+TEST(Terrain, BodyStopsAtABeamTheWheelsStraddle) {
+  models::Scene s = Floor(kHuskyMu);
+  models::TerrainPiece beam;
+  beam.name = "beam";
+  beam.length_m = 0.6;
+  beam.width_m = 0.3;
+  beam.thickness_m = 0.2;
+  beam.center_x_m = 1.5;
+  beam.center_z_m = 0.1;
+  s.terrain.push_back(beam);
+  auto robot = Husky(s);
+  ChassisUnit& u = *robot;
+  u.Initialize();
+  SpeedLoop loop;
+  TimeNs t = 0;
+  bool wheel_on_beam = false;
+  for (int i = 0; i < 5000; ++i) {
+    loop.Step(u, 0.3 / kHuskyWheelRadiusM);
+    StepOk(u, t);
+    for (double w : Get(u, "wheel_surface")) wheel_on_beam = wheel_on_beam || w == 1.0;
+  }
+  EXPECT_FALSE(wheel_on_beam);
+  EXPECT_NEAR(Get(u, "position")[0] + 0.5 * kHuskyBodyM[0], 1.2, 2e-3);
+  EXPECT_NEAR(Get(u, "velocity_3d")[0], 0.0, 1e-3);
+}
+
 // The van bay scene as the loader reads it.
 models::Scene VanBay() {
   return loader::LoadSceneFile(
