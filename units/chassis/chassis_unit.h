@@ -33,11 +33,12 @@ namespace linesim::chassis {
 /// body) and the coupling carries its share to the others. Wheels are
 /// spheres of their radius (one contact point each, directly below the
 /// steering axis or axle centre). Each wheel contact takes the surface
-/// velocity and friction of the belt patch under it, else the floor's, with
-/// Coulomb friction while it slides (units/chassis/floor_world.h). The body
-/// box (body_length x body_width x body_height about the centre of mass)
-/// collides with the scene's obstacles and carried objects, never with the
-/// floor. A payload (payload_mass at payload_position in base_link, a box of
+/// velocity and friction of the belt patch under it, else the floor's (or,
+/// on a terrain piece, the piece's surface friction, still), with Coulomb
+/// friction while it slides (units/chassis/floor_world.h). The body box
+/// (body_length x body_width x body_height about the body's centre of mass,
+/// com_height above base_link) collides with the scene's obstacles, carried
+/// objects and terrain pieces, never with the floor. A payload (payload_mass at payload_position in base_link, a box of
 /// payload_size) is part of the body: one rigid body whose origin ODE puts
 /// at the centre of mass of body box and payload (ODE requires it there), with
 /// their combined inertia about it (parallel axes), and the two boxes as

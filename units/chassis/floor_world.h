@@ -86,11 +86,12 @@ struct GeomContact {
 
 /// Owns the dWorld (gravity -z), a joint group for contacts and the static
 /// floor plane z = 0 with belt patches on it. Registered geoms (attached to
-/// bodies of this world) collide with the floor once per step, at its end:
-/// the points serve contact(i) and the next step's contact joints. Every
-/// contact point takes the surface velocity of the first belt patch that
-/// contains it, else of the floor (zero), through ODE's contact surface
-/// motion.
+/// bodies of this world) collide with the floor and the terrain pieces near
+/// them once per step, at its end: the points serve contact(i) and the next
+/// step's contact joints. Every floor contact point takes the surface
+/// velocity of the first belt patch that contains it, else of the floor
+/// (zero), through ODE's contact surface motion; a terrain contact point is
+/// still.
 ///
 /// Sign of the surface motion: a contact joint enforces
 ///   fdir_i . (v_body1 - v_body2) = motion_i   (i = 1, 2; fdir2 = n x fdir1)
