@@ -61,7 +61,10 @@ class Follow : public cosim::Observer {
       if (first_s < 0.0) first_s = cosim::NsToSeconds(t);
       last_s = cosim::NsToSeconds(t);
       for (int m = 4; m < 6; ++m) {
-        peak_a = std::max(peak_a, std::abs(v[m]));
+        if (std::abs(v[m]) > peak_a) {
+          peak_a = std::abs(v[m]);
+          peak_x = v[0];
+        }
         sum_sq += v[m] * v[m];
         ++samples;
       }
@@ -69,7 +72,7 @@ class Follow : public cosim::Observer {
   }
 
   double x = 0.0, y = 0.0, z = 0.0, done_s = -1.0, peak_a = 0.0, sum_sq = 0.0;
-  double first_s = -1.0, last_s = -1.0;
+  double first_s = -1.0, last_s = -1.0, peak_x = 0.0;
   int samples = 0;
 
  private:
@@ -101,9 +104,10 @@ TEST(VanClimbScenario, HuskyWithArmEntersTheVan) {
   const double climb_s = follow.last_s - follow.first_s;
   const double allowed_s = 41.5 * std::log(rms * rms / (rms * rms - nominal_a * nominal_a));
   std::printf("van climb: done at %.2f s, end (%.4f, %.4f, %.5f) m; motor current while "
-              "climbing (%.2f s): RMS %.2f A, peak %.2f A; RMS allowed for %.1f s\n",
+              "climbing (%.2f s): RMS %.2f A, peak %.2f A (at x = %.3f m); RMS allowed for "
+              "%.1f s\n",
               follow.done_s, follow.x, follow.y, follow.z, climb_s, rms, follow.peak_a,
-              allowed_s);
+              follow.peak_x, allowed_s);
   EXPECT_GT(follow.done_s, 0.0);
   EXPECT_NEAR(follow.x, 5.9, 0.05);
   EXPECT_NEAR(follow.y, 0.0, 0.05);
