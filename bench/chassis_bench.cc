@@ -17,6 +17,14 @@
 // Husky A200 (four fixed wheels, two coupled pairs): the same torque
 // pattern on its two drive motors.
 //
+// Terrain cost: the Husky with paper 2's arm payload (a second body geom)
+// on the van bay scene (models/scenes/van_bay.yaml: ramp, van floor slab,
+// bump, the van's walls and beacons), standing inside the van on its floor
+// and the bump (terrain near: every wheel collides with the slab or the bump
+// besides the floor plane, the body boxes test the near pieces' AABBs), and
+// in the hall 8 m from the van (terrain and van far: one AABB test per
+// step), against the same robot on an open floor.
+//
 // Counters: rtf = simulated seconds per second (real-time factor);
 // wheels_on_belt = mean number of wheels on the belt (2 while straddling).
 
@@ -29,6 +37,7 @@
 
 #include "cosim/time.h"
 #include "cosim/unit.h"
+#include "loader/scene_file.h"
 #include "tests/units/chassis/robots.h"
 #include "units/chassis/chassis_unit.h"
 
@@ -153,10 +162,34 @@ void BM_ChassisStep_HuskyFloor(benchmark::State& state) {
   Run(state, *unit, 0.0, 0.0);
 }
 
+models::Scene VanBay() {
+  return linesim::loader::LoadSceneFile(LINESIM_SOURCE_DIR "/models/scenes/van_bay.yaml");
+}
+
+void BM_ChassisStep_HuskyArmFloor(benchmark::State& state) {
+  auto unit = robots::HuskyWithArm(robots::Floor(robots::kHuskyMu));
+  Run(state, *unit, 0.0, 0.0);
+}
+
+void BM_ChassisStep_HuskyArmTerrainFar(benchmark::State& state) {
+  auto unit = robots::HuskyWithArm(VanBay());
+  robots::Set(*unit, "initial_x", -3.0);
+  Run(state, *unit, 0.0, 0.0);
+}
+
+void BM_ChassisStep_HuskyArmTerrainNear(benchmark::State& state) {
+  auto unit = robots::HuskyWithArm(VanBay());
+  robots::Set(*unit, "initial_x", 5.9);
+  Run(state, *unit, 0.0, 0.0);
+}
+
 BENCHMARK(BM_ChassisStep_Floor)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_ChassisStep_StraddlingBelt)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_ChassisStep_FactoryEmpty)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_ChassisStep_FactoryFurnished)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_ChassisStep_HuskyFloor)->Unit(benchmark::kNanosecond);
+BENCHMARK(BM_ChassisStep_HuskyArmFloor)->Unit(benchmark::kNanosecond);
+BENCHMARK(BM_ChassisStep_HuskyArmTerrainFar)->Unit(benchmark::kNanosecond);
+BENCHMARK(BM_ChassisStep_HuskyArmTerrainNear)->Unit(benchmark::kNanosecond);
 
 }  // namespace

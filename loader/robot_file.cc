@@ -36,13 +36,16 @@ class Reader {
     root_ = root;
     r_.CheckKeys(root, "",
                  {"description", "source", "body", "wheels", "motor_groups", "controller",
-                  "chassis", "motors", "path_follower", "sensor_mounts"});
+                  "chassis", "motors", "path_follower", "sensor_mounts", "payload"});
     robot.description = r_.String(root, "", "description", "");
     Body(Child(root, "body"), robot.body);
     MotorGroups(Child(root, "motor_groups"), robot);
     Wheels(Child(root, "wheels"), robot);
     Controller(Child(root, "controller"), out);
     SensorMounts(Child(root, "sensor_mounts"), out);
+    if (const YAML::Node p = Child(root, "payload"); p.IsDefined() && !p.IsNull()) {
+      robot.payload = ReadPayload(r_, p, "payload");
+    }
     out.chassis_settings = Settings(root, "chassis");
     out.motor_settings = Settings(root, "motors");
     out.follower_settings = Settings(root, "path_follower");
@@ -379,6 +382,31 @@ class Reader {
 };
 
 }  // namespace
+
+std::optional<models::PayloadDescription> ReadPayload(YamlReader& r, const YAML::Node& node,
+                                                      const std::string& path) {
+  if (!r.ExpectMap(node, path)) return std::nullopt;
+  r.CheckKeys(node, path, {"mass_kg", "x_m", "y_m", "z_m", "length_m", "width_m", "height_m"});
+  const std::size_t before = r.issues().size();
+  models::PayloadDescription p;
+  p.mass_kg = r.Real(node, path, "mass_kg", std::nullopt, {0.0, 1e4});
+  p.x_m = r.Real(node, path, "x_m", std::nullopt, kPositionM);
+  p.y_m = r.Real(node, path, "y_m", std::nullopt, kPositionM);
+  p.z_m = r.Real(node, path, "z_m", std::nullopt, kPositionM);
+  // The box is optional: without it a point mass.
+  constexpr Range kBoxM{0.0, 10.0};
+  p.length_m = r.Real(node, path, "length_m", 0.0, kBoxM);
+  p.width_m = r.Real(node, path, "width_m", 0.0, kBoxM);
+  p.height_m = r.Real(node, path, "height_m", 0.0, kBoxM);
+  const bool some = p.length_m > 0.0 || p.width_m > 0.0 || p.height_m > 0.0;
+  const bool all = p.length_m > 0.0 && p.width_m > 0.0 && p.height_m > 0.0;
+  if (some && !all) {
+    r.Error(node, path,
+            "length_m, width_m and height_m: give all three (a box) or none (a point mass)");
+  }
+  if (r.issues().size() != before) return std::nullopt;
+  return p;
+}
 
 std::optional<RobotFile> ReadRobotFile(YamlReader& r, const YAML::Node& at,
                                        const std::string& path, const std::string& model,

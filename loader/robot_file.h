@@ -40,6 +40,13 @@ struct RobotFile {
 /// wheel that names an unknown motor, a motor no wheel uses, a topology the
 /// controller kind cannot drive. Problems of the name itself are reported
 /// at `at`/`path`. Nothing when the file cannot be used.
+/// A payload map ({mass_kg, x_m, y_m, z_m (its centre of mass in base_link),
+/// and optionally length_m, width_m, height_m: its box}) at `path`, as a
+/// robot file's `payload` and a robot scenario's `robot.payload` write it;
+/// nothing (problems reported through `r`) when it is not usable.
+std::optional<models::PayloadDescription> ReadPayload(YamlReader& r, const YAML::Node& node,
+                                                      const std::string& path);
+
 std::optional<RobotFile> ReadRobotFile(YamlReader& r, const YAML::Node& at,
                                        const std::string& path, const std::string& model,
                                        const std::string& relative_to);

@@ -126,16 +126,21 @@ YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
     if (Child(root, key).IsDefined()) b.out()[key] = Child(root, key);
   }
 
-  const YAML::Node robot = b.Section(root, "", "robot", {"model", "pose"});
+  const YAML::Node robot = b.Section(root, "", "robot", {"model", "pose", "payload"});
   const YAML::Node pose = b.Section(robot, "robot", "pose", {"x_m", "y_m", "yaw_deg"});
   assembly::StartPose start;
   start.x_m = r.Real(pose, "robot.pose", "x_m", 0.0, {-1e6, 1e6});
   start.y_m = r.Real(pose, "robot.pose", "y_m", 0.0, {-1e6, 1e6});
   start.yaw_rad = r.Real(pose, "robot.pose", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad;
   const std::string model = r.String(robot, "robot", "model", std::nullopt);
-  const std::optional<RobotFile> file =
+  std::optional<RobotFile> file =
       model.empty() ? std::nullopt
                     : ReadRobotFile(r, Child(robot, "model"), "robot.model", model, r.file());
+  // robot.payload replaces the robot file's payload (mass_kg 0: none).
+  if (const YAML::Node p = Child(robot, "payload"); p.IsDefined() && !p.IsNull()) {
+    const auto payload = ReadPayload(r, p, "robot.payload");
+    if (file && payload) file->robot.payload = payload;
+  }
 
   const models::Scene scene = assembly::AddScene(b);
   CheckStartPose(b, scene, start);

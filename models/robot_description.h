@@ -28,6 +28,17 @@ struct BodyDescription {
   double com_height_m = 0.0;
 };
 
+/// A load fixed rigidly on the body (paper 2's Husky carries a UR10 arm on a
+/// mount plate): the chassis adds it to the body's mass and inertia.
+struct PayloadDescription {
+  double mass_kg = 0.0;
+  /// Its centre of mass in base_link.
+  double x_m = 0.0, y_m = 0.0, z_m = 0.0;
+  /// A box about its centre of mass (its inertia, and what it collides with
+  /// in the scene); all 0: a point mass that collides with nothing.
+  double length_m = 0.0, width_m = 0.0, height_m = 0.0;
+};
+
 struct WheelDescription {
   std::string name;
   /// Contact point below the wheel centre (the steering axis of a
@@ -107,6 +118,9 @@ struct RobotDescription {
   std::vector<MotorGroup> motor_groups;
   ControllerKind controller = ControllerKind::kSwerve;
   std::vector<SensorMount> sensor_mounts;
+  /// None unless the robot file's `payload` or the robot scenario's
+  /// `robot.payload` gives one.
+  std::optional<PayloadDescription> payload;
 
   /// Every motor of every group, in group order: the elements of the one
   /// dc_motor unit that simulates them. Each entry: group index, motor name.

@@ -89,6 +89,19 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
     const auto& group = robot.motor_groups[motors[joints->front()].first];
     c[std::string(joint) + "_rotor_inertia"] = Num(group.Joint().reflected_inertia_kgm2);
   }
+  // A payload on the body (the robot file's, or the scenario's
+  // robot.payload in its place).
+  if (const auto& p = robot.payload; p && p->mass_kg > 0.0) {
+    c["payload_mass"] = Num(p->mass_kg);
+    c["payload_position"] = List({p->x_m, p->y_m, p->z_m});
+    c["payload_size"] = List({p->length_m, p->width_m, p->height_m});
+    const YAML::Node scenario = Child(Child(b.root(), "robot"), "payload");
+    if (scenario.IsDefined()) {
+      b.Derived("units.chassis.parameters.payload_mass", scenario, "robot.payload", "mass_kg");
+      b.Derived("units.chassis.parameters.payload_position", scenario, "robot.payload", "x_m");
+      b.Derived("units.chassis.parameters.payload_size", scenario, "robot.payload", "length_m");
+    }
+  }
   c["initial_x"] = Num(start.x_m);
   c["initial_y"] = Num(start.y_m);
   c["initial_yaw"] = Num(start.yaw_rad);

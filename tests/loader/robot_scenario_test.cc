@@ -596,3 +596,70 @@ TEST(RobotScenario, YawInRadiansConnectsOnlyToRadianInputs) {
 
 }  // namespace
 }  // namespace linesim::loader
+
+namespace linesim::loader {
+namespace {
+
+using testing::Has;
+using testing::Issues;
+using testing::Param;
+using testing::WriteScenario;
+
+// Paper 2's Husky with its UR10 on the van bay scene, the payload given in
+// the scenario (models/robots/husky.yaml has none).
+constexpr const char* kVanEntry = R"(name: van_entry_payload
+duration_s: 1
+master: {algorithm: gauss_seidel, step_s: 0.001}
+robot:
+  model: husky
+  pose: {x_m: -1.5, y_m: -1.0, yaw_deg: 0}
+  payload: {mass_kg: 37.7, x_m: 0.0, y_m: 0.0, z_m: 0.61, length_m: 0.6, width_m: 0.3,
+            height_m: 0.55}
+scene: {model: van_bay}
+task: {type: path, waypoints: [[1.0, 0], [5.9, 0]], speed_mps: 0.3}
+sensors: {default: false}
+)";
+
+// Guards robot.payload: it reaches the chassis's payload parameters (and
+// only there), a --set changes it, a half-given box and unknown keys are
+// refused at robot.payload's keys.
+TEST(RobotScenario, PayloadReachesTheChassis) {
+  const std::string file = WriteScenario("van_entry_payload.yaml", kVanEntry);
+  const Scenario s = LoadScenario(file);
+  EXPECT_EQ(Param(s, "chassis", "payload_mass"), 37.7);
+  EXPECT_EQ(Param(s, "chassis", "payload_position", 2), 0.61);
+  EXPECT_EQ(Param(s, "chassis", "payload_size", 0), 0.6);
+  EXPECT_EQ(Param(s, "chassis", "mass"), 50.0);  // the robot file's, without the payload
+  EXPECT_EQ(s.scene.terrain.size(), 3u);
+  EXPECT_EQ(Param(LoadScenario(file, {"robot.payload.mass_kg=20"}), "chassis", "payload_mass"),
+            20.0);
+  const std::string half = Issues(file, {"robot.payload.height_m=0"});
+  EXPECT_TRUE(Has(half, "robot.payload")) << half;
+  EXPECT_TRUE(Has(half, "give all three")) << half;
+  const std::string unknown = Issues(file, {"robot.payload.mass=1"});
+  EXPECT_TRUE(Has(unknown, "robot.payload.mass")) << unknown;
+  // Without robot.payload the chassis carries none.
+  std::string text = kVanEntry;
+  const auto at = text.find("  payload:");
+  text.erase(at, text.find("scene:") - at);
+  const Scenario bare = LoadScenario(WriteScenario("van_entry_bare.yaml", text));
+  EXPECT_EQ(Param(bare, "chassis", "payload_mass"), 0.0);
+}
+
+// Guards the van bay's header: one key sets the bump's height (its top is
+// center_m.2 + 0.01, 6 mm above the 0.54 m van floor by default).
+TEST(RobotScenario, VanBayBumpHeightIsOneKey) {
+  const std::string file = WriteScenario("van_entry_bump.yaml", kVanEntry);
+  const Scenario s = LoadScenario(file);
+  ASSERT_EQ(s.scene.terrain.size(), 3u);
+  EXPECT_EQ(s.scene.terrain[2].name, "floor_bump");
+  EXPECT_NEAR(s.scene.terrain[2].center_z_m + 0.5 * s.scene.terrain[2].thickness_m - 0.54, 0.006,
+              1e-12);
+  const Scenario cm = LoadScenario(file, {"scene.terrain.2.center_m.2=0.54"});
+  EXPECT_NEAR(cm.scene.terrain[2].center_z_m + 0.5 * cm.scene.terrain[2].thickness_m - 0.54, 0.01,
+              1e-12);
+  EXPECT_EQ(cm.scene.terrain[2].center_x_m, 5.9);  // the rest of the piece kept
+}
+
+}  // namespace
+}  // namespace linesim::loader

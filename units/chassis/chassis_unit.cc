@@ -56,8 +56,17 @@ bool AllFinite(const dReal* v, int n) {
 struct ChassisUnit::Ode {
   std::unique_ptr<FloorWorld> floor;
   dBodyID body = nullptr;
-  // The body's collision box (obstacles and carried objects only).
+  // The body's collision box and the payload's (obstacles, carried objects
+  // and terrain only; nullptr: none).
   dGeomID body_geom = nullptr;
+  dGeomID payload_geom = nullptr;
+  // base_link's origin relative to the body's origin (the centre of mass of
+  // body box and payload), in the body's frame: -c with c the centre of
+  // mass in base_link.
+  double base_from_com[3] = {0.0, 0.0, 0.0};
+  // Slope (dz/dx, dz/dy in map) of the ground plane PlaceOnTerrain put the
+  // robot on; 0 on the floor.
+  double ground_slope[2] = {0.0, 0.0};
   std::vector<dBodyID> wheels;
   // Per wheel: its joint to the body, hinge2 when steered, else hinge.
   std::vector<dJointID> joints;
@@ -83,7 +92,9 @@ struct ChassisUnit::Ode {
     floor->SetBodyGeom(nullptr, 0.0);
     for (dGeomID g : geoms) dGeomDestroy(g);
     if (body_geom) dGeomDestroy(body_geom);
+    if (payload_geom) dGeomDestroy(payload_geom);
     body_geom = nullptr;
+    payload_geom = nullptr;
     geoms.clear();
     wheels.clear();
     joints.clear();
@@ -92,6 +103,7 @@ struct ChassisUnit::Ode {
     body = nullptr;
     floor.reset();
     suspension_h_s = 0.0;
+    ground_slope[0] = ground_slope[1] = 0.0;
     motor_fmax_nm = std::numeric_limits<double>::quiet_NaN();
   }
 
@@ -232,11 +244,17 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
                              "lie along the belt's length, or wait upstream of it)");
     }
   }
-  // The wheels drive on the flat floor only (a later issue adds ramps):
-  // a terrain piece would be driven through, not on.
-  if (!scene_.terrain.empty()) {
-    throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': terrain '" +
-                           scene_.terrain.front().name + "' is not simulated by the chassis yet");
+  for (const auto& piece : scene_.terrain) {
+    if (!surface_ok(piece.surface)) {
+      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': terrain '" + piece.name +
+                             "' has surface " + std::to_string(piece.surface) +
+                             ", not one of its " + std::to_string(scene_.surfaces.size()) +
+                             " surfaces");
+    }
+    if (!(piece.length_m > 0.0 && piece.width_m > 0.0 && piece.thickness_m > 0.0)) {
+      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': terrain '" + piece.name +
+                             "' needs a positive length, width and thickness");
+    }
   }
   if (!(scene_.floor.min_x_m < scene_.floor.max_x_m &&
         scene_.floor.min_y_m < scene_.floor.max_y_m)) {
@@ -283,6 +301,8 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   angular_velocity_.assign(3, 0.0);
   linear_velocity_.assign(2, 0.0);
   body_linear_velocity_.assign(2, 0.0);
+  payload_position_.assign(3, 0.0);
+  payload_size_.assign(3, 0.0);
   wheel_surface_.assign(w, -1.0);
   wheel_surface_velocity_.assign(2 * w, 0.0);
   wheel_contact_.assign(2 * w, 0.0);
@@ -322,6 +342,18 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
               "drive motor rotor inertia seen at the wheel (eta N^2 J_rotor), added once per "
               "drive motor about the axle of its first wheel",
               cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("payload_mass", "kg", &payload_mass_,
+              "mass of a payload fixed rigidly on the body (an arm and its mount), on top of "
+              "mass (default 0: none)",
+              cosim::Rule::NonNegative());
+  v.Parameter("payload_position", "m", &payload_position_,
+              "x, y, z in base_link of the payload's centre of mass (default 0, 0, 0)",
+              cosim::Rule::Finite());
+  v.Parameter("payload_size", "m", &payload_size_,
+              "length, width, height of the payload's box about its centre of mass: its "
+              "inertia (a uniform box) and its collision with obstacles, carried objects and "
+              "terrain (default 0, 0, 0: a point mass that collides with nothing)",
+              cosim::Rule::NonNegative());
   v.Parameter("steer_friction", "N.m.s/rad", &steer_friction_,
               "viscous friction of the steering joint (default 0.01: small against the motor "
               "torques, it only damps a free joint)",
@@ -398,9 +430,9 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   v.Output("body_linear_velocity", "m/s", &body_linear_velocity_,
            "vx, vy of base_link in base_link", {});
   v.Output("position_3d", "m", &position_3d_,
-           "x, y, z in map of base_link's origin: on the floor under the body's centre at rest "
-           "(the body's centre of mass minus com_height along the body's z axis), the point "
-           "sensor mounts refer to",
+           "x, y, z in map of base_link's origin: on the wheels' contact plane under the body "
+           "box's centre (com_height below it along the body's z axis; on a ramp, on the "
+           "ramp), the point sensor mounts refer to",
            {});
   v.Output("orientation", "1", &orientation_,
            "attitude of base_link in map as a unit quaternion w, x, y, z", {});
@@ -410,7 +442,9 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
            "what a gyro on it measures",
            {});
   v.Output("wheel_surface", "1", &wheel_surface_,
-           "surface under each wheel: -1 no contact, 0 floor, k + 1 scene belt k", {});
+           "surface under each wheel (its deepest contact point): -1 no contact, 0 floor, "
+           "k + 1 scene belt k, belt count + 1 + j scene terrain piece j",
+           {});
   v.Output("wheel_surface_velocity", "m/s", &wheel_surface_velocity_,
            "velocity of the surface under each wheel in base_link: vx, vy per wheel (zero on "
            "the floor or without contact)",
@@ -423,13 +457,24 @@ ChassisUnit::~ChassisUnit() = default;
 
 std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
   // The rules of single parameters are declared with them; here only what
-  // relates several: the wheels weigh less than the whole robot.
+  // relates several: the wheels weigh less than the whole robot, and the
+  // payload's box.
   auto problems = cosim::Unit::CheckParameters();
   if (mass_ > 0.0 && module_mass_ > 0.0 && !(wheel_count_ * module_mass_ < mass_)) {
     problems.push_back({"module_mass", std::nullopt,
                         "times " + std::to_string(wheel_count_) +
                             " wheels must be less than mass " + cosim::FormatValue(mass_) +
                             ", got " + cosim::FormatValue(module_mass_)});
+  }
+  // The payload's box: all three sizes (a box) or none (a point mass).
+  const auto boxed = std::count_if(payload_size_.begin(), payload_size_.end(),
+                                   [](double d) { return d > 0.0; });
+  if (boxed != 0 && boxed != 3) {
+    problems.push_back({"payload_size", std::nullopt,
+                        "give all three sizes (a box) or none (a point mass), got " +
+                            cosim::FormatValue(payload_size_[0]) + ", " +
+                            cosim::FormatValue(payload_size_[1]) + ", " +
+                            cosim::FormatValue(payload_size_[2])});
   }
   return problems;
 }
@@ -453,6 +498,7 @@ void ChassisUnit::Build() {
   f.SetSurface({mu_of(scene_.floor.surface), contact_stiffness_, contact_damping_, slip_damping_});
   for (const models::Obstacle& obstacle : scene_.obstacles) f.AddObstacle(obstacle.solid);
   for (const models::CarriedObject& obj : scene_.carried) f.AddCarried(obj.solid, obj.belt);
+  for (const models::TerrainPiece& piece : scene_.terrain) f.AddTerrain(piece, mu_of(piece.surface));
 
   // Start with the contacts pressed in by equal shares of the weight, so
   // that the settle has little to do. The suspension starts unloaded (its
@@ -464,15 +510,53 @@ void ChassisUnit::Build() {
   dMatrix3 rot;
   dRFromAxisAndAngle(rot, 0.0, 0.0, 1.0, initial_yaw_);
 
+  // The body: the body box (centre of mass at (0, 0, com_height) in
+  // base_link) and the payload as one rigid body, whose origin ODE wants at
+  // their joint centre of mass c; each part's inertia moved to c by the
+  // parallel-axis theorem (dMassTranslate). Without a payload c is the box
+  // centre and nothing is offset.
   o.body = dBodyCreate(f.world());
   dMass m;
   dMassSetBoxTotal(&m, body_mass, body_length_, body_width_, body_height_);
+  double com[3] = {0.0, 0.0, com_height_};
+  const bool payload = payload_mass_ > 0.0;
+  if (payload) {
+    const double total = body_mass + payload_mass_;
+    for (int d = 0; d < 3; ++d) {
+      const double box_d = d == 2 ? com_height_ : 0.0;
+      com[d] = (body_mass * box_d + payload_mass_ * payload_position_[static_cast<std::size_t>(d)]) /
+               total;
+    }
+    dMassTranslate(&m, -com[0], -com[1], com_height_ - com[2]);
+    dMass mp;
+    const double* size = payload_size_.data();
+    if (size[0] > 0.0 && size[1] > 0.0 && size[2] > 0.0) {
+      dMassSetBoxTotal(&mp, payload_mass_, size[0], size[1], size[2]);
+    } else {
+      dMassSetParameters(&mp, payload_mass_, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    }
+    dMassTranslate(&mp, payload_position_[0] - com[0], payload_position_[1] - com[1],
+                   payload_position_[2] - com[2]);
+    dMassAdd(&m, &mp);
+    // The sum's centre is 0 up to rounding; ODE requires it exactly there.
+    for (int d = 0; d < 3; ++d) m.c[d] = 0.0;
+  }
+  for (int d = 0; d < 3; ++d) o.base_from_com[d] = -com[d];
   dBodySetMass(o.body, &m);
-  dBodySetPosition(o.body, initial_x_, initial_y_, com_height_ - drop_m);
+  dBodySetPosition(o.body, initial_x_ + c * com[0] - s * com[1],
+                   initial_y_ + s * com[0] + c * com[1], com[2] - drop_m);
   dBodySetRotation(o.body, rot);
   o.body_geom = dCreateBox(nullptr, body_length_, body_width_, body_height_);
   dGeomSetBody(o.body_geom, o.body);
+  if (payload) dGeomSetOffsetPosition(o.body_geom, -com[0], -com[1], com_height_ - com[2]);
   f.SetBodyGeom(o.body_geom, body_friction_);
+  if (payload && payload_size_[0] > 0.0 && payload_size_[1] > 0.0 && payload_size_[2] > 0.0) {
+    o.payload_geom = dCreateBox(nullptr, payload_size_[0], payload_size_[1], payload_size_[2]);
+    dGeomSetBody(o.payload_geom, o.body);
+    dGeomSetOffsetPosition(o.payload_geom, payload_position_[0] - com[0],
+                           payload_position_[1] - com[1], payload_position_[2] - com[2]);
+    f.AddBodyGeom(o.payload_geom);
+  }
 
   // Wheel inertia: a thin disc of the wheel radius (axial m r^2 / 2,
   // diametral m r^2 / 4) plus the reflected rotor inertias: the steering
@@ -535,6 +619,112 @@ void ChassisUnit::Build() {
   }
 }
 
+void ChassisUnit::PlaceOnTerrain() {
+  Ode& o = *ode_;
+  const FloorWorld& f = *o.floor;
+  if (f.terrain_count() == 0) return;
+  // The ground under each wheel's contact point at the initial pose: the
+  // highest terrain top face there, else the floor.
+  const auto n = static_cast<std::size_t>(wheel_count_);
+  const double c = std::cos(initial_yaw_), s = std::sin(initial_yaw_);
+  std::vector<double> h(n);
+  bool raised = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double x = initial_x_ + c * wheel_x_[k] - s * wheel_y_[k];
+    const double y = initial_y_ + s * wheel_x_[k] + c * wheel_y_[k];
+    h[k] = std::max(0.0, f.TerrainTopAt(x, y));
+    raised = raised || h[k] > 0.0;
+  }
+  if (!raised) return;
+  // The plane z = a + b x + c y (base_link x, y) through those heights, by
+  // least squares (exact for wheels on one plane); a level lift by the
+  // highest one when the wheels do not span a plane.
+  double a = *std::max_element(h.begin(), h.end()), b = 0.0, cy = 0.0;
+  if (n >= 3) {
+    double m[3][4] = {};
+    for (std::size_t k = 0; k < n; ++k) {
+      const double row[3] = {1.0, wheel_x_[k], wheel_y_[k]};
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) m[i][j] += row[i] * row[j];
+        m[i][3] += row[i] * h[k];
+      }
+    }
+    // Gauss-Jordan with partial pivoting on the 3 x 3 normal equations.
+    bool ok = true;
+    for (int col = 0; col < 3 && ok; ++col) {
+      int piv = col;
+      for (int i = col + 1; i < 3; ++i) {
+        if (std::abs(m[i][col]) > std::abs(m[piv][col])) piv = i;
+      }
+      if (std::abs(m[piv][col]) < 1e-9) {
+        ok = false;
+        break;
+      }
+      for (int j = 0; j < 4; ++j) std::swap(m[col][j], m[piv][j]);
+      for (int i = 0; i < 3; ++i) {
+        if (i == col) continue;
+        const double ratio = m[i][col] / m[col][col];
+        for (int j = 0; j < 4; ++j) m[i][j] -= ratio * m[col][j];
+      }
+    }
+    if (ok) {
+      a = m[0][3] / m[0][0];
+      b = m[1][3] / m[1][1];
+      cy = m[2][3] / m[2][2];
+    }
+  }
+  // The tilt in the heading frame (x forward, y left): x' along (1, 0, b),
+  // y' (0, 1, cy) made orthogonal to it, z' = x' x y'; in map
+  // T = Rz(yaw) [x' y' z'] Rz(-yaw). Every body moves rigidly about the
+  // initial base_link origin and up by a; the joints keep their anchors in
+  // the bodies' frames.
+  double ex[3] = {1.0, 0.0, b};
+  const double lx = std::sqrt(1.0 + b * b);
+  for (double& e : ex) e /= lx;
+  double ey[3] = {0.0, 1.0, cy};
+  const double dot = ey[1] * ex[1] + ey[2] * ex[2];
+  for (int i = 0; i < 3; ++i) ey[i] -= dot * ex[i];
+  const double ly = std::sqrt(ey[0] * ey[0] + ey[1] * ey[1] + ey[2] * ey[2]);
+  for (double& e : ey) e /= ly;
+  const double ez[3] = {ex[1] * ey[2] - ex[2] * ey[1], ex[2] * ey[0] - ex[0] * ey[2],
+                        ex[0] * ey[1] - ex[1] * ey[0]};
+  // Heading-frame tilt matrix (columns ex, ey, ez), then conjugated by yaw.
+  const double th[3][3] = {{ex[0], ey[0], ez[0]}, {ex[1], ey[1], ez[1]}, {ex[2], ey[2], ez[2]}};
+  const double rz[3][3] = {{c, -s, 0.0}, {s, c, 0.0}, {0.0, 0.0, 1.0}};
+  double tmp[3][3] = {}, t[3][3] = {};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      for (int k = 0; k < 3; ++k) tmp[i][j] += rz[i][k] * th[k][j];
+    }
+  }
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      for (int k = 0; k < 3; ++k) t[i][j] += tmp[i][k] * rz[j][k];
+    }
+  }
+  dMatrix3 tr;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) tr[4 * i + j] = t[i][j];
+    tr[4 * i + 3] = 0.0;
+  }
+  dQuaternion qt;
+  dRtoQ(tr, qt);
+  // The ground's gradient in map: (b, cy) turned by the yaw.
+  o.ground_slope[0] = c * b - s * cy;
+  o.ground_slope[1] = s * b + c * cy;
+  for (std::size_t i = 0; i < o.BodyCount(); ++i) {
+    const dBodyID body = o.Body(i);
+    const dReal* p = dBodyGetPosition(body);
+    const double d[3] = {p[0] - initial_x_, p[1] - initial_y_, p[2]};
+    double moved[3];
+    for (int r = 0; r < 3; ++r) moved[r] = t[r][0] * d[0] + t[r][1] * d[1] + t[r][2] * d[2];
+    dBodySetPosition(body, initial_x_ + moved[0], initial_y_ + moved[1], a + moved[2]);
+    dQuaternion q;
+    dQMultiply0(q, qt, dBodyGetQuaternion(body));
+    dBodySetQuaternion(body, q);
+  }
+}
+
 void ChassisUnit::SetSuspension(double h_s) {
   if (h_s == ode_->suspension_h_s) return;
   const auto [erp, cfm] = ErpCfm(h_s, suspension_stiffness_, suspension_damping_);
@@ -593,6 +783,20 @@ void ChassisUnit::ApplyTorques() {
 
 void ChassisUnit::Settle() {
   FloorWorld& f = *ode_->floor;
+  // Built on the floor plane: a wheel deep in a terrain piece would be
+  // thrown out of it.
+  f.Probe();
+  for (int k = 0; k < wheel_count_; ++k) {
+    const GeomContact& gc = f.contact(k);
+    if (gc.surface > belt_count_ && gc.depth_m > kMaxStartDepthM) {
+      const auto& piece = scene_.terrain[static_cast<std::size_t>(gc.surface - belt_count_ - 1)];
+      throw cosim::UnitError(Where() + ": at the initial pose, wheel " + std::to_string(k) +
+                             " is " + cosim::FormatValue(gc.depth_m) +
+                             " m deep in terrain piece '" + piece.name +
+                             "' (the robot starts on the floor plane: start it clear of the "
+                             "terrain)");
+    }
+  }
   for (int k = 0; k < f.belt_count(); ++k) f.SetBeltVelocity(k, 0.0, 0.0);
   SetSuspension(kSettleStepS);
   SetJointMotors(true, kSettleHoldTorqueNm);
@@ -605,8 +809,15 @@ void ChassisUnit::Settle() {
   }
   // Move every body rigidly so that base_link is exactly at the initial
   // pose, and stop everything.
-  const dReal* p0 = dBodyGetPosition(ode_->body);
-  const double bx = p0[0], by = p0[1];
+  // base_link's origin: the body's origin plus base_from_com in its frame.
+  double origin[3];
+  dBodyGetRelPointPos(ode_->body, ode_->base_from_com[0], ode_->base_from_com[1],
+                      ode_->base_from_com[2], origin);
+  const double bx = origin[0], by = origin[1];
+  // On terrain the ground rises along its slope: moved back to the initial
+  // x, y, the robot moves up or down with it (0 on the floor).
+  const double lift = ode_->ground_slope[0] * (initial_x_ - bx) +
+                      ode_->ground_slope[1] * (initial_y_ - by);
   const double turn = initial_yaw_ - Yaw(dBodyGetRotation(ode_->body));
   const double c = std::cos(turn), s = std::sin(turn);
   dQuaternion q_turn;
@@ -615,7 +826,7 @@ void ChassisUnit::Settle() {
     const dBodyID b = ode_->Body(i);
     const dReal* p = dBodyGetPosition(b);
     const double dx = p[0] - bx, dy = p[1] - by;
-    dBodySetPosition(b, initial_x_ + c * dx - s * dy, initial_y_ + s * dx + c * dy, p[2]);
+    dBodySetPosition(b, initial_x_ + c * dx - s * dy, initial_y_ + s * dx + c * dy, p[2] + lift);
     dQuaternion q;
     dQMultiply0(q, q_turn, dBodyGetQuaternion(b));
     dBodySetQuaternion(b, q);
@@ -642,6 +853,7 @@ void ChassisUnit::Initialize() {
     ThrowIfBadParameters();
     initialized_ = false;
     Build();
+    PlaceOnTerrain();
     Settle();
     settled_parameters_ = std::move(parameters);
     stepped_since_settle_ = false;
@@ -723,27 +935,31 @@ void ChassisUnit::ComputeOutputs() {
   const dReal* wb = dBodyGetAngularVel(o.body);
   const double yaw = Yaw(rb);
   const double c = std::cos(yaw), s = std::sin(yaw);
-  position_[0] = pb[0];
-  position_[1] = pb[1];
   yaw_ = models::WrapAngle(yaw);
-  linear_velocity_[0] = vb[0];
-  linear_velocity_[1] = vb[1];
   yaw_rate_ = wb[2];
-  body_linear_velocity_[0] = c * vb[0] + s * vb[1];
-  body_linear_velocity_[1] = -s * vb[0] + c * vb[1];
 
   double ex[3], ey[3], ez[3], axle[3];
   Column(rb, 0, ex);
   Column(rb, 1, ey);
   Column(rb, 2, ez);
-  // base_link's origin: com_height below the body's centre along its z axis;
-  // its velocity v + w x (-com_height ez).
+  // base_link's origin: the body's origin (the centre of mass) plus
+  // r = R base_from_com (without a payload -com_height ez); its velocity
+  // v + w x r.
   const dReal* q = dBodyGetQuaternion(o.body);
-  for (int i = 0; i < 3; ++i) position_3d_[i] = pb[i] - com_height_ * ez[i];
+  const double* bc = o.base_from_com;
+  double r[3];
+  for (int i = 0; i < 3; ++i) r[i] = bc[0] * ex[i] + bc[1] * ey[i] + bc[2] * ez[i];
+  for (int i = 0; i < 3; ++i) position_3d_[i] = pb[i] + r[i];
   for (int i = 0; i < 4; ++i) orientation_[i] = q[i];
-  const double wxez[3] = {wb[1] * ez[2] - wb[2] * ez[1], wb[2] * ez[0] - wb[0] * ez[2],
-                          wb[0] * ez[1] - wb[1] * ez[0]};
-  for (int i = 0; i < 3; ++i) velocity_3d_[i] = vb[i] - com_height_ * wxez[i];
+  const double wxr[3] = {wb[1] * r[2] - wb[2] * r[1], wb[2] * r[0] - wb[0] * r[2],
+                         wb[0] * r[1] - wb[1] * r[0]};
+  for (int i = 0; i < 3; ++i) velocity_3d_[i] = vb[i] + wxr[i];
+  position_[0] = position_3d_[0];
+  position_[1] = position_3d_[1];
+  linear_velocity_[0] = velocity_3d_[0];
+  linear_velocity_[1] = velocity_3d_[1];
+  body_linear_velocity_[0] = c * velocity_3d_[0] + s * velocity_3d_[1];
+  body_linear_velocity_[1] = -s * velocity_3d_[0] + c * velocity_3d_[1];
   angular_velocity_[0] = Dot(ex, wb);
   angular_velocity_[1] = Dot(ey, wb);
   angular_velocity_[2] = Dot(ez, wb);

@@ -33,26 +33,42 @@ namespace linesim::chassis {
 /// body) and the coupling carries its share to the others. Wheels are
 /// spheres of their radius (one contact point each, directly below the
 /// steering axis or axle centre). Each wheel contact takes the surface
-/// velocity and friction of the belt patch under it, else the floor's, with
-/// Coulomb friction while it slides (units/chassis/floor_world.h). The body
-/// box (body_length x body_width x body_height about the centre of mass)
-/// collides with the scene's obstacles and carried objects, never with the
-/// floor. Input torques act between wheel and body (dBodyAddTorque in equal
+/// velocity and friction of the belt patch under it, else the floor's (or,
+/// on a terrain piece, the piece's surface friction, still), with Coulomb
+/// friction while it slides (units/chassis/floor_world.h). The body box
+/// (body_length x body_width x body_height about the body's centre of mass,
+/// com_height above base_link) collides with the scene's obstacles, carried
+/// objects and terrain pieces, never with the floor. A payload (payload_mass at payload_position in base_link, a box of
+/// payload_size) is part of the body: one rigid body whose origin ODE puts
+/// at the centre of mass of body box and payload (ODE requires it there), with
+/// their combined inertia about it (parallel axes), and the two boxes as
+/// geoms offset from it; no joint, so no constraint rows. Input torques act between wheel and body (dBodyAddTorque in equal
 /// and opposite pairs about the body's vertical and the wheel's axle), with
 /// the viscous joint friction, every internal step; the brake is an ODE
 /// joint motor (target velocity 0, force limit brake_torque) on every
 /// wheel joint axis.
 ///
-/// Frames: map (x, y, z up) and base_link (x forward, y left), whose origin
-/// in x and y is the planform centre of the body, which is also its centre of
-/// mass and the point wheel_x and wheel_y refer to. Wheel heading
+/// Frames: map (x, y, z up) and base_link (x forward, y left, z up from the
+/// wheels' contact plane), whose origin is the planform centre of the body
+/// box on the contact plane (under the body box's centre of mass, which is
+/// com_height above it), the point wheel_x and wheel_y refer to. position,
+/// position_3d, linear_velocity and velocity_3d are of that origin (on a
+/// ramp it lies on the ramp, and a payload moves the centre of mass, not
+/// it). Wheel heading
 /// (steer angle) 0 is base_link +x, positive counter-clockwise seen from
 /// above; fixed wheels head along +x. A positive drive torque or drive rate
 /// rolls the wheel forward along its heading.
 ///
 /// Scene: the flat floor (bounded by its rectangle: a step that ends with a
-/// wheel contact outside it fails), its belts, obstacles and carried
-/// objects; terrain pieces are refused (not simulated yet).
+/// wheel contact outside it fails), its belts, obstacles, carried objects
+/// and terrain pieces (rigid tilted boxes the wheels drive on with the
+/// friction of the piece's surface, and the body and payload boxes collide
+/// with; units/chassis/floor_world.h). The robot is built on the floor
+/// plane, or, when a terrain top face lies under a wheel at the initial
+/// pose, tilted and lifted onto the plane through the ground heights under
+/// its wheels (PlaceOnTerrain); Initialize refuses an initial pose whose
+/// wheels would still start sunk into a terrain piece (more than
+/// kMaxStartDepthM: against its side).
 ///
 /// Initialize builds the robot at the initial pose with every wheel
 /// pressed in by its share of the weight, then settles it for 0.3 s with
@@ -65,6 +81,9 @@ class ChassisUnit : public cosim::Unit {
   static constexpr const char* kTypeName = "chassis";
   /// Most wheels a chassis may have (wheel_count 1 to kMaxWheels).
   static constexpr int kMaxWheels = 64;
+  /// Deepest a wheel may start in a terrain piece (the robot is built on
+  /// the floor plane; a wheel deeper in a piece would be thrown out of it).
+  static constexpr double kMaxStartDepthM = 0.01;
 
   /// Checks a topology (steer_motor and drive_motor per wheel, as in the
   /// class comment): empty when usable, else what is wrong, naming the key.
@@ -77,10 +96,10 @@ class ChassisUnit : public cosim::Unit {
   /// `steer_motor` and `drive_motor` give the topology (one entry per
   /// wheel); `scene` the belts (one belt_velocity and belt_travel input
   /// each), the floor's and the belts' friction, the obstacles and carried
-  /// objects. Throws cosim::UnitError for a bad topology or scene: a scene
-  /// with terrain pieces (not simulated yet: the wheels drive on the flat
-  /// floor only), or a carried object not lying along its belt's length at
-  /// zero travel.
+  /// objects and terrain pieces. Throws cosim::UnitError for a bad
+  /// topology or scene: a surface index out of range, a terrain piece
+  /// without a positive size, or a carried object not lying along its belt's
+  /// length at zero travel.
   ChassisUnit(std::string name, std::vector<int> steer_motor, std::vector<int> drive_motor,
               models::Scene scene);
   ~ChassisUnit() override;
@@ -117,6 +136,10 @@ class ChassisUnit : public cosim::Unit {
 
   /// Creates a fresh world with the robot at the initial pose (no settle).
   void Build();
+  /// Before settling: when terrain lies under a wheel at the initial pose,
+  /// tilts and lifts the robot (rigidly, about base_link's origin) onto the
+  /// plane through the ground heights under its wheels.
+  void PlaceOnTerrain();
   void Settle();
   /// Suspension ERP/CFM for internal step h_s (only when h_s changes).
   void SetSuspension(double h_s);
@@ -154,6 +177,9 @@ class ChassisUnit : public cosim::Unit {
   // Rotor inertias reflected through the gears (eta N^2 J_rotor): robot-specific.
   double steer_rotor_inertia_;
   double drive_rotor_inertia_;
+  // A payload fixed on the body (none by default).
+  double payload_mass_ = 0.0;
+  std::vector<double> payload_position_, payload_size_;
   // Generic values, with the reasons in the parameter descriptions.
   double steer_friction_ = 0.01;
   double drive_friction_ = 0.01;

@@ -1,8 +1,10 @@
 #include "units/chassis/floor_world.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -58,6 +60,7 @@ FloorWorld::~FloorWorld() {
   dJointGroupDestroy(group_);
   dGeomDestroy(floor_);
   for (dGeomID g : obstacles_) dGeomDestroy(g);
+  for (const Terrain& t : terrain_) dGeomDestroy(t.geom);
   for (const Carried& c : carried_) dGeomDestroy(c.geom);
   dWorldDestroy(world_);
   dThreadingFreeImplementation(threading_);
@@ -104,6 +107,63 @@ void FloorWorld::AddObstacle(const models::Solid& solid) {
   dGeomGetAABB(obstacles_.back(), box.data());
   obstacle_aabbs_.push_back(box);
   near_region_ = {1.0, -1.0, 1.0, -1.0, 1.0, -1.0};  // list again
+  collided_ = false;
+}
+
+void FloorWorld::AddTerrain(const models::TerrainPiece& t, double mu) {
+  if (!(t.length_m > 0.0 && t.width_m > 0.0 && t.thickness_m > 0.0)) {
+    throw std::invalid_argument("FloorWorld: terrain piece '" + t.name +
+                                "' needs a positive length, width and thickness");
+  }
+  Terrain piece;
+  piece.mu = mu;
+  piece.geom = dCreateBox(nullptr, t.length_m, t.width_m, t.thickness_m);
+  dGeomSetPosition(piece.geom, t.center_x_m, t.center_y_m, t.center_z_m);
+  // R = Rz(yaw) Ry(-pitch) Rx(roll): + pitch raises the far (+length) end,
+  // as models::TerrainPiece says (and units/sensors/ray_scene.cc draws it);
+  // its columns are the piece's axes in map. ODE's rows hold 4 entries.
+  const double cy = std::cos(t.yaw_rad), sy = std::sin(t.yaw_rad);
+  const double cp = std::cos(-t.pitch_rad), sp = std::sin(-t.pitch_rad);
+  const double cr = std::cos(t.roll_rad), sr = std::sin(t.roll_rad);
+  const double ax[3] = {cy * cp, sy * cp, -sp};
+  const double ay[3] = {cy * sp * sr - sy * cr, sy * sp * sr + cy * cr, cp * sr};
+  const double az[3] = {cy * sp * cr + sy * sr, sy * sp * cr - cy * sr, cp * cr};
+  dMatrix3 rot;
+  for (int r = 0; r < 3; ++r) {
+    rot[4 * r + 0] = ax[r];
+    rot[4 * r + 1] = ay[r];
+    rot[4 * r + 2] = az[r];
+    rot[4 * r + 3] = 0.0;
+  }
+  dGeomSetRotation(piece.geom, rot);
+  dGeomGetAABB(piece.geom, piece.aabb.data());
+  terrain_.push_back(piece);
+  near_region_ = {1.0, -1.0, 1.0, -1.0, 1.0, -1.0};  // list again
+  collided_ = false;
+}
+
+double FloorWorld::TerrainTopAt(double x_m, double y_m) const {
+  double top = -std::numeric_limits<double>::infinity();
+  for (const Terrain& t : terrain_) {
+    const dReal* c = dGeomGetPosition(t.geom);
+    const dReal* r = dGeomGetRotation(t.geom);
+    dVector3 size;
+    dGeomBoxGetLengths(t.geom, size);
+    // The piece's axes (columns of R) and its top face's centre.
+    const double ax[3] = {r[0], r[4], r[8]}, ay[3] = {r[1], r[5], r[9]}, az[3] = {r[2], r[6], r[10]};
+    if (az[2] <= 0.0) continue;  // never for a tilt within +-89 deg
+    const double tc[3] = {c[0] + 0.5 * size[2] * az[0], c[1] + 0.5 * size[2] * az[1],
+                          c[2] + 0.5 * size[2] * az[2]};
+    // The top face's plane above (x, y), and that point in the piece's axes.
+    const double z = tc[2] - (az[0] * (x_m - tc[0]) + az[1] * (y_m - tc[1])) / az[2];
+    const double d[3] = {x_m - tc[0], y_m - tc[1], z - tc[2]};
+    const double along = ax[0] * d[0] + ax[1] * d[1] + ax[2] * d[2];
+    const double across = ay[0] * d[0] + ay[1] * d[1] + ay[2] * d[2];
+    if (std::abs(along) <= 0.5 * size[0] && std::abs(across) <= 0.5 * size[1]) {
+      top = std::max(top, z);
+    }
+  }
+  return top;
 }
 
 std::array<double, 2> CarriedTravelRange(const BeltPatch& b, const models::Solid& solid) {
@@ -141,11 +201,11 @@ double FloorWorld::CarriedSpeed(std::size_t i) const {
   return v[0] * belt_axes_[b][0] + v[1] * belt_axes_[b][1];
 }
 
-void FloorWorld::CollideObject(dGeomID object, const double v[3]) {
+void FloorWorld::CollideObject(dGeomID body_geom, dGeomID object, const double v[3]) {
   // The body geom first, so that the normal points into it (from the object).
   std::array<dContact, kMaxPoints> pts{};
-  const int n = dCollide(body_geom_, object, kMaxPoints, &pts[0].geom, sizeof(dContact));
-  const dBodyID body = dGeomGetBody(body_geom_);
+  const int n = dCollide(body_geom, object, kMaxPoints, &pts[0].geom, sizeof(dContact));
+  const dBodyID body = dGeomGetBody(body_geom);
   for (int j = 0; j < n; ++j) {
     dContact& p = pts[static_cast<std::size_t>(j)];
     const dReal* nrm = p.geom.normal;
@@ -179,42 +239,76 @@ void FloorWorld::CollideObject(dGeomID object, const double v[3]) {
   }
 }
 
+void FloorWorld::UpdateNear() {
+  if (obstacles_.empty() && terrain_.empty()) return;
+  // The AABB of every geom of the robot (wheels and body geoms).
+  Aabb robot = {1.0, -1.0, 1.0, -1.0, 1.0, -1.0};
+  bool any = false;
+  const auto grow = [&](dGeomID g) {
+    Aabb b;
+    dGeomGetAABB(g, b.data());
+    if (!any) {
+      robot = b;
+      any = true;
+      return;
+    }
+    for (int d = 0; d < 3; ++d) {
+      robot[2 * d] = std::min(robot[2 * d], b[2 * d]);
+      robot[2 * d + 1] = std::max(robot[2 * d + 1], b[2 * d + 1]);
+    }
+  };
+  for (dGeomID g : geoms_) grow(g);
+  for (dGeomID g : body_geoms_) grow(g);
+  if (!any) return;
+  const Aabb& r = near_region_;
+  if (r[0] <= robot[0] && robot[1] <= r[1] && r[2] <= robot[2] && robot[3] <= r[3] &&
+      r[4] <= robot[4] && robot[5] <= r[5]) {
+    return;
+  }
+  near_region_ = {robot[0] - kNearMarginM, robot[1] + kNearMarginM, robot[2] - kNearMarginM,
+                  robot[3] + kNearMarginM, robot[4] - kNearMarginM, robot[5] + kNearMarginM};
+  near_obstacles_.clear();
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    if (Overlap(obstacle_aabbs_[i], near_region_)) near_obstacles_.push_back(i);
+  }
+  near_terrain_.clear();
+  for (std::size_t j = 0; j < terrain_.size(); ++j) {
+    if (Overlap(terrain_[j].aabb, near_region_)) near_terrain_.push_back(j);
+  }
+}
+
 void FloorWorld::CollideObjects(double erp, double cfm) {
-  if (body_geom_ == nullptr || (obstacles_.empty() && carried_.empty())) return;
+  if (body_geoms_.empty() ||
+      (near_obstacles_.empty() && near_terrain_.empty() && carried_.empty())) {
+    return;
+  }
   object_erp_ = erp;
   object_cfm_ = cfm;
-  Aabb body;
-  dGeomGetAABB(body_geom_, body.data());
   const double still[3] = {0.0, 0.0, 0.0};
-  if (!obstacles_.empty()) {
-    const Aabb& r = near_region_;
-    if (!(r[0] <= body[0] && body[1] <= r[1] && r[2] <= body[2] && body[3] <= r[3] &&
-          r[4] <= body[4] && body[5] <= r[5])) {
-      near_region_ = {body[0] - kNearMarginM, body[1] + kNearMarginM, body[2] - kNearMarginM,
-                      body[3] + kNearMarginM, body[4] - kNearMarginM, body[5] + kNearMarginM};
-      near_obstacles_.clear();
-      for (std::size_t i = 0; i < obstacles_.size(); ++i) {
-        if (Overlap(obstacle_aabbs_[i], near_region_)) near_obstacles_.push_back(i);
-      }
-    }
+  for (dGeomID body_geom : body_geoms_) {
+    Aabb body;
+    dGeomGetAABB(body_geom, body.data());
     for (std::size_t i : near_obstacles_) {
-      if (Overlap(obstacle_aabbs_[i], body)) CollideObject(obstacles_[i], still);
+      if (Overlap(obstacle_aabbs_[i], body)) CollideObject(body_geom, obstacles_[i], still);
     }
-  }
-  for (std::size_t i = 0; i < carried_.size(); ++i) {
-    const Carried& c = carried_[i];
-    const auto b = static_cast<std::size_t>(c.belt);
-    const double speed = CarriedSpeed(i);
-    const double s = belt_travel_m_[b] + speed * travel_elapsed_s_;
-    // Past an end of its belt: lifted off the line, gone from the scene.
-    if (s < c.travel_min_m || s > c.travel_max_m) continue;
-    const double dx = s * belt_axes_[b][0], dy = s * belt_axes_[b][1];
-    const Aabb moved = {c.aabb0[0] + dx, c.aabb0[1] + dx, c.aabb0[2] + dy,
-                        c.aabb0[3] + dy, c.aabb0[4],      c.aabb0[5]};
-    if (!Overlap(moved, body)) continue;
-    dGeomSetPosition(c.geom, c.x0_m + dx, c.y0_m + dy, c.z_m);
-    const double v[3] = {speed * belt_axes_[b][0], speed * belt_axes_[b][1], 0.0};
-    CollideObject(c.geom, v);
+    for (std::size_t j : near_terrain_) {
+      if (Overlap(terrain_[j].aabb, body)) CollideObject(body_geom, terrain_[j].geom, still);
+    }
+    for (std::size_t i = 0; i < carried_.size(); ++i) {
+      const Carried& c = carried_[i];
+      const auto b = static_cast<std::size_t>(c.belt);
+      const double speed = CarriedSpeed(i);
+      const double s = belt_travel_m_[b] + speed * travel_elapsed_s_;
+      // Past an end of its belt: lifted off the line, gone from the scene.
+      if (s < c.travel_min_m || s > c.travel_max_m) continue;
+      const double dx = s * belt_axes_[b][0], dy = s * belt_axes_[b][1];
+      const Aabb moved = {c.aabb0[0] + dx, c.aabb0[1] + dx, c.aabb0[2] + dy,
+                          c.aabb0[3] + dy, c.aabb0[4],      c.aabb0[5]};
+      if (!Overlap(moved, body)) continue;
+      dGeomSetPosition(c.geom, c.x0_m + dx, c.y0_m + dy, c.z_m);
+      const double v[3] = {speed * belt_axes_[b][0], speed * belt_axes_[b][1], 0.0};
+      CollideObject(body_geom, c.geom, v);
+    }
   }
 }
 
@@ -252,8 +346,13 @@ int FloorWorld::SurfaceAt(double x_m, double y_m) const {
   return 0;
 }
 
+double FloorWorld::SurfaceMu(int s) const {
+  if (s > belt_count()) return terrain_[static_cast<std::size_t>(s - belt_count() - 1)].mu;
+  return s > 0 ? belts_[static_cast<std::size_t>(s - 1)].mu : surface_.mu;
+}
+
 void FloorWorld::SurfaceVelocity(int surface, double* vx_mps, double* vy_mps) const {
-  if (surface <= 0) {
+  if (surface <= 0 || surface > belt_count()) {
     *vx_mps = 0.0;
     *vy_mps = 0.0;
     return;
@@ -266,37 +365,60 @@ void FloorWorld::SurfaceVelocity(int surface, double* vx_mps, double* vy_mps) co
 void FloorWorld::Collide(std::size_t i) {
   const dGeomID geom = geoms_[i];
   Points& pts = points_[i];
-  const int n = dCollide(geom, floor_, kMaxPoints, &pts.contact[0].geom, sizeof(dContact));
-  pts.count = n;
   GeomContact& c = contacts_[i];
+  // Makes the moving geom g1 with the normal pointing into it (from the
+  // static one), whatever order the collider reports, so that the surface
+  // motion sign in MakeJoints holds; notes each point's surface.
+  const auto orient = [&](int from, int to, dGeomID other, int surface) {
+    for (std::size_t j = static_cast<std::size_t>(from); j < static_cast<std::size_t>(to); ++j) {
+      dContactGeom& g = pts.contact[j].geom;
+      if (g.g1 == other) {
+        std::swap(g.g1, g.g2);
+        for (int d = 0; d < 3; ++d) g.normal[d] = -g.normal[d];
+      }
+      pts.surface[j] = surface >= 0 ? surface : SurfaceAt(g.pos[0], g.pos[1]);
+    }
+  };
+  int n = dCollide(geom, floor_, kMaxPoints, &pts.contact[0].geom, sizeof(dContact));
+  orient(0, n, floor_, -1);
+  if (!near_terrain_.empty()) {
+    Aabb box;
+    dGeomGetAABB(geom, box.data());
+    for (std::size_t j : near_terrain_) {
+      const Terrain& t = terrain_[j];
+      if (n >= kMaxPoints || !Overlap(box, t.aabb)) continue;
+      const int m = dCollide(geom, t.geom, kMaxPoints - n,
+                             &pts.contact[static_cast<std::size_t>(n)].geom, sizeof(dContact));
+      orient(n, n + m, t.geom, belt_count() + 1 + static_cast<int>(j));
+      n += m;
+    }
+  }
+  pts.count = n;
   c.points = n;
   if (n == 0) {
     const dReal* p = dGeomGetPosition(geom);
     c.surface = -1;
     c.x_m = p[0];
     c.y_m = p[1];
+    c.depth_m = 0.0;
     return;
   }
   double sx = 0.0, sy = 0.0;
+  std::size_t deepest = 0;
   for (std::size_t j = 0; j < static_cast<std::size_t>(n); ++j) {
-    dContactGeom& g = pts.contact[j].geom;
-    // Make the moving geom g1 with the normal pointing into it (from the
-    // floor), whatever order the collider reports, so that the surface
-    // motion sign below holds.
-    if (g.g1 == floor_) {
-      std::swap(g.g1, g.g2);
-      for (int d = 0; d < 3; ++d) g.normal[d] = -g.normal[d];
-    }
-    pts.surface[j] = SurfaceAt(g.pos[0], g.pos[1]);
+    const dContactGeom& g = pts.contact[j].geom;
     sx += g.pos[0];
     sy += g.pos[1];
+    if (g.depth > pts.contact[deepest].geom.depth) deepest = j;
   }
   c.x_m = sx / n;
   c.y_m = sy / n;
-  c.surface = pts.surface[0];
+  c.surface = pts.surface[deepest];
+  c.depth_m = pts.contact[deepest].geom.depth;
 }
 
 void FloorWorld::Probe() {
+  UpdateNear();
   for (std::size_t i = 0; i < geoms_.size(); ++i) Collide(i);
   collided_ = true;
 }
@@ -340,8 +462,7 @@ void FloorWorld::MakeJoints(std::size_t i, double erp, double cfm) {
     const bool sliding = slip_mps > kSlipAlignMps;
     p.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP | dContactMotion1 |
                      dContactMotion2 | dContactFDir1 | (sliding ? dContactSlip2 : 0);
-    p.surface.mu =
-        pts.surface[j] > 0 ? belts_[static_cast<std::size_t>(pts.surface[j] - 1)].mu : surface_.mu;
+    p.surface.mu = SurfaceMu(pts.surface[j]);
     p.surface.slip2 = 1.0 / surface_.slip_damping_n_s_per_m;
     p.surface.soft_erp = erp;
     p.surface.soft_cfm = cfm;
@@ -352,7 +473,7 @@ void FloorWorld::MakeJoints(std::size_t i, double erp, double cfm) {
     p.surface.bounce_vel = 0.0;
     for (int d = 0; d < 3; ++d) p.fdir1[d] = t1[d];
     const dJointID joint = dJointCreateContact(world_, group_, &p);
-    // body1 = the moving geom's body, body2 = the static floor (0).
+    // body1 = the moving geom's body, body2 = the static floor or piece (0).
     dJointAttach(joint, body, dGeomGetBody(p.geom.g2));
   }
 }

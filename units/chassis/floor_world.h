@@ -74,19 +74,24 @@ struct ContactSurface {
 /// What one geom touched in the last collision pass (the end of the last
 /// Step, or Probe).
 struct GeomContact {
-  int surface = -1;  // -1 none, 0 floor, k + 1 belt k (of the first contact point)
+  // -1 none, 0 floor, k + 1 belt k, belt_count() + 1 + j terrain piece j
+  // (FloorWorld::SurfaceAt's numbering): of the deepest contact point (the
+  // first of equally deep ones).
+  int surface = -1;
   int points = 0;    // contact points found
   double x_m = 0.0;  // mean contact point in map, or the geom position without contact
   double y_m = 0.0;
+  double depth_m = 0.0;  // penetration of the deepest contact point (0 without contact)
 };
 
 /// Owns the dWorld (gravity -z), a joint group for contacts and the static
 /// floor plane z = 0 with belt patches on it. Registered geoms (attached to
-/// bodies of this world) collide with the floor once per step, at its end:
-/// the points serve contact(i) and the next step's contact joints. Every
-/// contact point takes the surface velocity of the first belt patch that
-/// contains it, else of the floor (zero), through ODE's contact surface
-/// motion.
+/// bodies of this world) collide with the floor and the terrain pieces near
+/// them once per step, at its end: the points serve contact(i) and the next
+/// step's contact joints. Every floor contact point takes the surface
+/// velocity of the first belt patch that contains it, else of the floor
+/// (zero), through ODE's contact surface motion; a terrain contact point is
+/// still.
 ///
 /// Sign of the surface motion: a contact joint enforces
 ///   fdir_i . (v_body1 - v_body2) = motion_i   (i = 1, 2; fdir2 = n x fdir1)
@@ -114,13 +119,28 @@ struct GeomContact {
 /// A slower (sticking) contact keeps both rows, fdir1 along the surface
 /// velocity, or map x on the still floor.
 ///
+/// Terrain: rigid tilted boxes (models::TerrainPiece: ramps, a van's load
+/// floor, a bump) that the registered geoms (the wheels) stand on exactly as
+/// on the floor plane: the same contact rows (soft normal, Coulomb friction
+/// with the slip-aligned row while sliding), the friction of the piece's own
+/// surface, no surface motion (a piece does not move). A wheel may touch the
+/// floor and a piece at once (at a ramp's foot), or two pieces (at its top);
+/// each touch is a contact point. The body geoms collide with them as with
+/// the obstacles (a belly scraping a crest). Wheels are spheres: ODE's
+/// sphere-box test returns one point, the box point nearest the sphere's
+/// centre, with the normal from it to the centre, so a wheel rolling over a
+/// box edge turns its normal continuously about the edge (no cylinder-box,
+/// whose edge contacts ODE approximates).
+///
 /// Objects: static obstacles and belt-carried objects are collision
-/// geometry for one registered body geom (the robot's body box; wheels touch
-/// the floor only), collided with it at the start of every step. Objects far
-/// from the robot cost next to nothing: the obstacles near the body (AABBs
-/// within kNearMarginM of its AABB) are listed once and listed again only
-/// when the body's AABB leaves that margin, so a step tests the body's AABB
-/// against one box and the near obstacles only; a carried object is tested
+/// geometry for the registered body geoms (the robot's body box and a
+/// payload's box; wheels touch the floor and the terrain only), collided
+/// with them at the start of every step. Objects far from the robot cost
+/// next to nothing: the obstacles and terrain pieces near the robot (AABBs
+/// within kNearMarginM of the AABB of all its geoms) are listed once and
+/// listed again only when the robot's AABB leaves that margin, so a step
+/// tests one AABB against one box and the near objects only (with no
+/// obstacle and no terrain piece in the scene, not even that); a carried object is tested
 /// by its AABB translated along its belt, and its geom is moved and
 /// collided only when that overlaps the body's. A carried object has no
 /// body: it is placed from its belt's travelled distance and its contacts
@@ -157,15 +177,35 @@ class FloorWorld {
   void ClearGeoms();
 
   /// The geom (attached to a body of this world) that collides with
-  /// obstacles and carried objects, or nullptr; the caller keeps ownership.
+  /// obstacles, carried objects and terrain pieces, or nullptr (none); the
+  /// caller keeps ownership. Replaces every body geom.
   void SetBodyGeom(dGeomID geom, double mu) {
-    body_geom_ = geom;
+    body_geoms_.clear();
+    if (geom != nullptr) body_geoms_.push_back(geom);
     body_mu_ = mu;
+    collided_ = false;
+  }
+  /// One more body geom (a payload's box on the same body), with the same
+  /// friction as SetBodyGeom's.
+  void AddBodyGeom(dGeomID geom) {
+    body_geoms_.push_back(geom);
+    collided_ = false;
   }
   /// Adds a static obstacle (box or vertical cylinder standing on the
   /// floor); FloorWorld owns its geom.
   void AddObstacle(const models::Solid& solid);
   int obstacle_count() const { return static_cast<int>(obstacles_.size()); }
+  /// Adds a terrain piece (a box placed and tilted as models::TerrainPiece
+  /// says: R = Rz(yaw) Ry(-pitch) Rx(roll), + pitch raising its far end)
+  /// whose surface has Coulomb coefficient `mu` against the wheels;
+  /// FloorWorld owns its geom. Surface index belt_count() + 1 + j for the
+  /// j-th piece added (add belts first). Throws std::invalid_argument for a
+  /// size that is not positive.
+  void AddTerrain(const models::TerrainPiece& piece, double mu);
+  int terrain_count() const { return static_cast<int>(terrain_.size()); }
+  /// Height of the highest terrain top face above map point (x, y) (its
+  /// edges included), or -infinity when no piece's top face is above it.
+  double TerrainTopAt(double x_m, double y_m) const;
   /// Adds an object carried by belt `belt` (0-based, < belt_count()), at
   /// `solid` when the belt has travelled 0 m; it leaves the scene when its
   /// footprint passes an end of the belt (see the class comment). Throws
@@ -177,11 +217,12 @@ class FloorWorld {
   /// direction within the step).
   void SetBeltTravel(int k, double travel_m);
 
-  /// Surface at map point (x, y): 0 floor, k + 1 for the first belt k that
-  /// contains it (edges included).
+  /// Surface of the floor plane at map point (x, y): 0 floor, k + 1 for the
+  /// first belt k that contains it (edges included). (A contact on terrain
+  /// piece j has surface belt_count() + 1 + j.)
   int SurfaceAt(double x_m, double y_m) const;
-  /// Velocity in map of a surface index as returned by SurfaceAt (zero for
-  /// the floor and for -1).
+  /// Velocity in map of a surface index as in GeomContact (zero for the
+  /// floor, the terrain and for -1).
   void SurfaceVelocity(int surface, double* vx_mps, double* vy_mps) const;
 
   /// Collides every registered geom with the floor at the current
@@ -213,15 +254,21 @@ class FloorWorld {
     int count = 0;
   };
 
-  /// Collides geom i with the floor into points_[i] and records contact(i).
+  /// Collides geom i with the floor and the near terrain into points_[i]
+  /// and records contact(i).
   void Collide(std::size_t i);
+  /// Lists again the obstacles and terrain pieces near the robot when the
+  /// AABB of all its geoms left the listed region.
+  void UpdateNear();
+  /// Coulomb coefficient of a wheel on surface index s (as GeomContact).
+  double SurfaceMu(int s) const;
   /// Contact joints for the points of geom i.
   void MakeJoints(std::size_t i, double erp, double cfm);
   /// Contact joints between the body geom and the objects it touches.
   void CollideObjects(double erp, double cfm);
-  /// Contact joints for the points where the body geom touches `object`
-  /// (moving at velocity v in map).
-  void CollideObject(dGeomID object, const double v[3]);
+  /// Contact joints for the points where body geom `body_geom` touches
+  /// `object` (moving at velocity v in map).
+  void CollideObject(dGeomID body_geom, dGeomID object, const double v[3]);
   /// Speed of carried object i along its belt's direction.
   double CarriedSpeed(std::size_t i) const;
 
@@ -258,14 +305,21 @@ class FloorWorld {
   // Per belt, the unit vectors along and across its length axis.
   std::vector<std::array<double, 4>> belt_axes_;
   std::vector<dGeomID> geoms_;
-  dGeomID body_geom_ = nullptr;
+  std::vector<dGeomID> body_geoms_;
   double body_mu_ = 0.5;
   std::vector<dGeomID> obstacles_;
   std::vector<Aabb> obstacle_aabbs_;
-  // The region the near list holds for (empty at first: min > max), and
-  // the obstacles whose AABB overlaps it.
+  struct Terrain {
+    dGeomID geom = nullptr;
+    Aabb aabb{};
+    double mu = 0.0;
+  };
+  std::vector<Terrain> terrain_;
+  // The region the near lists hold for (empty at first: min > max), and
+  // the obstacles and terrain pieces whose AABB overlaps it.
   Aabb near_region_{1.0, -1.0, 1.0, -1.0, 1.0, -1.0};
   std::vector<std::size_t> near_obstacles_;
+  std::vector<std::size_t> near_terrain_;
   std::vector<Carried> carried_;
   std::vector<double> belt_travel_m_;
   // Time since the last SetBeltTravel (substeps of one step).

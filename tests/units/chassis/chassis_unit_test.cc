@@ -563,6 +563,7 @@ TEST(ChassisUnit, CheckParametersRejectsBadValues) {
   Set(u, "substeps", std::int64_t{0});
   u.variables().SetRealElement(*u.variables().Find("wheel_x"), 2, std::nan(""));
   Set(u, "contact_stiffness", -1.0);
+  Set(u, "payload_size", std::vector<double>{0.5, 0.0, 0.3});  // a box needs all three
   const auto problems = u.CheckParameters();
   std::vector<std::string> names;
   for (const auto& p : problems) {
@@ -571,10 +572,12 @@ TEST(ChassisUnit, CheckParametersRejectsBadValues) {
   // The declared rules in declaration order, then the rule between
   // parameters.
   EXPECT_EQ(names, (std::vector<std::string>{"wheel_radius[1]", "wheel_x[2]", "contact_stiffness",
-                                             "substeps", "module_mass"}));
+                                             "substeps", "module_mass", "payload_size"}));
   EXPECT_EQ(problems[2].message, "must be > 0, got -1");
   EXPECT_EQ(problems[3].message, "must be in [1, 1000], got 0");
   EXPECT_EQ(problems[4].message, "times 4 wheels must be less than mass 15, got 5");
+  EXPECT_EQ(problems[5].message,
+            "give all three sizes (a box) or none (a point mass), got 0.5, 0, 0.3");
   try {
     u.Initialize();
     ADD_FAILURE() << "Initialize accepted bad parameters";
@@ -683,11 +686,18 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   // put on the line.
   bad.carried[0].solid.x_m = -6.0;
   EXPECT_EQ(scene_problem(bad), "");
-  // Terrain is not simulated yet: refused, naming the piece.
+  // A terrain piece without a size, or on a surface the scene lacks:
+  // refused, naming the piece.
   bad = models::OpenFloor();
   bad.terrain.push_back({});
   bad.terrain.back().name = "ramp";
-  EXPECT_NE(scene_problem(bad).find("terrain 'ramp' is not simulated by the chassis yet"),
+  EXPECT_NE(scene_problem(bad).find("terrain 'ramp' needs a positive length, width and thickness"),
+            std::string::npos)
+      << scene_problem(bad);
+  bad.terrain.back().length_m = bad.terrain.back().width_m = bad.terrain.back().thickness_m = 1.0;
+  EXPECT_EQ(scene_problem(bad), "");
+  bad.terrain.back().surface = 1;
+  EXPECT_NE(scene_problem(bad).find("terrain 'ramp' has surface 1, not one of its 1 surfaces"),
             std::string::npos)
       << scene_problem(bad);
   // A floor with no area: every wheel would be off it.
@@ -866,6 +876,9 @@ std::vector<Expected> Parameters(std::size_t wheels) {
           {"wheel_y", C::kParameter, "m", wheels},
           {"steer_rotor_inertia", C::kParameter, "kg.m2", 0},
           {"drive_rotor_inertia", C::kParameter, "kg.m2", 0},
+          {"payload_mass", C::kParameter, "kg", 0},
+          {"payload_position", C::kParameter, "m", 3},
+          {"payload_size", C::kParameter, "m", 3},
           {"steer_friction", C::kParameter, "N.m.s/rad", 0},
           {"drive_friction", C::kParameter, "N.m.s/rad", 0},
           {"body_friction", C::kParameter, "1", 0},

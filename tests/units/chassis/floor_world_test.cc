@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 #include <ode/ode.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -213,6 +215,123 @@ TEST(FloorWorld, NoContactAboveTheFloor) {
   EXPECT_EQ(f.contact(0).points, 0);
   EXPECT_EQ(f.contact(0).x_m, 0.3);
   EXPECT_EQ(f.contact(0).y_m, 0.4);
+}
+
+// A terrain piece tilted by `pitch_rad` about map y (+ raises its +x end),
+// its top face's centre at (0, 0, 1), wide enough for the tests below.
+models::TerrainPiece Slope(double pitch_rad) {
+  models::TerrainPiece t;
+  t.name = "slope";
+  t.length_m = 4.0;
+  t.width_m = 2.0;
+  t.thickness_m = 0.2;
+  t.pitch_rad = pitch_rad;
+  // Centre = top centre - half the thickness along the top's normal
+  // (-sin p, 0, cos p).
+  t.center_x_m = 0.1 * std::sin(pitch_rad);
+  t.center_z_m = 1.0 - 0.1 * std::cos(pitch_rad);
+  return t;
+}
+
+// Guards against terrain contacts that are not Coulomb's (a pyramid, or a
+// friction row left in map x), a wrong tilt sign, and the piece's own
+// friction not being used. Analytic (Coulomb, a block on an incline): below
+// the friction angle (mu > tan p) it stays; above it, it slides down the
+// slope with a = g (sin p - mu cos p). The block (2 kg, 0.2 m cube) is put
+// on the top face tilted with it, pressed in by its static deflection.
+TEST(FloorWorld, BlockOnATiltedTerrainPieceIsCoulomb) {
+  const double pitch = 20.0 * std::numbers::pi / 180.0;  // tan = 0.364
+  for (const double mu : {0.5, 0.25}) {
+    SCOPED_TRACE(mu);
+    FloorWorld f;
+    // The floor far below and slippery: only the piece's friction acts.
+    f.SetSurface({0.0, 1e6, 1e4});
+    f.AddTerrain(Slope(pitch), mu);
+    ASSERT_EQ(f.terrain_count(), 1);
+    Box box(f, 0.0, 0.0, 2.0, 0.2);
+    const double n[3] = {-std::sin(pitch), 0.0, std::cos(pitch)};
+    const double depth = 2.0 * kGravityMps2 * std::cos(pitch) / (4.0 * 1e6);
+    dBodySetPosition(box.body, (0.1 - depth) * n[0], 0.0, 1.0 + (0.1 - depth) * n[2]);
+    dMatrix3 rot;
+    dRFromAxisAndAngle(rot, 0.0, 1.0, 0.0, -pitch);  // x axis up the slope
+    dBodySetRotation(box.body, rot);
+    f.Probe();
+    EXPECT_EQ(f.contact(0).points, 4);
+    EXPECT_EQ(f.contact(0).surface, 1);  // no belts: terrain piece 0 is surface 1
+    EXPECT_NEAR(f.TerrainTopAt(0.5, 0.3), 1.0 + 0.5 * std::tan(pitch), 1e-12);
+    EXPECT_EQ(f.TerrainTopAt(3.0, 0.0), -std::numeric_limits<double>::infinity());
+    // Where it is once the contact springs settled (0.1 s: a few periods
+    // of the 2 kg block on 4 x 1e6 N/m).
+    double x0 = 0.0, v_half = 0.0;
+    for (int i = 1; i <= 1000; ++i) {
+      ASSERT_TRUE(f.Step(kStepS));
+      if (i == 100) x0 = box.x();
+      if (i == 500) v_half = dBodyGetLinearVel(box.body)[0];
+    }
+    const dReal* v = dBodyGetLinearVel(box.body);
+    const double along_mps = v[0] * std::cos(pitch) + v[2] * std::sin(pitch);
+    if (mu > std::tan(pitch)) {
+      EXPECT_NEAR(box.x(), x0, 1e-6);
+      EXPECT_NEAR(along_mps, 0.0, 1e-6);
+    } else {
+      // Down the slope (-x): a over the last 0.5 s from the velocity change.
+      const double a = kGravityMps2 * (std::sin(pitch) - mu * std::cos(pitch));
+      const double measured = -(v[0] - v_half) / std::cos(pitch) / 0.5;
+      EXPECT_NEAR(measured, a, 0.01 * a);
+      EXPECT_NEAR(v[1], 0.0, 1e-9);
+    }
+  }
+}
+
+// Guards against a wheel that sinks into a piece or jumps at its edge: a
+// sphere rolled over the foot of a ramp keeps one contact point with the
+// floor or the ramp (two while on the edge) and never sinks deeper than its
+// static deflection allows (a few times m g / k).
+TEST(FloorWorld, SphereRollsOntoARampOverItsEdge) {
+  const double pitch = 15.0 * std::numbers::pi / 180.0;
+  FloorWorld f;
+  f.SetSurface({0.8, 1e6, 1e4});
+  // The ramp's top face starts on the floor at x = 1.
+  models::TerrainPiece t;
+  t.name = "ramp";
+  t.length_m = 2.0;
+  t.width_m = 1.0;
+  t.thickness_m = 0.05;
+  t.pitch_rad = pitch;
+  t.center_x_m = 1.0 + std::cos(pitch) + 0.025 * std::sin(pitch);
+  t.center_z_m = std::sin(pitch) - 0.025 * std::cos(pitch);
+  f.AddTerrain(t, 0.8);
+  const double r = 0.15, m = 5.0;
+  const dBodyID b = dBodyCreate(f.world());
+  dMass mass;
+  dMassSetSphereTotal(&mass, m, r);
+  dBodySetMass(b, &mass);
+  dBodySetPosition(b, 0.0, 0.0, r - m * kGravityMps2 / 1e6);
+  dBodySetLinearVel(b, 2.0, 0.0, 0.0);
+  dBodySetAngularVel(b, 0.0, 2.0 / r, 0.0);
+  const dGeomID g = dCreateSphere(nullptr, r);
+  dGeomSetBody(g, b);
+  f.AddGeom(g);
+  double deepest = 0.0;
+  int most_points = 0;
+  bool on_ramp = false;
+  for (int i = 0; i < 800; ++i) {
+    ASSERT_TRUE(f.Step(kStepS));
+    deepest = std::max(deepest, f.contact(0).depth_m);
+    most_points = std::max(most_points, f.contact(0).points);
+    on_ramp = on_ramp || f.contact(0).surface == 1;
+  }
+  EXPECT_TRUE(on_ramp);
+  EXPECT_LE(most_points, 2);
+  // Static deflection 5 x 9.81 / 1e6 = 0.05 mm; the edge's impulse adds
+  // a few times that.
+  EXPECT_LT(deepest, 1e-3);
+  // Still rolling up the ramp's face, at most its radius above it.
+  const dReal* p = dBodyGetPosition(b);
+  EXPECT_GT(p[0], 1.3);
+  EXPECT_NEAR(p[2], (p[0] - 1.0) * std::tan(pitch) + r / std::cos(pitch), 2e-3);
+  f.ClearGeoms();
+  dGeomDestroy(g);
 }
 
 }  // namespace

@@ -57,6 +57,23 @@ inline constexpr double kHuskyComHeightM = 0.130 + 0.5 * kHuskyBodyM[2];
 /// Wheel contact mu 1.0 (URDF gazebo tags).
 inline constexpr double kHuskyMu = 1.0;
 
+/// Paper 2's payload: a UR10 (CB3) arm on a mount plate on the Husky's top.
+/// Arm 32.7 kg: the sum of the link masses in Universal Robots'
+/// ur_description physical_parameters.yaml (base 4.0, shoulder 7.778, upper
+/// arm 12.93, forearm 3.87, wrists 1.96, 1.96, 0.202 kg; 28.7 kg without
+/// the base link). Mount plate 5 kg: ASSUMPTION (a 10 mm aluminium plate of
+/// about 0.45 x 0.4 m with its bolts). Centre of mass 0.61 m above the floor
+/// on the robot's centre line: ASSUMPTION (the arm folded for transport over
+/// the centre of the top plate, whose surface is at 0.13 + 0.2475 =
+/// 0.3775 m; the folded arm's centre of mass about 0.26 m above its base,
+/// the plate's 5 mm above the top). Box 0.6 x 0.3 x 0.55 m about it:
+/// ASSUMPTION, the folded arm's envelope (top at 0.885 m).
+inline constexpr double kUr10MassKg = 32.7;
+inline constexpr double kMountPlateMassKg = 5.0;
+inline constexpr double kArmPayloadMassKg = kUr10MassKg + kMountPlateMassKg;
+inline constexpr double kArmPayloadComM[3] = {0.0, 0.0, 0.61};
+inline constexpr double kArmPayloadBoxM[3] = {0.6, 0.3, 0.55};
+
 inline void Set(cosim::Unit& u, const std::string& name, const cosim::Value& v) {
   u.variables().SetValue(*u.variables().Find(name), v);
 }
@@ -99,6 +116,16 @@ inline std::unique_ptr<ChassisUnit> Husky(models::Scene scene, const std::string
   // confirmed"): the tests leave it out; none of their steady states
   // depends on an inertia.
   Set(*u, "drive_rotor_inertia", 0.0);
+  return u;
+}
+
+/// The Husky with paper 2's arm payload (UR10 and mount plate).
+inline std::unique_ptr<ChassisUnit> HuskyWithArm(models::Scene scene,
+                                                 const std::string& name = "husky") {
+  auto u = Husky(std::move(scene), name);
+  Set(*u, "payload_mass", kArmPayloadMassKg);
+  Set(*u, "payload_position", std::vector<double>(kArmPayloadComM, kArmPayloadComM + 3));
+  Set(*u, "payload_size", std::vector<double>(kArmPayloadBoxM, kArmPayloadBoxM + 3));
   return u;
 }
 
