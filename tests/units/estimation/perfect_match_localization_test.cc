@@ -1,0 +1,2 @@
+// The perfect_match_localization unit and its EKF (pose_fusion).
+#include <gtest/gtest.h>
