@@ -29,10 +29,10 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
   }
   for (std::size_t i = 0; i < specs_.size(); ++i) {
     const MapSpec& m = specs_[i];
-    if (!std::isfinite(m.height_m) ||
+    if (!std::isfinite(m.height_m) || !(m.cell_m >= 0.0 && m.cell_m <= 0.5) ||
         (m.region && !(m.region->max_x > m.region->min_x && m.region->max_y > m.region->min_y))) {
       throw cosim::UnitError(Where() + ": map " + std::to_string(i) + " (" + m.name +
-                             ") needs a finite height_m and a region with max > min");
+                             ") needs a finite height_m, cell_m in [0, 0.5] and a region with max > min");
     }
   }
   std::size_t max_beams = 0;
@@ -98,8 +98,8 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
   v.Parameter("usable_range_max", "m", &usable_range_max_,
               "farther returns are skipped (the LMS151's 50 m, 8012471)", Rule::Positive());
   v.Parameter("lookup_cell", "m", &lookup_cell_,
-              "cell of the distance map's lookup grid (Tribots: 0.05; see distance_map.h for the "
-              "interpolation error)",
+              "cell of the distance maps' lookup grid, for the maps that give no cell_m (Tribots: "
+              "0.05; see distance_map.h for the interpolation error)",
               Rule::Range(0.005, 0.5));
   v.Parameter("map_margin", "m", &map_margin_,
               "the lookup grid extends this far beyond each map's region (or the floor)",
@@ -185,7 +185,7 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
            "sum of the points' weights c^4 / (c^2 + d^2)^2 over the points, latest accepted match "
            "(1: every point on an outline)",
            {});
-  v.Output("map_in_use", &map_in_use_, "the map of the latest scan matched (its index)", {});
+  v.Output("map_in_use", "1", &map_in_use_, "the map of the latest scan matched (its index)", {});
   v.Output("laser_status", "1", &laser_status_,
            "per laser: 0 ok, 1 no new scan within scan_timeout, 2 blacked out (fewer than "
            "min_points returns), 3 last match rejected, 4 map_index names no map",
@@ -243,6 +243,7 @@ void PerfectMatchLocalizationUnit::Derive() {
     o.cell = lookup_cell_;
     o.margin = map_margin_;
     for (const MapSpec& m : specs_) {
+      o.cell = m.cell_m > 0.0 ? m.cell_m : lookup_cell_;
       maps_.push_back(std::make_unique<DistanceMap>(scene_, m.height_m, m.region, o));
     }
     built_cell_ = lookup_cell_;
@@ -281,7 +282,7 @@ void PerfectMatchLocalizationUnit::Initialize() {
   match_count_ = 0.0;
   match_error_ = 0.0;
   match_inlier_fraction_ = 0.0;
-  map_in_use_ = map_index_;
+  map_in_use_ = static_cast<double>(map_index_);
   source_ = 1.0;
 }
 
@@ -337,7 +338,7 @@ void PerfectMatchLocalizationUnit::ProcessScan(int k) {
   }
   Pose start = estimate_;
   if (odometry_prediction_) start = Predict(odom_, cosim::NsToSeconds(match_ns - odom_ns_));
-  map_in_use_ = map_index_;
+  map_in_use_ = static_cast<double>(map_index_);
   const PerfectMatch::Result res =
       matcher_->Match(*maps_[static_cast<std::size_t>(map_index_)],
                       std::span<const double>(px_.data(), n),

@@ -64,6 +64,8 @@ class PerfectMatchLocalizationUnit : public cosim::Unit {
     std::string name;
     double height_m = 0.0;  // the slice's z above the floor
     std::optional<DistanceMap::Region> region;
+    /// The lookup grid's cell for this map (m); 0: the lookup_cell parameter.
+    double cell_m = 0.0;
   };
 
   /// One entry of `beam_counts` per laser (1..kMaxLasers, each 1..100000
@@ -129,8 +131,7 @@ class PerfectMatchLocalizationUnit : public cosim::Unit {
   // Outputs.
   std::vector<double> position_, covariance_, hessian_, laser_status_;
   double yaw_ = 0.0, match_time_ = 0.0, match_count_ = 0.0, match_error_ = 0.0,
-         match_inlier_fraction_ = 0.0, source_ = 1.0;
-  std::int64_t map_in_use_ = 0;
+         match_inlier_fraction_ = 0.0, source_ = 1.0, map_in_use_ = 0.0;
 
   // Derived: per laser and beam, cos and sin of the beam's direction in
   // base_link and its time after the scan's start.

@@ -18,55 +18,6 @@ namespace {
 
 using namespace pmtest;  // NOLINT
 
-// The first-order bound on the pose error a map error delta_i at each
-// point gives: the weighted least-squares shift e = A^-1 sum u J delta with
-// A = sum u J J^T (u <= 1) obeys |e_j| <= sqrt((A^-1)_jj sum delta_i^2)
-// (Cauchy-Schwarz in the metric of A). Per point, delta_i is bounded from
-// the lookup grid h (distance_map.h): 0 on a straight face (d linear over
-// the 2 x 2 nodes, which lie within sqrt(2) h of the point: true when the
-// point is more than 2 sqrt(2) h, taken 3 h, from any corner: the medial
-// axis leaves a corner at 45 deg); sqrt(2) h within 3 h of a corner (d is
-// 1-Lipschitz and the interpolant a convex combination of nodes within
-// sqrt(2) h); h^2 / (4 (R - sqrt(2) h)) on a cylinder of radius R (the
-// bilinear error (h^2 / 8)(|d_xx| + |d_yy|), |d''| <= 1 / rho); plus 1e-6 m
-// for the float tables.
-std::array<double, 3> PoseErrorBound(const std::vector<models::Solid>& solids, const Points& p,
-                                     const PerfectMatch::Pose& truth,
-                                     const PerfectMatch::Result& r, double h, double c,
-                                     const DistanceMap* measured = nullptr) {
-  const Features f = FeaturesOf(solids);
-  double sum = 0.0;
-  const double cs = std::cos(truth.yaw), sn = std::sin(truth.yaw);
-  for (std::size_t i = 0; i < p.x.size(); ++i) {
-    const double x = truth.x + cs * p.x[i] - sn * p.y[i];
-    const double y = truth.y + sn * p.x[i] + cs * p.y[i];
-    double e = 1e-6;
-    for (const auto& [cx, cy] : f.corners) {
-      if (std::hypot(x - cx, y - cy) < 3.0 * h) e = std::max(e, std::sqrt(2.0) * h);
-    }
-    for (const auto& cyl : f.cylinders) {
-      if (std::abs(std::hypot(x - cyl[0], y - cyl[1]) - cyl[2]) < 1e-6) {
-        e = std::max(e, h * h / (4.0 * (cyl[2] - std::sqrt(2.0) * h)));
-      }
-    }
-    if (measured) {
-      double gx, gy;
-      const double delta = measured->Lookup(x, y, gx, gy) - measured->ExactDistance(x, y);
-      EXPECT_LE(std::abs(delta), e) << "point " << i << " at " << x << ", " << y;
-      e = std::abs(delta) + 1e-6;
-    }
-    sum += e * e;
-  }
-  // A = (c^2 / 2) H.
-  const std::array<double, 6> a = {r.hessian[0], r.hessian[1], r.hessian[2],
-                                   r.hessian[4], r.hessian[5], r.hessian[8]};
-  std::array<double, 9> inv{};
-  EXPECT_TRUE(InverseSymmetric3(a, inv));
-  const double k = 2.0 / (c * c);  // A^-1 = (2 / c^2) H^-1 ... H = (2 / c^2) A
-  return {std::sqrt(sum * inv[0] * k), std::sqrt(sum * inv[4] * k),
-          std::sqrt(sum * inv[8] * k)};
-}
-
 class RecoversOffset : public ::testing::TestWithParam<double> {};
 
 // Guards against PM not recovering a known offset (0.1 m, 0.05 m,
@@ -83,11 +34,11 @@ TEST_P(RecoversOffset, WithinTheLookupGridsBound) {
   const PerfectMatch pm({});
   const auto r = pm.Match(map, p.x, p.y, {truth.x + 0.1, truth.y + 0.05, truth.yaw + 0.05});
   ASSERT_TRUE(r.ok);
-  const auto b = PoseErrorBound(solids, p, truth, r, h, 0.25);
+  const auto b = PoseErrorBound(RoomFeatures(solids), p, truth, r.hessian, h, 0.25);
   RecordProperty("bound_x_mm", std::to_string(b[0] * 1e3));
   // Tighter, with the map's actual error delta_i = D(q_i) - d(q_i) at the
   // true points (each within its grid bound) in the same propagation.
-  const auto t = PoseErrorBound(solids, p, truth, r, h, 0.25, &map);
+  const auto t = PoseErrorBound(RoomFeatures(solids), p, truth, r.hessian, h, 0.25, &map);
   std::printf("h %.3f: tight bound %.4f %.4f mm %.4f mrad\n", h, t[0] * 1e3, t[1] * 1e3,
               t[2] * 1e3);
   EXPECT_NEAR(r.pose.x, truth.x, t[0] + 1e-5);

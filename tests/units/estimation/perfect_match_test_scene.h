@@ -12,7 +12,12 @@
 #include <utility>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "models/scene.h"
+#include "units/estimation/distance_map.h"
+#include "units/estimation/scan_matcher.h"
+#include "units/estimation/perfect_match.h"
 
 namespace linesim::estimation::pmtest {
 
@@ -69,7 +74,12 @@ inline Features FeaturesOf(const std::vector<models::Solid>& solids) {
       }
     }
   }
-  // The room's inner corners (where two walls' faces meet).
+  return f;
+}
+// Room's: its boxes' and cylinders' and its inner corners (where two
+// walls' faces meet).
+inline Features RoomFeatures(const std::vector<models::Solid>& solids) {
+  Features f = FeaturesOf(solids);
   for (const double x : {-4.8, 4.8})
     for (const double y : {-3.8, 3.8}) f.corners.push_back({x, y});
   return f;
@@ -151,5 +161,123 @@ inline Points ToPoints(const std::vector<double>& r) {
   }
   return p;
 }
+
+}  // namespace linesim::estimation::pmtest
+
+namespace linesim::estimation::pmtest {
+
+// The van bay of paper 2's use case (Sobreira et al. 2019; dimensions of a
+// Renault Master L2H2 class van: load length 3.1 m, width 1.765 m, load
+// floor 0.54 m): a factory hall (x -6..10, y -5..5, 0.3 m walls), a few
+// carts and a pillar off the corridor, the van (cargo interior x 4.0..7.1,
+// |y| < 0.8825, 5 cm side and front walls from z 0.30 to 2.44, wheel arches
+// up to 0.82, four beacon cylinders r 0.04 m from the floor 0.54 to 1.34),
+// its floor slab (terrain, z 0.30..0.54) and a 2 m ramp (terrain, 15.1 deg).
+inline models::Scene VanBay() {
+  models::Scene s;
+  s.floor = {-6.0, 10.0, -5.0, 5.0, 0};
+  const auto box = [](double x, double y, double l, double w, double bottom, double top) {
+    return models::BoxSolid(x, y, 0.0, l, w, top - bottom, bottom);
+  };
+  s.obstacles = {
+      Ob("hall_n", box(2.0, 4.85, 16.0, 0.3, 0.0, 4.0)),
+      Ob("hall_s", box(2.0, -4.85, 16.0, 0.3, 0.0, 4.0)),
+      Ob("hall_w", box(-5.85, 0.0, 0.3, 10.0, 0.0, 4.0)),
+      Ob("hall_e", box(9.85, 0.0, 0.3, 10.0, 0.0, 4.0)),
+      Ob("cart", box(-4.0, 3.0, 1.2, 0.8, 0.0, 1.0)),
+      Ob("rack", box(8.0, 3.5, 2.0, 0.6, 0.0, 2.0)),
+      Ob("pillar", models::CylinderSolid(1.0, -3.5, 0.25, 4.0)),
+      Ob("van_left", box(5.55, 0.9075, 3.1, 0.05, 0.30, 2.44)),
+      Ob("van_right", box(5.55, -0.9075, 3.1, 0.05, 0.30, 2.44)),
+      Ob("van_front", box(7.125, 0.0, 0.05, 1.865, 0.30, 2.44)),
+      Ob("arch_left", box(5.1, 0.78625, 0.7, 0.1925, 0.54, 0.82)),
+      Ob("arch_right", box(5.1, -0.78625, 0.7, 0.1925, 0.54, 0.82)),
+      Ob("beacon1", models::CylinderSolid(6.0, 0.75, 0.04, 0.8, 0.54)),
+      Ob("beacon2", models::CylinderSolid(6.0, -0.75, 0.04, 0.8, 0.54)),
+      Ob("beacon3", models::CylinderSolid(6.95, 0.75, 0.04, 0.8, 0.54)),
+      Ob("beacon4", models::CylinderSolid(6.95, -0.75, 0.04, 0.8, 0.54))};
+  for (auto& o : s.obstacles) {
+    if (o.name.rfind("van", 0) == 0) o.kind = "vehicle";
+    if (o.name.rfind("beacon", 0) == 0) o.kind = "beacon";
+  }
+  models::TerrainPiece floor;
+  floor.name = "van_floor";
+  floor.center_x_m = 5.55;
+  floor.center_z_m = 0.42;
+  floor.length_m = 3.1;
+  floor.width_m = 1.765;
+  floor.thickness_m = 0.24;
+  s.terrain.push_back(floor);
+  // The ramp's top face from (2.0, z 0) to (4.0, z 0.54), 5 cm thick.
+  models::TerrainPiece ramp;
+  ramp.name = "ramp";
+  ramp.pitch_rad = std::atan2(0.54, 2.0);
+  ramp.length_m = std::hypot(2.0, 0.54);
+  ramp.width_m = 1.2;
+  ramp.thickness_m = 0.05;
+  ramp.center_x_m = 3.0 + 0.025 * std::sin(ramp.pitch_rad);
+  ramp.center_z_m = 0.27 - 0.025 * std::cos(ramp.pitch_rad);
+  s.terrain.push_back(ramp);
+  return s;
+}
+
+}  // namespace linesim::estimation::pmtest
+
+namespace linesim::estimation::pmtest {
+
+// The first-order bound on the pose error a map error delta_i at each
+// point gives: the weighted least-squares shift e = A^-1 sum u J delta with
+// A = sum u J J^T (u <= 1) obeys |e_j| <= sqrt((A^-1)_jj sum delta_i^2)
+// (Cauchy-Schwarz in the metric of A). Per point, delta_i is bounded from
+// the lookup grid h (distance_map.h): 0 on a straight face (d linear over
+// the 2 x 2 nodes, which lie within sqrt(2) h of the point: true when the
+// point is more than 2 sqrt(2) h, taken 3 h, from any corner: the medial
+// axis leaves a corner at 45 deg); sqrt(2) h within 3 h of a corner (d is
+// 1-Lipschitz and the interpolant a convex combination of nodes within
+// sqrt(2) h); h^2 / (4 (R - sqrt(2) h)) on a cylinder of radius R (the
+// bilinear error (h^2 / 8)(|d_xx| + |d_yy|), |d''| <= 1 / rho); plus 1e-6 m
+// for the float tables.
+inline std::array<double, 3> PoseErrorBound(const Features& f, const Points& p,
+                                     const PerfectMatch::Pose& truth,
+                                     const std::array<double, 9>& hessian, double h, double c,
+                                     const DistanceMap* measured = nullptr) {
+  double sum = 0.0;
+  const double cs = std::cos(truth.yaw), sn = std::sin(truth.yaw);
+  for (std::size_t i = 0; i < p.x.size(); ++i) {
+    const double x = truth.x + cs * p.x[i] - sn * p.y[i];
+    const double y = truth.y + sn * p.x[i] + cs * p.y[i];
+    double e = 1e-6;
+    for (const auto& [cx, cy] : f.corners) {
+      if (std::hypot(x - cx, y - cy) < 3.0 * h) e = std::max(e, std::sqrt(2.0) * h);
+    }
+    for (const auto& cyl : f.cylinders) {
+      if (std::abs(std::hypot(x - cyl[0], y - cyl[1]) - cyl[2]) < 1e-6) {
+        // (R <= sqrt(2) h: only the Lipschitz bound.)
+        const double den = cyl[2] - std::sqrt(2.0) * h;
+        e = std::max(e, den > 0.0 ? std::min(h * h / (4.0 * den), std::sqrt(2.0) * h)
+                                  : std::sqrt(2.0) * h);
+      }
+    }
+    if (measured) {
+      double gx, gy;
+      const double delta = measured->Lookup(x, y, gx, gy) - measured->ExactDistance(x, y);
+      if (!(std::abs(delta) <= e)) {
+        ADD_FAILURE() << "map error " << delta << " beyond its grid bound " << e << " at " << x
+                      << ", " << y;
+      }
+      e = std::abs(delta) + 1e-6;
+    }
+    sum += e * e;
+  }
+  // A = (c^2 / 2) H.
+  const std::array<double, 6> a = {hessian[0], hessian[1], hessian[2],
+                                   hessian[4], hessian[5], hessian[8]};
+  std::array<double, 9> inv{};
+  EXPECT_TRUE(InverseSymmetric3(a, inv));
+  const double k = 2.0 / (c * c);  // H = (2 / c^2) A: A^-1 = (2 / c^2) H^-1
+  return {std::sqrt(sum * inv[0] * k), std::sqrt(sum * inv[4] * k),
+          std::sqrt(sum * inv[8] * k)};
+}
+
 
 }  // namespace linesim::estimation::pmtest
