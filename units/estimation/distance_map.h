@@ -54,6 +54,13 @@ class OccupancyGrid;
 /// face; a signed d is linear across a straight face and reproduced exactly
 /// by the bilinear interpolant (the error d^2 / (c^2 + d^2) is even in d).
 ///
+/// The basin's limit from thin solids: inside a solid d is minus the
+/// distance to its NEAREST outline, so a point pushed deeper than half the
+/// solid's thickness (a pose error) is pulled out through its far face.
+/// Starts must stay within half the thinnest seen solid's thickness of the
+/// truth at the walls (25 mm for a van's 5 cm sheet walls, 0.1 m for 0.2 m
+/// hall walls); with odometry prediction at 50 Hz a start is mm off.
+///
 /// Interpolation error (what the tests bound): the bilinear interpolant of a
 /// function with second derivatives |d_xx|, |d_yy| <= K on the cell is off
 /// by at most K h^2 / 4 (K h^2 / 8 per axis), i.e. 0 on a straight face
