@@ -32,11 +32,12 @@ double PerfectMatch::Error(const DistanceMap& map, std::span<const double> px,
 }
 
 PerfectMatch::Normal PerfectMatch::Accumulate(const DistanceMap& map, std::span<const double> px,
-                                              std::span<const double> py,
-                                              const Pose& pose) const {
+                                              std::span<const double> py, const Pose& pose,
+                                              double ox, double oy) const {
   const double c2 = options_.c * options_.c, c4 = c2 * c2;
   const double cs = std::cos(pose.yaw), sn = std::sin(pose.yaw);
   double a00 = 0, a01 = 0, a02 = 0, a11 = 0, a12 = 0, a22 = 0, b0 = 0, b1 = 0, b2 = 0;
+  double k0 = 0, k1 = 0, k2 = 0;
   Normal r;
   const std::size_t n = std::min(px.size(), py.size());
   for (std::size_t i = 0; i < n; ++i) {
@@ -63,14 +64,28 @@ PerfectMatch::Normal PerfectMatch::Accumulate(const DistanceMap& map, std::span<
     b2 += u * d * j2;
     r.udd += u * d * d;
     r.u += u;
+    // The beam's direction in map: R (p - o) / |p - o|.
+    const double bx = px[i] - ox, by = py[i] - oy;
+    const double len = std::sqrt(bx * bx + by * by);
+    if (len > 0.0) {
+      const double kappa = (gx * (cs * bx - sn * by) + gy * (sn * bx + cs * by)) / len;
+      const double kd = u * kappa;
+      k0 += kd * gx;
+      k1 += kd * gy;
+      k2 += kd * j2;
+      r.ukk += kd * kappa;
+      r.ukd += kd * d;
+    }
   }
   r.a = {a00, a01, a02, a11, a12, a22};
   r.b = {b0, b1, b2};
+  r.k = {k0, k1, k2};
   return r;
 }
 
 PerfectMatch::Result PerfectMatch::Match(const DistanceMap& map, std::span<const double> px,
-                                         std::span<const double> py, Pose start) const {
+                                         std::span<const double> py, Pose start, double origin_x,
+                                         double origin_y) const {
   Result res;
   res.points = static_cast<int>(std::min(px.size(), py.size()));
   double param[3] = {start.x, start.y, start.yaw};
@@ -101,7 +116,7 @@ PerfectMatch::Result PerfectMatch::Match(const DistanceMap& map, std::span<const
   res.final_steps = {step[0], step[1], step[2]};
   Pose pose{param[0], param[1], param[2]};
   // Reweighted Gauss-Newton refinement, then the curvature at the end.
-  Normal nm = Accumulate(map, px, py, pose);
+  Normal nm = Accumulate(map, px, py, pose, origin_x, origin_y);
   for (int it = 0; it < options_.refine_iterations; ++it) {
     std::array<double, 3> dx{};
     if (!SolveSymmetric3(nm.a, nm.b, dx)) break;
@@ -111,7 +126,7 @@ PerfectMatch::Result PerfectMatch::Match(const DistanceMap& map, std::span<const
       break;
     }
     pose = {pose.x - dx[0], pose.y - dx[1], pose.yaw - dx[2]};
-    nm = Accumulate(map, px, py, pose);
+    nm = Accumulate(map, px, py, pose, origin_x, origin_y);
     ++res.iterations;
   }
   res.pose = pose;
@@ -124,10 +139,22 @@ PerfectMatch::Result PerfectMatch::Match(const DistanceMap& map, std::span<const
   for (std::size_t k = 0; k < 9; ++k)
     res.hessian[k] = scale * nm.a[static_cast<std::size_t>(full[k])];
   std::array<double, 9> inv{};
-  res.ok = nm.u > 3.0 && InverseSymmetric3(nm.a, inv);
+  res.ok = nm.u > 4.0 && InverseSymmetric3(nm.a, inv);
   if (res.ok) {
-    res.residual_variance = nm.udd / (nm.u - 3.0);
+    // The residuals with a common range bias fitted too (see the header).
+    double ktak = 0.0;
+    for (std::size_t r = 0; r < 3; ++r) {
+      for (std::size_t c = 0; c < 3; ++c) ktak += nm.k[r] * inv[3 * r + c] * nm.k[c];
+    }
+    const double perp = nm.ukk - ktak;
+    double rss = nm.udd;
+    if (perp > 1e-12 * nm.ukk) rss = std::max(0.0, rss - nm.ukd * nm.ukd / perp);
+    res.residual_variance = rss / (nm.u - 4.0);
     for (std::size_t k = 0; k < 9; ++k) res.covariance[k] = res.residual_variance * inv[k];
+    for (std::size_t r = 0; r < 3; ++r) {
+      res.bias_sensitivity[r] =
+          -(inv[3 * r] * nm.k[0] + inv[3 * r + 1] * nm.k[1] + inv[3 * r + 2] * nm.k[2]);
+    }
   }
   return res;
 }

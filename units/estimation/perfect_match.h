@@ -40,9 +40,17 @@ namespace linesim::estimation {
 /// |d| << c the Hessian of E: rho''(0) = 2 / c^2), scaled by the residual
 /// variance of the distances:
 ///   C = s^2 (2 / c^2) H^-1 = s^2 (sum u_i J_i J_i^T)^-1,
-///   s^2 = sum u_i d_i^2 / (sum u_i - 3)
-/// (weighted least squares in d: the weights u, near 1 for inliers, take
-/// outliers out of both). It treats the beams as independent and the map as
+///   s^2 = RSS / (sum u_i - 4),
+/// RSS the weighted residual sum of squares of the distances after fitting
+/// the pose AND a range bias common to the beams (weighted least squares in
+/// d: the weights u, near 1 for inliers, take outliers out of both). Why
+/// the bias in the fit: a range bias (the LMS151's systematic error) that
+/// the pose cannot absorb is left in the residuals and would inflate s^2,
+/// though it is not independent per beam; it enters the covariance through
+/// bias_sensitivity instead. With kappa_i = d d_i / d b = grad d_i . R
+/// rhat_i and the pose's normal equations A, K = sum u J kappa:
+///   RSS = sum u d^2 - (sum u kappa d)^2 / (sum u kappa^2 - K^T A^-1 K)
+/// (d orthogonal to J at the optimum). It treats the beams as independent and the map as
 /// exact: correlated errors (a range bias, the map's own error) are not in
 /// it; the unit adds floors for them.
 ///
@@ -74,7 +82,8 @@ class PerfectMatch {
     std::array<double, 9> hessian{};
     /// C = s^2 (2 / c^2) H^-1 (m^2, m rad, rad^2), row-major.
     std::array<double, 9> covariance{};
-    /// s^2 (m^2), the weighted residual variance of the distances.
+    /// s^2 (m^2), the weighted residual variance of the distances (pose and
+    /// bias fitted).
     double residual_variance = 0.0;
     /// sum u_i: the points that count (inliers, each near 1).
     double inlier_weight = 0.0;
@@ -86,12 +95,20 @@ class PerfectMatch {
     int iterations = 0;
     /// RPROP's step widths at its end (m, m, rad).
     std::array<double, 3> final_steps{};
+    /// g = d pose / d b for a range bias b common to all beams (every point
+    /// moved by b along its beam from the laser origin): to first order
+    /// g = -A^-1 sum u_i J_i (grad d_i . R rhat_i), A = sum u J J^T
+    /// (m/m, m/m, rad/m). A bias of sigma_b adds sigma_b^2 g g^T to the
+    /// covariance: an error common to the beams, which s^2 A^-1 misses.
+    std::array<double, 3> bias_sensitivity{};
   };
 
   explicit PerfectMatch(Options options) : options_(options) {}
 
+  /// The points px, py in base_link; (origin_x, origin_y) the laser's
+  /// origin in base_link (for bias_sensitivity only).
   Result Match(const DistanceMap& map, std::span<const double> px, std::span<const double> py,
-               Pose start) const;
+               Pose start, double origin_x = 0.0, double origin_y = 0.0) const;
 
   /// E and its gradient at `pose` (m, m, rad).
   double Error(const DistanceMap& map, std::span<const double> px, std::span<const double> py,
@@ -105,11 +122,13 @@ class PerfectMatch {
   struct Normal {
     std::array<double, 6> a{};
     std::array<double, 3> b{};
+    std::array<double, 3> k{};  // sum u J kappa, kappa = grad d . R rhat (d d / d bias)
+    double ukk = 0.0, ukd = 0.0;  // sum u kappa^2, sum u kappa d
     double udd = 0.0, u = 0.0, error = 0.0;
     int on_map = 0;
   };
   Normal Accumulate(const DistanceMap& map, std::span<const double> px,
-                    std::span<const double> py, const Pose& pose) const;
+                    std::span<const double> py, const Pose& pose, double ox, double oy) const;
 
   Options options_;
 };

@@ -151,6 +151,11 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
               "added to the position sigmas of the covariance (squared, on the diagonal): errors "
               "the curvature misses (range bias, the map's own error)",
               Rule::NonNegative());
+  v.Parameter("range_bias_sigma", "m", &range_bias_sigma_,
+              "sigma of a range bias common to a scan's beams (the laser model's bias_sigma: "
+              "LMS151 0.015): adds range_bias_sigma^2 g g^T to the covariance, g the match's "
+              "sensitivity to it",
+              Rule::NonNegative());
   v.Parameter("covariance_floor_yaw", "rad", &covariance_floor_yaw_,
               "added to the yaw sigma of the covariance (squared, on the diagonal)",
               Rule::NonNegative());
@@ -171,7 +176,9 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
   v.Output("position", "m", &position_, "base_link x, y in map (latest accepted match)", {});
   v.Output("yaw", "rad", &yaw_, "base_link yaw in map (latest accepted match)", {});
   v.Output("covariance", "1", &covariance_,
-           "row-major 3 x 3 of x (m), y (m), yaw (rad): s^2 (2 / c^2) H^-1 + floors", {});
+           "row-major 3 x 3 of x (m), y (m), yaw (rad): s^2 (2 / c^2) H^-1 + range_bias_sigma^2 "
+           "g g^T + floors",
+           {});
   v.Output("hessian", "1", &hessian_,
            "row-major 3 x 3 curvature H of the error at the latest accepted match (1/m^2, "
            "1/(m rad), 1/rad^2)",
@@ -342,7 +349,7 @@ void PerfectMatchLocalizationUnit::ProcessScan(int k) {
   const PerfectMatch::Result res =
       matcher_->Match(*maps_[static_cast<std::size_t>(map_index_)],
                       std::span<const double>(px_.data(), n),
-                      std::span<const double>(py_.data(), n), start);
+                      std::span<const double>(py_.data(), n), start, mx, my);
   last_result_ = res;
   const bool ok = res.ok && res.mean_error <= max_mean_error_ &&
                   std::hypot(res.pose.x - start.x, res.pose.y - start.y) <= max_jump_ &&
@@ -360,6 +367,12 @@ void PerfectMatchLocalizationUnit::ProcessScan(int k) {
   for (std::size_t i = 0; i < 9; ++i) {
     hessian_[i] = res.hessian[i];
     covariance_[i] = res.covariance[i];
+  }
+  const double sb2 = range_bias_sigma_ * range_bias_sigma_;
+  for (std::size_t a = 0; a < 3; ++a) {
+    for (std::size_t b = 0; b < 3; ++b) {
+      covariance_[3 * a + b] += sb2 * res.bias_sensitivity[a] * res.bias_sensitivity[b];
+    }
   }
   const double fp = covariance_floor_position_ * covariance_floor_position_;
   covariance_[0] += fp;

@@ -47,8 +47,10 @@ namespace linesim::estimation {
 ///    max_mean_error, or it lies farther than max_jump / max_jump_yaw from
 ///    its start;
 ///  - else accepted: position, yaw, covariance = the match's
-///    s^2 (2 / c^2) H^-1 (PerfectMatch) + diag(floor_p^2, floor_p^2,
-///    floor_yaw^2), hessian, match_error, match_inlier_fraction,
+///    s^2 (2 / c^2) H^-1 (PerfectMatch) + range_bias_sigma^2 g g^T (g the
+///    match's bias_sensitivity: a range bias common to a scan's beams, the
+///    LMS151's systematic error) + diag(floor_p^2, floor_p^2, floor_yaw^2),
+///    hessian, match_error, match_inlier_fraction,
 ///    match_time, match_count + 1.
 /// laser_status per laser: 0 ok, 1 no new scan within scan_timeout, 2
 /// blacked out, 3 rejected, 4 no such map. source: 0 the pose is from a
@@ -120,6 +122,7 @@ class PerfectMatchLocalizationUnit : public cosim::Unit {
   std::int64_t min_points_ = 20;
   double max_mean_error_ = 0.5, max_jump_ = 0.3, max_jump_yaw_ = 0.3;
   double covariance_floor_position_ = 0.0, covariance_floor_yaw_ = 0.0;
+  double range_bias_sigma_ = 0.0;
 
   // Inputs.
   std::vector<std::vector<double>> ranges_;

@@ -251,5 +251,71 @@ TEST(PerfectMatch, CovarianceMatchesTheScatterOfNoisyMatches) {
   EXPECT_LT(mean, 3.349);
 }
 
+// A range bias common to a scan's beams (the LMS151's systematic error,
+// +-30 mm typical, 8012471) shifts the match by g b to first order
+// (PerfectMatch::Result::bias_sensitivity). Exact ranges + 30 mm: the shift
+// is g b within the second-order term, b^2 / r over the ~1 m nearest ranges
+// (0.9 mm, taken 1 mm), and the map's own error (the tight bound of
+// RecoversOffset, 0.5 mm at 20 mm cells).
+TEST(PerfectMatch, BiasSensitivityPredictsTheShiftOfARangeBias) {
+  const models::Scene scene = Room();
+  const auto solids = SolidsAt(scene, 0.35);
+  const DistanceMap map(scene, 0.35, std::nullopt, {0.02, 1.0, 4.0});
+  const PerfectMatch pm({});
+  const PerfectMatch::Pose truth{1.3, -0.7, 0.4};
+  const double b = 0.03;
+  const Points p0 = ToPoints(Ranges(solids, truth.x, truth.y, truth.yaw));
+  const Points pb = ToPoints(Ranges(solids, truth.x, truth.y, truth.yaw, 0.0, nullptr, b));
+  const auto r0 = pm.Match(map, p0.x, p0.y, truth);
+  const auto rb = pm.Match(map, pb.x, pb.y, truth);
+  const auto& g = r0.bias_sensitivity;
+  std::printf("bias 30 mm: shift %.3f %.3f mm %.3f mrad, g b %.3f %.3f mm %.3f mrad\n",
+              (rb.pose.x - r0.pose.x) * 1e3, (rb.pose.y - r0.pose.y) * 1e3,
+              (rb.pose.yaw - r0.pose.yaw) * 1e3, g[0] * b * 1e3, g[1] * b * 1e3, g[2] * b * 1e3);
+  EXPECT_NEAR(rb.pose.x - r0.pose.x, g[0] * b, 1.5e-3);
+  EXPECT_NEAR(rb.pose.y - r0.pose.y, g[1] * b, 1.5e-3);
+  EXPECT_NEAR(rb.pose.yaw - r0.pose.yaw, g[2] * b, 1.5e-3 / 3.0);  // over the ~3 m ranges
+  // Not trivially zero: the room is seen off-centre.
+  EXPECT_GT(std::hypot(g[0], g[1]), 0.1);
+}
+
+// The same consistency with a bias drawn per scan, N(0, 15 mm) (the
+// LMS151 model's bias_sigma), and the covariance C + sigma_b^2 g g^T;
+// 200 scans: 95 % two-sided [2.670, 3.349].
+TEST(PerfectMatch, BiasTermMakesTheCovarianceConsistentWithABias) {
+  const models::Scene scene = Room();
+  const auto solids = SolidsAt(scene, 0.35);
+  const DistanceMap map(scene, 0.35, std::nullopt, {0.02, 1.0, 4.0});
+  const PerfectMatch pm({});
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const double sb = 0.015;
+  const int count = 200;
+  double sum = 0.0, sum_without = 0.0;
+  for (int k = 0; k < count; ++k) {
+    const PerfectMatch::Pose truth{-2.0 + 0.02 * k, -0.5 + 0.3 * std::sin(0.1 * k), 0.1 * k};
+    const double bias = sb * n(rng);
+    const Points p = ToPoints(Ranges(solids, truth.x, truth.y, truth.yaw, kNoise, &rng, bias));
+    const auto r = pm.Match(map, p.x, p.y, {truth.x + 0.02, truth.y - 0.01, truth.yaw + 0.01});
+    ASSERT_TRUE(r.ok);
+    std::array<double, 9> c = r.covariance;
+    std::array<double, 3> e = {r.pose.x - truth.x, r.pose.y - truth.y,
+                               std::remainder(r.pose.yaw - truth.yaw, 2 * std::numbers::pi)};
+    std::array<double, 3> sol{};
+    ASSERT_TRUE(SolveSymmetric3({c[0], c[1], c[2], c[4], c[5], c[8]}, e, sol));
+    sum_without += e[0] * sol[0] + e[1] * sol[1] + e[2] * sol[2];
+    for (std::size_t a = 0; a < 3; ++a)
+      for (std::size_t b = 0; b < 3; ++b)
+        c[3 * a + b] += sb * sb * r.bias_sensitivity[a] * r.bias_sensitivity[b];
+    ASSERT_TRUE(SolveSymmetric3({c[0], c[1], c[2], c[4], c[5], c[8]}, e, sol));
+    sum += e[0] * sol[0] + e[1] * sol[1] + e[2] * sol[2];
+  }
+  std::printf("per-match NEES with a 15 mm bias: %.3f with the bias term, %.1f without\n",
+              sum / count, sum_without / count);
+  EXPECT_GT(sum / count, 2.670);
+  EXPECT_LT(sum / count, 3.349);
+  EXPECT_GT(sum_without / count, 3.349);  // the term is needed
+}
+
 }  // namespace
 }  // namespace linesim::estimation
