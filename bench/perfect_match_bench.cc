@@ -94,7 +94,8 @@ BENCHMARK(BM_DistanceMapBuildFactory)->Arg(10)->Arg(20)->Arg(50)->Unit(benchmark
 
 // One match, started 5 cm, 3 cm, 1 deg off the truth (a robot at (1, -2.5)
 // heading +x, as the hector bench), at cell = arg0 / 1000 m; arg1: the
-// refinement's Gauss-Newton steps (0: Tribots' RPROP alone). Counters:
+// refinement's Gauss-Newton steps (0: Tribots' RPROP alone); arg2: 0 the
+// gradient tables (Tribots), 1 the interpolant's own gradient. Counters:
 // points, the error (mm, mrad; the scan carries the LMS151's noise and a
 // per-device bias), iterations.
 void BM_PerfectMatch541Factory(benchmark::State& state) {
@@ -104,6 +105,7 @@ void BM_PerfectMatch541Factory(benchmark::State& state) {
   const DistanceMap map(scene, kMountZ, std::nullopt, o);
   PerfectMatch::Options po;
   po.refine_iterations = static_cast<int>(state.range(1));
+  po.gradient_tables = state.range(2) == 0;
   const PerfectMatch pm(po);
   const double tx = 1.0, ty = -2.5, tyaw = 0.0;
   const Points s = Lms151Scan(scene, tx, ty, tyaw);
@@ -119,10 +121,14 @@ void BM_PerfectMatch541Factory(benchmark::State& state) {
   state.counters["iterations"] = r.iterations;
 }
 BENCHMARK(BM_PerfectMatch541Factory)
-    ->Args({10, 2})
-    ->Args({20, 0})
-    ->Args({20, 2})
-    ->Args({50, 2})
+    ->Args({10, 1, 0})
+    ->Args({20, 0, 0})
+    ->Args({20, 1, 0})
+    ->Args({20, 2, 0})
+    ->Args({50, 1, 0})
+    ->Args({10, 1, 1})
+    ->Args({20, 1, 1})
+    ->Args({50, 1, 1})
     ->Unit(benchmark::kMicrosecond);
 
 }  // namespace

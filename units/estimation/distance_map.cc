@@ -153,12 +153,13 @@ std::vector<std::array<double, 2>> DistanceMap::TerrainSlice(const models::Terra
   const double h[3] = {0.5 * t.length_m, 0.5 * t.width_m, 0.5 * t.thickness_m};
   std::array<std::array<double, 3>, 8> corner{};
   for (int i = 0; i < 8; ++i) {
-    const double u = (i & 1) ? h[0] : -h[0], v = (i & 2) ? h[1] : -h[1],
-                 w = (i & 4) ? h[2] : -h[2];
+    const double u = (i & 1) ? h[0] : -h[0], v = (i & 2) ? h[1] : -h[1], w = (i & 4) ? h[2] : -h[2];
     for (int j = 0; j < 3; ++j) {
-      corner[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] =
-          (j == 0 ? t.center_x_m : j == 1 ? t.center_y_m : t.center_z_m) + u * ax[j] +
-          v * ay[j] + w * az[j];
+      corner[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] = (j == 0   ? t.center_x_m
+                                                                          : j == 1 ? t.center_y_m
+                                                                                   : t.center_z_m) +
+                                                                         u * ax[j] + v * ay[j] +
+                                                                         w * az[j];
     }
   }
   Polygon pts;
@@ -246,11 +247,12 @@ DistanceMap::DistanceMap(const models::Scene& scene, double z, std::optional<Reg
       y1 = std::max(y1, q[1]);
     }
     const auto index = [&](double v, double origin, int count) {
-      return std::clamp(static_cast<int>(std::floor((v - origin) * inv_cell_ - 0.5)), 0,
-                        count - 1);
+      return std::clamp(static_cast<int>(std::floor((v - origin) * inv_cell_ - 0.5)), 0, count - 1);
     };
-    const int ix0 = index(x0 - w - cell_, origin_x_, nx_), ix1 = index(x1 + w + cell_, origin_x_, nx_);
-    const int iy0 = index(y0 - w - cell_, origin_y_, ny_), iy1 = index(y1 + w + cell_, origin_y_, ny_);
+    const int ix0 = index(x0 - w - cell_, origin_x_, nx_),
+              ix1 = index(x1 + w + cell_, origin_x_, nx_);
+    const int iy0 = index(y0 - w - cell_, origin_y_, ny_),
+              iy1 = index(y1 + w + cell_, origin_y_, ny_);
     for (int iy = iy0; iy <= iy1; ++iy) {
       const double y = origin_y_ + (iy + 0.5) * cell_;
       for (int ix = ix0; ix <= ix1; ++ix) {
@@ -309,10 +311,9 @@ DistanceMap::DistanceMap(const models::Scene& scene, double z, std::optional<Reg
       const std::size_t k = iy * sx + ix;
       const std::size_t xl = ix > 0 ? k - 1 : k, xr = ix + 1 < sx ? k + 1 : k;
       const std::size_t yl = iy > 0 ? k - sx : k, yr = iy + 1 < sy ? k + sx : k;
-      const double gx = (data_[3 * xr] - data_[3 * xl]) /
-                        (cell_ * static_cast<double>((xr - xl)));
-      const double gy = (data_[3 * yr] - data_[3 * yl]) /
-                        (cell_ * static_cast<double>((yr - yl) / sx));
+      const double gx = (data_[3 * xr] - data_[3 * xl]) / (cell_ * static_cast<double>((xr - xl)));
+      const double gy =
+          (data_[3 * yr] - data_[3 * yl]) / (cell_ * static_cast<double>((yr - yl) / sx));
       data_[3 * k + 1] = static_cast<float>(gx);
       data_[3 * k + 2] = static_cast<float>(gy);
     }

@@ -74,9 +74,9 @@ class DistanceMap {
     double min_x = 0.0, max_x = 0.0, min_y = 0.0, max_y = 0.0;
   };
   struct Options {
-    double cell = 0.02;        // m, the lookup grid's cell h
-    double margin = 1.0;       // m beyond the region (or the floor)
-    double band_cells = 4.0;   // the exact band, in cells (>= 2)
+    double cell = 0.02;       // m, the lookup grid's cell h
+    double margin = 1.0;      // m beyond the region (or the floor)
+    double band_cells = 4.0;  // the exact band, in cells (>= 2)
   };
   /// What outside the grid reads (m).
   static constexpr double kFar = 100.0;
@@ -84,8 +84,7 @@ class DistanceMap {
   /// The map of the scene's static solids at slice height z (m above the
   /// floor). Throws std::invalid_argument for a bad option, an empty
   /// region or a grid beyond 2^28 nodes.
-  DistanceMap(const models::Scene& scene, double z, std::optional<Region> region,
-              Options options);
+  DistanceMap(const models::Scene& scene, double z, std::optional<Region> region, Options options);
   ~DistanceMap();
   DistanceMap(const DistanceMap&) = delete;
   DistanceMap& operator=(const DistanceMap&) = delete;
@@ -109,14 +108,39 @@ class DistanceMap {
     }
     const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
     const double tx = fx - ix, ty = fy - iy;
-    const float* p = data_.data() + 3 * (static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) +
-                                         static_cast<std::size_t>(ix));
+    const float* p =
+        data_.data() + 3 * (static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) +
+                            static_cast<std::size_t>(ix));
     const float* q = p + 3 * static_cast<std::size_t>(nx_);
     const double w00 = (1.0 - tx) * (1.0 - ty), w10 = tx * (1.0 - ty), w01 = (1.0 - tx) * ty,
                  w11 = tx * ty;
     gx = w00 * p[1] + w10 * p[4] + w01 * q[1] + w11 * q[4];
     gy = w00 * p[2] + w10 * p[5] + w01 * q[2] + w11 * q[5];
     return w00 * p[0] + w10 * p[3] + w01 * q[0] + w11 * q[3];
+  }
+
+  /// Bilinear d (m) and the interpolant's own gradient (its derivative,
+  /// from the 4 nodes' d alone, no gradient tables). kFar and 0 outside
+  /// the grid.
+  double LookupInterpolant(double x, double y, double& gx, double& gy) const {
+    const double fx = (x - origin_x_) * inv_cell_ - 0.5;
+    const double fy = (y - origin_y_) * inv_cell_ - 0.5;
+    if (!(fx >= 0.0 && fy >= 0.0 && fx < nx_ - 1 && fy < ny_ - 1)) {
+      gx = gy = 0.0;
+      return kFar;
+    }
+    const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
+    const double tx = fx - ix, ty = fy - iy;
+    const float* p =
+        data_.data() + 3 * (static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) +
+                            static_cast<std::size_t>(ix));
+    const float* q = p + 3 * static_cast<std::size_t>(nx_);
+    const double v00 = p[0], v10 = p[3], v01 = q[0], v11 = q[3];
+    const double a = v00 + tx * (v10 - v00);
+    const double b = v01 + tx * (v11 - v01);
+    gx = ((v10 - v00) * (1.0 - ty) + (v11 - v01) * ty) * inv_cell_;
+    gy = (b - a) * inv_cell_;
+    return a + ty * (b - a);
   }
 
   double cell() const { return cell_; }
@@ -140,7 +164,7 @@ class DistanceMap {
   double cell_ = 0.0, inv_cell_ = 0.0, origin_x_ = 0.0, origin_y_ = 0.0;
   int nx_ = 0, ny_ = 0;
   std::size_t occupied_ = 0;
-  std::vector<float> data_;  // per node d, gx, gy; row-major in y
+  std::vector<float> data_;               // per node d, gx, gy; row-major in y
   std::unique_ptr<OccupancyGrid> probe_;  // the solids, for ExactDistance
 };
 

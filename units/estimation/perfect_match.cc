@@ -17,7 +17,9 @@ double PerfectMatch::Error(const DistanceMap& map, std::span<const double> px,
   for (std::size_t i = 0; i < n; ++i) {
     const double rx = cs * px[i] - sn * py[i], ry = sn * px[i] + cs * py[i];
     double gx, gy;
-    const double d = map.Lookup(pose.x + rx, pose.y + ry, gx, gy);
+    const double d = options_.gradient_tables
+                         ? map.Lookup(pose.x + rx, pose.y + ry, gx, gy)
+                         : map.LookupInterpolant(pose.x + rx, pose.y + ry, gx, gy);
     const double ef = c2 + d * d;
     e += 1.0 - c2 / ef;
     // d/dd of 1 - c^2 / (c^2 + d^2) = 2 c^2 d / (c^2 + d^2)^2; the point
@@ -31,9 +33,32 @@ double PerfectMatch::Error(const DistanceMap& map, std::span<const double> px,
   return e;
 }
 
+void PerfectMatch::Gradient(const DistanceMap& map, std::span<const double> px,
+                            std::span<const double> py, const Pose& pose,
+                            std::array<double, 3>& gradient) const {
+  // As Error without E: one division per point (RPROP needs the signs).
+  const double c2 = options_.c * options_.c;
+  const double cs = std::cos(pose.yaw), sn = std::sin(pose.yaw);
+  double g0 = 0.0, g1 = 0.0, g2 = 0.0;
+  const std::size_t n = std::min(px.size(), py.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const double rx = cs * px[i] - sn * py[i], ry = sn * px[i] + cs * py[i];
+    double gx, gy;
+    const double d = options_.gradient_tables
+                         ? map.Lookup(pose.x + rx, pose.y + ry, gx, gy)
+                         : map.LookupInterpolant(pose.x + rx, pose.y + ry, gx, gy);
+    const double inv = 1.0 / (c2 + d * d);
+    const double de = 2.0 * c2 * d * inv * inv;
+    g0 += de * gx;
+    g1 += de * gy;
+    g2 += de * (-gx * ry + gy * rx);
+  }
+  gradient = {g0, g1, g2};
+}
+
 PerfectMatch::Normal PerfectMatch::Accumulate(const DistanceMap& map, std::span<const double> px,
                                               std::span<const double> py, const Pose& pose,
-                                              double ox, double oy) const {
+                                              double ox, double oy, bool bias) const {
   const double c2 = options_.c * options_.c, c4 = c2 * c2;
   const double cs = std::cos(pose.yaw), sn = std::sin(pose.yaw);
   double a00 = 0, a01 = 0, a02 = 0, a11 = 0, a12 = 0, a22 = 0, b0 = 0, b1 = 0, b2 = 0;
@@ -43,7 +68,9 @@ PerfectMatch::Normal PerfectMatch::Accumulate(const DistanceMap& map, std::span<
   for (std::size_t i = 0; i < n; ++i) {
     const double rx = cs * px[i] - sn * py[i], ry = sn * px[i] + cs * py[i];
     double gx, gy;
-    const double d = map.Lookup(pose.x + rx, pose.y + ry, gx, gy);
+    const double d = options_.gradient_tables
+                         ? map.Lookup(pose.x + rx, pose.y + ry, gx, gy)
+                         : map.LookupInterpolant(pose.x + rx, pose.y + ry, gx, gy);
     if (d >= DistanceMap::kFar) {
       r.error += 1.0 - c2 / (c2 + d * d);
       continue;
@@ -64,6 +91,7 @@ PerfectMatch::Normal PerfectMatch::Accumulate(const DistanceMap& map, std::span<
     b2 += u * d * j2;
     r.udd += u * d * d;
     r.u += u;
+    if (!bias) continue;
     // The beam's direction in map: R (p - o) / |p - o|.
     const double bx = px[i] - ox, by = py[i] - oy;
     const double len = std::sqrt(bx * bx + by * by);
@@ -80,6 +108,7 @@ PerfectMatch::Normal PerfectMatch::Accumulate(const DistanceMap& map, std::span<
   r.a = {a00, a01, a02, a11, a12, a22};
   r.b = {b0, b1, b2};
   r.k = {k0, k1, k2};
+  r.bias = bias;
   return r;
 }
 
@@ -96,7 +125,7 @@ PerfectMatch::Result PerfectMatch::Match(const DistanceMap& map, std::span<const
   std::array<double, 3> g{};
   // RPROP as Tribots' VisualPositionOptimiser::optimise.
   for (int it = 0; it < iterations; ++it) {
-    Error(map, px, py, {param[0], param[1], param[2]}, g);
+    Gradient(map, px, py, {param[0], param[1], param[2]}, g);
     for (int j = 0; j < 3; ++j) {
       const double gj = g[static_cast<std::size_t>(j)];
       if (gj == 0.0) {
@@ -116,8 +145,9 @@ PerfectMatch::Result PerfectMatch::Match(const DistanceMap& map, std::span<const
   res.final_steps = {step[0], step[1], step[2]};
   Pose pose{param[0], param[1], param[2]};
   // Reweighted Gauss-Newton refinement, then the curvature at the end.
-  Normal nm = Accumulate(map, px, py, pose, origin_x, origin_y);
-  for (int it = 0; it < options_.refine_iterations; ++it) {
+  const int refine = options_.refine_iterations;
+  Normal nm = Accumulate(map, px, py, pose, origin_x, origin_y, refine == 0);
+  for (int it = 0; it < refine; ++it) {
     std::array<double, 3> dx{};
     if (!SolveSymmetric3(nm.a, nm.b, dx)) break;
     // A step beyond RPROP's first steps leaves the quadratic model: refused.
@@ -126,9 +156,11 @@ PerfectMatch::Result PerfectMatch::Match(const DistanceMap& map, std::span<const
       break;
     }
     pose = {pose.x - dx[0], pose.y - dx[1], pose.yaw - dx[2]};
-    nm = Accumulate(map, px, py, pose, origin_x, origin_y);
+    nm = Accumulate(map, px, py, pose, origin_x, origin_y, it + 1 == refine);
     ++res.iterations;
   }
+  // (A refinement refused before its last step: the bias sums once more.)
+  if (!nm.bias) nm = Accumulate(map, px, py, pose, origin_x, origin_y, true);
   res.pose = pose;
   res.error = nm.error;
   res.mean_error = res.points > 0 ? nm.error / res.points : 0.0;

@@ -31,8 +31,9 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
     const MapSpec& m = specs_[i];
     if (!std::isfinite(m.height_m) || !(m.cell_m >= 0.0 && m.cell_m <= 0.5) ||
         (m.region && !(m.region->max_x > m.region->min_x && m.region->max_y > m.region->min_y))) {
-      throw cosim::UnitError(Where() + ": map " + std::to_string(i) + " (" + m.name +
-                             ") needs a finite height_m, cell_m in [0, 0.5] and a region with max > min");
+      throw cosim::UnitError(
+          Where() + ": map " + std::to_string(i) + " (" + m.name +
+          ") needs a finite height_m, cell_m in [0, 0.5] and a region with max > min");
     }
   }
   std::size_t max_beams = 0;
@@ -104,8 +105,8 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
   v.Parameter("map_margin", "m", &map_margin_,
               "the lookup grid extends this far beyond each map's region (or the floor)",
               Rule::Range(0.0, 20.0));
-  v.Parameter("c", "m", &c_,
-              "scale of the error 1 - c^2 / (c^2 + d^2) (Tribots: 0.25 m)", Rule::Positive());
+  v.Parameter("c", "m", &c_, "scale of the error 1 - c^2 / (c^2 + d^2) (Tribots: 0.25 m)",
+              Rule::Positive());
   v.Parameter("step_position", "m", &step_position_,
               "RPROP's initial step in x and y (Tribots: 0.04 m)", Rule::Positive());
   v.Parameter("step_yaw", "rad", &step_yaw_, "RPROP's initial step in yaw (Tribots: 0.1 rad)",
@@ -143,8 +144,8 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
   v.Parameter("max_mean_error", "1", &max_mean_error_,
               "a match whose mean error E / n exceeds this is rejected (1: never)",
               Rule::Range(0.0, false, 1.0, true));
-  v.Parameter("max_jump", "m", &max_jump_,
-              "a match farther than this from its start is rejected", Rule::Positive());
+  v.Parameter("max_jump", "m", &max_jump_, "a match farther than this from its start is rejected",
+              Rule::Positive());
   v.Parameter("max_jump_yaw", "rad", &max_jump_yaw_,
               "a match turned more than this from its start is rejected", Rule::Positive());
   v.Parameter("covariance_floor_position", "m", &covariance_floor_position_,
@@ -198,8 +199,7 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
            "min_points returns), 3 last match rejected, 4 map_index names no map",
            {});
   v.Output("source", "1", &source_,
-           "0: pose from a match within scan_timeout; 1: held (or odometry-predicted) since",
-           {});
+           "0: pose from a match within scan_timeout; 1: held (or odometry-predicted) since", {});
 }
 
 PerfectMatchLocalizationUnit::~PerfectMatchLocalizationUnit() = default;
@@ -346,10 +346,9 @@ void PerfectMatchLocalizationUnit::ProcessScan(int k) {
   Pose start = estimate_;
   if (odometry_prediction_) start = Predict(odom_, cosim::NsToSeconds(match_ns - odom_ns_));
   map_in_use_ = static_cast<double>(map_index_);
-  const PerfectMatch::Result res =
-      matcher_->Match(*maps_[static_cast<std::size_t>(map_index_)],
-                      std::span<const double>(px_.data(), n),
-                      std::span<const double>(py_.data(), n), start, mx, my);
+  const PerfectMatch::Result res = matcher_->Match(
+      *maps_[static_cast<std::size_t>(map_index_)], std::span<const double>(px_.data(), n),
+      std::span<const double>(py_.data(), n), start, mx, my);
   last_result_ = res;
   const bool ok = res.ok && res.mean_error <= max_mean_error_ &&
                   std::hypot(res.pose.x - start.x, res.pose.y - start.y) <= max_jump_ &&

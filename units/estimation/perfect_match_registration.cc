@@ -27,7 +27,8 @@ std::optional<std::vector<int>> ReadBeams(const UnitBuildContext& c) {
   std::vector<int> beams;
   bool ok = true;
   for (std::size_t i = 0; i < list.size(); ++i) {
-    const auto n = c.reader.AsInteger(list[i], config::JoinPath(path, std::to_string(i)), 1, 100000);
+    const auto n =
+        c.reader.AsInteger(list[i], config::JoinPath(path, std::to_string(i)), 1, 100000);
     if (!n) {
       ok = false;
       continue;

@@ -47,7 +47,9 @@ std::unique_ptr<Unit> MakeUnit(const models::Scene& scene, std::vector<Unit::Map
   return u;
 }
 
-void SetMap(Unit& u, std::int64_t i) { u.variables().SetInteger(*u.variables().Find("map_index"), i); }
+void SetMap(Unit& u, std::int64_t i) {
+  u.variables().SetInteger(*u.variables().Find("map_index"), i);
+}
 
 // The LMS151's ranges with base_link at `p` (the laser at the mount).
 std::vector<double> ScanAt(const std::vector<models::Solid>& solids, const Pose& p,
@@ -272,9 +274,10 @@ TEST(PerfectMatchLocalization, FusedWithOdometryTheEkfIsConsistent) {
     worst = std::max(worst, nees);
   }
   const double mean = sum / seeds;
-  std::printf("EKF NEES mean %.3f over %d runs (95%%: [2.360, 3.716]), largest %.2f; "
-              "matches %d, fused %d\n",
-              mean, seeds, worst, matches, fused);
+  std::printf(
+      "EKF NEES mean %.3f over %d runs (95%%: [2.360, 3.716]), largest %.2f; "
+      "matches %d, fused %d\n",
+      mean, seeds, worst, matches, fused);
   EXPECT_EQ(matches, 150 * seeds);
   EXPECT_GE(fused, matches - seeds);  // the gate (99.9 %) refuses about 1 in 1000
   EXPECT_GT(mean, 2.360);
@@ -343,9 +346,10 @@ TEST(PerfectMatchLocalization, FactoryReadsBeamCountsAndMaps) {
   EXPECT_FALSE(make("{beam_counts: [541], maps: [{name: a}]}", issues));
   ASSERT_EQ(issues.size(), 1u);
   EXPECT_EQ(issues[0].key_path, "units.pm.parameters.maps.0.height_m");
-  EXPECT_FALSE(make("{beam_counts: [541], maps: [{name: a, height_m: 0.3, region: {min_x_m: 1, "
-                    "max_x_m: 0, min_y_m: 0, max_y_m: 1}}]}",
-                    issues));
+  EXPECT_FALSE(
+      make("{beam_counts: [541], maps: [{name: a, height_m: 0.3, region: {min_x_m: 1, "
+           "max_x_m: 0, min_y_m: 0, max_y_m: 1}}]}",
+           issues));
   ASSERT_EQ(issues.size(), 1u);
   EXPECT_FALSE(make("{beam_counts: [541], maps: [{name: a, height_m: 0.3, hieght: 1}]}", issues));
   ASSERT_GE(issues.size(), 1u);

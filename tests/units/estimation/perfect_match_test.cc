@@ -78,9 +78,10 @@ TEST(PerfectMatch, RpropAloneEndsNearTheOptimumAndTheRefinementAtIt) {
   EXPECT_EQ(r0.iterations, 10);  // Tribots: 10 with more than 20 points
   const double e0 = std::hypot(r0.pose.x - truth.x, r0.pose.y - truth.y);
   const double e2 = std::hypot(r2.pose.x - truth.x, r2.pose.y - truth.y);
-  std::printf("RPROP alone: %.3f mm %.3f mrad (last steps %.3f %.3f mm %.3f mrad); refined %.4f mm\n",
-              e0 * 1e3, (r0.pose.yaw - truth.yaw) * 1e3, r0.final_steps[0] * 1e3,
-              r0.final_steps[1] * 1e3, r0.final_steps[2] * 1e3, e2 * 1e3);
+  std::printf(
+      "RPROP alone: %.3f mm %.3f mrad (last steps %.3f %.3f mm %.3f mrad); refined %.4f mm\n",
+      e0 * 1e3, (r0.pose.yaw - truth.yaw) * 1e3, r0.final_steps[0] * 1e3, r0.final_steps[1] * 1e3,
+      r0.final_steps[2] * 1e3, e2 * 1e3);
   EXPECT_LT(e0, 0.04);
   EXPECT_LE(e2, e0);
   // 20 iterations with 20 points or fewer (Tribots).
@@ -116,8 +117,8 @@ TEST(PerfectMatch, ErrorAndGradientAreLauersFunction) {
     *l -= step[j];
     *u += step[j];
     std::array<double, 3> dummy{};
-    const double num = (pm.Error(map, px, py, hi, dummy) - pm.Error(map, px, py, lo, dummy)) /
-                       (2.0 * step[j]);
+    const double num =
+        (pm.Error(map, px, py, hi, dummy) - pm.Error(map, px, py, lo, dummy)) / (2.0 * step[j]);
     // The gradient table is the nodes' central differences, interpolated:
     // equal to the interpolant's derivative where d is linear.
     EXPECT_NEAR(g[static_cast<std::size_t>(j)], num, 1e-3 * (1.0 + std::abs(num))) << j;
@@ -152,7 +153,8 @@ TEST(DistanceMap, HoldsTheSignedDistanceToTheSlice) {
     }
   }
   EXPECT_LT(worst_band, 1e-6);
-  std::printf("h %.3f: band nodes worst %.2e m, far nodes worst %.4f m\n", h, worst_band, worst_far);
+  std::printf("h %.3f: band nodes worst %.2e m, far nodes worst %.4f m\n", h, worst_band,
+              worst_far);
   EXPECT_LE(worst_far, (std::sqrt(2.0) - 0.5) * h + h * h / 0.25);
   // The carried body's place (-1, 1) is free: the map reads a distance to
   // another solid there, not 0.
@@ -183,8 +185,10 @@ TEST(DistanceMap, SliceOfATiltedTerrainBoxIsWhereGeometrySaysIt) {
   const double cp = std::cos(t.pitch_rad), sp = std::sin(t.pitch_rad), dz = z - t.center_z_m;
   // u in [-L/2, L/2]: x - cx in [(-L/2 - dz sp) / cp, (L/2 - dz sp) / cp]
   // w in [-T/2, T/2]: x - cx in [(dz cp - T/2) / sp, (dz cp + T/2) / sp]
-  const double lo = std::max((-0.5 * t.length_m - dz * sp) / cp, (dz * cp - 0.5 * t.thickness_m) / sp);
-  const double hi = std::min((0.5 * t.length_m - dz * sp) / cp, (dz * cp + 0.5 * t.thickness_m) / sp);
+  const double lo =
+      std::max((-0.5 * t.length_m - dz * sp) / cp, (dz * cp - 0.5 * t.thickness_m) / sp);
+  const double hi =
+      std::min((0.5 * t.length_m - dz * sp) / cp, (dz * cp + 0.5 * t.thickness_m) / sp);
   const auto poly = DistanceMap::TerrainSlice(t, z);
   ASSERT_GE(poly.size(), 4u);
   double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
@@ -211,8 +215,7 @@ TEST(DistanceMap, SliceOfATiltedTerrainBoxIsWhereGeometrySaysIt) {
   EXPECT_NEAR(map.Lookup(t.center_x_m + hi + 0.03, 0.2, gx, gy), 0.03, 1e-6);
   EXPECT_NEAR(gx, 1.0, 1e-5);
   EXPECT_NEAR(map.Lookup(t.center_x_m + lo - 0.02, 0.2, gx, gy), 0.02, 1e-6);
-  EXPECT_NEAR(map.Lookup(0.5 * (2 * t.center_x_m + lo + hi), 0.2 + 0.6 + 0.04, gx, gy), 0.04,
-              1e-6);
+  EXPECT_NEAR(map.Lookup(0.5 * (2 * t.center_x_m + lo + hi), 0.2 + 0.6 + 0.04, gx, gy), 0.04, 1e-6);
   EXPECT_LT(map.Lookup(t.center_x_m + 0.5 * (lo + hi), 0.2, gx, gy), 0.0);  // inside
   // A region that does not hold the slice leaves it out.
   const DistanceMap none(s, z, DistanceMap::Region{0.0, 2.0, -2.0, 2.0}, {0.02, 0.5, 4.0});

@@ -1,6 +1,8 @@
 #pragma once
 // Synthetic scenes and exact scans for the Perfect Match tests.
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -12,12 +14,10 @@
 #include <utility>
 #include <vector>
 
-#include <gtest/gtest.h>
-
 #include "models/scene.h"
 #include "units/estimation/distance_map.h"
-#include "units/estimation/scan_matcher.h"
 #include "units/estimation/perfect_match.h"
+#include "units/estimation/scan_matcher.h"
 
 namespace linesim::estimation::pmtest {
 
@@ -179,23 +179,22 @@ inline models::Scene VanBay() {
   const auto box = [](double x, double y, double l, double w, double bottom, double top) {
     return models::BoxSolid(x, y, 0.0, l, w, top - bottom, bottom);
   };
-  s.obstacles = {
-      Ob("hall_n", box(2.0, 4.85, 16.0, 0.3, 0.0, 4.0)),
-      Ob("hall_s", box(2.0, -4.85, 16.0, 0.3, 0.0, 4.0)),
-      Ob("hall_w", box(-5.85, 0.0, 0.3, 10.0, 0.0, 4.0)),
-      Ob("hall_e", box(9.85, 0.0, 0.3, 10.0, 0.0, 4.0)),
-      Ob("cart", box(-4.0, 3.0, 1.2, 0.8, 0.0, 1.0)),
-      Ob("rack", box(8.0, 3.5, 2.0, 0.6, 0.0, 2.0)),
-      Ob("pillar", models::CylinderSolid(1.0, -3.5, 0.25, 4.0)),
-      Ob("van_left", box(5.55, 0.9075, 3.1, 0.05, 0.30, 2.44)),
-      Ob("van_right", box(5.55, -0.9075, 3.1, 0.05, 0.30, 2.44)),
-      Ob("van_front", box(7.125, 0.0, 0.05, 1.865, 0.30, 2.44)),
-      Ob("arch_left", box(5.1, 0.78625, 0.7, 0.1925, 0.54, 0.82)),
-      Ob("arch_right", box(5.1, -0.78625, 0.7, 0.1925, 0.54, 0.82)),
-      Ob("beacon1", models::CylinderSolid(6.0, 0.75, 0.04, 0.8, 0.54)),
-      Ob("beacon2", models::CylinderSolid(6.0, -0.75, 0.04, 0.8, 0.54)),
-      Ob("beacon3", models::CylinderSolid(6.95, 0.75, 0.04, 0.8, 0.54)),
-      Ob("beacon4", models::CylinderSolid(6.95, -0.75, 0.04, 0.8, 0.54))};
+  s.obstacles = {Ob("hall_n", box(2.0, 4.85, 16.0, 0.3, 0.0, 4.0)),
+                 Ob("hall_s", box(2.0, -4.85, 16.0, 0.3, 0.0, 4.0)),
+                 Ob("hall_w", box(-5.85, 0.0, 0.3, 10.0, 0.0, 4.0)),
+                 Ob("hall_e", box(9.85, 0.0, 0.3, 10.0, 0.0, 4.0)),
+                 Ob("cart", box(-4.0, 3.0, 1.2, 0.8, 0.0, 1.0)),
+                 Ob("rack", box(8.0, 3.5, 2.0, 0.6, 0.0, 2.0)),
+                 Ob("pillar", models::CylinderSolid(1.0, -3.5, 0.25, 4.0)),
+                 Ob("van_left", box(5.55, 0.9075, 3.1, 0.05, 0.30, 2.44)),
+                 Ob("van_right", box(5.55, -0.9075, 3.1, 0.05, 0.30, 2.44)),
+                 Ob("van_front", box(7.125, 0.0, 0.05, 1.865, 0.30, 2.44)),
+                 Ob("arch_left", box(5.1, 0.78625, 0.7, 0.1925, 0.54, 0.82)),
+                 Ob("arch_right", box(5.1, -0.78625, 0.7, 0.1925, 0.54, 0.82)),
+                 Ob("beacon1", models::CylinderSolid(6.0, 0.75, 0.04, 0.8, 0.54)),
+                 Ob("beacon2", models::CylinderSolid(6.0, -0.75, 0.04, 0.8, 0.54)),
+                 Ob("beacon3", models::CylinderSolid(6.95, 0.75, 0.04, 0.8, 0.54)),
+                 Ob("beacon4", models::CylinderSolid(6.95, -0.75, 0.04, 0.8, 0.54))};
   for (auto& o : s.obstacles) {
     if (o.name.rfind("van", 0) == 0) o.kind = "vehicle";
     if (o.name.rfind("beacon", 0) == 0) o.kind = "beacon";
@@ -238,9 +237,9 @@ namespace linesim::estimation::pmtest {
 // bilinear error (h^2 / 8)(|d_xx| + |d_yy|), |d''| <= 1 / rho); plus 1e-6 m
 // for the float tables.
 inline std::array<double, 3> PoseErrorBound(const Features& f, const Points& p,
-                                     const PerfectMatch::Pose& truth,
-                                     const std::array<double, 9>& hessian, double h, double c,
-                                     const DistanceMap* measured = nullptr) {
+                                            const PerfectMatch::Pose& truth,
+                                            const std::array<double, 9>& hessian, double h,
+                                            double c, const DistanceMap* measured = nullptr) {
   double sum = 0.0;
   const double cs = std::cos(truth.yaw), sn = std::sin(truth.yaw);
   for (std::size_t i = 0; i < p.x.size(); ++i) {
@@ -254,8 +253,8 @@ inline std::array<double, 3> PoseErrorBound(const Features& f, const Points& p,
       if (std::abs(std::hypot(x - cyl[0], y - cyl[1]) - cyl[2]) < 1e-6) {
         // (R <= sqrt(2) h: only the Lipschitz bound.)
         const double den = cyl[2] - std::sqrt(2.0) * h;
-        e = std::max(e, den > 0.0 ? std::min(h * h / (4.0 * den), std::sqrt(2.0) * h)
-                                  : std::sqrt(2.0) * h);
+        e = std::max(
+            e, den > 0.0 ? std::min(h * h / (4.0 * den), std::sqrt(2.0) * h) : std::sqrt(2.0) * h);
       }
     }
     if (measured) {
@@ -275,9 +274,7 @@ inline std::array<double, 3> PoseErrorBound(const Features& f, const Points& p,
   std::array<double, 9> inv{};
   EXPECT_TRUE(InverseSymmetric3(a, inv));
   const double k = 2.0 / (c * c);  // H = (2 / c^2) A: A^-1 = (2 / c^2) H^-1
-  return {std::sqrt(sum * inv[0] * k), std::sqrt(sum * inv[4] * k),
-          std::sqrt(sum * inv[8] * k)};
+  return {std::sqrt(sum * inv[0] * k), std::sqrt(sum * inv[4] * k), std::sqrt(sum * inv[8] * k)};
 }
-
 
 }  // namespace linesim::estimation::pmtest
