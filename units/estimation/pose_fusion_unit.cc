@@ -59,8 +59,9 @@ PoseFusionUnit::PoseFusionUnit(std::string name) : cosim::Unit(kTypeName, std::m
   // (0.19, 0.11, 0.093, 0.081 m; the crossing 4.8, 5.0, 5.3, 5.0 mm).
   v.Parameter("offset_random_walk", "m/(s2.Hz^0.5)", &offset_random_walk_,
               "random-walk intensity of the velocity offset b: each coordinate's variance grows "
-              "by offset_random_walk^2 dt",
-              cosim::Rule::Positive());
+              "by offset_random_walk^2 dt (0 with initial_offset_sigma 0: b stays 0, a 3-state "
+              "EKF on x, y, yaw, as for a skid-steer robot off the belt line, paper 2)",
+              cosim::Rule::NonNegative());
   // ASSUMPTIONS: the start pose is known to a tenth of a metre and radian
   // (the scenario gives it); b starts at 0 with the representative belt
   // speed of automotive lines, 0.1 m/s (paper 1, Sec. V), as its sigma.
@@ -69,8 +70,9 @@ PoseFusionUnit::PoseFusionUnit(std::string name) : cosim::Unit(kTypeName, std::m
   v.Parameter("initial_yaw_sigma", "rad", &initial_yaw_sigma_,
               "standard deviation of the initial yaw", cosim::Rule::Positive());
   v.Parameter("initial_offset_sigma", "m/s", &initial_offset_sigma_,
-              "standard deviation of the initial velocity offset (b starts at 0)",
-              cosim::Rule::Positive());
+              "standard deviation of the initial velocity offset (b starts at 0; 0 keeps it 0 "
+              "with offset_random_walk 0)",
+              cosim::Rule::NonNegative());
   // The finest hector_mapping grid cell is 0.025 m (paper 1's
   // localization): a match is not better than its quantization,
   // 0.025 / sqrt(12) = 7 mm; 0.01 m with margin. Yaw: 0.005 rad, the angle

@@ -1,0 +1,161 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cosim/time.h"
+#include "cosim/unit.h"
+#include "models/scene.h"
+#include "units/estimation/distance_map.h"
+#include "units/estimation/perfect_match.h"
+
+namespace linesim::estimation {
+
+/// Laser localization as paper 2 runs it (Sobreira et al. 2019, "Autonomous
+/// Robot Navigation for Automotive Assembly Task: An Industry Use-Case",
+/// Sec. 4): Perfect Match (PerfectMatch, Lauer, Lange, Riedmiller 2005) of
+/// each new scan against a distance map of the scene (DistanceMap), one of
+/// several maps chosen per scan by the `map_index` input (paper 2: the
+/// factory map outside, the van interior's map inside, the transition set
+/// by the position along the robot's path). Its outputs feed pose_fusion's
+/// match inputs (the EKF with odometry).
+///
+/// 3-DoF as paper 2's matcher: each laser's beams are put into base_link by
+/// its mount's x, y and yaw; roll and pitch (of the mount and of the robot
+/// on a ramp) are ignored. The maps are horizontal slices of the scene's
+/// static solids (structural key `maps`: name, height_m, optional region),
+/// all built in Initialize (before time zero); switching maps never resets
+/// the pose.
+///
+/// Per new scan of laser k (scan_count_k changed; several lasers' scans in
+/// one step in the order of their match times):
+///  - points: beam i at angle first_beam_angle + i angular_step, measured
+///    at scan_time + i angular_step / (2 pi) scan_period; returns outside
+///    [range_min, usable_range_max] (0 = no return) skipped; with `deskew`
+///    (and motion_prediction odometry) each point is moved from its beam's
+///    time to the match time (the middle beam's) by the odometry twist;
+///  - map_index outside 0..maps-1: laser_status 4, no match;
+///  - fewer than min_points: laser_status 2, no match;
+///  - the start: the last accepted match, moved to the match time by the
+///    odometry inputs with motion_prediction odometry (Tribots starts from
+///    the odometry-predicted pose);
+///  - the match; REJECTED (laser_status 3, the estimate unchanged) when its
+///    curvature is not positive definite, its mean error E / n exceeds
+///    max_mean_error, or it lies farther than max_jump / max_jump_yaw from
+///    its start;
+///  - else accepted: position, yaw, covariance = the match's
+///    s^2 (2 / c^2) H^-1 (PerfectMatch) + range_bias_sigma^2 g g^T (g the
+///    match's bias_sensitivity: a range bias common to a scan's beams, the
+///    LMS151's systematic error) + diag(floor_p^2, floor_p^2, floor_yaw^2),
+///    hessian, match_error, match_inlier_fraction,
+///    match_time, match_count + 1.
+/// laser_status per laser: 0 ok, 1 no new scan within scan_timeout, 2
+/// blacked out, 3 rejected, 4 no such map. source: 0 the pose is from a
+/// match within scan_timeout, 1 held (or odometry-predicted with
+/// motion_prediction odometry) since.
+class PerfectMatchLocalizationUnit : public cosim::Unit {
+ public:
+  static constexpr const char* kTypeName = "perfect_match_localization";
+  static constexpr int kMaxLasers = 8;
+  static constexpr int kMaxMaps = 16;
+
+  struct MapSpec {
+    std::string name;
+    double height_m = 0.0;  // the slice's z above the floor
+    std::optional<DistanceMap::Region> region;
+    /// The lookup grid's cell for this map (m); 0: the lookup_cell parameter.
+    double cell_m = 0.0;
+  };
+
+  /// One entry of `beam_counts` per laser (1..kMaxLasers, each 1..100000
+  /// beams), 1..kMaxMaps maps with finite heights; throws cosim::UnitError
+  /// otherwise. The scene is copied (the maps are built in Initialize).
+  PerfectMatchLocalizationUnit(std::string name, const models::Scene& scene,
+                               std::vector<int> beam_counts, std::vector<MapSpec> maps);
+  ~PerfectMatchLocalizationUnit() override;
+
+  std::vector<cosim::ParameterProblem> CheckParameters() const override;
+  void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
+  void Initialize() override;
+  cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
+
+  int laser_count() const { return static_cast<int>(beam_counts_.size()); }
+  int map_count() const { return static_cast<int>(specs_.size()); }
+  /// Map i (after Initialize).
+  const DistanceMap& map(int i) const { return *maps_[static_cast<std::size_t>(i)]; }
+  const MapSpec& map_spec(int i) const { return specs_[static_cast<std::size_t>(i)]; }
+  /// The last match tried (accepted or not).
+  const PerfectMatch::Result& last_result() const { return last_result_; }
+
+ protected:
+  void SaveInternal(cosim::UnitState& state) const override;
+  void RestoreInternal(const cosim::UnitState& state) override;
+
+ private:
+  using Pose = PerfectMatch::Pose;
+  void Derive();
+  void ProcessScan(int k);
+  Pose Predict(const Pose& p, double seconds) const;
+  void SetStatus(int k, int status) { laser_status_[static_cast<std::size_t>(k)] = status; }
+
+  std::vector<int> beam_counts_;
+  std::vector<MapSpec> specs_;
+  models::Scene scene_;
+  std::vector<std::unique_ptr<DistanceMap>> maps_;
+  double built_cell_ = 0.0, built_margin_ = 0.0;  // what maps_ were built with
+  std::unique_ptr<PerfectMatch> matcher_;
+
+  // Parameters (lists: one element per laser).
+  std::vector<double> mount_x_, mount_y_, mount_yaw_, first_beam_angle_, angular_step_,
+      scan_period_;
+  double range_min_ = 0.5, usable_range_max_ = 50.0;
+  double lookup_cell_ = 0.02, map_margin_ = 1.0;
+  double c_ = 0.25, step_position_ = 0.04, step_yaw_ = 0.1;
+  std::int64_t iterations_ = 10, few_iterations_ = 20, few_points_ = 20, refine_iterations_ = 1;
+  double initial_x_, initial_y_, initial_yaw_;
+  std::string motion_prediction_ = "none";
+  bool deskew_ = false;
+  double scan_timeout_ = 0.2;
+  std::int64_t min_points_ = 20;
+  double max_mean_error_ = 0.5, max_jump_ = 0.3, max_jump_yaw_ = 0.3;
+  double covariance_floor_position_ = 0.0, covariance_floor_yaw_ = 0.0;
+  double range_bias_sigma_ = 0.0;
+
+  // Inputs.
+  std::vector<std::vector<double>> ranges_;
+  std::vector<double> scan_count_, scan_time_;
+  std::vector<double> odometry_velocity_;
+  double odometry_yaw_rate_ = 0.0;
+  std::int64_t map_index_ = 0;
+
+  // Outputs.
+  std::vector<double> position_, covariance_, hessian_, laser_status_;
+  double yaw_ = 0.0, match_time_ = 0.0, match_count_ = 0.0, match_error_ = 0.0,
+         match_inlier_fraction_ = 0.0, source_ = 1.0, map_in_use_ = 0.0;
+
+  // Derived: per laser and beam, cos and sin of the beam's direction in
+  // base_link and its time after the scan's start.
+  std::vector<std::vector<double>> beam_cos_, beam_sin_, beam_dt_;
+  std::vector<cosim::TimeNs> mid_offset_ns_;
+  bool odometry_prediction_ = false;
+
+  // Scratch (sized in the constructor).
+  std::vector<double> px_, py_;
+  std::vector<int> order_;
+  PerfectMatch::Result last_result_;
+
+  // State.
+  cosim::TimeNs start_ = 0;
+  std::vector<double> last_count_;
+  std::vector<cosim::TimeNs> last_scan_ns_;
+  Pose estimate_;
+  cosim::TimeNs estimate_ns_ = 0;
+  bool have_match_ = false;
+  Pose odom_;
+  cosim::TimeNs odom_ns_ = 0;
+};
+
+}  // namespace linesim::estimation
