@@ -151,6 +151,8 @@ YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
     assembly::AddSensing(b, *file, start, scene, s);
     assembly::AddControl(b, *file, s);
     assembly::AddTask(b, *file, start, s, info);
+    assembly::ConnectMapSwitch(b, s);
+    assembly::AddBeaconGroundTruth(b, *file, start, scene, s);
     assembly::AddEvaluation(b, file->robot, s, info);
     assembly::AddRecording(b, s, info);
   }

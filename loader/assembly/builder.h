@@ -29,6 +29,9 @@ inline constexpr const char* kLaserLocalization = "laser_localization";
 inline constexpr const char* kOdometry = "odometry";
 inline constexpr const char* kPoseFusion = "pose_fusion";
 inline constexpr const char* kLocalizationError = "localization_error";
+inline constexpr const char* kPerfectMatch = "perfect_match";
+inline constexpr const char* kBeacons = "beacons";
+inline constexpr const char* kFinalPose = "final_pose";
 /// The Rob@Work 3 control cycle (IPA cob_control configuration): the
 /// controllers' period unless control.period_s says otherwise.
 inline constexpr cosim::TimeNs kControlPeriod = cosim::kNsPerSecond / 50;

@@ -39,6 +39,16 @@ struct Signals {
   /// The wheel controller's command inputs, which the task drives.
   std::string velocity_command_input, yaw_rate_command_input;
 
+  /// Map switching (paper 2): the localization's maps by name and its map
+  /// index input (empty without one); a route's maps by name (its graph's),
+  /// the follower's map index output, its done output and the route's end
+  /// pose {x, y, yaw} (empty without a route).
+  std::vector<std::string> localization_maps, route_maps;
+  std::string map_index_input, map_index_output, route_done;
+  std::vector<double> route_end;
+  /// The beacon system measuring the final pose ("" for none).
+  std::string beacon_unit;
+
   /// Belts of the scene: how many, and the belt unit's outputs.
   std::size_t belt_count = 0;
   /// Whether the scene has terrain pieces (the robot's height varies).
@@ -80,6 +90,18 @@ void AddLine(SystemBuilder& b, const models::Scene& scene, Signals& s);
 /// lasers, IMU, wheel encoders) and the belt's ground-truth encoder, as
 /// the scenario's `sensors:` section enables and configures them.
 void AddSensors(SystemBuilder& b, const RobotFile& robot, Signals& s);
+
+/// Connects the route follower's map index to the localization's (paper 2's
+/// map switching), after the task: the graph's maps and localization.maps
+/// must be the same names in the same order. Several maps without a route
+/// are refused.
+void ConnectMapSwitch(SystemBuilder& b, const Signals& s);
+
+/// Paper 2's ground truth: a beacon system (beacon_localization on the
+/// robot's first laser) when the scene has at least three beacons and the
+/// task is a route (the beacons are uncovered once it is done).
+void AddBeaconGroundTruth(SystemBuilder& b, const RobotFile& robot, const StartPose& start,
+                          const models::Scene& scene, Signals& s);
 
 /// sensing.surface_velocity and localization.source: who tells the
 /// controllers the surface velocity under each wheel and the pose

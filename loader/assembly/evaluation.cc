@@ -51,6 +51,34 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
   add("min_clearance_m", Signal(kClearance, "min_clearance"), "final");
   add("collisions", Signal(kClearance, "collisions"), "final");
 
+  // Paper 2 Table 1: the final pose against the route's end (the work
+  // pose), from the truth and from the beacons.
+  if (!s.route_end.empty()) {
+    b.Unit(kFinalPose, "final_pose_error");
+    YAML::Node f = b.Params(kFinalPose);
+    f["target_x"] = Num(s.route_end[0]);
+    f["target_y"] = Num(s.route_end[1]);
+    f["target_yaw"] = Num(s.route_end[2]);
+    f["beacons"] = !s.beacon_unit.empty();
+    b.Connect(s.true_position, Signal(kFinalPose, "position"));
+    b.Connect(s.true_yaw, Signal(kFinalPose, "yaw"));
+    b.Connect(s.route_done, Signal(kFinalPose, "done"));
+    add("final_error_x_m", Signal(kFinalPose, "error_x"), "final");
+    add("final_error_y_m", Signal(kFinalPose, "error_y"), "final");
+    add("final_error_yaw_deg", Signal(kFinalPose, "error_yaw"), "final");
+    if (!s.beacon_unit.empty()) {
+      b.Connect(Signal(s.beacon_unit, "position"), Signal(kFinalPose, "beacon_position"));
+      b.Connect(Signal(s.beacon_unit, "yaw"), Signal(kFinalPose, "beacon_yaw"));
+      b.Connect(Signal(s.beacon_unit, "valid"), Signal(kFinalPose, "beacon_valid"));
+      add("beacon_error_x_m", Signal(kFinalPose, "beacon_error_x"), "final");
+      add("beacon_error_y_m", Signal(kFinalPose, "beacon_error_y"), "final");
+      add("beacon_error_yaw_deg", Signal(kFinalPose, "beacon_error_yaw"), "final");
+      add("beacon_self_error_position_m", Signal(kFinalPose, "beacon_self_error_position"),
+          "final");
+      add("beacon_self_error_yaw_deg", Signal(kFinalPose, "beacon_self_error_yaw"), "final");
+    }
+  }
+
   // The localization the controllers use against the truth, when it is not
   // the truth itself.
   if (s.position != s.true_position) {

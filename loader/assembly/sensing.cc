@@ -164,10 +164,114 @@ void AddLaserLocalization(SystemBuilder& b, const ProviderContext& c, Signals& s
   s.localization_sources.push_back(Signal(kLaserLocalization, "source"));
 }
 
-// The odometry's twist into the matcher (for motion_prediction: odometry).
-void ConnectOdometryToMatcher(SystemBuilder& b) {
-  b.Connect(Signal(kOdometry, "body_velocity"), Signal(kLaserLocalization, "odometry_velocity"));
-  b.Connect(Signal(kOdometry, "yaw_rate"), Signal(kLaserLocalization, "odometry_yaw_rate"));
+// Perfect Match (paper 2 Sec. 4, after Lauer, Lange and Riedmiller 2005)
+// on the robot's lasers against maps sliced from the scene at the scan
+// height: `localization.maps` lists them ({name, floor_m, region, cell_m});
+// a route's graph chooses one per segment (ConnectMapSwitch). Without the
+// key, one map of the whole scene on the floor.
+void AddPerfectMatch(SystemBuilder& b, const ProviderContext& c, Signals& s) {
+  YamlReader& r = b.reader();
+  const auto lasers = Mounts(s, "laser_scanner");
+  b.Unit(kPerfectMatch, "perfect_match_localization");
+  YAML::Node p = b.Params(kPerfectMatch);
+  std::vector<int> beams;
+  std::vector<double> x, y, yaw, first, step, period;
+  std::optional<double> range_min, bias_sigma;
+  for (std::size_t k = 0; k < lasers.size(); ++k) {
+    const models::SensorMount& m = *lasers[k];
+    const DeviceNumbers device(b, c, m);
+    beams.push_back(static_cast<int>(device.Required("beam_count")));
+    x.push_back(m.x_m);
+    y.push_back(m.y_m);
+    yaw.push_back(m.yaw_rad);
+    first.push_back(device.Required("first_beam_angle"));
+    step.push_back(device.Required("angular_step"));
+    period.push_back(device.Required("scan_period"));
+    // The nearest usable range of all lasers, and the largest per-device
+    // range bias (the LMS151's systematic error) for the match covariance.
+    if (const auto v = device.Get("range_min")) range_min = std::max(range_min.value_or(0.0), *v);
+    if (const auto v = device.Get("bias_sigma")) bias_sigma = std::max(bias_sigma.value_or(0.0), *v);
+    const std::string suffix = "_" + std::to_string(k);
+    b.Connect(Signal(m.name, "ranges"), Signal(kPerfectMatch, "ranges" + suffix));
+    b.Connect(Signal(m.name, "scan_count"), Signal(kPerfectMatch, "scan_count" + suffix));
+    b.Connect(Signal(m.name, "scan_time"), Signal(kPerfectMatch, "scan_time" + suffix));
+  }
+  p["beam_counts"] = IntList(beams);
+  p["mount_x"] = List(x);
+  p["mount_y"] = List(y);
+  p["mount_yaw"] = List(yaw);
+  p["first_beam_angle"] = List(first);
+  p["angular_step"] = List(step);
+  p["scan_period"] = List(period);
+  if (range_min) p["range_min"] = Num(*range_min);
+  if (bias_sigma) p["range_bias_sigma"] = Num(*bias_sigma);
+  // 3 DoF as paper 2's matcher: every map is a slice at the first laser's
+  // height above the map's floor.
+  const double scan_z = lasers.empty() ? 0.0 : lasers.front()->z_m;
+  YAML::Node maps(YAML::NodeType::Sequence);
+  const YAML::Node given = Child(c.at, "maps");
+  if (!given.IsDefined()) {
+    YAML::Node one;
+    one["name"] = "scene";
+    one["height_m"] = Num(scan_z);
+    maps.push_back(one);
+    s.localization_maps = {"scene"};
+  } else if (r.ExpectSequence(given, "localization.maps")) {
+    if (given.size() == 0) r.Error(given, "localization.maps", "expected at least one map");
+    for (std::size_t i = 0; i < given.size(); ++i) {
+      const std::string path = JoinPath("localization.maps", std::to_string(i));
+      if (!r.ExpectMap(given[i], path)) continue;
+      r.CheckKeys(given[i], path, {"name", "floor_m", "region", "cell_m"});
+      YAML::Node one;
+      const std::string name = r.String(given[i], path, "name", std::nullopt);
+      one["name"] = name;
+      one["height_m"] = Num(r.Real(given[i], path, "floor_m", 0.0, {-10.0, 100.0}) + scan_z);
+      for (const char* key : {"region", "cell_m"}) {
+        if (Child(given[i], key).IsDefined()) one[key] = Child(given[i], key);
+      }
+      maps.push_back(one);
+      s.localization_maps.push_back(name);
+    }
+  }
+  p["maps"] = maps;
+  b.Origin(JoinPath(JoinPath(JoinPath("units", kPerfectMatch), "parameters"), "maps"),
+           {given.IsDefined() ? given : c.at, given.IsDefined() ? "localization.maps"
+                                                                : c.path,
+            r.file()});
+  s.map_index_input = Signal(kPerfectMatch, "map_index");
+  SetInitialPose(p, c.start);
+  SetStep(b, kPerfectMatch);
+  s.recorded.push_back(Signal(kPerfectMatch, "source"));
+  s.recorded.push_back(Signal(kPerfectMatch, "laser_status"));
+  s.recorded.push_back(Signal(kPerfectMatch, "map_in_use"));
+  s.recorded.push_back(Signal(kPerfectMatch, "match_error"));
+  s.localization_sources.push_back(Signal(kPerfectMatch, "source"));
+}
+
+// The odometry's twist into a matcher (for motion_prediction: odometry).
+void ConnectOdometryToMatcher(SystemBuilder& b, const char* matcher = kLaserLocalization) {
+  b.Connect(Signal(kOdometry, "body_velocity"), Signal(matcher, "odometry_velocity"));
+  b.Connect(Signal(kOdometry, "yaw_rate"), Signal(matcher, "odometry_yaw_rate"));
+}
+
+// The EKF of odometry and a matcher's poses (delayed to their scan's time).
+void AddPoseFusion(SystemBuilder& b, const ProviderContext& c, Signals& s, const char* matcher) {
+  b.Unit(kPoseFusion, "pose_fusion");
+  SetInitialPose(b.Params(kPoseFusion), c.start);
+  b.Connect(Signal(kOdometry, "body_velocity"), Signal(kPoseFusion, "odometry_velocity"));
+  b.Connect(Signal(kOdometry, "yaw_rate"), Signal(kPoseFusion, "odometry_yaw_rate"));
+  b.Connect(Signal(matcher, "position"), Signal(kPoseFusion, "match_position"));
+  b.Connect(Signal(matcher, "yaw"), Signal(kPoseFusion, "match_yaw"));
+  b.Connect(Signal(matcher, "covariance"), Signal(kPoseFusion, "match_covariance"));
+  b.Connect(Signal(matcher, "match_time"), Signal(kPoseFusion, "match_time"));
+  b.Connect(Signal(matcher, "match_count"), Signal(kPoseFusion, "match_count"));
+  SetStep(b, kPoseFusion);
+  s.position = Signal(kPoseFusion, "position");
+  s.yaw = Signal(kPoseFusion, "yaw");
+  s.velocity = Signal(kPoseFusion, "velocity");
+  s.yaw_rate = Signal(kPoseFusion, "yaw_rate");
+  s.recorded.push_back(Signal(kPoseFusion, "source"));
+  s.localization_sources.push_back(Signal(kPoseFusion, "source"));
 }
 
 // Dead reckoning from the wheel encoders (swerve: the module kinematics;
@@ -365,23 +469,23 @@ const std::map<std::string, Provider>& LocalizationProviders() {
          // scans after it are within the matcher's reach.
          b.Params(kLaserLocalization)["motion_prediction"] = "odometry";
          ConnectOdometryToMatcher(b);
-         b.Unit(kPoseFusion, "pose_fusion");
-         SetInitialPose(b.Params(kPoseFusion), c.start);
-         b.Connect(Signal(kOdometry, "body_velocity"), Signal(kPoseFusion, "odometry_velocity"));
-         b.Connect(Signal(kOdometry, "yaw_rate"), Signal(kPoseFusion, "odometry_yaw_rate"));
-         b.Connect(Signal(kLaserLocalization, "position"), Signal(kPoseFusion, "match_position"));
-         b.Connect(Signal(kLaserLocalization, "yaw"), Signal(kPoseFusion, "match_yaw"));
-         b.Connect(Signal(kLaserLocalization, "covariance"),
-                   Signal(kPoseFusion, "match_covariance"));
-         b.Connect(Signal(kLaserLocalization, "match_time"), Signal(kPoseFusion, "match_time"));
-         b.Connect(Signal(kLaserLocalization, "match_count"), Signal(kPoseFusion, "match_count"));
-         SetStep(b, kPoseFusion);
-         s.position = Signal(kPoseFusion, "position");
-         s.yaw = Signal(kPoseFusion, "yaw");
-         s.velocity = Signal(kPoseFusion, "velocity");
-         s.yaw_rate = Signal(kPoseFusion, "yaw_rate");
-         s.recorded.push_back(Signal(kPoseFusion, "source"));
-         s.localization_sources.push_back(Signal(kPoseFusion, "source"));
+         AddPoseFusion(b, c, s, kLaserLocalization);
+       }},
+      // Paper 2 Sec. 4: Perfect Match on the laser fused with the (skid-steer)
+      // odometry in an EKF of the pose alone: off a belt the odometry has no
+      // surface offset to learn, so the fusion's offset states are held at 0.
+      {"perfect_match", [](SystemBuilder& b, const ProviderContext& c, Signals& s) {
+         const bool lasers = Require(b, c, s, "laser_scanner", "perfect_match");
+         const bool encoders = Require(b, c, s, "wheel_encoder", "perfect_match");
+         if (!lasers || !encoders) return;
+         AddPerfectMatch(b, c, s);
+         AddOdometry(b, c, s);
+         b.Params(kPerfectMatch)["motion_prediction"] = "odometry";
+         ConnectOdometryToMatcher(b, kPerfectMatch);
+         AddPoseFusion(b, c, s, kPerfectMatch);
+         YAML::Node f = b.Params(kPoseFusion);
+         f["offset_random_walk"] = 0;
+         f["initial_offset_sigma"] = 0;
        }}};
   return providers;
 }
@@ -405,6 +509,66 @@ std::pair<std::string, YAML::Node> Choose(SystemBuilder& b, const std::string& s
 
 }  // namespace
 
+void AddBeaconGroundTruth(SystemBuilder& b, const RobotFile& file, const StartPose& start,
+                          const models::Scene& scene, Signals& s) {
+  int beacons = 0;
+  for (const auto& o : scene.obstacles) beacons += o.kind == "beacon";
+  const auto lasers = Mounts(s, "laser_scanner");
+  if (beacons < 3 || lasers.empty() || s.route_done.empty()) return;
+  const models::SensorMount& m = *lasers.front();
+  const ProviderContext c{file, start, scene, Child(b.root(), "sensors"), "sensors"};
+  const DeviceNumbers device(b, c, m);
+  b.Unit(kBeacons, "beacon_localization");
+  YAML::Node p = b.Params(kBeacons);
+  p["beam_count"] = static_cast<int>(device.Required("beam_count"));
+  p["mount_x"] = Num(m.x_m);
+  p["mount_y"] = Num(m.y_m);
+  p["mount_yaw"] = Num(m.yaw_rad);
+  p["first_beam_angle"] = Num(device.Required("first_beam_angle"));
+  p["angular_step"] = Num(device.Required("angular_step"));
+  // The laser's own figures: its nearest range, its statistical error and
+  // its per-device systematic error.
+  if (const auto v = device.Get("range_min")) p["range_min"] = Num(*v);
+  if (const auto v = device.Get("noise_sigma")) p["range_sigma"] = Num(*v);
+  if (const auto v = device.Get("bias_sigma")) p["systematic_sigma"] = Num(*v);
+  // Which way the robot faces, for the symmetric beacon layouts: the
+  // route's last node (only a half turn away would mislead it).
+  if (!s.route_end.empty()) p["heading_hint"] = Num(s.route_end[2]);
+  b.Connect(Signal(m.name, "ranges"), Signal(kBeacons, "ranges"));
+  b.Connect(Signal(m.name, "scan_count"), Signal(kBeacons, "scan_count"));
+  b.Connect(Signal(m.name, "scan_time"), Signal(kBeacons, "scan_time"));
+  // Paper 2 Sec. 6.1: the beacons are uncovered once the robot is in place.
+  b.Connect(s.route_done, Signal(kBeacons, "active"));
+  SetStep(b, kBeacons);
+  for (const char* v : {"position", "yaw", "valid", "beacons_seen"}) {
+    s.recorded.push_back(Signal(kBeacons, v));
+  }
+  s.beacon_unit = kBeacons;
+}
+
+void ConnectMapSwitch(SystemBuilder& b, const Signals& s) {
+  if (s.map_index_input.empty()) return;
+  const YAML::Node localization = Child(b.root(), "localization");
+  const YAML::Node at = Child(localization, "maps");
+  if (s.map_index_output.empty()) {
+    if (s.localization_maps.size() > 1) {
+      b.reader().Error(at, "localization.maps",
+                       "several maps need a route (task.type route) whose graph says which map "
+                       "each segment uses; without one only the first is used");
+    }
+    return;
+  }
+  if (s.route_maps != s.localization_maps) {
+    b.reader().Error(at.IsDefined() ? at : localization, "localization.maps",
+                     "the route graph's maps are [" + config::JoinNames(s.route_maps) +
+                         "]: localization.maps must name the same maps in the same order "
+                         "(the follower's map index counts in the graph's list), got [" +
+                         config::JoinNames(s.localization_maps) + "]");
+    return;
+  }
+  b.Connect(s.map_index_output, s.map_index_input);
+}
+
 void SetWheelPositions(YAML::Node params, const models::RobotDescription& robot) {
   std::vector<double> x, y;
   for (const auto& w : robot.wheels) {
@@ -427,7 +591,7 @@ void AddSensing(SystemBuilder& b, const RobotFile& file, const StartPose& start,
   const auto [surface, surface_node] =
       Choose(b, "sensing", "surface_velocity", SurfaceVelocityProviders());
   const auto [localization, localization_node] =
-      Choose(b, "localization", "source", LocalizationProviders(), {"map"});
+      Choose(b, "localization", "source", LocalizationProviders(), {"map", "maps"});
   // The pose and velocity first: the surface velocity (Eq. 2) needs the
   // robot's velocity; the odometry's rectification (Eq. 3) then takes the
   // surface velocity, whoever provides it. Neither depends directly on the
@@ -443,6 +607,10 @@ void AddSensing(SystemBuilder& b, const RobotFile& file, const StartPose& start,
   if (Child(localization_node, "map").IsDefined() && !b.HasUnit(kLaserLocalization)) {
     b.reader().Error(Child(localization_node, "map"), "localization.map",
                      "a map is matched against only with localization.source laser or fused");
+  }
+  if (Child(localization_node, "maps").IsDefined() && !b.HasUnit(kPerfectMatch)) {
+    b.reader().Error(Child(localization_node, "maps"), "localization.maps",
+                     "maps are switched only with localization.source perfect_match");
   }
   if (!s.odometry.empty() && !s.surface_velocity.empty()) {
     b.Connect(s.surface_velocity, Signal(s.odometry, "surface_velocity"));

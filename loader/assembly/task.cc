@@ -51,8 +51,16 @@ void AddRoute(SystemBuilder& b, const RobotFile& file, const YAML::Node& task, S
             "the scenario)");
   } else if (const auto name = r.AsString(graph_node, "task.graph")) {
     if (auto graph = ReadRouteGraphModel(r, graph_node, "task.graph", *name, r.file())) {
-      if (auto route = RouteSegments(r, *graph, Child(task, "route"), "task.route")) {
+      const YAML::Node route_node = Child(task, "route");
+      if (auto route = RouteSegments(r, *graph, route_node, "task.route")) {
         segments = std::move(*route);
+        // Where the route ends: the last node's pose (the work pose the
+        // final pose error is measured against).
+        const std::string last = route_node[route_node.size() - 1].Scalar();
+        for (const auto& node : graph->nodes) {
+          if (node.name == last) s.route_end = {node.x_m, node.y_m, node.yaw_rad};
+        }
+        s.route_maps = graph->maps;
       }
     }
   }
@@ -115,6 +123,8 @@ void AddRoute(SystemBuilder& b, const RobotFile& file, const YAML::Node& task, S
   b.Connect(s.yaw, Signal(kPathFollower, "yaw"));
   b.Connect(Signal(kPathFollower, "velocity_command"), s.velocity_command_input);
   b.Connect(Signal(kPathFollower, "yaw_rate_command"), s.yaw_rate_command_input);
+  s.map_index_output = Signal(kPathFollower, "map_index");
+  s.route_done = Signal(kPathFollower, "done");
   for (const char* v : {"velocity_command", "yaw_rate_command", "distance_error",
                         "orientation_error", "segment", "map_index", "done"}) {
     s.recorded.push_back(Signal(kPathFollower, v));

@@ -291,12 +291,29 @@ DistanceMap::DistanceMap(const models::Scene& scene, double z, std::optional<Reg
     }
     if (known) exact[k] = static_cast<float>(e);
   }
+  // Seen from a point: the free nodes connected to it (4-neighbours, within
+  // the region) are the only free space; the rest reads as inside.
+  std::vector<char> seen;
+  if (o.seen_from) {
+    seen = SeenFreeNodes(free_node, *o.seen_from, region);
+    for (std::size_t k = 0; k < n; ++k) free_node[k] = seen[k];
+  }
   const std::vector<float> out2 = SquaredEdt(occupied, nx_, ny_);
   const std::vector<float> in2 = SquaredEdt(free_node, nx_, ny_);
   data_.assign(3 * n, 0.0f);
   for (std::size_t k = 0; k < n; ++k) {
     double d;
-    if (!deep[k] && !std::isnan(exact[k])) {
+    if (!seen.empty() && !seen[k]) {
+      // Inside (a solid, or free space never seen): as deep as the nearest
+      // seen free node is far; in the band the exact depth when its nearest
+      // outline is the seen one (the two agree within a cell; a node nearer
+      // an unseen face reads more than a cell less exactly).
+      const double to_seen =
+          std::isfinite(in2[k]) ? (std::sqrt(static_cast<double>(in2[k])) - 0.5) * cell_ : kFar;
+      const bool band = occupied[k] && !deep[k] && !std::isnan(exact[k]) &&
+                        std::abs(static_cast<double>(exact[k]) - to_seen) <= cell_;
+      d = -(band ? static_cast<double>(exact[k]) : to_seen);
+    } else if (!deep[k] && !std::isnan(exact[k])) {
       d = -static_cast<double>(exact[k]);
     } else if (occupied[k]) {
       d = std::isfinite(in2[k]) ? -(std::sqrt(static_cast<double>(in2[k])) - 0.5) * cell_ : -kFar;
@@ -324,6 +341,55 @@ DistanceMap::DistanceMap(const models::Scene& scene, double z, std::optional<Reg
       solids_, rect,
       OccupancyGrid::Options{
           0.5 * std::min(rect.max_x_m - rect.min_x_m, rect.max_y_m - rect.min_y_m), 1, 0.0, 1.0});
+}
+
+std::vector<char> DistanceMap::SeenFreeNodes(const std::vector<char>& free_node,
+                                             const std::array<double, 2>& from,
+                                             const std::optional<Region>& region) const {
+  const auto sx = static_cast<std::size_t>(nx_);
+  const std::size_t n = free_node.size();
+  const auto inside = [&](std::size_t k) {
+    if (!region) return true;
+    const double x = origin_x_ + (static_cast<double>(k % sx) + 0.5) * cell_;
+    const double y = origin_y_ + (static_cast<double>(k / sx) + 0.5) * cell_;
+    return x >= region->min_x && x <= region->max_x && y >= region->min_y && y <= region->max_y;
+  };
+  // The seed: the free node nearest to `from` (within the region).
+  std::size_t seed = n;
+  double best = std::numeric_limits<double>::infinity();
+  const int cx = static_cast<int>(std::floor((from[0] - origin_x_) * inv_cell_));
+  const int cy = static_cast<int>(std::floor((from[1] - origin_y_) * inv_cell_));
+  for (int r = 0; r < std::max(nx_, ny_) && seed == n; ++r) {
+    for (int iy = std::max(0, cy - r); iy <= std::min(ny_ - 1, cy + r); ++iy) {
+      for (int ix = std::max(0, cx - r); ix <= std::min(nx_ - 1, cx + r); ++ix) {
+        const std::size_t k = static_cast<std::size_t>(iy) * sx + static_cast<std::size_t>(ix);
+        if (!free_node[k] || !inside(k)) continue;
+        const double d2 = std::pow(ix - cx, 2) + std::pow(iy - cy, 2);
+        if (d2 < best) {
+          best = d2;
+          seed = k;
+        }
+      }
+    }
+  }
+  std::vector<char> seen(n, 0);
+  if (seed == n) return seen;
+  std::vector<std::size_t> queue{seed};
+  seen[seed] = 1;
+  while (!queue.empty()) {
+    const std::size_t k = queue.back();
+    queue.pop_back();
+    const std::size_t ix = k % sx, iy = k / sx;
+    const std::size_t next[4] = {ix > 0 ? k - 1 : n, ix + 1 < sx ? k + 1 : n,
+                                 iy > 0 ? k - sx : n, k + sx < n ? k + sx : n};
+    for (std::size_t m : next) {
+      if (m < n && !seen[m] && free_node[m] && inside(m)) {
+        seen[m] = 1;
+        queue.push_back(m);
+      }
+    }
+  }
+  return seen;
 }
 
 DistanceMap::~DistanceMap() = default;

@@ -59,7 +59,7 @@ class OccupancyGrid;
 /// solid's thickness (a pose error) is pulled out through its far face.
 /// Starts must stay within half the thinnest seen solid's thickness of the
 /// truth at the walls (25 mm for a van's 5 cm sheet walls, 0.1 m for 0.2 m
-/// hall walls); with odometry prediction at 50 Hz a start is mm off.
+/// hall walls), unless Options::seen_from keeps only the seen faces.
 ///
 /// Interpolation error (what the tests bound): the bilinear interpolant of a
 /// function with second derivatives |d_xx|, |d_yy| <= K on the cell is off
@@ -77,6 +77,16 @@ class DistanceMap {
     double cell = 0.02;       // m, the lookup grid's cell h
     double margin = 1.0;      // m beyond the region (or the floor)
     double band_cells = 4.0;  // the exact band, in cells (>= 2)
+    /// A point (x, y) in the free space the robot drives in: the map then
+    /// holds only the outlines seen from the free space connected to it
+    /// (inside the region, when there is one), as a map built by SLAM
+    /// does (paper 2: "only the inner contours of the van interior").
+    /// Free space not connected to it (behind a wall, outside the region)
+    /// counts as inside a solid, and inside a solid d is minus the distance
+    /// to the nearest seen outline: a thin wall then has one face, and a
+    /// point pushed through it is pulled back out the side it was seen
+    /// from (without it, a 5 cm van wall gives two minima 5 cm apart).
+    std::optional<std::array<double, 2>> seen_from;
   };
   /// What outside the grid reads (m).
   static constexpr double kFar = 100.0;
@@ -93,6 +103,11 @@ class DistanceMap {
   /// (counter-clockwise, x y pairs), empty when the plane misses it.
   static std::vector<std::array<double, 2>> TerrainSlice(const models::TerrainPiece& t, double z);
 
+  /// The free nodes connected to the one nearest `from` (4-neighbours,
+  /// within `region` when given).
+  std::vector<char> SeenFreeNodes(const std::vector<char>& free_node,
+                                  const std::array<double, 2>& from,
+                                  const std::optional<Region>& region) const;
   /// Signed distance (positive outside) from (x, y) to the map's outlines,
   /// evaluated from the geometry (for tests and for the band).
   double ExactDistance(double x, double y) const;

@@ -251,6 +251,14 @@ void PerfectMatchLocalizationUnit::Derive() {
     o.margin = map_margin_;
     for (const MapSpec& m : specs_) {
       o.cell = m.cell_m > 0.0 ? m.cell_m : lookup_cell_;
+      // A map of a region (paper 2's van interior: "only the inner
+      // contours") holds the outlines seen from the region's centre, as a
+      // map built by SLAM inside it: its thin walls have one face each.
+      o.seen_from.reset();
+      if (m.region) {
+        o.seen_from = std::array<double, 2>{0.5 * (m.region->min_x + m.region->max_x),
+                                            0.5 * (m.region->min_y + m.region->max_y)};
+      }
       maps_.push_back(std::make_unique<DistanceMap>(scene_, m.height_m, m.region, o));
     }
     built_cell_ = lookup_cell_;

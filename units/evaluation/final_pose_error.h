@@ -49,6 +49,7 @@ class FinalPoseErrorUnit : public cosim::Unit {
   double target_x_, target_y_, target_yaw_;
   double settle_time_ = 2.0;
   bool fail_if_unmeasured_ = true;
+  bool beacons_ = true;
   // Inputs.
   std::vector<double> position_ = std::vector<double>(2, 0.0);
   std::vector<double> beacon_position_ = std::vector<double>(2, 0.0);

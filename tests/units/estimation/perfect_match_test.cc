@@ -27,7 +27,7 @@ TEST_P(RecoversOffset, WithinTheLookupGridsBound) {
   const double h = GetParam();
   const models::Scene scene = Room();
   const auto solids = SolidsAt(scene, 0.35);
-  const DistanceMap map(scene, 0.35, std::nullopt, {h, 1.0, 4.0});
+  const DistanceMap map(scene, 0.35, std::nullopt, {h, 1.0, 4.0, {}});
   const PerfectMatch::Pose truth{1.3, -0.7, 0.4};
   const Points p = ToPoints(Ranges(solids, truth.x, truth.y, truth.yaw));
   ASSERT_GT(p.x.size(), 500u);
@@ -68,7 +68,7 @@ INSTANTIATE_TEST_SUITE_P(Grids, RecoversOffset, ::testing::Values(0.02, 0.05));
 TEST(PerfectMatch, RpropAloneEndsNearTheOptimumAndTheRefinementAtIt) {
   const models::Scene scene = Room();
   const auto solids = SolidsAt(scene, 0.35);
-  const DistanceMap map(scene, 0.35, std::nullopt, {0.02, 1.0, 4.0});
+  const DistanceMap map(scene, 0.35, std::nullopt, {0.02, 1.0, 4.0, {}});
   const PerfectMatch::Pose truth{1.3, -0.7, 0.4};
   const Points p = ToPoints(Ranges(solids, truth.x, truth.y, truth.yaw));
   PerfectMatch::Options o;
@@ -94,7 +94,7 @@ TEST(PerfectMatch, RpropAloneEndsNearTheOptimumAndTheRefinementAtIt) {
 // differences of E (a straight-face pose, E smooth there).
 TEST(PerfectMatch, ErrorAndGradientAreLauersFunction) {
   const models::Scene scene = Room();
-  const DistanceMap map(scene, 0.35, std::nullopt, {0.02, 1.0, 4.0});
+  const DistanceMap map(scene, 0.35, std::nullopt, {0.02, 1.0, 4.0, {}});
   const std::vector<double> px = {2.0, 1.0, -0.5}, py = {0.3, -1.2, 0.9};
   const PerfectMatch pm({});
   const PerfectMatch::Pose at{0.5, 0.2, 0.3};
@@ -137,7 +137,7 @@ TEST(PerfectMatch, ErrorAndGradientAreLauersFunction) {
 TEST(DistanceMap, HoldsTheSignedDistanceToTheSlice) {
   const models::Scene scene = Room();
   const double h = 0.05;
-  const DistanceMap map(scene, 0.35, std::nullopt, {h, 1.0, 4.0});
+  const DistanceMap map(scene, 0.35, std::nullopt, {h, 1.0, 4.0, {}});
   EXPECT_EQ(map.solids().size(), 8u);  // 4 walls, pillar, 3 carts: no shelf, no body
   double worst_band = 0.0, worst_far = 0.0;
   for (int iy = 0; iy < map.ny(); ++iy) {
@@ -209,7 +209,7 @@ TEST(DistanceMap, SliceOfATiltedTerrainBoxIsWhereGeometrySaysIt) {
   models::Scene s;
   s.floor = {0.0, 6.0, -2.0, 2.0, 0};
   s.terrain.push_back(t);
-  const DistanceMap map(s, z, std::nullopt, {0.02, 0.5, 4.0});
+  const DistanceMap map(s, z, std::nullopt, {0.02, 0.5, 4.0, {}});
   EXPECT_EQ(map.terrain_count(), 1u);
   double gx, gy;
   EXPECT_NEAR(map.Lookup(t.center_x_m + hi + 0.03, 0.2, gx, gy), 0.03, 1e-6);
@@ -218,8 +218,40 @@ TEST(DistanceMap, SliceOfATiltedTerrainBoxIsWhereGeometrySaysIt) {
   EXPECT_NEAR(map.Lookup(0.5 * (2 * t.center_x_m + lo + hi), 0.2 + 0.6 + 0.04, gx, gy), 0.04, 1e-6);
   EXPECT_LT(map.Lookup(t.center_x_m + 0.5 * (lo + hi), 0.2, gx, gy), 0.0);  // inside
   // A region that does not hold the slice leaves it out.
-  const DistanceMap none(s, z, DistanceMap::Region{0.0, 2.0, -2.0, 2.0}, {0.02, 0.5, 4.0});
+  const DistanceMap none(s, z, DistanceMap::Region{0.0, 2.0, -2.0, 2.0}, {0.02, 0.5, 4.0, {}});
   EXPECT_EQ(none.terrain_count(), 0u);
+}
+
+// Guards Options::seen_from (a van's 5 cm wall seen from inside only): a
+// closed box room of 5 cm walls, x 0..2, y -1..1. Without it the wall's
+// inside is minus the distance to the NEARER face, so d rises again towards
+// the outer face (a second minimum 5 cm out); seen from inside, d keeps
+// falling through the wall (minus the distance to the inner face: 0.04 m at
+// 4 cm in, within the 1 cm EDT of cell centres) and stays negative beyond.
+TEST(DistanceMap, SeenFromInsideAThinWallHasOneFace) {
+  models::Scene s;
+  s.floor = {-1.0, 3.0, -2.0, 2.0, 0};
+  const auto wall = [&](double x, double y, double yaw, double length) {
+    s.obstacles.push_back({"w", "wall", models::BoxSolid(x, y, yaw, length, 0.05, 2.0)});
+  };
+  wall(1.0, 1.025, 0.0, 2.1);
+  wall(1.0, -1.025, 0.0, 2.1);
+  wall(2.025, 0.0, 0.5 * std::numbers::pi, 2.0);
+  wall(-0.025, 0.0, 0.5 * std::numbers::pi, 2.0);
+  const DistanceMap both(s, 0.35, std::nullopt, {0.01, 0.5, 4.0, {}});
+  const DistanceMap seen(s, 0.35, DistanceMap::Region{-0.2, 2.2, -1.2, 1.2},
+                         {0.01, 0.5, 4.0, std::array<double, 2>{1.0, 0.0}});
+  double gx, gy;
+  // Inside the room both read the distance to the wall's inner face.
+  EXPECT_NEAR(both.Lookup(1.97, 0.0, gx, gy), 0.03, 1e-6);
+  EXPECT_NEAR(seen.Lookup(1.97, 0.0, gx, gy), 0.03, 1e-6);
+  // 4 cm into the 5 cm wall: 1 cm from its outer face.
+  EXPECT_NEAR(both.Lookup(2.04, 0.0, gx, gy), -0.01, 2e-3);
+  EXPECT_NEAR(seen.Lookup(2.04, 0.0, gx, gy), -0.04, 6e-3);
+  EXPECT_LT(gx, 0.0);  // pulled back in, towards the seen face
+  // Beyond the wall: free space for one, never-seen (inside) for the other.
+  EXPECT_GT(both.Lookup(2.1, 0.0, gx, gy), 0.0);
+  EXPECT_LT(seen.Lookup(2.1, 0.0, gx, gy), -0.05);
 }
 
 // Noise: with the LMS151's 12 mm statistical error the matches scatter as
@@ -229,7 +261,7 @@ TEST(DistanceMap, SliceOfATiltedTerrainBoxIsWhereGeometrySaysIt) {
 TEST(PerfectMatch, CovarianceMatchesTheScatterOfNoisyMatches) {
   const models::Scene scene = Room();
   const auto solids = SolidsAt(scene, 0.35);
-  const DistanceMap map(scene, 0.35, std::nullopt, {0.02, 1.0, 4.0});
+  const DistanceMap map(scene, 0.35, std::nullopt, {0.02, 1.0, 4.0, {}});
   const PerfectMatch pm({});
   std::mt19937_64 rng(7);
   const int n = 200;
@@ -263,7 +295,7 @@ TEST(PerfectMatch, CovarianceMatchesTheScatterOfNoisyMatches) {
 TEST(PerfectMatch, BiasSensitivityPredictsTheShiftOfARangeBias) {
   const models::Scene scene = Room();
   const auto solids = SolidsAt(scene, 0.35);
-  const DistanceMap map(scene, 0.35, std::nullopt, {0.02, 1.0, 4.0});
+  const DistanceMap map(scene, 0.35, std::nullopt, {0.02, 1.0, 4.0, {}});
   const PerfectMatch pm({});
   const PerfectMatch::Pose truth{1.3, -0.7, 0.4};
   const double b = 0.03;
@@ -288,7 +320,7 @@ TEST(PerfectMatch, BiasSensitivityPredictsTheShiftOfARangeBias) {
 TEST(PerfectMatch, BiasTermMakesTheCovarianceConsistentWithABias) {
   const models::Scene scene = Room();
   const auto solids = SolidsAt(scene, 0.35);
-  const DistanceMap map(scene, 0.35, std::nullopt, {0.02, 1.0, 4.0});
+  const DistanceMap map(scene, 0.35, std::nullopt, {0.02, 1.0, 4.0, {}});
   const PerfectMatch pm({});
   std::mt19937_64 rng(11);
   std::normal_distribution<double> n(0.0, 1.0);

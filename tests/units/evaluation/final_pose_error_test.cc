@@ -149,6 +149,16 @@ TEST(FinalPoseError, NeverDoneFailsTheRunInsteadOfReportingZero) {
     EXPECT_EQ(u.DoStep(1'990'000'000, kStep), cosim::StepResult::kError);
     EXPECT_NE(u.last_error().find("beacons"), std::string::npos) << u.last_error();
   }
+  {
+    // Without a beacon system (beacons: false) the true pose is enough.
+    FinalPoseErrorUnit u("final");
+    SetBool(u, "beacons", false);
+    Make(u, 2.0);
+    SetBool(u, "done", true);
+    EXPECT_EQ(StepUntil(u, 0, 2'000'000'000), cosim::StepResult::kOk);
+    EXPECT_TRUE(GetBool(u, "measured"));
+    EXPECT_FALSE(GetBool(u, "beacon_measured"));
+  }
 }
 
 // Guards Save/Restore: the done time and the taken values survive.
