@@ -75,5 +75,11 @@ LINESIM_SCENARIO(hold_on_belt, "hold_on_belt.yaml");
 LINESIM_SCENARIO(hold_straddle, "hold_straddle.yaml");
 LINESIM_SCENARIO(husky_floor_path, "husky_floor_path.yaml");
 LINESIM_SCENARIO(optic_flow_profile, "optic_flow_profile.yaml");
+// Paper 2's van entry with the whole chain (LMS151 in 3D, Perfect Match, the
+// EKF, the beacons, the route follower, the Husky on the ramp), beside the
+// same route on the ground truth without sensors.
+LINESIM_SCENARIO(van_entry, "van_entry.yaml");
+LINESIM_SCENARIO(van_entry_ground_truth, "van_entry.yaml", "sensors.default=false",
+                 "localization.source=ground_truth");
 
 }  // namespace

@@ -24,10 +24,8 @@ using test_scenarios::Shipped;
 // they can.
 TEST(VanEntryScenario, HuskyClimbsIntoTheVanAndStopsAtTheWorkPose) {
   const auto m = RunFile(Shipped("van_entry"), {});
-  // Table 1's maxima, X with twice its margin: this model's X error is
-  // biased by the LMS151's per-device systematic range error (see
-  // docs/architecture.md, van entry), up to 3.4 cm over 20 seeds.
-  EXPECT_LT(std::abs(m.at("final_error_x_m")), 2 * 0.019);
+  // Table 1's maxima (this model's own 20 runs stay within them too).
+  EXPECT_LT(std::abs(m.at("final_error_x_m")), 0.019);
   EXPECT_LT(std::abs(m.at("final_error_y_m")), 0.014);
   EXPECT_LT(std::abs(m.at("final_error_yaw_deg")), 2.216);
   // The beacon system's own error: paper 2's 5 mm and 0.2 deg.
