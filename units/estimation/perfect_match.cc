@@ -35,13 +35,13 @@ double PerfectMatch::Error(const DistanceMap& map, std::span<const double> px,
 
 void PerfectMatch::Gradient(const DistanceMap& map, std::span<const double> px,
                             std::span<const double> py, const Pose& pose,
-                            std::array<double, 3>& gradient) const {
+                            std::array<double, 3>& gradient, std::size_t stride) const {
   // As Error without E: one division per point (RPROP needs the signs).
   const double c2 = options_.c * options_.c;
   const double cs = std::cos(pose.yaw), sn = std::sin(pose.yaw);
   double g0 = 0.0, g1 = 0.0, g2 = 0.0;
   const std::size_t n = std::min(px.size(), py.size());
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < n; i += stride) {
     const double rx = cs * px[i] - sn * py[i], ry = sn * px[i] + cs * py[i];
     double gx, gy;
     const double d = options_.gradient_tables
@@ -125,7 +125,8 @@ PerfectMatch::Result PerfectMatch::Match(const DistanceMap& map, std::span<const
   std::array<double, 3> g{};
   // RPROP as Tribots' VisualPositionOptimiser::optimise.
   for (int it = 0; it < iterations; ++it) {
-    Gradient(map, px, py, {param[0], param[1], param[2]}, g);
+    Gradient(map, px, py, {param[0], param[1], param[2]}, g,
+             static_cast<std::size_t>(std::max(1, options_.rprop_stride)));
     for (int j = 0; j < 3; ++j) {
       const double gj = g[static_cast<std::size_t>(j)];
       if (gj == 0.0) {

@@ -70,6 +70,13 @@ class PerfectMatch {
     int few_iterations = 20;  // 20 with fewer
     int few_points = 20;
     int refine_iterations = 1;  // Gauss-Newton steps after RPROP (ours)
+    /// RPROP's gradient over every `rprop_stride`-th point only (the
+    /// refinement and the covariance always take every point): RPROP only
+    /// needs the gradient's signs to close in on the optimum, which the
+    /// refinement then reaches with all points (ours; see
+    /// bench/perfect_match_bench.cc for the cost and the tests for the
+    /// accuracy).
+    int rprop_stride = 1;
     /// true: d's gradient from the gradient tables (Tribots); false: the
     /// bilinear interpolant's own derivative (measured: the same accuracy,
     /// about 5 % cheaper; see bench/perfect_match_bench.cc).
@@ -137,7 +144,8 @@ class PerfectMatch {
   Normal Accumulate(const DistanceMap& map, std::span<const double> px, std::span<const double> py,
                     const Pose& pose, double ox, double oy, bool bias) const;
   void Gradient(const DistanceMap& map, std::span<const double> px, std::span<const double> py,
-                const Pose& pose, std::array<double, 3>& gradient) const;
+                const Pose& pose, std::array<double, 3>& gradient,
+                std::size_t stride = 1) const;
 
   Options options_;
 };

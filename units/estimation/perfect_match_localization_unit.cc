@@ -119,6 +119,11 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
               Rule::Range(1, 1000));
   v.Parameter("few_points", &few_points_, "see few_iterations (Tribots: 20)",
               Rule::Range(0, 100000));
+  v.Parameter("rprop_stride", &rprop_stride_,
+              "RPROP's gradient over every n-th scan point (the Gauss-Newton refinement and the "
+              "covariance over all): 1 as Tribots; 2 halves RPROP's cost with the same pose "
+              "after the refinement (tests/units/estimation/perfect_match_test.cc)",
+              cosim::Rule::Range(1.0, true, 16.0, true));
   v.Parameter("refine_iterations", &refine_iterations_,
               "reweighted Gauss-Newton steps after RPROP (0: Tribots' RPROP alone; see "
               "perfect_match.h)",
@@ -272,6 +277,7 @@ void PerfectMatchLocalizationUnit::Derive() {
   mo.few_iterations = static_cast<int>(few_iterations_);
   mo.few_points = static_cast<int>(few_points_);
   mo.refine_iterations = static_cast<int>(refine_iterations_);
+  mo.rprop_stride = static_cast<int>(rprop_stride_);
   matcher_ = std::make_unique<PerfectMatch>(mo);
 }
 

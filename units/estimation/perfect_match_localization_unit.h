@@ -114,7 +114,8 @@ class PerfectMatchLocalizationUnit : public cosim::Unit {
   double range_min_ = 0.5, usable_range_max_ = 50.0;
   double lookup_cell_ = 0.02, map_margin_ = 1.0;
   double c_ = 0.25, step_position_ = 0.04, step_yaw_ = 0.1;
-  std::int64_t iterations_ = 10, few_iterations_ = 20, few_points_ = 20, refine_iterations_ = 1;
+  std::int64_t iterations_ = 10, few_iterations_ = 20, few_points_ = 20, refine_iterations_ = 1,
+               rprop_stride_ = 1;
   double initial_x_, initial_y_, initial_yaw_;
   std::string motion_prediction_ = "none";
   bool deskew_ = false;
