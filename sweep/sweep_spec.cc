@@ -490,8 +490,9 @@ SweepSpec LoadSweepSpec(const std::string& file) {
                   "in the scenario");
     }
   }
-  if (spec.reference.title.empty()) {
-    // The base scenario's reference, for the metrics this sweep collects.
+  if (spec.reference.title.empty() && spec.parameters.empty()) {
+    // Repeats of the scenario as it is: its reference, for the metrics this
+    // sweep collects (a sweep that varies it is not what the source ran).
     spec.reference.title = base.reference.title;
     for (const auto& m : base.reference.metrics) {
       if (std::find(spec.metrics.begin(), spec.metrics.end(), m.metric) != spec.metrics.end()) {

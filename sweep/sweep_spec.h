@@ -64,7 +64,8 @@ struct SweepSpec {
   /// names none.
   std::vector<std::string> metrics;
   /// Published figures the report prints beside the sweep's: the sweep
-  /// file's `reference:`, else the base scenario's (empty title: none).
+  /// file's `reference:`, else, for a sweep without parameters, the base
+  /// scenario's (empty title: none).
   /// Each of its metrics is one of `metrics`.
   loader::Reference reference;
 };
