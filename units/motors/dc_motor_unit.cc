@@ -221,6 +221,22 @@ void DcMotorUnit::Check(int flag, const char* function, cosim::TimeNs t, FlagNam
 // After a failed CVode call, the state to blame: one whose derivative is
 // not finite at the last state (an absurd input or parameter), else the one
 // with the largest weighted local error estimate.
+std::string DcMotorUnit::ElectricalTimeConstants() const {
+  std::string text;
+  for (std::size_t k = 0; k < inductance_.size(); ++k) {
+    text += (k ? ", " : "") + cosim::FormatValue(inductance_[k] / resistance_[k]);
+  }
+  return inductance_.size() == 1 ? text : "[" + text + "]";
+}
+
+std::string DcMotorUnit::VoltageText() const {
+  std::string text;
+  for (std::size_t k = 0; k < voltage_.size(); ++k) {
+    text += (k ? ", " : "") + cosim::FormatValue(voltage_[k]);
+  }
+  return voltage_.size() == 1 ? text : "[" + text + "]";
+}
+
 std::string DcMotorUnit::WorstState() const {
   const auto state_name = [&](std::size_t j) {
     const std::size_t motor = j / static_cast<std::size_t>(states_per_motor_);
@@ -410,8 +426,8 @@ int DcMotorUnit::Integrate(cosim::TimeNs t, double t0_s, double t1_s, bool resta
     steps_since_restart_ = 0;
   }
   Check(CVodeSetStopTime(sun_->cvode, t1_s), "CVodeSetStopTime", t);
-  double t_reached = t0_s;
-  return CVode(sun_->cvode, t1_s, sun_->y, &t_reached, CV_NORMAL);
+  t_reached_s_ = t0_s;
+  return CVode(sun_->cvode, t1_s, sun_->y, &t_reached_s_, CV_NORMAL);
 }
 
 cosim::StepResult DcMotorUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
@@ -442,6 +458,23 @@ cosim::StepResult DcMotorUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   }
   long nst = 0;
   Check(CVodeGetNumSteps(sun_->cvode, &nst), "CVodeGetNumSteps", t);
+  // A success that is not one: CVODE says it reached the step's end but did
+  // not get there, or got there in no step at all, or with its step size
+  // collapsed to rounding of the time (a time constant beyond double
+  // precision, such as an inductance of 1e-300 H): the states would stay
+  // frozen while the run reports ok.
+  double h_last = 0.0;
+  Check(CVodeGetLastStep(sun_->cvode, &h_last), "CVodeGetLastStep", t);
+  const double resolvable_s = 64.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, t1_s);
+  if (t_reached_s_ != t1_s || nst == steps_since_restart_ || !(std::abs(h_last) > resolvable_s)) {
+    return Fail(Where() + ": CVODE did not integrate the step from " + cosim::FormatSeconds(t) +
+                " s (reached " + cosim::FormatValue(t_reached_s_) + " s after " +
+                std::to_string(nst - steps_since_restart_) + " internal steps, the last of " +
+                cosim::FormatValue(h_last) +
+                " s): a state changes faster than double precision resolves (electrical time "
+                "constants L / R = " +
+                ElectricalTimeConstants() + " s; voltage " + VoltageText() + " V)");
+  }
   steps_ += nst - steps_since_restart_;
   steps_since_restart_ = nst;
 

@@ -98,6 +98,10 @@ class DcMotorUnit : public cosim::Unit {
   /// linear-solver functions pass CVodeGetLinReturnFlagName.
   void Check(int flag, const char* function, cosim::TimeNs t, FlagName flag_name = nullptr) const;
   std::string WorstState() const;
+  /// Each motor's L / R as text ("2.7e-4" or "[2.7e-4, 1e-300]").
+  std::string ElectricalTimeConstants() const;
+  /// The voltage inputs as text, as ElectricalTimeConstants.
+  std::string VoltageText() const;
   void SetTolerances();
 
   int count_;
@@ -147,6 +151,7 @@ class DcMotorUnit : public cosim::Unit {
   std::int64_t restarts_ = 0;
   std::int64_t steps_ = 0;
   long steps_since_restart_ = 0;
+  double t_reached_s_ = 0.0;  // where CVODE's last call ended
 
   std::unique_ptr<Sundials> sun_;
 };

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cosim/master.h"
@@ -141,6 +142,34 @@ TEST(DcMotorUnit, StepResponseBareMotorMatchesClosedForm) {
     // Constant inputs: one start, never a restart (the cheap path).
     EXPECT_EQ(restarts, 1);
   }
+}
+
+// Guards against a silent wrong result (issue: hardening): an inductance of
+// 1e-300 H (L / R = 3e-300 s) or a supply of 1e300 V leave CVODE unable to
+// take a step of any size a double can hold around t; it used to report
+// success with the current frozen at 0. The step now fails, naming the
+// time and the time constants.
+TEST(DcMotorUnit, AStepCvodeCannotResolveFailsInsteadOfFreezing) {
+  for (const auto& [inductance, volt] : {std::pair{1e-300, 24.0}, std::pair{0.0823e-3, 1e300}}) {
+    Motor m;
+    m.l = inductance;
+    DcMotorUnit u("m", 1, MotorMode::kFull);
+    ApplyParams(u, {m});
+    u.Initialize();
+    SetAll(u, "voltage", volt);
+    SetAll(u, "load_torque", 0.0);
+    EXPECT_EQ(u.DoStep(0, kMs), cosim::StepResult::kError) << inductance << " H, " << volt << " V";
+    EXPECT_NE(u.last_error().find("CVODE did not integrate the step from 0 s"), std::string::npos)
+        << u.last_error();
+    EXPECT_NE(u.last_error().find("L / R"), std::string::npos) << u.last_error();
+  }
+  // The data sheet's motor at 24 V integrates as before.
+  DcMotorUnit ok("m", 1, MotorMode::kFull);
+  ApplyParams(ok, {Motor{}});
+  ok.Initialize();
+  SetAll(ok, "voltage", 24.0);
+  SetAll(ok, "load_torque", 0.0);
+  EXPECT_EQ(ok.DoStep(0, kMs), cosim::StepResult::kOk) << ok.last_error();
 }
 
 // Gear 21 and efficiency 0.75 (raw3_drive.yaml) with a load inertia and a
