@@ -142,9 +142,15 @@ YAML::Node LoadModel(YamlReader& r, const YAML::Node& at, const std::string& pat
     case YamlFile::Problem::kNone:
       return loaded.root;
     case YamlFile::Problem::kMissing:
+      // A path names a file relative to the scenario; a bare name one of
+      // the shipped models: say both, with the models there are.
       r.Error(at, path,
               "no " + what + " file " + name +
-                  (is_path ? "" : cosim::ClosestHint(value, ModelNames(folder))));
+                  (is_path ? " (a path is relative to the scenario's folder; a name without '/' "
+                             "or .yaml is one of models/" +
+                                 folder + "/: " + config::JoinNames(ModelNames(folder)) + ")"
+                           : cosim::ClosestHint(value, ModelNames(folder)) + " (models/" + folder +
+                                 "/ has: " + config::JoinNames(ModelNames(folder)) + ")"));
       break;
     case YamlFile::Problem::kFolder:
       r.Error(at, path, "cannot read " + what + " file " + name + ": it is not a file (a folder?)");

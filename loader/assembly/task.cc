@@ -211,6 +211,16 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
                            : start.yaw_rad);
   }
   p["waypoints"] = PointList(info.path);
+  // A problem the follower finds with a waypoint (one that repeats the one
+  // before it) is reported at the point the user wrote.
+  if (const YAML::Node written = Child(task, "waypoints");
+      info.task == "path" && written.IsSequence() && written.size() == info.path.size()) {
+    for (std::size_t i = 0; i < written.size(); ++i) {
+      const std::string index = std::to_string(i);
+      b.Origin(JoinPath("units.path_follower.parameters.waypoints", index),
+               {written[i], JoinPath("task.waypoints", index), ""});
+    }
+  }
 
   b.RequireParameters(kPathFollower, file.follower_settings, file.robot.file, "path_follower");
 

@@ -445,11 +445,28 @@ TEST(RobotScenario, UnknownRobotModelNamesTheKnownOnes) {
   EXPECT_TRUE(Has(e, "robot.model")) << e;
   EXPECT_TRUE(Has(e, "no robot model file")) << e;
   EXPECT_TRUE(Has(e, "(closest: raw3)")) << e;
+  EXPECT_TRUE(Has(e, "models/robots/ has: husky, raw3")) << e;
+  // A path (here the repository's path, not relative to the scenario) says
+  // how paths are read and which model names there are.
+  const std::string p = Issues(kCross, {"robot.model=models/robots/husky.yaml"});
+  EXPECT_TRUE(Has(p, "robot.model (set on the command line): no robot model file")) << p;
+  EXPECT_TRUE(Has(p, "a path is relative to the scenario's folder")) << p;
+  EXPECT_TRUE(Has(p, "one of models/robots/: husky, raw3")) << p;
   // Loaded like every model file: a folder is refused before yaml-cpp reads
   // it (it leaked its buffer on one), at the key.
   const std::string f = Issues(kCross, {"robot.model=./"});
   EXPECT_TRUE(Has(f, "robot.model (set on the command line): cannot read robot model file")) << f;
   EXPECT_TRUE(Has(f, "it is not a file (a folder?)")) << f;
+}
+
+// Guards a problem the follower finds in an expanded waypoint list: it is
+// reported at the robot-level key the user wrote (task.waypoints.1, with
+// its line), not at units.path_follower.parameters.waypoints.1.
+TEST(RobotScenario, WaypointProblemIsReportedAtTheTasksKey) {
+  const std::string e = Issues(kCross, {"task.waypoints.1.1=-2.0"});
+  EXPECT_TRUE(Has(e, "cross_line.yaml:")) << e;
+  EXPECT_TRUE(Has(e, ": task.waypoints.1: repeats the previous waypoint")) << e;
+  EXPECT_FALSE(Has(e, "units.path_follower")) << e;
 }
 
 // Guards against a misspelled key in a robot model file going unread: it is
