@@ -121,13 +121,33 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s) {
 }  // namespace
 
 int RunCommand(const std::string& file, const std::string& out_dir,
-               const std::vector<std::string>& set_args) {
+               const std::vector<std::string>& set_args, double max_output_mb) {
   loader::Scenario s;
   try {
     s = loader::LoadScenario(file, set_args);
   } catch (const config::ScenarioError& e) {
     PrintIssues(e, "scenario", std::cerr);
     return kExitBadInput;
+  }
+  // The recording's size, said before anything runs: rows from the
+  // duration and the interval, each column at most 24 characters and its
+  // comma (a double's shortest round-trip text, sign and exponent included).
+  {
+    const cosim::MasterOptions& o = s.master->options();
+    const double rows =
+        std::floor(static_cast<double>(o.stop - o.start) /
+                   static_cast<double>(std::max<cosim::TimeNs>(1, s.record_interval))) +
+        2.0;
+    const double bytes = rows * 25.0 * static_cast<double>(s.recorded.size() + 1);
+    if (bytes > max_output_mb * 1024.0 * 1024.0) {
+      std::cerr << "linesim: " << file << ": the recording would take up to "
+                << cosim::FormatValue(std::ceil(bytes / (1024.0 * 1024.0))) << " MB ("
+                << cosim::FormatValue(rows) << " rows of " << s.recorded.size() + 1
+                << " columns), more than the " << cosim::FormatValue(max_output_mb)
+                << " MB allowed: record fewer variables or at a longer recording.interval_s, "
+                   "or raise the limit with --max-output-mb\n";
+      return kExitBadInput;
+    }
   }
 
   // Everything is checked: only now is anything written.

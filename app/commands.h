@@ -15,9 +15,17 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitRunFailed = 1;  // a unit failed during the run
 inline constexpr int kExitBadInput = 2;   // wrong file, key, value or option
 
-/// `linesim run FILE --out DIR [--set path=value ...]`.
+/// The most signals.csv a run may write unless --max-output-mb says more:
+/// 1 GiB (a run of 10 minutes recording 100 columns at 1 kHz needs 1.3 GB).
+inline constexpr double kDefaultMaxOutputMb = 1024.0;
+
+/// `linesim run FILE --out DIR [--set path=value ...] [--max-output-mb N]`.
+/// A run whose recording would exceed `max_output_mb` (estimated from its
+/// rows, columns and the longest text a number takes) is refused before it
+/// starts (exit 2, nothing written).
 int RunCommand(const std::string& file, const std::string& out_dir,
-               const std::vector<std::string>& set_args);
+               const std::vector<std::string>& set_args,
+               double max_output_mb = kDefaultMaxOutputMb);
 
 /// `linesim inspect TYPE|FILE [--set path=value ...]`.
 int InspectCommand(const std::string& what, const std::vector<std::string>& set_args);
@@ -35,6 +43,7 @@ struct SweepArgs {
   /// DIR/run_0 for its signals and plots.
   std::int64_t repeats = 0;
   std::vector<std::string> sets;
+  double max_output_mb = kDefaultMaxOutputMb;  // for the repeats' run_0
 };
 
 /// `linesim sweep FILE --out DIR [--jobs N] [--resume|--force]`; under

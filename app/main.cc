@@ -20,6 +20,10 @@ int main(int argc, char** argv) {
   run->add_option("--set", run_sets, "override a value: dotted.path=value (repeatable)")
       ->take_all();
   std::int64_t runs = 1;
+  double max_output_mb = linesim::app::kDefaultMaxOutputMb;
+  run->add_option("--max-output-mb", max_output_mb,
+                  "refuse a run whose signals.csv could exceed this many MB (default 1024)")
+      ->check(CLI::Range(0.001, 1e9));
   CLI::Option* runs_option = run->add_option("--runs", runs,
                   "run the scenario N times, each with its own seed, as a sweep (results.csv, "
                   "summary.json with the statistics and the scenario's reference, histograms), "
@@ -81,9 +85,10 @@ int main(int argc, char** argv) {
       repeats.force = true;
       repeats.repeats = runs;
       repeats.sets = run_sets;
+      repeats.max_output_mb = max_output_mb;
       return SweepCommand(repeats, mpi.get());
     }
-    if (run->parsed()) return RunCommand(run_file, out_dir, run_sets);
+    if (run->parsed()) return RunCommand(run_file, out_dir, run_sets, max_output_mb);
     if (sweep->parsed()) {
       if (linesim::sweep::LaunchedByMpi()) {
         mpi = std::make_unique<linesim::sweep::MpiSession>(&argc, &argv);

@@ -180,6 +180,23 @@ TEST(Cli, RunRepeatsWritesStatisticsReferenceHistogramsAndOneRun) {
   EXPECT_NE(refused.err.find("is not a metric of this scenario"), std::string::npos) << refused.err;
 }
 
+// Guards the output-size limit (issue: bounded resources): a recording that
+// could exceed --max-output-mb is refused before the run starts, saying how
+// large it would be, with exit 2 and nothing written; the default lets the
+// shipped scenario run. motor_step records 1502 rows of 11 columns: at most
+// 1502 x 11 x 25 bytes = 0.39 MB.
+TEST(Cli, RecordingBeyondTheOutputLimitIsRefusedBeforeTheRun) {
+  const std::string out = Fresh("output_limit");
+  const Result r = Linesim("run " + kMotorStep + " --out " + out + " --max-output-mb 0.1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("the recording would take up to 1 MB (1502 rows of 11 columns), more "
+                       "than the 0.1 MB allowed"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(Linesim("run " + kMotorStep + " --out " + out + " --max-output-mb 0.5").status, 0);
+}
+
 // Guards a robot scenario's own recording list: the columns the plots read
 // are added to it (the plots are drawn), and a column two items cover is
 // recorded once.
