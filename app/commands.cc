@@ -168,6 +168,21 @@ int RunCommand(const std::string& file, const std::string& out_dir,
       }
     }
   }
+  // A summary from the start, saying the run failed: the final one replaces
+  // it; a run killed on the way, or whose final summary cannot be written,
+  // still leaves a summary.json, and one that says what happened.
+  try {
+    Json started;
+    started["scenario"] = s.name;
+    started["file"] = file;
+    started["status"] = "failed";
+    started["errors"] = {"the run started but did not finish writing its summary (killed, or "
+                         "its final summary.json could not be written)"};
+    cosim::WriteFileAtomically((dir / "summary.json").string(), started.dump(2) + "\n");
+  } catch (const std::exception& e) {
+    std::cerr << "linesim: " << e.what() << "\n";
+    return kExitBadInput;
+  }
   const fs::path csv_path = dir / "signals.csv";
   std::ofstream csv(csv_path, std::ios::binary | std::ios::trunc);
   if (!csv) {

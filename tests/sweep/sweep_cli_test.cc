@@ -320,6 +320,27 @@ TEST(RunCli, CtrlCWritesAnInterruptedSummary) {
   EXPECT_LT(LineCount(fs::path(dir) / "signals.csv"), 60001u);
 }
 
+// Guards that a run that started always leaves a summary.json (issue:
+// hardening): killed outright (SIGKILL: no handler runs), the summary
+// written at its start says it failed and why, never a previous run's ok.
+TEST(RunCli, AKilledRunLeavesAFailedSummary) {
+  const std::string dir = Fresh("run_killed");
+  const std::string log = Temp("run_killed_log");
+  const pid_t pid =
+      Spawn({LINESIM_CLI, "run", kCrossLine, "--out", dir, "--set", "duration_s=600"}, log);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline &&
+         LineCount(fs::path(dir) / "signals.csv") < 101) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  kill(pid, SIGKILL);
+  Wait(pid);
+  const auto summary = nlohmann::json::parse(ReadFile(fs::path(dir) / "summary.json"));
+  EXPECT_EQ(summary["status"], "failed");
+  EXPECT_NE(summary["errors"][0].get<std::string>().find("did not finish writing its summary"),
+            std::string::npos);
+}
+
 TEST(SweepCli, AnInterruptedMpiSweepResumesToTheSameFile) {
   const std::string file = WriteSweep(
       "mpiint.yaml", "scenario: " + kCrossLine +
