@@ -38,6 +38,18 @@ int main(int argc, char** argv) {
   inspect->add_option("--set", inspect_sets, "override a value: dotted.path=value (repeatable)")
       ->take_all();
 
+  std::string export_type, export_out;
+  std::vector<std::string> export_sets;
+  CLI::App* export_fmu = cli.add_subcommand(
+      "export-fmu", "write an FMI 2.0 co-simulation FMU of a unit type (runs linesim's unit in "
+                    "other masters)");
+  export_fmu->add_option("type", export_type, "unit type name (linesim inspect TYPE)")->required();
+  export_fmu->add_option("--set", export_sets,
+                         "a structural key, `model` or a parameter of the unit: key=value "
+                         "(repeatable)")
+      ->take_all();
+  export_fmu->add_option("--out,-o", export_out, "the FMU to write (NAME.fmu)")->required();
+
   SweepArgs sweep_args;
   sweep_args.jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   CLI::App* sweep = cli.add_subcommand(
@@ -91,6 +103,7 @@ int main(int argc, char** argv) {
       sweep_args.jobs_given = jobs->count() > 0;
       return SweepCommand(sweep_args, mpi.get());
     }
+    if (export_fmu->parsed()) return ExportFmuCommand(export_type, export_sets, export_out);
     return InspectCommand(what, inspect_sets);
   } catch (const std::exception& e) {
     std::cerr << "linesim: " << e.what() << "\n";
