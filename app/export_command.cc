@@ -7,9 +7,9 @@
 namespace linesim::app {
 
 int ExportFmuCommand(const std::string& type, const std::vector<std::string>& set_args,
-                     const std::string& out) {
+                     const std::string& scene, const std::string& out) {
   try {
-    const auto result = fmu_export::ExportFmu({type, set_args, out, ""});
+    const auto result = fmu_export::ExportFmu({type, set_args, out, "", scene});
     std::cout << "wrote " << out << ": FMI 2.0 co-simulation, model identifier '"
               << result.model_identifier << "', " << result.variables << " variables, guid "
               << result.guid << "\n";

@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
   inspect->add_option("--set", inspect_sets, "override a value: dotted.path=value (repeatable)")
       ->take_all();
 
-  std::string export_type, export_out;
+  std::string export_type, export_out, export_scene;
   std::vector<std::string> export_sets;
   CLI::App* export_fmu = cli.add_subcommand(
       "export-fmu", "write an FMI 2.0 co-simulation FMU of a unit type (runs linesim's unit in "
@@ -48,6 +48,9 @@ int main(int argc, char** argv) {
                          "a structural key, `model` or a parameter of the unit: key=value "
                          "(repeatable)")
       ->take_all();
+  export_fmu->add_option("--scene", export_scene,
+                         "the scene a unit that needs one (belt, sensors) is built for: a name "
+                         "of models/scenes/ or a file (default: the open floor)");
   export_fmu->add_option("--out,-o", export_out, "the FMU to write (NAME.fmu)")->required();
 
   SweepArgs sweep_args;
@@ -103,7 +106,7 @@ int main(int argc, char** argv) {
       sweep_args.jobs_given = jobs->count() > 0;
       return SweepCommand(sweep_args, mpi.get());
     }
-    if (export_fmu->parsed()) return ExportFmuCommand(export_type, export_sets, export_out);
+    if (export_fmu->parsed()) return ExportFmuCommand(export_type, export_sets, export_scene, export_out);
     return InspectCommand(what, inspect_sets);
   } catch (const std::exception& e) {
     std::cerr << "linesim: " << e.what() << "\n";

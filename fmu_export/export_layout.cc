@@ -97,6 +97,10 @@ std::string GuidOf(const std::string& text) {
   return buffer;
 }
 
+std::string GuidOfResources(const std::string& resource, const std::string& scene) {
+  return GuidOf(scene.empty() ? resource : resource + "\n--- scene ---\n" + scene);
+}
+
 std::vector<char> SerializeState(const cosim::UnitState& state) {
   Writer w;
   w.out.insert(w.out.end(), kMagic, kMagic + 5);

@@ -38,6 +38,10 @@ Layout MakeLayout(const cosim::VariableTable& table);
 /// (two differently seeded hashes fill its 128 bits).
 std::string GuidOf(const std::string& text);
 
+/// The guid of an exported FMU: GuidOf its resource file and scene file
+/// (empty when it has none); fmi2Instantiate checks it.
+std::string GuidOfResources(const std::string& resource, const std::string& scene);
+
 /// A UnitState as bytes (fmi2SerializeFMUstate) and back; Deserialize
 /// throws std::runtime_error on bytes it did not write.
 std::vector<char> SerializeState(const cosim::UnitState& state);

@@ -159,6 +159,14 @@ ExportResult ExportFmu(const ExportOptions& o) {
   spec["type"] = type->name;
   if (params.size() > 0) spec["parameters"] = params;
   scenario["units"][instance] = spec;
+  if (!o.scene.empty()) {
+    std::string scene = o.scene;
+    if ((scene.find('/') != std::string::npos || scene.ends_with(".yaml")) &&
+        fs::path(scene).is_relative()) {
+      scene = fs::absolute(scene).lexically_normal().string();
+    }
+    scenario["scene"]["model"] = scene;
+  }
   const fs::path draft = scratch.path() / "draft.yaml";
   WriteFile(draft, Emit(scenario));
 
@@ -169,6 +177,14 @@ ExportResult ExportFmu(const ExportOptions& o) {
     throw ExportError("cannot build a " + type->name + " unit:" + Describe(e, instance));
   }
   const cosim::Unit& unit = s.system->unit(0);
+  std::string scene_text;
+  if (!o.scene.empty()) {
+    std::ifstream in(s.scene.file, std::ios::binary);
+    std::ostringstream buffer;
+    buffer << in.rdbuf();
+    scene_text = buffer.str();
+    if (!in || scene_text.empty()) throw ExportError("cannot read the scene file " + s.scene.file);
+  }
 
   // Structural keys: the --set value, else the model file's.
   YAML::Node model;
@@ -202,6 +218,7 @@ ExportResult ExportFmu(const ExportOptions& o) {
   scenario["duration_s"] = "1";
   scenario["seed"] = "1";
   scenario["units"][instance] = resource_spec;
+  if (!scene_text.empty()) scenario["scene"]["model"] = kSceneFile;  // beside this file
 
   ExportResult result;
   result.resource =
@@ -209,7 +226,7 @@ ExportResult ExportFmu(const ExportOptions& o) {
       "# fmi2Instantiate: a linesim scenario with this one unit.\n" +
       Emit(scenario);
   result.model_identifier = type->name;
-  result.guid = GuidOf(result.resource);
+  result.guid = GuidOfResources(result.resource, scene_text);
   const Layout layout = MakeLayout(unit.variables());
   result.variables = layout.variables.size();
   result.model_description = WriteModelDescription(
@@ -231,6 +248,7 @@ ExportResult ExportFmu(const ExportOptions& o) {
   try {
     AddBuffer(zip, "modelDescription.xml", result.model_description);
     AddBuffer(zip, std::string("resources/") + kResourceFile, result.resource);
+    if (!scene_text.empty()) AddBuffer(zip, std::string("resources/") + kSceneFile, scene_text);
     zip_source_t* so = zip_source_file(zip, runtime.c_str(), 0, -1);
     const std::string so_name = "binaries/linux64/" + result.model_identifier + ".so";
     if (!so || zip_file_add(zip, so_name.c_str(), so, ZIP_FL_OVERWRITE) < 0) {

@@ -21,6 +21,10 @@ struct ExportOptions {
   /// The runtime library to ship; empty: the one this build made
   /// (RuntimeLibraryPath()).
   std::string runtime_library;
+  /// The scene a unit that takes geometry from it (belt, sensors) is built
+  /// for: a name of models/scenes/ or a path; empty: the open floor. The
+  /// file goes into the FMU (resources/scene.yaml).
+  std::string scene;
 };
 
 struct ExportResult {
@@ -35,6 +39,7 @@ struct ExportResult {
 /// values, checked by the loader with the same messages), and writes `out`:
 ///   modelDescription.xml                  from the unit's VariableTable
 ///   resources/linesim_unit.yaml           the type and every parameter value
+///   resources/scene.yaml                  the scene file, with `scene`
 ///   binaries/linux64/<type>.so            the linesim FMU runtime
 /// Throws ExportError: an unknown type, a bad key or value, a variable FMI
 /// 2.0 cannot carry, a missing runtime library, a file that cannot be written.
@@ -44,7 +49,8 @@ ExportResult ExportFmu(const ExportOptions& options);
 /// build tree).
 std::string RuntimeLibraryPath();
 
-/// The resource file inside an FMU, relative to its resources folder.
+/// The resource files inside an FMU, relative to its resources folder.
 inline constexpr const char* kResourceFile = "linesim_unit.yaml";
+inline constexpr const char* kSceneFile = "scene.yaml";
 
 }  // namespace linesim::fmu_export

@@ -208,7 +208,10 @@ LINESIM_FMI_EXPORT fmi2::Component fmi2Instantiate(fmi2::String instance_name, f
     c->resource_file = (fs::path(PathOfUri(resource_location)) /
                         linesim::fmu_export::kResourceFile).string();
     const std::string text = ReadText(c->resource_file);
-    const std::string expected = linesim::fmu_export::GuidOf(text);
+    const fs::path scene_file =
+        fs::path(c->resource_file).parent_path() / linesim::fmu_export::kSceneFile;
+    const std::string scene = fs::exists(scene_file) ? ReadText(scene_file.string()) : "";
+    const std::string expected = linesim::fmu_export::GuidOfResources(text, scene);
     if (!guid || expected != guid) {
       throw std::runtime_error(std::string("guid ") + (guid ? guid : "(null)") +
                                " does not match this FMU's " + expected);

@@ -86,7 +86,7 @@ bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 TEST(FmuExport, ModelDescriptionReadsBackWithTheUnitsRangesAndDependencies) {
   Scratch s("md");
-  const auto result = ExportFmu({"dc_motor", kMotorSets, s / "motor.fmu", ""});
+  const auto result = ExportFmu({"dc_motor", kMotorSets, s / "motor.fmu", "", ""});
   ASSERT_TRUE(fs::is_regular_file(s / "motor.fmu"));
   const fmu::ModelDescription md =
       fmu::ParseModelDescriptionText(result.model_description, "modelDescription.xml");
@@ -132,7 +132,7 @@ TEST(FmuExport, ModelDescriptionReadsBackWithTheUnitsRangesAndDependencies) {
 TEST(FmuExport, OutputDependenciesComeFromTheTable) {
   Scratch s("deps");
   const auto result =
-      ExportFmu({"dc_motor", {"mode=current_only", "count=2"}, s / "motor.fmu", ""});
+      ExportFmu({"dc_motor", {"mode=current_only", "count=2"}, s / "motor.fmu", "", ""});
   const fmu::ModelDescription md =
       fmu::ParseModelDescriptionText(result.model_description, "modelDescription.xml");
   const auto index_of = [&](const std::string& name) {
@@ -154,7 +154,7 @@ TEST(FmuExport, OutputDependenciesComeFromTheTable) {
 // load torque, 1 ms steps for 0.6 s. Every output identical to the last bit.
 TEST(FmuExport, RoundTripIsBitIdenticalToTheNativeUnit) {
   Scratch s("roundtrip");
-  ExportFmu({"dc_motor", kMotorSets, s / "motor.fmu", ""});
+  ExportFmu({"dc_motor", kMotorSets, s / "motor.fmu", "", ""});
   cosim::Unit& native = NativeMotorUnit();
   fmu::FmuUnit imported("motor_fmu", s / "motor.fmu");
 
@@ -204,7 +204,7 @@ TEST(FmuExport, RoundTripIsBitIdenticalToTheNativeUnit) {
 // UnitState), run on, restored and run again gives the same outputs.
 TEST(FmuExport, StateSavedAndRestoredThroughTheFmuContinuesIdentically) {
   Scratch s("state");
-  ExportFmu({"dc_motor", kMotorSets, s / "motor.fmu", ""});
+  ExportFmu({"dc_motor", kMotorSets, s / "motor.fmu", "", ""});
   fmu::FmuUnit u("motor_fmu", s / "motor.fmu");
   u.Setup(0, 1'000 * kMs);
   u.Initialize();
@@ -234,7 +234,7 @@ TEST(FmuExport, StateSavedAndRestoredThroughTheFmuContinuesIdentically) {
 // the no-load speed at 24 V against k_t V / (R b + k_t^2).
 TEST(FmuExport, AStandaloneCLoaderRunsTheFmu) {
   Scratch s("cloader");
-  ExportFmu({"dc_motor", {"model=maxon_re40_148877"}, s / "motor.fmu", ""});
+  ExportFmu({"dc_motor", {"model=maxon_re40_148877"}, s / "motor.fmu", "", ""});
   const std::string command = std::string(LINESIM_C_LOADER) + " " + (s / "motor.fmu") + " " +
                               (s / "unpacked") + " > " + (s / "out.txt") + " 2>&1";
   const int status = std::system(command.c_str());
@@ -242,6 +242,61 @@ TEST(FmuExport, AStandaloneCLoaderRunsTheFmu) {
   const std::string output((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_EQ(status, 0) << output;
   EXPECT_NE(output.find("ok:"), std::string::npos) << output;
+}
+
+// A scenario in which one unit is an exported FMU: the belt unit, built for
+// the factory_line scene (models/scenes/factory_line.yaml, shipped inside the
+// FMU), imported with `type: fmu` next to the native belt unit, both stepped
+// by the master at 10 ms for 30 s (one and a half periods of the scene's
+// speed variation). The FMU's belt has the native one's name and scenario
+// seed, so the two are the same unit: every output identical to the last bit.
+TEST(FmuExport, AnExportedBeltRunsInAScenarioLikeTheNativeOne) {
+  Scratch s("belt");
+  const auto result = ExportFmu({"belt", {}, s / "belt.fmu", "", "factory_line"});
+  EXPECT_NE(result.resource.find("model: scene.yaml"), std::string::npos)
+      << result.resource;
+  std::ofstream(s / "belt_fmu.yaml")
+      << "name: belt_fmu\n"
+         "duration_s: 30\n"
+         "seed: 1\n"
+         "master: {step_s: 0.01}\n"
+         "scene: {model: factory_line}\n"
+         "units:\n"
+         "  belt:\n"
+         "    type: belt\n"
+         "  belt_fmu:\n"
+         "    type: fmu\n"
+         "    parameters: {path: belt.fmu}\n";
+  loader::Scenario sc = loader::LoadScenario(s / "belt_fmu.yaml");
+  const cosim::Unit& native = sc.system->unit(*sc.system->FindUnit("belt"));
+  const cosim::Unit& fmu = sc.system->unit(*sc.system->FindUnit("belt_fmu"));
+  // One belt: velocity (vx, vy) becomes velocity[1], velocity[2] in the
+  // FMU, which the importer names velocity_1_, velocity_2_.
+  const auto native_velocity = *native.variables().Find("velocity");
+  const auto native_travel = *native.variables().Find("travel");
+  const auto fmu_vx = *fmu.variables().Find("velocity_1_");
+  const auto fmu_travel = *fmu.variables().Find("travel");
+  sc.master->Start();
+  std::size_t steps = 0;
+  double max_speed = 0;
+  // Step() is false after the step that reaches the stop time.
+  for (bool more = true; more;) {
+    more = sc.master->Step();
+    ++steps;
+    ASSERT_TRUE(SameBits(native.variables().GetRealElement(native_velocity, 0),
+                         fmu.variables().GetReal(fmu_vx)))
+        << "at t = " << cosim::FormatSeconds(sc.master->time());
+    ASSERT_TRUE(SameBits(native.variables().GetRealElement(native_travel, 0),
+                         fmu.variables().GetReal(fmu_travel)))
+        << "at t = " << cosim::FormatSeconds(sc.master->time());
+    max_speed = std::max(max_speed, fmu.variables().GetReal(fmu_vx));
+  }
+  const auto run = sc.master->Finish();
+  ASSERT_TRUE(run.ok) << (run.errors.empty() ? "" : run.errors[0]);
+  EXPECT_EQ(steps, 3000u);
+  // The belt moved at the scene's 0.1 m/s +- 10 %.
+  EXPECT_GT(max_speed, 0.09);
+  EXPECT_LT(max_speed, 0.111);
 }
 
 TEST(FmuExport, RefusesWithNamedErrors) {
@@ -254,16 +309,16 @@ TEST(FmuExport, RefusesWithNamedErrors) {
     }
     return std::string("(exported)");
   };
-  EXPECT_NE(message({"dc_motr", {}, s / "a.fmu", ""}).find("dc_motor"), std::string::npos);
-  EXPECT_NE(message({"dc_motor", {}, s / "a.zip", ""}).find(".fmu"), std::string::npos);
-  const std::string unknown = message({"dc_motor", {"resistanse=1"}, s / "a.fmu", ""});
+  EXPECT_NE(message({"dc_motr", {}, s / "a.fmu", "", ""}).find("dc_motor"), std::string::npos);
+  EXPECT_NE(message({"dc_motor", {}, s / "a.zip", "", ""}).find(".fmu"), std::string::npos);
+  const std::string unknown = message({"dc_motor", {"resistanse=1"}, s / "a.fmu", "", ""});
   EXPECT_NE(unknown.find("--set resistanse"), std::string::npos) << unknown;
   EXPECT_NE(unknown.find("resistance"), std::string::npos) << unknown;
-  const std::string bad = message({"dc_motor", {"resistance=-1"}, s / "a.fmu", ""});
+  const std::string bad = message({"dc_motor", {"resistance=-1"}, s / "a.fmu", "", ""});
   EXPECT_NE(bad.find("--set resistance"), std::string::npos) << bad;
-  EXPECT_NE(message({"dc_motor", {"novalue"}, s / "a.fmu", ""}).find("key=value"),
+  EXPECT_NE(message({"dc_motor", {"novalue"}, s / "a.fmu", "", ""}).find("key=value"),
             std::string::npos);
-  EXPECT_NE(message({"dc_motor", {}, s / "a.fmu", "/nonexistent/runtime.so"}).find("missing"),
+  EXPECT_NE(message({"dc_motor", {}, s / "a.fmu", "/nonexistent/runtime.so", ""}).find("missing"),
             std::string::npos);
   EXPECT_FALSE(fs::exists(s / "a.fmu"));
 }
