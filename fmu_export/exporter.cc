@@ -81,7 +81,12 @@ std::string Describe(const config::ScenarioError& e, const std::string& instance
   for (const auto& issue : e.issues()) {
     std::string where = issue.key_path;
     if (where.rfind(prefix, 0) == 0) {
-      where = "--set " + where.substr(prefix.size());
+      // "mount_x.0": element 0 of an array, which --set gives whole.
+      std::string key = where.substr(prefix.size());
+      if (const auto dot = key.find('.'); dot != std::string::npos) {
+        key = key.substr(0, dot) + " (element " + key.substr(dot + 1) + ")";
+      }
+      where = "--set " + key;
     } else if (!issue.file.empty() && issue.file.find("linesim-export-") == std::string::npos) {
       where = issue.file + (issue.line > 0 ? ":" + std::to_string(issue.line) : "") +
               (where.empty() ? "" : " " + where);
@@ -111,6 +116,9 @@ std::string RuntimeLibraryPath() { return LINESIM_FMU_RUNTIME; }
 ExportResult ExportFmu(const ExportOptions& o) {
   const config::UnitType* type = config::FindUnitType(o.type);
   if (!type) throw ExportError(config::UnknownTypeMessage(o.type));
+  if (o.type == "fmu") {
+    throw ExportError("type fmu wraps an FMU that exists already: ship that FMU itself");
+  }
   if (o.out.size() <= 4 || !o.out.ends_with(".fmu")) {
     throw ExportError("--out must name a .fmu file, got '" + o.out + "'");
   }

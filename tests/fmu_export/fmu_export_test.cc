@@ -315,7 +315,9 @@ TEST(FmuExport, RefusesWithNamedErrors) {
   EXPECT_NE(unknown.find("--set resistanse"), std::string::npos) << unknown;
   EXPECT_NE(unknown.find("resistance"), std::string::npos) << unknown;
   const std::string bad = message({"dc_motor", {"resistance=-1"}, s / "a.fmu", "", ""});
-  EXPECT_NE(bad.find("--set resistance"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("--set resistance (element 0): must be > 0, got -1"), std::string::npos)
+      << bad;
+  EXPECT_NE(message({"fmu", {}, s / "a.fmu", "", ""}).find("FMU that exists"), std::string::npos);
   EXPECT_NE(message({"dc_motor", {"novalue"}, s / "a.fmu", "", ""}).find("key=value"),
             std::string::npos);
   EXPECT_NE(message({"dc_motor", {}, s / "a.fmu", "/nonexistent/runtime.so", ""}).find("missing"),
