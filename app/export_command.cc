@@ -7,10 +7,11 @@
 namespace linesim::app {
 
 int ExportFmuCommand(const std::string& type, const std::vector<std::string>& set_args,
-                     const std::string& scene, const std::string& out) {
+                     const std::string& scene, int fmi_version, const std::string& out) {
   try {
-    const auto result = fmu_export::ExportFmu({type, set_args, out, "", scene});
-    std::cout << "wrote " << out << ": FMI 2.0 co-simulation, model identifier '"
+    const auto result = fmu_export::ExportFmu({type, set_args, out, "", scene, fmi_version});
+    std::cout << "wrote " << out << ": FMI " << result.fmi_version
+              << ".0 co-simulation, model identifier '"
               << result.model_identifier << "', " << result.variables << " variables, guid "
               << result.guid << "\n";
     return kExitOk;

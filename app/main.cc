@@ -51,6 +51,11 @@ int main(int argc, char** argv) {
   export_fmu->add_option("--scene", export_scene,
                          "the scene a unit that needs one (belt, sensors) is built for: a name "
                          "of models/scenes/ or a file (default: the open floor)");
+  int export_fmi = 0;
+  export_fmu->add_option("--fmi", export_fmi,
+                         "FMI version, 2 or 3 (default: 3 when the unit has a Real array of "
+                         "more than one element, else 2)")
+      ->check(CLI::IsMember({2, 3}));
   export_fmu->add_option("--out,-o", export_out, "the FMU to write (NAME.fmu)")->required();
 
   SweepArgs sweep_args;
@@ -106,7 +111,7 @@ int main(int argc, char** argv) {
       sweep_args.jobs_given = jobs->count() > 0;
       return SweepCommand(sweep_args, mpi.get());
     }
-    if (export_fmu->parsed()) return ExportFmuCommand(export_type, export_sets, export_scene, export_out);
+    if (export_fmu->parsed()) return ExportFmuCommand(export_type, export_sets, export_scene, export_fmi, export_out);
     return InspectCommand(what, inspect_sets);
   } catch (const std::exception& e) {
     std::cerr << "linesim: " << e.what() << "\n";

@@ -196,7 +196,7 @@ struct ExportedMotor {
              ("linesim-bench-export-" + std::to_string(::getpid()));
     std::filesystem::create_directories(folder);
     const std::string fmu_file = (folder / "motor.fmu").string();
-    linesim::fmu_export::ExportFmu({"dc_motor", {"model=maxon_re40_148877"}, fmu_file, "", ""});
+    linesim::fmu_export::ExportFmu({"dc_motor", {"model=maxon_re40_148877"}, fmu_file, "", "", 0});
     const std::string yaml = (folder / "native.yaml").string();
     std::ofstream(yaml) << "duration_s: 1\nunits:\n  motor:\n    type: dc_motor\n"
                            "    parameters: {model: maxon_re40_148877}\n";

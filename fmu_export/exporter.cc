@@ -235,12 +235,26 @@ ExportResult ExportFmu(const ExportOptions& o) {
       Emit(scenario);
   result.model_identifier = type->name;
   result.guid = GuidOfResources(result.resource, scene_text);
-  const Layout layout = MakeLayout(unit.variables());
-  result.variables = layout.variables.size();
-  result.model_description = WriteModelDescription(
-      unit, layout,
-      {type->name, result.model_identifier, result.guid,
-       "linesim unit type " + type->name + ": " + type->description});
+  const DescriptionInfo info{type->name, result.model_identifier, result.guid,
+                             "linesim unit type " + type->name + ": " + type->description};
+  if (o.fmi_version != 0 && o.fmi_version != 2 && o.fmi_version != 3) {
+    throw ExportError("FMI version " + std::to_string(o.fmi_version) + ": linesim writes 2 or 3");
+  }
+  result.fmi_version = o.fmi_version;
+  if (result.fmi_version == 0) {
+    result.fmi_version = 2;
+    for (const auto& v : unit.variables().infos()) {
+      if (v.type == cosim::VarType::kRealArray && v.size > 1) result.fmi_version = 3;
+    }
+  }
+  if (result.fmi_version == 2) {
+    const Layout layout = MakeLayout(unit.variables());
+    result.variables = layout.variables.size();
+    result.model_description = WriteModelDescription(unit, layout, info);
+  } else {
+    result.variables = unit.variables().size();
+    result.model_description = WriteModelDescription3(unit, info);
+  }
 
   // The FMU, written beside its final name and renamed into place.
   const fs::path out = fs::absolute(o.out);
@@ -258,7 +272,9 @@ ExportResult ExportFmu(const ExportOptions& o) {
     AddBuffer(zip, std::string("resources/") + kResourceFile, result.resource);
     if (!scene_text.empty()) AddBuffer(zip, std::string("resources/") + kSceneFile, scene_text);
     zip_source_t* so = zip_source_file(zip, runtime.c_str(), 0, -1);
-    const std::string so_name = "binaries/linux64/" + result.model_identifier + ".so";
+    const std::string so_name =
+        std::string(result.fmi_version == 2 ? "binaries/linux64/" : "binaries/x86_64-linux/") +
+        result.model_identifier + ".so";
     if (!so || zip_file_add(zip, so_name.c_str(), so, ZIP_FL_OVERWRITE) < 0) {
       if (so) zip_source_free(so);
       throw ExportError("cannot add " + runtime + " to the FMU: " + zip_strerror(zip));

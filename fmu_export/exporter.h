@@ -25,12 +25,16 @@ struct ExportOptions {
   /// for: a name of models/scenes/ or a path; empty: the open floor. The
   /// file goes into the FMU (resources/scene.yaml).
   std::string scene;
+  /// 2 or 3; 0: FMI 3.0 when the unit has a Real array of more than one
+  /// element (kept whole as an FMI 3.0 array), else FMI 2.0.
+  int fmi_version;
 };
 
 struct ExportResult {
+  int fmi_version = 2;
   std::string model_identifier;
   std::string guid;
-  std::size_t variables = 0;  // FMI scalar variables
+  std::size_t variables = 0;  // FMI variables (FMI 2.0: scalars)
   std::string model_description;
   std::string resource;       // resources/linesim_unit.yaml
 };
@@ -40,7 +44,8 @@ struct ExportResult {
 ///   modelDescription.xml                  from the unit's VariableTable
 ///   resources/linesim_unit.yaml           the type and every parameter value
 ///   resources/scene.yaml                  the scene file, with `scene`
-///   binaries/linux64/<type>.so            the linesim FMU runtime
+///   binaries/linux64/<type>.so            the linesim FMU runtime (FMI 2.0;
+///   binaries/x86_64-linux/<type>.so       FMI 3.0)
 /// Throws ExportError: an unknown type, a bad key or value, a variable FMI
 /// 2.0 cannot carry, a missing runtime library, a file that cannot be written.
 ExportResult ExportFmu(const ExportOptions& options);

@@ -72,6 +72,29 @@ const char* TypeElement(cosim::VarType t) {
   }
 }
 
+// UnitDefinitions: each unit with its SI base units (FMI 2.0 and 3.0 alike).
+void WriteUnits(std::ostringstream& x, const std::set<std::string>& units) {
+  if (units.empty()) return;
+  static const char* kNames[8] = {"kg", "m", "s", "A", "K", "mol", "cd", "rad"};
+  x << "  <UnitDefinitions>\n";
+  for (const auto& u : units) {
+    x << "    <Unit name=\"" << Escape(u) << "\"";
+    const auto exps = fmu::SiExponents(u);
+    if (!exps) {
+      x << "/>\n";
+      continue;
+    }
+    x << ">\n      <BaseUnit";
+    for (int i = 0; i < 8; ++i) {
+      if ((*exps)[static_cast<std::size_t>(i)] != 0) {
+        x << " " << kNames[i] << "=\"" << (*exps)[static_cast<std::size_t>(i)] << "\"";
+      }
+    }
+    x << "/>\n    </Unit>\n";
+  }
+  x << "  </UnitDefinitions>\n";
+}
+
 }  // namespace
 
 std::string WriteModelDescription(const cosim::Unit& unit, const Layout& layout,
@@ -90,7 +113,6 @@ std::string WriteModelDescription(const cosim::Unit& unit, const Layout& layout,
        " canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\""
        " canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>\n";
 
-  // Units of Real variables (linesim's "1" is FMI's no unit).
   std::set<std::string> units;
   for (const auto& v : layout.variables) {
     const auto& info = table.info(v.ref);
@@ -98,26 +120,7 @@ std::string WriteModelDescription(const cosim::Unit& unit, const Layout& layout,
       units.insert(info.unit);
     }
   }
-  if (!units.empty()) {
-    static const char* kNames[8] = {"kg", "m", "s", "A", "K", "mol", "cd", "rad"};
-    x << "  <UnitDefinitions>\n";
-    for (const auto& u : units) {
-      x << "    <Unit name=\"" << Escape(u) << "\"";
-      const auto exps = fmu::SiExponents(u);
-      if (!exps) {
-        x << "/>\n";
-        continue;
-      }
-      x << ">\n      <BaseUnit";
-      for (int i = 0; i < 8; ++i) {
-        if ((*exps)[static_cast<std::size_t>(i)] != 0) {
-          x << " " << kNames[i] << "=\"" << (*exps)[static_cast<std::size_t>(i)] << "\"";
-        }
-      }
-      x << "/>\n    </Unit>\n";
-    }
-    x << "  </UnitDefinitions>\n";
-  }
+  WriteUnits(x, units);
   x << "  <DefaultExperiment startTime=\"0\" stepSize=\"0.001\"/>\n";
 
   x << "  <ModelVariables>\n";
@@ -174,6 +177,105 @@ std::string WriteModelDescription(const cosim::Unit& unit, const Layout& layout,
     for (std::uint32_t vr : outputs) x << "      <Unknown index=\"" << vr + 1 << "\"/>\n";
     x << "    </InitialUnknowns>\n";
   }
+  x << "  </ModelStructure>\n";
+  x << "</fmiModelDescription>\n";
+  return x.str();
+}
+
+std::string WriteModelDescription3(const cosim::Unit& unit, const DescriptionInfo& d) {
+  const cosim::VariableTable& table = unit.variables();
+  std::ostringstream x;
+  x << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+  x << "<fmiModelDescription fmiVersion=\"3.0\" modelName=\"" << Escape(d.model_name)
+    << "\" instantiationToken=\"" << d.guid << "\" description=\"" << Escape(d.description)
+    << "\" generationTool=\"linesim export-fmu\" variableNamingConvention=\"structured\">\n";
+  x << "  <CoSimulation modelIdentifier=\"" << d.model_identifier
+    << "\" needsExecutionTool=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\""
+       " canGetAndSetFMUState=\"true\" canSerializeFMUState=\"true\""
+       " providesDirectionalDerivatives=\"false\" providesAdjointDerivatives=\"false\""
+       " providesPerElementDependencies=\"false\" canHandleVariableCommunicationStepSize=\"true\""
+       " maxOutputDerivativeOrder=\"0\" providesIntermediateUpdate=\"false\""
+       " mightReturnEarlyFromDoStep=\"false\" canReturnEarlyAfterIntermediateUpdate=\"false\""
+       " hasEventMode=\"false\" providesEvaluateDiscreteStates=\"false\"/>\n";
+  std::set<std::string> units;
+  for (const auto& info : table.infos()) {
+    if ((info.type == cosim::VarType::kReal || info.type == cosim::VarType::kRealArray) &&
+        !info.unit.empty() && info.unit != "1") {
+      units.insert(info.unit);
+    }
+  }
+  WriteUnits(x, units);
+  x << "  <DefaultExperiment startTime=\"0\" stepSize=\"0.001\"/>\n";
+
+  x << "  <ModelVariables>\n";
+  std::vector<cosim::ValueRef> outputs;
+  for (const auto& info : table.infos()) {
+    const bool real = info.type == cosim::VarType::kReal || info.type == cosim::VarType::kRealArray;
+    const char* tag = real                                      ? "Float64"
+                      : info.type == cosim::VarType::kInteger ? "Int32"
+                      : info.type == cosim::VarType::kBoolean ? "Boolean"
+                                                              : "String";
+    const cosim::VarType scalar = real ? cosim::VarType::kReal : info.type;
+    const bool has_start = info.causality == cosim::Causality::kParameter ||
+                           info.causality == cosim::Causality::kInput;
+    if (info.causality == cosim::Causality::kOutput) outputs.push_back(info.ref);
+    x << "    <" << tag << " name=\"" << Escape(info.name) << "\" valueReference=\"" << info.ref
+      << "\" causality=\"" << Causality(info) << "\" variability=\"" << Variability(info, scalar)
+      << "\"";
+    if (!info.description.empty()) x << " description=\"" << Escape(info.description) << "\"";
+    if (real) {
+      if (!info.unit.empty() && info.unit != "1") x << " unit=\"" << Escape(info.unit) << "\"";
+      if (const auto lo = info.rule.lower()) x << " min=\"" << cosim::FormatValue(*lo) << "\"";
+      if (const auto hi = info.rule.upper()) x << " max=\"" << cosim::FormatValue(*hi) << "\"";
+    } else if (info.type == cosim::VarType::kInteger) {
+      if (const auto lo = info.rule.lower()) x << " min=\"" << static_cast<long long>(*lo) << "\"";
+      if (const auto hi = info.rule.upper()) x << " max=\"" << static_cast<long long>(*hi) << "\"";
+    }
+    const cosim::Value value = table.GetValue(info.ref);
+    std::string start;
+    if (has_start && info.type != cosim::VarType::kString) {
+      if (const auto* a = std::get_if<std::vector<double>>(&value)) {
+        for (std::size_t i = 0; i < a->size(); ++i) {
+          start += (i ? " " : "") + cosim::FormatValue((*a)[i]);
+        }
+      } else if (const auto* r = std::get_if<double>(&value)) {
+        start = cosim::FormatValue(*r);
+      } else if (const auto* n = std::get_if<std::int64_t>(&value)) {
+        start = std::to_string(*n);
+      } else if (const auto* b = std::get_if<bool>(&value)) {
+        start = *b ? "true" : "false";
+      }
+      x << " start=\"" << start << "\"";
+    }
+    const bool children = info.type == cosim::VarType::kRealArray ||
+                          (has_start && info.type == cosim::VarType::kString);
+    if (!children) {
+      x << "/>\n";
+      continue;
+    }
+    x << ">\n";
+    if (info.type == cosim::VarType::kRealArray) {
+      x << "      <Dimension start=\"" << info.size << "\"/>\n";
+    } else {
+      x << "      <Start value=\"" << Escape(std::get<std::string>(value)) << "\"/>\n";
+    }
+    x << "    </" << tag << ">\n";
+  }
+  x << "  </ModelVariables>\n";
+
+  x << "  <ModelStructure>\n";
+  for (cosim::ValueRef out : outputs) {
+    std::set<cosim::ValueRef> deps(table.info(out).depends_on.begin(),
+                                   table.info(out).depends_on.end());
+    x << "    <Output valueReference=\"" << out << "\" dependencies=\"";
+    bool first = true;
+    for (cosim::ValueRef in : deps) {
+      x << (first ? "" : " ") << in;
+      first = false;
+    }
+    x << "\"/>\n";
+  }
+  for (cosim::ValueRef out : outputs) x << "    <InitialUnknown valueReference=\"" << out << "\"/>\n";
   x << "  </ModelStructure>\n";
   x << "</fmiModelDescription>\n";
   return x.str();

@@ -25,4 +25,10 @@ struct DescriptionInfo {
 std::string WriteModelDescription(const cosim::Unit& unit, const Layout& layout,
                                   const DescriptionInfo& info);
 
+/// The FMI 3.0 co-simulation model description: the value reference of a
+/// variable is its index in the table, a Real array one Float64 variable
+/// with its fixed <Dimension>; linesim Integers are Int32 (as the FMI 2.0
+/// export's Integer); otherwise as WriteModelDescription.
+std::string WriteModelDescription3(const cosim::Unit& unit, const DescriptionInfo& info);
+
 }  // namespace linesim::fmu_export

@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -86,7 +87,7 @@ bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 TEST(FmuExport, ModelDescriptionReadsBackWithTheUnitsRangesAndDependencies) {
   Scratch s("md");
-  const auto result = ExportFmu({"dc_motor", kMotorSets, s / "motor.fmu", "", ""});
+  const auto result = ExportFmu({"dc_motor", kMotorSets, s / "motor.fmu", "", "", 0});
   ASSERT_TRUE(fs::is_regular_file(s / "motor.fmu"));
   const fmu::ModelDescription md =
       fmu::ParseModelDescriptionText(result.model_description, "modelDescription.xml");
@@ -128,11 +129,12 @@ TEST(FmuExport, ModelDescriptionReadsBackWithTheUnitsRangesAndDependencies) {
 }
 
 // Current-only mode: the torque depends directly on the shaft speed input,
-// and the dependency is in ModelStructure.
+// and the dependency is in ModelStructure (FMI 2.0 asked for: the arrays
+// of two motors are flattened).
 TEST(FmuExport, OutputDependenciesComeFromTheTable) {
   Scratch s("deps");
   const auto result =
-      ExportFmu({"dc_motor", {"mode=current_only", "count=2"}, s / "motor.fmu", "", ""});
+      ExportFmu({"dc_motor", {"mode=current_only", "count=2"}, s / "motor.fmu", "", "", 2});
   const fmu::ModelDescription md =
       fmu::ParseModelDescriptionText(result.model_description, "modelDescription.xml");
   const auto index_of = [&](const std::string& name) {
@@ -154,7 +156,7 @@ TEST(FmuExport, OutputDependenciesComeFromTheTable) {
 // load torque, 1 ms steps for 0.6 s. Every output identical to the last bit.
 TEST(FmuExport, RoundTripIsBitIdenticalToTheNativeUnit) {
   Scratch s("roundtrip");
-  ExportFmu({"dc_motor", kMotorSets, s / "motor.fmu", "", ""});
+  ExportFmu({"dc_motor", kMotorSets, s / "motor.fmu", "", "", 0});
   cosim::Unit& native = NativeMotorUnit();
   fmu::FmuUnit imported("motor_fmu", s / "motor.fmu");
 
@@ -200,11 +202,64 @@ TEST(FmuExport, RoundTripIsBitIdenticalToTheNativeUnit) {
   native.Terminate();
 }
 
+// FMI 3.0: two motors (count = 2, the motor_step scenario's bare motor and
+// geared one), whose per-motor parameters, inputs and outputs are arrays
+// kept whole; imported back and run beside the native unit: identical to
+// the last bit, array element by element.
+TEST(FmuExport, Fmi3ArraysRoundTripBitIdentical) {
+  Scratch s("fmi3");
+  const std::vector<std::string> sets = {"count=2", "model=maxon_re40_148877",
+                                         "gear_ratio=[1,21]", "gear_efficiency=[1,0.75]",
+                                         "load_inertia=[2e-5,1e-3]"};
+  const auto result = ExportFmu({"dc_motor", sets, s / "motors.fmu", "", "", 0});
+  EXPECT_EQ(result.fmi_version, 3);
+  EXPECT_NE(result.model_description.find("<Dimension start=\"2\"/>"), std::string::npos);
+  EXPECT_NE(result.model_description.find("start=\"1 21\""), std::string::npos);
+  const std::string yaml = s / "native.yaml";
+  std::ofstream(yaml) << "duration_s: 1\nunits:\n  motors:\n    type: dc_motor\n"
+                         "    parameters: {count: 2, model: maxon_re40_148877, gear_ratio: [1, 21],"
+                         " gear_efficiency: [1, 0.75], load_inertia: [2.0e-5, 1.0e-3]}\n";
+  loader::Scenario sc = loader::LoadScenario(yaml);
+  cosim::Unit& native = sc.system->unit(0);
+  fmu::FmuUnit imported("motors_fmu", s / "motors.fmu");
+  EXPECT_EQ(imported.description().fmi_major, 3);
+  const auto in_native = *native.variables().Find("voltage");
+  const auto in_fmu = *imported.variables().Find("voltage");
+  ASSERT_EQ(imported.variables().info(in_fmu).size, 2u);
+  native.Setup(0, 500 * kMs);
+  imported.Setup(0, 500 * kMs);
+  native.Initialize();
+  imported.Initialize();
+  std::size_t compared = 0;
+  for (TimeNs t = 0; t < 500 * kMs; t += kMs) {
+    // motor_step.yaml's supply: 12 V from 0.1 s, 24 V from 0.3 s (here).
+    const double v = t >= 300 * kMs ? 24.0 : t >= 100 * kMs ? 12.0 : 0.0;
+    const std::vector<double> volts = {v, -v};
+    native.variables().SetRealArray(in_native, volts);
+    imported.variables().SetRealArray(in_fmu, volts);
+    ASSERT_EQ(native.DoStep(t, kMs), cosim::StepResult::kOk);
+    ASSERT_EQ(imported.DoStep(t, kMs), cosim::StepResult::kOk) << imported.last_error();
+    for (const std::string name : {"current", "speed", "torque"}) {
+      const auto x = native.variables().RealValues(*native.variables().Find(name));
+      const auto y = imported.variables().RealValues(*imported.variables().Find(name));
+      ASSERT_EQ(x.size(), 2u);
+      ASSERT_EQ(y.size(), 2u);
+      ASSERT_EQ(std::memcmp(x.data(), y.data(), 2 * sizeof(double)), 0)
+          << name << " at t = " << cosim::FormatSeconds(t + kMs);
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 1500u);
+  // The geared motor was given the opposite voltage: it turns backwards.
+  EXPECT_GT(native.variables().RealValues(*native.variables().Find("speed"))[0], 0.0);
+  EXPECT_LT(native.variables().RealValues(*native.variables().Find("speed"))[1], 0.0);
+}
+
 // canSerializeFMUstate: the imported FMU saved (serialized into the
 // UnitState), run on, restored and run again gives the same outputs.
 TEST(FmuExport, StateSavedAndRestoredThroughTheFmuContinuesIdentically) {
   Scratch s("state");
-  ExportFmu({"dc_motor", kMotorSets, s / "motor.fmu", "", ""});
+  ExportFmu({"dc_motor", kMotorSets, s / "motor.fmu", "", "", 0});
   fmu::FmuUnit u("motor_fmu", s / "motor.fmu");
   u.Setup(0, 1'000 * kMs);
   u.Initialize();
@@ -234,7 +289,7 @@ TEST(FmuExport, StateSavedAndRestoredThroughTheFmuContinuesIdentically) {
 // the no-load speed at 24 V against k_t V / (R b + k_t^2).
 TEST(FmuExport, AStandaloneCLoaderRunsTheFmu) {
   Scratch s("cloader");
-  ExportFmu({"dc_motor", {"model=maxon_re40_148877"}, s / "motor.fmu", "", ""});
+  ExportFmu({"dc_motor", {"model=maxon_re40_148877"}, s / "motor.fmu", "", "", 0});
   const std::string command = std::string(LINESIM_C_LOADER) + " " + (s / "motor.fmu") + " " +
                               (s / "unpacked") + " > " + (s / "out.txt") + " 2>&1";
   const int status = std::system(command.c_str());
@@ -252,7 +307,7 @@ TEST(FmuExport, AStandaloneCLoaderRunsTheFmu) {
 // seed, so the two are the same unit: every output identical to the last bit.
 TEST(FmuExport, AnExportedBeltRunsInAScenarioLikeTheNativeOne) {
   Scratch s("belt");
-  const auto result = ExportFmu({"belt", {}, s / "belt.fmu", "", "factory_line"});
+  const auto result = ExportFmu({"belt", {}, s / "belt.fmu", "", "factory_line", 0});
   EXPECT_NE(result.resource.find("model: scene.yaml"), std::string::npos)
       << result.resource;
   std::ofstream(s / "belt_fmu.yaml")
@@ -270,12 +325,19 @@ TEST(FmuExport, AnExportedBeltRunsInAScenarioLikeTheNativeOne) {
   loader::Scenario sc = loader::LoadScenario(s / "belt_fmu.yaml");
   const cosim::Unit& native = sc.system->unit(*sc.system->FindUnit("belt"));
   const cosim::Unit& fmu = sc.system->unit(*sc.system->FindUnit("belt_fmu"));
-  // One belt: velocity (vx, vy) becomes velocity[1], velocity[2] in the
-  // FMU, which the importer names velocity_1_, velocity_2_.
-  const auto native_velocity = *native.variables().Find("velocity");
-  const auto native_travel = *native.variables().Find("travel");
-  const auto fmu_vx = *fmu.variables().Find("velocity_1_");
-  const auto fmu_travel = *fmu.variables().Find("travel");
+  // velocity (vx, vy) is an array of two: the export is FMI 3.0 and the
+  // import keeps every output as the native unit declares it.
+  EXPECT_EQ(result.fmi_version, 3);
+  std::vector<std::pair<cosim::ValueRef, cosim::ValueRef>> pairs;
+  for (cosim::ValueRef r : native.variables().real_outputs()) {
+    const auto& name = native.variables().info(r).name;
+    const auto other = fmu.variables().Find(name);
+    ASSERT_TRUE(other.has_value()) << name;
+    ASSERT_EQ(fmu.variables().info(*other).size, native.variables().info(r).size) << name;
+    pairs.emplace_back(r, *other);
+  }
+  ASSERT_GE(pairs.size(), 3u);  // velocity, speed, on, travel
+  const auto velocity = *fmu.variables().Find("velocity");
   sc.master->Start();
   std::size_t steps = 0;
   double max_speed = 0;
@@ -283,13 +345,13 @@ TEST(FmuExport, AnExportedBeltRunsInAScenarioLikeTheNativeOne) {
   for (bool more = true; more;) {
     more = sc.master->Step();
     ++steps;
-    ASSERT_TRUE(SameBits(native.variables().GetRealElement(native_velocity, 0),
-                         fmu.variables().GetReal(fmu_vx)))
-        << "at t = " << cosim::FormatSeconds(sc.master->time());
-    ASSERT_TRUE(SameBits(native.variables().GetRealElement(native_travel, 0),
-                         fmu.variables().GetReal(fmu_travel)))
-        << "at t = " << cosim::FormatSeconds(sc.master->time());
-    max_speed = std::max(max_speed, fmu.variables().GetReal(fmu_vx));
+    for (const auto& [a, b] : pairs) {
+      const auto x = native.variables().RealValues(a);
+      const auto y = fmu.variables().RealValues(b);
+      ASSERT_EQ(std::memcmp(x.data(), y.data(), x.size() * sizeof(double)), 0)
+          << native.variables().info(a).name << " at t = " << cosim::FormatSeconds(sc.master->time());
+    }
+    max_speed = std::max(max_speed, fmu.variables().GetRealElement(velocity, 0));
   }
   const auto run = sc.master->Finish();
   ASSERT_TRUE(run.ok) << (run.errors.empty() ? "" : run.errors[0]);
@@ -309,18 +371,18 @@ TEST(FmuExport, RefusesWithNamedErrors) {
     }
     return std::string("(exported)");
   };
-  EXPECT_NE(message({"dc_motr", {}, s / "a.fmu", "", ""}).find("dc_motor"), std::string::npos);
-  EXPECT_NE(message({"dc_motor", {}, s / "a.zip", "", ""}).find(".fmu"), std::string::npos);
-  const std::string unknown = message({"dc_motor", {"resistanse=1"}, s / "a.fmu", "", ""});
+  EXPECT_NE(message({"dc_motr", {}, s / "a.fmu", "", "", 0}).find("dc_motor"), std::string::npos);
+  EXPECT_NE(message({"dc_motor", {}, s / "a.zip", "", "", 0}).find(".fmu"), std::string::npos);
+  const std::string unknown = message({"dc_motor", {"resistanse=1"}, s / "a.fmu", "", "", 0});
   EXPECT_NE(unknown.find("--set resistanse"), std::string::npos) << unknown;
   EXPECT_NE(unknown.find("resistance"), std::string::npos) << unknown;
-  const std::string bad = message({"dc_motor", {"resistance=-1"}, s / "a.fmu", "", ""});
+  const std::string bad = message({"dc_motor", {"resistance=-1"}, s / "a.fmu", "", "", 0});
   EXPECT_NE(bad.find("--set resistance (element 0): must be > 0, got -1"), std::string::npos)
       << bad;
-  EXPECT_NE(message({"fmu", {}, s / "a.fmu", "", ""}).find("FMU that exists"), std::string::npos);
-  EXPECT_NE(message({"dc_motor", {"novalue"}, s / "a.fmu", "", ""}).find("key=value"),
+  EXPECT_NE(message({"fmu", {}, s / "a.fmu", "", "", 0}).find("FMU that exists"), std::string::npos);
+  EXPECT_NE(message({"dc_motor", {"novalue"}, s / "a.fmu", "", "", 0}).find("key=value"),
             std::string::npos);
-  EXPECT_NE(message({"dc_motor", {}, s / "a.fmu", "/nonexistent/runtime.so", ""}).find("missing"),
+  EXPECT_NE(message({"dc_motor", {}, s / "a.fmu", "/nonexistent/runtime.so", "", 0}).find("missing"),
             std::string::npos);
   EXPECT_FALSE(fs::exists(s / "a.fmu"));
 }
