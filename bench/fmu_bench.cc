@@ -174,7 +174,7 @@ BENCHMARK(BM_FmuUnitStepAndUpdate);
 //                              exported runtime, which steps its own dc_motor)
 // Arg: 0 = constant 24 V (CVODE continues), 1 = the voltage changes every
 // 10th step (CVODE restarts then). The difference is the export's and
-// import's cost per step together.
+// import's cost per step together. With one motor the FMU is FMI 2.0.
 
 #include <unistd.h>
 
