@@ -259,29 +259,37 @@ TEST(FmuExport, Fmi3ArraysRoundTripBitIdentical) {
 // UnitState), run on, restored and run again gives the same outputs.
 TEST(FmuExport, StateSavedAndRestoredThroughTheFmuContinuesIdentically) {
   Scratch s("state");
-  ExportFmu({"dc_motor", kMotorSets, s / "motor.fmu", "", "", 0});
-  fmu::FmuUnit u("motor_fmu", s / "motor.fmu");
-  u.Setup(0, 1'000 * kMs);
-  u.Initialize();
-  Set(u, "voltage", 12.0);
-  TimeNs t = 0;
-  for (; t < 20 * kMs; t += kMs) ASSERT_EQ(u.DoStep(t, kMs), cosim::StepResult::kOk);
-  const cosim::UnitState saved = u.SaveState();
-  const TimeNs t_saved = t;
-  std::vector<double> first;
-  for (; t < 40 * kMs; t += kMs) {
-    ASSERT_EQ(u.DoStep(t, kMs), cosim::StepResult::kOk);
-    first.push_back(Get(u, "speed"));
+  // FMI 2.0 (one motor) and FMI 3.0 (two motors: arrays).
+  for (const std::string count : {"1", "2"}) {
+    SCOPED_TRACE("count " + count);
+    const auto result = ExportFmu(
+        {"dc_motor", {"model=maxon_re40_148877", "count=" + count}, s / "motor.fmu", "", "", 0});
+    EXPECT_EQ(result.fmi_version, count == "1" ? 2 : 3);
+    fmu::FmuUnit u("motor_fmu", s / "motor.fmu");
+    u.Setup(0, 1'000 * kMs);
+    u.Initialize();
+    const auto voltage = *u.variables().Find("voltage");
+    const auto speed = *u.variables().Find("speed");
+    u.variables().SetValue(voltage, cosim::Value{12.0});  // every motor
+    TimeNs t = 0;
+    for (; t < 20 * kMs; t += kMs) ASSERT_EQ(u.DoStep(t, kMs), cosim::StepResult::kOk);
+    const cosim::UnitState saved = u.SaveState();
+    const TimeNs t_saved = t;
+    std::vector<double> first;
+    for (; t < 40 * kMs; t += kMs) {
+      ASSERT_EQ(u.DoStep(t, kMs), cosim::StepResult::kOk);
+      for (double x : u.variables().RealValues(speed)) first.push_back(x);
+    }
+    u.RestoreState(saved);
+    std::vector<double> second;
+    for (t = t_saved; t < 40 * kMs; t += kMs) {
+      ASSERT_EQ(u.DoStep(t, kMs), cosim::StepResult::kOk);
+      for (double x : u.variables().RealValues(speed)) second.push_back(x);
+    }
+    ASSERT_EQ(first.size(), second.size());
+    EXPECT_EQ(std::memcmp(first.data(), second.data(), first.size() * sizeof(double)), 0);
+    EXPECT_GT(first.back(), 0.0);
   }
-  u.RestoreState(saved);
-  std::vector<double> second;
-  for (t = t_saved; t < 40 * kMs; t += kMs) {
-    ASSERT_EQ(u.DoStep(t, kMs), cosim::StepResult::kOk);
-    second.push_back(Get(u, "speed"));
-  }
-  ASSERT_EQ(first.size(), second.size());
-  EXPECT_EQ(std::memcmp(first.data(), second.data(), first.size() * sizeof(double)), 0);
-  EXPECT_GT(first.back(), 0.0);
 }
 
 // The standalone C loader (c_loader.c): unzips the FMU, dlopens its binary
