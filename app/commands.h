@@ -30,6 +30,11 @@ int RunCommand(const std::string& file, const std::string& out_dir,
 /// `linesim inspect TYPE|FILE [--set path=value ...]`.
 int InspectCommand(const std::string& what, const std::vector<std::string>& set_args);
 
+/// `linesim export-fmu TYPE [--set key=value ...] [--scene S] [--fmi 2|3]
+/// --out NAME.fmu` (app/export_command.cc); fmi_version 0: automatic.
+int ExportFmuCommand(const std::string& type, const std::vector<std::string>& set_args,
+                     const std::string& scene, int fmi_version, const std::string& out);
+
 struct SweepArgs {
   std::string file;
   std::string out_dir;

@@ -42,6 +42,26 @@ int main(int argc, char** argv) {
   inspect->add_option("--set", inspect_sets, "override a value: dotted.path=value (repeatable)")
       ->take_all();
 
+  std::string export_type, export_out, export_scene;
+  std::vector<std::string> export_sets;
+  CLI::App* export_fmu = cli.add_subcommand(
+      "export-fmu", "write an FMI 2.0 co-simulation FMU of a unit type (runs linesim's unit in "
+                    "other masters)");
+  export_fmu->add_option("type", export_type, "unit type name (linesim inspect TYPE)")->required();
+  export_fmu->add_option("--set", export_sets,
+                         "a structural key, `model` or a parameter of the unit: key=value "
+                         "(repeatable)")
+      ->take_all();
+  export_fmu->add_option("--scene", export_scene,
+                         "the scene a unit that needs one (belt, sensors) is built for: a name "
+                         "of models/scenes/ or a file (default: the open floor)");
+  int export_fmi = 0;
+  export_fmu->add_option("--fmi", export_fmi,
+                         "FMI version, 2 or 3 (default: 3 when the unit has a Real array of "
+                         "more than one element, else 2)")
+      ->check(CLI::IsMember({2, 3}));
+  export_fmu->add_option("--out,-o", export_out, "the FMU to write (NAME.fmu)")->required();
+
   SweepArgs sweep_args;
   sweep_args.jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   CLI::App* sweep = cli.add_subcommand(
@@ -96,6 +116,7 @@ int main(int argc, char** argv) {
       sweep_args.jobs_given = jobs->count() > 0;
       return SweepCommand(sweep_args, mpi.get());
     }
+    if (export_fmu->parsed()) return ExportFmuCommand(export_type, export_sets, export_scene, export_fmi, export_out);
     return InspectCommand(what, inspect_sets);
   } catch (const std::exception& e) {
     std::cerr << "linesim: " << e.what() << "\n";

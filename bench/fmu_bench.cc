@@ -163,3 +163,84 @@ BENCHMARK(BM_FmuUnitDoStep);
 BENCHMARK(BM_FmuUnitStepAndUpdate);
 
 }  // namespace
+
+// --- export-fmu: the exported dc_motor FMU against the native unit --------
+//
+//   BM_ExportedMotor/native    the native dc_motor unit (maxon RE 40 148877,
+//                              models/motors/), DoStep of 1 ms
+//   BM_ExportedMotor/fmu       the same unit exported with `export-fmu` and
+//                              run through the fmu unit (FmuUnit::DoStep:
+//                              fmi2SetReal, fmi2DoStep, fmi2GetReal into the
+//                              exported runtime, which steps its own dc_motor)
+// Arg: 0 = constant 24 V (CVODE continues), 1 = the voltage changes every
+// 10th step (CVODE restarts then). The difference is the export's and
+// import's cost per step together. With one motor the FMU is FMI 2.0.
+
+#include <unistd.h>
+
+#include <fstream>
+#include <memory>
+
+#include "fmu_export/exporter.h"
+#include "loader/scenario.h"
+
+namespace {
+
+struct ExportedMotor {
+  std::filesystem::path folder;
+  std::unique_ptr<linesim::loader::Scenario> native;
+  std::unique_ptr<FmuUnit> fmu;
+
+  ExportedMotor() {
+    folder = std::filesystem::temp_directory_path() /
+             ("linesim-bench-export-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(folder);
+    const std::string fmu_file = (folder / "motor.fmu").string();
+    linesim::fmu_export::ExportFmu({"dc_motor", {"model=maxon_re40_148877"}, fmu_file, "", "", 0});
+    const std::string yaml = (folder / "native.yaml").string();
+    std::ofstream(yaml) << "duration_s: 1\nunits:\n  motor:\n    type: dc_motor\n"
+                           "    parameters: {model: maxon_re40_148877}\n";
+    native = std::make_unique<linesim::loader::Scenario>(linesim::loader::LoadScenario(yaml));
+    fmu = std::make_unique<FmuUnit>("motor_fmu", fmu_file);
+  }
+  ~ExportedMotor() {
+    fmu.reset();
+    std::filesystem::remove_all(folder);
+  }
+};
+
+void BM_ExportedMotor(benchmark::State& state, bool through_fmu) {
+  std::unique_ptr<ExportedMotor> m;
+  try {
+    m = std::make_unique<ExportedMotor>();
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  linesim::cosim::Unit& u = through_fmu ? static_cast<linesim::cosim::Unit&>(*m->fmu)
+                                        : m->native->system->unit(0);
+  u.Setup(0, INT64_MAX / 2);
+  u.Initialize();
+  u.variables().Lock();
+  const auto voltage = *u.variables().Find("voltage");
+  const bool is_array = u.variables().info(voltage).type == linesim::cosim::VarType::kRealArray;
+  const bool changing = state.range(0) != 0;
+  std::int64_t n = 0;
+  for (auto _ : state) {
+    const double v = changing && (n / 10) % 2 == 1 ? 12.0 : 24.0;
+    if (is_array) {
+      u.variables().SetRealElement(voltage, 0, v);
+    } else {
+      u.variables().SetReal(voltage, v);
+    }
+    if (u.DoStep(n * kStep, kStep) != linesim::cosim::StepResult::kOk) {
+      state.SkipWithError(u.last_error().c_str());
+      break;
+    }
+    ++n;
+  }
+}
+BENCHMARK_CAPTURE(BM_ExportedMotor, native, false)->Arg(0)->Arg(1);
+BENCHMARK_CAPTURE(BM_ExportedMotor, fmu, true)->Arg(0)->Arg(1);
+
+}  // namespace

@@ -96,6 +96,10 @@ class Rule {
 
   bool empty() const;
   bool required() const { return required_; }
+  /// The numeric bounds, for FMI's min / max (an exclusive end is given as
+  /// its value: FMI bounds are inclusive); nothing when unbounded.
+  std::optional<double> lower() const { return min_ ? std::optional<double>(min_->value) : std::nullopt; }
+  std::optional<double> upper() const { return max_ ? std::optional<double>(max_->value) : std::nullopt; }
   /// For tables: "> 0", "[0, 1]", "(0, 1]", "finite", "one of: a, b",
   /// "required", "required, > 0"; "" when there is no rule.
   std::string Text() const;

@@ -502,6 +502,10 @@ std::string LinesimUnit(const std::string& fmi_unit, const std::map<std::string,
   return fmi_unit;
 }
 
+std::optional<std::array<int, 8>> SiExponents(const std::string& unit) {
+  return ExpressionExponents(unit);
+}
+
 ModelDescription ParseModelDescriptionText(const std::string& text, const std::string& file) {
   return Parser(text, file).Parse();
 }

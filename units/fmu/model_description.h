@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -105,6 +106,13 @@ ModelDescription ParseModelDescriptionText(const std::string& text, const std::s
 /// (deg, rpm, degC) keeps its own name, so that it connects only to the
 /// same name (linesim converts no units).
 std::string LinesimUnit(const std::string& fmi_unit, const std::map<std::string, FmiUnit>& units);
+
+/// The SI base-unit exponents (kg, m, s, A, K, mol, cd, rad, FMI's order)
+/// of a unit expression in FMI / Modelica syntax or linesim's spelling
+/// ("N.m", "m/s2", "kg.m2", "N.m.s/rad", "1"); nothing when a symbol is not
+/// an SI one without prefix. The exporter writes UnitDefinitions with it, so
+/// an exported FMU's units read back as they were written.
+std::optional<std::array<int, 8>> SiExponents(const std::string& unit);
 
 /// "Float64", "Int32", "Boolean", "String" (FMI 3.0 names).
 const char* ToString(FmiType type);
