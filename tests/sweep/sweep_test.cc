@@ -502,7 +502,8 @@ TEST(SweepExecutor, OneAndTwoJobsWriteTheSameRowsAndAFailingRunIsIsolated) {
   std::getline(in, header);
   EXPECT_EQ(
       header,
-      "run_id,master.step_s,control.compensation,seed,max_path_deviation_m,status,error,wall_s");
+      "run_id,master.step_s,control.compensation,seed,max_path_deviation_m,status,error,error_unit,"
+      "error_time_s,error_phase,error_variable,error_cause,wall_s");
   std::vector<std::vector<std::string>> rows;
   for (std::string line; std::getline(in, line);) rows.push_back(*SplitCsvLine(line));
   ASSERT_EQ(rows.size(), 6u);
@@ -515,6 +516,12 @@ TEST(SweepExecutor, OneAndTwoJobsWriteTheSameRowsAndAFailingRunIsIsolated) {
       EXPECT_NE(rows[i][6].find("not an integer multiple of the master step 0.003 s"),
                 std::string::npos)
           << rows[i][6];
+      // The scenario was refused before any unit ran: no unit, no time.
+      EXPECT_EQ(rows[i][7], "") << i;
+      EXPECT_EQ(rows[i][8], "") << i;
+      EXPECT_EQ(rows[i][9], "scenario") << i;
+    } else {
+      for (int c = 7; c <= 11; ++c) EXPECT_EQ(rows[i][c], "") << i << " " << c;
     }
   }
   // A resumed file counts its failed rows (the two at 0.003 s).
@@ -589,7 +596,8 @@ TEST(ResultsFile, ResumeDropsRowsThatDoNotMatchThePlan) {
     const std::size_t end = line.find(',', begin);
     return line.replace(begin, end - begin, text);
   };
-  // Columns: run_id, speed, compensation, seed, 8 metrics..., status, error, wall_s.
+  // Columns: run_id, speed, compensation, seed, 8 metrics..., status, error,
+  // the 5 error fields, wall_s.
   const std::string path = dir + "/results.csv";
   std::ofstream(path, std::ios::trunc)
       << lines[0] << lines[1]                          // run 0 as it was

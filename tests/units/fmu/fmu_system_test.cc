@@ -33,7 +33,7 @@ TEST(FmuSystem, NativeSourceDrivesAnFmu) {
   options.stop = 1000 * kMs;
   cosim::Master master(system, options);
   const auto result = master.Run();
-  ASSERT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors[0]);
+  ASSERT_TRUE(result.ok) << result.ErrorText();
   const double exact = 0.3 + (1.0 - 0.3) * std::exp(-1.0);
   EXPECT_NEAR(fmu.variables().GetReal(*fmu.variables().Find("x")), exact, 1e-14);
 }
@@ -81,7 +81,7 @@ TEST(FmuSystem, FeedthroughChainAcrossFmiVersions) {
   options.stop = 100 * kMs;
   cosim::Master master(system, options);
   const auto result = master.Run();
-  ASSERT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors[0]);
+  ASSERT_TRUE(result.ok) << result.ErrorText();
   const auto& t = f3b.variables();
   EXPECT_EQ(t.GetReal(*t.Find("speed_out")), -1.0);
   EXPECT_EQ(t.GetInteger(*t.Find("count_out")), -7);
@@ -89,7 +89,7 @@ TEST(FmuSystem, FeedthroughChainAcrossFmiVersions) {
 }
 
 // fmi2Discard in a fixed-step master: the run stops at the discarded step,
-// naming unit and time (retrying is a later master's option). t_discard is
+// naming unit and time (master.retry is off by default). t_discard is
 // 0.5 s; the FMU discards a step ending after it: 0.4 + 0.1 is exactly 0.5
 // in binary floating point, so the step from 0.5 s is the first.
 TEST(FmuSystem, DiscardStopsAFixedStepRunNamingUnitAndTime) {
@@ -102,10 +102,35 @@ TEST(FmuSystem, DiscardStopsAFixedStepRunNamingUnitAndTime) {
   const auto result = master.Run();
   ASSERT_FALSE(result.ok);
   ASSERT_EQ(result.errors.size(), 1u);
-  const std::string& e = result.errors[0];
+  const std::string& e = result.errors[0].message;
   EXPECT_NE(e.find("unit 'd' (fmu) at t = 0.5 s"), std::string::npos) << e;
   EXPECT_NE(e.find("discarded the step"), std::string::npos) << e;
   EXPECT_EQ(result.end_time, 500 * kMs);
+  EXPECT_EQ(result.errors[0].unit, "d");
+  EXPECT_EQ(result.errors[0].phase, cosim::RunPhase::kStep);
+}
+
+// master.retry needs the FMU's state before every step: discard2 does not
+// offer canGetAndSetFMUstate, so a run with retry on is refused at its
+// first step, in the retry phase, naming the missing capability (rather
+// than failing later at the discard with nothing to go back to).
+TEST(FmuSystem, RetryNeedsAnFmuThatCanSaveItsState) {
+  cosim::System system;
+  system.Add(std::make_unique<FmuUnit>("d", Fmu("discard2")));
+  cosim::MasterOptions options;
+  options.base_step = 100 * kMs;
+  options.stop = 1000 * kMs;
+  options.retry.enabled = true;
+  cosim::Master master(system, options);
+  const auto result = master.Run();
+  ASSERT_FALSE(result.ok);
+  ASSERT_EQ(result.errors.size(), 1u);
+  const cosim::RunError& e = result.errors[0];
+  EXPECT_EQ(e.unit, "d");
+  EXPECT_EQ(e.time, TimeNs{0});
+  EXPECT_EQ(e.phase, cosim::RunPhase::kRetry);
+  EXPECT_NE(e.cause.find("canGetAndSetFMUstate"), std::string::npos) << e.message;
+  EXPECT_EQ(result.end_time, 0);
 }
 
 }  // namespace
