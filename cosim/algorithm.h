@@ -28,9 +28,9 @@ class StepContext {
  public:
   virtual ~StepContext() = default;
   /// The units that step at this communication point, in dependency order.
-  virtual std::span<const std::size_t> due() const = 0;
+  std::span<const std::size_t> due() const { return due_; }
   /// Whether some output of unit u depends directly on its inputs.
-  virtual bool has_feedthrough(std::size_t u) const = 0;
+  bool has_feedthrough(std::size_t u) const { return (*feedthrough_)[u]; }
   /// Sets u's inputs over the links whose source is at a communication point.
   virtual void TransferInto(std::size_t u) = 0;
   /// Passes u's outputs on to the due units it feeds.
@@ -45,6 +45,11 @@ class StepContext {
   virtual StepResult StepUnit(std::size_t u) = 0;
   /// The guard on u's outputs after its step; false (recorded) on NaN/Inf.
   virtual bool CheckOutputs(std::size_t u) = 0;
+
+ protected:
+  // Plain data, read per unit in the algorithms' loops (no virtual call).
+  std::span<const std::size_t> due_;
+  const std::vector<bool>* feedthrough_ = nullptr;
 };
 
 /// How a communication step ended.

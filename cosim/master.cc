@@ -113,6 +113,7 @@ Master::Master(System& system, MasterOptions options) : system_(system), options
     if (decimation_[u] == 1) every_step_.push_back(u);
   }
   algorithm_ = MakeAlgorithm(options_.algorithm, options_.threads);
+  feedthrough_ = &has_feedthrough_;
   if (retry.enabled) {
     // Every divisor of h, found by trial division up to sqrt(h): once.
     for (TimeNs d = 1; d * d <= h; ++d) {
@@ -362,15 +363,16 @@ void Master::Plan(TimeNs tau, TimeNs dt, bool first) {
   plan_dt_ = dt;
   plan_first_ = first;
   if (first) {
-    due_.clear();
+    due_at_point_.clear();
     for (std::size_t u : system_.dependency_order()) {
-      if (step_index_ % decimation_[u] == 0) due_.push_back(u);
+      if (step_index_ % decimation_[u] == 0) due_at_point_.push_back(u);
     }
-    plan_due_ = &due_;
+    plan_due_ = &due_at_point_;
   } else {
     // Between base points only the units at the master's own step step.
     plan_due_ = &every_step_;
   }
+  due_ = *plan_due_;
 }
 
 bool Master::Step() {

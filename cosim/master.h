@@ -121,8 +121,6 @@ class Master : private StepContext {
 
  private:
   // StepContext: what the algorithm calls.
-  std::span<const std::size_t> due() const override { return *plan_due_; }
-  bool has_feedthrough(std::size_t u) const override { return has_feedthrough_[u]; }
   void TransferInto(std::size_t u) override;
   void TransferFrom(std::size_t u) override;
   bool UpdateOutputs(std::size_t u) override;
@@ -156,12 +154,12 @@ class Master : private StepContext {
   std::vector<std::vector<std::size_t>> links_into_;  // per destination unit
   std::vector<std::vector<std::size_t>> links_from_;  // per source unit
   std::vector<bool> has_feedthrough_;                 // some output depends on an input
-  std::vector<std::size_t> due_;                      // due at the base point
+  std::vector<std::size_t> due_at_point_;             // due at the base point
   std::vector<std::size_t> every_step_;               // decimation 1, dependency order
   std::vector<double> unit_wall_seconds_;
   std::vector<RunError> errors_;
   // The communication step being taken (StepContext's view).
-  const std::vector<std::size_t>* plan_due_ = &due_;
+  const std::vector<std::size_t>* plan_due_ = &due_at_point_;
   TimeNs plan_t_ = 0;
   TimeNs plan_dt_ = 0;
   bool plan_first_ = true;
