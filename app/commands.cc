@@ -412,7 +412,12 @@ int InspectCommand(const std::string& what, const std::vector<std::string>& set_
   if (!s.description.empty()) std::cout << ": " << s.description;
   std::cout << "\n  duration " << cosim::FormatSeconds(o.stop - o.start) << " s, seed " << s.seed
             << ", master " << cosim::ToString(o.algorithm) << " step "
-            << cosim::FormatSeconds(o.base_step) << " s\n";
+            << cosim::FormatSeconds(o.base_step) << " s";
+  if (o.retry.enabled) {
+    std::cout << ", retry on (min step " << cosim::FormatSeconds(o.retry.min_step)
+              << " s, shrink " << o.retry.shrink << ", grow " << o.retry.grow << ")";
+  }
+  std::cout << "\n";
   if (s.robot) {
     // The robot-level file and what it stands for, in the system-level
     // format (a file of its own could be run as is).
