@@ -15,6 +15,7 @@
 #include "config/unit_registry.h"
 #include "cosim/files.h"
 #include "cosim/observers.h"
+#include "cosim/run_error_json.h"
 #include "loader/scenario.h"
 #include "plots/robot_plots.h"
 #include "units/fmu/fmu_unit.h"
@@ -219,14 +220,19 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   const bool csv_written = !csv.fail();
   if (!csv_written) {
     outcome.ok = false;
-    outcome.errors.push_back("cannot write " + csv_path.string() +
-                             " (disk full or not writable): the signals are incomplete");
+    cosim::RunError e = cosim::MakeRunError(
+        std::nullopt, cosim::RunPhase::kRecording, "",
+        "cannot write " + csv_path.string() + " (disk full or not writable): the signals are " +
+            "incomplete");
+    e.message = e.cause;
+    e.time = result.end_time;
+    outcome.errors.push_back(std::move(e));
   }
 
   // A metric that overflowed fails the run, naming the metric.
-  for (const auto& e : metrics.NonFiniteResults()) {
+  for (auto& e : metrics.NonFiniteErrors(result.end_time)) {
     outcome.ok = false;
-    outcome.errors.push_back(e);
+    outcome.errors.push_back(std::move(e));
   }
 
   const cosim::MasterOptions& options = s.master->options();
@@ -235,13 +241,26 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   summary["scenario"] = s.name;
   summary["file"] = file;
   summary["status"] = interrupted ? "interrupted" : outcome.ok ? "ok" : "failed";
-  summary["errors"] = outcome.errors;
+  // The first failure as data ({"unit", "time_s", "phase", "variable",
+  // "cause", "message"}), null when the run is ok; every message in
+  // "errors".
+  summary["error"] = outcome.errors.empty() ? Json(nullptr) : cosim::RunErrorJson(outcome.errors[0]);
+  Json messages = Json::array();
+  for (const auto& e : outcome.errors) messages.push_back(e.message);
+  summary["errors"] = messages;
   Json settings;
   settings["duration_s"] = s.duration_s;
   settings["seed"] = s.seed;
   settings["master"] = {{"algorithm", cosim::ToString(options.algorithm)},
                         {"step_s", cosim::NsToSeconds(options.base_step)},
                         {"threads", options.threads}};
+  if (options.retry.enabled) {
+    settings["master"]["retry"] = {{"min_step_s", cosim::NsToSeconds(options.retry.min_step)},
+                                   {"shrink", options.retry.shrink},
+                                   {"grow", options.retry.grow},
+                                   {"rejected_steps", result.rejected_steps},
+                                   {"smallest_step_s", cosim::NsToSeconds(result.smallest_step)}};
+  }
   Json overrides = Json::array();
   for (const auto& o : s.overrides) overrides.push_back(o.path + "=" + o.value);
   settings["overrides"] = overrides;
@@ -318,7 +337,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
             << recorder.rows() << " rows)";
   for (const auto& p : pictures) std::cout << ", " << p;
   std::cout << "\n";
-  for (const auto& e : outcome.errors) std::cerr << "linesim: " << e << "\n";
+  for (const auto& e : outcome.errors) std::cerr << "linesim: " << e.message << "\n";
   if (interrupted) return kExitInterrupted;
   return outcome.ok ? kExitOk : kExitRunFailed;
 }
@@ -428,7 +447,12 @@ int InspectCommand(const std::string& what, const std::vector<std::string>& set_
   if (!s.description.empty()) std::cout << ": " << s.description;
   std::cout << "\n  duration " << cosim::FormatSeconds(o.stop - o.start) << " s, seed " << s.seed
             << ", master " << cosim::ToString(o.algorithm) << " step "
-            << cosim::FormatSeconds(o.base_step) << " s\n";
+            << cosim::FormatSeconds(o.base_step) << " s";
+  if (o.retry.enabled) {
+    std::cout << ", retry on (min step " << cosim::FormatSeconds(o.retry.min_step)
+              << " s, shrink " << o.retry.shrink << ", grow " << o.retry.grow << ")";
+  }
+  std::cout << "\n";
   if (s.robot) {
     // The robot-level file and what it stands for, in the system-level
     // format (a file of its own could be run as is).

@@ -28,7 +28,7 @@ void BM_Scenario(benchmark::State& state, const std::string& file,
     state.ResumeTiming();
     const auto result = s.master->Run();
     if (!result.ok) {
-      state.SkipWithError(result.errors.front().c_str());
+      state.SkipWithError(result.ErrorText().c_str());
       break;
     }
     simulated_s += linesim::cosim::NsToSeconds(result.end_time);

@@ -1,9 +1,8 @@
 #include "cosim/master.h"
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
+#include <algorithm>
 #include <bit>
+#include <cmath>
 #include <chrono>
 #include <cstring>
 
@@ -37,36 +36,11 @@ bool SameBits(double a, double b) {
 
 }  // namespace
 
-std::string_view ToString(Algorithm a) {
-  switch (a) {
-    case Algorithm::kJacobi:
-      return "jacobi";
-    case Algorithm::kGaussSeidel:
-      return "gauss_seidel";
-  }
-  return "?";
+std::string RunResult::ErrorText() const {
+  std::string text;
+  for (const auto& e : errors) text += (text.empty() ? "" : "; ") + e.message;
+  return text;
 }
-
-bool ParseAlgorithm(std::string_view text, Algorithm* out) {
-  for (const Algorithm a : {Algorithm::kJacobi, Algorithm::kGaussSeidel}) {
-    if (text == ToString(a)) {
-      *out = a;
-      return true;
-    }
-  }
-  return false;
-}
-
-std::vector<std::string> AlgorithmNames() {
-  return {std::string(ToString(Algorithm::kJacobi)),
-          std::string(ToString(Algorithm::kGaussSeidel))};
-}
-
-// Keeps TBB out of the public header; limits Jacobi to `threads` threads.
-struct Master::Arena {
-  explicit Arena(int threads) : arena(threads) {}
-  tbb::task_arena arena;
-};
 
 Master::~Master() = default;
 
@@ -81,6 +55,21 @@ Master::Master(System& system, MasterOptions options) : system_(system), options
                         std::nullopt});
   }
   if (options_.threads < 1) problems.push_back({"threads must be at least 1", std::nullopt});
+  const RetryOptions& retry = options_.retry;
+  if (retry.enabled) {
+    if (!(retry.shrink > 0.0 && retry.shrink < 1.0)) {
+      problems.push_back({"master.retry.shrink must be in (0, 1)", std::nullopt});
+    }
+    if (!(retry.grow >= 1.0) || !std::isfinite(retry.grow)) {
+      problems.push_back({"master.retry.grow must be at least 1", std::nullopt});
+    }
+    if (retry.min_step <= 0 || (h > 0 && retry.min_step > h)) {
+      problems.push_back({"master.retry.min_step_s " + FormatSeconds(retry.min_step) +
+                              " s must be positive and at most the master step " +
+                              FormatSeconds(h) + " s",
+                          std::nullopt});
+    }
+  }
   const TimeNs duration = options_.stop - options_.start;
   if (h > 0 && duration % h != 0) {
     problems.push_back({"duration " + FormatSeconds(duration) +
@@ -120,7 +109,22 @@ Master::Master(System& system, MasterOptions options) : system_(system), options
       if (!info.depends_on.empty()) has_feedthrough_[u] = true;
     }
   }
-  if (options_.threads > 1) arena_ = std::make_unique<Arena>(options_.threads);
+  for (std::size_t u : system_.dependency_order()) {
+    if (decimation_[u] == 1) every_step_.push_back(u);
+  }
+  algorithm_ = MakeAlgorithm(options_.algorithm, options_.threads);
+  feedthrough_ = &has_feedthrough_;
+  if (retry.enabled) {
+    // Every divisor of h, found by trial division up to sqrt(h): once.
+    for (TimeNs d = 1; d * d <= h; ++d) {
+      if (h % d != 0) continue;
+      divisors_.push_back(d);
+      if (d != h / d) divisors_.push_back(h / d);
+    }
+    std::sort(divisors_.begin(), divisors_.end());
+    saved_.resize(n);
+  }
+  pending_.resize(n);
   time_ = options_.start;
 }
 
@@ -169,15 +173,11 @@ bool Master::Transfer(const Link& link) {
   return false;
 }
 
-void Master::RecordError(std::size_t u, TimeNs t, const std::string& phase,
-                         const std::string& cause) {
-  // Units name themselves in their messages, so that a unit used on its own
-  // reports clearly; here the master names it once, in front.
-  const std::string who = system_.unit(u).Where();
-  const std::string prefix = who + ": ";
-  const std::string what = cause.starts_with(prefix) ? cause.substr(prefix.size()) : cause;
-  errors_.push_back(who + " at t = " + FormatSeconds(t) +
-                    " s: " + (phase.empty() ? "" : phase + ": ") + what);
+void Master::RecordError(std::size_t u, TimeNs t, RunPhase phase, std::string_view phase_text,
+                         std::string cause, std::string variable) {
+  const Unit& unit = system_.unit(u);
+  errors_.push_back(MakeUnitRunError(unit.name(), unit.type_name(), t, phase, phase_text,
+                                     std::move(cause), std::move(variable)));
   failed_ = true;
 }
 
@@ -186,54 +186,98 @@ bool Master::InitializeUnit(std::size_t u) {
     const ScopedTimer timer(options_.profile, unit_wall_seconds_[u]);
     system_.unit(u).Initialize();
     return true;
+  } catch (const UnitError& e) {
+    RecordError(u, time_, RunPhase::kInitialize, "initialize failed", e.what(), e.variable());
+    return false;
   } catch (const std::exception& e) {
-    RecordError(u, time_, "initialize failed", e.what());
+    RecordError(u, time_, RunPhase::kInitialize, "initialize failed", e.what());
     return false;
   }
 }
 
-bool Master::CheckOutputs(std::size_t u, TimeNs t) {
+bool Master::CheckUnitOutputs(std::size_t u, TimeNs t, RunPhase phase) {
   const VariableTable& table = system_.unit(u).variables();
-  const auto problem = FirstNonFinite(table, table.real_outputs());
+  auto problem = FindNonFinite(table, table.real_outputs());
   if (!problem) return true;
-  RecordError(u, t, "", *problem);
+  RecordError(u, t, phase, "", std::move(problem->text), std::move(problem->variable));
   return false;
 }
 
-// Steps one unit; returns false with the cause in the unit's error slot.
-// Safe to call for different units concurrently.
-bool Master::StepUnit(std::size_t u, TimeNs t, TimeNs dt) {
-  Unit& unit = system_.unit(u);
-  StepResult result;
-  std::string cause;
-  try {
-    const ScopedTimer timer(options_.profile, unit_wall_seconds_[u]);
-    result = unit.DoStep(t, dt);
-    if (result == StepResult::kDiscard) {
-      cause = "discarded the step (" + unit.last_error() + "); a fixed-step master cannot retry it";
-    } else if (result == StepResult::kError) {
-      cause = unit.last_error().empty() ? "step failed" : unit.last_error();
-    }
-  } catch (const std::exception& e) {
-    result = StepResult::kError;
-    cause = e.what();
-  }
-  if (result != StepResult::kOk) {
-    pending_errors_[u] = std::move(cause);
-    return false;
-  }
-  return true;
+bool Master::CheckOutputs(std::size_t u) {
+  const TimeNs dt = decimation_[u] == 1 ? plan_dt_ : options_.base_step * decimation_[u];
+  return CheckUnitOutputs(u, plan_t_ + dt, RunPhase::kStep);
 }
 
-bool Master::UpdateUnitOutputs(std::size_t u, TimeNs t) {
+void Master::TransferInto(std::size_t u) {
+  // A link transfers when its destination steps now and its source is at a
+  // communication point too, so a slow unit's future output never leaks
+  // into a fast unit between the slow unit's points.
+  const auto& links = system_.links();
+  for (std::size_t l : links_into_[u]) {
+    if (AtPoint(links[l].from_unit)) Transfer(links[l]);
+  }
+}
+
+void Master::TransferFrom(std::size_t u) {
+  const auto& links = system_.links();
+  for (std::size_t l : links_from_[u]) {
+    if (AtPoint(links[l].to_unit)) Transfer(links[l]);
+  }
+}
+
+// Steps one unit; a failure or discard is kept in its pending slot. Safe to
+// call for different units concurrently.
+StepResult Master::StepUnit(std::size_t u) {
+  Unit& unit = system_.unit(u);
+  const TimeNs dt = decimation_[u] == 1 ? plan_dt_ : options_.base_step * decimation_[u];
+  Pending& p = pending_[u];
+  try {
+    const ScopedTimer timer(options_.profile, unit_wall_seconds_[u]);
+    p.result = unit.DoStep(plan_t_, dt);
+    if (p.result == StepResult::kDiscard) {
+      p.cause = "discarded the step (" + unit.last_error() + ")";
+      p.variable = unit.last_error_variable();
+    } else if (p.result == StepResult::kError) {
+      p.cause = unit.last_error().empty() ? "step failed" : unit.last_error();
+      p.variable = unit.last_error_variable();
+    }
+  } catch (const UnitError& e) {
+    p.result = StepResult::kError;
+    p.cause = e.what();
+    p.variable = e.variable();
+  } catch (const std::exception& e) {
+    p.result = StepResult::kError;
+    p.cause = e.what();
+  }
+  return p.result;
+}
+
+bool Master::UpdateOutputs(std::size_t u) {
   try {
     const ScopedTimer timer(options_.profile, unit_wall_seconds_[u]);
     system_.unit(u).UpdateOutputs();
+  } catch (const UnitError& e) {
+    RecordError(u, plan_t_, RunPhase::kUpdateOutputs, "updating outputs from new inputs failed",
+                e.what(), e.variable());
+    return false;
   } catch (const std::exception& e) {
-    RecordError(u, t, "updating outputs from new inputs failed", e.what());
+    RecordError(u, plan_t_, RunPhase::kUpdateOutputs, "updating outputs from new inputs failed",
+                e.what());
     return false;
   }
-  return CheckOutputs(u, t);
+  return CheckUnitOutputs(u, plan_t_, RunPhase::kUpdateOutputs);
+}
+
+void Master::RecordPendingErrors() {
+  for (std::size_t u : *plan_due_) {
+    Pending& p = pending_[u];
+    if (p.result == StepResult::kOk) continue;
+    if (p.result == StepResult::kDiscard && !options_.retry.enabled) {
+      p.cause += "; master.retry is off, so the step cannot be retried";
+    }
+    RecordError(u, plan_t_, RunPhase::kStep, "", std::move(p.cause), std::move(p.variable));
+    p = Pending{};
+  }
 }
 
 void Master::PropagateInitialValues() {
@@ -264,7 +308,6 @@ void Master::Notify(TimeNs t) {
 
 void Master::Start() {
   const std::size_t n = system_.unit_count();
-  pending_errors_.assign(n, {});
   unit_wall_seconds_.assign(n, 0.0);
   total_wall_seconds_ = 0;
   const ScopedTimer timer(options_.profile, total_wall_seconds_);
@@ -272,12 +315,18 @@ void Master::Start() {
   failed_ = false;
   time_ = options_.start;
   step_index_ = 0;
+  current_step_ = options_.base_step;
+  smallest_step_ = options_.base_step;
+  rejected_steps_ = 0;
+  for (Pending& p : pending_) p = Pending{};
   for (std::size_t u = 0; u < n; ++u) {
     try {
       const ScopedTimer unit_timer(options_.profile, unit_wall_seconds_[u]);
       system_.unit(u).Setup(options_.start, options_.stop);
     } catch (const std::exception& e) {
-      RecordError(u, time_, "setup failed", e.what());
+      const auto* unit_error = dynamic_cast<const UnitError*>(&e);
+      RecordError(u, time_, RunPhase::kSetup, "setup failed", e.what(),
+                  unit_error ? unit_error->variable() : std::string());
     }
   }
   if (!failed_) {
@@ -285,12 +334,11 @@ void Master::Start() {
       for (std::size_t u = 0; u < n; ++u) InitializeUnit(u);
       if (!failed_) PropagateInitialValues();
     } catch (const std::exception& e) {
-      errors_.push_back(std::string("initialization at t = ") + FormatSeconds(time_) +
-                        " s: " + e.what());
+      errors_.push_back(MakeRunError(time_, RunPhase::kInitialize, "initialization", e.what()));
       failed_ = true;
     }
   }
-  for (std::size_t u = 0; u < n && !failed_; ++u) CheckOutputs(u, time_);
+  for (std::size_t u = 0; u < n && !failed_; ++u) CheckUnitOutputs(u, time_, RunPhase::kInitialize);
   // Initialization is over: fixed parameters keep their values from here on
   // (FMI: they may change only before exiting initialization mode).
   for (std::size_t u = 0; u < n; ++u) system_.unit(u).variables().Lock();
@@ -301,106 +349,138 @@ void Master::Start() {
     try {
       o->OnStart(*this);
     } catch (const std::exception& e) {
-      errors_.push_back(std::string("observer at start: ") + e.what());
+      RunError error = MakeRunError(std::nullopt, RunPhase::kObserver, "observer at start", e.what());
+      error.time = time_;
+      errors_.push_back(std::move(error));
       failed_ = true;
     }
   }
   if (!failed_) Notify(time_);
 }
 
+void Master::Plan(TimeNs tau, TimeNs dt, bool first) {
+  plan_t_ = tau;
+  plan_dt_ = dt;
+  plan_first_ = first;
+  if (first) {
+    due_at_point_.clear();
+    for (std::size_t u : system_.dependency_order()) {
+      if (step_index_ % decimation_[u] == 0) due_at_point_.push_back(u);
+    }
+    plan_due_ = &due_at_point_;
+  } else {
+    // Between base points only the units at the master's own step step.
+    plan_due_ = &every_step_;
+  }
+  due_ = *plan_due_;
+}
+
 bool Master::Step() {
   if (!started_ || failed_ || time_ >= options_.stop) return false;
   const ScopedTimer timer(options_.profile, total_wall_seconds_);
   const TimeNs t = time_;
-  const TimeNs h = options_.base_step;
-  const auto& links = system_.links();
-  const auto at_point = [&](std::size_t u) { return step_index_ % decimation_[u] == 0; };
-  // A link transfers when its destination steps now and its source is at a
-  // communication point too, so a slow unit's future output never leaks
-  // into a fast unit between the slow unit's points.
-  const auto transfer_into = [&](std::size_t u) {
-    for (std::size_t l : links_into_[u]) {
-      if (at_point(links[l].from_unit)) Transfer(links[l]);
-    }
-  };
-
-  due_.clear();
-  for (std::size_t u : system_.dependency_order()) {
-    if (at_point(u)) due_.push_back(u);
-  }
-
-  // Outputs with direct feedthrough follow the inputs of this communication
-  // point (FMI: outputs read after inputs are set reflect them). Dependency
-  // order puts a feedthrough unit after the units feeding it, so one pass
-  // resolves chains; each update is passed on to the due units it feeds.
-  // Gauss-Seidel transfers into every unit right before it steps anyway, so
-  // here only the feedthrough units need their inputs.
-  const bool jacobi = options_.algorithm == Algorithm::kJacobi;
-  if (jacobi) {
-    for (std::size_t u : due_) transfer_into(u);
-  }
-  for (std::size_t u : due_) {
-    if (!has_feedthrough_[u]) continue;
-    if (!jacobi) transfer_into(u);
-    if (!UpdateUnitOutputs(u, t)) {
-      return false;
-    }
-    // Gauss-Seidel transfers into each unit right before it updates or
-    // steps; only Jacobi needs the new outputs passed on here.
-    if (jacobi) {
-      for (std::size_t l : links_from_[u]) {
-        if (at_point(links[l].to_unit)) Transfer(links[l]);
-      }
-    }
-  }
-
-  bool ok = true;
-  if (jacobi) {
-    if (options_.threads > 1 && due_.size() > 1) {
-      arena_->arena.execute([&] {
-        tbb::parallel_for(std::size_t{0}, due_.size(), [&](std::size_t i) {
-          const std::size_t u = due_[i];
-          StepUnit(u, t, h * decimation_[u]);
-        });
-      });
-      for (std::size_t u : due_) ok &= pending_errors_[u].empty();
-    } else {
-      for (std::size_t u : due_) ok &= StepUnit(u, t, h * decimation_[u]);
-    }
+  if (options_.retry.enabled) {
+    if (!StepWithRetry(t)) return false;
   } else {
-    // Check each unit before the next one consumes its outputs, so that a
-    // NaN is blamed on the unit that made it.
-    for (std::size_t u : due_) {
-      transfer_into(u);
-      if (!StepUnit(u, t, h * decimation_[u])) {
-        ok = false;
-        break;
-      }
-      if (!CheckOutputs(u, t + h * decimation_[u])) {
-        return false;
-      }
-    }
-  }
-
-  if (!ok) {
-    for (std::size_t u : due_) {
-      if (!pending_errors_[u].empty()) {
-        RecordError(u, t, "", pending_errors_[u]);
-        pending_errors_[u].clear();
-      }
-    }
-    return false;
-  }
-  if (jacobi) {
-    for (std::size_t u : due_) ok &= CheckOutputs(u, t + h * decimation_[u]);
-    if (!ok) {
+    Plan(t, options_.base_step, true);
+    if (algorithm_->Step(t, options_.base_step, *this) != StepStatus::kOk) {
+      RecordPendingErrors();
+      failed_ = true;
       return false;
     }
   }
   ++step_index_;
-  time_ = options_.start + step_index_ * h;
+  time_ = options_.start + step_index_ * options_.base_step;
   Notify(time_);
   return time_ < options_.stop;
+}
+
+TimeNs Master::DivisorAtMost(TimeNs limit) const {
+  const auto it = std::upper_bound(divisors_.begin(), divisors_.end(), limit);
+  return it == divisors_.begin() ? 0 : *(it - 1);
+}
+
+bool Master::StepWithRetry(TimeNs t) {
+  const TimeNs h = options_.base_step;
+  const TimeNs end = t + h;
+  TimeNs tau = t;
+  while (tau < end) {
+    // Never past the next base point: observers and slower units meet the
+    // master there.
+    const TimeNs dt = std::min(current_step_, end - tau);
+    Plan(tau, dt, tau == t);
+    for (std::size_t u : *plan_due_) {
+      try {
+        system_.unit(u).SaveStateInto(saved_[u]);
+      } catch (const std::exception& e) {
+        RecordError(u, tau, RunPhase::kRetry, "saving its state for master.retry failed",
+                    e.what());
+        return false;
+      }
+    }
+    const StepStatus status = algorithm_->Step(tau, dt, *this);
+    if (status == StepStatus::kOk) {
+      tau += dt;
+      smallest_step_ = std::min(smallest_step_, dt);
+      if (current_step_ < h) {
+        const double grown = std::floor(static_cast<double>(current_step_) * options_.retry.grow);
+        current_step_ = std::max(current_step_, DivisorAtMost(static_cast<TimeNs>(
+                                                     std::min(grown, static_cast<double>(h)))));
+      }
+      continue;
+    }
+    if (status == StepStatus::kError) {
+      RecordPendingErrors();
+      failed_ = true;
+      return false;
+    }
+    // Discarded: back to tau, every unit that took part.
+    ++rejected_steps_;
+    for (std::size_t u : *plan_due_) {
+      try {
+        system_.unit(u).RestoreState(saved_[u]);
+      } catch (const std::exception& e) {
+        RecordError(u, tau, RunPhase::kRetry, "restoring its state for master.retry failed",
+                    e.what());
+        return false;
+      }
+    }
+    const TimeNs smaller = DivisorAtMost(static_cast<TimeNs>(
+        std::floor(static_cast<double>(dt) * options_.retry.shrink)));
+    bool can_retry = smaller >= options_.retry.min_step && smaller < dt;
+    std::string why;
+    if (!can_retry) {
+      why = smaller == 0 ? "; no smaller step divides the master step " + FormatSeconds(h) + " s"
+                         : "; a step of " + FormatSeconds(smaller) +
+                               " s would be below master.retry.min_step_s = " +
+                               FormatSeconds(options_.retry.min_step) + " s";
+    }
+    for (std::size_t u : *plan_due_) {
+      Pending& p = pending_[u];
+      if (p.result == StepResult::kDiscard && decimation_[u] != 1) {
+        // A slower unit keeps its own step whatever the master's.
+        can_retry = false;
+        p.cause += "; its step " + FormatSeconds(h * decimation_[u]) +
+                   " s is a multiple of the master step, which master.retry does not shrink";
+      }
+    }
+    if (!can_retry) {
+      // "discarded the step (cause)" -> "discarded the step of dt s (cause); why"
+      constexpr std::string_view kDiscarded = "discarded the step";
+      for (std::size_t u : *plan_due_) {
+        Pending& p = pending_[u];
+        if (p.result != StepResult::kDiscard) continue;
+        p.cause = std::string(kDiscarded) + " of " + FormatSeconds(dt) + " s" +
+                  p.cause.substr(kDiscarded.size()) + (decimation_[u] == 1 ? why : "");
+      }
+      RecordPendingErrors();
+      failed_ = true;
+      return false;
+    }
+    for (std::size_t u : *plan_due_) pending_[u] = Pending{};
+    current_step_ = smaller;
+  }
+  return true;
 }
 
 RunResult Master::Finish() {
@@ -409,7 +489,7 @@ RunResult Master::Finish() {
     try {
       system_.unit(u).Terminate();
     } catch (const std::exception& e) {
-      RecordError(u, time_, "terminate failed", e.what());
+      RecordError(u, time_, RunPhase::kTerminate, "terminate failed", e.what());
     }
   }
   for (Observer* o : observers_) o->OnEnd(time_, !failed_);
@@ -418,6 +498,8 @@ RunResult Master::Finish() {
   r.end_time = time_;
   r.base_steps = step_index_;
   r.errors = errors_;
+  r.rejected_steps = rejected_steps_;
+  r.smallest_step = smallest_step_;
   return r;
 }
 

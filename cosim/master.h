@@ -6,17 +6,32 @@
 #include <string_view>
 #include <vector>
 
+#include "cosim/algorithm.h"
+#include "cosim/run_error.h"
 #include "cosim/system.h"
 #include "cosim/time.h"
 
 namespace linesim::cosim {
 
-enum class Algorithm { kJacobi, kGaussSeidel };
-/// "jacobi" or "gauss_seidel": the names scenarios, summaries and messages use.
-std::string_view ToString(Algorithm a);
-/// The inverse of ToString; false, leaving *out alone, for any other text.
-bool ParseAlgorithm(std::string_view text, Algorithm* out);
-std::vector<std::string> AlgorithmNames();
+/// Step rejection (scenario key master.retry). When a unit returns
+/// StepResult::kDiscard, every unit that took part in the step is restored
+/// to its start (Unit::SaveState / RestoreState, saved before each step
+/// only when this is on) and the step is tried again, smaller: the largest
+/// divisor of the master step at most `shrink` times the step that was
+/// discarded, so that the master's communication points stay start + k h.
+/// After each accepted step the step grows by `grow` (again a divisor of
+/// the master step) back to the master step. A step below `min_step` fails
+/// the run, naming the unit, the time and its cause. Deterministic: the
+/// sequence of steps depends only on which steps the units discard.
+/// Observers still see the system at the master's steps only. Units slower
+/// than the master (a multiple of its step) keep their step: a discard of
+/// theirs cannot be retried and fails the run.
+struct RetryOptions {
+  bool enabled = false;
+  TimeNs min_step = 1'000;  // 1 us
+  double shrink = 0.5;      // in (0, 1)
+  double grow = 2.0;        // >= 1
+};
 
 struct MasterOptions {
   Algorithm algorithm = Algorithm::kGaussSeidel;
@@ -28,6 +43,7 @@ struct MasterOptions {
   int threads = 1;
   /// Measure each unit's wall time (two clock reads per unit step).
   bool profile = true;
+  RetryOptions retry;
 };
 
 class Master;
@@ -51,19 +67,28 @@ struct RunResult {
   bool ok = true;
   TimeNs end_time = 0;  // the last time at which all outputs were valid
   std::int64_t base_steps = 0;
-  /// Each names the unit, the time and the cause.
-  std::vector<std::string> errors;
+  /// Each names the unit, the time, the phase and the cause (RunError::
+  /// message says it in one sentence).
+  std::vector<RunError> errors;
+  /// With master.retry: steps a unit discarded (each was retried smaller),
+  /// and the smallest step taken (the master step when none was rejected).
+  std::int64_t rejected_steps = 0;
+  TimeNs smallest_step = 0;
+  /// Every error's message, joined by "; " (empty when there is none).
+  std::string ErrorText() const;
 };
 
-/// The fixed-step co-simulation master: Jacobi or Gauss-Seidel, multirate by
-/// integer decimation of the base step, initial value propagation, and a
-/// guard that stops on a NaN or Inf output.
-class Master {
+/// The co-simulation master: the execution side (time, multirate by
+/// integer decimation of the base step, initial value propagation, the
+/// NaN/Inf guard, step rejection and retry, errors, observers) around a
+/// StepAlgorithm (Jacobi or Gauss-Seidel) that orders one communication
+/// step.
+class Master : private StepContext {
  public:
   /// Builds the system if needed and checks the steps; throws ConfigError
   /// listing every problem.
   Master(System& system, MasterOptions options);
-  ~Master();
+  ~Master() override;
 
   void AddObserver(Observer* observer) { observers_.push_back(observer); }
 
@@ -79,6 +104,7 @@ class Master {
 
   const System& system() const { return system_; }
   const MasterOptions& options() const { return options_; }
+  const StepAlgorithm& algorithm() const { return *algorithm_; }
   TimeNs time() const { return time_; }
   /// Communication step of unit i as a multiple of the base step.
   std::int64_t decimation(std::size_t unit) const { return decimation_[unit]; }
@@ -89,32 +115,67 @@ class Master {
   /// Wall time of Start, every Step and Finish together (units included);
   /// zero without `profile`.
   double total_wall_seconds() const { return total_wall_seconds_; }
+  /// With master.retry: the step the master takes next (a divisor of the
+  /// base step; the base step when nothing was discarded lately).
+  TimeNs current_step() const { return current_step_; }
 
  private:
+  // StepContext: what the algorithm calls.
+  void TransferInto(std::size_t u) override;
+  void TransferFrom(std::size_t u) override;
+  bool UpdateOutputs(std::size_t u) override;
+  StepResult StepUnit(std::size_t u) override;
+  bool CheckOutputs(std::size_t u) override;
+
+  bool AtPoint(std::size_t u) const {
+    return plan_first_ ? step_index_ % decimation_[u] == 0 : decimation_[u] == 1;
+  }
+  /// Advances one base step from t with retries (master.retry on).
+  bool StepWithRetry(TimeNs t);
+  /// Plans the communication step from tau by dt (first: tau is a base point).
+  void Plan(TimeNs tau, TimeNs dt, bool first);
+  /// The largest divisor of the base step <= limit, or 0 when none is.
+  TimeNs DivisorAtMost(TimeNs limit) const;
+  void RecordPendingErrors();
   void PropagateInitialValues();
   bool Transfer(const Link& link);
-  bool StepUnit(std::size_t u, TimeNs t, TimeNs dt);
-  bool CheckOutputs(std::size_t u, TimeNs t);
-  bool UpdateUnitOutputs(std::size_t u, TimeNs t);
-  /// "unit 'u' (type) at t = ... s: phase: cause", the unit named once.
-  void RecordError(std::size_t u, TimeNs t, const std::string& phase, const std::string& cause);
+  bool CheckUnitOutputs(std::size_t u, TimeNs t, RunPhase phase);
+  void RecordError(std::size_t u, TimeNs t, RunPhase phase, std::string_view phase_text,
+                   std::string cause, std::string variable = {});
   /// Initialize with profiling; a failure is recorded and returns false.
   bool InitializeUnit(std::size_t u);
   void Notify(TimeNs t);
 
   System& system_;
   MasterOptions options_;
+  std::unique_ptr<StepAlgorithm> algorithm_;
   std::vector<Observer*> observers_;
   std::vector<std::int64_t> decimation_;
   std::vector<std::vector<std::size_t>> links_into_;  // per destination unit
   std::vector<std::vector<std::size_t>> links_from_;  // per source unit
   std::vector<bool> has_feedthrough_;                 // some output depends on an input
-  struct Arena;                                       // TBB arena of `threads` threads
-  std::unique_ptr<Arena> arena_;
-  std::vector<std::size_t> due_;
+  std::vector<std::size_t> due_at_point_;             // due at the base point
+  std::vector<std::size_t> every_step_;               // decimation 1, dependency order
   std::vector<double> unit_wall_seconds_;
-  std::vector<std::string> errors_;
-  std::vector<std::string> pending_errors_;  // per unit, filled during a step
+  std::vector<RunError> errors_;
+  // The communication step being taken (StepContext's view).
+  const std::vector<std::size_t>* plan_due_ = &due_at_point_;
+  TimeNs plan_t_ = 0;
+  TimeNs plan_dt_ = 0;
+  bool plan_first_ = true;
+  // Per unit, filled during a step: its result and why.
+  struct Pending {
+    StepResult result = StepResult::kOk;
+    std::string cause;
+    std::string variable;
+  };
+  std::vector<Pending> pending_;
+  // master.retry
+  std::vector<UnitState> saved_;
+  std::vector<TimeNs> divisors_;  // of the base step, ascending
+  TimeNs current_step_ = 0;
+  TimeNs smallest_step_ = 0;
+  std::int64_t rejected_steps_ = 0;
   double total_wall_seconds_ = 0;
   TimeNs time_ = 0;
   std::int64_t step_index_ = 0;

@@ -156,6 +156,20 @@ std::vector<std::string> MetricsObserver::NonFiniteResults() const {
   return out;
 }
 
+std::vector<RunError> MetricsObserver::NonFiniteErrors(TimeNs end) const {
+  std::vector<RunError> out;
+  const auto texts = NonFiniteResults();
+  std::size_t k = 0;
+  for (const auto& [name, value] : Results()) {
+    if (std::isfinite(value)) continue;
+    RunError e = MakeRunError(std::nullopt, RunPhase::kMetric, "", texts[k++], name);
+    e.message = e.cause;  // the text names the metric already
+    e.time = end;
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
 std::vector<std::pair<std::string, double>> MetricsObserver::Results() const {
   std::vector<std::pair<std::string, double>> out;
   const double n = static_cast<double>(samples_);

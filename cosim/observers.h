@@ -70,6 +70,9 @@ class MetricsObserver : public Observer {
   /// overflowed, e.g. a mean of huge values, or no sample at all): a run
   /// with such a metric has failed, its numbers are not to be trusted.
   std::vector<std::string> NonFiniteResults() const;
+  /// The same as run errors (phase metric, the metric's name as the
+  /// variable), at `end`, the run's last time.
+  std::vector<RunError> NonFiniteErrors(TimeNs end) const;
 
  private:
   struct Accumulator {

@@ -4,12 +4,48 @@ namespace linesim::cosim {
 
 UnitState Unit::SaveState() const {
   UnitState state;
-  state.type_name = type_name_;
-  state.variables.reserve(variables_.size());
-  for (const auto& info : variables_.infos())
-    state.variables.push_back(variables_.GetValue(info.ref));
-  SaveInternal(state);
+  SaveStateInto(state);
   return state;
+}
+
+void Unit::SaveStateInto(UnitState& state) const {
+  state.type_name = type_name_;
+  state.variables.resize(variables_.size());
+  for (const auto& info : variables_.infos()) {
+    Value& slot = state.variables[info.ref];
+    // Numbers in place; strings and arrays keep their capacity.
+    switch (info.type) {
+      case VarType::kReal:
+        slot = variables_.GetReal(info.ref);
+        break;
+      case VarType::kInteger:
+        slot = variables_.GetInteger(info.ref);
+        break;
+      case VarType::kBoolean:
+        slot = variables_.GetBoolean(info.ref);
+        break;
+      case VarType::kString:
+        if (auto* s = std::get_if<std::string>(&slot)) {
+          *s = variables_.GetString(info.ref);
+        } else {
+          slot = variables_.GetString(info.ref);
+        }
+        break;
+      case VarType::kRealArray: {
+        const auto values = variables_.GetRealArray(info.ref);
+        if (auto* v = std::get_if<std::vector<double>>(&slot)) {
+          v->assign(values.begin(), values.end());
+        } else {
+          slot = std::vector<double>(values.begin(), values.end());
+        }
+        break;
+      }
+    }
+  }
+  state.reals.clear();
+  state.integers.clear();
+  state.strings.clear();
+  SaveInternal(state);
 }
 
 void Unit::RestoreState(const UnitState& state) {
@@ -31,9 +67,9 @@ void Unit::RestoreState(const UnitState& state) {
 std::vector<ParameterProblem> Unit::CheckParameters() const { return CheckRules(variables_); }
 
 bool Unit::InputsFinite(TimeNs t) {
-  const auto problem = FirstNonFinite(variables_, variables_.real_inputs());
+  const auto problem = FindNonFinite(variables_, variables_.real_inputs());
   if (!problem) return true;
-  Fail(Where() + ": " + *problem + " at t = " + FormatSeconds(t) + " s");
+  Fail(Where() + ": " + problem->text + " at t = " + FormatSeconds(t) + " s", problem->variable);
   return false;
 }
 
@@ -48,7 +84,8 @@ void Unit::ThrowIfBadParameters() const {
             (problem.index ? "[" + std::to_string(*problem.index) + "]" : "") + "' " +
             problem.message;
   }
-  throw UnitError(text);
+  const auto& first = problems.front();
+  throw UnitError(text, first.variable + (first.index ? "[" + std::to_string(*first.index) + "]" : ""));
 }
 
 }  // namespace linesim::cosim

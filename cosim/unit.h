@@ -28,6 +28,14 @@ struct UnitState {
 class UnitError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+  /// With the variable the failure concerns ("x", "ranges[3]"), which run
+  /// errors report in a field of their own.
+  UnitError(const std::string& what, std::string variable)
+      : std::runtime_error(what), variable_(std::move(variable)) {}
+  const std::string& variable() const { return variable_; }
+
+ private:
+  std::string variable_;
 };
 
 /// The FMI-style co-simulation unit. Lifecycle, in order:
@@ -83,6 +91,8 @@ class Unit {
 
   /// Why the last DoStep did not return kOk (empty when it did).
   const std::string& last_error() const { return last_error_; }
+  /// The variable that failure concerns (a non-finite input), or empty.
+  const std::string& last_error_variable() const { return last_error_variable_; }
 
   /// "unit 'name' (type)": how messages name this unit.
   std::string Where() const { return "unit '" + name_ + "' (" + type_name_ + ")"; }
@@ -91,6 +101,10 @@ class Unit {
   /// continues bit for bit like the one that was saved.
   UnitState SaveState() const;
   void RestoreState(const UnitState& state);
+  /// SaveState into `state`, reusing its storage: no allocation for a unit
+  /// whose variables are numbers, once `state` has held this unit's state
+  /// (the master saves every step with master.retry on).
+  void SaveStateInto(UnitState& state) const;
 
  protected:
   /// Internal state beyond the variable table; the default has none.
@@ -108,17 +122,22 @@ class Unit {
   bool InputsFinite(TimeNs t);
 
   /// For DoStep: record why the step failed and return kError.
-  StepResult Fail(std::string message) {
+  StepResult Fail(std::string message, std::string variable = {}) {
     last_error_ = std::move(message);
+    last_error_variable_ = std::move(variable);
     return StepResult::kError;
   }
-  void ClearError() { last_error_.clear(); }
+  void ClearError() {
+    last_error_.clear();
+    last_error_variable_.clear();
+  }
 
  private:
   std::string type_name_;
   std::string name_;
   VariableTable variables_;
   std::string last_error_;
+  std::string last_error_variable_;
 };
 
 }  // namespace linesim::cosim

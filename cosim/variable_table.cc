@@ -598,8 +598,8 @@ constexpr std::uint64_t kExponentBits = 0x7ff0000000000000ULL;
 constexpr std::uint64_t kExponentOne = std::uint64_t{1} << 52;
 }  // namespace
 
-std::optional<std::string> FirstNonFinite(const VariableTable& table,
-                                          std::span<const ValueRef> refs) {
+std::optional<NonFinite> FindNonFinite(const VariableTable& table,
+                                       std::span<const ValueRef> refs) {
   // The common case, all finite, in one branch-free pass that the compiler
   // vectorizes with SSE2 (every unit's real inputs and outputs are checked
   // every step, a laser's ranges among them): a value is inf or NaN exactly
@@ -612,20 +612,25 @@ std::optional<std::string> FirstNonFinite(const VariableTable& table,
     }
   }
   if ((carries >> 63) == 0) return std::nullopt;
-  const auto describe = [&](const VariableInfo& info, std::string element, double v) {
-    return std::string(ToString(info.causality)) + " '" + info.name + element + "' is " +
-           FormatValue(v);
-  };
   for (ValueRef ref : refs) {
     const VariableInfo& info = table.info(ref);
     const auto values = table.RealValues(ref);
     for (std::size_t k = 0; k < values.size(); ++k) {
       if (std::isfinite(values[k])) continue;
-      return describe(info, info.type == VarType::kReal ? "" : "[" + std::to_string(k) + "]",
-                      values[k]);
+      const std::string name =
+          info.name + (info.type == VarType::kReal ? "" : "[" + std::to_string(k) + "]");
+      return NonFinite{name, std::string(ToString(info.causality)) + " '" + name + "' is " +
+                                 FormatValue(values[k])};
     }
   }
   return std::nullopt;
+}
+
+std::optional<std::string> FirstNonFinite(const VariableTable& table,
+                                          std::span<const ValueRef> refs) {
+  auto found = FindNonFinite(table, refs);
+  if (!found) return std::nullopt;
+  return std::move(found->text);
 }
 
 std::vector<ParameterProblem> CheckRule(const VariableInfo& info, const Value& v) {

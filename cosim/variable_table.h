@@ -312,5 +312,12 @@ std::vector<ParameterProblem> CheckRules(const VariableTable& table);
 /// and the element of an array); nothing when all are finite.
 std::optional<std::string> FirstNonFinite(const VariableTable& table,
                                           std::span<const ValueRef> refs);
+/// The same, with the variable on its own ("x", "ranges[3]").
+struct NonFinite {
+  std::string variable;
+  std::string text;  // as FirstNonFinite says it
+};
+std::optional<NonFinite> FindNonFinite(const VariableTable& table,
+                                       std::span<const ValueRef> refs);
 
 }  // namespace linesim::cosim

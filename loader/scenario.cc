@@ -126,7 +126,7 @@ class Builder {
     const std::size_t issues_before_master = r_.issues().size();
     const YAML::Node master = Child(root, "master");
     if (master.IsDefined() && !master.IsNull() && r_.ExpectMap(master, "master")) {
-      r_.CheckKeys(master, "master", {"algorithm", "step_s", "threads"});
+      r_.CheckKeys(master, "master", {"algorithm", "step_s", "threads", "retry"});
     }
     const YAML::Node master_map = master.IsMap() ? master : YAML::Node(YAML::NodeType::Map);
     const std::string algorithm = r_.String(
@@ -135,6 +135,7 @@ class Builder {
     cosim::ParseAlgorithm(algorithm, &options.algorithm);
     options.base_step = ReadMasterStep(r_, master_map);
     options.threads = static_cast<int>(r_.Integer(master_map, "master", "threads", 1, 1, 256));
+    options.retry = ReadMasterRetry(r_, master_map, options.base_step);
     if (options.base_step > 0 && options.stop > 0 && options.stop % options.base_step != 0) {
       r_.Error(Child(root, "duration_s"), "duration_s",
                "duration " + cosim::FormatSeconds(options.stop) +
@@ -420,6 +421,31 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
 
 cosim::TimeNs ReadMasterStep(YamlReader& r, const YAML::Node& master) {
   return r.Time(master, "master", "step_s", 0.001, {0.0, 10.0, true});
+}
+
+cosim::RetryOptions ReadMasterRetry(YamlReader& r, const YAML::Node& master,
+                                    cosim::TimeNs base_step) {
+  cosim::RetryOptions retry;
+  const YAML::Node node = Child(master, "retry");
+  if (!node.IsDefined() || node.IsNull() || !r.ExpectMap(node, "master.retry")) return retry;
+  r.CheckKeys(node, "master.retry", {"enabled", "min_step_s", "shrink", "grow"});
+  const std::string path = "master.retry";
+  retry.enabled = r.Boolean(node, path, "enabled", false);
+  retry.min_step = r.Time(node, path, "min_step_s", cosim::NsToSeconds(retry.min_step),
+                          {0.0, 10.0, true});
+  retry.shrink = r.Real(node, path, "shrink", retry.shrink, {0.0, 1.0, true});
+  retry.grow = r.Real(node, path, "grow", retry.grow, {1.0, 1e6});
+  if (retry.shrink >= 1.0) {
+    r.Error(Child(node, "shrink"), path + ".shrink",
+            "must be below 1 (a retried step is smaller), got " +
+                cosim::FormatValue(retry.shrink));
+  }
+  if (base_step > 0 && retry.min_step > base_step) {
+    r.Error(Child(node, "min_step_s"), path + ".min_step_s",
+            "min_step_s " + cosim::FormatSeconds(retry.min_step) +
+                " s is above the master step " + cosim::FormatSeconds(base_step) + " s");
+  }
+  return retry;
 }
 
 std::unique_ptr<cosim::Unit> CreateDefaultUnit(const std::string& type_name) {

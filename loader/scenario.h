@@ -57,6 +57,10 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
 /// (0, 10] s, 1 ms when absent. A bad value is reported through `r` and
 /// reads as 1 ms.
 cosim::TimeNs ReadMasterStep(YamlReader& r, const YAML::Node& master);
+/// master.retry: {enabled, min_step_s, shrink, grow} (cosim::RetryOptions);
+/// the defaults (off) when absent.
+cosim::RetryOptions ReadMasterRetry(YamlReader& r, const YAML::Node& master,
+                                    cosim::TimeNs base_step);
 
 /// A unit of a registered type with default structural parameters, named
 /// after its type (for `linesim inspect TYPE`); throws ScenarioError with the

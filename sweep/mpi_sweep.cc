@@ -15,26 +15,53 @@ namespace {
 
 enum Tag : int { kReady = 1, kResult = 2, kRun = 3, kStop = 4 };
 
-// A run's outcome as bytes: fixed fields, the metrics, then the error text.
+// A run's outcome as bytes: fixed fields, the metrics, then the error's
+// texts, each after its length.
+void PackText(std::vector<char>& buf, const std::string& text) {
+  const std::int64_t n = static_cast<std::int64_t>(text.size());
+  const char* p = reinterpret_cast<const char*>(&n);
+  buf.insert(buf.end(), p, p + sizeof n);
+  buf.insert(buf.end(), text.begin(), text.end());
+}
+
+std::string UnpackText(const std::vector<char>& buf, std::size_t& at) {
+  std::int64_t n = 0;
+  if (buf.size() < at + sizeof n) throw std::runtime_error("short MPI result");
+  std::memcpy(&n, buf.data() + at, sizeof n);
+  at += sizeof n;
+  if (n < 0 || buf.size() - at < static_cast<std::size_t>(n)) {
+    throw std::runtime_error("short MPI result");
+  }
+  std::string text(buf.data() + at, static_cast<std::size_t>(n));
+  at += static_cast<std::size_t>(n);
+  return text;
+}
+
 std::vector<char> Pack(const RunOutcome& o) {
-  const std::int64_t head[4] = {o.id, static_cast<std::int64_t>(o.seed),
+  const cosim::RunError& e = o.failure;
+  const std::int64_t head[7] = {o.id,
+                                static_cast<std::int64_t>(o.seed),
                                 static_cast<std::int64_t>(o.status),
-                                static_cast<std::int64_t>(o.metrics.size())};
-  std::vector<char> buf(sizeof head + sizeof(double) * (1 + o.metrics.size()) + o.error.size());
+                                static_cast<std::int64_t>(o.metrics.size()),
+                                static_cast<std::int64_t>(e.phase),
+                                e.time ? 1 : 0,
+                                e.time.value_or(0)};
+  std::vector<char> buf(sizeof head + sizeof(double) * (1 + o.metrics.size()));
   char* at = buf.data();
   std::memcpy(at, head, sizeof head);
   at += sizeof head;
   std::memcpy(at, &o.wall_s, sizeof(double));
   at += sizeof(double);
   if (!o.metrics.empty()) std::memcpy(at, o.metrics.data(), sizeof(double) * o.metrics.size());
-  at += sizeof(double) * o.metrics.size();
-  if (!o.error.empty()) std::memcpy(at, o.error.data(), o.error.size());
+  for (const std::string* text : {&o.error, &e.unit, &e.unit_type, &e.variable, &e.cause}) {
+    PackText(buf, *text);
+  }
   return buf;
 }
 
 RunOutcome Unpack(const std::vector<char>& buf) {
   RunOutcome o;
-  std::int64_t head[4];
+  std::int64_t head[7];
   if (buf.size() < sizeof head + sizeof(double)) throw std::runtime_error("short MPI result");
   const char* at = buf.data();
   std::memcpy(head, at, sizeof head);
@@ -45,11 +72,17 @@ RunOutcome Unpack(const std::vector<char>& buf) {
   const auto n = static_cast<std::size_t>(head[3]);
   std::memcpy(&o.wall_s, at, sizeof(double));
   at += sizeof(double);
-  const std::size_t fixed = sizeof head + sizeof(double) * (1 + n);
-  if (buf.size() < fixed) throw std::runtime_error("short MPI result");
+  std::size_t pos = sizeof head + sizeof(double) * (1 + n);
+  if (buf.size() < pos) throw std::runtime_error("short MPI result");
   o.metrics.resize(n);
   if (n) std::memcpy(o.metrics.data(), at, sizeof(double) * n);
-  o.error.assign(buf.data() + fixed, buf.size() - fixed);
+  cosim::RunError& e = o.failure;
+  e.phase = static_cast<cosim::RunPhase>(head[4]);
+  if (head[5] != 0) e.time = head[6];
+  for (std::string* text : {&o.error, &e.unit, &e.unit_type, &e.variable, &e.cause}) {
+    *text = UnpackText(buf, pos);
+  }
+  e.message = o.error;
   return o;
 }
 

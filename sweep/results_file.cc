@@ -69,6 +69,11 @@ double ParseNumber(const std::string& text) {
 // plan writes: its values and seed as planned, a known status, and numbers
 // where numbers belong (an ok run's metrics are all finite: a run with a
 // non-finite metric fails).
+// Columns after the metrics: status, error, the error fields, wall_s.
+constexpr std::size_t kErrorFields = 5;  // unit, time_s, phase, variable, cause
+std::size_t StatusColumn(std::size_t np, std::size_t nm) { return 2 + np + nm; }
+std::size_t WallColumn(std::size_t np, std::size_t nm) { return 4 + np + nm + kErrorFields; }
+
 bool RowMatchesPlan(const SweepSpec& spec, const RunSpec& run,
                     const std::vector<std::string>& f) {
   const std::size_t np = spec.parameters.size(), nm = spec.metrics.size();
@@ -83,7 +88,7 @@ bool RowMatchesPlan(const SweepSpec& spec, const RunSpec& run,
     if (text.empty() && status == "failed") continue;
     if (!cosim::ParseFiniteValue(text)) return false;
   }
-  return cosim::ParseFiniteValue(f[4 + np + nm]).has_value();
+  return cosim::ParseFiniteValue(f[WallColumn(np, nm)]).has_value();
 }
 
 }  // namespace
@@ -93,7 +98,8 @@ std::vector<std::string> ResultsHeader(const SweepSpec& spec) {
   for (const auto& p : spec.parameters) h.push_back(p.path);
   h.push_back("seed");
   for (const auto& m : spec.metrics) h.push_back(m);
-  h.insert(h.end(), {"status", "error", "wall_s"});
+  h.insert(h.end(), {"status", "error", "error_unit", "error_time_s", "error_phase",
+                     "error_variable", "error_cause", "wall_s"});
   return h;
 }
 
@@ -136,6 +142,13 @@ std::string FormatRow(const RunSpec& run, const RunOutcome& outcome) {
   for (double m : outcome.metrics) f.push_back(Number(m));
   f.push_back(outcome.status == RunStatus::kOk ? "ok" : "failed");
   f.push_back(outcome.error);
+  const bool failed = outcome.status != RunStatus::kOk;
+  const cosim::RunError& e = outcome.failure;
+  f.push_back(failed ? e.unit : "");
+  f.push_back(failed && e.time ? cosim::FormatValue(cosim::NsToSeconds(*e.time)) : "");
+  f.push_back(failed ? std::string(cosim::ToString(e.phase)) : "");
+  f.push_back(failed ? e.variable : "");
+  f.push_back(failed ? e.cause : "");
   f.push_back(cosim::FormatValue(outcome.wall_s));
   return JoinCsvLine(f);
 }
@@ -262,7 +275,7 @@ ResultsFile ResultsFile::Resume(const std::string& path, const SweepSpec& spec) 
       continue;
     }
     rows.emplace(*id, line);
-    if ((*fields)[columns - 3] != "ok") ++failed;
+    if ((*fields)[StatusColumn(spec.parameters.size(), spec.metrics.size())] != "ok") ++failed;
   }
   ResultsFile f(path, header, nullptr, std::move(rows));
   f.failed_ = failed;
@@ -315,9 +328,14 @@ SweepTable ResultsFile::Table(const SweepSpec& spec) const {
     row.values.assign(f.begin() + 1, f.begin() + 1 + static_cast<std::ptrdiff_t>(np));
     row.seed = std::strtoull(f[1 + np].c_str(), nullptr, 10);
     for (std::size_t m = 0; m < nm; ++m) row.metrics.push_back(ParseNumber(f[2 + np + m]));
-    row.ok = f[2 + np + nm] == "ok";
+    row.ok = f[StatusColumn(np, nm)] == "ok";
     row.error = f[3 + np + nm];
-    row.metrics.push_back(ParseNumber(f[4 + np + nm]));
+    row.error_unit = f[4 + np + nm];
+    if (const auto time = cosim::ParseFiniteValue(f[5 + np + nm])) row.error_time_s = *time;
+    row.error_phase = f[6 + np + nm];
+    row.error_variable = f[7 + np + nm];
+    row.error_cause = f[8 + np + nm];
+    row.metrics.push_back(ParseNumber(f[WallColumn(np, nm)]));
     t.rows.push_back(std::move(row));
   }
   return t;

@@ -16,7 +16,10 @@
 namespace linesim::sweep {
 
 /// Column names of results.csv: run_id, each parameter path, seed, each
-/// metric, status, error, wall_s.
+/// metric, status, error, error_unit, error_time_s, error_phase,
+/// error_variable, error_cause, wall_s. `error` is the whole message; the
+/// error_* columns are the first failure's fields (cosim::RunError), empty
+/// for an ok run or a field that does not apply.
 std::vector<std::string> ResultsHeader(const SweepSpec& spec);
 
 /// One line of results.csv (with its newline). Numbers are written as the

@@ -26,9 +26,13 @@ RunOutcome ExecuteRun(const SweepSpec& spec, const RunSpec& run, const std::atom
   out.seed = run.seed;
   out.metrics.assign(spec.metrics.size(), std::numeric_limits<double>::quiet_NaN());
   const auto wall0 = std::chrono::steady_clock::now();
-  const auto finish = [&](RunStatus status, std::string error) {
+  const auto finish = [&](RunStatus status, std::string error,
+                          cosim::RunError failure = cosim::RunError{}) {
     out.status = status;
     out.error = OneLine(std::move(error));
+    failure.cause = OneLine(std::move(failure.cause));
+    failure.message = out.error;
+    out.failure = std::move(failure);
     out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     return out;
   };
@@ -42,8 +46,9 @@ RunOutcome ExecuteRun(const SweepSpec& spec, const RunSpec& run, const std::atom
       }
     }
     if (wanted.size() != spec.metrics.size()) {
-      return finish(RunStatus::kFailed,
-                    "the scenario with this run's overrides lacks a metric of the sweep");
+      const std::string text = "the scenario with this run's overrides lacks a metric of the sweep";
+      return finish(RunStatus::kFailed, text,
+                    cosim::MakeRunError(std::nullopt, cosim::RunPhase::kScenario, "", text));
     }
     cosim::MetricsObserver metrics(wanted);
     s.master->AddObserver(&metrics);
@@ -58,21 +63,28 @@ RunOutcome ExecuteRun(const SweepSpec& spec, const RunSpec& run, const std::atom
     const cosim::RunResult result = s.master->Finish();
     if (interrupted) return finish(RunStatus::kInterrupted, "interrupted");
     if (!result.ok) {
-      std::string error;
-      for (const auto& e : result.errors) error += (error.empty() ? "" : "; ") + e;
-      return finish(RunStatus::kFailed, error);
+      return finish(RunStatus::kFailed, result.ErrorText(),
+                    result.errors.empty() ? cosim::RunError{} : result.errors.front());
     }
     const auto values = metrics.Results();
     for (std::size_t i = 0; i < values.size(); ++i) out.metrics[i] = values[i].second;
     // A metric that overflowed fails the run, naming the metric.
-    std::string overflow;
-    for (const auto& e : metrics.NonFiniteResults()) overflow += (overflow.empty() ? "" : "; ") + e;
-    if (!overflow.empty()) return finish(RunStatus::kFailed, overflow);
+    const auto overflow = metrics.NonFiniteErrors(result.end_time);
+    if (!overflow.empty()) {
+      std::string text;
+      for (const auto& e : overflow) text += (text.empty() ? "" : "; ") + e.message;
+      return finish(RunStatus::kFailed, text, overflow.front());
+    }
     return finish(RunStatus::kOk, "");
   } catch (const std::exception& e) {
-    return finish(RunStatus::kFailed, e.what());
+    // The scenario with this run's overrides was refused (or could not be
+    // built): no unit ran.
+    return finish(RunStatus::kFailed, e.what(),
+                  cosim::MakeRunError(std::nullopt, cosim::RunPhase::kScenario, "", e.what()));
   } catch (...) {
-    return finish(RunStatus::kFailed, "an exception that is not a std::exception");
+    const std::string text = "an exception that is not a std::exception";
+    return finish(RunStatus::kFailed, text,
+                  cosim::MakeRunError(std::nullopt, cosim::RunPhase::kScenario, "", text));
   }
 }
 

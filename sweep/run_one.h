@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "cosim/run_error.h"
 #include "sweep/run_plan.h"
 #include "sweep/sweep_spec.h"
 
@@ -17,13 +18,17 @@ enum class RunStatus {
 };
 
 /// What one run gave: the sweep's metrics in its order (NaN when it failed),
-/// the error text, the scenario seed and the wall time.
+/// the error text (every message, one line) and the first error as data,
+/// the scenario seed and the wall time.
 struct RunOutcome {
   std::int64_t id = 0;
   std::uint64_t seed = 0;
   RunStatus status = RunStatus::kFailed;
   std::vector<double> metrics;
   std::string error;
+  /// The first failure's fields (unit, time, phase, variable, cause); its
+  /// message is `error`. Default (phase step, all empty) when ok.
+  cosim::RunError failure;
   double wall_s = 0;
 };
 

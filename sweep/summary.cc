@@ -491,10 +491,19 @@ nlohmann::ordered_json Summarize(const SweepTable& t) {
   Json failures = Json::array();
   for (const Row& r : t.rows) {
     if (r.ok) continue;
+    // The same object as `linesim run`'s summary.json "error".
+    const auto text_or_null = [](const std::string& x) { return x.empty() ? Json(nullptr) : Json(x); };
+    Json error;
+    error["unit"] = text_or_null(r.error_unit);
+    error["time_s"] = r.error_time_s ? Json(*r.error_time_s) : Json(nullptr);
+    error["phase"] = text_or_null(r.error_phase);
+    error["variable"] = text_or_null(r.error_variable);
+    error["cause"] = r.error_cause;
+    error["message"] = r.error;
     failures.push_back({{"id", r.id},
                         {"seed", r.seed},
                         {"values", ValuesJson(t, AllParameters(t), r.values)},
-                        {"error", r.error}});
+                        {"error", std::move(error)}});
   }
   s["failures"] = std::move(failures);
 

@@ -35,7 +35,8 @@ double Correlation(std::span<const double> x, std::span<const double> y);
 ///    "by_parameter": {path: [{"value", "runs", "failed", "metrics": {metric:
 ///      {"n", "mean", "std", "min", "max"}}}, ...]},
 ///    "by_point": [{"values": {path: value}, "runs", "failed", "metrics"}, ...],
-///    "failures": [{"id", "seed", "values", "error"}, ...],
+///    "failures": [{"id", "seed", "values", "error": {"unit", "time_s",
+///                  "phase", "variable", "cause", "message"}}, ...],
 ///    "overall": {metric: {"n", "mean", "std", "min", "max", "max_abs",
 ///      "mean_abs"}},
 ///    "reference": {"title", "metrics": {metric: {"label", "ours": {"max_abs",

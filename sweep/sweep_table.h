@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,13 @@ struct SweepTable {
     bool ok = false;
     std::vector<double> metrics;  // one per metric; NaN when not ok
     std::string error;            // empty when ok
+    /// The first failure's fields, as results.csv has them (empty when ok
+    /// or when the field does not apply).
+    std::string error_unit;
+    std::optional<double> error_time_s;
+    std::string error_phase;
+    std::string error_variable;
+    std::string error_cause;
   };
   std::vector<Row> rows;
 };

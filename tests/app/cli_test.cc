@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -78,6 +80,7 @@ TEST(Cli, RunMotorStepWritesSummaryAndSignals) {
   EXPECT_NE(r.out.find("final_speed_rad_s_motor0"), std::string::npos) << r.out;
   const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
   EXPECT_EQ(summary["status"], "ok");
+  EXPECT_TRUE(summary["error"].is_null());
   EXPECT_EQ(summary["settings"]["master"]["step_s"], 0.001);
   EXPECT_TRUE(summary["metrics"].contains("peak_current_a_motor1"));
   EXPECT_TRUE(summary["timing"]["units"].contains("motors"));
@@ -249,6 +252,53 @@ TEST(Cli, RobotLevelBadInputExitsTwo) {
 
 // Guards determinism of a robot run (ODE, CVODE, the seeded belt): same
 // file and seed give the same bytes, under Jacobi with 2 threads too.
+// Guards master.retry on a robot run where no unit discards: the run is
+// deterministic (same bytes twice), no step is rejected, and it stays with
+// the run without retry. Not to the bit: saving its state restarts the
+// dc_motor's CVODE integrator (so that a restored copy continues bit for
+// bit like the saved one), which moves its currents within the solver's
+// tolerance; the pose then moves by less than 1e-4 m, a 400th of the 4 cm
+// the cross-line runs are judged by (paper 1).
+TEST(Cli, RetryOnWithoutDiscardsIsDeterministicAndStaysWithTheRunWithout) {
+  const std::string off = Fresh("retry_off"), a = Fresh("retry_a"), b = Fresh("retry_b");
+  const std::string args = " --set duration_s=3";
+  const std::string retry = " --set 'master.retry={enabled: true}'";
+  ASSERT_EQ(Linesim("run " + kCrossLine + " --out " + off + args).status, 0);
+  const Result on = Linesim("run " + kCrossLine + " --out " + a + args + retry);
+  ASSERT_EQ(on.status, 0) << on.err;
+  ASSERT_EQ(Linesim("run " + kCrossLine + " --out " + b + args + retry).status, 0);
+  const std::string ca = ReadFile(fs::path(a) / "signals.csv");
+  EXPECT_GT(ca.size(), 1000u);
+  EXPECT_EQ(ca, ReadFile(fs::path(b) / "signals.csv"));
+  const auto summary = nlohmann::json::parse(ReadFile(fs::path(a) / "summary.json"));
+  EXPECT_EQ(summary["settings"]["master"]["retry"]["rejected_steps"], 0) << summary.dump();
+  EXPECT_EQ(summary["settings"]["master"]["retry"]["smallest_step_s"],
+            summary["settings"]["master"]["step_s"]);
+  // Columns of the position, then the largest difference over all rows.
+  const auto rows = [](const std::string& text) {
+    std::vector<std::vector<std::string>> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) {
+      std::vector<std::string> fields;
+      std::istringstream l(line);
+      for (std::string f; std::getline(l, f, ',');) fields.push_back(f);
+      out.push_back(std::move(fields));
+    }
+    return out;
+  };
+  const auto with = rows(ca), without = rows(ReadFile(fs::path(off) / "signals.csv"));
+  ASSERT_EQ(with.size(), without.size());
+  ASSERT_EQ(with[0], without[0]);
+  double largest = 0;
+  for (std::size_t c = 0; c < with[0].size(); ++c) {
+    if (with[0][c] != "chassis.position[0]" && with[0][c] != "chassis.position[1]") continue;
+    for (std::size_t r = 1; r < with.size(); ++r) {
+      largest = std::max(largest, std::abs(std::stod(with[r][c]) - std::stod(without[r][c])));
+    }
+  }
+  EXPECT_LT(largest, 1e-4);
+}
+
 TEST(Cli, RobotRunIsDeterministic) { ExpectIdenticalSignals(kCrossLine, " --set duration_s=3"); }
 
 // Guards against a master step that no int64 nanosecond count holds (or no
@@ -304,6 +354,16 @@ connections:
   EXPECT_NE(r.err.find("the derivative of current[0] is inf"), std::string::npos) << r.err;
   const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
   EXPECT_EQ(summary["status"], "failed");
+  // The same as data: unit, time of the failing step, phase, cause, and
+  // the whole message as printed.
+  const auto& error = summary["error"];
+  EXPECT_EQ(error["unit"], "motor") << summary.dump();
+  EXPECT_EQ(error["time_s"], 0.01);
+  EXPECT_EQ(error["phase"], "step");
+  EXPECT_NE(error["cause"].get<std::string>().find("the derivative of current[0] is inf"),
+            std::string::npos);
+  EXPECT_EQ(error["cause"].get<std::string>().find("unit 'motor'"), std::string::npos);
+  EXPECT_EQ(error["message"], summary["errors"][0]);
   const std::string csv = ReadFile(fs::path(out) / "signals.csv");
   // Jacobi: the motor sees the absurd voltage from the step starting at
   // 0.01 s, so rows 0 .. 0.01 s (11 rows at 1 ms) were recorded before.
@@ -329,6 +389,9 @@ metrics:
   EXPECT_NE(r.err.find("metric 'mean_supply' is infinite"), std::string::npos) << r.err;
   const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
   EXPECT_EQ(summary["status"], "failed");
+  EXPECT_EQ(summary["error"]["phase"], "metric") << summary.dump();
+  EXPECT_EQ(summary["error"]["variable"], "mean_supply");
+  EXPECT_TRUE(summary["error"]["unit"].is_null());
 }
 
 // Guards against files of two runs in one folder: a robot run draws its
@@ -361,6 +424,7 @@ TEST(Cli, FailedSignalsWriteFailsTheRun) {
   EXPECT_EQ(summary["status"], "failed");
   ASSERT_EQ(summary["errors"].size(), 1u) << summary.dump();
   EXPECT_NE(summary["errors"][0].get<std::string>().find("signals.csv"), std::string::npos);
+  EXPECT_EQ(summary["error"]["phase"], "recording");
 }
 
 // Guards `inspect` on a type and on a file, and an unknown type.

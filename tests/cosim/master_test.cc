@@ -252,8 +252,8 @@ TEST(MasterInitialValues, UnitThrowingDuringPropagationIsNamed) {
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.base_steps, 0);
   ASSERT_EQ(r.errors.size(), 1u);
-  EXPECT_THAT(r.errors[0], HasSubstr("unit 'picky' (Picky) at t = 0 s"));
-  EXPECT_THAT(r.errors[0], HasSubstr("above its limit"));
+  EXPECT_THAT(r.errors[0].message, HasSubstr("unit 'picky' (Picky) at t = 0 s"));
+  EXPECT_THAT(r.errors[0].message, HasSubstr("above its limit"));
 }
 
 struct FaultyRun {
@@ -290,7 +290,7 @@ TEST(MasterGuard, NanOutputStopsTheRunAndNamesUnitVariableAndTime) {
     EXPECT_EQ(run.result.end_time, 4 * kMs);
     EXPECT_EQ(run.result.base_steps, 4);
     ASSERT_EQ(run.result.errors.size(), 1u);
-    const std::string& e = run.result.errors[0];
+    const std::string& e = run.result.errors[0].message;
     EXPECT_THAT(e, HasSubstr("unit 'bad'"));
     EXPECT_THAT(e, HasSubstr("output 'y'"));
     EXPECT_THAT(e, HasSubstr("nan"));
@@ -306,8 +306,8 @@ TEST(MasterGuard, InfiniteOutputStopsTheRun) {
   EXPECT_FALSE(run.result.ok);
   EXPECT_EQ(run.result.end_time, 2 * kMs);
   ASSERT_EQ(run.result.errors.size(), 1u);
-  EXPECT_THAT(run.result.errors[0], HasSubstr("output 'y' is inf"));
-  EXPECT_THAT(run.result.errors[0], HasSubstr("t = 0.003 s"));
+  EXPECT_THAT(run.result.errors[0].message, HasSubstr("output 'y' is inf"));
+  EXPECT_THAT(run.result.errors[0].message, HasSubstr("t = 0.003 s"));
 }
 
 // Guards against: a failed step being ignored, or reported without the
@@ -320,7 +320,7 @@ TEST(MasterErrors, UnitReturningErrorStopsTheRunWithNameTimeAndCause) {
     EXPECT_EQ(run.result.end_time, 7 * kMs);
     EXPECT_EQ(run.result.base_steps, 7);
     ASSERT_EQ(run.result.errors.size(), 1u);
-    EXPECT_EQ(run.result.errors[0], "unit 'bad' (Faulty) at t = 0.007 s: actuator saturated");
+    EXPECT_EQ(run.result.errors[0].message, "unit 'bad' (Faulty) at t = 0.007 s: actuator saturated");
   }
 }
 
@@ -332,7 +332,7 @@ TEST(MasterErrors, UnitThrowingStopsTheRunWithNameTimeAndCause) {
     EXPECT_FALSE(run.result.ok);
     EXPECT_EQ(run.result.end_time, 7 * kMs);
     ASSERT_EQ(run.result.errors.size(), 1u);
-    EXPECT_EQ(run.result.errors[0], "unit 'bad' (Faulty) at t = 0.007 s: solver diverged");
+    EXPECT_EQ(run.result.errors[0].message, "unit 'bad' (Faulty) at t = 0.007 s: solver diverged");
   }
 }
 
@@ -342,9 +342,9 @@ TEST(MasterErrors, DiscardedStepStopsTheRun) {
   const FaultyRun run = RunFaulty(FaultyUnit::Mode::kDiscard, 2 * kMs, Algorithm::kGaussSeidel);
   EXPECT_FALSE(run.result.ok);
   ASSERT_EQ(run.result.errors.size(), 1u);
-  EXPECT_THAT(run.result.errors[0], HasSubstr("unit 'bad'"));
-  EXPECT_THAT(run.result.errors[0], HasSubstr("t = 0.002 s"));
-  EXPECT_THAT(run.result.errors[0], HasSubstr("discarded the step (tolerance not met)"));
+  EXPECT_THAT(run.result.errors[0].message, HasSubstr("unit 'bad'"));
+  EXPECT_THAT(run.result.errors[0].message, HasSubstr("t = 0.002 s"));
+  EXPECT_THAT(run.result.errors[0].message, HasSubstr("discarded the step (tolerance not met)"));
 }
 
 // Refuses a non-finite input in its step (Unit::InputsFinite).
@@ -375,8 +375,8 @@ TEST(MasterGuard, GaussSeidelBlamesTheUnitThatMadeTheNaN) {
   Master master(system, o);
   const RunResult r = master.Run();
   EXPECT_FALSE(r.ok);
-  ASSERT_EQ(r.errors.size(), 1u) << r.errors[0];
-  EXPECT_EQ(r.errors[0], "unit 'bad' (Faulty) at t = 0.003 s: output 'y' is nan");
+  ASSERT_EQ(r.errors.size(), 1u) << r.errors[0].message;
+  EXPECT_EQ(r.errors[0].message, "unit 'bad' (Faulty) at t = 0.003 s: output 'y' is nan");
 }
 
 // Guards Unit::InputsFinite: a non-finite input fails the step with the
@@ -407,7 +407,7 @@ TEST(MasterErrors, UnitIsNamedOnceWithThePhase) {
   const RunResult r = master.Run();
   EXPECT_FALSE(r.ok);
   ASSERT_EQ(r.errors.size(), 1u);
-  EXPECT_EQ(r.errors[0], "unit 'w' (SelfNaming) at t = 0 s: initialize failed: not ready");
+  EXPECT_EQ(r.errors[0].message, "unit 'w' (SelfNaming) at t = 0 s: initialize failed: not ready");
 }
 
 // Guards against: a failure inside a parallel Jacobi step being lost or
@@ -426,7 +426,7 @@ TEST(MasterErrors, FailureInParallelJacobiIsReported) {
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.end_time, 3 * kMs);
   ASSERT_EQ(r.errors.size(), 1u);
-  EXPECT_EQ(r.errors[0], "unit 'bad' (Faulty) at t = 0.003 s: solver diverged");
+  EXPECT_EQ(r.errors[0].message, "unit 'bad' (Faulty) at t = 0.003 s: solver diverged");
 }
 
 // Guards against: Step() advancing past the stop time or after a failure.

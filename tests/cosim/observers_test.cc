@@ -165,7 +165,7 @@ TEST(CsvRecorder, RefusesAnIntervalOffTheMasterSteps) {
   const RunResult r = master.Run();
   EXPECT_FALSE(r.ok);
   ASSERT_EQ(r.errors.size(), 1u);
-  EXPECT_THAT(r.errors[0], HasSubstr("observer at start"));
+  EXPECT_THAT(r.errors[0].message, HasSubstr("observer at start"));
 }
 
 std::vector<MetricSpec> RampMetrics(const System& system) {

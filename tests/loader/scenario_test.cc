@@ -53,6 +53,29 @@ TEST(LoadScenario, OverridesChangeValues) {
   EXPECT_EQ(supply.GetRealElement(*supply.Find("value"), 0), 6.0);
 }
 
+// Guards master.retry: off by default; its keys read back (from --set as
+// from a file); bad values refused at their keys.
+TEST(LoadScenario, MasterRetryOptions) {
+  const std::string f = WriteScenario("retry.yaml", kValidScenario);
+  EXPECT_FALSE(LoadScenario(f, {}).master->options().retry.enabled);
+  // The file has no master.retry map: --set gives the whole value.
+  const Scenario s = LoadScenario(
+      f, {"master.retry={enabled: true, min_step_s: 0.0001, shrink: 0.25, grow: 4}"});
+  const cosim::RetryOptions& r = s.master->options().retry;
+  EXPECT_TRUE(r.enabled);
+  EXPECT_EQ(r.min_step, 100'000);
+  EXPECT_EQ(r.shrink, 0.25);
+  EXPECT_EQ(r.grow, 4.0);
+  ASSERT_TRUE(s.master->Run().ok);
+  const std::string bad = Issues(
+      f, {"master.retry={enabled: true, shrink: 1, grow: 0.5, min_step_s: 0.01, tries: 3}"});
+  EXPECT_TRUE(Has(bad, "master.retry.shrink")) << bad;
+  EXPECT_TRUE(Has(bad, "must be below 1 (a retried step is smaller), got 1")) << bad;
+  EXPECT_TRUE(Has(bad, "master.retry.grow")) << bad;
+  EXPECT_TRUE(Has(bad, "min_step_s 0.01 s is above the master step 0.001 s")) << bad;
+  EXPECT_TRUE(Has(bad, "master.retry.tries")) << bad;
+}
+
 // Guards against a typo in --set going unnoticed: it names the closest path.
 TEST(LoadScenario, UnknownOverridePathNamesClosest) {
   const std::string f = WriteScenario("ov2.yaml", kValidScenario);

@@ -84,7 +84,7 @@ TEST(HuskyScenario, FinishesThePathAndCrossesTheLineBetweenTheBodies) {
   s.master->AddObserver(&metrics);
   s.master->AddObserver(&husky);
   const cosim::RunResult result = s.master->Run();
-  ASSERT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors.front());
+  ASSERT_TRUE(result.ok) << result.ErrorText();
   std::map<std::string, double> m;
   for (const auto& [metric, value] : metrics.Results()) m[metric] = value;
   std::cout << "husky_floor_path: done at " << husky.done_s << " s, across the line at "

@@ -24,7 +24,7 @@ ProfileRun RunProfile(std::vector<std::string> sets) {
   cosim::MetricsObserver metrics(s.metrics);
   s.master->AddObserver(&metrics);
   const cosim::RunResult result = s.master->Run();
-  EXPECT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors.front());
+  EXPECT_TRUE(result.ok) << result.ErrorText();
   ProfileRun run;
   for (const auto& [metric, value] : metrics.Results()) run.metrics[metric] = value;
   return run;

@@ -81,7 +81,7 @@ task:
   s.master->AddObserver(&metrics);
   s.master->AddObserver(&route);
   const cosim::RunResult result = s.master->Run();
-  ASSERT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors.front());
+  ASSERT_TRUE(result.ok) << result.ErrorText();
   std::map<std::string, double> m;
   for (const auto& [metric, value] : metrics.Results()) m[metric] = value;
 

@@ -20,7 +20,7 @@ inline std::map<std::string, double> RunFile(const std::string& file,
   cosim::MetricsObserver metrics(s.metrics);
   s.master->AddObserver(&metrics);
   const cosim::RunResult result = s.master->Run();
-  EXPECT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors.front());
+  EXPECT_TRUE(result.ok) << result.ErrorText();
   std::map<std::string, double> out;
   for (const auto& [metric, value] : metrics.Results()) out[metric] = value;
   std::cout << file;

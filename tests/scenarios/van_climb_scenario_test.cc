@@ -98,7 +98,7 @@ TEST(VanClimbScenario, HuskyWithArmEntersTheVan) {
   Follow follow(*s.system);
   s.master->AddObserver(&follow);
   const cosim::RunResult result = s.master->Run();
-  ASSERT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors.front());
+  ASSERT_TRUE(result.ok) << result.ErrorText();
   const double rms = std::sqrt(follow.sum_sq / std::max(1, follow.samples));
   const double nominal_a = 0.187 / 0.0302 + 0.137;
   const double climb_s = follow.last_s - follow.first_s;

@@ -26,7 +26,12 @@ Row Ok(std::int64_t id, std::vector<std::string> values, std::vector<double> met
           .seed = static_cast<std::uint64_t>(100 + id),
           .ok = true,
           .metrics = std::move(metrics),
-          .error = ""};
+          .error = "",
+          .error_unit = "",
+          .error_time_s = std::nullopt,
+          .error_phase = "",
+          .error_variable = "",
+          .error_cause = ""};
 }
 
 Row Failed(std::int64_t id, std::vector<std::string> values, std::string error,
@@ -36,7 +41,12 @@ Row Failed(std::int64_t id, std::vector<std::string> values, std::string error,
           .seed = static_cast<std::uint64_t>(100 + id),
           .ok = false,
           .metrics = std::move(metrics),
-          .error = std::move(error)};
+          .error = std::move(error),
+          .error_unit = "chassis",
+          .error_time_s = 3.2,
+          .error_phase = "step",
+          .error_variable = "pose[0]",
+          .error_cause = "output 'pose[0]' is nan"};
 }
 
 // Belt speed x compensation, two repeats; at 0.1 m/s without compensation
@@ -205,7 +215,7 @@ TEST(Summarize, ByPointGroupsRepeatsAndNullsEmptyStats) {
 }
 
 // Guards the failure list: every failed run with its id, seed (to rerun
-// it), values and error.
+// it), values and error (its fields and message).
 TEST(Summarize, ListsFailures) {
   const auto failures = Summarize(Grid())["failures"];
   ASSERT_EQ(failures.size(), 2u);
@@ -213,7 +223,15 @@ TEST(Summarize, ListsFailures) {
   EXPECT_EQ(failures[0]["seed"], 103);
   EXPECT_EQ(failures[0]["values"]["line.belts.0.speed_mps"], "0.1");
   EXPECT_EQ(failures[0]["values"]["control.compensation"], "false");
-  EXPECT_EQ(failures[0]["error"], "chassis: output 'pose[0]' is nan at t = 3.2 s");
+  // The error as data, the same object as `linesim run` writes, with the
+  // whole message.
+  const auto& error = failures[0]["error"];
+  EXPECT_EQ(error["message"], "chassis: output 'pose[0]' is nan at t = 3.2 s");
+  EXPECT_EQ(error["unit"], "chassis");
+  EXPECT_EQ(error["time_s"], 3.2);
+  EXPECT_EQ(error["phase"], "step");
+  EXPECT_EQ(error["variable"], "pose[0]");
+  EXPECT_EQ(error["cause"], "output 'pose[0]' is nan");
   EXPECT_EQ(failures[1]["id"], 7);
 }
 

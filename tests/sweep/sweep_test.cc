@@ -502,7 +502,8 @@ TEST(SweepExecutor, OneAndTwoJobsWriteTheSameRowsAndAFailingRunIsIsolated) {
   std::getline(in, header);
   EXPECT_EQ(
       header,
-      "run_id,master.step_s,control.compensation,seed,max_path_deviation_m,status,error,wall_s");
+      "run_id,master.step_s,control.compensation,seed,max_path_deviation_m,status,error,error_unit,"
+      "error_time_s,error_phase,error_variable,error_cause,wall_s");
   std::vector<std::vector<std::string>> rows;
   for (std::string line; std::getline(in, line);) rows.push_back(*SplitCsvLine(line));
   ASSERT_EQ(rows.size(), 6u);
@@ -515,6 +516,12 @@ TEST(SweepExecutor, OneAndTwoJobsWriteTheSameRowsAndAFailingRunIsIsolated) {
       EXPECT_NE(rows[i][6].find("not an integer multiple of the master step 0.003 s"),
                 std::string::npos)
           << rows[i][6];
+      // The scenario was refused before any unit ran: no unit, no time.
+      EXPECT_EQ(rows[i][7], "") << i;
+      EXPECT_EQ(rows[i][8], "") << i;
+      EXPECT_EQ(rows[i][9], "scenario") << i;
+    } else {
+      for (int c = 7; c <= 11; ++c) EXPECT_EQ(rows[i][c], "") << i << " " << c;
     }
   }
   // A resumed file counts its failed rows (the two at 0.003 s).
@@ -542,6 +549,51 @@ TEST(SweepExecutor, AStopLeavesNoRowForTheInterruptedRun) {
   EXPECT_LE(done.size(), 4u);
   const RunOutcome o = ExecuteRun(spec, PlanRun(spec, 0), &stop);
   EXPECT_EQ(o.status, RunStatus::kInterrupted);
+}
+
+// Guards the structured error of a run that fails while running: the
+// outcome and its results row carry the unit, the time of the failing
+// step, the phase and the cause beside the whole message. The supply
+// steps to 1e308 V at 0.01 s; the motor's di/dt overflows in the step from
+// 0.01 s (as in the CLI's numerical-failure test).
+TEST(ExecuteRun, AUnitFailureCarriesItsFields) {
+  const std::string scenario = WriteFile("blowup_scenario.yaml", R"(duration_s: 0.05
+master: {algorithm: jacobi}
+units:
+  supply:
+    type: step_signal
+    parameters: {unit: V, steps: [{time_s: 0.01, value: 1.0}]}
+  motor:
+    type: dc_motor
+connections:
+  - {from: supply.value, to: motor.voltage}
+metrics:
+  - {name: peak_current, of: "motor.current[0]", reduce: max_abs}
+)");
+  const SweepSpec spec = LoadSweepSpec(WriteFile(
+      "blowup.yaml", "scenario: " + scenario +
+                         "\nparameters: [{path: units.supply.parameters.steps.0.value, "
+                         "values: [1.0, 1.0e308]}]\n"));
+  const RunOutcome ok = ExecuteRun(spec, PlanRun(spec, 0));
+  ASSERT_EQ(ok.status, RunStatus::kOk) << ok.error;
+  const RunOutcome bad = ExecuteRun(spec, PlanRun(spec, 1));
+  ASSERT_EQ(bad.status, RunStatus::kFailed);
+  EXPECT_EQ(bad.failure.unit, "motor");
+  EXPECT_EQ(bad.failure.unit_type, "dc_motor");
+  EXPECT_EQ(bad.failure.time, cosim::TimeNs{10'000'000});
+  EXPECT_EQ(bad.failure.phase, cosim::RunPhase::kStep);
+  EXPECT_NE(bad.failure.cause.find("the derivative of current[0] is inf"), std::string::npos)
+      << bad.failure.cause;
+  EXPECT_EQ(bad.failure.message, bad.error);
+  const auto row = *SplitCsvLine(FormatRow(PlanRun(spec, 1), bad));
+  // run_id, value, seed, peak_current, status, error, the 5 fields, wall_s.
+  ASSERT_EQ(row.size(), 12u);
+  EXPECT_EQ(row[4], "failed");
+  EXPECT_EQ(row[5], bad.error);
+  EXPECT_EQ(row[6], "motor");
+  EXPECT_EQ(row[7], "0.01");
+  EXPECT_EQ(row[8], "step");
+  EXPECT_EQ(row[10].substr(0, 20), bad.failure.cause.substr(0, 20));
 }
 
 TEST(ResultsFile, ResumeKeepsCompleteRowsAndDropsACutOffLine) {
@@ -589,7 +641,8 @@ TEST(ResultsFile, ResumeDropsRowsThatDoNotMatchThePlan) {
     const std::size_t end = line.find(',', begin);
     return line.replace(begin, end - begin, text);
   };
-  // Columns: run_id, speed, compensation, seed, 8 metrics..., status, error, wall_s.
+  // Columns: run_id, speed, compensation, seed, 8 metrics..., status, error,
+  // the 5 error fields, wall_s.
   const std::string path = dir + "/results.csv";
   std::ofstream(path, std::ios::trunc)
       << lines[0] << lines[1]                          // run 0 as it was

@@ -274,7 +274,7 @@ Trace RunClosedLoop(double v, double omega, TimeNs duration) {
     trace.right.push_back(w[1]);
   }
   const cosim::RunResult result = master.Finish();
-  EXPECT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors.front());
+  EXPECT_TRUE(result.ok) << result.ErrorText();
   return trace;
 }
 

@@ -426,7 +426,7 @@ Trace RunClosedLoop(const std::vector<double>& twist, TimeNs duration,
     trace.steer_angle.push_back(Get(system.unit(3), "angle")[0]);
   }
   const cosim::RunResult result = master.Finish();
-  EXPECT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors.front());
+  EXPECT_TRUE(result.ok) << result.ErrorText();
   EXPECT_EQ(result.end_time, duration);
   return trace;
 }

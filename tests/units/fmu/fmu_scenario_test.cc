@@ -44,7 +44,7 @@ TEST(FmuScenario, LoadsAndRunsWithThePathRelativeToTheFile) {
   std::ofstream(s / "plant.yaml") << Scenario("fmus/dahlquist.fmu", "m/s");
   loader::Scenario sc = loader::LoadScenario(s / "plant.yaml");
   const auto result = sc.master->Run();
-  ASSERT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors[0]);
+  ASSERT_TRUE(result.ok) << result.ErrorText();
   const auto& plant = sc.system->unit(*sc.system->FindUnit("plant"));
   const double exact = 0.3 / 2.0 + (0.5 - 0.3 / 2.0) * std::exp(-2.0);
   EXPECT_NEAR(plant.variables().GetReal(*plant.variables().Find("x")), exact, 1e-14);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "cosim/master.h"
 #include "cosim/system.h"
@@ -33,7 +34,7 @@ TEST(FmuSystem, NativeSourceDrivesAnFmu) {
   options.stop = 1000 * kMs;
   cosim::Master master(system, options);
   const auto result = master.Run();
-  ASSERT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors[0]);
+  ASSERT_TRUE(result.ok) << result.ErrorText();
   const double exact = 0.3 + (1.0 - 0.3) * std::exp(-1.0);
   EXPECT_NEAR(fmu.variables().GetReal(*fmu.variables().Find("x")), exact, 1e-14);
 }
@@ -81,7 +82,7 @@ TEST(FmuSystem, FeedthroughChainAcrossFmiVersions) {
   options.stop = 100 * kMs;
   cosim::Master master(system, options);
   const auto result = master.Run();
-  ASSERT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors[0]);
+  ASSERT_TRUE(result.ok) << result.ErrorText();
   const auto& t = f3b.variables();
   EXPECT_EQ(t.GetReal(*t.Find("speed_out")), -1.0);
   EXPECT_EQ(t.GetInteger(*t.Find("count_out")), -7);
@@ -89,7 +90,7 @@ TEST(FmuSystem, FeedthroughChainAcrossFmiVersions) {
 }
 
 // fmi2Discard in a fixed-step master: the run stops at the discarded step,
-// naming unit and time (retrying is a later master's option). t_discard is
+// naming unit and time (master.retry is off by default). t_discard is
 // 0.5 s; the FMU discards a step ending after it: 0.4 + 0.1 is exactly 0.5
 // in binary floating point, so the step from 0.5 s is the first.
 TEST(FmuSystem, DiscardStopsAFixedStepRunNamingUnitAndTime) {
@@ -102,10 +103,84 @@ TEST(FmuSystem, DiscardStopsAFixedStepRunNamingUnitAndTime) {
   const auto result = master.Run();
   ASSERT_FALSE(result.ok);
   ASSERT_EQ(result.errors.size(), 1u);
-  const std::string& e = result.errors[0];
+  const std::string& e = result.errors[0].message;
   EXPECT_NE(e.find("unit 'd' (fmu) at t = 0.5 s"), std::string::npos) << e;
   EXPECT_NE(e.find("discarded the step"), std::string::npos) << e;
   EXPECT_EQ(result.end_time, 500 * kMs);
+  EXPECT_EQ(result.errors[0].unit, "d");
+  EXPECT_EQ(result.errors[0].phase, cosim::RunPhase::kStep);
+}
+
+// The step-rejecting master on an FMU that discards: edge2 refuses a step
+// over t_edge = 0.375 s (fmi2Discard). Master step 0.25 s, retry on
+// (shrink 0.5, grow 2), every time exact in binary. By hand: [0, 0.25];
+// [0.25, 0.5] passes the edge: discarded, the FMU set back (setFMUstate);
+// [0.25, 0.375] ends on it; the step grows to 0.25 s but only 0.125 s
+// remain to 0.5 s: [0.375, 0.5]; then [0.5, 0.75], [0.75, 1]. The run
+// continues past the discard and ends with x = 1 s; one step rejected, the
+// smallest 0.125 s. Without retry the same run stops at 0.25 s.
+TEST(FmuSystem, RetryStepsPastADiscardWithASmallerStep) {
+  for (const bool retry : {false, true}) {
+    cosim::System system;
+    auto& edge = system.Add(std::make_unique<FmuUnit>("edge", Fmu("edge2")));
+    cosim::MasterOptions options;
+    options.base_step = 250 * kMs;
+    options.stop = 1000 * kMs;
+    options.retry.enabled = retry;
+    cosim::Master master(system, options);
+    std::vector<double> x_at_points;
+    const auto result = [&] {
+      master.Start();
+      x_at_points.push_back(edge.variables().GetReal(*edge.variables().Find("x")));
+      // Step() is false at the stop time, or after a failure (no point then).
+      for (bool more = true; more;) {
+        const TimeNs before = master.time();
+        more = master.Step();
+        if (master.time() > before) {
+          x_at_points.push_back(edge.variables().GetReal(*edge.variables().Find("x")));
+        }
+      }
+      return master.Finish();
+    }();
+    if (!retry) {
+      ASSERT_FALSE(result.ok);
+      EXPECT_EQ(result.end_time, 250 * kMs);
+      EXPECT_EQ(result.errors[0].unit, "edge");
+      EXPECT_EQ(result.errors[0].time, 250 * kMs);
+      EXPECT_NE(result.errors[0].cause.find("would pass t_edge = 0.375 s"), std::string::npos)
+          << result.errors[0].message;
+      continue;
+    }
+    ASSERT_TRUE(result.ok) << result.ErrorText();
+    EXPECT_EQ(result.end_time, 1000 * kMs);
+    EXPECT_EQ(result.rejected_steps, 1);
+    EXPECT_EQ(result.smallest_step, 125 * kMs);
+    // x = the time, at the master's points: the sub-steps are inside.
+    EXPECT_EQ(x_at_points, (std::vector<double>{0.0, 0.25, 0.5, 0.75, 1.0}));
+  }
+}
+
+// master.retry needs the FMU's state before every step: discard2 does not
+// offer canGetAndSetFMUstate, so a run with retry on is refused at its
+// first step, in the retry phase, naming the missing capability (rather
+// than failing later at the discard with nothing to go back to).
+TEST(FmuSystem, RetryNeedsAnFmuThatCanSaveItsState) {
+  cosim::System system;
+  system.Add(std::make_unique<FmuUnit>("d", Fmu("discard2")));
+  cosim::MasterOptions options;
+  options.base_step = 100 * kMs;
+  options.stop = 1000 * kMs;
+  options.retry.enabled = true;
+  cosim::Master master(system, options);
+  const auto result = master.Run();
+  ASSERT_FALSE(result.ok);
+  ASSERT_EQ(result.errors.size(), 1u);
+  const cosim::RunError& e = result.errors[0];
+  EXPECT_EQ(e.unit, "d");
+  EXPECT_EQ(e.time, TimeNs{0});
+  EXPECT_EQ(e.phase, cosim::RunPhase::kRetry);
+  EXPECT_NE(e.cause.find("canGetAndSetFMUstate"), std::string::npos) << e.message;
+  EXPECT_EQ(result.end_time, 0);
 }
 
 }  // namespace

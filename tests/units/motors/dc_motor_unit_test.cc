@@ -745,7 +745,7 @@ TEST(DcMotorUnit, CurrentOnlyInALoopThroughTheMasterFollowsFullModel) {
     max_w = std::max(max_w, std::abs(x[1] / m.n));
   }
   const cosim::RunResult result = master.Finish();
-  ASSERT_TRUE(result.ok) << (result.errors.empty() ? "" : result.errors.front());
+  ASSERT_TRUE(result.ok) << result.ErrorText();
   EXPECT_EQ(result.end_time, opt.stop);
   std::cout << "current-only + rigid load via master: max rel speed error " << err / max_w << "\n";
   // The load is integrated by explicit Euler with the torque held over each
