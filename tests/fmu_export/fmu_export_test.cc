@@ -362,7 +362,7 @@ TEST(FmuExport, AnExportedBeltRunsInAScenarioLikeTheNativeOne) {
     max_speed = std::max(max_speed, fmu.variables().GetRealElement(velocity, 0));
   }
   const auto run = sc.master->Finish();
-  ASSERT_TRUE(run.ok) << (run.errors.empty() ? "" : run.errors[0]);
+  ASSERT_TRUE(run.ok) << run.ErrorText();
   EXPECT_EQ(steps, 3000u);
   // The belt moved at the scene's 0.1 m/s +- 10 %.
   EXPECT_GT(max_speed, 0.09);
