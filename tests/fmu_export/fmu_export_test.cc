@@ -15,11 +15,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <utility>
 #include <string>
 #include <vector>
 
+#include "cosim/observers.h"
 #include "cosim/time.h"
 #include "fmu_export/exporter.h"
 #include "loader/scenario.h"
@@ -367,6 +369,38 @@ TEST(FmuExport, AnExportedBeltRunsInAScenarioLikeTheNativeOne) {
   // The belt moved at the scene's 0.1 m/s +- 10 %.
   EXPECT_GT(max_speed, 0.09);
   EXPECT_LT(max_speed, 0.111);
+}
+
+// Guards a robot scenario with an imported FMU in it (how a user puts their
+// own unit into the robot): cross_line with its `belt` unit swapped for the
+// belt exported and imported back (`units: {belt: {type: fmu, parameters:
+// {path}}}`). The belt FMU is bit-identical to the native belt (above), so
+// the robot's whole run is too: the same metrics to the last bit.
+TEST(FmuExport, ARobotScenarioRunsWithItsBeltAsAnImportedFmu) {
+  Scratch s("robot_belt");
+  ExportFmu({"belt", {}, s / "belt.fmu", "", "factory_line", 0});
+  std::ifstream in(LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ofstream(s / "cross_line_fmu.yaml")
+      << text << "\nunits:\n  belt: {type: fmu, parameters: {path: belt.fmu}}\n";
+  const auto metrics = [](const std::string& file) {
+    loader::Scenario sc = loader::LoadScenario(file, {"duration_s=3"});
+    cosim::MetricsObserver m(sc.metrics);
+    sc.master->AddObserver(&m);
+    const auto run = sc.master->Run();
+    EXPECT_TRUE(run.ok) << run.ErrorText();
+    return std::make_pair(m.Results(), sc.system->unit(*sc.system->FindUnit("belt")).type_name());
+  };
+  const auto [native, native_type] = metrics(LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml");
+  const auto [imported, imported_type] = metrics(s / "cross_line_fmu.yaml");
+  EXPECT_EQ(native_type, "belt");
+  EXPECT_EQ(imported_type, "fmu");
+  ASSERT_EQ(native.size(), imported.size());
+  for (std::size_t i = 0; i < native.size(); ++i) {
+    EXPECT_EQ(native[i].first, imported[i].first);
+    EXPECT_EQ(std::memcmp(&native[i].second, &imported[i].second, sizeof(double)), 0)
+        << native[i].first << ": " << native[i].second << " against " << imported[i].second;
+  }
 }
 
 TEST(FmuExport, RefusesWithNamedErrors) {
