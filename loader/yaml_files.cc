@@ -1,7 +1,11 @@
 #include "loader/yaml_files.h"
 
+#include <yaml-cpp/eventhandler.h>
+
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <map>
 #include <optional>
 #include <set>
@@ -15,6 +19,45 @@ namespace linesim::loader {
 namespace fs = std::filesystem;
 
 namespace {
+
+// Sees a document's events and keeps only where it starts (its first node,
+// else its start marker): enough to tell whether a file holds a second
+// document, and where, without building it.
+class DocumentStarts : public YAML::EventHandler {
+ public:
+  YAML::Mark start = YAML::Mark::null_mark();
+  YAML::Mark content = YAML::Mark::null_mark();
+  int Line() const {
+    const YAML::Mark& m = content.is_null() ? start : content;
+    return m.is_null() ? 0 : m.line + 1;
+  }
+  void OnDocumentStart(const YAML::Mark& mark) override {
+    start = mark;
+    content = YAML::Mark::null_mark();
+  }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { Node(mark); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { Node(mark); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                const std::string&) override {
+    Node(mark);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    Node(mark);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    Node(mark);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  void Node(const YAML::Mark& mark) {
+    if (content.is_null()) content = mark;
+  }
+};
 
 // The first key a map of `node`'s tree gives twice (yaml-cpp keeps both
 // pairs and a lookup finds the first, so the second would be silently
@@ -64,19 +107,34 @@ YamlFile LoadYamlFile(const std::string& file) {
     return out;
   }
   try {
-    // Every document of the file: a second one (after "---", or after a
-    // "..." end marker) would be silently dropped by a single-document read.
-    const std::vector<YAML::Node> documents = YAML::LoadAllFromFile(file);
-    if (documents.size() > 1) {
-      out.problem = YamlFile::Problem::kInvalid;
-      out.detail =
-          "a second YAML document (after '---' or '...'): linesim reads one document per file, "
-          "so the rest would be ignored";
-      const YAML::Mark m = documents[1].Mark();
-      out.line = m.is_null() ? 0 : m.line + 1;
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream buffer;
+    buffer << in.rdbuf();
+    if (!in) {
+      out.problem = YamlFile::Problem::kUnreadable;
+      out.detail = "not readable";
       return out;
     }
-    if (!documents.empty()) out.root = documents.front();
+    const std::string text = buffer.str();
+    // A second document (after "---", or after a "..." end marker) would be
+    // silently dropped by a single-document read. Asked of the parser one
+    // document at a time, at most two: yaml-cpp's LoadAll never ends on text
+    // it cannot place in any document (a line starting with ',' yields an
+    // empty document forever, growing memory without bound).
+    {
+      std::istringstream events(text);
+      YAML::Parser parser(events);
+      DocumentStarts starts;
+      if (parser.HandleNextDocument(starts) && parser.HandleNextDocument(starts)) {
+        out.problem = YamlFile::Problem::kInvalid;
+        out.detail =
+            "a second YAML document (after '---' or '...'), or text outside any document: "
+            "linesim reads one document per file, so the rest would be ignored";
+        out.line = starts.Line();
+        return out;
+      }
+    }
+    out.root = YAML::Load(text);
     std::set<std::size_t> visited;
     if (const auto d = FindDuplicateKey(out.root, visited)) {
       out.problem = YamlFile::Problem::kInvalid;

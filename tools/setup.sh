@@ -10,6 +10,9 @@ packages=(
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libtbb-dev
   libopenmpi-dev openmpi-bin gnuplot-nox
   libzip-dev libpugixml-dev
+  # clang and its runtimes (libFuzzer, ASan, UBSan; libclang-rt-14-dev is only
+  # recommended by clang): the sanitizer and fuzz build (tools/sanitize.sh).
+  clang libclang-rt-14-dev
 )
 
 missing=()

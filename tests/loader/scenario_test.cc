@@ -8,6 +8,7 @@
 #include <iterator>
 
 #include "loader/config_names.h"
+#include "loader/scene_file.h"
 #include "models/dc_motor_params.h"
 #include "scenario_test.h"
 
@@ -411,6 +412,27 @@ units:
 // a second document after "---" and content after a "..." end marker (a
 // single-document read drops it). Each is refused at its line. An alias
 // used twice is one node, not a duplicate; a file ending in "..." is fine.
+// Fuzz finding (fuzz_description, tools/fuzz.sh): a line that starts with
+// ',' outside any flow collection made the loader hang, its memory growing
+// without bound: yaml-cpp 0.7's LoadAll yields an empty document for it
+// forever. The file is refused at once, as a scene file (the fuzzer's input
+// as it was found, a NUL byte and all) and as a scenario. Without the fix
+// this test does not end (ctest's timeout fails it).
+TEST(LoadScenario, TextOutsideAnyDocumentIsRefusedNotAHang) {
+  const std::string found =
+      std::string(LINESIM_SOURCE_DIR) + "/tests/loader/fuzz_findings/description_leading_comma_hang.yaml";
+  try {
+    (void)LoadSceneFile(found);
+    ADD_FAILURE() << "the scene file was accepted";
+  } catch (const ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("text outside any document"), std::string::npos)
+        << e.what();
+  }
+  const std::string comma = WriteScenario("leading_comma.yaml", ", x\nname: t\n");
+  EXPECT_TRUE(Has(Issues(comma), comma + ":") && Has(Issues(comma), "not valid YAML: a second YAML document"))
+      << Issues(comma);
+}
+
 TEST(LoadScenario, DuplicateKeysAndSecondDocumentsAreRefused) {
   const std::string twice =
       WriteScenario("twice.yaml", "name: t\nduration_s: 1\nunits: {}\nduration_s: 2\n");
