@@ -387,6 +387,18 @@ void FmuUnit::DeclareVariables() {
         } else {
           const std::size_t k = next[t]++;
           if (g) g->vrs.push_back(v.value_reference);
+          // An Integer, Boolean or String (no unit of measure) at `slot`,
+          // as a parameter, an input or an output.
+          const auto DeclareScalar = [&](auto* slot, const auto& start) {
+            *slot = start;
+            if (parameter) {
+              table.Parameter(name, slot, text, variability);
+            } else if (d == kInputs) {
+              table.Input(name, slot, text);
+            } else {
+              table.Output(name, slot, text, deps);
+            }
+          };
           switch (v.type) {
             case FmiType::kFloat64: {
               double* slot = &reals_[k];
@@ -402,42 +414,15 @@ void FmuUnit::DeclareVariables() {
               }
               break;
             }
-            case FmiType::kInt32: {
-              std::int64_t* slot = &integers_[k];
-              *slot = v.start_integer;
-              if (parameter) {
-                table.Parameter(name, slot, text, variability);
-              } else if (d == kInputs) {
-                table.Input(name, slot, text);
-              } else {
-                table.Output(name, slot, text, deps);
-              }
+            case FmiType::kInt32:
+              DeclareScalar(&integers_[k], v.start_integer);
               break;
-            }
-            case FmiType::kBoolean: {
-              bool* slot = &booleans_[k];
-              *slot = v.start_boolean;
-              if (parameter) {
-                table.Parameter(name, slot, text, variability);
-              } else if (d == kInputs) {
-                table.Input(name, slot, text);
-              } else {
-                table.Output(name, slot, text, deps);
-              }
+            case FmiType::kBoolean:
+              DeclareScalar(&booleans_[k], v.start_boolean);
               break;
-            }
-            case FmiType::kString: {
-              std::string* slot = &strings_[k];
-              *slot = v.start_string;
-              if (parameter) {
-                table.Parameter(name, slot, text, variability);
-              } else if (d == kInputs) {
-                table.Input(name, slot, text);
-              } else {
-                table.Output(name, slot, text, deps);
-              }
+            case FmiType::kString:
+              DeclareScalar(&strings_[k], v.start_string);
               break;
-            }
           }
         }
         if (d == kInputs) {
