@@ -107,22 +107,14 @@ class DeviceNumbers {
   YAML::Node params_, model_;
 };
 
-// hector_mapping on the robot's lasers (paper 1 Sec. IV-B): one
-// laser_localization unit matching every laser's scans against the scene.
-void AddLaserLocalization(SystemBuilder& b, const ProviderContext& c, Signals& s) {
-  // The map is a grid over the scene's floor: an unbounded floor (no scene)
-  // has nothing to match against and no grid to hold it.
-  const models::Floor& f = c.scene.floor;
-  constexpr double kMaxFloorSide = 1000.0;  // m: 40,000 cells of 0.025 m a side
-  if (!(f.max_x_m - f.min_x_m <= kMaxFloorSide && f.max_y_m - f.min_y_m <= kMaxFloorSide)) {
-    b.reader().Error(c.at, c.path,
-                     "laser localization matches scans against the scene's map: it needs a "
-                     "scene (scene: {model: ...}) whose floor is at most 1000 m a side");
-    return;
-  }
+// The robot's lasers into a scan matcher `unit` (laser_localization or
+// perfect_match_localization): per laser its mount (with mount_z when
+// `with_z`) and beam geometry from its device numbers, and its ranges,
+// scan count and scan time as the unit's inputs _0, _1, ...; `more` reads
+// further numbers of each laser's device (its model file read once).
+void WireLasers(SystemBuilder& b, const ProviderContext& c, const Signals& s, const char* unit,
+                bool with_z, const std::function<void(const DeviceNumbers&)>& more = {}) {
   const auto lasers = Mounts(s, "laser_scanner");
-  b.Unit(kLaserLocalization, "laser_localization");
-  YAML::Node p = b.Params(kLaserLocalization);
   std::vector<int> beams;
   std::vector<double> x, y, z, yaw, first, step, period;
   for (std::size_t k = 0; k < lasers.size(); ++k) {
@@ -136,19 +128,39 @@ void AddLaserLocalization(SystemBuilder& b, const ProviderContext& c, Signals& s
     first.push_back(device.Required("first_beam_angle"));
     step.push_back(device.Required("angular_step"));
     period.push_back(device.Required("scan_period"));
+    if (more) more(device);
     const std::string suffix = "_" + std::to_string(k);
-    b.Connect(Signal(m.name, "ranges"), Signal(kLaserLocalization, "ranges" + suffix));
-    b.Connect(Signal(m.name, "scan_count"), Signal(kLaserLocalization, "scan_count" + suffix));
-    b.Connect(Signal(m.name, "scan_time"), Signal(kLaserLocalization, "scan_time" + suffix));
+    b.Connect(Signal(m.name, "ranges"), Signal(unit, "ranges" + suffix));
+    b.Connect(Signal(m.name, "scan_count"), Signal(unit, "scan_count" + suffix));
+    b.Connect(Signal(m.name, "scan_time"), Signal(unit, "scan_time" + suffix));
   }
+  YAML::Node p = b.Params(unit);
   p["beam_counts"] = IntList(beams);
   p["mount_x"] = List(x);
   p["mount_y"] = List(y);
-  p["mount_z"] = List(z);
+  if (with_z) p["mount_z"] = List(z);
   p["mount_yaw"] = List(yaw);
   p["first_beam_angle"] = List(first);
   p["angular_step"] = List(step);
   p["scan_period"] = List(period);
+}
+
+// hector_mapping on the robot's lasers (paper 1 Sec. IV-B): one
+// laser_localization unit matching every laser's scans against the scene.
+void AddLaserLocalization(SystemBuilder& b, const ProviderContext& c, Signals& s) {
+  // The map is a grid over the scene's floor: an unbounded floor (no scene)
+  // has nothing to match against and no grid to hold it.
+  const models::Floor& f = c.scene.floor;
+  constexpr double kMaxFloorSide = 1000.0;  // m: 40,000 cells of 0.025 m a side
+  if (!(f.max_x_m - f.min_x_m <= kMaxFloorSide && f.max_y_m - f.min_y_m <= kMaxFloorSide)) {
+    b.reader().Error(c.at, c.path,
+                     "laser localization matches scans against the scene's map: it needs a "
+                     "scene (scene: {model: ...}) whose floor is at most 1000 m a side");
+    return;
+  }
+  b.Unit(kLaserLocalization, "laser_localization");
+  YAML::Node p = b.Params(kLaserLocalization);
+  WireLasers(b, c, s, kLaserLocalization, true);
   // localization.map: the scene's map (default) or one learned while
   // driving, as hector_mapping does.
   const YAML::Node map = Child(c.at, "map");
@@ -174,35 +186,13 @@ void AddPerfectMatch(SystemBuilder& b, const ProviderContext& c, Signals& s) {
   const auto lasers = Mounts(s, "laser_scanner");
   b.Unit(kPerfectMatch, "perfect_match_localization");
   YAML::Node p = b.Params(kPerfectMatch);
-  std::vector<int> beams;
-  std::vector<double> x, y, yaw, first, step, period;
+  // The nearest usable range of all lasers, and the largest per-device
+  // range bias (the LMS151's systematic error) for the match covariance.
   std::optional<double> range_min, bias_sigma;
-  for (std::size_t k = 0; k < lasers.size(); ++k) {
-    const models::SensorMount& m = *lasers[k];
-    const DeviceNumbers device(b, c, m);
-    beams.push_back(static_cast<int>(device.Required("beam_count")));
-    x.push_back(m.x_m);
-    y.push_back(m.y_m);
-    yaw.push_back(m.yaw_rad);
-    first.push_back(device.Required("first_beam_angle"));
-    step.push_back(device.Required("angular_step"));
-    period.push_back(device.Required("scan_period"));
-    // The nearest usable range of all lasers, and the largest per-device
-    // range bias (the LMS151's systematic error) for the match covariance.
+  WireLasers(b, c, s, kPerfectMatch, false, [&](const DeviceNumbers& device) {
     if (const auto v = device.Get("range_min")) range_min = std::max(range_min.value_or(0.0), *v);
     if (const auto v = device.Get("bias_sigma")) bias_sigma = std::max(bias_sigma.value_or(0.0), *v);
-    const std::string suffix = "_" + std::to_string(k);
-    b.Connect(Signal(m.name, "ranges"), Signal(kPerfectMatch, "ranges" + suffix));
-    b.Connect(Signal(m.name, "scan_count"), Signal(kPerfectMatch, "scan_count" + suffix));
-    b.Connect(Signal(m.name, "scan_time"), Signal(kPerfectMatch, "scan_time" + suffix));
-  }
-  p["beam_counts"] = IntList(beams);
-  p["mount_x"] = List(x);
-  p["mount_y"] = List(y);
-  p["mount_yaw"] = List(yaw);
-  p["first_beam_angle"] = List(first);
-  p["angular_step"] = List(step);
-  p["scan_period"] = List(period);
+  });
   if (range_min) p["range_min"] = Num(*range_min);
   if (bias_sigma) p["range_bias_sigma"] = Num(*bias_sigma);
   // 3 DoF as paper 2's matcher: every map is a slice at the first laser's
