@@ -1,3 +1,4 @@
+#include "units/estimation/laser_beams.h"
 #include "units/estimation/laser_localization_unit.h"
 
 #include <algorithm>
@@ -225,24 +226,8 @@ LaserLocalizationUnit::~LaserLocalizationUnit() = default;
 
 std::vector<cosim::ParameterProblem> LaserLocalizationUnit::CheckParameters() const {
   auto problems = cosim::Unit::CheckParameters();
-  if (!(range_min_ < usable_range_max_)) {
-    problems.push_back({"usable_range_max", std::nullopt,
-                        "must be > range_min (" + cosim::FormatValue(range_min_) + "), got " +
-                            cosim::FormatValue(usable_range_max_)});
-  }
-  for (std::size_t k = 0; k < beam_counts_.size(); ++k) {
-    if (angular_step_[k] * (beam_counts_[k] - 1) >= 2.0 * std::numbers::pi) {
-      problems.push_back({"angular_step", k,
-                          "the " + std::to_string(beam_counts_[k]) +
-                              " beams must fit in one turn: angular_step < 2 pi / (beams - 1)"});
-    }
-    if (scan_period_[k] >= scan_timeout_) {
-      problems.push_back({"scan_timeout", std::nullopt,
-                          "must be > every laser's scan_period (laser " + std::to_string(k) + ": " +
-                              cosim::FormatValue(scan_period_[k]) + " s), got " +
-                              cosim::FormatValue(scan_timeout_)});
-    }
-  }
+  AddLaserProblems(range_min_, usable_range_max_, beam_counts_, angular_step_, scan_period_,
+                   scan_timeout_, problems);
   return problems;
 }
 
@@ -252,16 +237,10 @@ void LaserLocalizationUnit::Derive() {
   odometry_prediction_ = motion_prediction_ == "odometry";
   mapping_ = map_ == "mapping";
   for (std::size_t k = 0; k < beam_counts_.size(); ++k) {
-    const int n = beam_counts_[k];
-    for (int i = 0; i < n; ++i) {
-      const auto j = static_cast<std::size_t>(i);
-      const double a = mount_yaw_[k] + first_beam_angle_[k] + i * angular_step_[k];
-      beam_cos_[k][j] = std::cos(a);
-      beam_sin_[k][j] = std::sin(a);
-      beam_dt_[k][j] = scan_period_[k] * i * angular_step_[k] / (2.0 * std::numbers::pi);
-    }
     // The middle of the sweep: the time the matched pose refers to.
-    mid_offset_ns_[k] = cosim::SecondsToNs(0.5 * beam_dt_[k][static_cast<std::size_t>(n - 1)]);
+    mid_offset_ns_[k] = LaserBeams(mount_yaw_[k], first_beam_angle_[k], angular_step_[k],
+                                   scan_period_[k], beam_counts_[k], beam_cos_[k], beam_sin_[k],
+                                   beam_dt_[k]);
   }
   // The map, once per set of the values it depends on.
   if (mapping_ && (!grid_ || grid_map_ != map_ || grid_resolution_ != map_resolution_ ||
