@@ -61,4 +61,27 @@ inline cosim::TimeNs LaserBeams(double mount_yaw, double first_beam_angle, doubl
   return cosim::SecondsToNs(0.5 * dt_out[static_cast<std::size_t>(beam_count - 1)]);
 }
 
+/// The lasers with a new scan (scan_count changed since last_count, which
+/// is updated) into order[0..n), earliest match time first (scan_time +
+/// mid_offset_ns: several lasers' scans are matched in time order); returns n.
+inline int OrderNewScans(const std::vector<double>& scan_count, std::vector<double>& last_count,
+                         const std::vector<double>& scan_time,
+                         const std::vector<cosim::TimeNs>& mid_offset_ns, std::vector<int>& order) {
+  int fresh = 0;
+  for (std::size_t k = 0; k < scan_count.size(); ++k) {
+    if (scan_count[k] == last_count[k]) continue;
+    last_count[k] = scan_count[k];
+    const cosim::TimeNs mk = cosim::SecondsToNs(scan_time[k]) + mid_offset_ns[k];
+    int j = fresh++;
+    while (j > 0) {
+      const auto prev = static_cast<std::size_t>(order[static_cast<std::size_t>(j - 1)]);
+      if (cosim::SecondsToNs(scan_time[prev]) + mid_offset_ns[prev] <= mk) break;
+      order[static_cast<std::size_t>(j)] = order[static_cast<std::size_t>(j - 1)];
+      --j;
+    }
+    order[static_cast<std::size_t>(j)] = static_cast<int>(k);
+  }
+  return fresh;
+}
+
 }  // namespace linesim::estimation

@@ -382,21 +382,7 @@ cosim::StepResult PerfectMatchLocalizationUnit::DoStep(cosim::TimeNs t, cosim::T
   if (!InputsFinite(t)) return cosim::StepResult::kError;
   const cosim::TimeNs end = t + dt;
   // The new scans, in the order of their match times.
-  int fresh = 0;
-  for (int k = 0; k < laser_count(); ++k) {
-    const auto kk = static_cast<std::size_t>(k);
-    if (scan_count_[kk] == last_count_[kk]) continue;
-    last_count_[kk] = scan_count_[kk];
-    const cosim::TimeNs mk = cosim::SecondsToNs(scan_time_[kk]) + mid_offset_ns_[kk];
-    int j = fresh++;
-    while (j > 0) {
-      const auto prev = static_cast<std::size_t>(order_[static_cast<std::size_t>(j - 1)]);
-      if (cosim::SecondsToNs(scan_time_[prev]) + mid_offset_ns_[prev] <= mk) break;
-      order_[static_cast<std::size_t>(j)] = order_[static_cast<std::size_t>(j - 1)];
-      --j;
-    }
-    order_[static_cast<std::size_t>(j)] = k;
-  }
+  const int fresh = OrderNewScans(scan_count_, last_count_, scan_time_, mid_offset_ns_, order_);
   for (int j = 0; j < fresh; ++j) ProcessScan(order_[static_cast<std::size_t>(j)]);
   const cosim::TimeNs timeout = cosim::SecondsToNs(scan_timeout_);
   for (int k = 0; k < laser_count(); ++k) {
