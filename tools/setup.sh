@@ -10,6 +10,10 @@ packages=(
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libtbb-dev
   libopenmpi-dev openmpi-bin gnuplot-nox
   libzip-dev libpugixml-dev
+  # SLEEF: the CPU-independent transcendental functions of every linesim
+  # executable (platform/deterministic_math.cc); OpenSSL's libcrypto: SHA-256
+  # for provenance and the golden hashes.
+  libsleef-dev libssl-dev
   # clang and its runtimes (libFuzzer, ASan, UBSan; libclang-rt-14-dev is only
   # recommended by clang): the sanitizer and fuzz build (tools/sanitize.sh).
   clang libclang-rt-14-dev

@@ -4,70 +4,45 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 #include <string>
+
+#include "platform/provenance.h"
 
 namespace linesim::sensors {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kTMin = 1e-9;
-// Rays per Embree packet (rtcIntersect16).
-constexpr std::size_t kPacket = 16;
 
-// Embree user-geometry callbacks for the cylinders.
-void CylinderBounds(const RTCBoundsFunctionArguments* args) {
-  const auto* cyl = static_cast<const RayScene::Cylinder*>(args->geometryUserPtr);
-  const RayScene::Cylinder& c = cyl[args->primID];
-  // Widened by a relative float epsilon so that rounding never cuts a hit.
-  const double pad = 1e-5 * (1.0 + std::abs(c.x) + std::abs(c.y) + c.radius + std::abs(c.z1));
+// The Embree user geometry's callbacks: bounds and exact intersection.
+void SolidBounds(const RTCBoundsFunctionArguments* args) {
+  const auto* scene = static_cast<const RayScene*>(args->geometryUserPtr);
+  const RayScene::StaticSolid& sd = scene->Solid(args->primID);
   RTCBounds* b = args->bounds_o;
-  b->lower_x = static_cast<float>(c.x - c.radius - pad);
-  b->lower_y = static_cast<float>(c.y - c.radius - pad);
-  b->lower_z = static_cast<float>(c.z0 - pad);
-  b->upper_x = static_cast<float>(c.x + c.radius + pad);
-  b->upper_y = static_cast<float>(c.y + c.radius + pad);
-  b->upper_z = static_cast<float>(c.z1 + pad);
+  b->lower_x = sd.lower[0];
+  b->lower_y = sd.lower[1];
+  b->lower_z = sd.lower[2];
+  b->upper_x = sd.upper[0];
+  b->upper_y = sd.upper[1];
+  b->upper_z = sd.upper[2];
 }
 
-void CylinderIntersect(const RTCIntersectFunctionNArguments* args) {
-  const auto* cyl = static_cast<const RayScene::Cylinder*>(args->geometryUserPtr);
-  const RayScene::Cylinder& c = cyl[args->primID];
+void SolidIntersect(const RTCIntersectFunctionNArguments* args) {
+  auto* scene = static_cast<RayScene*>(args->geometryUserPtr);
   RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, args->N);
-  RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, args->N);
   for (unsigned i = 0; i < args->N; ++i) {
     if (!args->valid[i]) continue;
-    const double o[3] = {RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i),
-                         RTCRayN_org_z(ray, args->N, i)};
-    const double d[3] = {RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i),
-                         RTCRayN_dir_z(ray, args->N, i)};
-    const double tfar = RTCRayN_tfar(ray, args->N, i);
-    double n[3] = {0.0, 0.0, 0.0};
-    const double t = IntersectCylinder(c, o, d, tfar, n);
-    if (!(t < tfar) || t < RTCRayN_tnear(ray, args->N, i)) continue;
-    RTCRayN_tfar(ray, args->N, i) = static_cast<float>(t);
-    RTCHitN_Ng_x(hit, args->N, i) = static_cast<float>(n[0]);
-    RTCHitN_Ng_y(hit, args->N, i) = static_cast<float>(n[1]);
-    RTCHitN_Ng_z(hit, args->N, i) = static_cast<float>(n[2]);
-    RTCHitN_u(hit, args->N, i) = 0.0f;
-    RTCHitN_v(hit, args->N, i) = 0.0f;
-    RTCHitN_primID(hit, args->N, i) = args->primID;
-    RTCHitN_geomID(hit, args->N, i) = args->geomID;
-    RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
+    scene->IntersectLaneOf(args->primID, RTCRayN_id(ray, args->N, i),
+                           RTCRayN_tfar(ray, args->N, i));
   }
 }
 
-// What Cast needs of a packet's hits.
-struct PacketHits {
-  unsigned geom[kPacket], prim[kPacket];
-  float tfar[kPacket];
-};
-
-// Intersects up to N rays as one Embree packet of width N (8 or 16).
+// Rays per Embree packet; the lane index travels as the ray's id.
 template <class Packet, std::size_t N>
-void IntersectPacket(std::span<const Ray> rays, RTCScene scene, RTCIntersectContext* context,
-                     PacketHits& out) {
+void IntersectPacket(std::span<const Ray> rays, RTCScene scene, RTCIntersectContext* context) {
   alignas(64) Packet packet;
   alignas(64) int valid[N];
   const std::size_t count = rays.size();
@@ -81,11 +56,11 @@ void IntersectPacket(std::span<const Ray> rays, RTCScene scene, RTCIntersectCont
     packet.ray.dir_y[k] = static_cast<float>(r.direction[1]);
     packet.ray.dir_z[k] = static_cast<float>(r.direction[2]);
     packet.ray.tnear[k] = 0.0f;
-    // Beyond max_range by a margin: the exact distance is decided below.
+    // Beyond max_range by a margin: the exact distance is decided in double.
     packet.ray.tfar[k] = static_cast<float>(r.max_range * (1.0 + 1e-5) + 1e-4);
     packet.ray.time[k] = 0.0f;
     packet.ray.mask[k] = ~0u;
-    packet.ray.id[k] = 0;
+    packet.ray.id[k] = static_cast<unsigned>(std::min(k, count - 1));
     packet.ray.flags[k] = 0;
     packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
     packet.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
@@ -96,11 +71,27 @@ void IntersectPacket(std::span<const Ray> rays, RTCScene scene, RTCIntersectCont
   } else {
     rtcIntersect8(valid, scene, context, &packet);
   }
-  for (std::size_t k = 0; k < count; ++k) {
-    out.geom[k] = packet.hit.geomID[k];
-    out.prim[k] = packet.hit.primID[k];
-    out.tfar[k] = packet.ray.tfar[k];
+}
+
+// What Embree's dispatch picks on this CPU (its rule: the widest kernels the
+// CPU and the build have), capped by LINESIM_EMBREE_MAX_ISA: for provenance.
+std::string KernelIsa(const char* max_isa) {
+  __builtin_cpu_init();
+  const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
+                      __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") &&
+                      __builtin_cpu_supports("avx512vl");
+  const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+                    __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
+  const char* order[] = {"avx512", "avx2", "avx", "sse4.2", "sse2"};
+  const bool have[] = {avx512, avx2, __builtin_cpu_supports("avx") != 0,
+                       __builtin_cpu_supports("sse4.2") != 0, true};
+  bool capped = max_isa != nullptr;
+  for (std::size_t i = 0; i < 5; ++i) {
+    if (capped && std::string(max_isa) != order[i]) continue;
+    capped = false;
+    if (have[i]) return order[i];
   }
+  return "sse2";
 }
 
 }  // namespace
@@ -190,48 +181,96 @@ double IntersectYawedBox(double cx, double cy, double cz, double hx, double hy, 
   return t_in;
 }
 
+double IntersectOrientedBox(const std::array<double, 3>& center, const std::array<double, 3>& half,
+                            const std::array<std::array<double, 3>, 3>& axes, const double* o,
+                            const double* d, double t_max, double* normal) {
+  const double p[3] = {o[0] - center[0], o[1] - center[1], o[2] - center[2]};
+  double t_in = -kInf, t_out = kInf;
+  int axis = -1;
+  double sign = 0.0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto& a = axes[k];
+    const double lo = a[0] * p[0] + a[1] * p[1] + a[2] * p[2];
+    const double ld = a[0] * d[0] + a[1] * d[1] + a[2] * d[2];
+    if (ld == 0.0) {
+      if (lo < -half[k] || lo > half[k]) return kInf;
+      continue;
+    }
+    const double inv = 1.0 / ld;
+    double t0 = (-half[k] - lo) * inv, t1 = (half[k] - lo) * inv;
+    double s = -1.0;  // the face entered: -half when moving +
+    if (t0 > t1) {
+      std::swap(t0, t1);
+      s = 1.0;
+    }
+    if (t0 > t_in) {
+      t_in = t0;
+      axis = static_cast<int>(k);
+      sign = s;
+    }
+    t_out = std::min(t_out, t1);
+  }
+  // A ray starting inside sees nothing of it (a sensor is never inside).
+  if (axis < 0 || t_in > t_out || t_in <= kTMin || t_in >= t_max) return kInf;
+  const auto& n = axes[static_cast<std::size_t>(axis)];
+  normal[0] = sign * n[0];
+  normal[1] = sign * n[1];
+  normal[2] = sign * n[2];
+  return t_in;
+}
+
 RayScene::RayScene(const models::Scene& scene)
     : obstacle_count_(static_cast<int>(scene.obstacles.size())),
       terrain_count_(static_cast<int>(scene.terrain.size())) {
   // Single-threaded: without "threads=1" Embree starts a worker per core.
-  device_ = rtcNewDevice("threads=1");
+  // The kernels Embree picks do not change a range (see the class comment);
+  // LINESIM_EMBREE_MAX_ISA caps them to show it.
+  const char* max_isa = std::getenv("LINESIM_EMBREE_MAX_ISA");
+  std::string config = "threads=1";
+  if (max_isa != nullptr && *max_isa != '\0') config += std::string(",max_isa=") + max_isa;
+  device_ = rtcNewDevice(config.c_str());
   if (!device_) {
-    throw std::runtime_error("Embree: cannot create a device (error " +
+    throw std::runtime_error("Embree: cannot create a device with \"" + config + "\" (error " +
                              std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")");
   }
+  platform::RecordDispatch(
+      "embree", KernelIsa(max_isa != nullptr && *max_isa != '\0' ? max_isa : nullptr) +
+                    " kernels (ranges independent of them: exact intersection in double)");
   scene_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
 
-  std::vector<float> vertices;
-  std::vector<unsigned> indices;
-  // The floor: its rectangle at z = 0, two triangles facing up.
+  const models::Floor& f = scene.floor;
   {
-    const models::Floor& f = scene.floor;
-    const unsigned base = static_cast<unsigned>(vertices.size() / 3);
-    const double xs[4] = {f.min_x_m, f.max_x_m, f.max_x_m, f.min_x_m};
-    const double ys[4] = {f.min_y_m, f.min_y_m, f.max_y_m, f.max_y_m};
-    for (int k = 0; k < 4; ++k) {
-      vertices.insert(vertices.end(), {static_cast<float>(xs[k]), static_cast<float>(ys[k]), 0.f});
-    }
-    indices.insert(indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-    faces_.push_back({0.0, 0.0, 1.0, 0.0, kFloor});
-    faces_.push_back({0.0, 0.0, 1.0, 0.0, kFloor});
+    StaticSolid floor{};
+    floor.kind = StaticSolid::Kind::kFloor;
+    floor.object = kFloor;
+    floor.floor_min_x = f.min_x_m;
+    floor.floor_max_x = f.max_x_m;
+    floor.floor_min_y = f.min_y_m;
+    floor.floor_max_y = f.max_y_m;
+    SetBounds(floor, {f.min_x_m, f.min_y_m, 0.0}, {f.max_x_m, f.max_y_m, 0.0});
+    solids_.push_back(floor);
   }
   for (int i = 0; i < obstacle_count_; ++i) {
     const models::Solid& s = scene.obstacles[static_cast<std::size_t>(i)].solid;
     if (s.kind == models::Solid::Kind::kCylinder) {
-      cylinders_.push_back({s.x_m, s.y_m, s.radius_m, s.bottom_m, s.bottom_m + s.height_m,
-                            ObjectOfObstacle(i)});
+      StaticSolid cyl{};
+      cyl.kind = StaticSolid::Kind::kCylinder;
+      cyl.object = ObjectOfObstacle(i);
+      cyl.cylinder = {s.x_m, s.y_m, s.radius_m, s.bottom_m, s.bottom_m + s.height_m, cyl.object};
+      SetBounds(cyl, {s.x_m - s.radius_m, s.y_m - s.radius_m, s.bottom_m},
+                {s.x_m + s.radius_m, s.y_m + s.radius_m, s.bottom_m + s.height_m});
+      solids_.push_back(cyl);
       continue;
     }
     const double c = std::cos(s.yaw_rad), sn = std::sin(s.yaw_rad);
-    AddBox(vertices, indices, {s.x_m, s.y_m, s.bottom_m + 0.5 * s.height_m},
+    AddBox({s.x_m, s.y_m, s.bottom_m + 0.5 * s.height_m},
            {0.5 * s.length_m, 0.5 * s.width_m, 0.5 * s.height_m},
            {{{c, sn, 0.0}, {-sn, c, 0.0}, {0.0, 0.0, 1.0}}}, ObjectOfObstacle(i));
   }
   for (int i = 0; i < terrain_count_; ++i) {
     const models::TerrainPiece& t = scene.terrain[static_cast<std::size_t>(i)];
-    AddBox(vertices, indices, {t.center_x_m, t.center_y_m, t.center_z_m},
+    AddBox({t.center_x_m, t.center_y_m, t.center_z_m},
            {0.5 * t.length_m, 0.5 * t.width_m, 0.5 * t.thickness_m}, models::TerrainAxes(t),
            ObjectOfTerrain(i));
   }
@@ -253,27 +292,14 @@ RayScene::RayScene(const models::Scene& scene)
   }
   candidates_.assign(carried_.size(), 0);
 
-  RTCGeometry mesh = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
-      mesh, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertices.size() / 3));
-  std::copy(vertices.begin(), vertices.end(), vb);
-  auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-      mesh, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), indices.size() / 3));
-  std::copy(indices.begin(), indices.end(), ib);
-  rtcCommitGeometry(mesh);
-  mesh_geom_ = rtcAttachGeometry(scene_, mesh);
-  rtcReleaseGeometry(mesh);
-
-  if (!cylinders_.empty()) {
-    RTCGeometry user = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
-    rtcSetGeometryUserPrimitiveCount(user, static_cast<unsigned>(cylinders_.size()));
-    rtcSetGeometryUserData(user, cylinders_.data());
-    rtcSetGeometryBoundsFunction(user, CylinderBounds, nullptr);
-    rtcSetGeometryIntersectFunction(user, CylinderIntersect);
-    rtcCommitGeometry(user);
-    cylinder_geom_ = rtcAttachGeometry(scene_, user);
-    rtcReleaseGeometry(user);
-  }
+  RTCGeometry user = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(user, static_cast<unsigned>(solids_.size()));
+  rtcSetGeometryUserData(user, this);
+  rtcSetGeometryBoundsFunction(user, SolidBounds, nullptr);
+  rtcSetGeometryIntersectFunction(user, SolidIntersect);
+  rtcCommitGeometry(user);
+  rtcAttachGeometry(scene_, user);
+  rtcReleaseGeometry(user);
   rtcCommitScene(scene_);
   if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) {
     rtcReleaseScene(scene_);
@@ -287,38 +313,74 @@ RayScene::~RayScene() {
   rtcReleaseDevice(device_);
 }
 
-void RayScene::AddBox(std::vector<float>& vertices, std::vector<unsigned>& indices,
-                      const std::array<double, 3>& center, const std::array<double, 3>& half,
-                      const std::array<std::array<double, 3>, 3>& axes, int object) {
-  const unsigned base = static_cast<unsigned>(vertices.size() / 3);
-  for (int k = 0; k < 8; ++k) {
-    const double s[3] = {(k & 1) ? 1.0 : -1.0, (k & 2) ? 1.0 : -1.0, (k & 4) ? 1.0 : -1.0};
-    for (int j = 0; j < 3; ++j) {
-      double p = center[static_cast<std::size_t>(j)];
-      for (int a = 0; a < 3; ++a) {
-        p += s[a] * half[static_cast<std::size_t>(a)] *
-             axes[static_cast<std::size_t>(a)][static_cast<std::size_t>(j)];
-      }
-      vertices.push_back(static_cast<float>(p));
-    }
+void RayScene::SetBounds(StaticSolid& s, std::array<double, 3> lo, std::array<double, 3> hi) {
+  // Padded by far more than Embree's single-precision slab tests can be off
+  // (a few ulp of the coordinates: ~1e-7 relative), so that its traversal
+  // never drops a solid whose exact hit could be the nearest.
+  for (std::size_t k = 0; k < 3; ++k) {
+    const double pad_lo = 1e-4 + 1e-5 * std::abs(lo[k]), pad_hi = 1e-4 + 1e-5 * std::abs(hi[k]);
+    s.lower[k] = std::nextafter(static_cast<float>(lo[k] - pad_lo), -HUGE_VALF);
+    s.upper[k] = std::nextafter(static_cast<float>(hi[k] + pad_hi), HUGE_VALF);
   }
-  // Per axis a, the faces at -half and +half: corners with bit a clear / set.
-  for (int a = 0; a < 3; ++a) {
-    const int b1 = 1 << ((a + 1) % 3), b2 = 1 << ((a + 2) % 3), ba = 1 << a;
-    for (int side = 0; side < 2; ++side) {
-      const unsigned o = side ? static_cast<unsigned>(ba) : 0u;
-      const unsigned q[4] = {base + o, base + o + static_cast<unsigned>(b1),
-                             base + o + static_cast<unsigned>(b1 | b2),
-                             base + o + static_cast<unsigned>(b2)};
-      indices.insert(indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
-      const double sg = side ? 1.0 : -1.0;
-      const auto& n = axes[static_cast<std::size_t>(a)];
-      Face f{sg * n[0], sg * n[1], sg * n[2], 0.0, object};
-      f.c = f.nx * center[0] + f.ny * center[1] + f.nz * center[2] +
-            half[static_cast<std::size_t>(a)];
-      faces_.push_back(f);
-      faces_.push_back(f);
-    }
+}
+
+void RayScene::AddBox(const std::array<double, 3>& center, const std::array<double, 3>& half,
+                      const std::array<std::array<double, 3>, 3>& axes, int object) {
+  StaticSolid box{};
+  box.kind = StaticSolid::Kind::kBox;
+  box.object = object;
+  box.center = center;
+  box.half = half;
+  box.axes = axes;
+  // The box's extent along each world axis: sum over its axes of |a_k[j]| h_k.
+  std::array<double, 3> lo{}, hi{};
+  for (std::size_t j = 0; j < 3; ++j) {
+    double r = 0.0;
+    for (std::size_t k = 0; k < 3; ++k) r += std::abs(axes[k][j]) * half[k];
+    lo[j] = center[j] - r;
+    hi[j] = center[j] + r;
+  }
+  SetBounds(box, lo, hi);
+  solids_.push_back(box);
+}
+
+void RayScene::IntersectLaneOf(unsigned prim, unsigned lane_index, float& tfar) {
+  Lane& lane = lanes_[lane_index];
+  const StaticSolid& sd = solids_[prim];
+  const Ray& r = *lane.ray;
+  const double* o = r.origin.data();
+  const double* d = r.direction.data();
+  // Hits up to max_range count (nextafter: t == max_range is in).
+  const double t_max = std::nextafter(r.max_range, kInf);
+  double n[3] = {0.0, 0.0, 0.0};
+  double t = kInf;
+  switch (sd.kind) {
+    case StaticSolid::Kind::kFloor:
+      if (d[2] != 0.0) {
+        const double tf = -o[2] / d[2];
+        const double x = o[0] + tf * d[0], y = o[1] + tf * d[1];
+        if (tf > kTMin && tf < t_max && x >= sd.floor_min_x && x <= sd.floor_max_x &&
+            y >= sd.floor_min_y && y <= sd.floor_max_y) {
+          t = tf;
+          n[2] = 1.0;
+        }
+      }
+      break;
+    case StaticSolid::Kind::kBox:
+      t = IntersectOrientedBox(sd.center, sd.half, sd.axes, o, d, t_max, n);
+      break;
+    case StaticSolid::Kind::kCylinder:
+      t = IntersectCylinder(sd.cylinder, o, d, t_max, n);
+      break;
+  }
+  if (std::isinf(t)) return;
+  // The nearest wins; an exact tie goes to the lower object index, so the
+  // order in which Embree offers candidates never matters.
+  if (t < lane.best.range || (t == lane.best.range && sd.object < lane.best.object)) {
+    lane.best = {t, std::abs(n[0] * d[0] + n[1] * d[1] + n[2] * d[2]), sd.object};
+    // Embree may skip what lies beyond: never below the exact hit.
+    const float rounded_up = std::nextafter(static_cast<float>(t), HUGE_VALF);
+    if (rounded_up < tfar) tfar = rounded_up;
   }
 }
 
@@ -451,20 +513,25 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
                     std::span<const double> belt_travel, std::span<const double> belt_speed) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  // The beams of a scan are neighbours: coherent packets of 16 while 16
-  // rays are left, then of 8 (a 1 ms step's 14 beams are cast faster as 8
-  // and 6 than as one packet of 16, measured).
-  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  PacketHits ph;
+  // Packets of 16 while 16 rays are left, then of 8 (a 1 ms step's 14 beams
+  // are cast faster as 8 and 6 than as one packet of 16, measured). Not
+  // Embree's coherent mode: its frustum traversal dropped level beams (a
+  // vertical component of rounding size) against the factory's walls, on
+  // AVX2 and AVX-512 kernels but not SSE: walls vanished on some machines
+  // (tests/units/sensors/ray_scene_test.cc catches it).
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
   int candidates = 0;
   for (std::size_t first = 0; first < rays.size();) {
     const std::size_t count =
         rays.size() - first >= 16 ? 16 : std::min<std::size_t>(8, rays.size() - first);
     const auto packet_rays = rays.subspan(first, count);
+    for (std::size_t k = 0; k < count; ++k) {
+      lanes_[k] = {&packet_rays[k], {kInf, 0.0, -1}};
+    }
     if (count == 16) {
-      IntersectPacket<RTCRayHit16, 16>(packet_rays, scene_, &context, ph);
+      IntersectPacket<RTCRayHit16, 16>(packet_rays, scene_, &context);
     } else {
-      IntersectPacket<RTCRayHit8, 8>(packet_rays, scene_, &context, ph);
+      IntersectPacket<RTCRayHit8, 8>(packet_rays, scene_, &context);
     }
     // The carried objects are culled once per group of kCullGroup rays (a
     // 1 ms step's beams are one group): a group's cone is a few degrees
@@ -478,29 +545,10 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
                     belt_travel, belt_speed);
     }
     for (std::size_t k = 0; k < count; ++k) {
-      const Ray& r = rays[first + k];
       RayHit& h = hits[first + k];
-      h = {std::numeric_limits<double>::infinity(), 0.0, -1};
-      const unsigned geom = ph.geom[k];
-      if (geom == mesh_geom_) {
-        // The exact distance to the face's plane.
-        const Face& f = faces_[ph.prim[k]];
-        const double dn = f.nx * r.direction[0] + f.ny * r.direction[1] + f.nz * r.direction[2];
-        const double on = f.nx * r.origin[0] + f.ny * r.origin[1] + f.nz * r.origin[2];
-        const double t = dn != 0.0 ? (f.c - on) / dn : static_cast<double>(ph.tfar[k]);
-        if (t > 0.0 && t <= r.max_range) h = {t, std::abs(dn), f.object};
-      } else if (geom == cylinder_geom_ && geom != RTC_INVALID_GEOMETRY_ID) {
-        const Cylinder& c = cylinders_[ph.prim[k]];
-        double n[3];
-        const double t = IntersectCylinder(c, r.origin.data(), r.direction.data(),
-                                           r.max_range * 1.001 + 1e-3, n);
-        if (t <= r.max_range) {
-          h = {t, std::abs(n[0] * r.direction[0] + n[1] * r.direction[1] + n[2] * r.direction[2]),
-               c.object};
-        }
-      }
+      h = lanes_[k].best;
       if (candidates > 0) {
-        CastCarried(r,
+        CastCarried(packet_rays[k],
                     std::span<const int>(candidates_.data(), static_cast<std::size_t>(candidates)),
                     belt_travel, belt_speed, h);
       }

@@ -38,13 +38,17 @@ struct RayHit {
 
 /// The geometry a range sensor sees, built once from a models::Scene.
 ///
-/// Static geometry (the floor's rectangle at z = 0, obstacle boxes, terrain
-/// pieces) is one committed Embree scene of triangles; vertical cylinders are
-/// an Embree user geometry intersected analytically (exact, not a mesh).
-/// Embree works in single precision: its hit only says which face (or
-/// cylinder) is met first; the distance is then recomputed in double from
-/// that face's plane (or the cylinder's equation) and the ray's double
-/// origin, so ranges are exact to double rounding.
+/// Static geometry (the floor's rectangle at z = 0, obstacle boxes and
+/// cylinders, terrain pieces) is one Embree user geometry, a primitive per
+/// solid with its bounds padded: Embree only finds the candidates a ray may
+/// meet (its BVH traversal, in single precision, with kernels it picks by CPU
+/// at run time), and each candidate is intersected exactly in double by the
+/// solid's own equation (IntersectOrientedBox, IntersectCylinder, the floor's
+/// plane). The nearest exact hit wins, ties to the lower object index, and
+/// Embree's far distance is only ever shortened to a value rounded up from
+/// it. So a range does not depend on which kernels Embree chose (SSE2 to
+/// AVX-512), on its BVH or on the order it visits candidates: the same bytes
+/// on every x86-64 machine. Measured on BM_RayScene* (bench/laser_bench.cc).
 ///
 /// Objects carried by belts move every step; re-committing Embree instance
 /// transforms costs 10-15 us a frame, so they are not in the Embree scene:
@@ -57,7 +61,9 @@ struct RayHit {
 /// are skipped for the whole group (a conservative cull: exactness kept).
 ///
 /// One RayScene per unit: it owns its Embree device (created single-threaded
-/// with "threads=1") and is not shared between threads. Not copyable.
+/// with "threads=1"; `LINESIM_EMBREE_MAX_ISA`, e.g. sse2, caps Embree's
+/// kernels, so that a test can show that they do not matter) and is not
+/// shared between threads. Not copyable.
 class RayScene {
  public:
   static constexpr int kFloor = 0;
@@ -80,16 +86,36 @@ class RayScene {
   int ObjectOfTerrain(int i) const { return 1 + obstacle_count_ + i; }
   int ObjectOfCarried(int i) const { return 1 + obstacle_count_ + terrain_count_ + i; }
 
-  /// A cylinder of the user geometry (public for the Embree callbacks).
+  /// A vertical cylinder (an obstacle, or a carried one where its belt puts it).
   struct Cylinder {
     double x, y, radius, z0, z1;
     int object;
   };
-  /// A face of the triangle mesh: its plane n.p = c (n unit) and object.
-  struct Face {
-    double nx, ny, nz, c;
+  /// A static solid: a primitive of the Embree user geometry.
+  struct StaticSolid {
+    enum class Kind { kFloor, kBox, kCylinder } kind;
     int object;
+    /// kFloor: the rectangle [min_x, max_x] x [min_y, max_y] at z = 0.
+    double floor_min_x, floor_max_x, floor_min_y, floor_max_y;
+    /// kBox: centre, half sizes along its unit axes.
+    std::array<double, 3> center, half;
+    std::array<std::array<double, 3>, 3> axes;
+    /// kCylinder.
+    Cylinder cylinder;
+    /// The padded bounds Embree tests (float, rounded outwards).
+    std::array<float, 3> lower, upper;
   };
+  /// The best exact hit of a lane of the packet being cast (for the callback).
+  struct Lane {
+    const Ray* ray;
+    RayHit best;
+  };
+  /// For the Embree callbacks: a static solid, and the exact intersection
+  /// of a lane of the packet being cast with one (keeps the lane's nearest
+  /// hit; shortens Embree's far distance `tfar` to it, rounded up).
+  const StaticSolid& Solid(unsigned prim) const { return solids_[prim]; }
+  void IntersectLaneOf(unsigned prim, unsigned lane, float& tfar);
+
   /// A carried object with its belt: footprint at zero travel.
   struct Carried {
     models::Solid solid;
@@ -104,9 +130,10 @@ class RayScene {
   };
 
  private:
-  void AddBox(std::vector<float>& vertices, std::vector<unsigned>& indices,
-              const std::array<double, 3>& center, const std::array<double, 3>& half,
+  void AddBox(const std::array<double, 3>& center, const std::array<double, 3>& half,
               const std::array<std::array<double, 3>, 3>& axes, int object);
+  /// A solid's bounds for Embree, padded (its float traversal never misses it).
+  static void SetBounds(StaticSolid& s, std::array<double, 3> lo, std::array<double, 3> hi);
   /// The carried objects (of `candidates`, indices into carried_) met
   /// before `best` (updated in place).
   void CastCarried(const Ray& ray, std::span<const int> candidates,
@@ -122,10 +149,9 @@ class RayScene {
 
   RTCDeviceTy* device_ = nullptr;
   RTCSceneTy* scene_ = nullptr;
-  unsigned mesh_geom_ = ~0u, cylinder_geom_ = ~0u;
   int obstacle_count_ = 0, terrain_count_ = 0;
-  std::vector<Face> faces_;  // per triangle
-  std::vector<Cylinder> cylinders_;
+  std::vector<StaticSolid> solids_;
+  std::array<Lane, 16> lanes_{};  // the packet being cast
   std::vector<Carried> carried_;
   std::vector<int> candidates_;  // CullCarried's answer (carried_.size() long)
 };
@@ -135,6 +161,11 @@ class RayScene {
 /// none. Used by RayScene and its tests.
 double IntersectCylinder(const RayScene::Cylinder& c, const double* o, const double* d,
                          double t_max, double* normal);
+/// The same for a box given by its centre, its half sizes along its unit axes
+/// (rows of `axes`).
+double IntersectOrientedBox(const std::array<double, 3>& center, const std::array<double, 3>& half,
+                            const std::array<std::array<double, 3>, 3>& axes, const double* o,
+                            const double* d, double t_max, double* normal);
 /// The same for a box given by its centre, half sizes along its yaw-rotated
 /// x, y and the vertical, and cos / sin of its yaw.
 double IntersectYawedBox(double cx, double cy, double cz, double hx, double hy, double hz,
