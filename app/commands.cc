@@ -17,6 +17,7 @@
 #include "cosim/observers.h"
 #include "cosim/run_error_json.h"
 #include "loader/scenario.h"
+#include "platform/provenance.h"
 #include "plots/robot_plots.h"
 #include "units/fmu/fmu_unit.h"
 
@@ -273,6 +274,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   }
   settings["units"] = units;
   summary["settings"] = settings;
+  summary["provenance"] = platform::ProvenanceJson(s.sha256, s.seed);
 
   Json metric_values = Json::object();
   for (const auto& [name, value] : metrics.Results()) metric_values[name] = Number(value);

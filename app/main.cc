@@ -4,12 +4,15 @@
 #include <thread>
 
 #include "app/commands.h"
+#include "platform/provenance.h"
 #include "sweep/mpi_sweep.h"
 
 int main(int argc, char** argv) {
   using namespace linesim::app;
   CLI::App cli{"linesim: co-simulation of mobile robots on moving-floor assembly lines"};
   cli.require_subcommand(1);
+  // Version, commit, compiler and build type: what a result was made with.
+  cli.set_version_flag("--version", linesim::platform::VersionLine());
 
   std::string run_file, out_dir;
   std::vector<std::string> run_sets;

@@ -16,6 +16,7 @@
 #include "app/commands.h"
 #include "app/console.h"
 #include "config/scenario_error.h"
+#include "platform/provenance.h"
 #include "sweep/executor.h"
 #include "sweep/mpi_sweep.h"
 #include "sweep/progress.h"
@@ -212,7 +213,8 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
     std::cerr << "linesim: " << e.what() << "\n";
     return kExitRunFailed;
   }
-  const sweep::SweepTable table = results->Table(spec);
+  sweep::SweepTable table = results->Table(spec);
+  table.provenance = platform::ProvenanceJson(spec.scenario_sha256, spec.seed);
   std::cout << "sweep " << spec.name << ": finished in " << std::setprecision(3) << wall_s
             << " s wall\n";
   sweep::PrintSummary(table, std::cout);

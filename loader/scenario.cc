@@ -1,5 +1,7 @@
 #include "loader/scenario.h"
 
+#include "platform/sha256.h"
+
 #include <algorithm>
 #include <filesystem>
 #include <map>
@@ -416,6 +418,9 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
   }
   Builder(s, reader).Build(tree);
   if (!reader.ok()) throw ScenarioError(reader.issues());
+  YAML::Emitter text;
+  text << tree;
+  s.sha256 = platform::Sha256Hex(text.c_str());
   return s;
 }
 

@@ -28,6 +28,10 @@ struct Scenario {
   std::string description;
   std::uint64_t seed = 1;
   double duration_s = 0;
+  /// SHA-256 of the scenario as built: its YAML tree after the `--set`
+  /// overrides (a robot scenario's expansion, which carries the robot file's
+  /// values), for provenance.
+  std::string sha256;
   std::vector<Override> overrides;
   /// The scene every unit that needs geometry builds from (`scene:`);
   /// models::OpenFloor() when the scenario names none.

@@ -454,6 +454,7 @@ nlohmann::ordered_json Summarize(const SweepTable& t) {
   s["failed"] = failed;
   s["parameters"] = t.parameters;
   s["metrics"] = t.metrics;
+  if (!t.provenance.is_null()) s["provenance"] = t.provenance;
 
   Json by_parameter = Json::object();
   for (std::size_t p = 0; p < t.parameters.size(); ++p) {

@@ -345,6 +345,7 @@ SweepSpec RepeatSweepSpec(const std::string& scenario, const std::vector<std::st
   spec.scenario = scenario;
   spec.name = base.name;
   spec.description = base.description;
+  spec.scenario_sha256 = base.sha256;
   for (const std::string& a : set_args) {
     const auto eq = a.find('=');
     spec.fixed.emplace_back(a.substr(0, eq), eq == std::string::npos ? "" : a.substr(eq + 1));
@@ -465,6 +466,7 @@ SweepSpec LoadSweepSpec(const std::string& file) {
     issues.insert(issues.end(), e.issues().begin(), e.issues().end());
     throw ScenarioError(issues);
   }
+  spec.scenario_sha256 = base.sha256;
   std::vector<std::string> defined;
   for (const auto& m : base.metrics) defined.push_back(m.name);
   if (spec.metrics.empty()) spec.metrics = defined;

@@ -60,6 +60,8 @@ struct SweepSpec {
   std::int64_t repeats = 1;  // runs per point, each with its own seed
   std::uint64_t seed = 1;
   SeedPolicy seeds = SeedPolicy::kCommon;
+  /// The base scenario's SHA-256 with `set:` applied (loader::Scenario::sha256).
+  std::string scenario_sha256;
   /// Metrics of the base scenario to collect; all of them when the file
   /// names none.
   std::vector<std::string> metrics;

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "loader/reference.h"
 
 namespace linesim::sweep {
@@ -28,6 +30,8 @@ struct SweepTable {
   /// Published figures to print beside the sweep's own (empty title:
   /// none); each of its metrics is one of `metrics`.
   loader::Reference reference;
+  /// What the results depend on beyond the sweep file (platform::ProvenanceJson).
+  nlohmann::json provenance;
 
   struct Row {
     std::int64_t id = 0;

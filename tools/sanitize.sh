@@ -16,6 +16,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
 source tools/sanitizer_build.sh
-selection=(-E 'SweepCli\..*Mpi')
+# The golden hashes pin the Release (GCC) build's bytes: another compiler and
+# optimisation level round differently (the mask test still runs here).
+selection=(-E 'SweepCli\..*Mpi|determinism\.GoldenSignalHashes')
 [ "${LINESIM_SANITIZE_ALL:-0}" = 1 ] && selection=()
 ctest --test-dir build-asan --output-on-failure -j"$(nproc)" "${selection[@]}" "$@"
