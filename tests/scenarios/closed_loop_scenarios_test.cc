@@ -19,8 +19,13 @@
 namespace linesim {
 namespace {
 
-using test_scenarios::RunFile;
+using test_scenarios::RunSeeds;
 using test_scenarios::Shipped;
+
+// Seeds per test: every bound below must hold for each of them (the seed
+// draws the belt's speed variation, the PX4Flow's and lasers' noise and
+// biases, the IMU's): the spreads quoted are min / median / max over these.
+constexpr int kSeeds = 8;
 
 const std::vector<std::string> kClosedLoop = {"sensing.surface_velocity=px4flow",
                                               "localization.source=fused"};
@@ -50,13 +55,19 @@ std::string WithSensors(const std::string& name, const std::string& add, const s
 // paper met it with perfect sensing in Gazebo): crossing the line at
 // 0.10 m/s the robot stays within 4 cm of its path. The localization (the
 // fusion of odometry and matching against a 0.025 m grid) stays within one
-// cell of the truth all the way.
+// cell of the truth all the way. The fusion is on odometry alone only before
+// the first match: one 40 ms scan and the 5 ms step, 45 ms of 20 s (0.00225).
+// Seeds 1..8: max_path_deviation_m 0.0041 / 0.0058 / 0.0087 (20 runs of
+// `linesim run --runs 20`: 0.0037 / 0.0066 / 0.0107); localization_error_max_m
+// 0.0096 / 0.0100 / 0.0105 (20 runs: 0.0092 / 0.0101 / 0.0109);
+// final_progress_m 3.9807 / 3.9809 / 3.9818; pose_fusion_fallback_fraction
+// 0.00225 at every seed.
 TEST(ClosedLoopScenarios, CrossLineWithItsOwnSensorsStaysWithin4cm) {
-  const auto m = RunFile(Shipped("cross_line"), kClosedLoop);
-  EXPECT_LT(m.at("max_path_deviation_m"), 0.04);
-  EXPECT_GT(m.at("final_progress_m"), 3.9);
-  EXPECT_LT(m.at("localization_error_max_m"), 0.025);
-  EXPECT_LT(m.at("pose_fusion_fallback_fraction"), 0.01);  // only before the first match
+  const auto m = RunSeeds(Shipped("cross_line"), kClosedLoop, kSeeds);
+  EXPECT_LT(m["max_path_deviation_m"].max(), 0.04);
+  EXPECT_GT(m["final_progress_m"].min(), 3.9);
+  EXPECT_LT(m["localization_error_max_m"].max(), 0.025);
+  EXPECT_LT(m["pose_fusion_fallback_fraction"].max(), 0.01);  // only before the first match
 }
 
 // Fallback: both S300 blacked out for 4 s while the robot is on the belt
@@ -77,15 +88,15 @@ TEST(ClosedLoopScenarios, LasersBlackedOutTheFusionFallsBackToOdometryAndReturns
                   "  laser_front: {parameters: {blackout_from: 5, blackout_until: 9}}\n"
                   "  laser_rear: {parameters: {blackout_from: 5, blackout_until: 9}}\n",
                   "blackout");
-  const auto m = RunFile(file, kClosedLoop);
-  EXPECT_GT(m.at("pose_fusion_fallback_fraction"), 0.17);
+  const auto m = RunSeeds(file, kClosedLoop, kSeeds);
+  EXPECT_GT(m["pose_fusion_fallback_fraction"].min(), 0.17);
   // At most: the 3.5 s, one scan period (40 ms) and one control period
   // (20 ms) at each edge of the blackout (the scans straddling it and the
   // steps that see them), and the same 60 ms at the start, before the
   // first match: (3.5 + 3 x 0.06) s / 20 s.
-  EXPECT_LT(m.at("pose_fusion_fallback_fraction"), (3.5 + 3 * 0.06) / 20);
-  EXPECT_LT(m.at("localization_error_max_m"), 0.11 * 3.5);
-  EXPECT_LT(m.at("final_path_deviation_m"), 0.04);
+  EXPECT_LT(m["pose_fusion_fallback_fraction"].max(), (3.5 + 3 * 0.06) / 20);
+  EXPECT_LT(m["localization_error_max_m"].max(), 0.11 * 3.5);
+  EXPECT_LT(m["final_path_deviation_m"].max(), 0.04);
 }
 
 // Fallback: the light goes out under all four PX4Flow at 4 s, before the
@@ -96,7 +107,11 @@ TEST(ClosedLoopScenarios, LasersBlackedOutTheFusionFallsBackToOdometryAndReturns
 // held and then stale, and the wheels get no surface velocity: the robot
 // crosses as the nominal system does, with the standing error v / k of a
 // loop of gain k = 1/s against a belt at v = 0.10 m/s (+10 % variation):
-// bounded by 0.11 m, never carried away.
+// bounded by 0.11 m, never carried away. Seeds 1..8: max_path_deviation_m
+// 0.0916 / 0.0973 / 0.1012 (within 8 % of the analytic 0.11: the belt's
+// speed nears its +10 % at some seeds and the loop nears v / k);
+// refused_front_left 96 / 97 / 98; wheel_source_max 3 at every seed;
+// final_progress_m 3.9802 / 3.9808 / 3.9819.
 TEST(ClosedLoopScenarios, DarkFlowSensorsAreRefusedAndTheRobotStaysBounded) {
   std::string file =
       WithSensors("cross_line",
@@ -109,11 +124,11 @@ TEST(ClosedLoopScenarios, DarkFlowSensorsAreRefusedAndTheRobotStaysBounded) {
       << "metrics:\n  - {name: refused_front_left, of: 'surface_estimator.implausible_count[0]', "
          "reduce: final}\n  - {name: wheel_source_max, of: "
          "'surface_estimator.wheel_source[0]', reduce: max}\n";
-  const auto m = RunFile(file, kClosedLoop);
-  EXPECT_GT(m.at("refused_front_left"), 10.0);
-  EXPECT_GE(m.at("wheel_source_max"), 2.0);  // held, then none
-  EXPECT_LT(m.at("max_path_deviation_m"), 0.11);
-  EXPECT_GT(m.at("final_progress_m"), 3.9);
+  const auto m = RunSeeds(file, kClosedLoop, kSeeds);
+  EXPECT_GT(m["refused_front_left"].min(), 10.0);
+  EXPECT_GE(m["wheel_source_max"].min(), 2.0);  // held, then none
+  EXPECT_LT(m["max_path_deviation_m"].max(), 0.11);
+  EXPECT_GT(m["final_progress_m"].min(), 3.9);
 }
 
 }  // namespace

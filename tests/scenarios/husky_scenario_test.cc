@@ -14,6 +14,7 @@
 
 #include "cosim/observers.h"
 #include "loader/scenario.h"
+#include "tests/spread.h"
 
 namespace linesim {
 namespace {
@@ -76,25 +77,41 @@ class HuskyObserver : public cosim::Observer {
 //  - it crosses between the car bodies: its footprint never touches them
 //    (conservative bounding box), and it is across the line before the rear
 //    body's front edge (-4.7 + 0.11 t m) could reach it at x = 0.66 m (49 s).
-TEST(HuskyScenario, FinishesThePathAndCrossesTheLineBetweenTheBodies) {
+// Seeds 1..8 (the seed draws the belt's speed variation; the sensors are
+// off, nothing reads them): done_s 39.641 / 39.641 / 39.661; across_s
+// 22.719 / 22.722 / 22.727; nearest car body 2.4998 / 2.4999 / 2.4999 m;
+// final_progress_m 24.978 / 24.981 / 24.981; max_path_deviation_m 0.1215 /
+// 0.1259 / 0.1352 (20 runs, `linesim run --runs 20`: 0.1179 / 0.1269 /
+// 0.1351) against the analytic 0.145: within 7 %, since the belt's speed
+// nears its +10 % at some seeds and the bound is what the loop reaches at
+// that speed; final_path_deviation_m 0.0001 / 0.0002 / 0.0004.
+// One seed's run: the observer's numbers, the metrics and the analytic
+// bound of the belt's sideways carry (from the run's own parameters).
+struct HuskyRun {
+  double done_s = -1.0, across_s = -1.0, min_gap_m = 0.0, bound = 0.0;
+  std::map<std::string, double> m;
+};
+
+HuskyRun RunHusky(int seed) {
   loader::Scenario s =
-      loader::LoadScenario(std::string(LINESIM_SOURCE_DIR "/scenarios/husky_floor_path.yaml"), {});
+      loader::LoadScenario(std::string(LINESIM_SOURCE_DIR "/scenarios/husky_floor_path.yaml"),
+                           {"seed=" + std::to_string(seed), "sensors.default=false"});
   cosim::MetricsObserver metrics(s.metrics);
   HuskyObserver husky(s);
   s.master->AddObserver(&metrics);
   s.master->AddObserver(&husky);
   const cosim::RunResult result = s.master->Run();
-  ASSERT_TRUE(result.ok) << result.ErrorText();
-  std::map<std::string, double> m;
-  for (const auto& [metric, value] : metrics.Results()) m[metric] = value;
-  std::cout << "husky_floor_path: done at " << husky.done_s << " s, across the line at "
-            << husky.across_s << " s, nearest car body " << husky.min_gap_m << " m";
-  for (const auto& [metric, value] : m) std::cout << "\n  " << metric << " = " << value;
+  EXPECT_TRUE(result.ok) << result.ErrorText();
+  HuskyRun run;
+  for (const auto& [metric, value] : metrics.Results()) run.m[metric] = value;
+  run.done_s = husky.done_s;
+  run.across_s = husky.across_s;
+  run.min_gap_m = husky.min_gap_m;
+  std::cout << "husky_floor_path seed " << seed << ": done at " << husky.done_s
+            << " s, across the line at " << husky.across_s << " s, nearest car body "
+            << husky.min_gap_m << " m";
+  for (const auto& [metric, value] : run.m) std::cout << "\n  " << metric << " = " << value;
   std::cout << "\n";
-
-  EXPECT_GT(husky.done_s, 0.0);
-  EXPECT_LT(husky.done_s, 45.0);
-  EXPECT_NEAR(m.at("final_progress_m"), 25.0, 0.03);
 
   // The bound's numbers from the run itself: the belt's top speed (nominal
   // + its variation), the follower's gains (a double pole at k_yaw / 2 when
@@ -108,17 +125,44 @@ TEST(HuskyScenario, FinishesThePathAndCrossesTheLineBetweenTheBodies) {
   const double d = line.nominal_speed_mps * (1.0 + line.speed_variation);
   const double k_cross = param("path_follower", "k_cross");
   const double pole = 0.5 * param("path_follower", "k_yaw");
-  ASSERT_NEAR(param("path_follower", "k_yaw"), 4.0 * k_cross, 1e-12);  // the double pole
-  const double t_on = (line.area.width_m + param("chassis", "body_length")) /
-                      param("path_follower", "speed");
-  const double bound =
-      d / k_cross * (1.0 - std::exp(-pole * t_on)) - d * t_on * std::exp(-pole * t_on);
-  EXPECT_LT(m.at("max_path_deviation_m"), bound);
-  EXPECT_LT(m.at("final_path_deviation_m"), 0.02);
+  EXPECT_NEAR(param("path_follower", "k_yaw"), 4.0 * k_cross, 1e-12);  // the double pole
+  const double t_on =
+      (line.area.width_m + param("chassis", "body_length")) / param("path_follower", "speed");
+  run.bound = d / k_cross * (1.0 - std::exp(-pole * t_on)) - d * t_on * std::exp(-pole * t_on);
+  return run;
+}
 
-  EXPECT_GT(husky.min_gap_m, 0.0);
-  EXPECT_GT(husky.across_s, 0.0);
-  EXPECT_LT(husky.across_s, (0.66 + 4.7) / 0.11);
+TEST(HuskyScenario, FinishesThePathAndCrossesTheLineBetweenTheBodies) {
+  constexpr int kSeeds = 8;
+  std::vector<double> done, across, gap, progress, deviation, final_deviation;
+  double bound = 0.0;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    const HuskyRun r = RunHusky(seed);
+    done.push_back(r.done_s);
+    across.push_back(r.across_s);
+    gap.push_back(r.min_gap_m);
+    progress.push_back(r.m.at("final_progress_m"));
+    deviation.push_back(r.m.at("max_path_deviation_m"));
+    final_deviation.push_back(r.m.at("final_path_deviation_m"));
+    bound = r.bound;
+  }
+  using test_spread::Print;
+  const auto done_s = Print("done_s", done);
+  const auto across_s = Print("across_s", across);
+  const auto min_gap = Print("min_gap_m", gap);
+  const auto final_progress = Print("final_progress_m", progress);
+  const auto max_dev = Print("max_path_deviation_m", deviation);
+  const auto final_dev = Print("final_path_deviation_m", final_deviation);
+
+  EXPECT_GT(done_s.min(), 0.0);
+  EXPECT_LT(done_s.max(), 45.0);
+  EXPECT_LT(std::abs(final_progress.min() - 25.0), 0.03);
+  EXPECT_LT(std::abs(final_progress.max() - 25.0), 0.03);
+  EXPECT_LT(max_dev.max(), bound) << "bound " << bound;
+  EXPECT_LT(final_dev.max(), 0.02);
+  EXPECT_GT(min_gap.min(), 0.0);
+  EXPECT_GT(across_s.min(), 0.0);
+  EXPECT_LT(across_s.max(), (0.66 + 4.7) / 0.11);
 }
 
 }  // namespace

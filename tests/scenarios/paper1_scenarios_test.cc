@@ -16,9 +16,21 @@
 namespace linesim {
 namespace {
 
-std::map<std::string, double> RunScenario(const std::string& name,
-                                          const std::vector<std::string>& sets) {
-  return test_scenarios::RunFile(test_scenarios::Shipped(name), sets);
+// Seeds per run: every bound below must hold for each of them (the seed
+// draws the belt's speed variation, the only random input of these runs'
+// control loops); the spreads quoted are min / median / max over them.
+constexpr int kSeeds = 8;
+
+// The shipped files run the robot's sensors beside the ground-truth control;
+// nothing reads them here, so they are off (half the time; the control's
+// metrics are the same to the last bit: max_path_deviation_m of cross_line,
+// seed 3, 0.004990585113832743 both ways).
+const std::string kNoSensors = "sensors.default=false";
+
+test_scenarios::SeedRuns RunScenario(const std::string& name, std::vector<std::string> sets,
+                                     int seeds = kSeeds) {
+  sets.push_back(kNoSensors);
+  return test_scenarios::RunSeeds(test_scenarios::Shipped(name), sets, seeds);
 }
 
 // The path follower's gains (units/control defaults): cross-track and
@@ -41,32 +53,51 @@ constexpr double kGain = 1.0;
 // 1 s) takes it back: at most 4 v T = 8 mm in all. The nominal deviation is
 // at least 0.5 v/k = 50 mm, more than 6 times that; a factor 3 keeps half
 // of the margin for the contact dynamics.
+//
+// Seeds 1..8: max_path_deviation_m compensated 0.0047 / 0.0051 / 0.0056,
+// nominal 0.0931 / 0.0978 / 0.1012 (the nominal's upper bound, 1.2 v/k =
+// 0.12, is the analytic limit v (1 + 10 %) / k plus 10 % for the loop's
+// lag: the loop nears v / k by design, so the margin is 16 %, not 20);
+// final_progress_m 3.9807 / 3.9809 / 3.9810 (both).
 TEST(Paper1Scenarios, CrossLineCompensatedStaysWithin4cmNominalDoesNot) {
   const auto on = RunScenario("cross_line", {"control.compensation=true"});
   const auto off = RunScenario("cross_line", {"control.compensation=false"});
   const double v_over_k = 0.10 / kGain;
-  EXPECT_LT(on.at("max_path_deviation_m"), 0.04);
-  EXPECT_GT(off.at("max_path_deviation_m"), 0.04);
-  EXPECT_GT(off.at("max_path_deviation_m"), 0.5 * v_over_k);
-  EXPECT_LT(off.at("max_path_deviation_m"), 1.2 * v_over_k);  // +-10 % belt speed
-  EXPECT_GT(off.at("max_path_deviation_m"), 3.0 * on.at("max_path_deviation_m"));
-  EXPECT_GT(on.at("final_progress_m"), 3.9);
-  EXPECT_GT(off.at("final_progress_m"), 3.9);
+  EXPECT_LT(on["max_path_deviation_m"].max(), 0.04);
+  EXPECT_GT(off["max_path_deviation_m"].min(), 0.04);
+  EXPECT_GT(off["max_path_deviation_m"].min(), 0.5 * v_over_k);
+  EXPECT_LT(off["max_path_deviation_m"].max(), 1.2 * v_over_k);  // +-10 % belt speed
+  for (std::size_t i = 0; i < on.seeds.size(); ++i) {
+    EXPECT_GT(off["max_path_deviation_m"].values[i], 3.0 * on["max_path_deviation_m"].values[i])
+        << "seed " << on.seeds[i];
+  }
+  EXPECT_GT(on["final_progress_m"].min(), 3.9);
+  EXPECT_GT(off["final_progress_m"].min(), 3.9);
 }
 
 // The result is the system's, not an artefact of the coupling: it holds
 // under the other master algorithm, at half and twice the step, and for a
 // robot crossing at another heading (it is omnidirectional).
+// max_path_deviation_m over seeds 1..8 (measured once; the test runs 1..2):
+// jacobi 0.0049 / 0.0053 / 0.0059; step 0.5 ms 0.0050 / 0.0052 / 0.0057;
+// step 2 ms 0.0049 / 0.0052 / 0.0057; yaw 0 deg 0.0076 at every seed (the
+// start's transient, not the belt); yaw 45 deg 0.0022 (seeds 1..2).
+// final_progress_m 3.9807..3.9810 in all.
 TEST(Paper1Scenarios, CrossLineHoldsAcrossAlgorithmStepAndHeading) {
+  // Two seeds per variant: the seed's effect is the belt's variation, which
+  // CrossLineCompensatedStaysWithin4cmNominalDoesNot covers over 8 seeds;
+  // each variant was measured over seeds 1..8 once (below) and its spread
+  // is as narrow as the shipped case's.
+  constexpr int kVariantSeeds = 2;
   for (const std::vector<std::string>& sets :
        std::vector<std::vector<std::string>>{{"master.algorithm=jacobi"},
                                              {"master.step_s=0.0005"},
                                              {"master.step_s=0.002"},
                                              {"robot.pose.yaw_deg=0"},
                                              {"robot.pose.yaw_deg=45"}}) {
-    const auto on = RunScenario("cross_line", sets);
-    EXPECT_LT(on.at("max_path_deviation_m"), 0.04) << sets.front();
-    EXPECT_GT(on.at("final_progress_m"), 3.9) << sets.front();
+    const auto on = RunScenario("cross_line", sets, kVariantSeeds);
+    EXPECT_LT(on["max_path_deviation_m"].max(), 0.04) << sets.front();
+    EXPECT_GT(on["final_progress_m"].min(), 3.9) << sets.front();
   }
 }
 
@@ -82,14 +113,20 @@ TEST(Paper1Scenarios, CrossLineHoldsAcrossAlgorithmStepAndHeading) {
 // 0.20 m/s over 20 s: dv/dt <= 0.1 * 0.20 * 2 pi / 20 = 6.3 mm/s2, seen T =
 // 20 ms late, held by k at 6.3e-3 * 0.02 / k = 0.13 mm). The final bound,
 // 5 mm = 2.5 % of v/k, leaves room for the contact dynamics.
+// Seeds 1..8: compensated max_position_drift_m 0.0075 / 0.0077 / 0.0081,
+// final_position_drift_m 0.00001 / 0.00012 / 0.00019; nominal
+// max_position_drift_m 0.2039 / 0.2053 / 0.2125 against [0.85, 1.15] v/k =
+// [0.17, 0.23] (the upper end is the analytic limit 1.1 v/k, the belt's
+// top speed over k, plus 5 % for the loop's lag: the nominal robot nears
+// v/k by design, so its margin is 8 %, not 20).
 TEST(Paper1Scenarios, HoldOnBeltHoldsWithCompensation) {
   const auto on = RunScenario("hold_on_belt", {"control.compensation=true"});
   const auto off = RunScenario("hold_on_belt", {"control.compensation=false"});
   const double v_over_k = 0.20 / kGain;
-  EXPECT_LT(on.at("max_position_drift_m"), 0.1 * v_over_k);
-  EXPECT_LT(on.at("final_position_drift_m"), 0.025 * v_over_k);  // 5 mm
-  EXPECT_GT(off.at("max_position_drift_m"), 0.85 * v_over_k);
-  EXPECT_LT(off.at("max_position_drift_m"), 1.15 * v_over_k);
+  EXPECT_LT(on["max_position_drift_m"].max(), 0.1 * v_over_k);
+  EXPECT_LT(on["final_position_drift_m"].max(), 0.025 * v_over_k);  // 5 mm
+  EXPECT_GT(off["max_position_drift_m"].min(), 0.85 * v_over_k);
+  EXPECT_LT(off["max_position_drift_m"].max(), 1.15 * v_over_k);
 }
 
 // Straddling the edge only two wheels are dragged (the braked robot would
@@ -104,15 +141,19 @@ TEST(Paper1Scenarios, HoldOnBeltHoldsWithCompensation) {
 // than the robot's centre, so by twice that against the floor row if that
 // row held still: 0.37 rad; the heading loop takes most of it back, and we
 // ask for a seventh, 0.05 rad.
+// Seeds 1..8: compensated max_position_drift_m 0.0037 / 0.0038 / 0.0040,
+// final_position_drift_m 0.000002 / 0.00009 / 0.00017, |final_yaw_rad| under
+// 4e-8; nominal max_position_drift_m 0.1040 / 0.1099 / 0.1167,
+// final_yaw_rad 0.0987 / 0.1026 / 0.1044.
 TEST(Paper1Scenarios, HoldStraddlingHoldsWithCompensation) {
   const auto on = RunScenario("hold_straddle", {"control.compensation=true"});
   const auto off = RunScenario("hold_straddle", {"control.compensation=false"});
   const double v_over_k = 0.20 / kGain;
-  EXPECT_LT(on.at("max_position_drift_m"), 0.1 * v_over_k);
-  EXPECT_LT(on.at("final_position_drift_m"), 0.025 * v_over_k);
-  EXPECT_LT(std::abs(on.at("final_yaw_rad")), 0.01);
-  EXPECT_GT(off.at("max_position_drift_m"), 0.3 * v_over_k);
-  EXPECT_GT(std::abs(off.at("final_yaw_rad")), 0.05);
+  EXPECT_LT(on["max_position_drift_m"].max(), 0.1 * v_over_k);
+  EXPECT_LT(on["final_position_drift_m"].max(), 0.025 * v_over_k);
+  EXPECT_LT(on["final_yaw_rad"].max_abs(), 0.01);
+  EXPECT_GT(off["max_position_drift_m"].min(), 0.3 * v_over_k);
+  for (double yaw : off["final_yaw_rad"].values) EXPECT_GT(std::abs(yaw), 0.05);
 }
 
 // Records the period-2 part of every wheel's drive rate,
@@ -156,16 +197,23 @@ class StepChatter : public cosim::Observer {
 // constant is the bare wheel's J / b = 0.022 kg.m2 / 1.01 N.m.s/rad = 22 ms
 // (chassis model and motor back-EMF at the wheel), so over h = 1 ms its
 // second difference is of order (h / tau)^2 = 0.2 % of the rate; a step
-// chatter is far above that.
+// chatter is far above that. Seeds 1..8: rms / max rate 0.00079 / 0.00096
+// / 0.00103 against 0.002.
 TEST(Paper1Scenarios, WheelRatesHaveNoStepChatterWhenFightingTheBelt) {
-  loader::Scenario s = loader::LoadScenario(
-      std::string(LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml"), {"control.compensation=false"});
-  StepChatter chatter;
-  s.master->AddObserver(&chatter);
-  ASSERT_TRUE(s.master->Run().ok);
-  std::cout << "period-2 drive-rate amplitude: rms " << chatter.rms() << " rad/s, max rate "
-            << chatter.max_rate() << " rad/s\n";
-  EXPECT_LT(chatter.rms(), 0.002 * chatter.max_rate());
+  std::vector<double> ratio;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    loader::Scenario s = loader::LoadScenario(
+        std::string(LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml"),
+        {"control.compensation=false", kNoSensors, "seed=" + std::to_string(seed)});
+    StepChatter chatter;
+    s.master->AddObserver(&chatter);
+    ASSERT_TRUE(s.master->Run().ok);
+    std::cout << "seed " << seed << ": period-2 drive-rate amplitude: rms " << chatter.rms()
+              << " rad/s, max rate " << chatter.max_rate() << " rad/s\n";
+    ratio.push_back(chatter.rms() / chatter.max_rate());
+  }
+  const auto r = test_spread::Print("chatter rms / max rate", ratio);
+  EXPECT_LT(r.max(), 0.002);
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 // files) and returns its metrics, printing them for the test log.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
 #include <iostream>
 #include <map>
 #include <string>
@@ -11,11 +13,13 @@
 
 #include "cosim/observers.h"
 #include "loader/scenario.h"
+#include "tests/spread.h"
 
 namespace linesim::test_scenarios {
 
 inline std::map<std::string, double> RunFile(const std::string& file,
-                                             const std::vector<std::string>& sets) {
+                                             const std::vector<std::string>& sets,
+                                             bool print = true) {
   loader::Scenario s = loader::LoadScenario(file, sets);
   cosim::MetricsObserver metrics(s.metrics);
   s.master->AddObserver(&metrics);
@@ -23,11 +27,56 @@ inline std::map<std::string, double> RunFile(const std::string& file,
   EXPECT_TRUE(result.ok) << result.ErrorText();
   std::map<std::string, double> out;
   for (const auto& [metric, value] : metrics.Results()) out[metric] = value;
+  if (!print) return out;
   std::cout << file;
   for (const auto& set : sets) std::cout << " --set " << set;
   for (const auto& [metric, value] : out) std::cout << "\n  " << metric << " = " << value;
   std::cout << "\n";
   return out;
+}
+
+/// Every metric of a file run for seeds first..first+count-1 (the
+/// scenario's top-level `seed:`, set after `sets`), one value per seed in
+/// seed order.
+struct SeedRuns {
+  std::vector<std::uint64_t> seeds;
+  std::map<std::string, test_spread::Spread> metrics;
+
+  /// One metric's spread; a metric the scenario does not have fails the test.
+  const test_spread::Spread& operator[](const std::string& metric) const {
+    const auto it = metrics.find(metric);
+    if (it == metrics.end()) {
+      ADD_FAILURE() << "no metric " << metric;
+      static const test_spread::Spread kNone{{std::nan("")}};
+      return kNone;
+    }
+    return it->second;
+  }
+};
+
+/// Runs `file` with `sets` once per seed and prints each metric's
+/// min / median / max over the seeds.
+inline SeedRuns RunSeeds(const std::string& file, std::vector<std::string> sets, int count,
+                         std::uint64_t first = 1) {
+  SeedRuns runs;
+  sets.push_back("");
+  for (int i = 0; i < count; ++i) {
+    const std::uint64_t seed = first + static_cast<std::uint64_t>(i);
+    sets.back() = "seed=" + std::to_string(seed);
+    runs.seeds.push_back(seed);
+    for (const auto& [metric, value] : RunFile(file, sets, false)) {
+      runs.metrics[metric].values.push_back(value);
+    }
+  }
+  sets.pop_back();
+  std::cout << file;
+  for (const auto& set : sets) std::cout << " --set " << set;
+  std::cout << ", seeds " << first << ".." << first + static_cast<std::uint64_t>(count) - 1;
+  for (const auto& [metric, spread] : runs.metrics) {
+    std::cout << "\n  " << metric << ": " << spread.Text();
+  }
+  std::cout << "\n";
+  return runs;
 }
 
 /// A shipped scenario (scenarios/NAME.yaml).
