@@ -6,6 +6,8 @@
 // "min / median / max over N" for the test log and the test's comment.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -15,14 +17,32 @@ namespace linesim::test_spread {
 
 struct Spread {
   std::vector<double> values;  // in seed order
+  /// The seed of each value, when known: the text then names the seeds of
+  /// the smallest and the largest.
+  std::vector<std::uint64_t> seeds = {};
 
-  double min() const { return *std::min_element(values.begin(), values.end()); }
-  double max() const { return *std::max_element(values.begin(), values.end()); }
+  double min() const {
+    return values.empty() ? std::nan("") : *std::min_element(values.begin(), values.end());
+  }
+  double max() const {
+    return values.empty() ? std::nan("") : *std::max_element(values.begin(), values.end());
+  }
+  /// The k-th smallest value (0-based; the values are few: no copy, no sort).
+  double kth(std::size_t k) const {
+    for (double x : values) {
+      std::size_t below = 0, at_or_below = 0;
+      for (double y : values) {
+        below += y < x;
+        at_or_below += y <= x;
+      }
+      if (below <= k && k < at_or_below) return x;
+    }
+    return std::nan("");
+  }
   double median() const {
-    std::vector<double> v = values;
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    const std::size_t n = values.size();
+    if (n == 0) return std::nan("");
+    return n % 2 ? kth(n / 2) : 0.5 * (kth(n / 2 - 1) + kth(n / 2));
   }
   /// The largest magnitude (for signed errors bounded on both sides).
   double max_abs() const {
@@ -32,9 +52,19 @@ struct Spread {
   }
   std::string Text() const {
     if (values.empty()) return "no values";
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "min %.6g / median %.6g / max %.6g over %zu", min(), median(),
-                  max(), values.size());
+    char buf[200];
+    if (seeds.size() == values.size()) {
+      const auto lo = std::min_element(values.begin(), values.end()) - values.begin();
+      const auto hi = std::max_element(values.begin(), values.end()) - values.begin();
+      std::snprintf(buf, sizeof buf,
+                    "min %.6g (seed %llu) / median %.6g / max %.6g (seed %llu) over %zu", min(),
+                    static_cast<unsigned long long>(seeds[static_cast<std::size_t>(lo)]), median(),
+                    max(), static_cast<unsigned long long>(seeds[static_cast<std::size_t>(hi)]),
+                    values.size());
+    } else {
+      std::snprintf(buf, sizeof buf, "min %.6g / median %.6g / max %.6g over %zu", min(), median(),
+                    max(), values.size());
+    }
     return buf;
   }
 };

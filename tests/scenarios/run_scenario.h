@@ -66,6 +66,7 @@ inline SeedRuns RunSeeds(const std::string& file, std::vector<std::string> sets,
     runs.seeds.push_back(seed);
     for (const auto& [metric, value] : RunFile(file, sets, false)) {
       runs.metrics[metric].values.push_back(value);
+      runs.metrics[metric].seeds.push_back(seed);
     }
   }
   sets.pop_back();

@@ -442,6 +442,12 @@ TEST(SweepCli, ShippedSweepsRunAndShowTheCompensationsBenefit) {
   // cross_line.yaml) plus 5 % allowed for the lag of the wheel loops.
   // With it: paper 1, Sec. VI-B, < 4 cm at 0.10 m/s, taken as 0.4 s times
   // the belt speed at the other speeds.
+  // The shipped sweep's 2 repeats per point (its file is what is tested);
+  // the same sweep with 8 repeats per point, measured once (sensors off,
+  // which leaves the control's metrics the same), each run's
+  // max_path_deviation_m over the belt speed v: without compensation 0.949
+  // to 1.072 (the bound 0.85..1.15; the loop nears v / k by design, so the
+  // upper margin is 7 %, not 20), with it at most 0.083 (0.4 asked).
   const auto summary = nlohmann::json::parse(ReadFile(fs::path(belt) / "summary.json"));
   ASSERT_EQ(summary["by_point"].size(), 10u);
   for (const auto& point : summary["by_point"]) {

@@ -13,6 +13,7 @@
 
 #include "config/unit_registry.h"
 #include "config/yaml_reader.h"
+#include "tests/spread.h"
 #include "tests/units/estimation/perfect_match_test_scene.h"
 #include "tests/units/test_helpers.h"
 #include "units/estimation/perfect_match_localization_unit.h"
@@ -189,7 +190,14 @@ TEST(PerfectMatchLocalization, MatchesAgainstTheMapThatMapIndexNames) {
 // straight run of 3 s at 0.5 m/s through the room (150 scans at 50 Hz):
 // the normalized estimation error squared e^T P^-1 e at the end, averaged
 // over N = 50 seeds, is chi-square(3 N) / N if the filter is consistent:
-// 95 % two-sided [2.360, 3.716] (Wilson-Hilferty).
+// 99.99 % two-sided [1.834, 4.542] (Wilson-Hilferty; the 95 % interval
+// [2.360, 3.716] would fail one set of seeds in 20). The 50 seeds are
+// already 50 independent draws (one set runs: 8 take 30 s); the mean over
+// them, measured once for 8 disjoint sets (seeds 1..400, kSets = 8):
+// 2.050 / 2.625 / 3.620 (the set of seeds 351..400 at 2.050 is outside
+// the 95 % interval; the single worst run's NEES 14.0). The filter is on
+// the conservative side (median below 3), and its lowest set mean sits
+// 12 % above the 99.99 % lower bound.
 // Odometry noise: the filter's velocity_noise q_v = 0.02 m/sqrt(s) and
 // yaw_rate_noise q_w = 0.01 rad/sqrt(s) (its defaults) are white-noise
 // densities: per 10 ms step each velocity component and the yaw rate carry
@@ -203,85 +211,93 @@ TEST(PerfectMatchLocalization, FusedWithOdometryTheEkfIsConsistent) {
   const double qv = 0.02, qw = 0.01, dt = 0.01, v = 0.5, yaw = 0.05;
   const double p0 = 0.02, y0 = 0.01;
   const int seeds = 50;
+  // Sets of 50 seeds: set j runs seeds 50 j + 1 .. 50 (j + 1).
+  constexpr int kSets = 1;
   const auto truth_at = [&](double t) {
     return Pose{-2.0 + v * std::cos(yaw) * t, -0.5 + v * std::sin(yaw) * t, yaw};
   };
-  double sum = 0.0, worst = 0.0;
-  int matches = 0, fused = 0;
-  for (int seed = 1; seed <= seeds; ++seed) {
-    std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
-    std::normal_distribution<double> n(0.0, 1.0);
-    const Pose t0 = truth_at(0.0);
-    const Pose init{t0.x + p0 * n(rng), t0.y + p0 * n(rng), t0.yaw + y0 * n(rng)};
-    auto loc = MakeUnit(scene, {{"room", 0.35, std::nullopt, 0.0}}, init);
-    loc->variables().SetString(*loc->variables().Find("motion_prediction"), "odometry");
-    PoseFusionUnit f("ekf");
-    SetAll(f, "velocity_noise", qv);
-    SetAll(f, "yaw_rate_noise", qw);
-    SetAll(f, "offset_random_walk", 0.0);
-    SetAll(f, "initial_offset_sigma", 0.0);
-    SetAll(f, "initial_position_sigma", p0);
-    SetAll(f, "initial_yaw_sigma", y0);
-    SetAll(f, "position_floor", 1e-9);
-    SetAll(f, "yaw_floor", 1e-9);
-    SetAll(f, "initial_x", init.x);
-    SetAll(f, "initial_y", init.y);
-    SetAll(f, "initial_yaw", init.yaw);
-    loc->Setup(0, 10'000 * kMs);
-    f.Setup(0, 10'000 * kMs);
-    loc->Initialize();
-    f.Initialize();
-    const cosim::TimeNs step = 10 * kMs;
-    double count = 0.0;
-    for (cosim::TimeNs t = 0; t < 3000 * kMs; t += step) {
-      const double sd = std::sqrt(1.0 / dt);
-      const std::vector<double> odo = {v + qv * sd * n(rng), qv * sd * n(rng)};
-      const double w = qw * sd * n(rng);
-      for (cosim::Unit* u : {static_cast<cosim::Unit*>(loc.get()), static_cast<cosim::Unit*>(&f)}) {
-        SetArray(*u, "odometry_velocity", odo);
-        SetAll(*u, "odometry_yaw_rate", w);
+  std::vector<double> set_means;
+  for (int set = 0; set < kSets; ++set) {
+    double sum = 0.0, worst = 0.0;
+    int matches = 0, fused = 0;
+    for (int seed = 50 * set + 1; seed <= 50 * set + seeds; ++seed) {
+      std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
+      std::normal_distribution<double> n(0.0, 1.0);
+      const Pose t0 = truth_at(0.0);
+      const Pose init{t0.x + p0 * n(rng), t0.y + p0 * n(rng), t0.yaw + y0 * n(rng)};
+      auto loc = MakeUnit(scene, {{"room", 0.35, std::nullopt, 0.0}}, init);
+      loc->variables().SetString(*loc->variables().Find("motion_prediction"), "odometry");
+      PoseFusionUnit f("ekf");
+      SetAll(f, "velocity_noise", qv);
+      SetAll(f, "yaw_rate_noise", qw);
+      SetAll(f, "offset_random_walk", 0.0);
+      SetAll(f, "initial_offset_sigma", 0.0);
+      SetAll(f, "initial_position_sigma", p0);
+      SetAll(f, "initial_yaw_sigma", y0);
+      SetAll(f, "position_floor", 1e-9);
+      SetAll(f, "yaw_floor", 1e-9);
+      SetAll(f, "initial_x", init.x);
+      SetAll(f, "initial_y", init.y);
+      SetAll(f, "initial_yaw", init.yaw);
+      loc->Setup(0, 10'000 * kMs);
+      f.Setup(0, 10'000 * kMs);
+      loc->Initialize();
+      f.Initialize();
+      const cosim::TimeNs step = 10 * kMs;
+      double count = 0.0;
+      for (cosim::TimeNs t = 0; t < 3000 * kMs; t += step) {
+        const double sd = std::sqrt(1.0 / dt);
+        const std::vector<double> odo = {v + qv * sd * n(rng), qv * sd * n(rng)};
+        const double w = qw * sd * n(rng);
+        for (cosim::Unit* u :
+             {static_cast<cosim::Unit*>(loc.get()), static_cast<cosim::Unit*>(&f)}) {
+          SetArray(*u, "odometry_velocity", odo);
+          SetAll(*u, "odometry_yaw_rate", w);
+        }
+        const cosim::TimeNs end = t + step;
+        if (end % (20 * kMs) == 0) {
+          // A scan from end - 20 ms to end; its match time is its middle beam's.
+          const double start = cosim::NsToSeconds(end - 20 * kMs);
+          const double mid = start + 0.5 * (kBeams - 1) * kStep / (2 * std::numbers::pi) * kPeriod;
+          SetArray(*loc, "ranges_0", ScanAt(solids, truth_at(mid), kNoise, &rng));
+          count += 1.0;
+          SetAll(*loc, "scan_count_0", count);
+          SetAll(*loc, "scan_time_0", start);
+        }
+        ASSERT_EQ(loc->DoStep(t, step), cosim::StepResult::kOk) << loc->last_error();
+        SetArray(f, "match_position", Get(*loc, "position"));
+        SetAll(f, "match_yaw", Get(*loc, "yaw")[0]);
+        SetArray(f, "match_covariance", Get(*loc, "covariance"));
+        SetAll(f, "match_time", Get(*loc, "match_time")[0]);
+        SetAll(f, "match_count", Get(*loc, "match_count")[0]);
+        ASSERT_EQ(f.DoStep(t, step), cosim::StepResult::kOk) << f.last_error();
       }
-      const cosim::TimeNs end = t + step;
-      if (end % (20 * kMs) == 0) {
-        // A scan from end - 20 ms to end; its match time is its middle beam's.
-        const double start = cosim::NsToSeconds(end - 20 * kMs);
-        const double mid = start + 0.5 * (kBeams - 1) * kStep / (2 * std::numbers::pi) * kPeriod;
-        SetArray(*loc, "ranges_0", ScanAt(solids, truth_at(mid), kNoise, &rng));
-        count += 1.0;
-        SetAll(*loc, "scan_count_0", count);
-        SetAll(*loc, "scan_time_0", start);
-      }
-      ASSERT_EQ(loc->DoStep(t, step), cosim::StepResult::kOk) << loc->last_error();
-      SetArray(f, "match_position", Get(*loc, "position"));
-      SetAll(f, "match_yaw", Get(*loc, "yaw")[0]);
-      SetArray(f, "match_covariance", Get(*loc, "covariance"));
-      SetAll(f, "match_time", Get(*loc, "match_time")[0]);
-      SetAll(f, "match_count", Get(*loc, "match_count")[0]);
-      ASSERT_EQ(f.DoStep(t, step), cosim::StepResult::kOk) << f.last_error();
+      matches += static_cast<int>(Get(*loc, "match_count")[0]);
+      fused += static_cast<int>(Get(f, "accepted_matches")[0]);
+      EXPECT_EQ(Get(f, "velocity_offset"), (std::vector<double>{0.0, 0.0}));  // 3-state
+      const Pose tr = truth_at(3.0);
+      const auto pos = Get(f, "position");
+      const auto c = Get(f, "covariance");
+      std::array<double, 3> e = {pos[0] - tr.x, pos[1] - tr.y,
+                                 std::remainder(Get(f, "yaw")[0] - tr.yaw, 2 * std::numbers::pi)};
+      std::array<double, 3> sol{};
+      ASSERT_TRUE(SolveSymmetric3({c[0], c[1], c[2], c[4], c[5], c[8]}, e, sol));
+      const double nees = e[0] * sol[0] + e[1] * sol[1] + e[2] * sol[2];
+      sum += nees;
+      worst = std::max(worst, nees);
     }
-    matches += static_cast<int>(Get(*loc, "match_count")[0]);
-    fused += static_cast<int>(Get(f, "accepted_matches")[0]);
-    EXPECT_EQ(Get(f, "velocity_offset"), (std::vector<double>{0.0, 0.0}));  // 3-state
-    const Pose tr = truth_at(3.0);
-    const auto pos = Get(f, "position");
-    const auto c = Get(f, "covariance");
-    std::array<double, 3> e = {pos[0] - tr.x, pos[1] - tr.y,
-                               std::remainder(Get(f, "yaw")[0] - tr.yaw, 2 * std::numbers::pi)};
-    std::array<double, 3> sol{};
-    ASSERT_TRUE(SolveSymmetric3({c[0], c[1], c[2], c[4], c[5], c[8]}, e, sol));
-    const double nees = e[0] * sol[0] + e[1] * sol[1] + e[2] * sol[2];
-    sum += nees;
-    worst = std::max(worst, nees);
+    const double mean = sum / seeds;
+    std::printf(
+        "EKF NEES mean %.3f over %d runs (99.99%%: [1.834, 4.542]), largest %.2f; "
+        "matches %d, fused %d\n",
+        mean, seeds, worst, matches, fused);
+    EXPECT_EQ(matches, 150 * seeds);
+    EXPECT_GE(fused, matches - seeds);  // the gate (99.9 %) refuses about 1 in 1000
+    EXPECT_GT(mean, 1.834);
+    EXPECT_LT(mean, 4.542);
+    set_means.push_back(mean);
   }
-  const double mean = sum / seeds;
-  std::printf(
-      "EKF NEES mean %.3f over %d runs (95%%: [2.360, 3.716]), largest %.2f; "
-      "matches %d, fused %d\n",
-      mean, seeds, worst, matches, fused);
-  EXPECT_EQ(matches, 150 * seeds);
-  EXPECT_GE(fused, matches - seeds);  // the gate (99.9 %) refuses about 1 in 1000
-  EXPECT_GT(mean, 2.360);
-  EXPECT_LT(mean, 3.716);
+  test_spread::Print("EKF NEES mean over 50 runs", set_means);
 }
 
 // A restored unit continues bit for bit (its maps are rebuilt from the

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "models/angle.h"
+#include "tests/spread.h"
 #include "tests/units/test_helpers.h"
 #include "units/evaluation/beacon_localization.h"
 #include "units/sensors/laser_scanner_unit.h"
@@ -222,7 +223,10 @@ TEST(BeaconLocalization, DetectsAllFourBeacons) {
 // position error <= 12 mm / sqrt(50 x 4) + 15 mm; RMS yaw error <= that
 // over the beacons' lever about the laser (>= 0.6 m at these poses).
 // Paper 2 states 5 mm and 0.2 deg for the real system: the measured
-// numbers are printed beside.
+// numbers are printed beside. 30 seeds (devices) per pose, 120 in all:
+// position error 0.0001 / 0.0011 / 0.0078 m, |yaw error| 0.0004 / 0.019 /
+// 0.136 deg; each pose's RMS over its bound 0.004 / 0.056 / 0.169 (position
+// and yaw, 8 values); mean NEES 4.0 against the 6 asked.
 TEST(BeaconLocalization, OwnErrorOverSeedsWithinTheLms151Figures) {
   const std::vector<Pose> poses = {
       {5.9, 0.0, 0.0}, {5.6, 0.1, 0.1}, {5.9, -0.15, -0.08}, {5.45, 0.0, 0.05}};
@@ -235,6 +239,7 @@ TEST(BeaconLocalization, OwnErrorOverSeedsWithinTheLms151Figures) {
   int all_n = 0;
   double nees_sum = 0.0, beacons_sum = 0.0;
   int nees_n = 0;
+  std::vector<double> position_errors, yaw_errors, rms_ratio;
   for (const Pose& truth : poses) {
     double sum = 0, sq = 0, max = 0, ysum = 0, ysq = 0, ymax = 0;
     for (int s = 0; s < kSeeds; ++s) {
@@ -251,6 +256,8 @@ TEST(BeaconLocalization, OwnErrorOverSeedsWithinTheLms151Figures) {
       nees_sum += Mahalanobis3(c, ex, ey, et);
       ++nees_n;
       beacons_sum += static_cast<double>(rig.seen());
+      position_errors.push_back(e);
+      yaw_errors.push_back(ye / kDeg);
       sum += e;
       sq += e * e;
       max = std::max(max, e);
@@ -266,6 +273,8 @@ TEST(BeaconLocalization, OwnErrorOverSeedsWithinTheLms151Figures) {
         ysum / kSeeds / kDeg, yrms / kDeg, ymax / kDeg);
     EXPECT_LT(rms, position_bound);
     EXPECT_LT(yrms, yaw_bound);
+    rms_ratio.push_back(rms / position_bound);
+    rms_ratio.push_back(yrms / yaw_bound);
     all_sq += sq;
     all_yaw_sq += ysq;
     all_sum += sum;
@@ -281,6 +290,9 @@ TEST(BeaconLocalization, OwnErrorOverSeedsWithinTheLms151Figures) {
       all_n, 1e3 * all_sum / all_n, 1e3 * std::sqrt(all_sq / all_n), 1e3 * all_max,
       all_yaw_sum / all_n / kDeg, std::sqrt(all_yaw_sq / all_n) / kDeg, all_yaw_max / kDeg,
       nees_sum / nees_n, beacons_sum / nees_n);
+  test_spread::Print("position error (m), per device", position_errors);
+  test_spread::Print("|yaw error| (deg), per device", yaw_errors);
+  test_spread::Print("RMS over 30 devices / bound, per pose (position, yaw)", rms_ratio);
   // The covariance (filter plus the systematic part) is not overconfident:
   // the mean normalized squared error of a 3-DoF estimate is 3 when the
   // covariance is right; below 3 it is conservative (as it should be: it
@@ -290,10 +302,13 @@ TEST(BeaconLocalization, OwnErrorOverSeedsWithinTheLms151Figures) {
 
 // Guards the statistical part alone: without the device bias (bias_sigma
 // 0) the error after 50 scans is a fraction of the 12 mm per beam.
+// Ten seeds (devices): position error 0.00047 / 0.00064 / 0.00085 m, RMS
+// 0.65 mm against the 1.28 mm bound.
 TEST(BeaconLocalization, WithoutBiasOnlyTheAveragedNoiseRemains) {
   const Pose truth{5.9, 0.0, 0.0};
   double sq = 0, ysq = 0;
   constexpr int kSeeds = 10;
+  std::vector<double> errors;
   for (int s = 0; s < kSeeds; ++s) {
     models::Scene scene = Van();
     Rig rig(scene, 2000 + static_cast<std::uint64_t>(s), truth);
@@ -301,11 +316,13 @@ TEST(BeaconLocalization, WithoutBiasOnlyTheAveragedNoiseRemains) {
     rig.laser->Initialize();
     rig.Run(50);
     ASSERT_TRUE(rig.valid());
+    errors.push_back(PositionError(rig.pose(), truth));
     sq += std::pow(PositionError(rig.pose(), truth), 2);
     ysq += std::pow(YawError(rig.pose(), truth), 2);
   }
   const double rms = std::sqrt(sq / kSeeds), yrms = std::sqrt(ysq / kSeeds);
   std::printf("no bias: position RMS %.2f mm, yaw RMS %.3f deg\n", 1e3 * rms, yrms / kDeg);
+  test_spread::Print("no bias: position error (m), per device", errors);
   // 12 mm per beam over about 7 fitted beams x 4 beacons x 50 scans: 0.5 mm;
   // a factor 4 for the fit's geometry (less than half the circle seen).
   EXPECT_LT(rms, 4 * 0.012 / std::sqrt(7.0 * 4 * 50));

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "tests/spread.h"
 #include "tests/units/test_helpers.h"
 #include "units/sensors/px4flow_image.h"
 #include "units/sensors/px4flow_unit.h"
@@ -88,44 +89,65 @@ Stats Fast(double contrast, double lux, double v, int frames, std::uint64_t seed
 // agreement are printed; the assertions hold what the calibration reaches
 // (see the report in px4flow_unit.h): quality within one firmware step
 // (255/25 = 10.2) in most cells, noise within a factor given below.
+// One set of seeds runs (a set takes 2.7 s). Over 8 sets (kSets = 8),
+// measured once, the share of cells with the quality within one step:
+// 0.889 / 0.986 / 1 (36 cells; 3/4 asked); with the noise within 20 % +
+// 0.03 px: 0.704 / 0.848 / 0.931 (27 to 30 cells; 3/4 asked). The noise
+// criterion DOES NOT HOLD on every seed: set 1 (textures 104..107, fast
+// seed 201) has 19 of 27 cells, one short. The 20 % per cell is about one
+// standard error of the reference's own std over 24 frames (15 %), so the
+// count of passing cells is itself a random draw; the bound is left as it
+// was, pending a reference of more frames or a tolerance from its
+// sampling error.
 TEST(Px4FlowFastVsImage, QualityAndNoiseAgreeOverTheGrid) {
   const double contrasts[] = {0.02, 0.05, 0.1, 0.3};
   const double luxes[] = {20.0, 200.0, 1000.0};
   const double speeds[] = {0.0, 0.25, 0.5};
   constexpr int kImageFrames = 24, kFastFrames = 2000;
-  int cells = 0, quality_ok = 0, noise_ok = 0, noise_cells = 0, strict_ok = 0;
-  for (double c : contrasts) {
-    for (double lux : luxes) {
-      for (double v : speeds) {
-        const Stats im = Image(c, lux, v, kImageFrames, 100);
-        const Stats fa = Fast(c, lux, v, kFastFrames, 200);
-        ++cells;
-        const bool q_ok = std::abs(im.quality - fa.quality) <= 255.0 / 25.0;
-        quality_ok += q_ok;
-        // Noise compared where it is resolvable: the image reference's std
-        // over 24 frames is itself uncertain by ~15 %, and below 0.05 px
-        // it is dominated by the half-pixel quantization of a single texture.
-        bool n_ok = true;
-        if (im.std > 0.05 || fa.std > 0.05) {
-          ++noise_cells;
-          n_ok = std::abs(fa.std - im.std) <= 0.2 * std::max(im.std, 0.05) + 0.03;
-          noise_ok += n_ok;
-          strict_ok += std::abs(fa.std - im.std) <= 0.2 * im.std;
+  // Sets of seeds: set j renders textures 100 + 4 j .. 103 + 4 j and runs
+  // the fast model with seed 200 + j.
+  constexpr int kSets = 1;
+  std::vector<double> quality_share, noise_share;
+  for (int set = 0; set < kSets; ++set) {
+    int cells = 0, quality_ok = 0, noise_ok = 0, noise_cells = 0, strict_ok = 0;
+    for (double c : contrasts) {
+      for (double lux : luxes) {
+        for (double v : speeds) {
+          const Stats im =
+              Image(c, lux, v, kImageFrames, 100 + 4 * static_cast<std::uint64_t>(set));
+          const Stats fa = Fast(c, lux, v, kFastFrames, 200 + static_cast<std::uint64_t>(set));
+          ++cells;
+          const bool q_ok = std::abs(im.quality - fa.quality) <= 255.0 / 25.0;
+          quality_ok += q_ok;
+          // Noise compared where it is resolvable: the image reference's std
+          // over 24 frames is itself uncertain by ~15 %, and below 0.05 px
+          // it is dominated by the half-pixel quantization of a single texture.
+          bool n_ok = true;
+          if (im.std > 0.05 || fa.std > 0.05) {
+            ++noise_cells;
+            n_ok = std::abs(fa.std - im.std) <= 0.2 * std::max(im.std, 0.05) + 0.03;
+            noise_ok += n_ok;
+            strict_ok += std::abs(fa.std - im.std) <= 0.2 * im.std;
+          }
+          std::printf(
+              "c=%.2f lux=%6.0f v=%.2f | quality image %6.1f fast %6.1f %s | flow mean image "
+              "%6.3f fast %6.3f | std image %.3f fast %.3f %s\n",
+              c, lux, v, im.quality, fa.quality, q_ok ? "ok" : "--", im.mean, fa.mean, im.std,
+              fa.std, n_ok ? "ok" : "--");
         }
-        std::printf(
-            "c=%.2f lux=%6.0f v=%.2f | quality image %6.1f fast %6.1f %s | flow mean image "
-            "%6.3f fast %6.3f | std image %.3f fast %.3f %s\n",
-            c, lux, v, im.quality, fa.quality, q_ok ? "ok" : "--", im.mean, fa.mean, im.std,
-            fa.std, n_ok ? "ok" : "--");
       }
     }
+    std::printf(
+        "quality within one step: %d of %d cells; noise within 20 %% + 0.03 px: %d of %d cells, "
+        "within 20 %%: %d\n",
+        quality_ok, cells, noise_ok, noise_cells, strict_ok);
+    EXPECT_GE(quality_ok, cells * 3 / 4);
+    EXPECT_GE(noise_ok, noise_cells * 3 / 4);
+    quality_share.push_back(static_cast<double>(quality_ok) / cells);
+    noise_share.push_back(static_cast<double>(noise_ok) / noise_cells);
   }
-  std::printf(
-      "quality within one step: %d of %d cells; noise within 20 %% + 0.03 px: %d of %d cells, "
-      "within 20 %%: %d\n",
-      quality_ok, cells, noise_ok, noise_cells, strict_ok);
-  EXPECT_GE(quality_ok, cells * 3 / 4);
-  EXPECT_GE(noise_ok, noise_cells * 3 / 4);
+  test_spread::Print("share of cells with the quality within one step", quality_share);
+  test_spread::Print("share of cells with the noise within 20 % + 0.03 px", noise_share);
 }
 
 }  // namespace
