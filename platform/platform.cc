@@ -28,7 +28,7 @@ std::string MathLibrary() {
   if (!DeterministicMathBound()) return "glibc libm (CPU-dispatched)";
   return "sleef " + std::to_string(SLEEF_VERSION_MAJOR) + "." +
          std::to_string(SLEEF_VERSION_MINOR) + "." + std::to_string(SLEEF_VERSION_PATCHLEVEL) +
-         " pure C, 1 ulp (every library)";
+         " pure C, 1 to 3.5 ulp (every library)";
 }
 
 std::string CpuModel() {
