@@ -25,6 +25,8 @@ struct Stats {
   double mean = 0.0;     // mean frame flow x over frames of quality > 0
   double std = 0.0;      // its standard deviation
   int valid = 0;
+  /// The standard error of `std` (a normal sample's: std / sqrt(2 (n - 1))).
+  double StdError() const { return valid > 1 ? std / std::sqrt(2.0 * (valid - 1)) : 0.0; }
 };
 
 Stats Summarize(const std::vector<double>& q, const std::vector<double>& f) {
@@ -88,17 +90,18 @@ Stats Fast(double contrast, double lux, double v, int frames, std::uint64_t seed
 // to 4.5 px/frame, inside the 2014 firmware's window). The figures of
 // agreement are printed; the assertions hold what the calibration reaches
 // (see the report in px4flow_unit.h): quality within one firmware step
-// (255/25 = 10.2) in most cells, noise within a factor given below.
+// (255/25 = 10.2) in most cells, noise within what the reference's own
+// sampling error allows. The reference's std over n valid frames (24) is
+// itself a random draw with a standard error of std / sqrt(2 (n - 1)) (15 %
+// at 24 frames; the fast model's, over 2000 frames, 1.6 %): a cell agrees
+// when the two differ by at most 3 of those standard errors combined, plus
+// 0.03 px (the half-pixel quantization of a single texture). A fixed 20 %
+// (about 1.3 standard errors) made the count of agreeing cells a coin toss:
+// one seed set in 8 fell short of 3/4.
 // One set of seeds runs (a set takes 2.7 s). Over 8 sets (kSets = 8),
-// measured once, the share of cells with the quality within one step:
-// 0.889 / 0.986 / 1 (36 cells; 3/4 asked); with the noise within 20 % +
-// 0.03 px: 0.704 / 0.848 / 0.931 (27 to 30 cells; 3/4 asked). The noise
-// criterion DOES NOT HOLD on every seed: set 1 (textures 104..107, fast
-// seed 201) has 19 of 27 cells, one short. The 20 % per cell is about one
-// standard error of the reference's own std over 24 frames (15 %), so the
-// count of passing cells is itself a random draw; the bound is left as it
-// was, pending a reference of more frames or a tolerance from its
-// sampling error.
+// measured once: quality within one step in 0.889 / 0.986 / 1 of the cells
+// (36 cells; 3/4 asked); noise within 3 standard errors + 0.03 px in
+// 0.966 / 1 / 1 of the cells (27 to 30 cells; 9/10 asked).
 TEST(Px4FlowFastVsImage, QualityAndNoiseAgreeOverTheGrid) {
   const double contrasts[] = {0.02, 0.05, 0.1, 0.3};
   const double luxes[] = {20.0, 200.0, 1000.0};
@@ -119,13 +122,13 @@ TEST(Px4FlowFastVsImage, QualityAndNoiseAgreeOverTheGrid) {
           ++cells;
           const bool q_ok = std::abs(im.quality - fa.quality) <= 255.0 / 25.0;
           quality_ok += q_ok;
-          // Noise compared where it is resolvable: the image reference's std
-          // over 24 frames is itself uncertain by ~15 %, and below 0.05 px
-          // it is dominated by the half-pixel quantization of a single texture.
+          // Noise compared where it is resolvable: below 0.05 px it is
+          // dominated by the half-pixel quantization of a single texture.
           bool n_ok = true;
           if (im.std > 0.05 || fa.std > 0.05) {
             ++noise_cells;
-            n_ok = std::abs(fa.std - im.std) <= 0.2 * std::max(im.std, 0.05) + 0.03;
+            const double se = std::hypot(im.StdError(), fa.StdError());
+            n_ok = std::abs(fa.std - im.std) <= 3.0 * se + 0.03;
             noise_ok += n_ok;
             strict_ok += std::abs(fa.std - im.std) <= 0.2 * im.std;
           }
@@ -138,16 +141,18 @@ TEST(Px4FlowFastVsImage, QualityAndNoiseAgreeOverTheGrid) {
       }
     }
     std::printf(
-        "quality within one step: %d of %d cells; noise within 20 %% + 0.03 px: %d of %d cells, "
+        "quality within one step: %d of %d cells; noise within 3 standard errors + 0.03 px: %d of "
+        "%d cells, "
         "within 20 %%: %d\n",
         quality_ok, cells, noise_ok, noise_cells, strict_ok);
     EXPECT_GE(quality_ok, cells * 3 / 4);
-    EXPECT_GE(noise_ok, noise_cells * 3 / 4);
+    EXPECT_GE(noise_ok, noise_cells * 9 / 10);
     quality_share.push_back(static_cast<double>(quality_ok) / cells);
     noise_share.push_back(static_cast<double>(noise_ok) / noise_cells);
   }
   test_spread::Print("share of cells with the quality within one step", quality_share);
-  test_spread::Print("share of cells with the noise within 20 % + 0.03 px", noise_share);
+  test_spread::Print("share of cells with the noise within 3 standard errors + 0.03 px",
+                     noise_share);
 }
 
 }  // namespace
