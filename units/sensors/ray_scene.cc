@@ -141,46 +141,6 @@ double IntersectCylinder(const RayScene::Cylinder& c, const double* o, const dou
   return best;
 }
 
-double IntersectYawedBox(double cx, double cy, double cz, double hx, double hy, double hz,
-                         double cos_yaw, double sin_yaw, const double* o, const double* d,
-                         double t_max, double* normal) {
-  // Into the box frame (yaw only).
-  const double px = o[0] - cx, py = o[1] - cy, pz = o[2] - cz;
-  const double lo[3] = {cos_yaw * px + sin_yaw * py, -sin_yaw * px + cos_yaw * py, pz};
-  const double ld[3] = {cos_yaw * d[0] + sin_yaw * d[1], -sin_yaw * d[0] + cos_yaw * d[1], d[2]};
-  const double h[3] = {hx, hy, hz};
-  double t_in = -kInf, t_out = kInf;
-  int axis = -1;
-  double sign = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    if (ld[k] == 0.0) {
-      if (lo[k] < -h[k] || lo[k] > h[k]) return kInf;
-      continue;
-    }
-    const double inv = 1.0 / ld[k];
-    double t0 = (-h[k] - lo[k]) * inv, t1 = (h[k] - lo[k]) * inv;
-    double s = -1.0;  // the face entered: -h when moving +
-    if (t0 > t1) {
-      std::swap(t0, t1);
-      s = 1.0;
-    }
-    if (t0 > t_in) {
-      t_in = t0;
-      axis = k;
-      sign = s;
-    }
-    t_out = std::min(t_out, t1);
-  }
-  // A ray starting inside sees nothing of it (a sensor is never inside).
-  if (axis < 0 || t_in > t_out || t_in <= kTMin || t_in >= t_max) return kInf;
-  double ln[3] = {0.0, 0.0, 0.0};
-  ln[axis] = sign;
-  normal[0] = cos_yaw * ln[0] - sin_yaw * ln[1];
-  normal[1] = sin_yaw * ln[0] + cos_yaw * ln[1];
-  normal[2] = ln[2];
-  return t_in;
-}
-
 double IntersectOrientedBox(const std::array<double, 3>& center, const std::array<double, 3>& half,
                             const std::array<std::array<double, 3>, 3>& axes, const double* o,
                             const double* d, double t_max, double* normal) {
@@ -217,6 +177,14 @@ double IntersectOrientedBox(const std::array<double, 3>& center, const std::arra
   normal[1] = sign * n[1];
   normal[2] = sign * n[2];
   return t_in;
+}
+
+double IntersectYawedBox(double cx, double cy, double cz, double hx, double hy, double hz,
+                         double cos_yaw, double sin_yaw, const double* o, const double* d,
+                         double t_max, double* normal) {
+  return IntersectOrientedBox({cx, cy, cz}, {hx, hy, hz},
+                              {{{cos_yaw, sin_yaw, 0.0}, {-sin_yaw, cos_yaw, 0.0}, {0.0, 0.0, 1.0}}},
+                              o, d, t_max, normal);
 }
 
 RayScene::RayScene(const models::Scene& scene)
