@@ -1,4 +1,7 @@
 #include <CLI/CLI.hpp>
+#include <cmath>
+#include <exception>
+#include <string>
 #include <iostream>
 #include <memory>
 #include <thread>
@@ -6,6 +9,24 @@
 #include "app/commands.h"
 #include "platform/provenance.h"
 #include "sweep/mpi_sweep.h"
+
+namespace {
+
+// CLI::Range lets NaN through (every comparison with it is false): a number
+// option must be a finite number first.
+const CLI::Validator kFinite(
+    [](std::string& text) -> std::string {
+      try {
+        std::size_t used = 0;
+        const double v = std::stod(text, &used);
+        if (used == text.size() && std::isfinite(v)) return "";
+      } catch (const std::exception&) {
+      }
+      return "expected a finite number, got '" + text + "'";
+    },
+    "FINITE");
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace linesim::app;
@@ -26,6 +47,7 @@ int main(int argc, char** argv) {
   double max_output_mb = linesim::app::kDefaultMaxOutputMb;
   run->add_option("--max-output-mb", max_output_mb,
                   "refuse a run whose signals.csv could exceed this many MB (default 1024)")
+      ->check(kFinite)
       ->check(CLI::Range(0.001, 1e9));
   CLI::Option* runs_option = run->add_option("--runs", runs,
                   "run the scenario N times, each with its own seed, as a sweep (results.csv, "

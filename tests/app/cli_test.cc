@@ -198,6 +198,16 @@ TEST(Cli, RecordingBeyondTheOutputLimitIsRefusedBeforeTheRun) {
       << r.err;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_EQ(Linesim("run " + kMotorStep + " --out " + out + " --max-output-mb 0.5").status, 0);
+  // NaN passes a range check (every comparison is false) and would turn the
+  // limit off; infinities and text are refused too.
+  for (const char* bad : {"nan", "NaN", "inf", "-inf", "1e999", "0.5x"}) {
+    const std::string out2 = Fresh(std::string("output_limit_") + bad);
+    const Result n =
+        Linesim("run " + kMotorStep + " --out " + out2 + " --max-output-mb " + bad);
+    EXPECT_EQ(n.status, 2) << bad;
+    EXPECT_NE(n.err.find("--max-output-mb"), std::string::npos) << bad << ": " << n.err;
+    EXPECT_FALSE(fs::exists(out2)) << bad;
+  }
 }
 
 // Guards a robot scenario's own recording list: the columns the plots read
