@@ -92,6 +92,30 @@ TEST(Cli, RunMotorStepWritesSummaryAndSignals) {
   EXPECT_NE(csv.find("\n1.5,"), std::string::npos);
 }
 
+// Guards provenance: a result says what made it (build, machine, the
+// libraries' run-time choices, the scenario as run, the seed), and a --set
+// changes the scenario's hash.
+TEST(Cli, SummaryRecordsProvenanceAndVersionPrintsIt) {
+  const std::string out = Fresh("provenance");
+  ASSERT_EQ(Linesim("run " + kMotorStep + " --out " + out).status, 0);
+  const auto p = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"))["provenance"];
+  EXPECT_EQ(p["seed"], 1);
+  EXPECT_EQ(p["scenario_sha256"].get<std::string>().size(), 64u);
+  EXPECT_NE(p["dispatch"]["libm"].get<std::string>().find("sleef"), std::string::npos);
+  EXPECT_FALSE(p["commit"].get<std::string>().empty());
+  EXPECT_FALSE(p["cpu_model"].get<std::string>().empty());
+  const std::string out2 = Fresh("provenance_seed");
+  ASSERT_EQ(Linesim("run " + kMotorStep + " --out " + out2 + " --set seed=7").status, 0);
+  const auto p2 = nlohmann::json::parse(ReadFile(fs::path(out2) / "summary.json"))["provenance"];
+  EXPECT_EQ(p2["seed"], 7);
+  EXPECT_NE(p2["scenario_sha256"], p["scenario_sha256"]);
+  const Result v = Linesim("--version");
+  EXPECT_EQ(v.status, 0);
+  EXPECT_NE(v.out.find("linesim " + p["linesim_version"].get<std::string>()), std::string::npos)
+      << v.out;
+  EXPECT_NE(v.out.find(p["commit"].get<std::string>()), std::string::npos) << v.out;
+}
+
 // Guards determinism (same scenario and seed -> same bytes), also with the
 // other master algorithm and Jacobi threads.
 TEST(Cli, SameFileAndSeedGiveIdenticalSignals) { ExpectIdenticalSignals(kMotorStep, ""); }
