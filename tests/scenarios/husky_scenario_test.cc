@@ -81,7 +81,7 @@ class HuskyObserver : public cosim::Observer {
 // off, nothing reads them: every metric the same to the bit, measured at
 // seed 5): done_s 39.641 / 39.641 / 39.661; across_s
 // 22.719 / 22.722 / 22.727; nearest car body 2.4998 / 2.4999 / 2.4999 m;
-// final_progress_m 24.978 / 24.981 / 24.981; max_path_deviation_m 0.1215 /
+// final_progress_m 24.980 / 24.981 / 24.981; max_path_deviation_m 0.1215 /
 // 0.1259 / 0.1352 (20 runs, `linesim run --runs 20`: 0.1179 / 0.1269 /
 // 0.1351) against the analytic 0.145: within 7 %, since the belt's speed
 // nears its +10 % at some seeds and the bound is what the loop reaches at

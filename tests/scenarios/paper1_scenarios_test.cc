@@ -55,10 +55,10 @@ constexpr double kGain = 1.0;
 // of the margin for the contact dynamics.
 //
 // Seeds 1..8: max_path_deviation_m compensated 0.0047 / 0.0051 / 0.0056,
-// nominal 0.0931 / 0.0978 / 0.1012 (the nominal's upper bound, 1.2 v/k =
+// nominal 0.0930 / 0.0978 / 0.1012 (the nominal's upper bound, 1.2 v/k =
 // 0.12, is the analytic limit v (1 + 10 %) / k plus 10 % for the loop's
 // lag: the loop nears v / k by design, so the margin is 16 %, not 20);
-// final_progress_m 3.9807 / 3.9809 / 3.9810 (both).
+// final_progress_m 3.9807 / 3.9809 / 3.9811 (both).
 TEST(Paper1Scenarios, CrossLineCompensatedStaysWithin4cmNominalDoesNot) {
   const auto on = RunScenario("cross_line", {"control.compensation=true"});
   const auto off = RunScenario("cross_line", {"control.compensation=false"});
@@ -81,7 +81,7 @@ TEST(Paper1Scenarios, CrossLineCompensatedStaysWithin4cmNominalDoesNot) {
 // max_path_deviation_m over seeds 1..8 (measured once; the test runs 1..2):
 // jacobi 0.0049 / 0.0053 / 0.0059; step 0.5 ms 0.0050 / 0.0052 / 0.0057;
 // step 2 ms 0.0049 / 0.0052 / 0.0057; yaw 0 deg 0.0076 at every seed (the
-// start's transient, not the belt); yaw 45 deg 0.0022 (seeds 1..2).
+// start's transient, not the belt); yaw 45 deg 0.0022 at every seed.
 // final_progress_m 3.9807..3.9810 in all.
 TEST(Paper1Scenarios, CrossLineHoldsAcrossAlgorithmStepAndHeading) {
   // Two seeds per variant: the seed's effect is the belt's variation, which
@@ -197,8 +197,8 @@ class StepChatter : public cosim::Observer {
 // constant is the bare wheel's J / b = 0.022 kg.m2 / 1.01 N.m.s/rad = 22 ms
 // (chassis model and motor back-EMF at the wheel), so over h = 1 ms its
 // second difference is of order (h / tau)^2 = 0.2 % of the rate; a step
-// chatter is far above that. Seeds 1..8: rms / max rate 0.00079 / 0.00096
-// / 0.00103 against 0.002.
+// chatter is far above that. Seeds 1..8: rms / max rate 0.00083 / 0.00093
+// / 0.00098 against 0.002.
 TEST(Paper1Scenarios, WheelRatesHaveNoStepChatterWhenFightingTheBelt) {
   std::vector<double> ratio;
   for (int seed = 1; seed <= kSeeds; ++seed) {
