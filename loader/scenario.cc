@@ -386,6 +386,32 @@ class Builder {
 
 }  // namespace
 
+// The tree as unambiguous text for its hash: every scalar with its length
+// (no quoting rules to apply; YAML::Emitter took 30 M instructions, a third of
+// a short run's start, measured with callgrind), maps in file order.
+static void AppendCanonical(const YAML::Node& node, std::string& out) {
+  switch (node.Type()) {
+    case YAML::NodeType::Scalar:
+      out += 's' + std::to_string(node.Scalar().size()) + ':' + node.Scalar();
+      break;
+    case YAML::NodeType::Sequence:
+      out += "[" + std::to_string(node.size());
+      for (const auto& item : node) AppendCanonical(item, out);
+      out += ']';
+      break;
+    case YAML::NodeType::Map:
+      out += "{" + std::to_string(node.size());
+      for (const auto& kv : node) {
+        AppendCanonical(kv.first, out);
+        AppendCanonical(kv.second, out);
+      }
+      out += '}';
+      break;
+    default:  // null, undefined
+      out += '~';
+  }
+}
+
 Scenario LoadScenario(const std::string& file, const std::vector<std::string>& set_args) {
   Scenario s;
   s.file = file;
@@ -418,9 +444,9 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
   }
   Builder(s, reader).Build(tree);
   if (!reader.ok()) throw ScenarioError(reader.issues());
-  YAML::Emitter text;
-  text << tree;
-  s.sha256 = platform::Sha256Hex(text.c_str());
+  std::string canonical;
+  AppendCanonical(tree, canonical);
+  s.sha256 = platform::Sha256Hex(canonical);
   return s;
 }
 

@@ -52,13 +52,22 @@ LINESIM_UNARY(asinh, Sleef_asinhd1_u10purec)
 LINESIM_UNARY(acosh, Sleef_acoshd1_u10purec)
 LINESIM_UNARY(atanh, Sleef_atanhd1_u10purec)
 double atan2(double y, double x) noexcept { return Sleef_atan2d1_u35purec(y, x); }
-// x^1 and x^2 exactly (CVODE's step-size rule takes roots of order 1 most of
-// the time; SLEEF's pow costs 76 ns against glibc's 10, measured).
+// SLEEF's pow costs 76 ns against glibc's 10 (measured); CVODE's step-size
+// rule takes roots of order 1 to 3 at almost every step (x^1, x^(1/2),
+// x^(1/3) after each restart), so these go faster: x^1 and x^2 exactly,
+// x^(1/2) as the correctly rounded sqrt, and x^(1/3) (y the double nearest a
+// third) as SLEEF's cube root (3.5 ulp; 15 ns), for x > 0 where the two
+// agree in meaning (pow(-0, 0.5) is +0, sqrt(-0) is -0).
 double pow(double x, double y) noexcept {
   if (y == 1.0) return x;
   if (y == 2.0) return x * x;
+  if (x > 0.0) {
+    if (y == 0.5) return __builtin_sqrt(x);
+    if (y == 1.0 / 3.0) return Sleef_cbrtd1_u35purec(x);
+  }
   return Sleef_powd1_u10purec(x, y);
 }
+
 void sincos(double x, double* s, double* c) noexcept {
   const Sleef_double_2 r = Sleef_sincosd1_u35purec(x);
   *s = r.x;

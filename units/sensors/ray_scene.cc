@@ -3,6 +3,8 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -318,8 +320,7 @@ void RayScene::IntersectLaneOf(unsigned prim, unsigned lane_index, float& tfar) 
   const Ray& r = *lane.ray;
   const double* o = r.origin.data();
   const double* d = r.direction.data();
-  // Hits up to max_range count (nextafter: t == max_range is in).
-  const double t_max = std::nextafter(r.max_range, kInf);
+  const double t_max = lane.t_max;
   double n[3] = {0.0, 0.0, 0.0};
   double t = kInf;
   switch (sd.kind) {
@@ -346,8 +347,10 @@ void RayScene::IntersectLaneOf(unsigned prim, unsigned lane_index, float& tfar) 
   // order in which Embree offers candidates never matters.
   if (t < lane.best.range || (t == lane.best.range && sd.object < lane.best.object)) {
     lane.best = {t, std::abs(n[0] * d[0] + n[1] * d[1] + n[2] * d[2]), sd.object};
-    // Embree may skip what lies beyond: never below the exact hit.
-    const float rounded_up = std::nextafter(static_cast<float>(t), HUGE_VALF);
+    // Embree may skip what lies beyond: never below the exact hit (t > 0:
+    // one float step up from the nearest float is above it).
+    const float rounded_up =
+        std::bit_cast<float>(std::bit_cast<std::uint32_t>(static_cast<float>(t)) + 1u);
     if (rounded_up < tfar) tfar = rounded_up;
   }
 }
@@ -494,7 +497,9 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
         rays.size() - first >= 16 ? 16 : std::min<std::size_t>(8, rays.size() - first);
     const auto packet_rays = rays.subspan(first, count);
     for (std::size_t k = 0; k < count; ++k) {
-      lanes_[k] = {&packet_rays[k], {kInf, 0.0, -1}};
+      // Hits up to max_range count (nextafter: t == max_range is in).
+      lanes_[k] = {&packet_rays[k], std::nextafter(packet_rays[k].max_range, kInf),
+                   {kInf, 0.0, -1}};
     }
     if (count == 16) {
       IntersectPacket<RTCRayHit16, 16>(packet_rays, scene_, &context);

@@ -108,6 +108,7 @@ class RayScene {
   /// The best exact hit of a lane of the packet being cast (for the callback).
   struct Lane {
     const Ray* ray;
+    double t_max;  // just above the ray's max_range: a hit there counts
     RayHit best;
   };
   /// For the Embree callbacks: a static solid, and the exact intersection
