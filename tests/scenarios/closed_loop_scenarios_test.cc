@@ -57,10 +57,10 @@ std::string WithSensors(const std::string& name, const std::string& add, const s
 // fusion of odometry and matching against a 0.025 m grid) stays within one
 // cell of the truth all the way. The fusion is on odometry alone only before
 // the first match: one 40 ms scan and the 5 ms step, 45 ms of 20 s (0.00225).
-// Seeds 1..8: max_path_deviation_m 0.0044 / 0.0074 / 0.0089 (20 runs of
-// `linesim run --runs 20`: 0.0038 / 0.0071 / 0.0118); localization_error_max_m
-// 0.0094 / 0.0098 / 0.0106 (20 runs: 0.0087 / 0.0102 / 0.0108);
-// final_progress_m 3.9806 / 3.9811 / 3.9817; pose_fusion_fallback_fraction
+// Seeds 1..8: max_path_deviation_m 0.0042 / 0.0073 / 0.0088 (20 runs of
+// `linesim run --runs 20`: 0.0036 / 0.0070 / 0.0117); localization_error_max_m
+// 0.0094 / 0.0098 / 0.0104 (20 runs: 0.0089 / 0.0102 / 0.0113);
+// final_progress_m 3.9806 / 3.9810 / 3.9817; pose_fusion_fallback_fraction
 // 0.00225 at every seed.
 TEST(ClosedLoopScenarios, CrossLineWithItsOwnSensorsStaysWithin4cm) {
   const auto m = RunSeeds(Shipped("cross_line"), kClosedLoop, kSeeds);
@@ -78,8 +78,8 @@ TEST(ClosedLoopScenarios, CrossLineWithItsOwnSensorsStaysWithin4cm) {
 // Meanwhile the pose is dead reckoning on a moving floor: its drift over the
 // 3.5 s is the error of the fusion's belt-velocity state, bounded by losing
 // the belt altogether: 0.11 m/s (0.10 m/s + 10 %) x 3.5 s = 0.385 m; over 8
-// seeds it drifted 9.5 to 63.5 mm (localization) and the path deviated 4.6 to
-// 56.3 mm, beyond paper 1's 4 cm, which it sets for a robot that sees. Once
+// seeds it drifted 12.1 to 58.8 mm (localization) and the path deviated 7.3 to
+// 51.8 mm, beyond paper 1's 4 cm, which it sets for a robot that sees. Once
 // the lasers are back the matches pull the pose in, and the robot ends
 // within the paper's 4 cm of its path.
 TEST(ClosedLoopScenarios, LasersBlackedOutTheFusionFallsBackToOdometryAndReturns) {
