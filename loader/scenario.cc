@@ -404,9 +404,15 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
   RefuseOverridesThroughAliases(tree, s.overrides, file, issues);
   ExposeSceneModelToOverrides(tree, s.overrides, file);
   ApplyOverrides(tree, s.overrides, file, issues);
-  std::set<std::string> overridden;
-  for (const auto& o : s.overrides) overridden.insert(o.path);
+  std::set<std::string> overridden, without_value;
+  for (const auto& o : s.overrides) {
+    overridden.insert(o.path);
+    // `--set key=` (or only blanks): null in the tree, which must not read
+    // as the default.
+    if (o.value.find_first_not_of(" \t") == std::string::npos) without_value.insert(o.path);
+  }
   YamlReader reader(file, overridden);
+  reader.SetGivenWithoutValue(without_value);
   reader.Add(issues);
   if (IsRobotScenario(tree)) {
     RobotInfo info;
