@@ -342,12 +342,17 @@ void FmuUnit::DeclareVariables() {
   std::set<std::string> used;
   std::map<std::size_t, std::string> input_names;  // variable index -> table name
   std::vector<std::string> all_inputs;
+  // Per identifier, the suffix to try next: names that all become one
+  // identifier ("a.b", "a_b", ...) would otherwise search from _2 each time,
+  // quadratic in their number. The names are the same as with that search
+  // (the set of used names only grows).
+  std::map<std::string, int> next_suffix;
   const auto unique_name = [&](const std::string& fmi_name) {
     std::string n = Identifier(fmi_name);
     if (used.count(n)) {
-      int k = 2;
+      int& k = next_suffix.try_emplace(n, 2).first->second;
       while (used.count(n + "_" + std::to_string(k))) ++k;
-      n += "_" + std::to_string(k);
+      n += "_" + std::to_string(k++);
     }
     used.insert(n);
     return n;

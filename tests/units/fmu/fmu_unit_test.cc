@@ -5,6 +5,7 @@
 #include <dlfcn.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -387,6 +388,40 @@ TEST(FmuUnit, ModelIdentifierCannotLeadOutOfTheFmu) {
   // Resolved inside the folder: the FMU's own binary.
   FmuUnit inside("inside", with_identifier("sub/../dahlquist"));
   EXPECT_TRUE(inside.variables().Find("x"));
+}
+
+// Guards issue 24's quadratic loading in the naming step: FMI names that
+// become one identifier ("a.,-+()", "a[]..." -> "a______") searched their
+// suffix from _2 each time (20k of them: 2*10^8 set lookups). The suffix to
+// try next is kept per identifier: the same names (_2, _3, ... in order),
+// in linear time; the bound is far above it and far below the quadratic.
+TEST(FmuUnit, NamesThatCollideAreMadeUniqueInLinearTime) {
+  test::Scratch s("collide");
+  constexpr std::size_t n = 20'000;
+  const char kPunct[] = ".,-+()[]";
+  std::string vars;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::string name = "a";
+    for (std::size_t k = i, d = 0; d < 6; ++d, k /= 8) name += kPunct[k % 8];
+    vars += "<ScalarVariable name=\"" + name + "\" valueReference=\"" + std::to_string(i) +
+            "\" causality=\"local\"><Real/></ScalarVariable>\n";
+  }
+  const std::string xml =
+      "<?xml version=\"1.0\"?>\n<fmiModelDescription fmiVersion=\"2.0\" modelName=\"m\" "
+      "guid=\"g\">\n<CoSimulation modelIdentifier=\"dahlquist\"/>\n<ModelVariables>\n" +
+      vars + "</ModelVariables>\n</fmiModelDescription>\n";
+  test::MakeZip(s / "c.fmu", {{"modelDescription.xml", xml},
+                              {"binaries/linux64/dahlquist.so",
+                               test::ReadFile(LINESIM_DAHLQUIST_SO)}});
+  const auto start = std::chrono::steady_clock::now();
+  FmuUnit u("c", s / "c.fmu");
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 10.0);
+  EXPECT_TRUE(u.variables().Find("a______"));
+  EXPECT_TRUE(u.variables().Find("a_______2"));
+  EXPECT_TRUE(u.variables().Find("a_______" + std::to_string(n)));
+  EXPECT_FALSE(u.variables().Find("a_______" + std::to_string(n + 1)));
 }
 
 // The unit made without an FMU (`linesim inspect fmu`) says what is missing.
