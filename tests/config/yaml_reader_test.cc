@@ -56,12 +56,20 @@ TEST(YamlReader, KeyGivenWithoutValueOnTheCommandLineIsRefused) {
   const auto& s = r.issues()[0];
   EXPECT_EQ(s.key_path, "m.s");
   EXPECT_TRUE(s.from_command_line);
-  EXPECT_TRUE(Has(s.message, "no value given (--set m.s=): expected one of ground_truth, px4flow"))
+  EXPECT_TRUE(Has(s.message, "no value given (--set m.s=): expected one of ground_truth, px4flow; "
+                             "to keep the default, leave the --set out"))
       << s.message;
   EXPECT_TRUE(Has(r.issues()[1].message, "expected a number > 0 and <= 2")) << r.issues()[1].message;
   EXPECT_TRUE(Has(r.issues()[2].message, "expected a time in seconds")) << r.issues()[2].message;
   EXPECT_TRUE(Has(r.issues()[3].message, "expected an integer from 1 to 9")) << r.issues()[3].message;
   EXPECT_TRUE(Has(r.issues()[4].message, "expected true or false")) << r.issues()[4].message;
+  // A required key has no default to offer.
+  YamlReader q("f.yaml", {"m.s"});
+  q.SetGivenWithoutValue({"m.s"});
+  q.String(map, "m", "s", std::nullopt);
+  ASSERT_EQ(q.issues().size(), 1u);
+  EXPECT_TRUE(Has(q.issues()[0].message, "no value given (--set m.s=): expected a text"));
+  EXPECT_FALSE(Has(q.issues()[0].message, "default")) << q.issues()[0].message;
 }
 
 }  // namespace

@@ -542,7 +542,7 @@ metrics:
 // reader took it as absent. LoadScenario tells the reader which keys came
 // without a value; it refuses them naming the allowed values, whether the
 // key is a robot scenario's or a system scenario's, and blanks count as
-// nothing.
+// nothing; a key no typed reader reads is refused too.
 TEST(LoadScenario, SetWithoutValueIsRefusedNamingWhatTheKeyTakes) {
   const std::string cross = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
   std::string e = Issues(cross, {"sensing.surface_velocity="});
@@ -557,6 +557,14 @@ TEST(LoadScenario, SetWithoutValueIsRefusedNamingWhatTheKeyTakes) {
                      "master.step_s=): expected a time in seconds > 0 and <= 10"))
       << e;
   EXPECT_EQ(Issues(cross, {"sensing.surface_velocity=px4flow"}), "(no error)");
+  // A key no typed reader reads (a section, whose null means all its
+  // defaults) is refused by LoadScenario itself; an explicit null is not
+  // empty.
+  e = Issues(cross, {"control="});
+  EXPECT_TRUE(Has(e, "control (set on the command line): no value given (--set control=): an "
+                     "empty value does not mean the default"))
+      << e;
+  EXPECT_EQ(Issues(cross, {"control=null"}), "(no error)");
 }
 
 TEST(UnitTypes, EveryTypeBuildsWithDefaults) {
