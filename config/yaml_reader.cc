@@ -137,6 +137,34 @@ const YAML::Node YamlReader::Lookup(const YAML::Node& map, const std::string& pa
   return node;
 }
 
+bool YamlReader::RefuseNoValue(const YAML::Node& map, const std::string& path,
+                               const std::string& key, const std::string& expected,
+                               bool has_default) {
+  const std::string p = JoinPath(path, key);
+  const YAML::Node node = Child(map, key);
+  if ((node.IsDefined() && !node.IsNull()) || !without_value_.count(p)) return false;
+  Error(map, p,
+        "no value given (--set " + p + "=): expected " + expected +
+            (has_default ? "; to keep the default, leave the --set out" : ""));
+  return true;
+}
+
+namespace {
+
+// " >= 0 and <= 2" for a range, "" for every number.
+std::string RangeText(const Range& range) {
+  std::string want;
+  if (std::isfinite(range.min)) {
+    want = (range.min_exclusive ? "> " : ">= ") + YAML::Node(range.min).Scalar();
+  }
+  if (std::isfinite(range.max)) {
+    want += (want.empty() ? "<= " : " and <= ") + YAML::Node(range.max).Scalar();
+  }
+  return want.empty() ? "" : " " + want;
+}
+
+}  // namespace
+
 std::optional<double> YamlReader::DecodeReal(const YAML::Node& node) {
   double v = 0;
   if (!node.IsScalar() || !YAML::convert<double>::decode(node, v) || std::isnan(v)) {
@@ -155,14 +183,8 @@ std::optional<double> YamlReader::AsReal(const YAML::Node& node, const std::stri
   const double v = *decoded;
   const bool below = range.min_exclusive ? v <= range.min : v < range.min;
   if (below || v > range.max) {
-    std::string want;
-    if (std::isfinite(range.min)) {
-      want = (range.min_exclusive ? "> " : ">= ") + YAML::Node(range.min).Scalar();
-    }
-    if (std::isfinite(range.max)) {
-      want += (want.empty() ? "<= " : " and <= ") + YAML::Node(range.max).Scalar();
-    }
-    Error(node, path, "value " + node.Scalar() + " is out of range: expected a number " + want);
+    Error(node, path,
+          "value " + node.Scalar() + " is out of range: expected a number" + RangeText(range));
     return std::nullopt;
   }
   return v;
@@ -235,6 +257,9 @@ std::optional<std::array<double, 2>> YamlReader::AsPoint(const YAML::Node& node,
 
 double YamlReader::Real(const YAML::Node& map, const std::string& path, const std::string& key,
                         std::optional<double> fallback, Range range) {
+  if (RefuseNoValue(map, path, key, "a number" + RangeText(range), fallback.has_value())) {
+    return fallback.value_or(0.0);
+  }
   const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
   if (!node.IsDefined() || node.IsNull()) return fallback.value_or(0.0);
   return AsReal(node, JoinPath(path, key), range).value_or(fallback.value_or(0.0));
@@ -245,6 +270,10 @@ cosim::TimeNs YamlReader::Time(const YAML::Node& map, const std::string& path,
                                Range range) {
   // Fallbacks are the caller's own values, in range by construction.
   const cosim::TimeNs otherwise = fallback ? cosim::SecondsToNs(*fallback) : 0;
+  if (RefuseNoValue(map, path, key, "a time in seconds" + RangeText(range),
+                    fallback.has_value())) {
+    return otherwise;
+  }
   const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
   if (!node.IsDefined() || node.IsNull()) return otherwise;
   const std::string p = JoinPath(path, key);
@@ -295,6 +324,11 @@ std::optional<bool> YamlReader::AsBoolean(const YAML::Node& node, const std::str
 std::int64_t YamlReader::Integer(const YAML::Node& map, const std::string& path,
                                  const std::string& key, std::optional<std::int64_t> fallback,
                                  std::int64_t min, std::int64_t max) {
+  if (RefuseNoValue(map, path, key,
+                    "an integer from " + std::to_string(min) + " to " + std::to_string(max),
+                    fallback.has_value())) {
+    return fallback.value_or(0);
+  }
   const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
   if (!node.IsDefined() || node.IsNull()) return fallback.value_or(0);
   return AsInteger(node, JoinPath(path, key), min, max).value_or(fallback.value_or(0));
@@ -302,6 +336,9 @@ std::int64_t YamlReader::Integer(const YAML::Node& map, const std::string& path,
 
 bool YamlReader::Boolean(const YAML::Node& map, const std::string& path, const std::string& key,
                          std::optional<bool> fallback) {
+  if (RefuseNoValue(map, path, key, "true or false", fallback.has_value())) {
+    return fallback.value_or(false);
+  }
   const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
   if (!node.IsDefined() || node.IsNull()) return fallback.value_or(false);
   return AsBoolean(node, JoinPath(path, key)).value_or(fallback.value_or(false));
@@ -310,6 +347,10 @@ bool YamlReader::Boolean(const YAML::Node& map, const std::string& path, const s
 std::string YamlReader::String(const YAML::Node& map, const std::string& path,
                                const std::string& key, std::optional<std::string> fallback,
                                const std::vector<std::string>& allowed) {
+  if (RefuseNoValue(map, path, key, allowed.empty() ? "a text" : "one of " + JoinNames(allowed),
+                    fallback.has_value())) {
+    return fallback.value_or("");
+  }
   const YAML::Node node = Lookup(map, path, key, !fallback.has_value());
   if (!node.IsDefined() || node.IsNull()) return fallback.value_or("");
   const std::string p = JoinPath(path, key);

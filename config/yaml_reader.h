@@ -122,14 +122,25 @@ class YamlReader {
 
   /// Whether `path`, or a key above it, was set with --set.
   bool FromCommandLine(const std::string& path) const;
+  /// The key paths given on the command line with no value (`--set key=`).
+  /// The tree holds null there, which a reader would take as absent and
+  /// silently replace by its default: the typed readers (Real, Time,
+  /// Integer, Boolean, String) refuse it instead, naming what they expect;
+  /// LoadScenario refuses the others no reader reported (a section).
+  void SetGivenWithoutValue(std::set<std::string> paths) { without_value_ = std::move(paths); }
 
  private:
   const YAML::Node Lookup(const YAML::Node& map, const std::string& path, const std::string& key,
                           bool required);
+  /// Reports and returns true when `key` of `map` holds no value because
+  /// the command line gave none; `expected` says what the key takes.
+  bool RefuseNoValue(const YAML::Node& map, const std::string& path, const std::string& key,
+                     const std::string& expected, bool has_default);
 
   std::string file_;
   const std::string own_file_;
   std::set<std::string> overridden_;
+  std::set<std::string> without_value_;
   std::map<std::string, Origin> origins_;
   std::vector<Issue> issues_;
 };

@@ -430,19 +430,45 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
   RefuseOverridesThroughAliases(tree, s.overrides, file, issues);
   ExposeSceneModelToOverrides(tree, s.overrides, file);
   ApplyOverrides(tree, s.overrides, file, issues);
-  std::set<std::string> overridden;
-  for (const auto& o : s.overrides) overridden.insert(o.path);
+  std::set<std::string> overridden, without_value;
+  for (const auto& o : s.overrides) {
+    overridden.insert(o.path);
+    // `--set key=` (or only blanks): null in the tree, which must not read
+    // as the default.
+    if (o.value.find_first_not_of(" \t") == std::string::npos) without_value.insert(o.path);
+  }
   YamlReader reader(file, overridden);
+  reader.SetGivenWithoutValue(without_value);
   reader.Add(issues);
+  // A key given without a value that no typed reader refused (naming what
+  // it takes) is one whose null would silently mean its default too (a
+  // section such as control=): refused here.
+  const auto refuse_unread_without_value = [&] {
+    for (const std::string& path : without_value) {
+      const auto& all = reader.issues();
+      if (std::any_of(all.begin(), all.end(),
+                      [&](const Issue& i) { return i.key_path == path; })) {
+        continue;
+      }
+      reader.Error(YAML::Node(), path,
+                   "no value given (--set " + path +
+                       "=): an empty value does not mean the default; give a value, or leave "
+                       "the --set out for the default (" + path + "=null is an explicit null)");
+    }
+  };
   if (IsRobotScenario(tree)) {
     RobotInfo info;
     s.expanded = ExpandRobotScenario(tree, reader, info);
     // A robot-level problem would only echo as problems of the expansion.
-    if (!reader.ok()) throw ScenarioError(reader.issues());
+    if (!reader.ok()) {
+      refuse_unread_without_value();
+      throw ScenarioError(reader.issues());
+    }
     s.robot = std::move(info);
     tree = s.expanded;
   }
   Builder(s, reader).Build(tree);
+  refuse_unread_without_value();
   if (!reader.ok()) throw ScenarioError(reader.issues());
   std::string canonical;
   AppendCanonical(tree, canonical);

@@ -408,11 +408,24 @@ struct ScenarioSource {
 YAML::Node Record(const YAML::Node& node, const std::string& path,
                   std::map<std::string, ScenarioSource>& sources);
 
+// An empty list the scenario writes over a list with items: merged by
+// index it would remove nothing and leave the items as they were.
+struct EmptyListOver {
+  std::string path;
+  YAML::Node node;
+  std::size_t items = 0;  // of the list it would merge onto
+};
+
 // `over` merged onto `base` (the scene file's tree, which is never
 // modified): maps by key, lists by index; anything else replaces. Every
-// path `over` writes is recorded in `sources` (relative to the scene).
+// path `over` writes is recorded in `sources` (relative to the scene), and
+// every empty list over a list with items, at any depth, in `empty`.
 YAML::Node Merge(const YAML::Node& base, const YAML::Node& over, const std::string& path,
-                 std::map<std::string, ScenarioSource>& sources) {
+                 std::map<std::string, ScenarioSource>& sources,
+                 std::vector<EmptyListOver>& empty) {
+  if (base.IsSequence() && base.size() > 0 && over.IsSequence() && over.size() == 0) {
+    empty.push_back({path, over, base.size()});
+  }
   if (base.IsMap() && over.IsMap()) {
     YAML::Node out(YAML::NodeType::Map);
     for (const auto& kv : base) out[kv.first.Scalar()] = kv.second;
@@ -422,7 +435,8 @@ YAML::Node Merge(const YAML::Node& base, const YAML::Node& over, const std::stri
       const std::string p = JoinPath(path, key);
       sources[p] = {kv.first, kv.second};
       const YAML::Node b = Child(base, key);
-      out[key] = b.IsDefined() ? Merge(b, kv.second, p, sources) : Record(kv.second, p, sources);
+      out[key] =
+          b.IsDefined() ? Merge(b, kv.second, p, sources, empty) : Record(kv.second, p, sources);
     }
     return out;
   }
@@ -432,7 +446,7 @@ YAML::Node Merge(const YAML::Node& base, const YAML::Node& over, const std::stri
       const std::string p = JoinPath(path, std::to_string(i));
       if (i < over.size()) sources[p] = {over[i], over[i]};
       if (i < base.size() && i < over.size()) {
-        out.push_back(Merge(base[i], over[i], p, sources));
+        out.push_back(Merge(base[i], over[i], p, sources, empty));
       } else if (i < base.size()) {
         out.push_back(base[i]);
       } else {
@@ -461,6 +475,23 @@ YAML::Node Record(const YAML::Node& node, const std::string& path,
     }
   }
   return node;
+}
+
+// Lists merge item by item, at every depth (scene.obstacles, a belt's
+// schedule): an empty one would silently remove nothing, so it is refused at
+// its key (through the reader's origins, at the key the user wrote, e.g.
+// line.belts.0.schedule).
+void RefuseEmptyLists(YamlReader& r, const std::vector<EmptyListOver>& empty,
+                      const std::string& whose) {
+  for (const EmptyListOver& e : empty) {
+    const bool top = std::count(e.path.begin(), e.path.end(), '.') == 1;
+    r.Error(e.node, e.path,
+            "an empty list removes nothing: lists merge item by item onto " + whose + " " +
+                std::to_string(e.items) + " items" +
+                (top && whose == "the scene file's"
+                     ? "; to leave them out, write the scene without model"
+                     : ", which stay as they are; write the items wanted instead"));
+  }
 }
 
 }  // namespace
@@ -511,7 +542,9 @@ models::Scene ReadScenarioScene(YamlReader& r, const YAML::Node& scene,
     // No file: the open floor, with what the scenario writes added to it or
     // overriding it.
     std::map<std::string, ScenarioSource> sources;
-    const YAML::Node merged = Merge(OpenFloorTree(), scene, "scene", sources);
+    std::vector<EmptyListOver> empty;
+    const YAML::Node merged = Merge(OpenFloorTree(), scene, "scene", sources, empty);
+    RefuseEmptyLists(r, empty, "the open floor's");
     models::Scene out;
     out.name = fs::path(scenario_file).stem().string();
     out.file = scenario_file;
@@ -542,23 +575,13 @@ models::Scene ReadScenarioScene(YamlReader& r, const YAML::Node& scene,
     if (scene.size() == 1) return alone;  // only `model`
   }
 
-  // Lists merge item by item: an empty one would silently remove nothing.
-  for (const auto& kv : scene) {
-    const YAML::Node own = Child(model, kv.first.Scalar());
-    if (kv.second.IsSequence() && kv.second.size() == 0 && own.IsSequence() && own.size() > 0) {
-      r.Error(kv.second, JoinPath("scene", kv.first.Scalar()),
-              "an empty list removes nothing: lists merge item by item onto the scene file's " +
-                  std::to_string(own.size()) +
-                  " items; to leave them out, write the scene "
-                  "without model");
-    }
-  }
-
   // Then the scenario's keys on top. What goes wrong now is the scenario's
   // doing: each problem is reported at the scenario's key path under
   // `scene`, at the line of the nearest node the scenario writes.
   std::map<std::string, ScenarioSource> sources;
-  const YAML::Node merged = Merge(model, scene, "scene", sources);
+  std::vector<EmptyListOver> empty;
+  const YAML::Node merged = Merge(model, scene, "scene", sources, empty);
+  RefuseEmptyLists(r, empty, "the scene file's");
   YamlReader merged_reader(file);
   models::Scene out = ReadScene(merged_reader, merged, "scene", name, file);
   for (const Issue& issue : merged_reader.issues()) {

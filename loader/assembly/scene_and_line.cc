@@ -22,7 +22,15 @@ models::Scene AddScene(SystemBuilder& b) {
   // the keys; what is wrong is reported here, where the user wrote it.
   const YAML::Node line = b.Section(root, "", "line", {"belts"});
   const YAML::Node belts = Child(line, "belts");
-  if (belts.IsDefined() && !belts.IsNull() && r.ExpectSequence(belts, "line.belts")) {
+  const bool has_belts =
+      belts.IsDefined() && !belts.IsNull() && r.ExpectSequence(belts, "line.belts");
+  // Item by item, an empty list would leave the scene's belts as they are:
+  // refused here, and not merged (the scene would echo it at scene.belts).
+  if (has_belts && belts.size() == 0) {
+    r.Error(belts, "line.belts",
+            "an empty list removes nothing: line.belts overrides the scene's belts item by "
+            "item, which stay as they are; leave line out, or write the belts wanted");
+  } else if (has_belts) {
     const YAML::Node own = Child(scene, "belts");
     YAML::Node merged(YAML::NodeType::Sequence);
     for (std::size_t i = 0; i < std::max(belts.size(), own.IsSequence() ? own.size() : 0); ++i) {

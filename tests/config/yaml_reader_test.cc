@@ -36,5 +36,41 @@ TEST(YamlReader, TimeIsWholeNanosecondsAndRefusesWhatTheyCannotHold) {
   EXPECT_FALSE(Has(r.issues()[3].message, "0 or")) << r.issues()[3].message;
 }
 
+// Guards issue 24: `--set key=` leaves null in the tree, which every typed
+// reader took as absent, so the key silently got its default (ground truth
+// for sensing.surface_velocity) with exit 0. A key given without a value is
+// refused, naming the key and what it takes (the allowed values); the same
+// null written in the file, or an absent key, still means the default.
+TEST(YamlReader, KeyGivenWithoutValueOnTheCommandLineIsRefused) {
+  const YAML::Node map = YAML::Load("{s: ~, r: ~, t: ~, i: ~, b: ~, written: ~}");
+  YamlReader r("f.yaml", {"m.s", "m.r", "m.t", "m.i", "m.b"});
+  r.SetGivenWithoutValue({"m.s", "m.r", "m.t", "m.i", "m.b"});
+  EXPECT_EQ(r.String(map, "m", "s", "ground_truth", {"ground_truth", "px4flow"}), "ground_truth");
+  r.Real(map, "m", "r", 1.0, {0.0, 2.0, true});
+  r.Time(map, "m", "t", 0.5);
+  r.Integer(map, "m", "i", 3, 1, 9);
+  r.Boolean(map, "m", "b", true);
+  EXPECT_EQ(r.String(map, "m", "written", "x"), "x");
+  EXPECT_EQ(r.Real(map, "m", "absent", 2.0), 2.0);
+  ASSERT_EQ(r.issues().size(), 5u);
+  const auto& s = r.issues()[0];
+  EXPECT_EQ(s.key_path, "m.s");
+  EXPECT_TRUE(s.from_command_line);
+  EXPECT_TRUE(Has(s.message, "no value given (--set m.s=): expected one of ground_truth, px4flow; "
+                             "to keep the default, leave the --set out"))
+      << s.message;
+  EXPECT_TRUE(Has(r.issues()[1].message, "expected a number > 0 and <= 2")) << r.issues()[1].message;
+  EXPECT_TRUE(Has(r.issues()[2].message, "expected a time in seconds")) << r.issues()[2].message;
+  EXPECT_TRUE(Has(r.issues()[3].message, "expected an integer from 1 to 9")) << r.issues()[3].message;
+  EXPECT_TRUE(Has(r.issues()[4].message, "expected true or false")) << r.issues()[4].message;
+  // A required key has no default to offer.
+  YamlReader q("f.yaml", {"m.s"});
+  q.SetGivenWithoutValue({"m.s"});
+  q.String(map, "m", "s", std::nullopt);
+  ASSERT_EQ(q.issues().size(), 1u);
+  EXPECT_TRUE(Has(q.issues()[0].message, "no value given (--set m.s=): expected a text"));
+  EXPECT_FALSE(Has(q.issues()[0].message, "default")) << q.issues()[0].message;
+}
+
 }  // namespace
 }  // namespace linesim::config

@@ -537,6 +537,36 @@ metrics:
 }
 
 // Guards `inspect TYPE`: every registered type builds with its defaults.
+// Guards issue 24: `--set sensing.surface_velocity=` (no value) ran with the
+// default (ground truth) and exit 0, since the override wrote null and the
+// reader took it as absent. LoadScenario tells the reader which keys came
+// without a value; it refuses them naming the allowed values, whether the
+// key is a robot scenario's or a system scenario's, and blanks count as
+// nothing; a key no typed reader reads is refused too.
+TEST(LoadScenario, SetWithoutValueIsRefusedNamingWhatTheKeyTakes) {
+  const std::string cross = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
+  std::string e = Issues(cross, {"sensing.surface_velocity="});
+  EXPECT_TRUE(Has(e, "sensing.surface_velocity (set on the command line): no value given (--set "
+                     "sensing.surface_velocity=): expected one of ground_truth, px4flow"))
+      << e;
+  e = Issues(cross, {"sensing.surface_velocity= "});
+  EXPECT_TRUE(Has(e, "sensing.surface_velocity (set on the command line): no value given")) << e;
+  const std::string f = WriteScenario("no_value.yaml", kValidScenario);
+  e = Issues(f, {"master.step_s="});
+  EXPECT_TRUE(Has(e, "master.step_s (set on the command line): no value given (--set "
+                     "master.step_s=): expected a time in seconds > 0 and <= 10"))
+      << e;
+  EXPECT_EQ(Issues(cross, {"sensing.surface_velocity=px4flow"}), "(no error)");
+  // A key no typed reader reads (a section, whose null means all its
+  // defaults) is refused by LoadScenario itself; an explicit null is not
+  // empty.
+  e = Issues(cross, {"control="});
+  EXPECT_TRUE(Has(e, "control (set on the command line): no value given (--set control=): an "
+                     "empty value does not mean the default"))
+      << e;
+  EXPECT_EQ(Issues(cross, {"control=null"}), "(no error)");
+}
+
 TEST(UnitTypes, EveryTypeBuildsWithDefaults) {
   for (const auto& name : UnitTypeNames()) {
     const auto unit = CreateDefaultUnit(name);

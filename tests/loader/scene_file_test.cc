@@ -284,6 +284,43 @@ TEST(ScenarioScene, EmptyListOverTheFilesItemsIsRefused) {
       << e;
 }
 
+// Guards the merge by index below the top level (issue 24): an empty list
+// inside an item (a belt's schedule) merged onto the scene file's items
+// left them unchanged and the run went on with exit 0. It is refused at the
+// key the user wrote: the scenario's scene key, or in a robot scenario the
+// line.belts key it came from; and over the open floor's surfaces too.
+TEST(ScenarioScene, EmptyListAtAnyDepthOverItemsIsRefused) {
+  const std::string f = WriteScenario("empty_nested.yaml", std::string(kValidScenario) +
+                                                               "scene: {model: factory_line}\n");
+  std::string e = Issues(f, {"scene.belts.0.schedule=[]"});
+  EXPECT_TRUE(Has(e,
+                  "scene.belts.0.schedule (set on the command line): an empty list removes "
+                  "nothing: lists merge item by item onto the scene file's 1 items"))
+      << e;
+  const std::string hold = LINESIM_SOURCE_DIR "/scenarios/hold_on_belt.yaml";
+  e = Issues(hold, {"line.belts.0.schedule=[]"});
+  EXPECT_TRUE(Has(e, "line.belts.0.schedule (set on the command line): an empty list removes "
+                     "nothing"))
+      << e;
+  EXPECT_FALSE(Has(e, "scene.belts")) << e;
+  // Written in the file, it is refused at its line.
+  const std::string written = WriteScenario(
+      "empty_nested_written.yaml",
+      std::string(kValidScenario) +
+          "scene:\n  model: factory_line\n  belts:\n    - schedule: []\n");
+  e = Issues(written);
+  EXPECT_TRUE(Has(e, written + ":16: scene.belts.0.schedule: an empty list removes nothing")) << e;
+  // Without model: the open floor's surfaces.
+  const std::string open =
+      WriteScenario("empty_open.yaml", std::string(kValidScenario) + "scene: {surfaces: []}\n");
+  e = Issues(open);
+  EXPECT_TRUE(Has(e, "scene.surfaces: an empty list removes nothing: lists merge item by item "
+                     "onto the open floor's 1 items"))
+      << e;
+  // A list with items still merges.
+  EXPECT_EQ(Issues(f, {"scene.belts.0.schedule=[{time_s: 0, on: false}]"}), "(no error)");
+}
+
 TEST(ScenarioScene, ProblemsAreReportedWhereTheyAreWritten) {
   const std::string f = WriteScenario("bad_merge.yaml", std::string(kValidScenario) + R"(scene:
   model: factory_line

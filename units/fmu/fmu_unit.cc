@@ -208,6 +208,32 @@ std::string Identifier(const std::string& name) {
 
 std::atomic<std::int64_t> next_id{1};
 
+// `relative`, a path inside the FMU built from its model description (the
+// binary from the modelIdentifier), under the unpacked folder `root`,
+// checked after resolving it: `..`, an absolute name or a link on the way
+// could otherwise lead out of the folder (a modelIdentifier
+// "../../../x/outside" loaded a library from beside it). Throws FmuError
+// naming the FMU, the attribute and the path.
+fs::path InsideFolder(const fs::path& root, const std::string& relative,
+                      const std::string& fmu_file, const std::string& attribute) {
+  const auto refuse = [&](const std::string& why) -> FmuError {
+    return FmuError(fmu_file + ": " + attribute + " makes the path '" + relative + "', which " +
+                    why + ": refused (every path built from the model description must stay in "
+                          "the FMU)");
+  };
+  std::error_code ec;
+  const fs::path base = fs::canonical(root, ec);
+  if (ec) throw FmuError(fmu_file + ": cannot resolve the unpacked folder: " + ec.message());
+  // An absolute `relative` would replace `base` altogether in base / relative.
+  if (fs::path(relative).has_root_path()) throw refuse("is absolute");
+  const fs::path resolved = fs::weakly_canonical(base / relative, ec);
+  if (ec) throw refuse("cannot be resolved (" + ec.message() + ")");
+  // Inside means: base's components are a proper prefix of resolved's.
+  const auto [b, r] = std::mismatch(base.begin(), base.end(), resolved.begin(), resolved.end());
+  if (b != base.end() || r == resolved.end()) throw refuse("leads outside the unpacked FMU");
+  return resolved;
+}
+
 }  // namespace
 
 void FmuUnit::Log(int status, const char* category, const char* message) {
@@ -254,8 +280,9 @@ FmuUnit::FmuUnit(std::string name, const std::string& fmu_file)
                    "terminals are not supported");
   }
   const char* platform = description_.fmi_major == 2 ? "linux64" : "x86_64-linux";
-  const fs::path so =
-      root / "binaries" / platform / (description_.model_identifier + ".so");
+  const fs::path so = InsideFolder(
+      root, std::string("binaries/") + platform + "/" + description_.model_identifier + ".so",
+      fmu_file, "modelIdentifier '" + description_.model_identifier + "'");
   if (!fs::is_regular_file(so, ec)) {
     std::string found;
     for (const auto& e : fs::directory_iterator(root / "binaries", ec)) {
@@ -315,12 +342,17 @@ void FmuUnit::DeclareVariables() {
   std::set<std::string> used;
   std::map<std::size_t, std::string> input_names;  // variable index -> table name
   std::vector<std::string> all_inputs;
+  // Per identifier, the suffix to try next: names that all become one
+  // identifier ("a.b", "a_b", ...) would otherwise search from _2 each time,
+  // quadratic in their number. The names are the same as with that search
+  // (the set of used names only grows).
+  std::map<std::string, int> next_suffix;
   const auto unique_name = [&](const std::string& fmi_name) {
     std::string n = Identifier(fmi_name);
     if (used.count(n)) {
-      int k = 2;
+      int& k = next_suffix.try_emplace(n, 2).first->second;
       while (used.count(n + "_" + std::to_string(k))) ++k;
-      n += "_" + std::to_string(k);
+      n += "_" + std::to_string(k++);
     }
     used.insert(n);
     return n;

@@ -2,12 +2,16 @@
 // unit, each against its analytic result.
 #include "units/fmu/fmu_unit.h"
 
+#include <dlfcn.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 
 #include "tests/units/fmu/fmu_test_support.h"
+#include "tests/units/fmu/fmu_test_zip.h"
 
 namespace linesim::fmu {
 namespace {
@@ -331,6 +335,93 @@ TEST(FmuUnit, AnErrorStatusIsNamedWithTheFmuLog) {
       << e;
   EXPECT_NE(e.find("does the FMU refuse this step size?"), std::string::npos) << e;
   EXPECT_NE(e.find("step size 0 refused: must be > 0"), std::string::npos) << e;
+}
+
+// Guards issue 24's path escape: the binary's path is built from the
+// modelIdentifier, and "../../../x/outside" (or an absolute one) made
+// linesim dlopen a library from outside the unpacked FMU. The path is
+// checked after resolving: one that leads out is refused, naming the
+// attribute, and the library there is never loaded; one whose ".." stays
+// inside the folder still loads.
+TEST(FmuUnit, ModelIdentifierCannotLeadOutOfTheFmu) {
+  namespace fs = std::filesystem;
+  test::Scratch s("escape");
+  // The library an attacker placed beside the unpacked FMU's folder (both
+  // are in the temporary directory).
+  const std::string outside = s / "outside.so";
+  fs::copy_file(LINESIM_DAHLQUIST_SO, outside);
+  std::string xml = test::ReadFile(LINESIM_SOURCE_DIR "/tests/units/fmu/fmus/dahlquist.xml");
+  const std::string from = "modelIdentifier=\"dahlquist\"";
+  const std::string so = test::ReadFile(LINESIM_DAHLQUIST_SO);
+  const auto with_identifier = [&](const std::string& identifier) {
+    std::string text = xml;
+    text.replace(text.find(from), from.size(), "modelIdentifier=\"" + identifier + "\"");
+    test::MakeZip(s / "escape.fmu",
+                  {{"modelDescription.xml", text}, {"binaries/linux64/dahlquist.so", so}});
+    return s / "escape.fmu";
+  };
+  const std::string identifier = "../../../" + s.path().filename().string() + "/outside";
+  try {
+    FmuUnit u("escape", with_identifier(identifier));
+    ADD_FAILURE() << "loaded with modelIdentifier " << identifier;
+  } catch (const FmuError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("modelIdentifier '" + identifier + "' makes the path 'binaries/linux64/" +
+                        identifier + ".so', which leads outside the unpacked FMU: refused "
+                        "(every path built from the model description must stay in the FMU)"),
+              std::string::npos)
+        << what;
+  }
+  // An absolute identifier replaced the whole path (root / "/tmp/x.so" is
+  // "/tmp/x.so"); now it is a name inside binaries/linux64/, which is not
+  // there.
+  const std::string absolute = (s.path() / "outside").string();
+  try {
+    FmuUnit u("escape", with_identifier(absolute));
+    ADD_FAILURE() << "loaded with modelIdentifier " << absolute;
+  } catch (const FmuError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("binaries/linux64/" + absolute + ".so is missing"), std::string::npos)
+        << what;
+  }
+  EXPECT_EQ(::dlopen(outside.c_str(), RTLD_NOW | RTLD_NOLOAD), nullptr);
+  // Resolved inside the folder: the FMU's own binary.
+  FmuUnit inside("inside", with_identifier("sub/../dahlquist"));
+  EXPECT_TRUE(inside.variables().Find("x"));
+}
+
+// Guards issue 24's quadratic loading in the naming step: FMI names that
+// become one identifier ("a.,-+()", "a[]..." -> "a______") searched their
+// suffix from _2 each time (20k of them: 2*10^8 set lookups). The suffix to
+// try next is kept per identifier: the same names (_2, _3, ... in order),
+// in linear time; the bound is far above it and far below the quadratic.
+TEST(FmuUnit, NamesThatCollideAreMadeUniqueInLinearTime) {
+  test::Scratch s("collide");
+  constexpr std::size_t n = 20'000;
+  const char kPunct[] = ".,-+()[]";
+  std::string vars;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::string name = "a";
+    for (std::size_t k = i, d = 0; d < 6; ++d, k /= 8) name += kPunct[k % 8];
+    vars += "<ScalarVariable name=\"" + name + "\" valueReference=\"" + std::to_string(i) +
+            "\" causality=\"local\"><Real/></ScalarVariable>\n";
+  }
+  const std::string xml =
+      "<?xml version=\"1.0\"?>\n<fmiModelDescription fmiVersion=\"2.0\" modelName=\"m\" "
+      "guid=\"g\">\n<CoSimulation modelIdentifier=\"dahlquist\"/>\n<ModelVariables>\n" +
+      vars + "</ModelVariables>\n</fmiModelDescription>\n";
+  test::MakeZip(s / "c.fmu", {{"modelDescription.xml", xml},
+                              {"binaries/linux64/dahlquist.so",
+                               test::ReadFile(LINESIM_DAHLQUIST_SO)}});
+  const auto start = std::chrono::steady_clock::now();
+  FmuUnit u("c", s / "c.fmu");
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 10.0);
+  EXPECT_TRUE(u.variables().Find("a______"));
+  EXPECT_TRUE(u.variables().Find("a_______2"));
+  EXPECT_TRUE(u.variables().Find("a_______" + std::to_string(n)));
+  EXPECT_FALSE(u.variables().Find("a_______" + std::to_string(n + 1)));
 }
 
 // The unit made without an FMU (`linesim inspect fmu`) says what is missing.
