@@ -4,7 +4,6 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <string>
 
 namespace linesim::fmu {
@@ -65,17 +64,13 @@ std::string Fmi3WithVariables(std::size_t n) {
 // Guards issue 24's quadratic reading (5k variables 0.45 s, 40k 30 s,
 // 200k more than 120 s: the line of each variable counted the newlines
 // from the start, and each ModelStructure output searched the variables).
-// 200k variables with 50k outputs now read in well under a second here; the
-// bound leaves room for a loaded machine and sanitizers, and is far below
-// the quadratic time. The lines and dependencies stay right.
+// 200k variables with 50k outputs now read in well under a second here (no
+// timing assertion: the quadratic reader needed minutes, which ctest's
+// 300 s timeout stops). The lines and dependencies stay right.
 TEST(ModelDescription, ReadingIsLinearInTheVariables) {
   constexpr std::size_t n = 200'000;
   const std::string text = Fmi3WithVariables(n);
-  const auto start = std::chrono::steady_clock::now();
   const ModelDescription md = ParseModelDescriptionText(text, "md.xml");
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_LT(seconds, 20.0);
   ASSERT_EQ(md.variables.size(), n);
   EXPECT_EQ(md.variables[0].line, 5);
   EXPECT_EQ(md.variables[n - 1].line, static_cast<int>(n) + 4);
