@@ -261,6 +261,14 @@ ExportResult ExportFmu(const ExportOptions& o) {
   if (out.has_parent_path() && !fs::is_directory(out.parent_path())) {
     throw ExportError("cannot write " + o.out + ": no folder " + out.parent_path().string());
   }
+  // Refused before anything is written: an FMU replaces a file, never a folder.
+  {
+    std::error_code status_ec;
+    const fs::file_status st = fs::symlink_status(out, status_ec);
+    if (fs::exists(st) && !fs::is_regular_file(st)) {
+      throw ExportError("cannot write " + o.out + ": it exists and is not a file (a folder?)");
+    }
+  }
   const std::string partial = out.string() + ".partial";
   std::error_code ec;
   fs::remove(partial, ec);
@@ -289,7 +297,11 @@ ExportResult ExportFmu(const ExportOptions& o) {
     throw ExportError("cannot write " + o.out + ": " + why);
   }
   fs::rename(partial, out, ec);
-  if (ec) throw ExportError("cannot write " + o.out + ": " + ec.message());
+  if (ec) {
+    std::error_code ignored;
+    fs::remove(partial, ignored);  // nothing half-written stays behind
+    throw ExportError("cannot write " + o.out + ": " + ec.message());
+  }
   return result;
 }
 

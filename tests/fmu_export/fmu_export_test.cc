@@ -431,6 +431,13 @@ TEST(FmuExport, RefusesWithNamedErrors) {
   EXPECT_NE(message({"dc_motor", {}, s / "a.fmu", "/nonexistent/runtime.so", "", 0}).find("missing"),
             std::string::npos);
   EXPECT_FALSE(fs::exists(s / "a.fmu"));
+  // Onto an existing folder: refused before anything is written (it left
+  // X.fmu.partial, 1.5 MB, beside it).
+  fs::create_directories(s / "folder.fmu");
+  EXPECT_NE(message({"dc_motor", {}, s / "folder.fmu", "", "", 0}).find("not a file"),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(s / "folder.fmu.partial"));
+  EXPECT_TRUE(fs::is_empty(s / "folder.fmu"));
 }
 
 // The command line: `linesim export-fmu`, then `linesim inspect` of the FMU.
