@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "plots/gnuplot.h"
+
 namespace linesim::sweep {
 class MpiSession;
 }
@@ -19,13 +21,37 @@ inline constexpr int kExitBadInput = 2;   // wrong file, key, value or option
 /// 1 GiB (a run of 10 minutes recording 100 columns at 1 kHz needs 1.3 GB).
 inline constexpr double kDefaultMaxOutputMb = 1024.0;
 
-/// `linesim run FILE --out DIR [--set path=value ...] [--max-output-mb N]`.
-/// A run whose recording would exceed `max_output_mb` (estimated from its
-/// rows, columns and the longest text a number takes) is refused before it
-/// starts (exit 2, nothing written).
+/// What a robot run's plots read, for a caller that draws more from its
+/// signals.csv (the comparison of runs).
+struct RunColumns {
+  std::string error_column;                 // deviation or drift ("" for none)
+  std::vector<std::string> belt_on_columns;  // each belt's scheduled on state
+  std::string task;                          // path, hold, route
+};
+
+/// `linesim run FILE --out DIR [--set path=value ...] [--max-output-mb N]
+/// [--format png|svg|pdf]`. A run whose recording would exceed
+/// `max_output_mb` (estimated from its rows, columns and the longest text a
+/// number takes) is refused before it starts (exit 2, nothing written). A
+/// file with a top-level `compare` key is a comparison of runs
+/// (CompareCommand). `columns`, when given, receives what the plots read.
 int RunCommand(const std::string& file, const std::string& out_dir,
                const std::vector<std::string>& set_args,
-               double max_output_mb = kDefaultMaxOutputMb);
+               double max_output_mb = kDefaultMaxOutputMb,
+               plots::PlotFormat format = plots::PlotFormat::kPng,
+               RunColumns* columns = nullptr);
+
+/// `linesim run COMPARE.yaml --out DIR`: every run the file lists, its base
+/// scenario with the run's settings (and `set_args`), into DIR/FOLDER as
+/// `linesim run` writes it, then their deviations or drifts over time in one
+/// figure, DIR/comparison.png (app/compare_command.cc). Exit 0 when every
+/// run is ok, 1 when one failed, 2 on bad input with nothing run.
+/// Whether `file` is a comparison (a YAML map with a top-level `compare`).
+bool IsComparisonFile(const std::string& file);
+
+int CompareCommand(const std::string& file, const std::string& out_dir,
+                   const std::vector<std::string>& set_args, double max_output_mb,
+                   plots::PlotFormat format);
 
 /// `linesim inspect TYPE|FILE [--set path=value ...]`.
 int InspectCommand(const std::string& what, const std::vector<std::string>& set_args);
@@ -49,6 +75,7 @@ struct SweepArgs {
   std::int64_t repeats = 0;
   std::vector<std::string> sets;
   double max_output_mb = kDefaultMaxOutputMb;  // for the repeats' run_0
+  plots::PlotFormat format = plots::PlotFormat::kPng;  // run_0's pictures
 };
 
 /// `linesim sweep FILE --out DIR [--jobs N] [--resume|--force]`; under

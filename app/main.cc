@@ -43,6 +43,10 @@ int main(int argc, char** argv) {
   run->add_option("--out,-o", out_dir, "output folder (created if missing)")->required();
   run->add_option("--set", run_sets, "override a value: dotted.path=value (repeatable)")
       ->take_all();
+  std::string run_format = "png";
+  run->add_option("--format", run_format,
+                  "the plots' file format: png (default), or svg or pdf (vector, for papers)")
+      ->check(CLI::IsMember({"png", "svg", "pdf"}));
   std::int64_t runs = 1;
   double max_output_mb = linesim::app::kDefaultMaxOutputMb;
   run->add_option("--max-output-mb", max_output_mb,
@@ -131,9 +135,13 @@ int main(int argc, char** argv) {
       repeats.repeats = runs;
       repeats.sets = run_sets;
       repeats.max_output_mb = max_output_mb;
+      repeats.format = *linesim::plots::ParsePlotFormat(run_format);
       return SweepCommand(repeats, mpi.get());
     }
-    if (run->parsed()) return RunCommand(run_file, out_dir, run_sets, max_output_mb);
+    if (run->parsed()) {
+      return RunCommand(run_file, out_dir, run_sets, max_output_mb,
+                        *linesim::plots::ParsePlotFormat(run_format));
+    }
     if (sweep->parsed()) {
       if (linesim::sweep::LaunchedByMpi()) {
         mpi = std::make_unique<linesim::sweep::MpiSession>(&argc, &argv);

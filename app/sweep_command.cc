@@ -237,7 +237,8 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
     std::cout << "\nthe first run again, with its signals and plots, into "
               << (dir / "run_0").string() << ":\n"
               << std::flush;
-    one_run = RunCommand(args.file, (dir / "run_0").string(), sets, args.max_output_mb);
+    one_run = RunCommand(args.file, (dir / "run_0").string(), sets, args.max_output_mb,
+                         args.format);
   }
   if (one_run == kExitInterrupted) return kExitInterrupted;
   return results->failed_count() == 0 && one_run == kExitOk ? kExitOk : kExitRunFailed;

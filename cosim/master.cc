@@ -40,11 +40,52 @@ class ScopedTimer {
 // that is not a multiple of it (no aliasing).
 constexpr std::int64_t kProfileEvery = 31;
 
+std::int64_t NowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
+      .count();
+}
+
 bool SameBits(double a, double b) {
   return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
 }
 
 }  // namespace
+
+// Times one DoStep or UpdateOutputs of unit u on a timed base step: the same
+// two clock reads give the unit's sampled time, its scaled estimate and the
+// busy union, so that on one thread the units' times add up to the union.
+class UnitCallTimer {
+ public:
+  UnitCallTimer(Master& m, std::size_t u) : m_(m.profile_step_ ? &m : nullptr), u_(u) {
+    if (m_) started_ns_ = m_->UnitCallStarts();
+  }
+  ~UnitCallTimer() {
+    if (m_) m_->UnitCallEnds(u_, started_ns_);
+  }
+  UnitCallTimer(const UnitCallTimer&) = delete;
+  UnitCallTimer& operator=(const UnitCallTimer&) = delete;
+
+ private:
+  Master* m_;
+  std::size_t u_;
+  std::int64_t started_ns_ = 0;
+};
+
+std::int64_t Master::UnitCallStarts() {
+  const std::lock_guard<std::mutex> lock(busy_mutex_);
+  const std::int64_t now = NowNs();
+  if (units_running_++ == 0) busy_since_ns_ = now;
+  return now;
+}
+
+void Master::UnitCallEnds(std::size_t u, std::int64_t started_ns) {
+  const std::lock_guard<std::mutex> lock(busy_mutex_);
+  const std::int64_t now = NowNs();
+  const double own_s = 1e-9 * static_cast<double>(now - started_ns);
+  sampled_unit_seconds_[u] += own_s;
+  unit_wall_seconds_[u] += static_cast<double>(kProfileEvery) * own_s;
+  if (--units_running_ == 0) sampled_busy_seconds_ += 1e-9 * static_cast<double>(now - busy_since_ns_);
+}
 
 std::string RunResult::ErrorText() const {
   std::string text;
@@ -242,7 +283,7 @@ StepResult Master::StepUnit(std::size_t u) {
   const TimeNs dt = decimation_[u] == 1 ? plan_dt_ : options_.base_step * decimation_[u];
   Pending& p = pending_[u];
   try {
-    const ScopedTimer timer(profile_step_, unit_wall_seconds_[u], kProfileEvery);
+    const UnitCallTimer timer(*this, u);
     p.result = unit.DoStep(plan_t_, dt);
     if (p.result == StepResult::kDiscard) {
       p.cause = "discarded the step (" + unit.last_error() + ")";
@@ -264,7 +305,7 @@ StepResult Master::StepUnit(std::size_t u) {
 
 bool Master::UpdateOutputs(std::size_t u) {
   try {
-    const ScopedTimer timer(profile_step_, unit_wall_seconds_[u], kProfileEvery);
+    const UnitCallTimer timer(*this, u);
     system_.unit(u).UpdateOutputs();
   } catch (const UnitError& e) {
     RecordError(u, plan_t_, RunPhase::kUpdateOutputs, "updating outputs from new inputs failed",
@@ -319,6 +360,10 @@ void Master::Notify(TimeNs t) {
 void Master::Start() {
   const std::size_t n = system_.unit_count();
   unit_wall_seconds_.assign(n, 0.0);
+  sampled_unit_seconds_.assign(n, 0.0);
+  sampled_step_seconds_ = 0;
+  sampled_busy_seconds_ = 0;
+  units_running_ = 0;
   total_wall_seconds_ = 0;
   const ScopedTimer timer(options_.profile, total_wall_seconds_);
   errors_.clear();
@@ -389,6 +434,8 @@ bool Master::Step() {
   if (!started_ || failed_ || time_ >= options_.stop) return false;
   const ScopedTimer timer(options_.profile, total_wall_seconds_);
   profile_step_ = options_.profile && step_index_ % kProfileEvery == 0;
+  // The whole timed step, observers included: the units' calls lie inside.
+  const ScopedTimer step_timer(profile_step_, sampled_step_seconds_);
   const TimeNs t = time_;
   if (options_.retry.enabled) {
     if (!StepWithRetry(t)) return false;

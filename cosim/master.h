@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -117,6 +118,16 @@ class Master : private StepContext {
   /// Wall time of Start, every Step and Finish together (units included);
   /// zero without `profile`.
   double total_wall_seconds() const { return total_wall_seconds_; }
+  /// The timed base steps (one in 31), measured whole and unscaled: their
+  /// wall time (transfers, checks and observers included), the time at least
+  /// one unit was running in them (the union of the units' intervals: with
+  /// threads, overlapping units count once), and each unit's own time in
+  /// them. Busy <= step by construction (every unit interval lies inside its
+  /// step), so 1 - busy / step is the master's and observers' share in
+  /// [0, 1]; without threads the units' own times add up to busy exactly.
+  double sampled_step_seconds() const { return sampled_step_seconds_; }
+  double sampled_busy_seconds() const { return sampled_busy_seconds_; }
+  const std::vector<double>& sampled_unit_seconds() const { return sampled_unit_seconds_; }
   /// With master.retry: the step the master takes next (a divisor of the
   /// base step; the base step when nothing was discarded lately).
   TimeNs current_step() const { return current_step_; }
@@ -147,6 +158,10 @@ class Master : private StepContext {
   /// Initialize with profiling; a failure is recorded and returns false.
   bool InitializeUnit(std::size_t u);
   void Notify(TimeNs t);
+  /// A unit's DoStep or UpdateOutputs on a timed step starts / ends.
+  std::int64_t UnitCallStarts();
+  void UnitCallEnds(std::size_t u, std::int64_t started_ns);
+  friend class UnitCallTimer;
 
   System& system_;
   MasterOptions options_;
@@ -159,6 +174,14 @@ class Master : private StepContext {
   std::vector<std::size_t> due_at_point_;             // due at the base point
   std::vector<std::size_t> every_step_;               // decimation 1, dependency order
   std::vector<double> unit_wall_seconds_;
+  std::vector<double> sampled_unit_seconds_;
+  double sampled_step_seconds_ = 0;
+  double sampled_busy_seconds_ = 0;
+  // The timed steps' busy union: units running now (threads may overlap)
+  // and since when; guarded by busy_mutex_ (taken on timed steps only).
+  std::mutex busy_mutex_;
+  int units_running_ = 0;
+  std::int64_t busy_since_ns_ = 0;
   std::vector<RunError> errors_;
   // The communication step being taken (StepContext's view).
   const std::vector<std::size_t>* plan_due_ = &due_at_point_;

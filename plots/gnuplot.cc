@@ -44,6 +44,48 @@ std::string GnuplotPngTerminal(int width_px, int height_px) {
          "}\n";
 }
 
+std::string_view PlotExtension(PlotFormat format) {
+  switch (format) {
+    case PlotFormat::kSvg:
+      return "svg";
+    case PlotFormat::kPdf:
+      return "pdf";
+    case PlotFormat::kPng:
+      break;
+  }
+  return "png";
+}
+
+std::optional<PlotFormat> ParsePlotFormat(std::string_view text) {
+  for (PlotFormat f : {PlotFormat::kPng, PlotFormat::kSvg, PlotFormat::kPdf}) {
+    if (text == PlotExtension(f)) return f;
+  }
+  return std::nullopt;
+}
+
+std::string PlotFile(const std::string& name, PlotFormat format) {
+  return name + "." + std::string(PlotExtension(format));
+}
+
+std::string GnuplotTerminal(PlotFormat format, int width_px, int height_px) {
+  switch (format) {
+    case PlotFormat::kSvg:
+      return "set terminal svg size " + std::to_string(width_px) + "," +
+             std::to_string(height_px) + " noenhanced font ',10' background rgb 'white'\n";
+    case PlotFormat::kPdf: {
+      // pdfcairo takes inches: 100 pixels to the inch keeps the PNG's layout.
+      const auto inches = [](int px) { return std::to_string(px / 100) + "." +
+                                              std::to_string((px % 100) / 10) +
+                                              std::to_string(px % 10); };
+      return "set terminal pdfcairo size " + inches(width_px) + "in," + inches(height_px) +
+             "in noenhanced font ',10'\n";
+    }
+    case PlotFormat::kPng:
+      break;
+  }
+  return GnuplotPngTerminal(width_px, height_px);
+}
+
 GnuplotResult RunGnuplot(const std::string& dir, const std::string& script_name) {
   int err_pipe[2];
   if (pipe(err_pipe) != 0) {

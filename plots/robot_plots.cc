@@ -138,6 +138,15 @@ void AppendPolygon(std::string& block, const std::array<Point, 4>& corners) {
   block += "\n";
 }
 
+// Names `name` (without extension) as the next picture in the spec's
+// format: its `set output` line, and the file among the outputs.
+std::string SetOutput(const std::string& name, PlotFormat format,
+                      std::vector<std::string>* outputs) {
+  const std::string file = PlotFile(name, format);
+  outputs->push_back(file);
+  return "set output " + GnuplotQuote(file) + "\n";
+}
+
 void AppendBlock(std::string& script, const std::string& name, const std::string& data) {
   script += "$" + name + " << EOD\n" + data + "EOD\n";
 }
@@ -198,7 +207,7 @@ void ReadRow(Signals& signals, const std::vector<std::streamoff>& row_starts, st
   SplitCsv(line, fields);
 }
 
-// scan.png: see RobotPlotSpec::Scan.
+// scan.png (or .svg, .pdf): see RobotPlotSpec::Scan.
 std::string ScanPlot(const RobotPlotSpec& spec, Signals& signals,
                      const std::vector<std::streamoff>& row_starts, int ix, int iy, int iyaw,
                      const std::vector<int>& travels, const std::string& title_prefix,
@@ -280,8 +289,7 @@ std::string ScanPlot(const RobotPlotSpec& spec, Signals& signals,
   if (!obstacles.polygons.empty()) AppendBlock(s, "scan_obstacles", obstacles.polygons);
   if (!obstacles.circles.empty()) AppendBlock(s, "scan_obstacles_circles", obstacles.circles);
   if (!carried.polygons.empty()) AppendBlock(s, "scan_carried", carried.polygons);
-  outputs->push_back("scan.png");
-  s += "set output 'scan.png'\nset title " +
+  s += SetOutput("scan", spec.format, outputs) + "set title " +
        GnuplotQuote(title_prefix + scan.sensor + ", the scan started at t = " + Num(start_s) +
                     " s (" + std::to_string(range.size()) + " beams, every 4th ray drawn)") +
        "\nset xlabel 'x (m)'\nset ylabel 'y (m)'\nset size ratio -1\nset key outside bottom "
@@ -350,10 +358,9 @@ std::string SideView(const RobotPlotSpec& spec, Signals& signals,
     data += Num(travelled_m) + "," + Num(*z) + "," + Num(GroundAt(spec.scene, *x, *y)) + "\n";
   }
   if (data.empty()) return {};
-  outputs->push_back("side_view.png");
   std::string s;
   AppendBlock(s, "side", data);
-  return s + "set output 'side_view.png'\nset title " +
+  return s + SetOutput("side_view", spec.format, outputs) + "set title " +
          GnuplotQuote(title_prefix + "side view: height along the track") +
          "\nset xlabel 'distance travelled in the plane (m)'\nset ylabel 'height (m)'\n"
          "unset y2label\nunset y2tics\nset ytics mirror\n"
@@ -403,7 +410,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   std::string s =
       "# Written by linesim (plots/robot_plots.cc). Run `gnuplot plots.gp` in this folder\n"
       "# to redraw; data come from signals.csv (columns by number, header skipped).\n" +
-      GnuplotPngTerminal(kCanvasWidthPx, kCanvasHeightPx) +
+      GnuplotTerminal(spec.format, kCanvasWidthPx, kCanvasHeightPx) +
       "set datafile separator comma\n"
       "set grid\n";
 
@@ -574,8 +581,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
 
   // Top view of the robot's neighbourhood (path, track, outlines), not of
   // the whole line: belts are clipped to it.
-  outputs->push_back("top_view.png");
-  s += "\nset output 'top_view.png'\n"
+  s += "\n" + SetOutput("top_view", spec.format, outputs) +
        "set title " +
        GnuplotQuote(title_prefix + "top view (map frame)") +
        "\n"
@@ -660,64 +666,107 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
        "set size noratio\nset autoscale\nset key default\n"
        "set lmargin -1\nset rmargin -1\nset bmargin -1\nset tmargin -1\n";
 
+  // The time plots: legends below the data (never over a curve), time from
+  // the first row to the last.
+  const std::string time_plot =
+      "set xlabel 'time (s)'\nunset y2label\nunset y2tics\nset ytics mirror\n"
+      "set autoscale\nset offsets 0, 0, 0, 0\nset key below horizontal\n";
+  // Where any belt is scheduled on, as a column expression (1 on, 0 off).
+  std::string any_on;
+  for (std::size_t i = 0; i < ons.size(); ++i) {
+    any_on += (i ? " || " : "") + std::string("column(") + std::to_string(ons[i]) + ") > 0.5";
+  }
+  // The line's on state as grey bands behind the data (paper 1 Figs. 5-7
+  // mark the line's state): filled from 0 to 1 on the second y axis.
+  const auto on_shading = [&]() -> std::string {
+    if (any_on.empty()) return {};
+    return signals_file + " skip 1 using 1:((" + any_on +
+           ") ? 1 : 0) axes x1y2 with filledcurves y=0 fillcolor rgb '#e4e4e4' "
+           "fillstyle solid 1.0 noborder title 'line on'";
+  };
+  // The grid in front: the bands would hide it.
+  const std::string shading_axes =
+      any_on.empty() ? "" : "set y2range [0:1]\nunset y2tics\nset grid front\n";
+
   if (ierr > 0) {
-    outputs->push_back("error.png");
-    s += "\nset output 'error.png'\nset title " + GnuplotQuote(title_prefix + spec.error_label) +
-         "\nset xlabel 'time (s)'\nset ylabel " + GnuplotQuote(spec.error_label) + "\nplot " +
-         signals_file + " skip 1 using 1:" + std::to_string(ierr) + " with lines lw 1.5 title " +
-         GnuplotQuote(spec.error_column) + "\n";
+    s += "\n" + SetOutput("error", spec.format, outputs) + "set title " +
+         GnuplotQuote(title_prefix + spec.error_label) + "\n" + time_plot + shading_axes +
+         "set ylabel " + GnuplotQuote(spec.error_label) + "\nset yrange [0:*]\n";
+    items.clear();
+    if (const std::string shading = on_shading(); !shading.empty()) items.push_back(shading);
+    items.push_back(signals_file + " skip 1 using 1:" + std::to_string(ierr) +
+                    " with lines lw 2 lc rgb '#1f77b4' title " +
+                    GnuplotQuote(spec.error_name.empty() ? spec.error_label : spec.error_name));
+    if (spec.error_bound_m > 0.0) {
+      // The bound as a line across the whole time axis; the y range takes
+      // it in, so a run far below it still shows where it is.
+      s += "set yrange [0:*] noextend\nset offsets 0, 0, graph 0.05, 0\n";
+      items.push_back(Num(spec.error_bound_m) + " with lines dt 2 lw 2 lc rgb '#d62728' title " +
+                      GnuplotQuote(spec.error_bound_label.empty()
+                                       ? "bound " + Num(spec.error_bound_m) + " m"
+                                       : spec.error_bound_label));
+    }
+    s += "plot ";
+    for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
+    s += "\nset yrange [*:*]\nset y2range [*:*]\nset grid back\n";
   }
 
   if (!speeds.empty() || !ons.empty()) {
-    outputs->push_back("belt.png");
-    s += "\nset output 'belt.png'\nset title " + GnuplotQuote(title_prefix + "belts") +
-         "\nset xlabel 'time (s)'\nset ylabel 'belt speed (m/s)'\n"
+    s += "\n" + SetOutput("belt", spec.format, outputs) + "set title " +
+         GnuplotQuote(title_prefix + "belts") + "\n" + time_plot +
+         "set ylabel 'belt speed (m/s)'\n"
          "set y2label 'scheduled on (1) / off (0)'\n"
          "set yrange [0:*]\nset offsets 0, 0, graph 0.08, 0\n"
          "set y2range [-0.05:1.05]\nset y2tics 0, 1, 1\nset ytics nomirror\nplot ";
     items.clear();
     for (std::size_t i = 0; i < speeds.size(); ++i) {
       items.push_back(signals_file + " skip 1 using 1:" + std::to_string(speeds[i]) +
-                      " with lines lw 2 title " + GnuplotQuote(spec.belt_speed_columns[i]));
+                      " with lines lw 2 title " +
+                      GnuplotQuote("speed of belt " + std::to_string(i)));
     }
     for (std::size_t i = 0; i < ons.size(); ++i) {
       items.push_back(signals_file + " skip 1 using 1:" + std::to_string(ons[i]) +
                       " axes x1y2 with steps dt 2 lw 1.5 title " +
-                      GnuplotQuote(spec.belt_on_columns[i]));
+                      GnuplotQuote("belt " + std::to_string(i) + " scheduled on"));
     }
     for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
-    s += "\n";
+    s += "\nset yrange [*:*]\nset y2range [*:*]\n";
   }
   if (!flows.empty() && iref > 0) {
-    outputs->push_back("optic_flow.png");
-    s += "\nset output 'optic_flow.png'\nset title " +
-         GnuplotQuote(title_prefix + (filtered.empty()
-                                          ? "raw optic flow against the belt's ground truth"
-                                          : "raw and filtered optic flow against the belt's "
-                                            "ground truth")) +
-         "\nset xlabel 'time (s)'\nset ylabel 'surface speed along the belt (m/s)'\n"
-         "unset y2label\nunset y2tics\nset ytics mirror\nset autoscale y\n"
-         "set offsets 0, 0, graph 0.05, graph 0.05\nplot ";
+    // The PX4Flow read the robot's motion relative to the surface under
+    // them; a surface speed is that reading plus the robot's own motion at
+    // the sensor (paper 1 Eq. 2), here the true motion, so that the curves
+    // show the sensor's error alone.
+    s += "\n" + SetOutput("optic_flow", spec.format, outputs) + "set title " +
+         GnuplotQuote(title_prefix +
+                      (filtered.empty() ? "optic flow" : "raw and filtered optic flow") +
+                      " (each PX4Flow's reading of the robot's motion over the surface + the "
+                      "robot's true motion, Eq. 2) against the belt's ground truth") +
+         "\n" + time_plot + shading_axes + "set ylabel 'surface speed along the belt (m/s)'\n"
+         "set offsets 0, 0, graph 0.05, graph 0.05\nset key below horizontal maxcols 3\nplot ";
     items.clear();
-    static const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd"};
+    if (const std::string shading = on_shading(); !shading.empty()) items.push_back(shading);
+    // Raw thin and pale (visibly noisy), filtered bold in the same hue,
+    // ground truth black on top.
+    static const char* kColours[] = {"#9ecae1", "#fdbf6f", "#a1d99b", "#cbc9e2"};
     for (std::size_t i = 0; i < flows.size(); ++i) {
       const std::string label = i < spec.flow_labels.size() ? spec.flow_labels[i] : "sensor";
       items.push_back(signals_file + " skip 1 using 1:" + std::to_string(flows[i]) +
                       " with lines lw 1 lc rgb '" + kColours[i % 4] + "' title " +
-                      GnuplotQuote("raw optic flow, " + label));
+                      GnuplotQuote("raw, " + label));
     }
     // Paper 1 Fig. 4: the steady-state Kalman filter's output beside the raw.
-    static const char* kDark[] = {"#0b3c5d", "#a64d00", "#14601c", "#4b2a75"};
+    static const char* kDark[] = {"#08519c", "#d95f02", "#238b45", "#6a51a3"};
     for (std::size_t i = 0; i < filtered.size(); ++i) {
       const std::string label = i < spec.flow_labels.size() ? spec.flow_labels[i] : "sensor";
       items.push_back(signals_file + " skip 1 using 1:" + std::to_string(filtered[i]) +
-                      " with lines lw 2 dt 2 lc rgb '" + kDark[i % 4] + "' title " +
+                      " with lines lw 2 lc rgb '" + kDark[i % 4] + "' title " +
                       GnuplotQuote("filtered, " + label));
     }
     items.push_back(signals_file + " skip 1 using 1:" + std::to_string(iref) +
                     " with lines lw 2.5 lc rgb 'black' title 'ground truth (encoder wheel)'");
     for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
-    s += "\n";
+    s += "\nset y2range [*:*]\nset grid back\n";
   }
   if (!spec.scan.range_columns.empty()) {
     s += ScanPlot(spec, signals, row_starts, ix, iy, iyaw, travels, title_prefix, outputs);
@@ -730,9 +779,16 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
 }  // namespace
 
 const std::vector<std::string>& RobotPlotFiles() {
-  static const std::vector<std::string> files = {
-      kScript, "top_view.png", "error.png", "belt.png", "optic_flow.png", "scan.png",
-      "side_view.png"};
+  static const std::vector<std::string> files = [] {
+    std::vector<std::string> names = {kScript};
+    for (PlotFormat f : {PlotFormat::kPng, PlotFormat::kSvg, PlotFormat::kPdf}) {
+      for (const char* name :
+           {"top_view", "error", "belt", "optic_flow", "scan", "side_view"}) {
+        names.push_back(PlotFile(name, f));
+      }
+    }
+    return names;
+  }();
   return files;
 }
 

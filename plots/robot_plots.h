@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "models/scene.h"
+#include "plots/gnuplot.h"
 
 namespace linesim::plots {
 
@@ -44,6 +45,14 @@ struct RobotPlotSpec {
   /// (error.png); none when empty. The label names it on the y axis.
   std::string error_column;
   std::string error_label = "error (m)";
+  /// The curve's name in the legend ("deviation from the path"); the
+  /// label when empty.
+  std::string error_name;
+  /// A bound drawn across error.png (m), with its legend entry; none when 0.
+  /// The time plots shade the spans where any belt is scheduled on (from
+  /// belt_on_columns) as "line on".
+  double error_bound_m = 0.0;
+  std::string error_bound_label;
   /// Belt speed (m/s) and on state (0/1) columns for belt.png; none when
   /// both are empty.
   std::vector<std::string> belt_speed_columns, belt_on_columns;
@@ -76,19 +85,22 @@ struct RobotPlotSpec {
   /// (Rob@Work 3: 1.03 x 0.57 m, paper 1 Table I).
   double body_length_m = 1.03;
   double body_width_m = 0.57;
+  /// The pictures' format (and file extension): PNG, SVG or PDF.
+  PlotFormat format = PlotFormat::kPng;
 };
 
 /// Writes top_view.png, and error.png, belt.png, optic_flow.png, scan.png and side_view.png when the spec asks for
 /// them, into `dir`, from `dir`/signals.csv. The gnuplot script is left in
 /// `dir`/plots.gp with paths relative to `dir`, so `gnuplot plots.gp` run in
-/// `dir` redraws the plots. Returns the paths of the PNG files written.
+/// `dir` redraws the plots. Returns the paths of the pictures written (spec.format).
 /// Throws std::runtime_error when signals.csv cannot be read, a column is
 /// unknown (naming every unknown column and the closest known ones), or
 /// gnuplot is missing or fails (with gnuplot's error text).
 std::vector<std::string> WriteRobotPlots(const std::string& dir, const RobotPlotSpec& spec);
 
-/// Every file WriteRobotPlots may write (the script and each picture), so
-/// that a new run can clear a previous run's before it starts.
+/// Every file WriteRobotPlots may write (the script and each picture in
+/// every format), so that a new run can clear a previous run's before it
+/// starts.
 const std::vector<std::string>& RobotPlotFiles();
 
 }  // namespace linesim::plots

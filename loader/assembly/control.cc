@@ -78,7 +78,11 @@ void AddSwerve(SystemBuilder& b, const RobotFile& file, bool compensation, Signa
   ConnectJoints(b, "steer_angle", s.wheel_steer_joint);
   ConnectJoints(b, "steer_rate", s.wheel_steer_joint);
   ConnectJoints(b, "drive_rate", s.wheel_drive_joint);
-  b.Connect(s.surface_velocity, Signal(kWheelController, "surface_velocity"));
+  // sensing.surface_velocity: none gives the controllers no surface
+  // velocity: the input stays 0 (the nominal system).
+  if (!s.surface_velocity.empty()) {
+    b.Connect(s.surface_velocity, Signal(kWheelController, "surface_velocity"));
+  }
   for (const char* v : {"steer_voltage", "drive_voltage"}) {
     s.recorded.push_back(Signal(kWheelController, v));
   }
@@ -139,6 +143,12 @@ void AddControl(SystemBuilder& b, const RobotFile& file, Signals& s) {
   for (const char* name : {kWheelController, kPathFollower}) {
     b.SetStep(name, period);
     b.Derived(JoinPath(JoinPath("units", name), "step_s"), control, "control", "period_s");
+  }
+  if (compensation && s.surface_velocity.empty()) {
+    r.Error(Child(control, "compensation").IsDefined() ? Child(control, "compensation") : control,
+            "control.compensation",
+            "Algorithm 1 needs the surface velocity, and sensing.surface_velocity: none gives "
+            "the controllers none (the nominal system): set control.compensation: false");
   }
   if (steered) {
     AddSwerve(b, file, compensation, s);

@@ -336,6 +336,11 @@ const std::map<std::string, Provider>& SurfaceVelocityProviders() {
   static const std::map<std::string, Provider> providers = {
       {"ground_truth", [](SystemBuilder&, const ProviderContext&,
                           Signals& s) { s.surface_velocity = s.true_surface_velocity; }},
+      // Paper 1's nominal system (Fig. 6): no knowledge of the surface. The
+      // controllers and the odometry's rectification (Eq. 3) get none, as
+      // if every floor were still; AddSensing holds the pose fusion's
+      // surface offset at 0.
+      {"none", [](SystemBuilder&, const ProviderContext&, Signals&) {}},
       // Paper 1 Sec. IV-A: the PX4Flow at the corners, made absolute with
       // the localization's velocity (Eq. 2), filtered by the steady-state
       // Kalman filter, assigned to the wheels the line map puts on a belt.
@@ -604,6 +609,15 @@ void AddSensing(SystemBuilder& b, const RobotFile& file, const StartPose& start,
   }
   if (!s.odometry.empty() && !s.surface_velocity.empty()) {
     b.Connect(s.surface_velocity, Signal(s.odometry, "surface_velocity"));
+  }
+  // Without surface knowledge the fusion is the nominal EKF of x, y, yaw:
+  // its velocity offset (what the odometry misses while a surface moves
+  // under it) would be surface knowledge learnt on the way. A scenario's
+  // units.pose_fusion.parameters still override this.
+  if (surface == "none" && b.HasUnit(kPoseFusion)) {
+    YAML::Node f = b.Params(kPoseFusion);
+    f["offset_random_walk"] = 0;
+    f["initial_offset_sigma"] = 0;
   }
 }
 

@@ -520,3 +520,106 @@ TEST(Cli, UsageErrorsExitTwo) {
 }
 
 }  // namespace
+
+namespace {
+
+const std::string kHoldStraddle = LINESIM_SOURCE_DIR "/scenarios/hold_straddle.yaml";
+const std::string kNominalVsModified =
+    LINESIM_SOURCE_DIR "/scenarios/nominal_vs_modified.yaml";
+
+}  // namespace
+
+// Guards `run --format svg`: every picture of a robot run is an SVG
+// document (its root element opened and closed), none a PNG, and the
+// summary lists the SVG names.
+TEST(Cli, FormatSvgWritesVectorPlots) {
+  const std::string out = Fresh("robot_svg");
+  const Result r =
+      Linesim("run " + kCrossLine + " --out " + out + " --set duration_s=2 --format svg");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
+  ASSERT_EQ(summary["plots"]["files"].size(), 4u) << summary.dump();
+  for (const auto& name : summary["plots"]["files"]) {
+    const std::string file = name.get<std::string>();
+    EXPECT_EQ(fs::path(file).extension(), ".svg") << file;
+    const std::string svg = ReadFile(fs::path(out) / file);
+    EXPECT_NE(svg.find("<svg"), std::string::npos) << file;
+    EXPECT_NE(svg.find("</svg>"), std::string::npos) << file;
+  }
+  EXPECT_FALSE(fs::exists(fs::path(out) / "error.png"));
+  EXPECT_EQ(Linesim("run " + kCrossLine + " --out " + out + " --format gif").status, 2);
+}
+
+// Guards the timing shares of a run on the robot's own sensors (PX4Flow,
+// odometry fused with laser matches), where a unit's extrapolated time
+// could exceed the run's wall time (hold_straddle: -0.067 for the master):
+// every share is in [0, 1], and on one thread the units' shares and the
+// master's add up to 1 (they split the same timed steps; rounding apart).
+TEST(Cli, TimingSharesOnOwnSensorsAreFractionsThatAddUp) {
+  const std::string out = Fresh("shares");
+  const Result r = Linesim("run " + kHoldStraddle + " --out " + out +
+                           " --set duration_s=3 --set sensing.surface_velocity=px4flow"
+                           " --set localization.source=fused");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto timing = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"))["timing"];
+  const double master = timing["master_and_observers_share"].get<double>();
+  EXPECT_GE(master, 0.0);
+  EXPECT_LE(master, 1.0);
+  double total = master;
+  for (const auto& [name, unit] : timing["units"].items()) {
+    const double share = unit["share"].get<double>();
+    EXPECT_GE(share, 0.0) << name;
+    EXPECT_LE(share, 1.0) << name;
+    total += share;
+  }
+  EXPECT_NEAR(total, 1.0, 1e-9);
+}
+
+// Guards paper 1 Fig. 6 from one command: the comparison file runs the
+// nominal system (no surface knowledge: no Algorithm 1, no Eq. 3, the
+// fusion without its surface offset; its own localization) and the
+// modified one into folders of their own, each as `linesim run` writes
+// it, and draws both deviations in comparison.png; its summary lists the
+// runs with their settings and metrics.
+TEST(Cli, ComparisonRunsNominalAndModifiedIntoOneFigure) {
+  const std::string out = Fresh("compare");
+  const Result r = Linesim("run " + kNominalVsModified + " --out " + out + " --set duration_s=2");
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  for (const char* run : {"nominal", "modified"}) {
+    EXPECT_TRUE(fs::exists(fs::path(out) / run / "signals.csv")) << run;
+    EXPECT_TRUE(fs::exists(fs::path(out) / run / "error.png")) << run;
+  }
+  EXPECT_EQ(ReadFile(fs::path(out) / "comparison.png").substr(0, 8), "\x89PNG\r\n\x1a\n");
+  const std::string script = ReadFile(fs::path(out) / "comparison.gp");
+  EXPECT_NE(script.find("'nominal/signals.csv'"), std::string::npos) << script;
+  EXPECT_NE(script.find("'modified/signals.csv'"), std::string::npos) << script;
+  const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
+  ASSERT_EQ(summary["runs"].size(), 2u) << summary.dump();
+  EXPECT_EQ(summary["runs"][0]["name"], "nominal");
+  EXPECT_TRUE(summary["runs"][0]["metrics"].contains("max_path_deviation_m"));
+  // The nominal run's own settings: nothing of the surface reaches it.
+  const auto nominal = nlohmann::json::parse(ReadFile(fs::path(out) / "nominal" / "summary.json"));
+  const auto& units = nominal["settings"]["units"];
+  EXPECT_TRUE(units.contains("pose_fusion")) << units.dump();
+  EXPECT_FALSE(units.contains("surface_estimator")) << units.dump();
+}
+
+// Guards the comparison file's and the nominal system's bad input: a run
+// without a name and an unknown key are refused at their keys with nothing
+// run, and Algorithm 1 without a surface velocity is refused at
+// control.compensation.
+TEST(Cli, BadComparisonAndCompensationWithoutSurfaceAreRefused) {
+  const std::string file = WriteScenario(
+      "bad_compare.yaml", "name: bad\ncompare: " + kCrossLine +
+                              "\nruns:\n  - {label: x}\n  - {name: b, colour: red}\n");
+  const std::string out = Fresh("bad_compare");
+  Result r = Linesim("run " + file + " --out " + out);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("runs.0.name"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("runs.1.colour"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  r = Linesim("run " + kCrossLine + " --out " + out + " --set sensing.surface_velocity=none");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("control.compensation"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}

@@ -344,6 +344,36 @@ localization: {source: laser}
   EXPECT_FALSE(Has(bad, "has no scan_period")) << bad;
 }
 
+// Guards paper 1's nominal system (Fig. 6), sensing.surface_velocity:
+// none: nothing of the surface reaches it: no connection into the
+// controller's or the odometry's surface_velocity (both stay 0: Algorithm 1
+// and Eq. 3 see a still floor), and the pose fusion's surface offset held
+// at 0 (the 3-state EKF). With ground truth the same fusion keeps its offset
+// and the odometry gets the surface velocity.
+TEST(RobotScenario, NominalSystemGetsNoSurfaceKnowledge) {
+  const auto fed = [](const Scenario& s, const std::string& input) {
+    for (const auto& c : s.system->connections()) {
+      if (c.to.ToString() == input) return true;
+    }
+    return false;
+  };
+  const Scenario nominal =
+      LoadScenario(kCross, {"control.compensation=false", "sensing.surface_velocity=none",
+                            "localization.source=fused"});
+  EXPECT_FALSE(fed(nominal, "wheel_controller.surface_velocity"));
+  EXPECT_FALSE(fed(nominal, "odometry.surface_velocity"));
+  EXPECT_EQ(Param(nominal, "pose_fusion", "offset_random_walk"), 0.0);
+  EXPECT_EQ(Param(nominal, "pose_fusion", "initial_offset_sigma"), 0.0);
+  const Scenario modified = LoadScenario(kCross, {"localization.source=fused"});
+  EXPECT_TRUE(fed(modified, "wheel_controller.surface_velocity"));
+  EXPECT_TRUE(fed(modified, "odometry.surface_velocity"));
+  EXPECT_GT(Param(modified, "pose_fusion", "offset_random_walk"), 0.0);
+  // Algorithm 1 without a surface velocity is refused where it is asked for.
+  const std::string e = Issues(kCross, {"sensing.surface_velocity=none"});
+  EXPECT_TRUE(Has(e, "control.compensation")) << e;
+  EXPECT_TRUE(Has(e, "Algorithm 1 needs the surface velocity")) << e;
+}
+
 // Guards the robot-level checks: unknown keys name the closest, values out
 // of range and a bad task are reported with their key paths, all at once.
 TEST(RobotScenario, BadRobotLevelValuesAreListedWithKeyPaths) {

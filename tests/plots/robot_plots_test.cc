@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -328,6 +329,122 @@ TEST_F(RobotPlotsTest, GnuplotFailureCarriesItsErrorText) {
     const std::string what = e.what();
     EXPECT_NE(what.find("gnuplot failed"), std::string::npos) << what;
     EXPECT_NE(what.find("plots.gp"), std::string::npos) << what;
+  }
+}
+
+// Guards paper 1 Figs. 5 and 7 as error.png draws them: the curve under
+// the user's name (not the column's), the 4 cm bound of paper 1 Sec. VI-B
+// as a line with its legend entry, the spans the belt is scheduled on
+// (0-10 s in the synthetic run) shaded "line on" from its on column, and the
+// legend below the data.
+TEST_F(RobotPlotsTest, ErrorPlotDrawsTheBoundTheLineStateAndTheUsersNames) {
+  WriteSignals();
+  RobotPlotSpec spec = Spec();
+  spec.error_name = "deviation of the robot's centre from the desired path";
+  spec.error_bound_m = 0.04;
+  spec.error_bound_label = "4 cm (paper 1, Sec. VI-B)";
+  WriteRobotPlots(dir_.string(), spec);
+  const std::string script = ReadAll(dir_ / "plots.gp");
+  const auto at = script.find("set output 'error.png'");
+  ASSERT_NE(at, std::string::npos) << script;
+  const std::string error = script.substr(at, script.find("set output", at + 1) - at);
+  EXPECT_NE(error.find("title 'deviation of the robot''s centre from the desired path'"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(error.find("title 'metrics.deviation'"), std::string::npos) << error;
+  EXPECT_NE(error.find("0.04 with lines"), std::string::npos) << error;
+  EXPECT_NE(error.find("title '4 cm (paper 1, Sec. VI-B)'"), std::string::npos) << error;
+  // belt.on[0] is column 15 (time, 3 pose, 8 contacts, deviation, speed,
+  // on).
+  EXPECT_NE(error.find("using 1:((column(15) > 0.5) ? 1 : 0) axes x1y2 with filledcurves"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("title 'line on'"), std::string::npos) << error;
+  EXPECT_NE(error.find("set key below"), std::string::npos) << error;
+}
+
+// Guards paper 1 Fig. 4's legend: four sensors raw and filtered and the
+// ground truth (nine entries) go below the data, never over the plateau; the
+// raw curves are named as the readings they are.
+TEST_F(RobotPlotsTest, OpticFlowLegendIsOutsideTheData) {
+  {
+    std::ofstream out(dir_ / "signals.csv");
+    out << "time,x,y";
+    for (int k = 0; k < 4; ++k) out << ",raw[" << k << "],filtered[" << k << "]";
+    out << ",truth,on\n";
+    for (int i = 0; i <= 100; ++i) {
+      out << 0.1 * i << ",0,0";
+      for (int k = 0; k < 4; ++k) out << "," << 0.2 + 0.01 * (k - 2) << ",0.2";
+      out << ",0.2,1\n";
+    }
+  }
+  RobotPlotSpec spec;
+  spec.x_column = "x";
+  spec.y_column = "y";
+  for (int k = 0; k < 4; ++k) {
+    spec.flow_columns.push_back("raw[" + std::to_string(k) + "]");
+    spec.flow_filtered_columns.push_back("filtered[" + std::to_string(k) + "]");
+    spec.flow_labels.push_back("optic_flow_" + std::to_string(k));
+  }
+  spec.flow_reference_column = "truth";
+  spec.belt_on_columns = {"on"};
+  const auto files = WriteRobotPlots(dir_.string(), spec);
+  ASSERT_EQ(files.size(), 3u);  // top view, belt (its on state), optic flow
+  const std::string script = ReadAll(dir_ / "plots.gp");
+  const std::string flow = script.substr(script.find("set output 'optic_flow.png'"));
+  EXPECT_NE(flow.find("set key below"), std::string::npos) << flow;
+  EXPECT_NE(flow.find("title 'raw, optic_flow_3'"), std::string::npos) << flow;
+  EXPECT_NE(flow.find("title 'filtered, optic_flow_3'"), std::string::npos) << flow;
+  EXPECT_NE(flow.find("reading of the robot''s motion over the surface"), std::string::npos)
+      << flow;
+  EXPECT_NE(flow.find("title 'line on'"), std::string::npos) << flow;
+}
+
+// Guards --format svg and pdf: the pictures are written in the format asked
+// for (the same names, another extension), each a valid file of its kind
+// (an SVG document with its root element closed and the legend's text in
+// it; a PDF starting with its header, ISO 32000-1 sec. 7.5.2), and the
+// script names them.
+TEST_F(RobotPlotsTest, VectorFormatsWriteSvgAndPdf) {
+  WriteSignals();
+  RobotPlotSpec spec = Spec();
+  spec.error_bound_m = 0.04;
+  spec.error_bound_label = "4 cm (paper 1, Sec. VI-B)";
+  spec.format = PlotFormat::kSvg;
+  auto files = WriteRobotPlots(dir_.string(), spec);
+  ASSERT_EQ(files.size(), 3u);
+  EXPECT_EQ(fs::path(files[1]).filename(), "error.svg");
+  for (const auto& f : files) {
+    const std::string svg = ReadAll(f);
+    EXPECT_EQ(svg.rfind("<?xml", 0), 0u) << f;
+    EXPECT_NE(svg.find("<svg"), std::string::npos) << f;
+    EXPECT_NE(svg.find("</svg>"), std::string::npos) << f;
+  }
+  const std::string error = ReadAll(files[1]);
+  EXPECT_NE(error.find("4 cm (paper 1, Sec. VI-B)"), std::string::npos);
+  EXPECT_NE(error.find("line on"), std::string::npos);
+  EXPECT_NE(ReadAll(dir_ / "plots.gp").find("set terminal svg"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir_ / "error.png"));
+
+  spec.format = PlotFormat::kPdf;
+  files = WriteRobotPlots(dir_.string(), spec);
+  ASSERT_EQ(files.size(), 3u);
+  for (const auto& f : files) {
+    EXPECT_EQ(fs::path(f).extension(), ".pdf");
+    EXPECT_EQ(ReadAll(f).rfind("%PDF-", 0), 0u) << f;
+  }
+}
+
+TEST(PlotFormat, NamesAndExtensions) {
+  EXPECT_EQ(ParsePlotFormat("svg"), PlotFormat::kSvg);
+  EXPECT_EQ(ParsePlotFormat("pdf"), PlotFormat::kPdf);
+  EXPECT_EQ(ParsePlotFormat("png"), PlotFormat::kPng);
+  EXPECT_EQ(ParsePlotFormat("jpeg"), std::nullopt);
+  EXPECT_EQ(PlotFile("error", PlotFormat::kPdf), "error.pdf");
+  // Every format's pictures are among the files a new run clears.
+  const auto& all = RobotPlotFiles();
+  for (const char* name : {"plots.gp", "error.png", "error.svg", "optic_flow.pdf"}) {
+    EXPECT_NE(std::find(all.begin(), all.end(), name), all.end()) << name;
   }
 }
 
