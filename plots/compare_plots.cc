@@ -53,7 +53,9 @@ std::string ComparisonScript(const std::string& dir, const ComparisonPlotSpec& s
       "# Written by linesim (plots/compare_plots.cc). Run `gnuplot comparison.gp` in this\n"
       "# folder to redraw; data come from each run's signals.csv (header skipped).\n" +
       GnuplotTerminal(spec.format, kWidthPx, kHeightPx) +
-      "set datafile separator comma\nset grid\nset key below horizontal\n"
+      "set datafile separator comma\nset grid\n"
+      // The legend (a row per run) at the canvas' foot, under the axes.
+      "set bmargin at screen 0.25\nset key at screen 0.5, 0.01 center bottom vertical\n"
       "set output " + GnuplotQuote(PlotFile("comparison", spec.format)) + "\nset title " +
       GnuplotQuote(spec.title) + "\nset xlabel 'time (s)'\nset ylabel " +
       GnuplotQuote(spec.error_label) + "\nset yrange [0:*]\nset offsets 0, 0, graph 0.05, 0\n";

@@ -117,6 +117,10 @@ struct Bounds {
 // to the area's aspect ratio, so that an equal-scale view fills it.
 constexpr int kCanvasWidthPx = 1000, kCanvasHeightPx = 800;
 constexpr double kLeft = 0.09, kRight = 0.97, kBottom = 0.16, kTop = 0.93;
+// The time plots' legend: up to four rows (Fig. 4's ten entries, three to a
+// row) at the canvas' foot, under the axes' bottom margin.
+constexpr const char* kTimeKey =
+    "set bmargin at screen 0.17\nset key at screen 0.5, 0.01 center bottom horizontal\n";
 
 // Corners of a rectangle centred at (x, y), `length` along heading `yaw`.
 std::array<Point, 4> Rectangle(double x, double y, double yaw, double length, double width) {
@@ -666,11 +670,12 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
        "set size noratio\nset autoscale\nset key default\n"
        "set lmargin -1\nset rmargin -1\nset bmargin -1\nset tmargin -1\n";
 
-  // The time plots: legends below the data (never over a curve), time from
-  // the first row to the last.
+  // The time plots: legends in a band of the canvas below the axes (never
+  // over a curve: "set key below" would share its row with the x label),
+  // time from the first row to the last.
   const std::string time_plot =
       "set xlabel 'time (s)'\nunset y2label\nunset y2tics\nset ytics mirror\n"
-      "set autoscale\nset offsets 0, 0, 0, 0\nset key below horizontal\n";
+      "set autoscale\nset offsets 0, 0, 0, 0\n" + std::string(kTimeKey);
   // Where any belt is scheduled on, as a column expression (1 on, 0 off).
   std::string any_on;
   for (std::size_t i = 0; i < ons.size(); ++i) {
@@ -708,7 +713,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     }
     s += "plot ";
     for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
-    s += "\nset yrange [*:*]\nset y2range [*:*]\nset grid back\n";
+    s += "\nset yrange [*:*]\nset y2range [*:*]\nset grid back\nset bmargin -1\n";
   }
 
   if (!speeds.empty() || !ons.empty()) {
@@ -730,20 +735,23 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
                       GnuplotQuote("belt " + std::to_string(i) + " scheduled on"));
     }
     for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
-    s += "\nset yrange [*:*]\nset y2range [*:*]\n";
+    s += "\nset yrange [*:*]\nset y2range [*:*]\nset bmargin -1\n";
   }
   if (!flows.empty() && iref > 0) {
     // The PX4Flow read the robot's motion relative to the surface under
     // them; a surface speed is that reading plus the robot's own motion at
     // the sensor (paper 1 Eq. 2), here the true motion, so that the curves
     // show the sensor's error alone.
+    // Two title lines: gnuplot joins single-quoted text and a "\n".
     s += "\n" + SetOutput("optic_flow", spec.format, outputs) + "set title " +
          GnuplotQuote(title_prefix +
                       (filtered.empty() ? "optic flow" : "raw and filtered optic flow") +
-                      " (each PX4Flow's reading of the robot's motion over the surface + the "
-                      "robot's true motion, Eq. 2) against the belt's ground truth") +
+                      " against the belt's ground truth (paper 1, Fig. 4)") +
+         " . \"\\n\" . " +
+         GnuplotQuote("each PX4Flow reads the robot's motion over the surface; drawn: that "
+                      "reading + the robot's true motion (Eq. 2)") +
          "\n" + time_plot + shading_axes + "set ylabel 'surface speed along the belt (m/s)'\n"
-         "set offsets 0, 0, graph 0.05, graph 0.05\nset key below horizontal maxcols 3\nplot ";
+         "set offsets 0, 0, graph 0.05, graph 0.05\nset key maxcols 3\nplot ";
     items.clear();
     if (const std::string shading = on_shading(); !shading.empty()) items.push_back(shading);
     // Raw thin and pale (visibly noisy), filtered bold in the same hue,
@@ -766,7 +774,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     items.push_back(signals_file + " skip 1 using 1:" + std::to_string(iref) +
                     " with lines lw 2.5 lc rgb 'black' title 'ground truth (encoder wheel)'");
     for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
-    s += "\nset y2range [*:*]\nset grid back\n";
+    s += "\nset y2range [*:*]\nset grid back\nset bmargin -1\n";
   }
   if (!spec.scan.range_columns.empty()) {
     s += ScanPlot(spec, signals, row_starts, ix, iy, iyaw, travels, title_prefix, outputs);

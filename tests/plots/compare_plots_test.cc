@@ -70,7 +70,7 @@ TEST_F(ComparePlotsTest, OverlaysEveryRunWithTheLineStateAndTheBound) {
   EXPECT_NE(s.find("title 'modified'"), std::string::npos);
   EXPECT_NE(s.find("0.04 with lines"), std::string::npos);
   EXPECT_NE(s.find("title 'line on'"), std::string::npos);
-  EXPECT_NE(s.find("set key below"), std::string::npos);
+  EXPECT_NE(s.find("set key at screen 0.5, 0.01 center bottom"), std::string::npos);
   const std::string png = WriteComparisonPlot(dir_.string(), Spec());
   EXPECT_EQ(fs::path(png).filename(), "comparison.png");
   EXPECT_EQ(ReadAll(png).substr(0, 8), "\x89PNG\r\n\x1a\n");

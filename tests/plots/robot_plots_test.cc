@@ -360,7 +360,7 @@ TEST_F(RobotPlotsTest, ErrorPlotDrawsTheBoundTheLineStateAndTheUsersNames) {
             std::string::npos)
       << error;
   EXPECT_NE(error.find("title 'line on'"), std::string::npos) << error;
-  EXPECT_NE(error.find("set key below"), std::string::npos) << error;
+  EXPECT_NE(error.find("set key at screen 0.5, 0.01 center bottom"), std::string::npos) << error;
 }
 
 // Guards paper 1 Fig. 4's legend: four sensors raw and filtered and the
@@ -392,10 +392,10 @@ TEST_F(RobotPlotsTest, OpticFlowLegendIsOutsideTheData) {
   ASSERT_EQ(files.size(), 3u);  // top view, belt (its on state), optic flow
   const std::string script = ReadAll(dir_ / "plots.gp");
   const std::string flow = script.substr(script.find("set output 'optic_flow.png'"));
-  EXPECT_NE(flow.find("set key below"), std::string::npos) << flow;
+  EXPECT_NE(flow.find("set key at screen 0.5, 0.01 center bottom"), std::string::npos) << flow;
   EXPECT_NE(flow.find("title 'raw, optic_flow_3'"), std::string::npos) << flow;
   EXPECT_NE(flow.find("title 'filtered, optic_flow_3'"), std::string::npos) << flow;
-  EXPECT_NE(flow.find("reading of the robot''s motion over the surface"), std::string::npos)
+  EXPECT_NE(flow.find("reads the robot''s motion over the surface"), std::string::npos)
       << flow;
   EXPECT_NE(flow.find("title 'line on'"), std::string::npos) << flow;
 }
