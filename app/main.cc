@@ -120,6 +120,12 @@ int main(int argc, char** argv) {
   // The commands report what they expect; anything else escaping is still
   // answered with a message and an exit status, never an abort.
   try {
+    if (run->parsed() && runs > 1 && IsComparisonFile(run_file)) {
+      std::cerr << "linesim: " << run_file
+                << ": --runs repeats a scenario; a comparison file (compare:) runs each of its "
+                   "runs once (a run's set: may give it a seed)\n";
+      return kExitBadInput;
+    }
     if (run->parsed() && runs > 1) {
       // Repeats are a sweep without parameters, on threads or MPI ranks.
       if (linesim::sweep::LaunchedByMpi()) {

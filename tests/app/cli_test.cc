@@ -618,6 +618,10 @@ TEST(Cli, BadComparisonAndCompensationWithoutSurfaceAreRefused) {
   EXPECT_NE(r.err.find("runs.0.name"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("runs.1.colour"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
+  r = Linesim("run " + kNominalVsModified + " --out " + out + " --runs 3");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("--runs repeats a scenario"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
   r = Linesim("run " + kCrossLine + " --out " + out + " --set sensing.surface_velocity=none");
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("control.compensation"), std::string::npos) << r.err;
