@@ -37,8 +37,8 @@ const test_scenarios::SeedRuns& Textured() {
 // valid, so the mean quality is at least 112, the firmware's lowest valid
 // quality (11 blocks x 255 / 25). Seeds 1..8 (with the disturbances of
 // issue 21: the lab's flicker and roughness, gyro compensation, per-device
-// scale): surface_velocity_rmse_raw_mps 0.01030 / 0.0107 / 0.01155;
-// optic_flow_quality_mean 252.28 / 252.3 / 252.36.
+// scale): surface_velocity_rmse_raw_mps 0.01024 / 0.01072 / 0.01147;
+// optic_flow_quality_mean 252.23 / 252.27 / 252.35.
 TEST(OpticFlowScenario, RawFlowTracksTheTreadmillWithinThePapersNoise) {
   const auto& run = Textured();
   const auto& rmse = run["surface_velocity_rmse_raw_mps"];
@@ -52,8 +52,8 @@ TEST(OpticFlowScenario, RawFlowTracksTheTreadmillWithinThePapersNoise) {
 // Expected: on a featureless belt (texture contrast 0) the blocks match
 // noise, so the raw flow misses the treadmill by more than paper 1's 3 cm/s
 // and the quality drops below a textured belt's. Seeds 1..8, featureless:
-// surface_velocity_rmse_raw_mps 0.1487 / 0.1496 / 0.1500;
-// optic_flow_quality_mean 150.9 / 151.5 / 152.1 (textured: 252.28 and up).
+// surface_velocity_rmse_raw_mps 0.1491 / 0.1498 / 0.1502;
+// optic_flow_quality_mean 151.2 / 151.7 / 152.2 (textured: 252.23 and up).
 TEST(OpticFlowScenario, AFeaturelessBeltDefeatsTheSensor) {
   const auto& textured = Textured();
   const auto bare = RunProfile({"scene.surfaces.1.texture_contrast=0"});
@@ -73,10 +73,10 @@ TEST(OpticFlowScenario, AFeaturelessBeltDefeatsTheSensor) {
 // raw. The raw error here (about 1 cm/s) is not white noise a low-pass
 // filter removes but the firmware's half-pixel quantization bias and the
 // Eq. 2 window; the filter can only add its lag to it.
-// Seeds 1..8: surface_velocity_rmse_filtered_mps 0.02553 / 0.0258 /
-// 0.02623: within 15 % of paper 1's 3 cm/s (the filter's lag over the
-// ramps, nearly the same at every seed); max_position_drift_m 0.0472 /
-// 0.0477 / 0.0484.
+// Seeds 1..8: surface_velocity_rmse_filtered_mps 0.02561 / 0.02585 /
+// 0.02619: within 15 % of paper 1's 3 cm/s (the filter's lag over the
+// ramps, nearly the same at every seed); max_position_drift_m 0.0471 /
+// 0.0480 / 0.0483.
 TEST(OpticFlowScenario, TheRobotHoldsOnTheTreadmillWithItsFilteredFlow) {
   const auto& run = Textured();
   EXPECT_LT(run["surface_velocity_rmse_filtered_mps"].max(), 0.03);
@@ -96,8 +96,8 @@ TEST(OpticFlowScenario, TheRobotHoldsOnTheTreadmillWithItsFilteredFlow) {
 // Not asserted, because it does not hold: the plateaus' filtered RMSE a
 // third of the raw; what is left on them is the per-device scale (a bias)
 // and the half-pixel quantization, not white noise (docs/results.md).
-// Seeds 1..8: surface_velocity_settling_time_s 1.775 / 1.955 / 2.455;
-// plateau RMSE raw 3.1 / 4.7 / 6.7 mm/s, filtered 4.6 / 5.6 / 7.3 mm/s.
+// Seeds 1..8: surface_velocity_settling_time_s 1.795 / 2.015 / 2.455;
+// plateau RMSE raw 3.2 / 4.5 / 6.5 mm/s, filtered 4.5 / 5.7 / 7.2 mm/s.
 TEST(OpticFlowScenario, TheFilteredEstimateSettlesAfterEachSwitch) {
   const auto& run = Textured();
   EXPECT_LT(run["surface_velocity_settling_time_s"].max(), 3.2);

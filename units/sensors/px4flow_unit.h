@@ -221,6 +221,7 @@ class Px4FlowUnit : public cosim::Unit {
   double tyre_pitch_ = 0.0, tyre_pitch_rate_ = 0.0, tyre_roll_ = 0.0, tyre_roll_rate_ = 0.0;
   double last_pitch_ = 0.0, last_roll_ = 0.0;
   double gyro_lagged_[3] = {0, 0, 0};
+  double gyro_lag_factor_ = 1.0;  // 1 - exp(-dt / gyro_lag) (CacheCamera)
   // Body acceleration (m/s^2, base_link) over the current step.
   double accel_x_ = 0.0, accel_y_ = 0.0, last_vx_ = 0.0, last_vy_ = 0.0;
   bool have_last_velocity_ = false;
