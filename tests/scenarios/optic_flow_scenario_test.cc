@@ -35,9 +35,10 @@ const test_scenarios::SeedRuns& Textured() {
 // noise) and within paper 1's in-house figure for the measurement noise,
 // sigma = 3 cm/s (Sec. VI-A); on a lit, textured treadmill every frame is
 // valid, so the mean quality is at least 112, the firmware's lowest valid
-// quality (11 blocks x 255 / 25). Seeds 1..8: surface_velocity_rmse_raw_mps
-// 0.01046 / 0.01052 / 0.01054; optic_flow_quality_mean 252.25 / 252.29 /
-// 252.36.
+// quality (11 blocks x 255 / 25). Seeds 1..8 (with the disturbances of
+// issue 21: the lab's flicker and roughness, gyro compensation, per-device
+// scale): surface_velocity_rmse_raw_mps 0.01024 / 0.01072 / 0.01147;
+// optic_flow_quality_mean 252.23 / 252.27 / 252.35.
 TEST(OpticFlowScenario, RawFlowTracksTheTreadmillWithinThePapersNoise) {
   const auto& run = Textured();
   const auto& rmse = run["surface_velocity_rmse_raw_mps"];
@@ -51,8 +52,8 @@ TEST(OpticFlowScenario, RawFlowTracksTheTreadmillWithinThePapersNoise) {
 // Expected: on a featureless belt (texture contrast 0) the blocks match
 // noise, so the raw flow misses the treadmill by more than paper 1's 3 cm/s
 // and the quality drops below a textured belt's. Seeds 1..8, featureless:
-// surface_velocity_rmse_raw_mps 0.1489 / 0.1499 / 0.1505;
-// optic_flow_quality_mean 150.9 / 151.5 / 151.9 (textured: 252.25 and up).
+// surface_velocity_rmse_raw_mps 0.1491 / 0.1498 / 0.1502;
+// optic_flow_quality_mean 151.2 / 151.7 / 152.2 (textured: 252.23 and up).
 TEST(OpticFlowScenario, AFeaturelessBeltDefeatsTheSensor) {
   const auto& textured = Textured();
   const auto bare = RunProfile({"scene.surfaces.1.texture_contrast=0"});
@@ -72,14 +73,35 @@ TEST(OpticFlowScenario, AFeaturelessBeltDefeatsTheSensor) {
 // raw. The raw error here (about 1 cm/s) is not white noise a low-pass
 // filter removes but the firmware's half-pixel quantization bias and the
 // Eq. 2 window; the filter can only add its lag to it.
-// Seeds 1..8: surface_velocity_rmse_filtered_mps 0.02612 / 0.02615 /
-// 0.02619: within 13 % of paper 1's 3 cm/s (the filter's lag over the
-// ramps, the same at every seed); max_position_drift_m 0.0489 / 0.0490 /
-// 0.0491.
+// Seeds 1..8: surface_velocity_rmse_filtered_mps 0.02561 / 0.02585 /
+// 0.02619: within 15 % of paper 1's 3 cm/s (the filter's lag over the
+// ramps, nearly the same at every seed); max_position_drift_m 0.0471 /
+// 0.0480 / 0.0483.
 TEST(OpticFlowScenario, TheRobotHoldsOnTheTreadmillWithItsFilteredFlow) {
   const auto& run = Textured();
   EXPECT_LT(run["surface_velocity_rmse_filtered_mps"].max(), 0.03);
   EXPECT_LT(run["max_position_drift_m"].max(), 0.07);
+}
+
+
+// Guards the settling after each switch (issue 21 item 2). Expected, from
+// paper 1's gain (K = 0.105) and the switch detector (units/estimation):
+// the 1 s ramp of 0.02 m/s per message restarts the filter at its 7th
+// message, the last 3 leave a lag of 0.02 (1 - 0.895^3) / 0.105 = 5.4 cm/s,
+// which decays by 0.895 per message. Every sensor is within 2 cm/s of the
+// truth once the lag is under 2 cm/s less its own scale bias; at 3 sigma
+// of scale_error (3 x 2.5 % x 0.2 m/s = 1.5 cm/s) that is 0.5 cm/s, after
+// ln(0.005 / 0.054) / ln(0.895) = 21 messages: 1 s + 2.1 s, plus one
+// message for the detector's restart moving with the noise: 3.2 s.
+// Not asserted, because it does not hold: the plateaus' filtered RMSE a
+// third of the raw; what is left on them is the per-device scale (a bias)
+// and the half-pixel quantization, not white noise (docs/results.md).
+// Seeds 1..8: surface_velocity_settling_time_s 1.795 / 2.015 / 2.455;
+// plateau RMSE raw 3.2 / 4.5 / 6.5 mm/s, filtered 4.5 / 5.7 / 7.2 mm/s.
+TEST(OpticFlowScenario, TheFilteredEstimateSettlesAfterEachSwitch) {
+  const auto& run = Textured();
+  EXPECT_LT(run["surface_velocity_settling_time_s"].max(), 3.2);
+  EXPECT_GT(run["surface_velocity_settling_time_s"].min(), 1.0);  // not before the ramp's end
 }
 
 }  // namespace
