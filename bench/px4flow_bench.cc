@@ -7,6 +7,11 @@
 // frames per unit on average; a message every 100 ms. Target: under 2 us
 // per step for the four.
 //
+// BM_Px4FlowFourUnitsDisturbed: the same with every disturbance of issue 21
+// on (the treadmill lab's flicker and roughness on both surfaces, the
+// model file's gyro compensation, gyro noise, bias and lag, scale error,
+// and raw3's tilt on its tyres).
+//
 // BM_Px4FlowImageFrame: one image-level reference frame (render 64x64 with
 // motion blur and noise, then the firmware's compute_flow), for a moving
 // belt at 0.25 m/s under 1000 lx, contrast 0.1.
@@ -27,10 +32,18 @@ using linesim::cosim::TimeNs;
 namespace models = linesim::models;
 namespace sensors = linesim::sensors;
 
-models::Scene BeltScene() {
+models::Scene BeltScene(bool disturbed = false) {
   models::Scene s;
   s.surfaces.push_back({"concrete", 0.8, 0.2, 500.0});
   s.surfaces.push_back({"belt", 0.8, 0.1, 500.0});
+  if (disturbed) {
+    for (auto& surf : s.surfaces) {
+      surf.flicker_hz = 120.0;
+      surf.flicker_depth = 0.1;
+      surf.roughness_m = 0.0002;
+      surf.roughness_length_m = 0.02;
+    }
+  }
   s.floor = {-50, 50, -50, 50, 0};
   models::Belt b;
   b.area = {0.0, 0.0, 20.0, 0.6, 0.0};
@@ -47,8 +60,8 @@ void SetArray(sensors::Px4FlowUnit& u, const char* name, const std::vector<doubl
   u.variables().SetRealArray(*u.variables().Find(name), v);
 }
 
-void BM_Px4FlowFourUnits(benchmark::State& state) {
-  const models::Scene scene = BeltScene();
+void FourUnits(benchmark::State& state, bool disturbed) {
+  const models::Scene scene = BeltScene(disturbed);
   const std::array<std::array<double, 2>, 4> corners = {
       {{0.3, 0.25}, {0.3, -0.25}, {-0.3, 0.25}, {-0.3, -0.25}}};
   std::vector<std::unique_ptr<sensors::Px4FlowUnit>> units;
@@ -58,6 +71,17 @@ void BM_Px4FlowFourUnits(benchmark::State& state) {
     SetReal(*u, "mount_y", corners[i][1]);
     SetReal(*u, "mount_height", 0.1841);
     SetReal(*u, "added_light", 1500.0);
+    if (disturbed) {
+      u->variables().SetValue(*u->variables().Find("gyro_compensation"),
+                              linesim::cosim::Value{true});
+      SetReal(*u, "gyro_noise", 0.0074);
+      SetReal(*u, "gyro_bias", 0.0052);
+      SetReal(*u, "gyro_lag", 0.003);
+      SetReal(*u, "scale_error", 0.025);
+      SetReal(*u, "pitch_per_acceleration", 4.4e-5);
+      SetReal(*u, "roll_per_acceleration", 2.3e-4);
+      SetReal(*u, "tyre_mode_frequency", 34.0);
+    }
     u->Setup(0, TimeNs{1} << 60);
     u->Initialize();
     // base_link straddling the belt's edge (y = 0.3): two sensors over it.
@@ -77,7 +101,12 @@ void BM_Px4FlowFourUnits(benchmark::State& state) {
   state.counters["rtf"] = benchmark::Counter(static_cast<double>(state.iterations()) * 1e-3,
                                              benchmark::Counter::kIsRate);
 }
+
+void BM_Px4FlowFourUnits(benchmark::State& state) { FourUnits(state, false); }
 BENCHMARK(BM_Px4FlowFourUnits);
+
+void BM_Px4FlowFourUnitsDisturbed(benchmark::State& state) { FourUnits(state, true); }
+BENCHMARK(BM_Px4FlowFourUnitsDisturbed);
 
 void BM_Px4FlowImageFrame(benchmark::State& state) {
   sensors::Px4FlowCamera cam;

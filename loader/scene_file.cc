@@ -110,7 +110,10 @@ class SceneParser {
     if (list.IsSequence() && list.size() == 0)
       r_.Error(list, path, "expected at least one surface");
     for (const auto& [p, item] : items) {
-      r_.CheckKeys(item, p, {"name", "friction", "texture_contrast", "illumination_lux"});
+      r_.CheckKeys(item, p,
+                   {"name", "friction", "texture_contrast", "illumination_lux", "flicker_hz",
+                    "flicker_depth", "roughness_m", "roughness_length_m", "texture_period_m",
+                    "texture_periodic_share"});
       models::Surface surface;
       surface.name = Name(item, p, surface_names_);
       // Rubber or polyurethane on floors and belts is 0.5-1.0; 3 leaves
@@ -119,6 +122,14 @@ class SceneParser {
       surface.texture_contrast = r_.Real(item, p, "texture_contrast", std::nullopt, {0.0, 1.0});
       // Direct sunlight is about 1e5 lx.
       surface.illumination_lux = r_.Real(item, p, "illumination_lux", std::nullopt, {0.0, 1e5});
+      // Optional (the optic-flow sensor's disturbances; see models/scene.h).
+      surface.flicker_hz = r_.Real(item, p, "flicker_hz", 0.0, {0.0, 1000.0});
+      surface.flicker_depth = r_.Real(item, p, "flicker_depth", 0.0, {0.0, 1.0});
+      surface.roughness_m = r_.Real(item, p, "roughness_m", 0.0, {0.0, 0.05});
+      surface.roughness_length_m = r_.Real(item, p, "roughness_length_m", 0.01, {1e-4, 10.0});
+      surface.texture_period_m = r_.Real(item, p, "texture_period_m", 0.0, {0.0, 1.0});
+      surface.texture_periodic_share =
+          r_.Real(item, p, "texture_periodic_share", 0.0, {0.0, 1.0});
       s_.surfaces.push_back(surface);
     }
   }

@@ -30,6 +30,26 @@ struct Surface {
   /// adds. Factory halls are lit at 300-750 lx (EN 12464-1 gives 300 lx
   /// for rough assembly, 500 lx for medium work).
   double illumination_lux = 0.0;
+  /// Flicker of the ambient light (not of a robot's own light): lamps on
+  /// AC mains flicker at twice the mains frequency (100 Hz at 50 Hz mains,
+  /// 120 Hz at 60 Hz); 0: steady light.
+  double flicker_hz = 0.0;
+  /// Its modulation depth (max - min) / (max + min) of the illuminance
+  /// (IEEE 1789-2015 "percent flicker" / 100): about 0.1 incandescent,
+  /// 0.3-0.4 fluorescent on magnetic ballasts, up to 1 for some LED drivers.
+  double flicker_depth = 0.0;
+  /// Standard deviation (m) of the surface's height profile under a rolling
+  /// wheel (joints of slats, the weave of a belt, floor unevenness): what
+  /// shakes a robot that rolls over it. 0: perfectly flat.
+  double roughness_m = 0.0;
+  /// Correlation length (m) of that profile along the path (the slat pitch
+  /// or the size of the bumps).
+  double roughness_length_m = 0.01;
+  /// Period (m) of a periodic part of the texture along the belt's
+  /// direction (slats, a weave); 0: none.
+  double texture_period_m = 0.0;
+  /// Share (0..1) of the texture's contrast that is periodic.
+  double texture_periodic_share = 0.0;
 };
 
 /// A rectangle on the floor: centre, size, and the direction of its length

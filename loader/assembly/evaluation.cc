@@ -132,11 +132,15 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     b.Connect(s.belt_ground_truth, Signal(kFlowError, "reference"));
     s.recorded.push_back(Signal(kFlowError, "surface_speed"));
     add("surface_velocity_rmse_raw_mps", Signal(kFlowError, "rmse"), "final");
+    add("surface_velocity_plateau_rmse_raw_mps", Signal(kFlowError, "rmse_plateau"), "final");
     if (!s.surface_estimate.empty()) {
       // The surface estimator's filtered value per sensor, the same order.
       b.Connect(s.surface_estimate, Signal(kFlowError, "estimated"));
       s.recorded.push_back(Signal(kFlowError, "estimated_speed"));
       add("surface_velocity_rmse_filtered_mps", Signal(kFlowError, "rmse_estimated"), "final");
+      add("surface_velocity_plateau_rmse_filtered_mps",
+          Signal(kFlowError, "rmse_plateau_estimated"), "final");
+      add("surface_velocity_settling_time_s", Signal(kFlowError, "settling_time"), "final");
     }
     // The first sensor's quality (0..255, OPTICAL_FLOW_RAD's mean over its
     // publishing interval), over the run.

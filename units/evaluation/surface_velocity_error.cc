@@ -1,9 +1,19 @@
 #include "units/evaluation/surface_velocity_error.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include "cosim/time.h"
 #include <utility>
 
 namespace linesim::evaluation {
+
+namespace {
+// Time without a change after which the reference's level is re-taken: a
+// tenth of a second, the ground-truth encoder's jitter (one count) averaged
+// out, shorter than any plateau delay that makes sense.
+constexpr double kSettleLevel = 0.1;
+}  // namespace
 
 SurfaceVelocityErrorUnit::SurfaceVelocityErrorUnit(std::string name, int sensors,
                                                    const models::Belt& belt, bool estimated)
@@ -51,6 +61,22 @@ SurfaceVelocityErrorUnit::SurfaceVelocityErrorUnit(std::string name, int sensors
   v.Output("rmse", "m/s", &rmse_,
            "root mean square of the error over every sensor and step compared so far", {});
   v.Output("samples", "1", &samples_out_, "how many (sensor, step) pairs rmse holds", {});
+  // Issue 21 item 2: plateaus from 1 s after a switch; within 2 cm/s.
+  v.Parameter("plateau_delay", "s", &plateau_delay_,
+              "a plateau starts this long after the reference last changed", cosim::Rule::NonNegative());
+  v.Parameter("switch_step", "m/s", &switch_step_,
+              "the reference changes (a switch) where it moves this far from where it settled "
+              "(default 0.01: 5 % of a 0.2 m/s line; the ground-truth encoder's quantization, "
+              "2.6 mm/s at 0.2 m/s, and a line's slow speed variation stay below it)",
+              cosim::Rule::Positive());
+  v.Parameter("settle_tolerance", "m/s", &settle_tolerance_,
+              "a switch has settled when every estimate over the belt stays this close",
+              cosim::Rule::Positive());
+  v.Output("rmse_plateau", "m/s", &rmse_plateau_,
+           "root mean square of error over the plateau samples (line steadily on or off)", {});
+  v.Output("plateau_samples", "1", &plateau_samples_out_,
+           "how many (sensor, step) pairs rmse_plateau holds", {});
+  v.Output("switches", "1", &switches_out_, "switches of the reference seen so far", {});
   if (estimated) {
     estimated_.assign(2 * n, 0.0);
     estimated_speed_.assign(n, 0.0);
@@ -60,6 +86,12 @@ SurfaceVelocityErrorUnit::SurfaceVelocityErrorUnit(std::string name, int sensors
              "each sensor's estimated absolute surface velocity along the belt", {"estimated"});
     v.Output("rmse_estimated", "m/s", &rmse_estimated_,
              "root mean square of estimated_speed - reference over the samples rmse holds", {});
+    v.Output("rmse_plateau_estimated", "m/s", &rmse_plateau_estimated_,
+             "root mean square of estimated_speed - reference over the plateau samples", {});
+    v.Output("settling_time", "s", &settling_out_,
+             "largest time from a switch's start until every estimate over the belt stayed "
+             "within settle_tolerance of the reference (until the next switch)",
+             {});
   }
 }
 
@@ -94,6 +126,14 @@ void SurfaceVelocityErrorUnit::Initialize() {
   samples_ = 0;
   samples_out_ = 0.0;
   rmse_ = rmse_estimated_ = 0.0;
+  anchor_ = last_t_ = last_change_ = 0.0;
+  have_last_ = in_switch_ = level_taken_ = false;
+  switch_start_ = 0.0;
+  last_bad_ = -1.0;
+  settling_max_ = plateau_sum_ = plateau_sum_estimated_ = 0.0;
+  plateau_samples_ = switches_ = 0;
+  rmse_plateau_ = rmse_plateau_estimated_ = settling_out_ = switches_out_ = 0.0;
+  plateau_samples_out_ = 0.0;
   Evaluate();
 }
 
@@ -102,14 +142,55 @@ cosim::StepResult SurfaceVelocityErrorUnit::DoStep(cosim::TimeNs t, cosim::TimeN
   if (!InputsFinite(t)) return cosim::StepResult::kError;
   // The inputs are those at the step's start: compare them, then count.
   Evaluate();
+  const double now = cosim::NsToSeconds(t);
+  // A switch starts where the reference starts changing.
+  if (!have_last_) anchor_ = reference_;
+  if (std::abs(reference_ - anchor_) > switch_step_) {
+    if (now - last_change_ >= plateau_delay_) {
+      FinishSwitch();
+      in_switch_ = true;
+      switch_start_ = now;
+      last_bad_ = -1.0;
+      ++switches_;
+    }
+    last_change_ = now;
+    anchor_ = reference_;
+    level_taken_ = false;
+  } else if (!level_taken_ && now - last_change_ >= kSettleLevel) {
+    // Steady for a while after a change: the level is where the reference
+    // is now (within a step of the last anchor; a ramp moves a step faster).
+    anchor_ = reference_;
+    level_taken_ = true;
+  }
+  const bool plateau = now - last_change_ >= plateau_delay_;
+  // A violation counts towards the switch's settling only where the
+  // reference is at its level (within half a switch step of where it
+  // settled): the first samples of the next switch, before it has moved a
+  // whole step, belong to that one.
+  const bool at_level = std::abs(reference_ - anchor_) <= 0.5 * switch_step_;
   for (std::size_t k = 0; k < sensors_; ++k) {
     if (over_belt_[k] == 0.0) continue;
     sum_squared_ += error_[k] * error_[k];
+    if (plateau) plateau_sum_ += error_[k] * error_[k];
     if (!estimated_.empty()) {
       const double e = estimated_speed_[k] - reference_;
       sum_squared_estimated_ += e * e;
+      if (plateau) plateau_sum_estimated_ += e * e;
+      if (in_switch_ && at_level && std::abs(e) > settle_tolerance_) last_bad_ = now;
     }
     ++samples_;
+    if (plateau) ++plateau_samples_;
+  }
+  // The switch stays open (its settling time can still grow) until the next.
+  if (in_switch_) settling_out_ = std::max(settling_max_, std::max(last_bad_ - switch_start_, 0.0));
+  last_t_ = now;
+  have_last_ = true;
+  switches_out_ = static_cast<double>(switches_);
+  plateau_samples_out_ = static_cast<double>(plateau_samples_);
+  if (plateau_samples_ > 0) {
+    const double np = static_cast<double>(plateau_samples_);
+    rmse_plateau_ = std::sqrt(plateau_sum_ / np);
+    rmse_plateau_estimated_ = std::sqrt(plateau_sum_estimated_ / np);
   }
   samples_out_ = static_cast<double>(samples_);
   const double n = static_cast<double>(samples_);
@@ -118,20 +199,42 @@ cosim::StepResult SurfaceVelocityErrorUnit::DoStep(cosim::TimeNs t, cosim::TimeN
   return cosim::StepResult::kOk;
 }
 
+void SurfaceVelocityErrorUnit::FinishSwitch() {
+  if (in_switch_) settling_max_ = std::max(settling_max_, std::max(last_bad_ - switch_start_, 0.0));
+  in_switch_ = false;
+}
+
 void SurfaceVelocityErrorUnit::SaveInternal(cosim::UnitState& state) const {
-  state.reals = {sum_squared_, sum_squared_estimated_};
-  state.integers = {samples_};
+  state.reals = {sum_squared_,  sum_squared_estimated_, anchor_, last_t_,
+                 last_change_,  switch_start_,          last_bad_,       settling_max_,
+                 plateau_sum_,  plateau_sum_estimated_};
+  state.integers = {samples_,           plateau_samples_,    switches_, have_last_ ? 1 : 0,
+                    in_switch_ ? 1 : 0, level_taken_ ? 1 : 0};
 }
 
 void SurfaceVelocityErrorUnit::RestoreInternal(const cosim::UnitState& state) {
-  if (state.reals.size() != 2 || state.integers.size() != 1) {
+  if (state.reals.size() != 10 || state.integers.size() != 6) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
-                           " integers, expected 2 and 1");
+                           " integers, expected 10 and 6");
   }
-  sum_squared_ = state.reals[0];
-  sum_squared_estimated_ = state.reals[1];
+  const auto& r = state.reals;
+  sum_squared_ = r[0];
+  sum_squared_estimated_ = r[1];
+  anchor_ = r[2];
+  last_t_ = r[3];
+  last_change_ = r[4];
+  switch_start_ = r[5];
+  last_bad_ = r[6];
+  settling_max_ = r[7];
+  plateau_sum_ = r[8];
+  plateau_sum_estimated_ = r[9];
   samples_ = state.integers[0];
+  plateau_samples_ = state.integers[1];
+  switches_ = state.integers[2];
+  have_last_ = state.integers[3] != 0;
+  in_switch_ = state.integers[4] != 0;
+  level_taken_ = state.integers[5] != 0;
 }
 
 }  // namespace linesim::evaluation

@@ -25,6 +25,18 @@ namespace linesim::evaluation {
 /// surface velocity per sensor (map frame, e.g. the filtered value of
 /// paper 1's Kalman filter) with the same reference over the same samples:
 /// `estimated_speed` and `rmse_estimated`.
+///
+/// Plateaus and switches (issue 21, "the filter earns its place"): the
+/// line is steadily on or off where the reference has not moved more than
+/// switch_step away from where it last settled for plateau_delay; `rmse_plateau` and
+/// `rmse_plateau_estimated` are the two root mean square errors over those
+/// samples only. A switch starts where the reference starts changing after
+/// a plateau (has moved switch_step); its settling time is the time from then to the last
+/// sample, before the next switch, at which some sensor's estimate over the
+/// belt was more than settle_tolerance off the reference while the
+/// reference was at a level (within switch_step / 2 of where it last
+/// settled: the next switch's first samples are not this one's);
+/// `settling_time` is the largest so far, `switches` their count.
 class SurfaceVelocityErrorUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "surface_velocity_error";
@@ -46,6 +58,7 @@ class SurfaceVelocityErrorUnit : public cosim::Unit {
 
  private:
   void Evaluate();
+  void FinishSwitch();
 
   std::size_t sensors_;
   models::Rect belt_area_;
@@ -66,6 +79,15 @@ class SurfaceVelocityErrorUnit : public cosim::Unit {
   double sum_squared_ = 0.0, sum_squared_estimated_ = 0.0;
   std::int64_t samples_ = 0;
   double samples_out_ = 0.0;
+  // Plateaus and switches: parameters, state and outputs.
+  double plateau_delay_ = 1.0, switch_step_ = 0.01, settle_tolerance_ = 0.02;
+  double anchor_ = 0.0, last_t_ = 0.0, last_change_ = 0.0;
+  bool have_last_ = false, in_switch_ = false, level_taken_ = false;
+  double switch_start_ = 0.0, last_bad_ = -1.0, settling_max_ = 0.0;
+  double plateau_sum_ = 0.0, plateau_sum_estimated_ = 0.0;
+  std::int64_t plateau_samples_ = 0, switches_ = 0;
+  double rmse_plateau_ = 0.0, rmse_plateau_estimated_ = 0.0, settling_out_ = 0.0,
+         switches_out_ = 0.0, plateau_samples_out_ = 0.0;
 };
 
 }  // namespace linesim::evaluation

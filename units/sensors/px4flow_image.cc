@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <numbers>
 
 namespace linesim::sensors {
 
@@ -166,12 +167,29 @@ double Px4FlowImageModel::Field(double x, double y) const {
   };
   const double a = node(ix, iy), b = node(ix + 1, iy), c = node(ix, iy + 1),
                d = node(ix + 1, iy + 1);
-  return 1.5 * ((a * (1 - u) + b * u) * (1 - v) + (c * (1 - u) + d * u) * v);
+  const double aperiodic = 1.5 * ((a * (1 - u) + b * u) * (1 - v) + (c * (1 - u) + d * u) * v);
+  if (periodic_share_ <= 0.0) return aperiodic;
+  // A sine of unit variance (sqrt 2 amplitude) along the period's direction.
+  const double along = x * period_cos_ + y * period_sin_;
+  const double periodic = 1.4142135623730951 * std::sin(2.0 * std::numbers::pi * along / period_m_);
+  return std::sqrt(1.0 - periodic_share_) * aperiodic + std::sqrt(periodic_share_) * periodic;
+}
+
+void Px4FlowImageModel::SetPeriodicTexture(double period_m, double cos_dir, double sin_dir,
+                                           double share) {
+  period_m_ = period_m;
+  period_cos_ = cos_dir;
+  period_sin_ = sin_dir;
+  periodic_share_ = period_m > 0.0 ? std::clamp(share, 0.0, 1.0) : 0.0;
 }
 
 void Px4FlowImageModel::Render(double dx_m, double dy_m, double vx_mps, double vy_mps,
-                               double height_m, double contrast, double lux, Image& out) {
-  const Exposure e = AutoExposure(cam_, lux);
+                               double height_m, double contrast, double lux, Image& out,
+                               double brightness) {
+  Exposure e = AutoExposure(cam_, lux);
+  // The auto exposure follows the mean light; a flickering lamp makes this
+  // exposure brighter or darker than that.
+  e.mean_dn *= brightness;
   const double pix_m = height_m / cam_.focal_length_px;
   // Motion blur: the exposure [t - T, t] sampled at K instants, K growing
   // with the blur length so that samples are at most 1/2 pixel apart.
@@ -203,16 +221,16 @@ void Px4FlowImageModel::Render(double dx_m, double dy_m, double vx_mps, double v
 }
 
 FlowResult Px4FlowImageModel::Step(double vx_mps, double vy_mps, double height_m, double contrast,
-                                   double lux) {
+                                   double lux, double brightness) {
   const double dt = 1.0 / cam_.frame_rate_hz;
   if (!have_previous_) {
-    Render(dx_m_, dy_m_, vx_mps, vy_mps, height_m, contrast, lux, current_);
+    Render(dx_m_, dy_m_, vx_mps, vy_mps, height_m, contrast, lux, current_, brightness);
     have_previous_ = true;
   }
   previous_ = current_;
   dx_m_ += vx_mps * dt;
   dy_m_ += vy_mps * dt;
-  Render(dx_m_, dy_m_, vx_mps, vy_mps, height_m, contrast, lux, current_);
+  Render(dx_m_, dy_m_, vx_mps, vy_mps, height_m, contrast, lux, current_, brightness);
   return ComputeFlow(previous_, current_, cam_.search_range_px, cam_.feature_threshold);
 }
 

@@ -76,18 +76,28 @@ class Px4FlowImageModel {
   /// Renders the frame whose exposure ends when the surface has moved by
   /// (dx, dy) metres relative to the sensor (in the sensor frame), with
   /// the surface moving at (vx, vy) m/s during the exposure (motion blur),
-  /// height h (m), contrast c and illuminance `lux`.
+  /// height h (m), contrast c and illuminance `lux` (which sets the auto
+  /// exposure); `brightness` scales the light of this exposure against the
+  /// one the auto exposure adapted to (a flickering lamp: 1 + its deviation
+  /// averaged over the exposure).
   void Render(double dx_m, double dy_m, double vx_mps, double vy_mps, double height_m,
-              double contrast, double lux, Image& out);
+              double contrast, double lux, Image& out, double brightness = 1.0);
 
   /// Renders the next frame after a frame interval at the given relative
   /// velocity and returns the firmware's flow between the two frames.
-  FlowResult Step(double vx_mps, double vy_mps, double height_m, double contrast, double lux);
+  FlowResult Step(double vx_mps, double vy_mps, double height_m, double contrast, double lux,
+                  double brightness = 1.0);
+
+  /// A periodic part of the texture (slats, a weave): period (m) along the
+  /// direction (cos, sin) in the sensor frame, carrying `share` of the
+  /// texture's variance (0: none, the default).
+  void SetPeriodicTexture(double period_m, double cos_dir, double sin_dir, double share);
 
  private:
   double Field(double x, double y) const;
 
   Px4FlowCamera cam_;
+  double period_m_ = 0.0, period_cos_ = 1.0, period_sin_ = 0.0, periodic_share_ = 0.0;
   std::uint64_t texture_seed_;
   std::mt19937_64 rng_;
   double dx_m_ = 0.0, dy_m_ = 0.0;

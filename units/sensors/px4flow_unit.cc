@@ -25,7 +25,12 @@ constexpr double kNoiseSpread = 0.2;       // relative spread of a noise-only me
 constexpr double kLostSnr = 0.18;          // snr at which half the blocks match noise
 constexpr double kMatchNoise = 0.42;       // block offset std * snr (px)
 constexpr double kMatchNoiseMax = 1.0;     // its limit at low snr (px)
-constexpr double kAliasScalePx = 2.3;      // beyond the window: P(edge match) = exp(-(e/2.3)^2)
+constexpr double kAliasScalePx = 2.3;
+// The whole-pixel match's snr under a brightness step scales with the SAD
+// gap's ratio to this power: fitted to the image-level reference's frame
+// flow under 120 Hz flicker of depth 0.05..0.3 (the competition between
+// offsets then turns on the block means, which a mean gap alone overstates).
+constexpr double kFlickerGapPower = 0.65;      // beyond the window: P(edge match) = exp(-(e/2.3)^2)
 
 inline double Uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
@@ -66,6 +71,19 @@ inline double Normal(std::mt19937_64& rng) {
 }
 
 inline double RoundHalf(double x) { return 0.5 * std::nearbyint(2.0 * x); }
+
+// E|mu + s Z| for a standard normal Z (the folded normal's mean): the mean
+// absolute difference a pixel adds to the SAD when the two frames differ by
+// a brightness step mu and a zero-mean difference of std s.
+inline double FoldedMean(double mu, double s) {
+  constexpr double kSqrt2OverPi = 0.7978845608028654;
+  if (s <= 0.0) return std::abs(mu);
+  const double r = mu / s;
+  return s * kSqrt2OverPi * std::exp(-0.5 * r * r) + mu * std::erf(r * 0.7071067811865476);
+}
+
+// Salts keeping the per-device and per-run draws apart from the frame stream.
+constexpr std::uint64_t kDeviceSalt = 0xd1b54a32d192ed03ULL;
 
 }  // namespace
 
@@ -144,6 +162,47 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
               "standard deviation of each gyro axis per frame sample", Rule::NonNegative());
   v.Parameter("gyro_range", "rad/s", &gyro_range_, "gyro full scale (saturates beyond)",
               Rule::Positive());
+  v.Parameter("gyro_compensation", &gyro_compensation_,
+              "firmware subtracts the board gyro's rotation from each frame's flow before "
+              "`velocity` (paper 1 Sec. IV-A: on); integrated_x/y stay uncompensated");
+  v.Parameter("gyro_bias", "rad/s", &gyro_bias_,
+              "standard deviation of each gyro axis' constant bias, drawn once per device from "
+              "the seed",
+              Rule::NonNegative());
+  v.Parameter("gyro_lag", "s", &gyro_lag_,
+              "time constant of the gyro's low-pass and read delay against the image",
+              Rule::Range(0.0, 1.0));
+  v.Parameter("scale_error", "1", &scale_error_,
+              "standard deviation of the device's focal length over its nominal, drawn once per "
+              "device from the seed (what a calibration leaves)",
+              Rule::Range(0.0, 0.5));
+  v.Parameter("pitch_per_acceleration", "rad.s^2/m", &pitch_per_acceleration_,
+              "static body pitch on the tyres per m/s^2 of forward acceleration (nose up)",
+              Rule::NonNegative());
+  v.Parameter("roll_per_acceleration", "rad.s^2/m", &roll_per_acceleration_,
+              "static body roll on the tyres per m/s^2 of leftward acceleration",
+              Rule::NonNegative());
+  v.Parameter("tyre_mode_frequency", "Hz", &tyre_mode_frequency_,
+              "natural frequency of the body's pitch and roll on its tyres",
+              Rule::Range(0.1, 200.0));
+  v.Parameter("tyre_mode_damping", "1", &tyre_mode_damping_,
+              "damping ratio of that mode", Rule::Range(0.0, 10.0));
+  v.Parameter("wheelbase", "m", &wheelbase_,
+              "distance between front and rear wheel contacts (pitch from the surface profile)",
+              Rule::Positive());
+  v.Parameter("track", "m", &track_,
+              "distance between left and right wheel contacts (roll from the surface profile)",
+              Rule::Positive());
+  v.Parameter("rotation_flow", &rotation_,
+              "the chassis' roll and pitch rates (angular_velocity x, y) turn the sensor: its "
+              "image and its gyro (off: they are ignored)");
+  v.Parameter("shake", &shake_,
+              "the wheels rolling over the surface's roughness shake the body (scene surface "
+              "roughness_m)");
+  v.Parameter("flicker", &flicker_,
+              "the ambient light flickers (scene surface flicker_hz, flicker_depth)");
+  v.Parameter("periodic_texture", &periodic_texture_,
+              "the surface's periodic texture can alias (scene surface texture_period_m)");
 
   v.Input("position", "m", &position_, "base_link x, y in map");
   v.Input("yaw", "rad", &yaw_, "base_link yaw in map");
@@ -238,9 +297,25 @@ void Px4FlowUnit::Initialize() {
   publish_index_ = 1;
   next_frame_ = start_ + static_cast<cosim::TimeNs>(std::llround(1e9 / frame_rate_));
   next_publish_ = start_ + static_cast<cosim::TimeNs>(std::llround(1e9 / publish_rate_));
-  acc_x_ = acc_y_ = 0.0;
+  acc_x_ = acc_y_ = comp_x_ = comp_y_ = 0.0;
   acc_gyro_[0] = acc_gyro_[1] = acc_gyro_[2] = 0.0;
   acc_count_ = acc_quality_ = 0;
+  // The device's own errors, from its seed (not the frame stream, so that a
+  // parameter set to 0 leaves the other draws as they were): its lens'
+  // focal length and its gyro's bias; and the mains phase of this run.
+  std::mt19937_64 device(seed_ ^ kDeviceSalt);
+  focal_factor_ = 1.0 + scale_error_ * Normal(device);
+  for (double& b : bias_) b = gyro_bias_ * Normal(device);
+  flicker_phase_ = 2.0 * std::numbers::pi * Uniform(device);
+  for (double& c : contact_) c = 0.0;
+  tyre_pitch_ = tyre_pitch_rate_ = tyre_roll_ = tyre_roll_rate_ = 0.0;
+  last_pitch_ = last_roll_ = 0.0;
+  for (double& g : gyro_lagged_) g = 0.0;
+  accel_x_ = accel_y_ = last_vx_ = last_vy_ = 0.0;
+  have_last_velocity_ = false;
+  rot_x_ = rot_y_ = 0.0;
+  height_ = mount_height_;
+  brightness_ = last_brightness_ = 1.0;
   integrated_x_ = integrated_y_ = integration_time_ = quality_ = frame_count_ = 0.0;
   std::fill(integrated_gyro_.begin(), integrated_gyro_.end(), 0.0);
   std::fill(velocity_.begin(), velocity_.end(), 0.0);
@@ -250,42 +325,134 @@ void Px4FlowUnit::Initialize() {
 }
 
 void Px4FlowUnit::TrueFlow(double& fx, double& fy, int& surface) const {
+  double dc = 1.0, ds = 0.0;
+  TrueFlowAndDirection(fx, fy, surface, dc, ds);
+}
+
+void Px4FlowUnit::TrueFlowAndDirection(double& fx, double& fy, int& surface, double& dir_c,
+                                       double& dir_s) const {
   const double c = std::cos(yaw_), s = std::sin(yaw_);
   const double rx = c * mount_x_ - s * mount_y_, ry = s * mount_x_ + c * mount_y_;
   const double px = position_[0] + rx, py = position_[1] + ry;
   // Velocity of the sensor point in map: v + omega x r.
   const double vsx = linear_velocity_[0] - yaw_rate_ * ry;
   const double vsy = linear_velocity_[1] + yaw_rate_ * rx;
-  double ux = 0.0, uy = 0.0;
+  double ux = 0.0, uy = 0.0, mc = 1.0, ms = 0.0;
   surface = floor_surface_;
   for (std::size_t b = 0; b < belts_.size(); ++b) {
     if (models::InsideRect(belts_[b].area, belts_[b].cos_dir, belts_[b].sin_dir, px, py)) {
       ux = belt_velocity_[2 * b];
       uy = belt_velocity_[2 * b + 1];
       surface = belts_[b].surface;
+      mc = belts_[b].cos_dir;
+      ms = belts_[b].sin_dir;
       break;
     }
   }
   const double rel_x = ux - vsx, rel_y = uy - vsy;
   // cos and sin of yaw + mount_yaw by the angle sum.
   const double ca = c * cos_mount_ - s * sin_mount_, sa = s * cos_mount_ + c * sin_mount_;
+  dir_c = ca * mc + sa * ms;
+  dir_s = -sa * mc + ca * ms;
   const double scale = focal_length_px_ / (frame_rate_ * mount_height_);
   fx = (ca * rel_x + sa * rel_y) * scale;
   fy = (-sa * rel_x + ca * rel_y) * scale;
 }
 
-void Px4FlowUnit::Frame() {
-  double fx = 0.0, fy = 0.0;
+double Px4FlowUnit::Brightness(const models::Surface& surf, double t, double exposure_s) const {
+  if (!flicker_ || surf.flicker_depth <= 0.0 || surf.flicker_hz <= 0.0 || dark_) return 1.0;
+  const double total = surf.illumination_lux + added_light_;
+  if (total <= 0.0) return 1.0;
+  // Mean of sin(2 pi f tau + phase) over the exposure [t - T, t].
+  const double w = 2.0 * std::numbers::pi * surf.flicker_hz;
+  const double mean_sin =
+      (std::cos(w * (t - exposure_s) + flicker_phase_) - std::cos(w * t + flicker_phase_)) /
+      (w * exposure_s);
+  return 1.0 + surf.flicker_depth * surf.illumination_lux / total * mean_sin;
+}
+
+void Px4FlowUnit::BodyMotion(double rel_speed, const models::Surface& surf) {
+  const double dt = 1.0 / frame_rate_;
+  // The surface's profile under the four wheels, advanced by the distance
+  // the wheels roll over it in this frame (a first-order Gauss-Markov
+  // process in distance: correlation length roughness_length_m).
+  double pitch = 0.0, roll = 0.0, heave = 0.0;
+  if (shake_ && surf.roughness_m > 0.0) {
+    const double a = std::exp(-rel_speed * dt / surf.roughness_length_m);
+    const double b = std::sqrt(std::max(0.0, 1.0 - a * a)) * surf.roughness_m;
+    if (b > 0.0) {
+      for (double& c : contact_) c = a * c + b * IrwinHall4(rng_());
+    }
+    const double front = 0.5 * (contact_[0] + contact_[1]), rear = 0.5 * (contact_[2] + contact_[3]);
+    const double left = 0.5 * (contact_[0] + contact_[2]), right = 0.5 * (contact_[1] + contact_[3]);
+    pitch = -(front - rear) / wheelbase_;  // + nose down (about base_link y)
+    roll = (left - right) / track_;        // + left side up (about base_link x)
+    heave = 0.25 * (contact_[0] + contact_[1] + contact_[2] + contact_[3]);
+  }
+  // The body on its tyres: a second-order mode driven by the acceleration
+  // (semi-implicit Euler at the frame rate; stable for w dt < 2).
+  if (pitch_per_acceleration_ > 0.0 || roll_per_acceleration_ > 0.0) {
+    const double wn = 2.0 * std::numbers::pi * tyre_mode_frequency_;
+    const double target_pitch = -pitch_per_acceleration_ * accel_x_;
+    const double target_roll = roll_per_acceleration_ * accel_y_;
+    tyre_pitch_rate_ += dt * (wn * wn * (target_pitch - tyre_pitch_) -
+                              2.0 * tyre_mode_damping_ * wn * tyre_pitch_rate_);
+    tyre_pitch_ += dt * tyre_pitch_rate_;
+    tyre_roll_rate_ += dt * (wn * wn * (target_roll - tyre_roll_) -
+                             2.0 * tyre_mode_damping_ * wn * tyre_roll_rate_);
+    tyre_roll_ += dt * tyre_roll_rate_;
+    pitch += tyre_pitch_;
+    roll += tyre_roll_;
+  }
+  // The body's rotation over this frame (base_link): the chassis' rates and
+  // the change of the angles above.
+  double bx = roll - last_roll_, by = pitch - last_pitch_;
+  last_roll_ = roll;
+  last_pitch_ = pitch;
+  if (rotation_) {
+    bx += angular_velocity_[0] * dt;
+    by += angular_velocity_[1] * dt;
+  }
+  rot_x_ = cos_mount_ * bx + sin_mount_ * by;
+  rot_y_ = -sin_mount_ * bx + cos_mount_ * by;
+  // The lens' height over the surface: pitch lowers the front, roll raises the left.
+  height_ = mount_height_ + heave - pitch * mount_x_ + roll * mount_y_;
+}
+
+void Px4FlowUnit::Frame(double t_s) {
+  double fx = 0.0, fy = 0.0, dir_c = 1.0, dir_s = 0.0;
   int surface = 0;
-  TrueFlow(fx, fy, surface);
+  TrueFlowAndDirection(fx, fy, surface, dir_c, dir_s);
   const models::Surface& surf = surfaces_[static_cast<std::size_t>(surface)];
+  const double to_mps = frame_rate_ * mount_height_ / focal_length_px_;
+  BodyMotion(std::hypot(fx, fy) * to_mps, surf);
+  // The image moves by the translation at the real height, seen through
+  // this device's lens, plus the rotation (rad) times its focal length.
+  const double f_true = focal_length_px_ * focal_factor_;
+  const double k = focal_factor_ * mount_height_ / std::max(height_, 1e-3);
+  fx *= k;
+  fy *= k;
+  fx += rot_y_ * f_true;
+  fy -= rot_x_ * f_true;
+  // A periodic texture's period in the image (px, sensor frame).
+  periodic_share_ = periodic_texture_ && surf.texture_period_m > 0.0 ? surf.texture_periodic_share
+                                                                     : 0.0;
+  const double period_px = surf.texture_period_m * f_true / std::max(height_, 1e-3);
+  period_px_x_ = period_px * dir_c;
+  period_px_y_ = period_px * dir_s;
+  const double exposure_s = AutoExposure(cam_, Illuminance(surf)).exposure_s;
+  last_brightness_ = brightness_;
+  brightness_ = Brightness(surf, t_s, exposure_s);
+  if (frame_index_ == 1) last_brightness_ = brightness_;
   int q = 0;
   double flow_x = 0.0, flow_y = 0.0;
   if (image_) {
-    // The surface's velocity relative to the sensor (m/s, sensor frame).
-    const double to_mps = frame_rate_ * mount_height_ / focal_length_px_;
+    // The image model renders the displacement (fx, fy) px at mount_height.
+    image_->SetPeriodicTexture(surf.texture_period_m * mount_height_ / std::max(height_, 1e-3) *
+                                   focal_factor_,
+                               dir_c, dir_s, periodic_share_);
     const FlowResult r = image_->Step(fx * to_mps, fy * to_mps, mount_height_,
-                                      surf.texture_contrast, Illuminance(surf));
+                                      surf.texture_contrast, Illuminance(surf), brightness_);
     q = r.quality;
     flow_x = r.flow_x_px;
     flow_y = r.flow_y_px;
@@ -304,16 +471,49 @@ void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, i
                    std::sqrt(0.5 * (1.0 + 1.0 / (1.0 + br * br)));
   const double n2 = 2.0 * e.noise_dn * e.noise_dn + 1.0 / 6.0;
   const double n = std::sqrt(n2);
-  const double snr = d / std::max(e.noise_dn, 1e-9);
+  double snr = d / std::max(e.noise_dn, 1e-9);
+  double snr_sub = snr;  // the half-pixel refinement's
+  if (brightness_ != last_brightness_) {
+    // A brightness step between the frames: the mean SAD per pixel at the
+    // true offset is E|delta + n| (n the two frames' noise, std sqrt(n2)),
+    // at a wrong one E|delta + t| (t adds the texture difference: std d at
+    // a whole pixel, d / 2 at the half-pixel neighbours the refinement
+    // compares); the match's margin is their gap, which the step shrinks,
+    // the half-pixel one first.
+    const double delta = e.mean_dn * (brightness_ - last_brightness_);
+    const double s_wrong = std::sqrt(d * d + n2), s_half = std::sqrt(0.25 * d * d + n2);
+    const double gap0 = FoldedMean(0.0, s_wrong) - FoldedMean(0.0, n);
+    const double gap0_half = FoldedMean(0.0, s_half) - FoldedMean(0.0, n);
+    if (gap0 > 0.0) {
+      const double ratio = (FoldedMean(delta, s_wrong) - FoldedMean(delta, n)) / gap0;
+      snr *= std::pow(std::max(ratio, 0.0), kFlickerGapPower);
+    }
+    if (gap0_half > 0.0) {
+      snr_sub *= (FoldedMean(delta, s_half) - FoldedMean(delta, n)) / gap0_half;
+    }
+  }
   const double lost_ratio = kLostSnr / std::max(snr, 1e-9);
   const double p_true = 1.0 / (1.0 + lost_ratio * lost_ratio * lost_ratio);
-  const double sigma_b = std::min(kMatchNoise / std::max(snr, 1e-9), kMatchNoiseMax);
+  const double sigma_b = std::min(kMatchNoise / std::max(snr_sub, 1e-9), kMatchNoiseMax);
   const double S = static_cast<double>(search_range_);
   const double thr = static_cast<double>(feature_threshold_);
   const double edge = S + 0.5;  // largest offset the search can report
   const double beyond = std::max({std::abs(fx) - edge, std::abs(fy) - edge, 0.0});
   const double bb = beyond / kAliasScalePx;
   const double p_edge = beyond > 0.0 ? std::exp(-bb * bb) : 1.0;
+  // A periodic texture: the match one period off ties with the true one
+  // unless the aperiodic part (variance share 1 - s) tells them apart; it
+  // does as a block tells its true match from noise (the same lost-snr law).
+  double p_alias = 0.0;
+  bool alias_minus = false, alias_plus = false;
+  if (periodic_share_ > 0.0) {
+    const double snr_ap = snr * std::sqrt(1.0 - periodic_share_);
+    const double ratio = snr_ap / kLostSnr;
+    p_alias = 0.5 / (1.0 + ratio * ratio * ratio);
+    alias_minus = std::abs(fx - period_px_x_) <= edge && std::abs(fy - period_px_y_) <= edge;
+    alias_plus = std::abs(fx + period_px_x_) <= edge && std::abs(fy + period_px_y_) <= edge;
+    if (!alias_minus && !alias_plus) p_alias = 0.0;
+  }
 
   double sum_x = 0.0, sum_y = 0.0;
   int used = 0;
@@ -330,8 +530,15 @@ void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, i
       // is correlated over a few pixels), refined to half pixels.
       const double zx = sigma_b > 0.0 ? IrwinHall4(rng_()) : 0.0;
       const double zy = sigma_b > 0.0 ? IrwinHall4(rng_()) : 0.0;
-      ox = std::clamp(RoundHalf(fx + sigma_b * zx), -edge, edge);
-      oy = std::clamp(RoundHalf(fy + sigma_b * zy), -edge, edge);
+      double tx = fx, ty = fy;
+      if (p_alias > 0.0 && U16(r, 0) < p_alias) {
+        // One period off: x - p or x + p, whichever the window holds.
+        const bool minus = alias_minus && (!alias_plus || (r & 0x10000) != 0);
+        tx += minus ? -period_px_x_ : period_px_x_;
+        ty += minus ? -period_px_y_ : period_px_y_;
+      }
+      ox = std::clamp(RoundHalf(tx + sigma_b * zx), -edge, edge);
+      oy = std::clamp(RoundHalf(ty + sigma_b * zy), -edge, edge);
     } else if (u < p_true) {
       // Aliased: the true match lies outside the window; the SAD minimum
       // is an unrelated patch anywhere in it (wrong, not flagged).
@@ -357,23 +564,34 @@ void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, i
 
 void Px4FlowUnit::CommitFrame(int q, double flow_x, double flow_y) {
   const double dt = 1.0 / frame_rate_;
+  // The board gyro (sensor frame; z down the optical axis is the body z):
+  // the rotation of this frame as a rate, through its low-pass and read
+  // delay, plus its bias and noise, saturating at its range.
+  const double g_true[3] = {rot_x_ / dt, rot_y_ / dt, angular_velocity_[2]};
+  const double lag = gyro_lag_ > 0.0 ? 1.0 - std::exp(-dt / gyro_lag_) : 1.0;
+  double g[3];
+  for (int i = 0; i < 3; ++i) {
+    gyro_lagged_[i] += lag * (g_true[i] - gyro_lagged_[i]);
+    double r = gyro_lagged_[i] + bias_[i];
+    if (gyro_noise_ > 0.0) r += gyro_noise_ * Normal(rng_);
+    g[i] = std::clamp(r, -gyro_range_, gyro_range_);
+  }
   if (q > 0) {
     frame_quality_ = q;
     frame_flow_[0] = flow_x;
     frame_flow_[1] = flow_y;
     acc_x_ += flow_y / focal_length_px_;
     acc_y_ -= flow_x / focal_length_px_;
-    // The board gyro, in the sensor frame (z down the optical axis is the
-    // body z; the mount turns x, y by mount_yaw), saturating at its range.
-    const double cm = cos_mount_, sm = sin_mount_;
-    const double g[3] = {cm * angular_velocity_[0] + sm * angular_velocity_[1],
-                         -sm * angular_velocity_[0] + cm * angular_velocity_[1],
-                         angular_velocity_[2]};
-    for (int i = 0; i < 3; ++i) {
-      double r = g[i];
-      if (gyro_noise_ > 0.0) r += gyro_noise_ * Normal(rng_);
-      acc_gyro_[i] += std::clamp(r, -gyro_range_, gyro_range_) * dt;
+    // The firmware's compensation: minus the gyro's rotation in pixels
+    // (nominal focal length), the inverse of the rotation flow.
+    if (gyro_compensation_) {
+      comp_x_ += flow_x - g[1] * dt * focal_length_px_;
+      comp_y_ += flow_y + g[0] * dt * focal_length_px_;
+    } else {
+      comp_x_ += flow_x;
+      comp_y_ += flow_y;
     }
+    for (int i = 0; i < 3; ++i) acc_gyro_[i] += g[i] * dt;
     ++acc_count_;
     acc_quality_ += q;
   } else {
@@ -395,14 +613,15 @@ void Px4FlowUnit::Publish() {
   if (sonar_noise_ > 0.0) sonar += sonar_noise_ * Normal(rng_);
   distance_ = (sonar >= sonar_min_ && sonar <= sonar_max_) ? sonar : -1.0;
   if (acc_count_ > 0) {
-    // Surface relative to the sensor: +flow / f / T * h; flow_x = -f * integrated_y.
-    velocity_[0] = -acc_y_ / integration_time_ * mount_height_;
-    velocity_[1] = acc_x_ / integration_time_ * mount_height_;
+    // Surface relative to the sensor: +flow / f / T * h (the gyro-compensated
+    // flow when the firmware compensates).
+    velocity_[0] = comp_x_ / focal_length_px_ / integration_time_ * mount_height_;
+    velocity_[1] = comp_y_ / focal_length_px_ / integration_time_ * mount_height_;
     valid_ = 1.0;
   } else {
     valid_ = 0.0;
   }
-  acc_x_ = acc_y_ = 0.0;
+  acc_x_ = acc_y_ = comp_x_ = comp_y_ = 0.0;
   acc_gyro_[0] = acc_gyro_[1] = acc_gyro_[2] = 0.0;
   acc_count_ = acc_quality_ = 0;
   message_count_ += 1.0;
@@ -413,13 +632,27 @@ cosim::StepResult Px4FlowUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   if (!InputsFinite(t)) return cosim::StepResult::kError;
   const cosim::TimeNs t_end = t + dt;
   const double frame_ns = 1e9 / frame_rate_, publish_ns = 1e9 / publish_rate_;
+  // The body's acceleration in base_link over this step (the tyre mode's input).
+  {
+    const double c = std::cos(yaw_), s = std::sin(yaw_);
+    const double vx = c * linear_velocity_[0] + s * linear_velocity_[1];
+    const double vy = -s * linear_velocity_[0] + c * linear_velocity_[1];
+    const double step_s = cosim::NsToSeconds(dt);
+    if (have_last_velocity_ && step_s > 0.0) {
+      accel_x_ = (vx - last_vx_) / step_s;
+      accel_y_ = (vy - last_vy_) / step_s;
+    }
+    last_vx_ = vx;
+    last_vy_ = vy;
+    have_last_velocity_ = true;
+  }
   // Frames and messages inside (t, t_end], in time order (a frame at the
   // same time as a message goes into it).
   while (next_frame_ <= t_end || next_publish_ <= t_end) {
     if (next_frame_ <= next_publish_) {
       const double frame_s = cosim::NsToSeconds(next_frame_);
       dark_ = frame_s >= dark_from_ && frame_s < dark_until_;
-      Frame();
+      Frame(frame_s);
       ++frame_index_;
       next_frame_ = start_ + static_cast<cosim::TimeNs>(
                                  std::llround(frame_ns * static_cast<double>(frame_index_)));
@@ -442,13 +675,20 @@ void Px4FlowUnit::SaveInternal(cosim::UnitState& state) const {
   std::ostringstream rng;
   rng << rng_;
   state.strings = {rng.str()};
-  state.reals = {acc_x_, acc_y_, acc_gyro_[0], acc_gyro_[1], acc_gyro_[2]};
+  state.reals = {acc_x_,       acc_y_,          acc_gyro_[0],     acc_gyro_[1],
+                 acc_gyro_[2], comp_x_,         comp_y_,          focal_factor_,
+                 bias_[0],     bias_[1],        bias_[2],         contact_[0],
+                 contact_[1],  contact_[2],     contact_[3],      tyre_pitch_,
+                 tyre_pitch_rate_, tyre_roll_,  tyre_roll_rate_,  last_pitch_,
+                 last_roll_,   gyro_lagged_[0], gyro_lagged_[1],  gyro_lagged_[2],
+                 accel_x_,     accel_y_,        last_vx_,         last_vy_,
+                 have_last_velocity_ ? 1.0 : 0.0, brightness_,    flicker_phase_};
   state.integers = {start_,         next_frame_, next_publish_, frame_index_,
                     publish_index_, acc_count_,  acc_quality_};
 }
 
 void Px4FlowUnit::RestoreInternal(const cosim::UnitState& state) {
-  if (state.strings.size() != 1 || state.reals.size() != 5 || state.integers.size() != 7) {
+  if (state.strings.size() != 1 || state.reals.size() != 31 || state.integers.size() != 7) {
     throw cosim::UnitError(Where() + ": saved state has the wrong shape");
   }
   std::istringstream rng_text(state.strings[0]);
@@ -456,9 +696,29 @@ void Px4FlowUnit::RestoreInternal(const cosim::UnitState& state) {
   rng_text >> rng;
   if (!rng_text) throw cosim::UnitError(Where() + ": saved generator state is not readable");
   rng_ = rng;
-  acc_x_ = state.reals[0];
-  acc_y_ = state.reals[1];
-  for (int i = 0; i < 3; ++i) acc_gyro_[i] = state.reals[static_cast<std::size_t>(2 + i)];
+  const auto& r = state.reals;
+  acc_x_ = r[0];
+  acc_y_ = r[1];
+  for (int i = 0; i < 3; ++i) acc_gyro_[i] = r[static_cast<std::size_t>(2 + i)];
+  comp_x_ = r[5];
+  comp_y_ = r[6];
+  focal_factor_ = r[7];
+  for (int i = 0; i < 3; ++i) bias_[i] = r[static_cast<std::size_t>(8 + i)];
+  for (int i = 0; i < 4; ++i) contact_[i] = r[static_cast<std::size_t>(11 + i)];
+  tyre_pitch_ = r[15];
+  tyre_pitch_rate_ = r[16];
+  tyre_roll_ = r[17];
+  tyre_roll_rate_ = r[18];
+  last_pitch_ = r[19];
+  last_roll_ = r[20];
+  for (int i = 0; i < 3; ++i) gyro_lagged_[i] = r[static_cast<std::size_t>(21 + i)];
+  accel_x_ = r[24];
+  accel_y_ = r[25];
+  last_vx_ = r[26];
+  last_vy_ = r[27];
+  have_last_velocity_ = r[28] != 0.0;
+  brightness_ = r[29];
+  flicker_phase_ = r[30];
   start_ = state.integers[0];
   next_frame_ = state.integers[1];
   next_publish_ = state.integers[2];

@@ -63,6 +63,42 @@ namespace linesim::sensors {
 /// += frame interval, integrated_gyro += gyro * frame interval, quality sum;
 /// published and reset at publish_rate.
 ///
+/// Disturbances (issue 21: each a mechanism of the device, with its unit
+/// parameter and source in models/sensors/px4flow.yaml, each switchable
+/// off) act on the image motion before the matcher, or on the firmware's
+/// arithmetic after it, identically in both modes:
+///  - rotation: the body's roll and pitch rates (the chassis' angular
+///    velocity) plus the mount's shake add the apparent flow omega f /
+///    frame_rate px per frame (omega x h in metres); the sensor's real
+///    height (the chassis' z and attitude plus the shake's heave) scales
+///    the translation flow, while the firmware converts with mount_height.
+///  - shake: the wheels roll over the surface's height profile (scene
+///    surface roughness_m, roughness_length_m): four Gauss-Markov contact
+///    heights in travelled distance give the body's pitch, roll and heave
+///    (a rigid body on stiff tyres follows the profile).
+///  - acceleration pitch: the body pitches and rolls on its tyres' compliance
+///    under horizontal acceleration (pitch_per_acceleration, a second-order
+///    mode at tyre_mode_frequency): nose up when speeding up, so the
+///    rotation flow first opposes the translation (PX4-Flow #23).
+///  - gyro compensation (gyro_compensation, paper 1 Sec. IV-A: the flow is
+///    compensated "using on-board gyroscope"): the frame flow minus the
+///    board gyro's rate (lagged by gyro_lag, with gyro_bias drawn per
+///    device and gyro_noise) times f / frame_rate; the residual is the
+///    gyro's error times h.
+///  - flicker: the ambient light (not the robot's own) of a surface with
+///    flicker_hz and flicker_depth changes between exposures; the SAD is
+///    not brightness invariant, so a brightness step Delta between frames
+///    shrinks the SAD gap between the true and a wrong offset (fast model:
+///    the snr scaled by that gap, from folded-normal means; image model:
+///    the frame rendered brighter or darker).
+///  - periodic texture (surface texture_period_m, texture_periodic_share):
+///    a block may match one period off (x - p or x + p) when its aperiodic
+///    part cannot tell them apart.
+///  - scale: the lens' focal length differs per device by a draw of
+///    sigma scale_error from the unit's seed (the firmware uses the nominal
+///    focal_length_px).
+///  - the compute rate: frame_rate.
+///
 /// With `mode: image` each frame is rendered and matched instead
 /// (Px4FlowImageModel: the 64 x 64 binned image of the surface's procedural
 /// texture with its exposure, blur and noise, and the firmware's SAD search
@@ -83,7 +119,8 @@ class Px4FlowUnit : public cosim::Unit {
   void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
   void Initialize() override;
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
-  /// True flow (px per frame, sensor frame) at the current inputs.
+  /// True flow (px per frame, sensor frame) at the current inputs, of the
+  /// translation only, at mount_height and the nominal focal length.
   void TrueFlow(double& fx, double& fy, int& surface) const;
 
  protected:
@@ -92,13 +129,24 @@ class Px4FlowUnit : public cosim::Unit {
 
  private:
   void CacheCamera();
-  void Frame();
+  /// TrueFlow, and the direction of the surface's length (its belt's
+  /// direction, map x for the floor) in the sensor frame.
+  void TrueFlowAndDirection(double& fx, double& fy, int& surface, double& dir_c,
+                            double& dir_s) const;
+  void Frame(double t_s);
   /// The fast model's frame: quality and flow (px) of the true flow (fx, fy)
   /// over surface `surf`; q stays 0 with 10 or fewer blocks.
   void FastFrame(double fx, double fy, const models::Surface& surf, int& q, double& flow_x,
                  double& flow_y);
   /// Integrates a frame of quality q (> 0: counted) into OPTICAL_FLOW_RAD.
   void CommitFrame(int q, double flow_x, double flow_y);
+  /// Advances the body's shake and acceleration pitch by one frame; sets
+  /// rot_x_, rot_y_ (the sensor's rotation over the frame, rad, sensor
+  /// frame) and height_ (m).
+  void BodyMotion(double rel_speed, const models::Surface& surf);
+  /// The ambient light's brightness over the exposure ending at time t (s),
+  /// relative to its mean (1 without flicker).
+  double Brightness(const models::Surface& surf, double t, double exposure_s) const;
   void Publish();
   /// The light on `surf` under the sensor (0 in an injected dark spell).
   double Illuminance(const models::Surface& surf) const {
@@ -129,6 +177,13 @@ class Px4FlowUnit : public cosim::Unit {
   bool dark_ = false;  // the frame being computed falls in it
   double sonar_noise_ = 0.005, sonar_min_ = 0.12, sonar_max_ = 3.5;
   double gyro_noise_ = 0.0, gyro_range_ = 4.363323129985824;  // 250 deg/s
+  bool gyro_compensation_ = false;
+  double gyro_bias_ = 0.0, gyro_lag_ = 0.0, scale_error_ = 0.0;
+  double pitch_per_acceleration_ = 0.0, roll_per_acceleration_ = 0.0;
+  double tyre_mode_frequency_ = 15.0, tyre_mode_damping_ = 0.1;
+  double wheelbase_ = 0.736, track_ = 0.32;
+  // Mechanisms switched off one at a time (their share in the error).
+  bool rotation_ = true, shake_ = true, flicker_ = true, periodic_texture_ = true;
 
   // Inputs.
   std::vector<double> position_, linear_velocity_, angular_velocity_, belt_velocity_;
@@ -155,6 +210,27 @@ class Px4FlowUnit : public cosim::Unit {
   std::int64_t frame_index_ = 0, publish_index_ = 0;
   double acc_x_ = 0.0, acc_y_ = 0.0, acc_gyro_[3] = {0, 0, 0};
   std::int64_t acc_count_ = 0, acc_quality_ = 0;
+  // The firmware's gyro-compensated flow sums (px), for `velocity`.
+  double comp_x_ = 0.0, comp_y_ = 0.0;
+  // Per device (drawn from the seed at Initialize): focal length factor and gyro bias.
+  double focal_factor_ = 1.0, bias_[3] = {0, 0, 0};
+  // Body motion state: contact heights (m) front-left, front-right,
+  // rear-left, rear-right; tyre-mode pitch and roll (rad) and their rates;
+  // the previous frame's body angles; the lagged gyro (rad/s, sensor frame).
+  double contact_[4] = {0, 0, 0, 0};
+  double tyre_pitch_ = 0.0, tyre_pitch_rate_ = 0.0, tyre_roll_ = 0.0, tyre_roll_rate_ = 0.0;
+  double last_pitch_ = 0.0, last_roll_ = 0.0;
+  double gyro_lagged_[3] = {0, 0, 0};
+  // Body acceleration (m/s^2, base_link) over the current step.
+  double accel_x_ = 0.0, accel_y_ = 0.0, last_vx_ = 0.0, last_vy_ = 0.0;
+  bool have_last_velocity_ = false;
+  // The frame being computed: rotation (rad, sensor frame), height (m),
+  // brightness and the previous frame's brightness.
+  double rot_x_ = 0.0, rot_y_ = 0.0, height_ = 0.0, brightness_ = 1.0, last_brightness_ = 1.0;
+  double flicker_phase_ = 0.0;  // mains phase at the start (rad), drawn per run
+  // The period of the frame's surface texture in the sensor frame (px; 0: none).
+  double period_px_x_ = 0.0, period_px_y_ = 0.0;
+  double periodic_share_ = 0.0;
 };
 
 }  // namespace linesim::sensors

@@ -141,5 +141,52 @@ TEST(SurfaceVelocityError, MountsAreRequired) {
   EXPECT_THROW(SurfaceVelocityErrorUnit("e", 0, Treadmill()), cosim::UnitError);
 }
 
+
+// Plateaus and settling (issue 21 item 2): one sensor over the belt, robot
+// at rest; the reference is 0 until 2 s, ramps to 0.2 m/s over 1 s, holds;
+// the estimate follows it as a first-order lag of 0.5 s and the raw reads
+// the reference + 0.01 m/s. Plateau samples (reference within 1 cm/s of
+// its level for 1 s): t < 2 s after the first 1 s, and t >= 3 s + 1 s; the
+// raw error there is 0.01 exactly, the filtered error on the off plateau 0.
+// Settling: the lag behind a ramp of slope a with time constant tau is
+// a tau (1 - e^(-t/tau)), at the ramp's end 0.2 * 0.5 (1 - e^-2) = 0.0865,
+// then decays as e^(-(t - 3)/tau): below 0.02 m/s after tau ln(0.0865 /
+// 0.02) = 0.732 s, so the estimate is last off by more than 2 cm/s at
+// 3.732 s; the switch was seen where the reference had moved 1 cm/s, at
+// 2.05 s: settling 1.682 s (to the 1 ms step).
+TEST(SurfaceVelocityError, PlateauRmseAndSettlingTime) {
+  SurfaceVelocityErrorUnit u("e", 1, Treadmill(), true);
+  SetArray(u, "mount_x", {0.0});
+  SetArray(u, "mount_y", {0.0});
+  SetArray(u, "mount_yaw", {0.0});
+  u.Initialize();
+  const double tau = 0.5, dt = 0.001;
+  double est = 0.0;
+  for (int k = 0; k < 6000; ++k) {
+    const double t = k * dt;
+    const double ref = t < 2.0 ? 0.0 : (t < 3.0 ? 0.2 * (t - 2.0) : 0.2);
+    Set(u, "reference", ref);
+    SetArray(u, "measured", {ref + 0.01, 0.0});
+    SetArray(u, "estimated", {est, 0.0});
+    ASSERT_EQ(u.DoStep(static_cast<cosim::TimeNs>(k) * 1'000'000, 1'000'000),
+              cosim::StepResult::kOk);
+    est += (ref - est) * (1.0 - std::exp(-dt / tau));
+  }
+  EXPECT_NEAR(Get(u, "rmse_plateau")[0], 0.01, 1e-12);
+  // The filtered error on the plateaus: 0 on the off plateau (t in [1,
+  // 2.05): 1050 samples), the lag 0.0865 e^(-(t - 3)/tau) on the on plateau,
+  // which starts 1 s after the reference's last step of 1 cm/s, between
+  // 2.95 and 3 s: the mean square is between those of the two starts.
+  auto rms_from = [&](double start) {
+    const double on = 0.0865 * 0.0865 * tau / 2.0 *
+                      (std::exp(-2.0 * (start - 3.0) / tau) - std::exp(-2.0 * 3.0 / tau));
+    return std::sqrt(on / ((6.0 - start) + 1.05) / 1.0);
+  };
+  EXPECT_GT(Get(u, "rmse_plateau_estimated")[0], rms_from(4.0) * 0.99);
+  EXPECT_LT(Get(u, "rmse_plateau_estimated")[0], rms_from(3.95) * 1.01);
+  EXPECT_EQ(Get(u, "switches")[0], 1.0);
+  EXPECT_NEAR(Get(u, "settling_time")[0], 1.682, 0.003);
+}
+
 }  // namespace
 }  // namespace linesim::evaluation
