@@ -409,6 +409,59 @@ const std::map<std::string, Provider>& SurfaceVelocityProviders() {
          s.recorded.push_back(Signal(kSurfaceEstimator, "wheel_source"));
          s.recorded.push_back(Signal(kSurfaceEstimator, "sensor_status"));
          s.recorded.push_back(Signal(kSurfaceEstimator, "switch_count"));
+       }},
+      // Paper 1's future work (Sec. VI-D): each belt's velocity from the
+      // laser localization's velocity minus the wheel encoders, and the
+      // PX4Flow with the encoders as the robot's motion, in one Kalman
+      // filter per belt (units/estimation/surface_fusion_unit.h).
+      {"fused_flow", [](SystemBuilder& b, const ProviderContext& c, Signals& s) {
+         constexpr const char* kFusion = "surface_fusion";
+         const bool flows_on = Require(b, c, s, "px4flow", "fused_flow");
+         const bool encoders_on = Require(b, c, s, "wheel_encoder", "fused_flow");
+         if (!flows_on || !encoders_on) return;
+         if (!b.HasUnit(kLaserLocalization)) {
+           b.reader().Error(c.at, c.path,
+                            "'fused_flow' needs the laser localization's velocity: "
+                            "localization.source laser or fused");
+           return;
+         }
+         const auto flows = Mounts(s, "px4flow");
+         const models::RobotDescription& robot = c.file.robot;
+         b.Unit(kFusion, "surface_fusion");
+         YAML::Node p = b.Params(kFusion);
+         p["sensors"] = static_cast<int>(flows.size());
+         p["wheels"] = static_cast<int>(robot.wheels.size());
+         std::vector<double> sx, sy, syaw;
+         for (std::size_t k = 0; k < flows.size(); ++k) {
+           const models::SensorMount& m = *flows[k];
+           sx.push_back(m.x_m);
+           sy.push_back(m.y_m);
+           syaw.push_back(m.yaw_rad);
+           for (std::size_t i = 0; i < 2; ++i) {
+             b.Connect(Element(m.name, "velocity", i),
+                       Element(kFusion, "sensor_velocity", 2 * k + i));
+           }
+           b.Connect(Signal(m.name, "valid"), Element(kFusion, "sensor_valid", k));
+           b.Connect(Signal(m.name, "quality"), Element(kFusion, "sensor_quality", k));
+           b.Connect(Signal(m.name, "message_count"),
+                     Element(kFusion, "sensor_message_count", k));
+         }
+         p["sensor_x"] = List(sx);
+         p["sensor_y"] = List(sy);
+         p["sensor_yaw"] = List(syaw);
+         SetWheelPositions(p, robot);
+         if (s.odometry.empty()) AddOdometry(b, c, s);
+         b.Connect(Signal(s.odometry, "wheel_velocity"), Signal(kFusion, "wheel_velocity"));
+         b.Connect(Signal(kLaserLocalization, "position"), Signal(kFusion, "laser_position"));
+         b.Connect(Signal(kLaserLocalization, "match_time"), Signal(kFusion, "match_time"));
+         b.Connect(Signal(kLaserLocalization, "match_count"), Signal(kFusion, "match_count"));
+         b.Connect(s.position, Signal(kFusion, "position"));
+         b.Connect(s.yaw, Signal(kFusion, "yaw"));
+         SetStep(b, kFusion);
+         s.surface_velocity = Signal(kFusion, "wheel_surface_velocity");
+         s.surface_estimate = Signal(kFusion, "sensor_surface_velocity");
+         s.recorded.push_back(Signal(kFusion, "belt_velocity"));
+         s.recorded.push_back(Signal(kFusion, "switch_count"));
        }}};
   return providers;
 }

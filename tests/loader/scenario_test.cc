@@ -547,7 +547,7 @@ TEST(LoadScenario, SetWithoutValueIsRefusedNamingWhatTheKeyTakes) {
   const std::string cross = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
   std::string e = Issues(cross, {"sensing.surface_velocity="});
   EXPECT_TRUE(Has(e, "sensing.surface_velocity (set on the command line): no value given (--set "
-                     "sensing.surface_velocity=): expected one of ground_truth, none, px4flow"))
+                     "sensing.surface_velocity=): expected one of fused_flow, ground_truth, none, px4flow"))
       << e;
   e = Issues(cross, {"sensing.surface_velocity= "});
   EXPECT_TRUE(Has(e, "sensing.surface_velocity (set on the command line): no value given")) << e;
