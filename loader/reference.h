@@ -15,14 +15,20 @@ struct ReferenceFigures {
   std::string metric;
   std::string label;  // the column's heading, e.g. "X (m)"
   double max_abs = 0.0, std = 0.0, mean_abs = 0.0;
+  /// What makes this metric's spread in the simulation (optional, for the
+  /// written table).
+  std::string note;
 };
 
-/// `reference: {title, metrics: {METRIC: {label, max_abs, std, mean_abs}}}`
-/// of a scenario or sweep file: what repeated runs print beside their own
-/// figures. An empty title means none.
+/// `reference: {title, file, metrics: {METRIC: {label, max_abs, std,
+/// mean_abs, note}}}` of a scenario or sweep file: what repeated runs print
+/// beside their own figures, and write as FILE.csv and FILE.md beside
+/// summary.json (file: [A-Za-z0-9_-], default "reference"). An empty title
+/// means none.
 struct Reference {
   std::string title;
   std::vector<ReferenceFigures> metrics;
+  std::string file = "reference";
 };
 
 /// Reads the `reference` node of a file (absent: an empty Reference),

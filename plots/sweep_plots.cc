@@ -146,11 +146,47 @@ std::string HistogramScript(const SweepChart& chart, std::size_t index) {
     s += Num(lo + (b + 0.5) * width) + " " + std::to_string(counts[static_cast<std::size_t>(b)]) +
          "\n";
   }
+  // The x range: the bins, the fitted normal's +-3 std and the source's
+  // marks.
+  const SweepChart::Reference& ref = chart.reference;
+  const bool marked = !ref.label.empty();
+  double x0 = lo, x1 = hi;
+  if (sd > 0.0) {
+    x0 = std::min(x0, mean - 3.0 * sd);
+    x1 = std::max(x1, mean + 3.0 * sd);
+  }
+  if (marked && std::isfinite(ref.max_abs)) {
+    x0 = std::min(x0, -ref.max_abs);
+    x1 = std::max(x1, ref.max_abs);
+  }
+  if (marked && std::isfinite(ref.std) && ref.std > 0.0) {
+    x0 = std::min(x0, -3.0 * ref.std);
+    x1 = std::max(x1, 3.0 * ref.std);
+  }
+  const double pad = 0.05 * (x1 - x0);
   s += "EOD\nset output " + GnuplotQuote(chart.file) + "\nset title " +
        GnuplotQuote(chart.title) + "\nset xlabel " + GnuplotQuote(chart.x_label) +
-       "\nset ylabel 'runs'\nset autoscale x\nset xtics autofreq\nset key title ''\n"
-       "set yrange [0:*]\nset ytics 1\n"
+       "\nset ylabel 'runs'\nset xrange [" + Num(x0 - pad) + ":" + Num(x1 + pad) +
+       "]\nset xtics autofreq\nset key title ''\n"
+       "set yrange [0:*]\nset ytics 1\nunset arrow\n"
        "set boxwidth " + Num(width) + " absolute\nset style fill solid 0.5 border -1\n";
+  std::string extra;
+  if (marked && std::isfinite(ref.max_abs)) {
+    for (const double x : {-ref.max_abs, ref.max_abs}) {
+      s += "set arrow from " + Num(x) + ", graph 0 to " + Num(x) +
+           ", graph 1 nohead lw 2 lc rgb '#cc0000' dt 2\n";
+    }
+    std::string what = ref.label + ": max |error| " + Short(ref.max_abs);
+    if (std::isfinite(ref.mean_abs)) what += ", mean |error| " + Short(ref.mean_abs);
+    extra += ", \\\n     NaN with lines lw 2 lc rgb '#cc0000' dt 2 title " + GnuplotQuote(what);
+  }
+  if (marked && std::isfinite(ref.std) && ref.std > 0.0) {
+    const std::string k = Num(n * width / (ref.std * std::sqrt(2.0 * std::numbers::pi)));
+    extra += ", \\\n     [" + Num(-4.0 * ref.std) + ":" + Num(4.0 * ref.std) + "] " + k +
+             " * exp(-0.5 * (x / " + Num(ref.std) +
+             ") ** 2) with lines lw 2 lc rgb '#cc0000' dt 3 title " +
+             GnuplotQuote(ref.label + ": std " + Short(ref.std) + " (as N(0, std))");
+  }
   s += "plot " + block + " using 1:2 with boxes lt 1 title " +
        GnuplotQuote(std::to_string(v.size()) + " runs, bins of " + Short(width));
   if (sd > 0.0) {
@@ -160,8 +196,9 @@ std::string HistogramScript(const SweepChart& chart, std::size_t index) {
          ") ** 2) with lines lw 2 lt 2 title " +
          GnuplotQuote("normal: mean " + Short(mean) + ", std " + Short(sd));
   }
+  s += extra;
   // The next chart scales its own axes.
-  return s + "\nset autoscale y\nset ytics autofreq\n";
+  return s + "\nunset arrow\nset autoscale x\nset autoscale y\nset ytics autofreq\n";
 }
 
 // The script lines of one chart; empty when it has nothing to draw.

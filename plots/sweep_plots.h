@@ -33,6 +33,15 @@ struct SweepChart {
   /// scaled to counts over it (as paper 2's Figs. 6-11 show a histogram and
   /// its normal distribution). `x_label` names the sample's quantity.
   bool histogram = false;
+  /// A source's figures marked on a histogram (when `label` is not empty):
+  /// +-max_abs as vertical lines and the zero-mean normal of `std` scaled
+  /// to counts, dashed (NaN figures are left out; paper 2's Table 1 gives
+  /// these three of its signed errors, not their mean); mean_abs is named
+  /// in the legend. The x range widens to show them.
+  struct Reference {
+    std::string label;
+    double max_abs = 0.0, std = 0.0, mean_abs = 0.0;
+  } reference;
   std::vector<SweepSeries> series;
 };
 

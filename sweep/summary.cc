@@ -14,6 +14,7 @@
 
 #include "cosim/files.h"
 #include "cosim/variable_table.h"
+#include "sweep/results_file.h"
 
 namespace linesim::sweep {
 
@@ -312,6 +313,12 @@ void PrintOverall(const SweepTable& t, const Rows& all, std::ostream& out) {
                     Sig4(s.mean_abs)});
   }
   PrintColumns(rows, {false, true, true, false, false, true, true}, out);
+  std::string constant;
+  for (std::size_t m = 0; m < t.metrics.size(); ++m) {
+    const Stats s = StatsOf(OkValues(all, m));
+    if (s.n > 1 && s.min == s.max) constant += (constant.empty() ? "" : ", ") + t.metrics[m];
+  }
+  if (!constant.empty()) out << "the same in every run (no histogram): " << constant << "\n";
 }
 
 // The reference's table: a row per figure, a column per metric, ours beside
@@ -584,7 +591,15 @@ std::vector<plots::SweepChart> SweepCharts(const SweepTable& t) {
       chart.x_label = t.metrics[m];
       plots::SweepSeries samples;
       samples.mean = OkValues(all, m);
-      if (StatsOf(samples.mean).n == 0) continue;
+      const Stats st = StatsOf(samples.mean);
+      // A metric the same in every run has no distribution to draw (the
+      // summary says its value).
+      if (st.n == 0 || st.min == st.max) continue;
+      for (const auto& ref : t.reference.metrics) {
+        if (ref.metric != t.metrics[m]) continue;
+        chart.reference = {t.reference.title, ref.max_abs, ref.std, ref.mean_abs};
+        chart.x_label = ref.label;
+      }
       chart.series.push_back(std::move(samples));
       chart.file = UniqueFile(plots::SafeFileName(t.metrics[m] + "_histogram.png"), taken);
       charts.push_back(std::move(chart));
@@ -625,11 +640,67 @@ std::vector<plots::SweepChart> SweepCharts(const SweepTable& t) {
   return charts;
 }
 
+std::vector<std::string> WriteReferenceTable(const std::string& dir, const SweepTable& t) {
+  if (t.reference.title.empty()) return {};
+  const Rows all = AllRows(t);
+  std::vector<Stats> ours;
+  for (const auto& ref : t.reference.metrics) ours.push_back(StatsOf(OkValues(all, MetricIndex(t, ref.metric))));
+  const auto num = [](double x) { return std::isfinite(x) ? cosim::FormatValue(x) : std::string(); };
+  std::string csv = "metric,label,figure,ours,reference\n";
+  for (std::size_t i = 0; i < ours.size(); ++i) {
+    const auto& ref = t.reference.metrics[i];
+    const Stats& s = ours[i];
+    std::string head = JoinCsvLine({ref.metric, ref.label});  // ends in a newline
+    head.back() = ',';
+    csv += head + "max_abs," + num(s.max_abs) + "," + num(ref.max_abs) + "\n";
+    csv += head + "std," + num(s.std) + "," + num(ref.std) + "\n";
+    csv += head + "mean_abs," + num(s.mean_abs) + "," + num(ref.mean_abs) + "\n";
+    csv += head + "mean," + num(s.mean) + ",\n";
+    csv += head + "min," + num(s.min) + ",\n";
+    csv += head + "max," + num(s.max) + ",\n";
+    csv += head + "runs," + std::to_string(s.n) + ",\n";
+  }
+  // Markdown: the source's layout (a row per figure), two columns per
+  // metric (ours, the reference's); then what makes each metric.
+  const auto ref_cell = [](double v) { return std::isfinite(v) ? Sig4(v) : std::string("-"); };
+  std::string md = "# " + t.reference.title + "\n\nOurs: " + t.name + ", " +
+                   std::to_string(all.size()) + " runs (" +
+                   std::to_string(static_cast<std::int64_t>(all.size()) - CountFailed(all)) +
+                   " ok).\n\n|  |";
+  std::string rule = "|---|", max_row = "| maximum absolute error |", std_row = "| standard deviation |",
+              mean_row = "| mean absolute error |", dist_row = "| mean [min, max] |";
+  for (std::size_t i = 0; i < ours.size(); ++i) {
+    const auto& ref = t.reference.metrics[i];
+    const Stats& s = ours[i];
+    md += " " + ref.label + ", ours | " + ref.label + ", reference |";
+    rule += "---|---|";
+    max_row += " " + Sig4(s.max_abs) + " | " + ref_cell(ref.max_abs) + " |";
+    std_row += " " + Sig4(s.std) + " | " + ref_cell(ref.std) + " |";
+    mean_row += " " + Sig4(s.mean_abs) + " | " + ref_cell(ref.mean_abs) + " |";
+    dist_row += " " + Sig4(s.mean) + " [" + Sig4(s.min) + ", " + Sig4(s.max) + "] | - |";
+  }
+  md += "\n" + rule + "\n" + max_row + "\n" + std_row + "\n" + mean_row + "\n" + dist_row + "\n";
+  bool notes = false;
+  for (const auto& ref : t.reference.metrics) notes = notes || !ref.note.empty();
+  if (notes) {
+    md += "\nWhat makes each column in the simulation:\n\n";
+    for (const auto& ref : t.reference.metrics) {
+      if (!ref.note.empty()) md += "- " + ref.label + ": " + ref.note + "\n";
+    }
+  }
+  fs::create_directories(dir);
+  const fs::path base = fs::path(dir) / t.reference.file;
+  cosim::WriteFileAtomically(base.string() + ".csv", csv);
+  cosim::WriteFileAtomically(base.string() + ".md", md);
+  return {base.string() + ".csv", base.string() + ".md"};
+}
+
 std::vector<std::string> WriteSweepReport(const std::string& dir, const SweepTable& t) {
   Json summary = Summarize(t);
   fs::create_directories(dir);
   const fs::path summary_path = fs::path(dir) / "summary.json";
   std::vector<std::string> written{summary_path.string()};
+  const std::vector<std::string> tables = WriteReferenceTable(dir, t);
   // The numbers matter more than the pictures: a plot failure is recorded,
   // not thrown.
   try {
@@ -646,6 +717,7 @@ std::vector<std::string> WriteSweepReport(const std::string& dir, const SweepTab
   // Run errors and gnuplot's text may hold bytes that are not UTF-8.
   cosim::WriteFileAtomically(summary_path.string(),
                              summary.dump(2, ' ', false, Json::error_handler_t::replace) + "\n");
+  written.insert(written.begin() + 1, tables.begin(), tables.end());
   return written;
 }
 

@@ -67,8 +67,19 @@ void PrintSummary(const SweepTable& table, std::ostream& out);
 /// scatter of the runs. Charts without ok runs are left out.
 std::vector<plots::SweepChart> SweepCharts(const SweepTable& table);
 
-/// Writes `dir`/summary.json (through a temporary file and a rename) and
-/// the plots of SweepCharts; returns the paths written, summary.json first.
+/// With a reference: writes `dir`/FILE.csv (metric, label, figure, ours,
+/// reference: max_abs, std, mean_abs of both; mean, min, max and runs of
+/// ours) and `dir`/FILE.md (the source's table, ours | theirs per cell, our
+/// mean and range, and each metric's note), FILE the reference's `file`;
+/// returns their paths (none without a reference). Throws
+/// std::runtime_error when they cannot be written.
+std::vector<std::string> WriteReferenceTable(const std::string& dir, const SweepTable& table);
+
+/// Writes `dir`/summary.json (through a temporary file and a rename), the
+/// reference's table (WriteReferenceTable) and the plots of SweepCharts
+/// (a histogram for each metric that varies over the runs, with the
+/// reference's figures marked); returns the paths written, summary.json
+/// first.
 /// A plot failure (no gnuplot, gnuplot errors) does not throw: summary.json
 /// then says {"plots": {"error": text}} instead of {"plots": {"files":
 /// [names]}}. Throws std::runtime_error when summary.json cannot be written.

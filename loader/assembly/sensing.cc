@@ -193,6 +193,12 @@ void AddPerfectMatch(SystemBuilder& b, const ProviderContext& c, Signals& s) {
     if (const auto v = device.Get("range_min")) range_min = std::max(range_min.value_or(0.0), *v);
     if (const auto v = device.Get("bias_sigma")) bias_sigma = std::max(bias_sigma.value_or(0.0), *v);
   });
+  // The maps a laser built by SLAM (source: own_laser) carry its device's
+  // range bias.
+  for (std::size_t k = 0; k < lasers.size(); ++k) {
+    b.Connect(Signal(lasers[k]->name, "range_bias"),
+              Signal(kPerfectMatch, "mapping_range_bias_" + std::to_string(k)));
+  }
   if (range_min) p["range_min"] = Num(*range_min);
   if (bias_sigma) p["range_bias_sigma"] = Num(*bias_sigma);
   // 3 DoF as paper 2's matcher: every map is a slice at the first laser's
@@ -211,12 +217,12 @@ void AddPerfectMatch(SystemBuilder& b, const ProviderContext& c, Signals& s) {
     for (std::size_t i = 0; i < given.size(); ++i) {
       const std::string path = JoinPath("localization.maps", std::to_string(i));
       if (!r.ExpectMap(given[i], path)) continue;
-      r.CheckKeys(given[i], path, {"name", "floor_m", "region", "cell_m"});
+      r.CheckKeys(given[i], path, {"name", "floor_m", "region", "cell_m", "source"});
       YAML::Node one;
       const std::string name = r.String(given[i], path, "name", std::nullopt);
       one["name"] = name;
       one["height_m"] = Num(r.Real(given[i], path, "floor_m", 0.0, {-10.0, 100.0}) + scan_z);
-      for (const char* key : {"region", "cell_m"}) {
+      for (const char* key : {"region", "cell_m", "source"}) {
         if (Child(given[i], key).IsDefined()) one[key] = Child(given[i], key);
       }
       maps.push_back(one);

@@ -693,19 +693,20 @@ TEST(RobotScenario, PayloadReachesTheChassis) {
   EXPECT_EQ(Param(bare, "chassis", "payload_mass"), 0.0);
 }
 
-// Guards the van bay's header: one key sets the bump's height (its top is
-// center_m.2 + 0.01, 6 mm above the 0.54 m van floor by default).
+// Guards the van bay's header: one key sets the floor irregularity's height
+// (its top is center_m.2 + 0.01: by default 5 mm below the 0.54 m van
+// floor's top, i.e. none; 0.54 makes it 1 cm).
 TEST(RobotScenario, VanBayBumpHeightIsOneKey) {
   const std::string file = WriteScenario("van_entry_bump.yaml", kVanEntry);
   const Scenario s = LoadScenario(file);
   ASSERT_EQ(s.scene.terrain.size(), 3u);
   EXPECT_EQ(s.scene.terrain[2].name, "floor_bump");
-  EXPECT_NEAR(s.scene.terrain[2].center_z_m + 0.5 * s.scene.terrain[2].thickness_m - 0.54, 0.006,
+  EXPECT_NEAR(s.scene.terrain[2].center_z_m + 0.5 * s.scene.terrain[2].thickness_m - 0.54, -0.005,
               1e-12);
   const Scenario cm = LoadScenario(file, {"scene.terrain.2.center_m.2=0.54"});
   EXPECT_NEAR(cm.scene.terrain[2].center_z_m + 0.5 * cm.scene.terrain[2].thickness_m - 0.54, 0.01,
               1e-12);
-  EXPECT_EQ(cm.scene.terrain[2].center_x_m, 5.9);  // the rest of the piece kept
+  EXPECT_EQ(cm.scene.terrain[2].center_x_m, 4.9);  // the rest of the piece kept
 }
 
 }  // namespace

@@ -23,24 +23,27 @@ using test_scenarios::Shipped;
 // paper 2's robot did, and the beacons measure it as well as paper 2 says
 // they can.
 //
-// The spread over 20 runs (`linesim run scenarios/van_entry.yaml --runs 20`; |value|
-// min / median / max): final_error_x_m 0.0001 / 0.0057 / 0.0147;
-// final_error_y_m 0.0000 / 0.0013 / 0.0049; final_error_yaw_deg 0.030 /
-// 0.467 / 0.860; beacon_self_error_position_m 0.0023 / 0.0034 / 0.0053;
-// beacon_self_error_yaw_deg 0.001 / 0.024 / 0.110; max_path_deviation_m
-// 0.0101 / 0.0108 / 0.0140; min_clearance_m 0.387 / 0.395 / 0.401;
-// collisions 0. Seeds 1..8 (signed): final_error_x_m -0.0191 / -0.0032 /
-// 0.0131; final_error_y_m -0.0014 / 0.0010 / 0.0045; final_error_yaw_deg
-// -0.727 / 0.418 / 0.817; beacon_self_error_position_m 0.0026 / 0.0033 /
-// 0.0048; beacon_self_error_yaw_deg -0.042 / 0.014 / 0.072;
-// max_path_deviation_m 0.0100 / 0.0113 / 0.0147; min_clearance_m 0.388 /
-// 0.394 / 0.396; collisions 0. (The heading's spread moves by a factor of
-// two with the last bits of a math function: see docs/results.md.)
-// Table 1's maximum is the largest of paper 2's own 20 runs, itself a draw:
-// one of our 8 seeds may pass it (one stops 19.1 mm off in x with the exact
-// ray casting), so a single run is held to twice it (a gross failure) and
-// the median of the runs to it; the beacons likewise (their stated 5 mm is
-// a typical accuracy: median under it, every run under twice it).
+// The spread over 20 runs (`linesim run scenarios/van_entry.yaml --runs 20`;
+// one LMS151, maps built with it, the beacons' installation 1; signed
+// mean +- std [min, max]): final_error_x_m -0.0026 +- 0.0003 [-0.0031,
+// -0.0021]; final_error_y_m 0.0005 +- 0.0010 [-0.0022, 0.0020];
+// final_error_yaw_deg 0.865 +- 0.032 [0.815, 0.948] (the edge of the
+// skid-steer's heading band: docs/architecture.md); beacon_self_error_
+// position_m 0.0035 +- 0.0005 [0.0020, 0.0041] and beacon_self_error_yaw_deg
+// -0.021 +- 0.029 [-0.076, 0.032] (mostly the installation's survey offset,
+// the same in every run); max_path_deviation_m 0.0106 +- 0.0001;
+// min_clearance_m 0.3925 +- 0.0003; collisions 0. Seeds 1..8 (min /
+// median / max): final_error_x_m -0.0029 / -0.0027 / -0.0023;
+// final_error_y_m 0.0001 / 0.0007 / 0.0020; final_error_yaw_deg 0.840 /
+// 0.858 / 0.891; beacon_self_error_position_m 0.0032 / 0.0035 / 0.0039;
+// beacon_self_error_yaw_deg -0.074 / -0.024 / 0.002; max_path_deviation_m
+// 0.0105 / 0.0106 / 0.0108; min_clearance_m 0.392 / 0.393 / 0.393.
+// Table 1's maximum is the largest of paper 2's own 20 runs, itself a draw,
+// so a single run is held to twice it (a gross failure) and the median of
+// the runs to it. The beacons' stated 5 mm and 0.2 deg are the system's
+// 1-sigma accuracy, which the scenario draws once as the installation's
+// survey (installation_seed, not changed by the run's seed): held to 3
+// sigma, which any installation but one in 370 passes.
 TEST(VanEntryScenario, HuskyClimbsIntoTheVanAndStopsAtTheWorkPose) {
   constexpr int kSeeds = 8;
   const auto m = RunSeeds(Shipped("van_entry"), {}, kSeeds);
@@ -51,10 +54,9 @@ TEST(VanEntryScenario, HuskyClimbsIntoTheVanAndStopsAtTheWorkPose) {
   EXPECT_LT(std::abs(m["final_error_x_m"].median()), 0.019);
   EXPECT_LT(std::abs(m["final_error_y_m"].median()), 0.014);
   EXPECT_LT(std::abs(m["final_error_yaw_deg"].median()), 2.216);
-  // The beacon system's own error: paper 2's 5 mm and 0.2 deg.
-  EXPECT_LT(m["beacon_self_error_position_m"].median(), 0.005);
-  EXPECT_LT(m["beacon_self_error_position_m"].max(), 2 * 0.005);
-  EXPECT_LT(m["beacon_self_error_yaw_deg"].max_abs(), 0.2);
+  // The beacon system's own error: paper 2's 5 mm and 0.2 deg, 3 sigma.
+  EXPECT_LT(m["beacon_self_error_position_m"].max(), 3 * 0.005);
+  EXPECT_LT(m["beacon_self_error_yaw_deg"].max_abs(), 3 * 0.2);
   // The robot stayed on its route (the follower on the fused pose) and
   // never touched the van: the body clears the walls and arches.
   EXPECT_LT(m["max_path_deviation_m"].max(), 0.05);

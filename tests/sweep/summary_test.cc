@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "cosim/variable_table.h"
+
 namespace linesim::sweep {
 namespace {
 
@@ -509,7 +511,9 @@ SweepTable Repeats() {
   t.metrics = {"error_x_m", "wall_s"};
   for (int i = 0; i < 5; ++i) t.rows.push_back(Ok(i, {}, {i - 2.0, 1.0}));
   t.rows.push_back(Failed(5, {}, "follower: did not reach the route's end", {NAN, 1.0}));
-  t.reference = {"paper 2, Table 1", {{"error_x_m", "X (m)", 0.019, 0.005, 0.004}}};
+  t.reference = {"paper 2, Table 1",
+                 {{"error_x_m", "X (m)", 0.019, 0.005, 0.004, "the scanner's noise"}},
+                 "table1"};
   return t;
 }
 
@@ -543,21 +547,71 @@ TEST(PrintSummary, RepeatsPrintOverallAndTheReferenceTable) {
   EXPECT_NE(text.find("run 5 (seed 105): follower"), std::string::npos) << text;
 }
 
-// Guards the histograms: one per metric but wall_s, of the ok runs only.
+// Guards the histograms: one per metric but wall_s, of the ok runs only,
+// with the reference's figures and label on it.
 TEST(SweepCharts, RepeatsGiveOneHistogramPerMetric) {
   const auto charts = SweepCharts(Repeats());
   ASSERT_EQ(charts.size(), 1u);
   EXPECT_TRUE(charts[0].histogram);
   EXPECT_EQ(charts[0].file, "error_x_m_histogram.png");
   EXPECT_EQ(charts[0].series[0].mean, (std::vector<double>{-2, -1, 0, 1, 2}));
+  EXPECT_EQ(charts[0].reference.label, "paper 2, Table 1");
+  EXPECT_EQ(charts[0].reference.max_abs, 0.019);
+  EXPECT_EQ(charts[0].reference.std, 0.005);
+  EXPECT_EQ(charts[0].x_label, "X (m)");
 }
 
-// Guards that gnuplot draws the histogram with its normal curve.
+// Guards against a histogram of a metric that is the same in every run
+// (its axes would span +-1e-12): no chart, and the terminal names it.
+TEST(SweepCharts, AConstantMetricGetsNoHistogram) {
+  SweepTable t = Repeats();
+  t.metrics = {"error_x_m", "collisions", "wall_s"};
+  for (auto& row : t.rows) row.metrics.insert(row.metrics.begin() + 1, 0.0);
+  const auto charts = SweepCharts(t);
+  ASSERT_EQ(charts.size(), 1u);
+  EXPECT_EQ(charts[0].file, "error_x_m_histogram.png");
+  std::ostringstream out;
+  PrintSummary(t, out);
+  EXPECT_NE(out.str().find("the same in every run (no histogram): collisions"), std::string::npos)
+      << out.str();
+}
+
+// Guards that gnuplot draws the histogram with its normal curve, the
+// reference's maxima as lines and its std as a curve, beside the
+// reference's table files.
 TEST_F(WriteSweepReportTest, WritesHistograms) {
   const auto files = WriteSweepReport(dir_.string(), Repeats());
+  ASSERT_EQ(files.size(), 4u);
+  EXPECT_EQ(fs::path(files[1]).filename(), "table1.csv");
+  EXPECT_EQ(fs::path(files[2]).filename(), "table1.md");
+  EXPECT_EQ(ReadAll(files[3]).substr(0, 8), "\x89PNG\r\n\x1a\n");
+  const std::string script = ReadAll(dir_ / "sweep_plots.gp");
+  EXPECT_NE(script.find("exp(-0.5 *"), std::string::npos);
+  EXPECT_NE(script.find("set arrow from -0.019, graph 0 to -0.019, graph 1"), std::string::npos)
+      << script;
+  EXPECT_NE(script.find("paper 2, Table 1: std 0.005"), std::string::npos) << script;
+}
+
+// Guards Table 1 as files: ours (the 5 ok runs -2..2: max |x| 2, std
+// sqrt(10 / 4), mean |x| 6 / 5) beside the reference's, each figure a row
+// of the CSV; the Markdown in the source's layout with the metric's note.
+TEST_F(WriteSweepReportTest, WritesTheReferenceTable) {
+  const auto files = WriteReferenceTable(dir_.string(), Repeats());
   ASSERT_EQ(files.size(), 2u);
-  EXPECT_EQ(ReadAll(files[1]).substr(0, 8), "\x89PNG\r\n\x1a\n");
-  EXPECT_NE(ReadAll(dir_ / "sweep_plots.gp").find("exp(-0.5 *"), std::string::npos);
+  const std::string csv = ReadAll(dir_ / "table1.csv");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "metric,label,figure,ours,reference");
+  EXPECT_NE(csv.find("error_x_m,X (m),max_abs,2,0.019\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("error_x_m,X (m),mean_abs,1.2,0.004\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("error_x_m,X (m),std," + cosim::FormatValue(std::sqrt(2.5)) + ",0.005\n"),
+            std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find("error_x_m,X (m),runs,5,\n"), std::string::npos) << csv;
+  const std::string md = ReadAll(dir_ / "table1.md");
+  EXPECT_NE(md.find("| maximum absolute error | 2 | 0.019 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("- X (m): the scanner's noise"), std::string::npos) << md;
+  SweepTable none = Repeats();
+  none.reference = {};
+  EXPECT_TRUE(WriteReferenceTable(dir_.string(), none).empty());
 }
 
 }  // namespace

@@ -265,6 +265,18 @@ TEST(SweepSpec, RepeatsWithoutParametersAndAReference) {
   EXPECT_EQ(spec.reference.metrics[0].label, "max (m)");
   EXPECT_EQ(spec.reference.metrics[0].max_abs, 0.04);
   EXPECT_TRUE(std::isnan(spec.reference.metrics[0].std));
+  EXPECT_EQ(spec.reference.file, "reference");  // the table files' default name
+  EXPECT_EQ(spec.reference.metrics[0].note, "");
+  const SweepSpec named = LoadSweepSpec(WriteFile(
+      "named.yaml", head + "repeats: 2\nmetrics: [max_path_deviation_m]\n"
+                           "reference: {title: t, file: table1, metrics: {max_path_deviation_m: "
+                           "{max_abs: 0.04, note: the follower}}}\n"));
+  EXPECT_EQ(named.reference.file, "table1");
+  EXPECT_EQ(named.reference.metrics[0].note, "the follower");
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(WriteFile("reffile.yaml", head + "repeats: 2\nreference: {title: t, file: "
+                                                  "'../x', metrics: {}}\n")),
+      "reference.file", "[A-Za-z0-9_-]"));
   EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("once.yaml", head)), "parameters",
                           "repeats: N (N >= 2)"));
   EXPECT_TRUE(AnyContains(

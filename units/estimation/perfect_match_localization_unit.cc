@@ -67,6 +67,7 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
   }
   scan_count_.assign(L, 0.0);
   scan_time_.assign(L, 0.0);
+  mapping_range_bias_.assign(L, 0.0);
   odometry_velocity_.assign(2, 0.0);
   position_.assign(2, 0.0);
   covariance_.assign(9, 0.0);
@@ -172,6 +173,9 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
     v.Input("ranges_" + s, "m", &ranges_[k], "laser " + s + ": ranges of its last complete scan");
     v.Input("scan_count_" + s, "1", &scan_count_[k], "laser " + s + ": complete scans so far");
     v.Input("scan_time_" + s, "s", &scan_time_[k], "laser " + s + ": start time of its last scan");
+    v.Input("mapping_range_bias_" + s, "m", &mapping_range_bias_[k],
+            "laser " + s + ": its device's range bias, which the maps it built by SLAM "
+            "(maps with from_own_laser) carry in their outlines (its range_bias output)");
   }
   v.Input("odometry_velocity", "m/s", &odometry_velocity_,
           "odometry: velocity of base_link in base_link (motion_prediction odometry only)");
@@ -317,10 +321,14 @@ void PerfectMatchLocalizationUnit::ProcessScan(int k) {
   const bool deskew = deskew_ && odometry_prediction_;
   const double vx = odometry_velocity_[0], vy = odometry_velocity_[1], w = odometry_yaw_rate_;
   const double mid_s = cosim::NsToSeconds(mid_offset_ns_[kk]);
+  // A map this laser built by SLAM carries its bias (see the header).
+  const double map_bias = specs_[static_cast<std::size_t>(map_index_)].from_own_laser
+                              ? mapping_range_bias_[kk]
+                              : 0.0;
   std::size_t n = 0;
   for (std::size_t i = 0; i < r.size(); ++i) {
-    const double ri = r[i];
-    if (!(ri >= range_min_ && ri <= usable_range_max_) || ri <= 0.0) continue;
+    if (!(r[i] >= range_min_ && r[i] <= usable_range_max_) || r[i] <= 0.0) continue;
+    const double ri = r[i] - map_bias;
     double x = mx + ri * bc[i], y = my + ri * bs[i];
     if (deskew) {
       const double dt = beam_dt_[kk][i] - mid_s;

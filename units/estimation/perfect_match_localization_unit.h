@@ -34,7 +34,14 @@ namespace linesim::estimation {
 /// one step in the order of their match times):
 ///  - points: beam i at angle first_beam_angle + i angular_step, measured
 ///    at scan_time + i angular_step / (2 pi) scan_period; returns outside
-///    [range_min, usable_range_max] (0 = no return) skipped; with `deskew`
+///    [range_min, usable_range_max] (0 = no return) skipped; against a map
+///    built by the robot's own laser (MapSpec::from_own_laser) each range
+///    less that laser's mapping_range_bias: SLAM with a scanner whose ranges
+///    read b long puts every outline b beyond the face along the mapping
+///    beams, so a return of the same device matches the map's outline at
+///    r - b on the geometry (first order: exact where the mapping beams met
+///    a face along the same line as now, off by b (1 - cos) of the angle
+///    between them otherwise); with `deskew`
 ///    (and motion_prediction odometry) each point is moved from its beam's
 ///    time to the match time (the middle beam's) by the odometry twist;
 ///  - map_index outside 0..maps-1: laser_status 4, no match;
@@ -68,6 +75,10 @@ class PerfectMatchLocalizationUnit : public cosim::Unit {
     std::optional<DistanceMap::Region> region;
     /// The lookup grid's cell for this map (m); 0: the lookup_cell parameter.
     double cell_m = 0.0;
+    /// Built by SLAM with the robot's own lasers (paper 2 Sec. 3.2: both
+    /// its maps "built using SLAM"), not from the geometry: see
+    /// mapping_range_bias.
+    bool from_own_laser = false;
   };
 
   /// One entry of `beam_counts` per laser (1..kMaxLasers, each 1..100000
@@ -128,6 +139,7 @@ class PerfectMatchLocalizationUnit : public cosim::Unit {
   // Inputs.
   std::vector<std::vector<double>> ranges_;
   std::vector<double> scan_count_, scan_time_;
+  std::vector<double> mapping_range_bias_;  // per laser
   std::vector<double> odometry_velocity_;
   double odometry_yaw_rate_ = 0.0;
   std::int64_t map_index_ = 0;

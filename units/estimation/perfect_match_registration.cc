@@ -64,11 +64,13 @@ std::optional<std::vector<Unit::MapSpec>> ReadMaps(const UnitBuildContext& c) {
       ok = false;
       continue;
     }
-    c.reader.CheckKeys(m, mp, {"name", "height_m", "region", "cell_m"});
+    c.reader.CheckKeys(m, mp, {"name", "height_m", "region", "cell_m", "source"});
     Unit::MapSpec spec;
     spec.name = c.reader.String(m, mp, "name", std::nullopt);
     spec.height_m = c.reader.Real(m, mp, "height_m", std::nullopt, {-100.0, 100.0});
     spec.cell_m = c.reader.Real(m, mp, "cell_m", 0.0, {0.0, 0.5});
+    spec.from_own_laser = c.reader.String(m, mp, "source", "geometry",
+                                          {"geometry", "own_laser"}) == "own_laser";
     for (std::size_t j = 0; j < maps.size(); ++j) {
       if (maps[j].name == spec.name) {
         c.reader.Error(m, mp, "map name '" + spec.name + "' is used twice");
@@ -127,7 +129,9 @@ const config::UnitTypeRegistrar kPerfectMatch(
        "the maps, in map_index order: each {name, height_m (the slice's z above the floor), "
        "region (optional, {min_x_m, max_x_m, min_y_m, max_y_m}: only the solids whose footprint "
        "lies inside it; absent: every static solid), cell_m (optional: its lookup grid's cell, "
-       "else the lookup_cell parameter)}"}},
+       "else the lookup_cell parameter), source (optional: geometry, the default, a map of the "
+       "scene's solids as drawn; own_laser, built by SLAM with the robot's lasers, whose range "
+       "bias its outlines then carry: see the mapping_range_bias inputs)}"}},
      MakePerfectMatch});
 
 }  // namespace

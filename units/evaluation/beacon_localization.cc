@@ -4,8 +4,10 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <random>
 #include <utility>
 
+#include "cosim/seed.h"
 #include "models/angle.h"
 
 namespace linesim::evaluation {
@@ -52,9 +54,9 @@ std::vector<const models::Obstacle*> BeaconLocalizationUnit::SceneBeacons(
 }
 
 BeaconLocalizationUnit::BeaconLocalizationUnit(std::string name, std::vector<Beacon> beacons,
-                                               int beam_count)
-    : cosim::Unit(kTypeName, std::move(name)), beacons_(std::move(beacons)),
-      beam_count_(beam_count) {
+                                               int beam_count, std::uint64_t seed)
+    : cosim::Unit(kTypeName, std::move(name)), scene_beacons_(std::move(beacons)),
+      beacons_(scene_beacons_), beam_count_(beam_count), seed_(seed) {
   if (beam_count_ < 1 || beam_count_ > 100000) {
     throw cosim::UnitError(Where() + ": beam_count must be 1..100000, got " +
                            std::to_string(beam_count_));
@@ -175,6 +177,15 @@ BeaconLocalizationUnit::BeaconLocalizationUnit(std::string name, std::vector<Bea
   v.Parameter("initial_sigma_yaw", "rad", &initial_sigma_yaw_,
               "the filter's yaw sigma at the geometric fix (ASSUMPTION 0.1)", Rule::Positive());
 
+  v.Parameter("survey_sigma", "m", &survey_sigma_,
+              "error of each surveyed beacon coordinate (1 sigma), drawn once per installation: "
+              "the filter knows the beacons there, not where they stand (0: exactly)",
+              Rule::Range(0.0, true, 0.1, true));
+  v.Parameter("installation_seed", &installation_seed_,
+              "which installation: >= 0 draws the survey errors from this seed, the same in "
+              "every run; -1: from the run's seed (a new installation per run)",
+              Rule::Range(-1, 4294967295.0));
+
   v.Input("ranges", "m", &ranges_, "the laser's last complete scan (0: no return)");
   v.Input("scan_count", "1", &scan_count_, "the laser's complete scans so far");
   v.Input("scan_time", "s", &scan_time_, "start time of the laser's last scan");
@@ -234,6 +245,27 @@ std::vector<cosim::ParameterProblem> BeaconLocalizationUnit::CheckParameters() c
 void BeaconLocalizationUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }
 
 void BeaconLocalizationUnit::Derive() {
+  // The installation's survey: Box-Muller normals from its own generator
+  // (the same draws on every Derive).
+  std::mt19937_64 survey(installation_seed_ >= 0
+                             ? cosim::DeriveSeed(static_cast<std::uint64_t>(installation_seed_),
+                                                 name() + " survey")
+                             : seed_);
+  const auto uniform = [&survey] {
+    return (static_cast<double>(survey() >> 11) + 0.5) * 0x1.0p-53;  // (0, 1)
+  };
+  for (std::size_t j = 0; j < scene_beacons_.size(); ++j) {
+    const double r = std::sqrt(-2.0 * std::log(uniform())), a = 2.0 * std::numbers::pi * uniform();
+    beacons_[j] = {scene_beacons_[j].x + survey_sigma_ * r * std::cos(a),
+                   scene_beacons_[j].y + survey_sigma_ * r * std::sin(a), scene_beacons_[j].radius};
+  }
+  const std::size_t nb = beacons_.size();
+  for (std::size_t a = 0; a < nb; ++a) {
+    for (std::size_t b = 0; b < nb; ++b) {
+      beacon_distance_[a * nb + b] =
+          std::hypot(beacons_[a].x - beacons_[b].x, beacons_[a].y - beacons_[b].y);
+    }
+  }
   for (int i = 0; i < beam_count_; ++i) {
     const double a = first_beam_angle_ + i * angular_step_;
     cos_a_[static_cast<std::size_t>(i)] = std::cos(a);

@@ -34,7 +34,7 @@ std::unique_ptr<cosim::Unit> MakeBeaconLocalization(const UnitBuildContext& c) {
   }
   if (c.reader.issues().size() != issues_before) return nullptr;
   return std::make_unique<BeaconLocalizationUnit>(c.name, std::move(beacons),
-                                                  static_cast<int>(beams));
+                                                  static_cast<int>(beams), c.seed);
 }
 
 const config::UnitTypeRegistrar kBeaconLocalization(

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <utility>
 
+#include "cosim/seed.h"
 #include "models/rotation.h"
 
 namespace linesim::sensors {
@@ -133,6 +134,11 @@ LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene,
               cosim::Rule::NonNegative());
   v.Parameter("bias_max", "m", &bias_max_, "the drawn bias is clamped to +-bias_max",
               cosim::Rule::NonNegative());
+  v.Parameter("device_seed", &device_seed_,
+              "which physical unit: >= 0 draws the bias from this seed and the unit's name, "
+              "the same in every run (one scanner for all runs); -1: a new unit per run "
+              "(the bias from the run's seed)",
+              cosim::Rule::Range(-1, 4294967295.0));
   v.Parameter("max_incidence", "rad", &max_incidence_,
               "no return when the beam meets the surface further than this from its normal",
               cosim::Rule::Range(0, false, std::numbers::pi / 2, true).NoDefault());
@@ -171,6 +177,10 @@ LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene,
            "range of each beam of the last complete scan (no_return_value: no echo)", {});
   v.Output("scan_time", "s", &scan_time_, "start time of the last complete scan", {});
   v.Output("scan_count", "1", &scan_count_, "complete scans so far", {});
+  v.Output("range_bias", "m", &bias_,
+           "this device's systematic range error (constant: what a calibration against a "
+           "known target reads; maps built by SLAM with this scanner carry it)",
+           {});
   if (has_field_) {
     v.Output("field_clear", "1", &field_clear_,
              "1: protective field clear (OSSDs on), 0: object in the field (OSSDs off)", {});
@@ -181,14 +191,16 @@ LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene,
   bias_draw_ = Normal();
 }
 
-double LaserScannerUnit::Normal() {
+double LaserScannerUnit::Normal() { return NormalFrom(rng_); }
+
+double LaserScannerUnit::NormalFrom(std::mt19937_64& rng) {
   // The ziggurat (see Ziggurat): one 64-bit draw gives the layer (8 bits),
   // the sign (1 bit) and the abscissa (53 bits); 98.8 % of the draws end in
   // a layer's rectangle, without log, sqrt or division. Nothing is cached
   // between calls: the generator's state is the whole state.
   const Ziggurat& zg = ZigguratTables();
   while (true) {
-    const std::uint64_t u = rng_();
+    const std::uint64_t u = rng();
     const auto i = static_cast<std::size_t>(u & 0xffu);
     // The sign as a bit flip: the same value as a product by -1 or 1, but
     // without a branch on a random bit (mispredicted half the time).
@@ -203,13 +215,13 @@ double LaserScannerUnit::Normal() {
       // accepted when -2 ln(U2) > a^2.
       double a, b;
       do {
-        a = -std::log(1.0 - Uniform(rng_)) / Ziggurat::kR;
-        b = -std::log(1.0 - Uniform(rng_));
+        a = -std::log(1.0 - Uniform(rng)) / Ziggurat::kR;
+        b = -std::log(1.0 - Uniform(rng));
       } while (b + b < a * a);
       return sign(Ziggurat::kR + a);
     }
     // The wedge: a uniform height in the layer, under the curve or not.
-    const double y = zg.f[i] + Uniform(rng_) * (zg.f[i + 1] - zg.f[i]);
+    const double y = zg.f[i] + Uniform(rng) * (zg.f[i + 1] - zg.f[i]);
     if (y < std::exp(-0.5 * z * z)) return sign(z);
   }
 }
@@ -270,7 +282,13 @@ void LaserScannerUnit::Derive() {
                     std::array<double, 3>{mount[1], mount[4], mount[7]},
                     std::array<double, 3>{mount_x_, mount_y_, mount_z_}};
   cos_max_incidence_ = std::cos(max_incidence_);
-  bias_ = std::clamp(bias_draw_ * bias_sigma_, -bias_max_, bias_max_);
+  double draw = bias_draw_;
+  if (device_seed_ >= 0) {
+    std::mt19937_64 device(cosim::DeriveSeed(static_cast<std::uint64_t>(device_seed_),
+                                             name() + " range bias"));
+    draw = NormalFrom(device);
+  }
+  bias_ = std::clamp(draw * bias_sigma_, -bias_max_, bias_max_);
 }
 
 void LaserScannerUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }

@@ -50,7 +50,8 @@ namespace linesim::sensors {
 ///     or its incidence angle exceeds max_incidence (the energy of a
 ///     Lambertian return falls with cos(incidence); see the model files);
 ///  4. noise: + bias (drawn once per device, N(0, bias_sigma) clamped to
-///     +-bias_max) + N(0, noise_sigma), then rounded to range_resolution
+///     +-bias_max; the device is the run's own unless device_seed names
+///     one: see Randomness) + N(0, noise_sigma), then rounded to range_resolution
 ///     (never below 0).
 /// A beam without return reads no_return_value (what the device reports).
 ///
@@ -65,7 +66,13 @@ namespace linesim::sensors {
 /// Randomness: one std::mt19937_64 seeded with the constructor's seed: the
 /// bias first, then one normal per returning beam, beam after beam (normals
 /// by Marsaglia and Tsang's ziggurat: the generator's state is all there is
-/// to save).
+/// to save). The bias is a property of the physical unit, not of a run:
+/// with device_seed >= 0 it is drawn instead from a generator seeded by
+/// (device_seed, the unit's name), so every run of `--runs N` (each with
+/// its own seed) uses the same scanner, as an experiment's repetitions do
+/// (paper 2's 20 runs: one LMS151); another device_seed is another unit
+/// off the line. The run's stream is unchanged by it (the constructor's
+/// draw is still taken).
 class LaserScannerUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "laser_scanner";
@@ -83,7 +90,8 @@ class LaserScannerUnit : public cosim::Unit {
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
 
   int beam_count() const { return beam_count_; }
-  /// The per-device range bias drawn from the seed (m; after Initialize).
+  /// The per-device range bias (m; after Initialize): from device_seed when
+  /// it is >= 0, else from the run's seed.
   double bias() const { return bias_; }
   /// Time of beam i after its scan's start (ns).
   cosim::TimeNs BeamOffset(int i) const { return beam_offset_ns_[static_cast<std::size_t>(i)]; }
@@ -119,6 +127,8 @@ class LaserScannerUnit : public cosim::Unit {
   void MixEcho(const std::array<Sample, kSpotSamples>& samples, double& r, double& cos_inc) const;
   void CompleteScan();
   double Normal();
+  /// A standard normal from `rng` (the ziggurat of Normal()).
+  static double NormalFrom(std::mt19937_64& rng);
 
   int beam_count_;
   bool has_field_;
@@ -161,6 +171,7 @@ class LaserScannerUnit : public cosim::Unit {
   int next_beam_ = 0;    // first beam not yet cast
   int finalized_ = 0;    // beams [0, finalized_) have their reported range
   double bias_draw_ = 0.0;  // N(0, 1), drawn in the constructor
+  std::int64_t device_seed_ = -1;  // < 0: the device is the run's (bias_draw_)
   double bias_ = 0.0;       // bias_draw_ * bias_sigma clamped to +-bias_max
   std::int64_t infringing_scans_ = 0;  // consecutive
   // Per beam of the scan under way: its ray, the centre hit, the spot

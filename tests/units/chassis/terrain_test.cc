@@ -231,7 +231,9 @@ Drive HuskyDrive() {
 //   in BrakedHuskyWithArmOnAnInclineIsCoulomb at 15 deg: less); 1e-3 rad;
 // - it never rolls back (mu 0.6 > tan 15.11 deg = 0.27);
 // - at the end base_link's origin is on the van floor, z = 0.54, lifted by
-//   half the 6 mm bump under its right wheels (van_bay's floor_bump), and
+//   half the 6 mm bump under its right wheels (van_bay's floor_bump, which
+//   the scene ships sunk mid-van: this test raises it to 6 mm and moves it
+//   under the work pose, x 5.5..6.3), and
 //   rolled right by atan(0.006 / 0.5708) = 0.0105 rad; the contacts sink
 //   by m g / 4 k = 0.2 mm: 0.3 mm and 5e-4 rad tolerances;
 // - climbing at constant speed each drive motor supplies half of
@@ -248,11 +250,13 @@ Drive HuskyDrive() {
 // (I / I_N)^2 times its allowed rise, reaching the allowed rise after
 // t = tau ln(I^2 / (I^2 - I_N^2)) (first-order thermal model, from cold).
 TEST(Terrain, HuskyWithArmClimbsTheVanRamp) {
-  const models::Scene scene = VanBay();
+  models::Scene scene = VanBay();
   ASSERT_EQ(scene.terrain.size(), 3u);
   ASSERT_EQ(scene.terrain[0].name, "ramp");
   ASSERT_EQ(scene.terrain[1].name, "van_floor");
   ASSERT_EQ(scene.terrain[2].name, "floor_bump");
+  scene.terrain[2].center_x_m = 5.9;
+  scene.terrain[2].center_z_m = 0.536;  // its top 6 mm above the floor
   const double ramp = std::atan(0.54 / 2.0);
   EXPECT_NEAR(scene.terrain[0].pitch_rad, ramp, 1e-8);
   auto robot = HuskyWithArm(scene);

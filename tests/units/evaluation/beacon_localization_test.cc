@@ -500,6 +500,60 @@ TEST(BeaconLocalization, RestoredUnitContinuesIdentically) {
   EXPECT_EQ(a.used(), b.used());
 }
 
+// Guards the installation's survey: without survey_sigma the filter knows
+// the beacons where they stand; with it and an installation_seed, every
+// run (whatever its seed) shares one installation's errors; their spread is
+// survey_sigma. Over 1000 installations x 4 beacons x 2 coordinates (8000
+// draws of N(0, 1) by Box-Muller): the mean within 4 standard errors of 0
+// (4 / sqrt(8000) = 0.045) and the rms within 4 standard errors of 1
+// (4 / sqrt(2 x 8000) = 0.032). Measured once: mean 0.0019, rms 0.9958.
+TEST(BeaconLocalization, SurveyErrorsAreTheInstallations) {
+  auto exact = Beacons();
+  exact->Initialize();
+  for (std::size_t j = 0; j < 4; ++j) {
+    EXPECT_EQ(exact->surveyed_beacons()[j].x, kBeaconX[j]);
+    EXPECT_EQ(exact->surveyed_beacons()[j].y, kBeaconY[j]);
+  }
+  const double sigma = 0.0062;
+  std::vector<BeaconLocalizationUnit::Beacon> first;
+  for (std::uint64_t run = 1; run <= 8; ++run) {
+    BeaconLocalizationUnit u("beacons", KnownBeacons(), 541, run);
+    for (const char* k : {"mount_x", "mount_y", "mount_yaw", "first_beam_angle"}) SetAll(u, k, 0.0);
+    SetAll(u, "angular_step", 0.5 * kDeg);
+    SetAll(u, "survey_sigma", sigma);
+    u.variables().SetInteger(*u.variables().Find("installation_seed"), 7);
+    u.Initialize();
+    if (first.empty()) first = u.surveyed_beacons();
+    for (std::size_t j = 0; j < 4; ++j) {
+      EXPECT_EQ(u.surveyed_beacons()[j].x, first[j].x);
+      EXPECT_EQ(u.surveyed_beacons()[j].y, first[j].y);
+      EXPECT_NE(u.surveyed_beacons()[j].x, kBeaconX[j]);
+    }
+  }
+  double sum = 0.0, sum_sq = 0.0;
+  int n = 0;
+  for (std::int64_t installation = 0; installation < 1000; ++installation) {
+    BeaconLocalizationUnit u("beacons", KnownBeacons(), 541, 1);
+    for (const char* k : {"mount_x", "mount_y", "mount_yaw", "first_beam_angle"}) SetAll(u, k, 0.0);
+    SetAll(u, "angular_step", 0.5 * kDeg);
+    SetAll(u, "survey_sigma", sigma);
+    u.variables().SetInteger(*u.variables().Find("installation_seed"), installation);
+    u.Initialize();
+    for (std::size_t j = 0; j < 4; ++j) {
+      for (const double e : {(u.surveyed_beacons()[j].x - kBeaconX[j]) / sigma,
+                             (u.surveyed_beacons()[j].y - kBeaconY[j]) / sigma}) {
+        sum += e;
+        sum_sq += e * e;
+        ++n;
+      }
+    }
+  }
+  const double mean = sum / n, rms = std::sqrt(sum_sq / n);
+  std::printf("survey errors / sigma over %d draws: mean %.4f, rms %.4f\n", n, mean, rms);
+  EXPECT_LT(std::abs(mean), 4.0 / std::sqrt(8000.0));
+  EXPECT_NEAR(rms, 1.0, 4.0 / std::sqrt(16000.0));
+}
+
 // Guards the parameter checks: too few beacons, beacons of two radii.
 TEST(BeaconLocalization, RefusesTooFewOrMixedBeacons) {
   auto b = KnownBeacons();
