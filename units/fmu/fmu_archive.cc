@@ -232,7 +232,11 @@ void Unpack(const std::string& fmu, const std::string& folder) {
         throw FmuError(fmu + ": refused: entry '" + name +
                        "' is a symbolic link (it could point outside the FMU's folder)");
       }
-      if (mode != 0 && !S_ISREG(mode) && !S_ISDIR(mode)) {
+      // Permissions without file-type bits (Python's zipfile.writestr
+      // writes 0600 << 16) say nothing of the kind: a file, or a folder
+      // when the name ends in '/'. Type bits that are neither (a FIFO, a
+      // device) are refused.
+      if ((mode & S_IFMT) != 0 && !S_ISREG(mode) && !S_ISDIR(mode)) {
         throw FmuError(fmu + ": refused: entry '" + name + "' is not a file or a folder");
       }
     }

@@ -211,6 +211,23 @@ TEST(FmuMalformed, InstantiationRefusedIsNamedWithTheLog) {
   }
 }
 
+// Guards issue 24: entries whose Unix attributes carry permissions but no
+// file-type bits (Python's zipfile.writestr writes 0600 << 16) were refused
+// as "not a file or a folder"; such an FMU loads and steps. A FIFO's type
+// bits are still refused.
+TEST(FmuMalformed, EntriesWithoutFileTypeBitsAreFiles) {
+  Scratch s("writestr");
+  MakeZip(s / "w.fmu", {{"modelDescription.xml", Dahlquist2Xml(), false, 0600},
+                        {"binaries/linux64/dahlquist.so", ReadFile(LINESIM_DAHLQUIST_SO), false, 0600}});
+  FmuUnit u("w", s / "w.fmu");
+  u.Setup(0, 1'000'000'000);
+  u.Initialize();
+  EXPECT_EQ(u.DoStep(0, 10'000'000), cosim::StepResult::kOk) << u.last_error();
+  MakeZip(s / "f.fmu", {{"modelDescription.xml", Dahlquist2Xml(), false, S_IFIFO | 0600}});
+  const std::string e = LoadError(s / "f.fmu");
+  EXPECT_NE(e.find("entry 'modelDescription.xml' is not a file or a folder"), std::string::npos) << e;
+}
+
 // The folder an FMU unpacks into is private and goes with the unit.
 TEST(FmuArchive, UnpacksIntoAPrivateFolderRemovedAfterwards) {
   std::string folder;
