@@ -68,7 +68,7 @@ void RemoveTreeAt(int parent, const char* name, int depth) noexcept {
 
 extern "C" void RemoveAtExit() { RemoveLiveTempFolders(); }
 
-// Crash signals, and SIGTERM / SIGINT while nobody else handles them:
+// Crash signals, SIGTERM and SIGINT, while nobody else handles them:
 // remove the folders, then die of the signal as before (the handler is
 // reset to the default by SA_RESETHAND).
 extern "C" void RemoveOnSignal(int sig) {
@@ -84,8 +84,9 @@ void InstallCleanupOnce() {
     action.sa_handler = RemoveOnSignal;
     action.sa_flags = SA_RESETHAND | SA_NODEFER;
     sigemptyset(&action.sa_mask);
-    for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) sigaction(sig, &action, nullptr);
-    for (int sig : {SIGTERM, SIGINT}) {
+    // Only where nobody else handles the signal: a sanitizer's or a
+    // debugger's handler (and its report) stays.
+    for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGTERM, SIGINT}) {
       struct sigaction old {};
       if (sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_DFL &&
           !(old.sa_flags & SA_SIGINFO)) {

@@ -8,10 +8,10 @@ namespace linesim::fmu {
 
 /// A private temporary folder (mkdtemp, mode 0700),
 /// $TMPDIR/linesim-fmu-<pid>-XXXXXX, removed with everything in it when the
-/// object goes, and also when the process ends otherwise: at exit(), on a
-/// crash signal (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT: an FMU's binary
-/// that crashes), and on SIGTERM / SIGINT while no other handler is
-/// installed (the app's stop handler calls RemoveLiveTempFolders before it
+/// object goes, and also when the process ends otherwise: at exit(), and,
+/// while no other handler is installed for them (a sanitizer's stays), on
+/// a crash signal (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT: an FMU's
+/// binary that crashes) and on SIGTERM / SIGINT (the app's stop handler calls RemoveLiveTempFolders before it
 /// gives up on a second signal). The first folder of a process also sweeps
 /// the folders of processes that are gone (SweepStaleTempFolders). Only
 /// SIGKILL leaves a folder behind, until the next run's sweep.
