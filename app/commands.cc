@@ -265,6 +265,9 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   Json messages = Json::array();
   for (const auto& e : outcome.errors) messages.push_back(e.message);
   summary["errors"] = messages;
+  // A unit that asked to end the run early (an FMU's terminate request):
+  // which and why; absent when the run reached its stop time.
+  if (!result.ended_by.empty()) summary["ended_by"] = result.ended_by;
   Json settings;
   settings["duration_s"] = s.duration_s;
   settings["seed"] = s.seed;
@@ -355,6 +358,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
             << ", " << cosim::FormatSeconds(result.end_time - options.start) << " s simulated in "
             << std::setprecision(3) << wall_s << " s wall (" << std::setprecision(4)
             << simulated_s / wall_s << "x real time)\n";
+  if (!result.ended_by.empty()) std::cout << "  ended early by " << result.ended_by << "\n";
   std::size_t name_width = 0;
   for (const auto& [name, value] : metrics.Results())
     name_width = std::max(name_width, name.size());

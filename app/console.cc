@@ -8,6 +8,8 @@
 #include <iostream>
 #include <system_error>
 
+#include "units/fmu/fmu_archive.h"
+
 namespace linesim::app {
 
 void PrintIssues(const config::ScenarioError& e, const std::string& what, std::ostream& out) {
@@ -33,6 +35,8 @@ std::atomic<const char*> g_stop_message{""};
 
 extern "C" void OnStopSignal(int sig) {
   if (g_stop.exchange(true)) {
+    // A second signal ends the process at once: the unpacked FMUs go first.
+    fmu::RemoveLiveTempFolders();
     std::signal(sig, SIG_DFL);
     std::raise(sig);
     return;

@@ -368,6 +368,7 @@ void Master::Start() {
   const ScopedTimer timer(options_.profile, total_wall_seconds_);
   errors_.clear();
   failed_ = false;
+  ended_by_.clear();
   time_ = options_.start;
   step_index_ = 0;
   current_step_ = options_.base_step;
@@ -430,8 +431,18 @@ void Master::Plan(TimeNs tau, TimeNs dt, bool first) {
   due_ = *plan_due_;
 }
 
+bool Master::StopRequested() {
+  for (std::size_t u : *plan_due_) {
+    const Unit& unit = system_.unit(u);
+    if (unit.stop_request().empty()) continue;
+    ended_by_ = unit.Where() + ": " + unit.stop_request();
+    return true;
+  }
+  return false;
+}
+
 bool Master::Step() {
-  if (!started_ || failed_ || time_ >= options_.stop) return false;
+  if (!started_ || failed_ || !ended_by_.empty() || time_ >= options_.stop) return false;
   const ScopedTimer timer(options_.profile, total_wall_seconds_);
   profile_step_ = options_.profile && step_index_ % kProfileEvery == 0;
   // The whole timed step, observers included: the units' calls lie inside.
@@ -439,6 +450,13 @@ bool Master::Step() {
   const TimeNs t = time_;
   if (options_.retry.enabled) {
     if (!StepWithRetry(t)) return false;
+    if (!ended_by_.empty() && stopped_at_ != t + options_.base_step) {
+      // A unit ended the run inside the base step: the observers see that
+      // time last (a recorder keeps only its own grid's points).
+      time_ = stopped_at_;
+      Notify(time_);
+      return false;
+    }
   } else {
     Plan(t, options_.base_step, true);
     if (algorithm_->Step(t, options_.base_step, *this) != StepStatus::kOk) {
@@ -446,11 +464,12 @@ bool Master::Step() {
       failed_ = true;
       return false;
     }
+    StopRequested();
   }
   ++step_index_;
   time_ = options_.start + step_index_ * options_.base_step;
   Notify(time_);
-  return time_ < options_.stop;
+  return ended_by_.empty() && time_ < options_.stop;
 }
 
 TimeNs Master::DivisorAtMost(TimeNs limit) const {
@@ -480,6 +499,10 @@ bool Master::StepWithRetry(TimeNs t) {
     if (status == StepStatus::kOk) {
       tau += dt;
       smallest_step_ = std::min(smallest_step_, dt);
+      if (StopRequested()) {
+        stopped_at_ = tau;
+        return true;
+      }
       if (current_step_ < h) {
         const double grown = std::floor(static_cast<double>(current_step_) * options_.retry.grow);
         current_step_ = std::max(current_step_, DivisorAtMost(static_cast<TimeNs>(
@@ -558,6 +581,7 @@ RunResult Master::Finish() {
   r.errors = errors_;
   r.rejected_steps = rejected_steps_;
   r.smallest_step = smallest_step_;
+  r.ended_by = ended_by_;
   return r;
 }
 

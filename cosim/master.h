@@ -75,6 +75,10 @@ struct RunResult {
   /// and the smallest step taken (the master step when none was rejected).
   std::int64_t rejected_steps = 0;
   TimeNs smallest_step = 0;
+  /// Non-empty when a unit asked to end the simulation before the stop
+  /// time (Unit::stop_request): the run ended normally at end_time, after
+  /// the step in which it asked; "unit 'name' (type): why".
+  std::string ended_by;
   /// Every error's message, joined by "; " (empty when there is none).
   std::string ErrorText() const;
 };
@@ -145,6 +149,9 @@ class Master : private StepContext {
   }
   /// Advances one base step from t with retries (master.retry on).
   bool StepWithRetry(TimeNs t);
+  /// After an accepted step: the first due unit (dependency order) that
+  /// asked to end the run, recorded in ended_by_; true when one did.
+  bool StopRequested();
   /// Plans the communication step from tau by dt (first: tau is a base point).
   void Plan(TimeNs tau, TimeNs dt, bool first);
   /// The largest divisor of the base step <= limit, or 0 when none is.
@@ -208,6 +215,9 @@ class Master : private StepContext {
   bool profile_step_ = false;
   bool started_ = false;
   bool failed_ = false;
+  std::string ended_by_;
+  // With master.retry: where a stop request inside a base step ended it.
+  TimeNs stopped_at_ = 0;
 };
 
 }  // namespace linesim::cosim

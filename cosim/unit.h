@@ -93,6 +93,11 @@ class Unit {
   const std::string& last_error() const { return last_error_; }
   /// The variable that failure concerns (a non-finite input), or empty.
   const std::string& last_error_variable() const { return last_error_variable_; }
+  /// Non-empty when the unit asked, during its last DoStep (which
+  /// succeeded), to end the simulation there (an FMU's terminate request):
+  /// why, in one sentence. The master ends the run normally after that
+  /// step.
+  const std::string& stop_request() const { return stop_request_; }
 
   /// "unit 'name' (type)": how messages name this unit.
   std::string Where() const { return "unit '" + name_ + "' (" + type_name_ + ")"; }
@@ -130,7 +135,10 @@ class Unit {
   void ClearError() {
     last_error_.clear();
     last_error_variable_.clear();
+    stop_request_.clear();
   }
+  /// For DoStep: the step succeeded and the unit asks to end the run here.
+  void RequestStop(std::string reason) { stop_request_ = std::move(reason); }
 
  private:
   std::string type_name_;
@@ -138,6 +146,7 @@ class Unit {
   VariableTable variables_;
   std::string last_error_;
   std::string last_error_variable_;
+  std::string stop_request_;
 };
 
 }  // namespace linesim::cosim

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -18,8 +19,15 @@ struct YamlFile {
   int line = 0;        // of invalid YAML; 0 when unknown
 };
 
+/// The largest YAML file linesim reads (scenario, robot, scene, sweep and
+/// model files), checked before parsing: the repository's largest is 9 KB,
+/// and yaml-cpp needs some 50 times a file's size in memory, so 4 MiB
+/// bounds a read to a few hundred MB.
+inline constexpr std::uintmax_t kMaxYamlBytes = std::uintmax_t{4} << 20;
+
 /// Reads `file` (a folder is refused before yaml-cpp, which would leak its
-/// buffer reading one); never throws.
+/// buffer reading one; a file larger than kMaxYamlBytes before reading it);
+/// never throws.
 YamlFile LoadYamlFile(const std::string& file);
 
 /// The tree of `file`, or ScenarioError naming the file (and the line of

@@ -44,6 +44,20 @@ std::uint64_t Fnv1a(std::uint64_t h, std::string_view text) {
   return h;
 }
 
+// The row's proof (results.csv's last column): FNV-1a 64 of the row's
+// text before it (run id, the plan's values and seed, metrics, status,
+// errors, wall time) as 16 hex digits. Resume recomputes it, so a row that
+// was edited in any field (a metric made 999) is done again rather than
+// parsed into the results.
+std::string RowCheck(std::string_view row_text) {
+  const std::uint64_t h = Fnv1a(1469598103934665603ull, row_text);
+  char hex[17];
+  static const char* kDigits = "0123456789abcdef";
+  for (int i = 0; i < 16; ++i) hex[i] = kDigits[(h >> (60 - 4 * i)) & 0xf];
+  hex[16] = '\0';
+  return hex;
+}
+
 // A missing file reads as empty: the fingerprint then differs from any
 // file's, and Resume finds no header.
 std::string ReadWhole(const std::string& path) { return cosim::ReadWholeFile(path).value_or(""); }
@@ -99,7 +113,7 @@ std::vector<std::string> ResultsHeader(const SweepSpec& spec) {
   h.push_back("seed");
   for (const auto& m : spec.metrics) h.push_back(m);
   h.insert(h.end(), {"status", "error", "error_unit", "error_time_s", "error_phase",
-                     "error_variable", "error_cause", "wall_s"});
+                     "error_variable", "error_cause", "wall_s", "row_check"});
   return h;
 }
 
@@ -150,6 +164,8 @@ std::string FormatRow(const RunSpec& run, const RunOutcome& outcome) {
   f.push_back(failed ? e.variable : "");
   f.push_back(failed ? e.cause : "");
   f.push_back(cosim::FormatValue(outcome.wall_s));
+  const std::string text = JoinCsvLine(f);
+  f.push_back(RowCheck(std::string_view(text).substr(0, text.size() - 1)));
   return JoinCsvLine(f);
 }
 
@@ -270,7 +286,9 @@ ResultsFile ResultsFile::Resume(const std::string& path, const SweepSpec& spec) 
     const auto id = ParseId(fields->front());
     if (!id || *id < 0 || *id >= count) continue;
     if (rows.count(*id) != 0) continue;  // the first of duplicates stands
-    if (!RowMatchesPlan(spec, PlanRun(spec, *id), *fields)) {
+    const std::string_view row_text = std::string_view(line).substr(0, line.rfind(','));
+    if (RowCheck(row_text) != fields->back() ||
+        !RowMatchesPlan(spec, PlanRun(spec, *id), *fields)) {
       ++dropped;
       continue;
     }

@@ -17,7 +17,9 @@ namespace linesim::sweep {
 
 /// Column names of results.csv: run_id, each parameter path, seed, each
 /// metric, status, error, error_unit, error_time_s, error_phase,
-/// error_variable, error_cause, wall_s. `error` is the whole message; the
+/// error_variable, error_cause, wall_s, row_check (FNV-1a 64 of the row's
+/// text before it, 16 hex digits: Resume drops a row that was edited).
+/// `error` is the whole message; the
 /// error_* columns are the first failure's fields (cosim::RunError), empty
 /// for an ok run or a field that does not apply.
 std::vector<std::string> ResultsHeader(const SweepSpec& spec);
@@ -58,7 +60,8 @@ class ResultsFile {
   /// whose parameter values or seed are not the plan's for its run id,
   /// whose status is neither ok nor failed, whose ok metrics or wall time
   /// do not read as finite numbers (a failed run's may be empty) is dropped
-  /// (its run is done again) and counted in dropped_count(). Throws
+  /// (its run is done again) and counted in dropped_count(); so is a row
+  /// whose row_check is not its text's (an edited row). Throws
   /// std::runtime_error when the header is not this sweep's.
   static ResultsFile Resume(const std::string& path, const SweepSpec& spec);
 

@@ -7,6 +7,8 @@
 #   fuzz_sweep_file         scenarios/sweeps/*.yaml
 #   fuzz_results_file       a results.csv of scenarios/sweeps/master_step.yaml
 #   fuzz_model_description  tests/units/fmu/fmus/*.xml
+#   fuzz_fmu_loader         the test FMUs (build-asan/tests/units/fmu/*.fmu,
+#                           when the sanitizer build made them)
 #     bash tools/fuzz.sh [SECONDS] [HARNESS ...]
 # The corpora grow in build-asan/fuzz/corpus/HARNESS; an input that crashes,
 # leaks, runs over 30 s, allocates over 2 GB at once or trips a sanitizer is saved as
@@ -18,7 +20,8 @@ seconds=${1:-60}
 shift || true
 harnesses=("$@")
 [ ${#harnesses[@]} -gt 0 ] || harnesses=(fuzz_scenario fuzz_description fuzz_sweep_file
-                                         fuzz_results_file fuzz_model_description)
+                                         fuzz_results_file fuzz_model_description
+                                         fuzz_fmu_loader)
 bash tools/setup.sh
 source tools/sanitizer_build.sh "${harnesses[@]}"
 
@@ -42,6 +45,10 @@ seed fuzz_sweep_file scenarios/sweeps/*.yaml
 mkdir -p "$out/corpus/fuzz_results_file"
 LINESIM_FUZZ_SEED_DIR="$out/corpus/fuzz_results_file" build-asan/fuzz/fuzz_results_file
 seed fuzz_model_description tests/units/fmu/fmus/*.xml
+mkdir -p "$out/corpus/fuzz_fmu_loader"
+for f in build-asan/tests/units/fmu/*.fmu; do
+  [ -e "$f" ] && seed fuzz_fmu_loader "$f"
+done
 
 status=0
 for h in "${harnesses[@]}"; do

@@ -9,6 +9,7 @@
 
 #include "loader/config_names.h"
 #include "loader/scene_file.h"
+#include "loader/yaml_files.h"
 #include "models/dc_motor_params.h"
 #include "scenario_test.h"
 
@@ -586,6 +587,30 @@ TEST(UnitTypes, EveryFamilyRegistersItsTypes) {
   }
   const std::vector<std::string> names = UnitTypeNames();
   EXPECT_TRUE(std::is_sorted(names.begin(), names.end()));
+}
+
+// Guards issue 24: a 40 MB scenario made yaml-cpp exhaust 2 GB and report
+// std::bad_alloc. A file above kMaxYamlBytes (4 MiB) is refused before it
+// is parsed, naming the file and the limit; one byte less is parsed (here:
+// YAML comments, so the error is the missing keys, not the size).
+TEST(LoadScenario, AFileAboveTheSizeLimitIsRefusedBeforeParsing) {
+  const auto file_of = [](const std::string& name, std::uintmax_t bytes) {
+    std::string text(bytes, 'x');
+    for (std::size_t i = 0; i < text.size(); i += 64) text[i] = '\n';
+    text[1] = '#';
+    for (std::size_t i = 0; i + 1 < text.size(); ++i) {
+      if (text[i] == '\n') text[i + 1] = '#';
+    }
+    return WriteScenario(name, text);
+  };
+  const std::string big = file_of("big.yaml", kMaxYamlBytes + 1);
+  const std::string e = Issues(big);
+  EXPECT_NE(e.find(big), std::string::npos) << e.substr(0, 300);
+  EXPECT_NE(e.find("more than the 4 MiB linesim reads from a YAML file"), std::string::npos)
+      << e.substr(0, 300);
+  const std::string e2 = Issues(file_of("limit.yaml", kMaxYamlBytes));
+  EXPECT_EQ(e2.find("MiB"), std::string::npos) << e2.substr(0, 300);
+  std::remove(big.c_str());
 }
 
 }  // namespace

@@ -478,7 +478,11 @@ std::string FreshDir(const std::string& name) {
 std::string WithoutWallTime(const std::string& csv) {
   std::string out;
   std::istringstream in(csv);
-  for (std::string line; std::getline(in, line);) out += line.substr(0, line.rfind(',')) + "\n";
+  // wall_s and row_check (which covers wall_s): the two last columns.
+  for (std::string line; std::getline(in, line);) {
+    line = line.substr(0, line.rfind(','));
+    out += line.substr(0, line.rfind(',')) + "\n";
+  }
   return out;
 }
 
@@ -515,7 +519,7 @@ TEST(SweepExecutor, OneAndTwoJobsWriteTheSameRowsAndAFailingRunIsIsolated) {
   EXPECT_EQ(
       header,
       "run_id,master.step_s,control.compensation,seed,max_path_deviation_m,status,error,error_unit,"
-      "error_time_s,error_phase,error_variable,error_cause,wall_s");
+      "error_time_s,error_phase,error_variable,error_cause,wall_s,row_check");
   std::vector<std::vector<std::string>> rows;
   for (std::string line; std::getline(in, line);) rows.push_back(*SplitCsvLine(line));
   ASSERT_EQ(rows.size(), 6u);
@@ -598,8 +602,9 @@ metrics:
       << bad.failure.cause;
   EXPECT_EQ(bad.failure.message, bad.error);
   const auto row = *SplitCsvLine(FormatRow(PlanRun(spec, 1), bad));
-  // run_id, value, seed, peak_current, status, error, the 5 fields, wall_s.
-  ASSERT_EQ(row.size(), 12u);
+  // run_id, value, seed, peak_current, status, error, the 5 fields, wall_s,
+  // row_check.
+  ASSERT_EQ(row.size(), 13u);
   EXPECT_EQ(row[4], "failed");
   EXPECT_EQ(row[5], bad.error);
   EXPECT_EQ(row[6], "motor");
@@ -654,18 +659,21 @@ TEST(ResultsFile, ResumeDropsRowsThatDoNotMatchThePlan) {
     return line.replace(begin, end - begin, text);
   };
   // Columns: run_id, speed, compensation, seed, 8 metrics..., status, error,
-  // the 5 error fields, wall_s.
+  // the 5 error fields, wall_s, row_check. Guards issue 24: a metric edited
+  // into a finished row (999, a number the plan checks cannot tell from a
+  // result) was kept; row_check proves the row.
   const std::string path = dir + "/results.csv";
   std::ofstream(path, std::ios::trunc)
       << lines[0] << lines[1]                          // run 0 as it was
       << field_replaced(lines[2], 1, "0.3")            // run 1: a value not planned
       << field_replaced(lines[3], 3, "12345")          // run 2: another seed
       << field_replaced(lines[4], 4, "lots")           // run 3: a metric that is no number
-      << field_replaced(lines[5], 12, "fine");         // run 4: an unknown status
+      << field_replaced(lines[5], 12, "fine")          // run 4: an unknown status
+      << field_replaced(lines[6], 5, "999");           // run 5: an edited metric
   ResultsFile resumed = ResultsFile::Resume(path, spec);
   EXPECT_EQ(resumed.row_count(), 1u);
   EXPECT_TRUE(resumed.HasRow(0));
-  EXPECT_EQ(resumed.dropped_count(), 4);
+  EXPECT_EQ(resumed.dropped_count(), 5);
   EXPECT_EQ(ReadFile(path), lines[0] + lines[1]);
 }
 

@@ -97,6 +97,14 @@ using Boolean = bool;
 using Char = char;
 using String = const Char*;
 using Byte = std::uint8_t;
+using Float32 = float;
+using Int8 = std::int8_t;
+using UInt8 = std::uint8_t;
+using Int16 = std::int16_t;
+using UInt16 = std::uint16_t;
+using UInt32 = std::uint32_t;
+using Int64 = std::int64_t;
+using UInt64 = std::uint64_t;
 
 enum Status : int { kOK = 0, kWarning = 1, kDiscard = 2, kError = 3, kFatal = 4 };
 
@@ -152,5 +160,11 @@ using DoStepTYPE = Status (*)(Instance, Float64 current_communication_point,
                               Boolean* event_handling_needed, Boolean* terminate_simulation,
                               Boolean* early_return, Float64* last_successful_time);
 }
+
+// fmi3Get<T> / fmi3Set<T> for the other scalar types (section 2.2.6.2).
+template <typename T>
+using GetTYPE = Status (*)(Instance, const ValueReference[], std::size_t, T[], std::size_t);
+template <typename T>
+using SetTYPE = Status (*)(Instance, const ValueReference[], std::size_t, const T[], std::size_t);
 
 }  // namespace linesim::fmu::fmi3

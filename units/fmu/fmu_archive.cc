@@ -1,12 +1,20 @@
 #include "units/fmu/fmu_archive.h"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 #include <zip.h>
 
+#include <array>
+#include <atomic>
 #include <cerrno>
+#include <charconv>
+#include <csignal>
+#include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <filesystem>
 #include <memory>
 #include <string_view>
@@ -19,11 +27,122 @@ namespace linesim::fmu {
 
 namespace fs = std::filesystem;
 
-TempFolder::TempFolder() {
+namespace {
+
+// The live folders, for removal at exit and from signal handlers: fixed
+// slots of heap copies (a handler only reads them), claimed and released
+// with atomic exchanges.
+constexpr std::size_t kMaxLiveFolders = 256;
+std::array<std::atomic<char*>, kMaxLiveFolders> g_live{};
+
+// Removes the tree at `dir` (relative to `parent`) with system calls only:
+// openat, getdents64, unlinkat (async-signal-safe; no readdir, which may
+// allocate). Does not follow links. `depth` bounds the recursion.
+void RemoveTreeAt(int parent, const char* name, int depth) noexcept {
+  if (depth > 64) return;
+  const int fd = openat(parent, name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd >= 0) {
+    alignas(8) char buffer[4096];
+    for (;;) {
+      const long n = syscall(SYS_getdents64, fd, buffer, sizeof buffer);
+      if (n <= 0) break;
+      for (long at = 0; at < n;) {
+        // struct linux_dirent64: ino (8), off (8), reclen (2), type (1), name.
+        unsigned short reclen = 0;
+        std::memcpy(&reclen, buffer + at + 16, sizeof reclen);
+        const unsigned char type = static_cast<unsigned char>(buffer[at + 18]);
+        const char* entry = buffer + at + 19;
+        at += reclen;
+        if (std::strcmp(entry, ".") == 0 || std::strcmp(entry, "..") == 0) continue;
+        if (type == DT_DIR) {
+          RemoveTreeAt(fd, entry, depth + 1);
+        } else if (unlinkat(fd, entry, 0) != 0 && errno == EISDIR) {
+          RemoveTreeAt(fd, entry, depth + 1);
+        }
+      }
+    }
+    close(fd);
+  }
+  unlinkat(parent, name, AT_REMOVEDIR);
+}
+
+extern "C" void RemoveAtExit() { RemoveLiveTempFolders(); }
+
+// Crash signals, SIGTERM and SIGINT, while nobody else handles them:
+// remove the folders, then die of the signal as before (the handler is
+// reset to the default by SA_RESETHAND).
+extern "C" void RemoveOnSignal(int sig) {
+  RemoveLiveTempFolders();
+  raise(sig);
+}
+
+void InstallCleanupOnce() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    std::atexit(RemoveAtExit);
+    struct sigaction action {};
+    action.sa_handler = RemoveOnSignal;
+    action.sa_flags = SA_RESETHAND | SA_NODEFER;
+    sigemptyset(&action.sa_mask);
+    // Only where nobody else handles the signal: a sanitizer's or a
+    // debugger's handler (and its report) stays.
+    for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGTERM, SIGINT}) {
+      struct sigaction old {};
+      if (sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_DFL &&
+          !(old.sa_flags & SA_SIGINFO)) {
+        sigaction(sig, &action, nullptr);
+      }
+    }
+    SweepStaleTempFolders();
+  });
+}
+
+constexpr std::string_view kPrefix = "linesim-fmu-";
+
+}  // namespace
+
+void RemoveLiveTempFolders() noexcept {
+  for (auto& slot : g_live) {
+    char* path = slot.exchange(nullptr);
+    if (path) RemoveTreeAt(AT_FDCWD, path, 0);
+    // Not freed: a handler must not call free, and the process is ending.
+  }
+}
+
+std::size_t SweepStaleTempFolders() {
   std::error_code ec;
   fs::path base = fs::temp_directory_path(ec);
   if (ec) base = "/tmp";
-  std::string pattern = (base / "linesim-fmu-XXXXXX").string();
+  std::size_t removed = 0;
+  const pid_t self = getpid();
+  for (const auto& entry : fs::directory_iterator(base, ec)) {
+    const std::string name = entry.path().filename().string();
+    // linesim-fmu-<pid>-XXXXXX: the pid in decimal, then mkdtemp's six.
+    if (name.compare(0, kPrefix.size(), kPrefix) != 0) continue;
+    const std::size_t dash = name.find('-', kPrefix.size());
+    if (dash == std::string::npos || dash == kPrefix.size() || name.size() != dash + 7) continue;
+    long pid = 0;
+    const auto [end, err] = std::from_chars(name.data() + kPrefix.size(), name.data() + dash, pid);
+    if (err != std::errc() || end != name.data() + dash || pid <= 0 || pid == self) continue;
+    struct stat st {};
+    if (lstat(entry.path().c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != geteuid()) {
+      continue;
+    }
+    if (kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;  // alive (or not ours to judge)
+    std::error_code remove_ec;
+    fs::remove_all(entry.path(), remove_ec);
+    if (!remove_ec) ++removed;
+  }
+  return removed;
+}
+
+TempFolder::TempFolder() {
+  InstallCleanupOnce();
+  std::error_code ec;
+  fs::path base = fs::temp_directory_path(ec);
+  if (ec) base = "/tmp";
+  std::string pattern =
+      (base / (std::string(kPrefix) + std::to_string(getpid()) + "-XXXXXX")).string();
   std::vector<char> buffer(pattern.begin(), pattern.end());
   buffer.push_back('\0');
   if (!mkdtemp(buffer.data())) {
@@ -31,9 +150,25 @@ TempFolder::TempFolder() {
                    std::strerror(errno));
   }
   path_ = buffer.data();
+  char* copy = strdup(path_.c_str());
+  for (auto& slot : g_live) {
+    char* expected = nullptr;
+    if (copy && slot.compare_exchange_strong(expected, copy)) {
+      copy = nullptr;
+      break;
+    }
+  }
+  std::free(copy);  // more than kMaxLiveFolders at once: removed by the destructor only
 }
 
 TempFolder::~TempFolder() {
+  for (auto& slot : g_live) {
+    char* p = slot.load();
+    if (p && path_ == p && slot.compare_exchange_strong(p, nullptr)) {
+      std::free(p);
+      break;
+    }
+  }
   std::error_code ec;
   fs::remove_all(path_, ec);
 }
@@ -98,7 +233,11 @@ void Unpack(const std::string& fmu, const std::string& folder) {
         throw FmuError(fmu + ": refused: entry '" + name +
                        "' is a symbolic link (it could point outside the FMU's folder)");
       }
-      if (mode != 0 && !S_ISREG(mode) && !S_ISDIR(mode)) {
+      // Permissions without file-type bits (Python's zipfile.writestr
+      // writes 0600 << 16) say nothing of the kind: a file, or a folder
+      // when the name ends in '/'. Type bits that are neither (a FIFO, a
+      // device) are refused.
+      if ((mode & S_IFMT) != 0 && !S_ISREG(mode) && !S_ISDIR(mode)) {
         throw FmuError(fmu + ": refused: entry '" + name + "' is not a file or a folder");
       }
     }

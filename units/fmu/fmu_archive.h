@@ -1,12 +1,20 @@
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
 namespace linesim::fmu {
 
-/// A private temporary folder (mkdtemp, mode 0700) removed with everything
-/// in it when the object goes.
+/// A private temporary folder (mkdtemp, mode 0700),
+/// $TMPDIR/linesim-fmu-<pid>-XXXXXX, removed with everything in it when the
+/// object goes, and also when the process ends otherwise: at exit(), and,
+/// while no other handler is installed for them (a sanitizer's stays), on
+/// a crash signal (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT: an FMU's
+/// binary that crashes) and on SIGTERM / SIGINT (the app's stop handler calls RemoveLiveTempFolders before it
+/// gives up on a second signal). The first folder of a process also sweeps
+/// the folders of processes that are gone (SweepStaleTempFolders). Only
+/// SIGKILL leaves a folder behind, until the next run's sweep.
 class TempFolder {
  public:
   TempFolder();
@@ -18,6 +26,16 @@ class TempFolder {
  private:
   std::string path_;
 };
+
+/// Removes every TempFolder of this process that still exists; safe in a
+/// signal handler (no allocation, system calls only).
+void RemoveLiveTempFolders() noexcept;
+
+/// Removes $TMPDIR/linesim-fmu-<pid>-* folders owned by this user whose
+/// process no longer exists (kill(pid, 0) fails with ESRCH); folders of
+/// live processes and of other users are left alone. Returns how many were
+/// removed.
+std::size_t SweepStaleTempFolders();
 
 /// The most an FMU may unpack to (every file's size added up), so that a
 /// crafted archive cannot fill the disk.

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <cfloat>
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +14,7 @@
 #include <filesystem>
 #include <map>
 #include <set>
+#include <type_traits>
 
 #include "units/fmu/fmi_api.h"
 #include "units/fmu/fmu_archive.h"
@@ -55,6 +58,7 @@ class FmuBinary {
       Resolve(f2.SetString, "fmi2SetString");
       Resolve(f2.DoStep, "fmi2DoStep");
       Resolve(f2.GetRealStatus, "fmi2GetRealStatus", false);
+      Resolve(f2.GetBooleanStatus, "fmi2GetBooleanStatus", false);
       Resolve(f2.GetFMUstate, "fmi2GetFMUstate", state);
       Resolve(f2.SetFMUstate, "fmi2SetFMUstate", state);
       Resolve(f2.FreeFMUstate, "fmi2FreeFMUstate", state);
@@ -77,6 +81,22 @@ class FmuBinary {
       Resolve(f3.SetBoolean, "fmi3SetBoolean");
       Resolve(f3.SetString, "fmi3SetString");
       Resolve(f3.DoStep, "fmi3DoStep");
+      Resolve(f3.GetFloat32, "fmi3GetFloat32", false);
+      Resolve(f3.SetFloat32, "fmi3SetFloat32", false);
+      Resolve(f3.GetInt8, "fmi3GetInt8", false);
+      Resolve(f3.SetInt8, "fmi3SetInt8", false);
+      Resolve(f3.GetUInt8, "fmi3GetUInt8", false);
+      Resolve(f3.SetUInt8, "fmi3SetUInt8", false);
+      Resolve(f3.GetInt16, "fmi3GetInt16", false);
+      Resolve(f3.SetInt16, "fmi3SetInt16", false);
+      Resolve(f3.GetUInt16, "fmi3GetUInt16", false);
+      Resolve(f3.SetUInt16, "fmi3SetUInt16", false);
+      Resolve(f3.GetUInt32, "fmi3GetUInt32", false);
+      Resolve(f3.SetUInt32, "fmi3SetUInt32", false);
+      Resolve(f3.GetInt64, "fmi3GetInt64", false);
+      Resolve(f3.SetInt64, "fmi3SetInt64", false);
+      Resolve(f3.GetUInt64, "fmi3GetUInt64", false);
+      Resolve(f3.SetUInt64, "fmi3SetUInt64", false);
       Resolve(f3.GetFMUState, "fmi3GetFMUState", state);
       Resolve(f3.SetFMUState, "fmi3SetFMUState", state);
       Resolve(f3.FreeFMUState, "fmi3FreeFMUState", state);
@@ -93,6 +113,29 @@ class FmuBinary {
   }
   ~FmuBinary() {
     if (handle_) dlclose(handle_);
+  }
+  /// Throws FmuError when the binary lacks fmi3Get<T> / fmi3Set<T> of a
+  /// type the FMU has variables of.
+  void RequireTypeFunctions(FmiType type) const {
+    const auto need = [&](const void* get, const void* set, const char* name) {
+      if (!get || !set) {
+        throw FmuError(file_ + ": the binary " + fs::path(so_).filename().string() +
+                       " does not export fmi3Get" + name + " / fmi3Set" + name +
+                       ", and the FMU has " + name + " variables (missing symbol)");
+      }
+    };
+    const auto p = [](auto f) { return reinterpret_cast<const void*>(f); };
+    switch (type) {
+      case FmiType::kFloat32: need(p(f3.GetFloat32), p(f3.SetFloat32), "Float32"); break;
+      case FmiType::kInt8: need(p(f3.GetInt8), p(f3.SetInt8), "Int8"); break;
+      case FmiType::kUInt8: need(p(f3.GetUInt8), p(f3.SetUInt8), "UInt8"); break;
+      case FmiType::kInt16: need(p(f3.GetInt16), p(f3.SetInt16), "Int16"); break;
+      case FmiType::kUInt16: need(p(f3.GetUInt16), p(f3.SetUInt16), "UInt16"); break;
+      case FmiType::kUInt32: need(p(f3.GetUInt32), p(f3.SetUInt32), "UInt32"); break;
+      case FmiType::kInt64: need(p(f3.GetInt64), p(f3.SetInt64), "Int64"); break;
+      case FmiType::kUInt64: need(p(f3.GetUInt64), p(f3.SetUInt64), "UInt64"); break;
+      default: break;
+    }
   }
   FmuBinary(const FmuBinary&) = delete;
   FmuBinary& operator=(const FmuBinary&) = delete;
@@ -115,6 +158,7 @@ class FmuBinary {
     fmi2::SetStringTYPE SetString = nullptr;
     fmi2::DoStepTYPE DoStep = nullptr;
     fmi2::GetRealStatusTYPE GetRealStatus = nullptr;
+    fmi2::GetBooleanStatusTYPE GetBooleanStatus = nullptr;
     fmi2::GetFMUstateTYPE GetFMUstate = nullptr;
     fmi2::SetFMUstateTYPE SetFMUstate = nullptr;
     fmi2::FreeFMUstateTYPE FreeFMUstate = nullptr;
@@ -138,6 +182,24 @@ class FmuBinary {
     fmi3::SetBooleanTYPE SetBoolean = nullptr;
     fmi3::SetStringTYPE SetString = nullptr;
     fmi3::DoStepTYPE DoStep = nullptr;
+    // The other scalar types: resolved when exported, required when the
+    // FMU has a variable of the type (RequireTypeFunctions).
+    fmi3::GetTYPE<fmi3::Float32> GetFloat32 = nullptr;
+    fmi3::SetTYPE<fmi3::Float32> SetFloat32 = nullptr;
+    fmi3::GetTYPE<fmi3::Int8> GetInt8 = nullptr;
+    fmi3::SetTYPE<fmi3::Int8> SetInt8 = nullptr;
+    fmi3::GetTYPE<fmi3::UInt8> GetUInt8 = nullptr;
+    fmi3::SetTYPE<fmi3::UInt8> SetUInt8 = nullptr;
+    fmi3::GetTYPE<fmi3::Int16> GetInt16 = nullptr;
+    fmi3::SetTYPE<fmi3::Int16> SetInt16 = nullptr;
+    fmi3::GetTYPE<fmi3::UInt16> GetUInt16 = nullptr;
+    fmi3::SetTYPE<fmi3::UInt16> SetUInt16 = nullptr;
+    fmi3::GetTYPE<fmi3::UInt32> GetUInt32 = nullptr;
+    fmi3::SetTYPE<fmi3::UInt32> SetUInt32 = nullptr;
+    fmi3::GetTYPE<fmi3::Int64> GetInt64 = nullptr;
+    fmi3::SetTYPE<fmi3::Int64> SetInt64 = nullptr;
+    fmi3::GetTYPE<fmi3::UInt64> GetUInt64 = nullptr;
+    fmi3::SetTYPE<fmi3::UInt64> SetUInt64 = nullptr;
     fmi3::GetFMUStateTYPE GetFMUState = nullptr;
     fmi3::SetFMUStateTYPE SetFMUState = nullptr;
     fmi3::FreeFMUStateTYPE FreeFMUState = nullptr;
@@ -293,7 +355,6 @@ FmuUnit::FmuUnit(std::string name, const std::string& fmu_file)
                    (found.empty() ? "none" : found) + ")");
   }
   binary_ = std::make_unique<FmuBinary>(so.string(), description_, fmu_file);
-  if (description_.fixed_internal_step) fixed_step_ = cosim::SecondsToNs(*description_.fixed_internal_step);
   DeclareVariables();
 }
 
@@ -328,9 +389,13 @@ void FmuUnit::DeclareVariables() {
     if (!v.dimensions.empty()) {
       ++array_count;
     } else {
-      ++count[static_cast<int>(v.type)];
+      ++count[StorageOf(v.type)];
+      binary_->RequireTypeFunctions(v.type);
     }
   }
+  for (const std::string& name : description_.left_out) mapping_.push_back({name, "", 0, false});
+  conversion_ = std::make_unique<unsigned char[]>(8 * std::max<std::size_t>({count[0], count[1], 1}));
+  integer_variable_.assign(count[1], 0);
   reals_ = std::make_unique<double[]>(count[0]);
   integers_ = std::make_unique<std::int64_t[]>(count[1]);
   booleans_ = std::make_unique<bool[]>(count[2]);
@@ -357,20 +422,28 @@ void FmuUnit::DeclareVariables() {
     used.insert(n);
     return n;
   };
-  std::size_t next[4] = {};
+  std::size_t next[4] = {};  // per storage
   for (int d = 0; d <= kDirections; ++d) {
-    for (int t = 0; t < 5; ++t) {  // 4: arrays of Float64
+    for (int t = 0; t <= kFmiTypeCount; ++t) {  // kFmiTypeCount: arrays of Float64
+      const bool arrays = t == kFmiTypeCount;
+      const FmiType type = arrays ? FmiType::kFloat64 : static_cast<FmiType>(t);
+      const int storage = StorageOf(type);
       Group* g = nullptr;
-      if (d < kDirections && t < 4) {
+      if (d < kDirections && !arrays) {
         Groups& gs = groups_[d];
-        g = t == 0 ? &gs.real : t == 1 ? &gs.integer : t == 2 ? &gs.boolean : &gs.string;
-        g->first = next[t];
+        if (t < 4) {
+          g = t == 0 ? &gs.real : t == 1 ? &gs.integer : t == 2 ? &gs.boolean : &gs.string;
+        } else {
+          gs.extras.push_back({type, {}});
+          g = &gs.extras.back().group;
+        }
+        g->first = next[storage];
       }
       for (std::size_t i = 0; i < vars.size(); ++i) {
         const FmiVariable& v = vars[i];
         if (direction[i] != d) continue;
         const bool is_array = !v.dimensions.empty();
-        if (t == 4 ? !is_array : (is_array || static_cast<int>(v.type) != t)) continue;
+        if (arrays ? !is_array : (is_array || v.type != type)) continue;
         const std::string name = unique_name(v.name);
         mapping_[i].name = name;
         std::string text = v.description;
@@ -378,6 +451,19 @@ void FmuUnit::DeclareVariables() {
                 std::to_string(v.value_reference);
         if (!v.fmi_unit.empty() && v.fmi_unit != v.unit) text += ", unit '" + v.fmi_unit + "'";
         if (v.causality == "calculatedParameter") text += ", calculated parameter";
+        if (v.type != FmiType::kFloat64 && v.type != FmiType::kInt32 &&
+            v.type != FmiType::kBoolean && v.type != FmiType::kString) {
+          text += std::string(", ") + ToString(v.type);
+        }
+        if (!v.items.empty()) {
+          text += ", enumeration '" + v.declared_type + "':";
+          for (const auto& [value, item] : v.items) text += " " + std::to_string(value) + " " + item;
+        }
+        if (v.min) text += ", min " + cosim::FormatValue(*v.min);
+        if (v.max) text += ", max " + cosim::FormatValue(*v.max);
+        if (v.nominal) text += ", nominal " + cosim::FormatValue(*v.nominal);
+        // The table shows 0 for it until the FMU gives a value.
+        if (!v.has_start) text += ", no start value";
         if (v.dimensions.size() > 1) {
           text += ", ";
           for (std::size_t k = 0; k < v.dimensions.size(); ++k) {
@@ -402,7 +488,7 @@ void FmuUnit::DeclareVariables() {
             : d == kTunables ? cosim::Variability::kTunable
                              : cosim::Variability::kFixed;
         const bool parameter = d == kParameters || d == kTunables || d == kDirections;
-        if (t == 4) {
+        if (arrays) {
           arrays_.emplace_back(v.size, 0.0);
           std::vector<double>* slot = &arrays_.back();
           if (v.has_start) *slot = v.start_reals;
@@ -417,7 +503,7 @@ void FmuUnit::DeclareVariables() {
             table.Local(name, v.unit, slot, text);
           }
         } else {
-          const std::size_t k = next[t]++;
+          const std::size_t k = next[storage]++;
           if (g) g->vrs.push_back(v.value_reference);
           // An Integer, Boolean or String (no unit of measure) at `slot`,
           // as a parameter, an input or an output.
@@ -431,8 +517,8 @@ void FmuUnit::DeclareVariables() {
               table.Output(name, slot, text, deps);
             }
           };
-          switch (v.type) {
-            case FmiType::kFloat64: {
+          switch (storage) {
+            case 0: {
               double* slot = &reals_[k];
               *slot = v.has_start ? v.start_reals[0] : 0.0;
               if (parameter) {
@@ -446,13 +532,14 @@ void FmuUnit::DeclareVariables() {
               }
               break;
             }
-            case FmiType::kInt32:
+            case 1:
+              integer_variable_[k] = i;
               DeclareScalar(&integers_[k], v.start_integer);
               break;
-            case FmiType::kBoolean:
+            case 2:
               DeclareScalar(&booleans_[k], v.start_boolean);
               break;
-            case FmiType::kString:
+            default:
               DeclareScalar(&strings_[k], v.start_string);
               break;
           }
@@ -462,12 +549,14 @@ void FmuUnit::DeclareVariables() {
           all_inputs.push_back(name);
         }
       }
+      if (g && t >= 4 && g->vrs.empty()) groups_[d].extras.pop_back();
     }
   }
   // Tunable parameters: what was last given to the FMU.
   const Groups& tun = groups_[kTunables];
   has_tunables_ = !tun.real.vrs.empty() || !tun.integer.vrs.empty() ||
-                  !tun.boolean.vrs.empty() || !tun.string.vrs.empty() || !tun.arrays.empty();
+                  !tun.boolean.vrs.empty() || !tun.string.vrs.empty() || !tun.arrays.empty() ||
+                  !tun.extras.empty();
 }
 
 std::vector<cosim::ParameterProblem> FmuUnit::CheckParameters() const {
@@ -498,7 +587,11 @@ std::string FmuUnit::Describe(const char* call, int status) const {
 
 void FmuUnit::Check(int status, const char* call, const char* phase) {
   if (status == 0 || status == 1) return;  // OK, Warning (kept in the log)
-  if (status == 4) mode_ = Mode::kBroken;  // Fatal: no further call
+  // Fatal: no further call. Error: no call but freeing the instance or
+  // restoring a state (FMI 2.0.4 section 2.1.3, FMI 3.0 section 2.2.3): in
+  // particular no Terminate, whatever phase failed.
+  if (status == 4) mode_ = Mode::kBroken;
+  if (status == 3 && mode_ != Mode::kBroken) mode_ = Mode::kError;
   throw UnitError(Where() + ": " + phase + ": " + Describe(call, status) +
                   RecentMessages(call_messages_));
 }
@@ -513,11 +606,7 @@ void FmuUnit::SetGroups(const Groups& g, const char* phase) {
     if (const std::size_t n = g.integer.vrs.size()) {
       for (std::size_t i = 0; i < n; ++i) {
         const std::int64_t x = integers_[g.integer.first + i];
-        if (x < INT32_MIN || x > INT32_MAX) {
-          throw UnitError(Where() + ": " + phase + ": Integer value " + std::to_string(x) +
-                          " (vr " + std::to_string(g.integer.vrs[i]) +
-                          ") is outside the FMI 2.0 Integer range");
-        }
+        CheckInteger(g.integer.first + i, x, phase);
         int_buffer_[i] = static_cast<int>(x);
       }
       Check(f.SetInteger(c, g.integer.vrs.data(), n, int_buffer_.data()), "fmi2SetInteger", phase);
@@ -543,10 +632,7 @@ void FmuUnit::SetGroups(const Groups& g, const char* phase) {
   if (const std::size_t n = g.integer.vrs.size()) {
     for (std::size_t i = 0; i < n; ++i) {
       const std::int64_t x = integers_[g.integer.first + i];
-      if (x < INT32_MIN || x > INT32_MAX) {
-        throw UnitError(Where() + ": " + phase + ": Int32 value " + std::to_string(x) + " (vr " +
-                        std::to_string(g.integer.vrs[i]) + ") is outside the Int32 range");
-      }
+      CheckInteger(g.integer.first + i, x, phase);
       int_buffer_[i] = static_cast<int>(x);
     }
     static_assert(sizeof(int) == sizeof(fmi3::Int32));
@@ -561,6 +647,105 @@ void FmuUnit::SetGroups(const Groups& g, const char* phase) {
   if (const std::size_t n = g.string.vrs.size()) {
     for (std::size_t i = 0; i < n; ++i) string_buffer_[i] = strings_[g.string.first + i].c_str();
     Check(f.SetString(c, g.string.vrs.data(), n, string_buffer_.data(), n), "fmi3SetString", phase);
+  }
+  for (const TypedGroup& x : g.extras) SetExtra(x, phase);
+}
+
+void FmuUnit::CheckInteger(std::size_t slot, std::int64_t x, const char* phase) const {
+  const FmiVariable& v = description_.variables[integer_variable_[slot]];
+  const auto [lo, hi] = IntegerRange(v.type);
+  if (x < lo || x > hi) {
+    throw UnitError(Where() + ": " + phase + ": " + ToString(v.type) + " value " +
+                        std::to_string(x) + " of '" + v.name + "' is outside the " +
+                        ToString(v.type) + " range [" + std::to_string(lo) + ", " +
+                        std::to_string(hi) + "]",
+                    v.name);
+  }
+  if (v.items.empty()) return;
+  const auto it = std::lower_bound(v.items.begin(), v.items.end(), x,
+                                   [](const auto& item, std::int64_t value) { return item.first < value; });
+  if (it == v.items.end() || it->first != x) {
+    std::string items;
+    for (const auto& [value, name] : v.items) {
+      items += (items.empty() ? "" : ", ") + std::to_string(value) + " (" + name + ")";
+    }
+    throw UnitError(Where() + ": " + phase + ": value " + std::to_string(x) + " of '" + v.name +
+                        "' is no item of enumeration '" + v.declared_type + "': " + items,
+                    v.name);
+  }
+}
+
+// The other FMI 3.0 types, converted through conversion_ (range-checked
+// before the conversion, so that nothing wraps).
+void FmuUnit::SetExtra(const TypedGroup& x, const char* phase) {
+  const auto& f = binary_->f3;
+  const Group& g = x.group;
+  const std::size_t n = g.vrs.size();
+  const auto set = [&](auto function, auto zero, const char* call) {
+    using T = decltype(zero);
+    T* buffer = reinterpret_cast<T*>(conversion_.get());
+    for (std::size_t i = 0; i < n; ++i) {
+      if constexpr (std::is_floating_point_v<T>) {
+        const double v = reals_[g.first + i];
+        if (std::isfinite(v) && std::fabs(v) > FLT_MAX) {
+          throw UnitError(Where() + ": " + phase + ": Float32 value " + cosim::FormatValue(v) +
+                          " (vr " + std::to_string(g.vrs[i]) + ") is outside the Float32 range");
+        }
+        buffer[i] = static_cast<T>(v);
+      } else {
+        const std::int64_t v = integers_[g.first + i];
+        CheckInteger(g.first + i, v, phase);
+        buffer[i] = static_cast<T>(v);
+      }
+    }
+    Check(function(instance_, g.vrs.data(), n, buffer, n), call, phase);
+  };
+  switch (x.type) {
+    case FmiType::kFloat32: set(f.SetFloat32, fmi3::Float32{}, "fmi3SetFloat32"); break;
+    case FmiType::kInt8: set(f.SetInt8, fmi3::Int8{}, "fmi3SetInt8"); break;
+    case FmiType::kUInt8: set(f.SetUInt8, fmi3::UInt8{}, "fmi3SetUInt8"); break;
+    case FmiType::kInt16: set(f.SetInt16, fmi3::Int16{}, "fmi3SetInt16"); break;
+    case FmiType::kUInt16: set(f.SetUInt16, fmi3::UInt16{}, "fmi3SetUInt16"); break;
+    case FmiType::kUInt32: set(f.SetUInt32, fmi3::UInt32{}, "fmi3SetUInt32"); break;
+    case FmiType::kInt64: set(f.SetInt64, fmi3::Int64{}, "fmi3SetInt64"); break;
+    case FmiType::kUInt64: set(f.SetUInt64, fmi3::UInt64{}, "fmi3SetUInt64"); break;
+    default: break;
+  }
+}
+
+void FmuUnit::GetExtra(const TypedGroup& x, const char* phase) {
+  const auto& f = binary_->f3;
+  const Group& g = x.group;
+  const std::size_t n = g.vrs.size();
+  const auto get = [&](auto function, auto zero, const char* call) {
+    using T = decltype(zero);
+    T* buffer = reinterpret_cast<T*>(conversion_.get());
+    Check(function(instance_, g.vrs.data(), n, buffer, n), call, phase);
+    for (std::size_t i = 0; i < n; ++i) {
+      if constexpr (std::is_floating_point_v<T>) {
+        reals_[g.first + i] = buffer[i];
+      } else {
+        if constexpr (std::is_same_v<T, fmi3::UInt64>) {
+          if (buffer[i] > static_cast<fmi3::UInt64>(INT64_MAX)) {
+            throw UnitError(Where() + ": " + phase + ": UInt64 value " + std::to_string(buffer[i]) +
+                            " (vr " + std::to_string(g.vrs[i]) +
+                            ") is above linesim's Integer range (at most 2^63 - 1)");
+          }
+        }
+        integers_[g.first + i] = static_cast<std::int64_t>(buffer[i]);
+      }
+    }
+  };
+  switch (x.type) {
+    case FmiType::kFloat32: get(f.GetFloat32, fmi3::Float32{}, "fmi3GetFloat32"); break;
+    case FmiType::kInt8: get(f.GetInt8, fmi3::Int8{}, "fmi3GetInt8"); break;
+    case FmiType::kUInt8: get(f.GetUInt8, fmi3::UInt8{}, "fmi3GetUInt8"); break;
+    case FmiType::kInt16: get(f.GetInt16, fmi3::Int16{}, "fmi3GetInt16"); break;
+    case FmiType::kUInt16: get(f.GetUInt16, fmi3::UInt16{}, "fmi3GetUInt16"); break;
+    case FmiType::kUInt32: get(f.GetUInt32, fmi3::UInt32{}, "fmi3GetUInt32"); break;
+    case FmiType::kInt64: get(f.GetInt64, fmi3::Int64{}, "fmi3GetInt64"); break;
+    case FmiType::kUInt64: get(f.GetUInt64, fmi3::UInt64{}, "fmi3GetUInt64"); break;
+    default: break;
   }
 }
 
@@ -611,6 +796,7 @@ void FmuUnit::GetGroups(const Groups& g, const char* phase) {
       strings_[g.string.first + i] = string_buffer_[i] ? string_buffer_[i] : "";
     }
   }
+  for (const TypedGroup& x : g.extras) GetExtra(x, phase);
 }
 
 // The tunable parameters, when one changed since they were last given.
@@ -628,6 +814,17 @@ void FmuUnit::SetTunables() {
   }
   for (std::size_t i = 0; i < g.string.vrs.size() && !changed; ++i) {
     changed = strings_[g.string.first + i] != sent_strings_[i];
+  }
+  {
+    std::size_t r = 0, k = 0;
+    for (const TypedGroup& x : g.extras) {
+      for (std::size_t i = 0; i < x.group.vrs.size() && !changed; ++i) {
+        const std::size_t slot = x.group.first + i;
+        changed = StorageOf(x.type) == 0
+                      ? std::memcmp(&reals_[slot], &sent_extra_reals_[r++], sizeof(double)) != 0
+                      : integers_[slot] != sent_extra_integers_[k++];
+      }
+    }
   }
   std::size_t offset = g.real.vrs.size();
   for (const ArraySlot& a : g.arrays) {
@@ -653,6 +850,18 @@ void FmuUnit::RememberTunables() {
   sent_booleans_.clear();
   for (std::size_t i = 0; i < g.boolean.vrs.size(); ++i) {
     sent_booleans_.push_back(booleans_[g.boolean.first + i] ? 1 : 0);
+  }
+  sent_extra_reals_.clear();
+  sent_extra_integers_.clear();
+  for (const TypedGroup& x : g.extras) {
+    for (std::size_t i = 0; i < x.group.vrs.size(); ++i) {
+      const std::size_t slot = x.group.first + i;
+      if (StorageOf(x.type) == 0) {
+        sent_extra_reals_.push_back(reals_[slot]);
+      } else {
+        sent_extra_integers_.push_back(integers_[slot]);
+      }
+    }
   }
   sent_strings_.assign(strings_.begin() + static_cast<std::ptrdiff_t>(g.string.first),
                        strings_.begin() + static_cast<std::ptrdiff_t>(g.string.first + g.string.vrs.size()));
@@ -759,13 +968,21 @@ void FmuUnit::UpdateOutputs() {
 
 StepResult FmuUnit::DoStep(TimeNs t, TimeNs dt) {
   ClearError();
+  if (mode_ == Mode::kError) {
+    return Fail(Where() + ": the FMU returned an error before t = " + cosim::FormatSeconds(t) +
+                " s: it cannot be stepped again (FMI: only freeing or restoring a state is allowed)");
+  }
   if (mode_ != Mode::kInitialization && mode_ != Mode::kStep) {
     return Fail(Where() + ": the FMU is not initialized (or was terminated) at t = " +
                 cosim::FormatSeconds(t) + " s");
   }
   call_messages_ = message_count_;
   if (!InputsFinite(t)) return StepResult::kError;
-  // Step sizes the FMU cannot take, named before it is asked.
+  // Step sizes the FMU cannot take, named before it is asked. A step that
+  // is no multiple of fixedInternalStepSize is not among them: that
+  // attribute is information (FMI 3.0, section 4.2.1), and an FMU that
+  // cannot take such a step refuses it itself (its status and log are
+  // reported).
   if (first_dt_ == 0) first_dt_ = dt;
   if (dt != first_dt_ && !description_.can_handle_variable_step) {
     return Fail(Where() + ": step size refused at t = " + cosim::FormatSeconds(t) + " s: the FMU " +
@@ -773,16 +990,14 @@ StepResult FmuUnit::DoStep(TimeNs t, TimeNs dt) {
                 "(canHandleVariableCommunicationStepSize is false); it was stepped with " +
                 cosim::FormatSeconds(first_dt_) + " s, now " + cosim::FormatSeconds(dt) + " s");
   }
-  if (fixed_step_ > 0 && dt % fixed_step_ != 0) {
-    return Fail(Where() + ": step size refused: " + cosim::FormatSeconds(dt) +
-                " s is not a whole multiple of the FMU's fixedInternalStepSize " +
-                cosim::FormatSeconds(fixed_step_) + " s");
-  }
-  const double tc = cosim::NsToSeconds(t);
-  const double h = cosim::NsToSeconds(dt);
+  const double target = cosim::NsToSeconds(t + dt);
+  double tc = cosim::NsToSeconds(t);
+  double h = cosim::NsToSeconds(dt);
+  const bool v2 = description_.fmi_major == 2;
+  const char* call = v2 ? "fmi2DoStep" : "fmi3DoStep";
   try {
     if (mode_ == Mode::kInitialization) {
-      if (description_.fmi_major == 2) {
+      if (v2) {
         Check(binary_->f2.ExitInitializationMode(instance_), "fmi2ExitInitializationMode",
               "leaving initialization");
       } else {
@@ -794,29 +1009,77 @@ StepResult FmuUnit::DoStep(TimeNs t, TimeNs dt) {
     if (has_tunables_) SetTunables();
     SetGroups(groups_[kInputs], "step");
     int status = 0;
-    bool early = false;
-    double last_time = tc + h;
+    double last_time = target;
     bool terminate = false;
-    if (description_.fmi_major == 2) {
+    if (v2) {
       status = binary_->f2.DoStep(instance_, tc, h, fmi2::kTrue);
-    } else {
-      bool event_needed = false;
-      status = binary_->f3.DoStep(instance_, tc, h, true, &event_needed, &terminate, &early,
-                                  &last_time);
-    }
-    const char* call = description_.fmi_major == 2 ? "fmi2DoStep" : "fmi3DoStep";
-    if (status == 2 || (status <= 1 && early)) {
-      // Discard / early return: the master decides (a fixed-step master
-      // stops, naming unit and time).
-      std::string why = status == 2 ? Describe(call, status) : std::string(call) + " returned early";
-      if (description_.fmi_major == 2 && binary_->f2.GetRealStatus) {
-        double t_ok = 0;
-        if (binary_->f2.GetRealStatus(instance_, fmi2::kLastSuccessfulTime, &t_ok) <= 1) {
-          last_time = t_ok;
+      if (status == fmi2::kDiscard) {
+        if (binary_->f2.GetRealStatus) {
+          double t_ok = 0;
+          if (binary_->f2.GetRealStatus(instance_, fmi2::kLastSuccessfulTime, &t_ok) <= 1) {
+            last_time = t_ok;
+          }
         }
+        // fmi2Discard with fmi2Terminated: the FMU ends the simulation
+        // (FMI 2.0.4, section 4.2.3: the master calls fmi2Terminate), not
+        // a step to retry smaller.
+        fmi2::Boolean ended = fmi2::kFalse;
+        terminate = binary_->f2.GetBooleanStatus &&
+                    binary_->f2.GetBooleanStatus(instance_, fmi2::kTerminated, &ended) <= 1 &&
+                    ended == fmi2::kTrue;
       }
-      // No unit name in front: the master's message names it, around this.
-      Fail(why + " for the step from t = " + cosim::FormatSeconds(t) + " s to " +
+    } else {
+      // Early return (FMI 3.0, section 4.2.4, fmi3DoStep; the FMU is
+      // instantiated with earlyReturnAllowed and without event mode): the
+      // FMU stopped inside the step at lastSuccessfulTime, at an event it
+      // handled itself (a bounce, a staircase's step), and is valid there.
+      // The unit continues it from that time to the communication point
+      // with the inputs held, as for the whole step; the other units and
+      // the master see a step from t to t + dt as always, so the
+      // communication points stay start + k h. An event at the end of the
+      // step (lastSuccessfulTime = t + dt) is a step that succeeded.
+      for (std::size_t returns = 0;; ++returns) {
+        bool event_needed = false;
+        bool early = false;
+        last_time = tc + h;
+        status = binary_->f3.DoStep(instance_, tc, h, true, &event_needed, &terminate, &early,
+                                    &last_time);
+        if (status > fmi3::kWarning || terminate || !early || !(last_time < target)) break;
+        if (!(last_time > tc)) {
+          return Fail(Where() + ": fmi3DoStep returned early at lastSuccessfulTime " +
+                      cosim::FormatValue(last_time) + " s, not after the step's start " +
+                      cosim::FormatValue(tc) + " s (no progress)" +
+                      RecentMessages(call_messages_));
+        }
+        if (returns >= kMaxEarlyReturns) {
+          return Fail(Where() + ": fmi3DoStep returned early " + std::to_string(returns + 1) +
+                      " times in the step from t = " + cosim::FormatSeconds(t) + " s to " +
+                      cosim::FormatSeconds(t + dt) + " s (at most " +
+                      std::to_string(kMaxEarlyReturns) + ": an event that does not end?)" +
+                      RecentMessages(call_messages_));
+        }
+        ++early_returns_;
+        tc = last_time;
+        h = target - last_time;
+      }
+    }
+    if (terminate && status <= 2) {
+      // The FMU asks to end the simulation, its values valid at the time it
+      // reached: they are read, and the run ends normally after this step.
+      GetGroups(groups_[kOutputs], "step");
+      GetGroups(groups_[kLocals], "step");
+      RequestStop(std::string(call) + " returned " + StatusName(description_.fmi_major, status) +
+                  (v2 ? " with fmi2Terminated = true" : " with terminateSimulation = true") +
+                  " in the step from t = " + cosim::FormatSeconds(t) + " s (last successful time " +
+                  cosim::FormatValue(last_time) + " s): the FMU asks to end the simulation" +
+                  RecentMessages(call_messages_));
+      return StepResult::kOk;
+    }
+    if (status == 2) {
+      // Discard: the master decides (a fixed-step master stops, naming
+      // unit and time). No unit name in front: the master's message names
+      // it, around this.
+      Fail(Describe(call, status) + " for the step from t = " + cosim::FormatSeconds(t) + " s to " +
            cosim::FormatSeconds(t + dt) + " s (last successful time " + cosim::FormatValue(last_time) +
            " s)" + RecentMessages(call_messages_));
       return StepResult::kDiscard;
@@ -826,15 +1089,11 @@ StepResult FmuUnit::DoStep(TimeNs t, TimeNs dt) {
                   " s: asynchronous steps are not supported");
     }
     if (status >= 3) {
-      if (status == 4) mode_ = Mode::kBroken;
+      mode_ = status == 4 ? Mode::kBroken : Mode::kError;
       std::string text = Where() + ": " + Describe(call, status) + " for the step of " +
                          cosim::FormatSeconds(dt) + " s at t = " + cosim::FormatSeconds(t) + " s";
       if (t == start_) text += " (its first step: does the FMU refuse this step size?)";
       return Fail(text + RecentMessages(call_messages_));
-    }
-    if (terminate) {
-      return Fail(Where() + ": the FMU asks to terminate the simulation at t = " +
-                  cosim::FormatSeconds(t + dt) + " s" + RecentMessages(call_messages_));
     }
     GetGroups(groups_[kOutputs], "step");
     GetGroups(groups_[kLocals], "step");
@@ -862,8 +1121,9 @@ void FmuUnit::SaveInternal(cosim::UnitState& state) const {
   // serialized into strings[0], -2: no FMU instance).
   state.integers = {static_cast<std::int64_t>(mode_), first_dt_, id_, -2};
   if (!binary_ || !instance_ || mode_ == Mode::kNone) return;
-  if (mode_ == Mode::kBroken) {
-    throw UnitError(Where() + ": cannot save the state of an FMU after a fatal error");
+  if (mode_ == Mode::kBroken || mode_ == Mode::kError) {
+    throw UnitError(Where() + ": cannot save the state of an FMU after " +
+                    (mode_ == Mode::kBroken ? "a fatal error" : "an error"));
   }
   if (!description_.can_get_and_set_state) {
     throw UnitError(Where() + ": cannot save the state: the FMU does not offer it "

@@ -40,8 +40,11 @@ struct MappedVariable {
 /// Initialize sets inputs and reads outputs in it; the first DoStep exits
 /// it. DoStep(t, dt) calls doStep at t and dt as the master gives them
 /// (integer nanoseconds, so every communication point is start + k h
-/// exactly). fmi2Discard / fmi3Discard and FMI 3.0's earlyReturn give
-/// StepResult::kDiscard. SaveState / RestoreState use get/setFMUstate
+/// exactly). fmi2Discard / fmi3Discard give StepResult::kDiscard; an FMI
+/// 3.0 early return is continued from lastSuccessfulTime to t + dt; a
+/// terminate request (fmi2Discard with fmi2Terminated, fmi3DoStep's
+/// terminateSimulation) reads the outputs and asks the master to end the
+/// run there (Unit::stop_request). SaveState / RestoreState use get/setFMUstate
 /// (serialized into the UnitState when canSerializeFMUstate), and throw
 /// naming the capability when the FMU has neither.
 class FmuUnit : public cosim::Unit {
@@ -69,6 +72,12 @@ class FmuUnit : public cosim::Unit {
   /// kMaxMessages are dropped).
   std::size_t message_count() const { return message_count_; }
   static constexpr std::size_t kMaxMessages = 1000;
+  /// FMI 3.0 early returns the unit continued (see DoStep), since loading.
+  std::size_t early_returns() const { return early_returns_; }
+  /// The most early returns within one communication step: each must
+  /// advance the FMU's time; beyond this many the step fails (an event
+  /// that never ends would otherwise hang the run).
+  static constexpr std::size_t kMaxEarlyReturns = 100'000;
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
   void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
@@ -85,7 +94,11 @@ class FmuUnit : public cosim::Unit {
   void RestoreInternal(const cosim::UnitState& state) override;
 
  private:
-  enum class Mode : std::int64_t { kNone = 0, kInstantiated, kInitialization, kStep, kTerminated, kBroken };
+  // kError: a call returned Error (only FreeInstance or a state restore
+  // may follow); kBroken: Fatal (nothing may follow but forgetting it).
+  enum class Mode : std::int64_t {
+    kNone = 0, kInstantiated, kInitialization, kStep, kTerminated, kBroken, kError
+  };
   // One direction of one type: the FMI value references and the first slot
   // of its contiguous storage.
   struct Group {
@@ -96,9 +109,16 @@ class FmuUnit : public cosim::Unit {
     std::uint32_t vr;
     std::size_t index;  // into arrays_
   };
+  // A group of one of the FMI 3.0 types beyond Float64 / Int32 / Boolean /
+  // String (Float32 in reals_, the other integer types in integers_).
+  struct TypedGroup {
+    FmiType type;
+    Group group;
+  };
   struct Groups {
     Group real, integer, boolean, string;
     std::vector<ArraySlot> arrays;
+    std::vector<TypedGroup> extras;
   };
   // Fixed parameters, tunable parameters, inputs, outputs, locals (and
   // calculated parameters). Structural parameters are declared read-only
@@ -110,6 +130,11 @@ class FmuUnit : public cosim::Unit {
   // Each returns false after recording why (Fail) when a call fails.
   void SetGroups(const Groups& g, const char* phase);
   void GetGroups(const Groups& g, const char* phase);
+  void SetExtra(const TypedGroup& x, const char* phase);
+  void GetExtra(const TypedGroup& x, const char* phase);
+  /// Throws UnitError when integer slot `slot` holds `x` outside its FMI
+  /// type's range or, for an enumeration, no item.
+  void CheckInteger(std::size_t slot, std::int64_t x, const char* phase) const;
   void SetTunables();
   void RememberTunables();
   /// Status of an FMI call: throws UnitError for error / fatal (and for
@@ -136,6 +161,12 @@ class FmuUnit : public cosim::Unit {
   // Conversion buffers (FMI 2.0 Integer and Boolean are int; strings are
   // passed as pointers), sized once.
   std::vector<int> int_buffer_;
+  // Conversion to the other FMI 3.0 types (a char array provides storage
+  // for any of them), and per integer slot its variable (for its range).
+  std::unique_ptr<unsigned char[]> conversion_;
+  std::vector<std::size_t> integer_variable_;
+  std::vector<double> sent_extra_reals_;
+  std::vector<std::int64_t> sent_extra_integers_;
   std::vector<const char*> string_buffer_;
   // Tunable parameters: the values last given to the FMU.
   std::vector<double> sent_reals_;
@@ -149,11 +180,11 @@ class FmuUnit : public cosim::Unit {
   cosim::TimeNs start_ = 0;
   cosim::TimeNs stop_ = 0;
   cosim::TimeNs first_dt_ = 0;  // the first communication step (variable steps refused when the FMU cannot)
-  cosim::TimeNs fixed_step_ = 0;
   // States kept by the FMU when it cannot serialize them: a saved
   // UnitState names one by index (and this unit by id_).
   mutable std::vector<void*> kept_states_;
   std::int64_t id_ = 0;
+  std::size_t early_returns_ = 0;
 
   std::deque<std::string> messages_;
   std::size_t message_count_ = 0;  // all ever logged

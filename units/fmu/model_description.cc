@@ -6,8 +6,11 @@
 #include <array>
 #include <cctype>
 #include <charconv>
+#include <cfloat>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -189,13 +192,16 @@ class Parser {
     ReadTypes(root, md.fmi_major);
     if (md.fmi_major == 2) {
       ReadVariables2(root, md);
+      CheckRules(root, md);
       ReadStructure2(root, md);
     } else {
       ReadVariables3(root, md);
+      ResolveDimensions(md);
+      CheckRules(root, md);
       ReadStructure3(root, md);
     }
     for (auto& v : md.variables) {
-      v.unit = v.type == FmiType::kFloat64 ? LinesimUnit(v.fmi_unit, md.units) : "";
+      v.unit = StorageOf(v.type) == 0 ? LinesimUnit(v.fmi_unit, md.units) : "";
     }
     return md;
   }
@@ -255,28 +261,94 @@ class Parser {
     }
   }
 
-  // Declared types: name -> unit (and, FMI 3.0, the type element's name).
+  // A declared type: its element ("Real", "Enumeration", "Float64Type",
+  // "EnumerationType", ...), unit, bounds, nominal and items.
+  struct DeclaredType {
+    std::string element;
+    std::string unit;
+    std::optional<double> min, max, nominal;
+    std::vector<std::pair<std::int64_t, std::string>> items;
+  };
+
+  std::optional<double> OptionalNumber(const pugi::xml_node& at, const char* name) const {
+    if (const auto a = at.attribute(name)) return Real(at, a);
+    return std::nullopt;
+  }
+
   void ReadTypes(const pugi::xml_node& root, int major) {
     for (const auto& t : root.child("TypeDefinitions").children()) {
-      if (major == 2) {
-        // <SimpleType name="..."><Real unit="..."/></SimpleType>
-        const pugi::xml_node real = t.child("Real");
-        type_units_[t.attribute("name").as_string()] = real ? real.attribute("unit").as_string() : "";
-      } else {
-        // <Float64Type name="..." unit="..."/>
-        type_units_[t.attribute("name").as_string()] = t.attribute("unit").as_string();
+      if (t.type() != pugi::node_element) continue;
+      DeclaredType d;
+      // FMI 2.0: <SimpleType name="..."><Real unit="..."/></SimpleType>;
+      // FMI 3.0: <Float64Type name="..." unit="..."/>.
+      const pugi::xml_node body = major == 2 ? t.first_child() : t;
+      d.element = body.name();
+      d.unit = body.attribute("unit").as_string();
+      d.min = OptionalNumber(body, "min");
+      d.max = OptionalNumber(body, "max");
+      d.nominal = OptionalNumber(body, "nominal");
+      if (d.element == "Enumeration" || d.element == "EnumerationType") {
+        std::set<std::int64_t> values;
+        for (const auto& item : body.children("Item")) {
+          const std::string text = item.attribute("value").as_string();
+          std::int64_t value = 0;
+          const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+          if (ec != std::errc() || end != text.data() + text.size()) {
+            Fail(item, "enumeration '" + std::string(t.attribute("name").as_string()) +
+                           "': item value '" + text + "' is not an integer");
+          }
+          if (!values.insert(value).second) {
+            Fail(item, "enumeration '" + std::string(t.attribute("name").as_string()) +
+                           "': two items have the value " + text +
+                           " (item values must be unique)");
+          }
+          d.items.emplace_back(value, item.attribute("name").as_string());
+        }
+        if (d.items.empty()) {
+          Fail(body, "enumeration '" + std::string(t.attribute("name").as_string()) +
+                         "' has no <Item> (an enumeration needs at least one)");
+        }
+        std::sort(d.items.begin(), d.items.end());
       }
+      types_[t.attribute("name").as_string()] = std::move(d);
     }
   }
 
-  std::string UnitOf(const pugi::xml_node& element) const {
-    if (const auto a = element.attribute("unit")) return a.as_string();
-    if (const auto d = element.attribute("declaredType")) {
-      if (const auto it = type_units_.find(d.as_string()); it != type_units_.end()) return it->second;
+  // The declared type of `element`, checked to exist and to be of the
+  // variable's kind (`kinds`: the type elements that fit, "" for none
+  // declared); nullptr when none is declared.
+  const DeclaredType* DeclaredTypeOf(const pugi::xml_node& element, const FmiVariable& v,
+                                     std::initializer_list<const char*> kinds) const {
+    const auto d = element.attribute("declaredType");
+    if (!d) return nullptr;
+    const auto it = types_.find(d.as_string());
+    if (it == types_.end()) {
       Fail(element, std::string("declaredType '") + d.as_string() +
                         "' is not in <TypeDefinitions>");
     }
-    return "";
+    for (const char* k : kinds) {
+      if (it->second.element == k) return &it->second;
+    }
+    Fail(element, "variable '" + v.name + "': declaredType '" + d.as_string() + "' is a " +
+                      it->second.element + ", not a type for this variable (" +
+                      *kinds.begin() + ")");
+  }
+
+  // Unit, bounds, nominal and items from the variable's element, else its
+  // declared type.
+  void Attributes(FmiVariable& v, const pugi::xml_node& element, const DeclaredType* d) {
+    v.declared_type = element.attribute("declaredType").as_string();
+    if (d) {
+      v.fmi_unit = d->unit;
+      v.min = d->min;
+      v.max = d->max;
+      v.nominal = d->nominal;
+      v.items = d->items;
+    }
+    if (const auto a = element.attribute("unit")) v.fmi_unit = a.as_string();
+    if (auto x = OptionalNumber(element, "min")) v.min = x;
+    if (auto x = OptionalNumber(element, "max")) v.max = x;
+    if (auto x = OptionalNumber(element, "nominal")) v.nominal = x;
   }
 
   void ReadStart(FmiVariable& v, const pugi::xml_node& at, const char* text) {
@@ -290,6 +362,7 @@ class Parser {
     };
     switch (v.type) {
       case FmiType::kFloat64:
+      case FmiType::kFloat32:
         for (const auto& w : words) {
           double x = 0;
           if (w == "INF" || w == "inf") {
@@ -302,24 +375,18 @@ class Parser {
             const auto [end, ec] = std::from_chars(w.data(), w.data() + w.size(), x);
             if (ec != std::errc() || end != w.data() + w.size()) bad(w);
           }
+          if (v.type == FmiType::kFloat32 && std::isfinite(x) && std::fabs(x) > FLT_MAX) {
+            Fail(at, "variable '" + v.name + "': start value '" + w +
+                         "' is outside the Float32 range");
+          }
           v.start_reals.push_back(x);
         }
         if (v.start_reals.size() == 1 && v.size > 1) v.start_reals.assign(v.size, v.start_reals[0]);
-        if (v.start_reals.size() != v.size) {
+        if (v.start_reals.size() != v.size && !v.size_from_structural) {
           Fail(at, "variable '" + v.name + "' has " + std::to_string(v.start_reals.size()) +
                        " start values for " + std::to_string(v.size) + " elements");
         }
         break;
-      case FmiType::kInt32: {
-        if (words.size() != 1) bad(text);
-        std::int64_t x = 0;
-        const auto [end, ec] = std::from_chars(words[0].data(), words[0].data() + words[0].size(), x);
-        if (ec != std::errc() || end != words[0].data() + words[0].size() || x < INT32_MIN ||
-            x > INT32_MAX)
-          bad(words[0]);
-        v.start_integer = x;
-        break;
-      }
       case FmiType::kBoolean:
         if (words.size() != 1) bad(text);
         if (words[0] == "true" || words[0] == "1") {
@@ -333,6 +400,27 @@ class Parser {
       case FmiType::kString:
         v.start_string = text;
         break;
+      default: {  // the integer types
+        if (words.size() != 1) bad(text);
+        const std::string& w = words[0];
+        const auto [lo, hi] = IntegerRange(v.type);
+        std::int64_t x = 0;
+        if (v.type == FmiType::kUInt64) {
+          std::uint64_t u = 0;
+          const auto [end, ec] = std::from_chars(w.data(), w.data() + w.size(), u);
+          if (ec != std::errc() || end != w.data() + w.size()) bad(w);
+          if (u > static_cast<std::uint64_t>(hi)) {
+            Fail(at, "variable '" + v.name + "': UInt64 start value " + w +
+                         " is above linesim's Integer range (at most 2^63 - 1)");
+          }
+          x = static_cast<std::int64_t>(u);
+        } else {
+          const auto [end, ec] = std::from_chars(w.data(), w.data() + w.size(), x);
+          if (ec != std::errc() || end != w.data() + w.size() || x < lo || x > hi) bad(w);
+        }
+        v.start_integer = x;
+        break;
+      }
     }
   }
 
@@ -376,17 +464,26 @@ class Parser {
       const std::string tag = t.name();
       if (tag == "Real") {
         v.type = FmiType::kFloat64;
-        v.fmi_unit = UnitOf(t);
+        Attributes(v, t, DeclaredTypeOf(t, v, {"Real"}));
       } else if (tag == "Integer") {
         v.type = FmiType::kInt32;
+        Attributes(v, t, DeclaredTypeOf(t, v, {"Integer"}));
+      } else if (tag == "Enumeration") {
+        // fmi2Get/SetInteger carry it; its values are the items'.
+        v.type = FmiType::kInt32;
+        const DeclaredType* d = DeclaredTypeOf(t, v, {"Enumeration"});
+        if (!d) Fail(t, "Enumeration variable '" + v.name + "' has no declaredType (required)");
+        Attributes(v, t, d);
+        v.fmi_unit.clear();
       } else if (tag == "Boolean") {
         v.type = FmiType::kBoolean;
+        DeclaredTypeOf(t, v, {"Boolean"});
       } else if (tag == "String") {
         v.type = FmiType::kString;
+        DeclaredTypeOf(t, v, {"String"});
       } else {
-        Unsupported(v, sv, tag.empty() ? "no type" : "type " + tag);
-        index2_.push_back(-1);
-        continue;
+        Fail(sv, "variable '" + v.name + "' has " + (tag.empty() ? "no type" : "type " + tag) +
+                     ": FMI 2.0 knows Real, Integer, Enumeration, Boolean and String");
       }
       if (const auto s = t.attribute("start")) ReadStart(v, t, s.as_string());
       index2_.push_back(static_cast<long>(md.variables.size()));
@@ -405,34 +502,54 @@ class Parser {
       if (tag == "Clock") {
         Fail(e, "variable '" + v.name + "' is a clock: FMI 3.0 clocks are not supported");
       }
-      if (tag == "Float64") {
-        v.type = FmiType::kFloat64;
-        v.fmi_unit = UnitOf(e);
-      } else if (tag == "Int32") {
-        v.type = FmiType::kInt32;
-      } else if (tag == "Boolean") {
-        v.type = FmiType::kBoolean;
-      } else if (tag == "String") {
-        v.type = FmiType::kString;
-      } else {
-        Unsupported(v, e, "type " + tag);
+      static const std::map<std::string, FmiType> kTypes = {
+          {"Float64", FmiType::kFloat64}, {"Float32", FmiType::kFloat32},
+          {"Int8", FmiType::kInt8},       {"UInt8", FmiType::kUInt8},
+          {"Int16", FmiType::kInt16},     {"UInt16", FmiType::kUInt16},
+          {"Int32", FmiType::kInt32},     {"UInt32", FmiType::kUInt32},
+          {"Int64", FmiType::kInt64},     {"UInt64", FmiType::kUInt64},
+          {"Boolean", FmiType::kBoolean}, {"String", FmiType::kString},
+          {"Enumeration", FmiType::kInt64}};
+      if (tag == "Binary") {
+        // Left out: the FMU keeps its start value; nothing to connect.
+        md.left_out.push_back(v.name + " (Binary)");
+        binary_vrs_.insert(v.value_reference);
         continue;
       }
-      for (const auto& d : e.children("Dimension")) {
+      const auto known = kTypes.find(tag);
+      if (known == kTypes.end()) {
+        Fail(e, "variable '" + v.name + "' has type " + tag +
+                    ": not an FMI 3.0 variable type");
+      }
+      v.type = known->second;
+      const std::string type_element = tag + "Type";
+      const DeclaredType* d = DeclaredTypeOf(e, v, {type_element.c_str()});
+      if (tag == "Enumeration" && !d) {
+        Fail(e, "Enumeration variable '" + v.name + "' has no declaredType (required)");
+      }
+      Attributes(v, e, d);
+      if (v.type != FmiType::kFloat64 && v.type != FmiType::kFloat32) v.fmi_unit.clear();
+      for (const auto& dim : e.children("Dimension")) {
         if (v.type != FmiType::kFloat64) {
-          Fail(d, "variable '" + v.name + "' is an array of " + tag +
-                      ": linesim maps arrays of Float64 only");
+          Fail(dim, "variable '" + v.name + "' is an array of " + tag +
+                        ": linesim maps arrays of Float64 only");
         }
-        if (d.attribute("valueReference")) {
-          Fail(d, "variable '" + v.name +
-                      "' has a dimension set by a structural parameter: linesim maps arrays of "
-                      "fixed dimensions only");
+        if (const auto a = dim.attribute("valueReference")) {
+          // Sized by a structural parameter: its start value, resolved
+          // once every variable is read.
+          pending_dimensions_.push_back({md.variables.size(), v.dimensions.size(),
+                                         Unsigned(dim, "valueReference"), dim});
+          v.size_from_structural = true;
+          v.dimensions.push_back(0);
+          continue;
         }
-        v.dimensions.push_back(Unsigned(d, "start"));
+        v.dimensions.push_back(Unsigned(dim, "start"));
       }
       v.size = 1;
       for (std::size_t n : v.dimensions) v.size *= n;
-      if (!v.dimensions.empty() && v.size == 0) Fail(e, "variable '" + v.name + "' has no elements");
+      if (!v.dimensions.empty() && v.size == 0 && !v.size_from_structural) {
+        Fail(e, "variable '" + v.name + "' has no elements");
+      }
       if (v.type == FmiType::kString) {
         const auto s = e.child("Start");
         if (s) ReadStart(v, s, s.attribute("value").as_string());
@@ -443,25 +560,180 @@ class Parser {
     }
   }
 
-  // A variable of a type linesim does not map: refused where it would be
-  // exchanged (parameters, inputs, outputs), left out where it stays
-  // inside the FMU (locals, calculated parameters, the independent time).
-  void Unsupported(const FmiVariable& v, const pugi::xml_node& e, const std::string& what) {
-    if (v.causality == "input" || v.causality == "output" || v.causality == "parameter" ||
-        v.causality == "structuralParameter") {
-      Fail(e, "variable '" + v.name + "' (" + v.causality + ") has " + what +
-                  ": linesim maps Real/Float64, Integer/Int32, Boolean and String (and arrays of "
-                  "Float64)");
+  // Dimensions given by a structural parameter (FMI 3.0 section 2.4.7.6):
+  // the parameter's start value, which linesim never changes (structural
+  // parameters are constants of the unit).
+  struct PendingDimension {
+    std::size_t variable, dimension;
+    std::uint32_t vr;
+    pugi::xml_node at;
+  };
+  void ResolveDimensions(ModelDescription& md) {
+    if (pending_dimensions_.empty()) return;
+    std::unordered_map<std::uint32_t, std::size_t> by_vr;
+    for (std::size_t i = 0; i < md.variables.size(); ++i) by_vr.emplace(md.variables[i].value_reference, i);
+    for (const PendingDimension& p : pending_dimensions_) {
+      FmiVariable& v = md.variables[p.variable];
+      const auto it = by_vr.find(p.vr);
+      if (it == by_vr.end()) {
+        Fail(p.at, "variable '" + v.name + "': the dimension's valueReference " +
+                       std::to_string(p.vr) + " names no variable");
+      }
+      const FmiVariable& n = md.variables[it->second];
+      if ((n.causality != "structuralParameter" && n.variability != "constant") ||
+          StorageOf(n.type) != 1 || !n.has_start || n.start_integer < 1) {
+        Fail(p.at, "variable '" + v.name + "': the dimension's valueReference " +
+                       std::to_string(p.vr) + " names '" + n.name +
+                       "', not a structural parameter or constant of an integer type with a "
+                       "start value of at least 1 (FMI 3.0 section 2.4.7.6)");
+      }
+      v.dimensions[p.dimension] = static_cast<std::size_t>(n.start_integer);
+    }
+    for (const PendingDimension& p : pending_dimensions_) {
+      FmiVariable& v = md.variables[p.variable];
+      std::size_t size = 1;
+      for (std::size_t d : v.dimensions) {
+        if (d > kMaxVariables || size * d > kMaxVariables) {
+          Fail(p.at, "variable '" + v.name + "' would have more than " +
+                         std::to_string(kMaxVariables) + " elements");
+        }
+        size *= d;
+      }
+      v.size = size;
+      if (v.has_start && v.start_reals.size() == 1 && size > 1) v.start_reals.assign(size, v.start_reals[0]);
+      if (v.has_start && v.start_reals.size() != size) {
+        Fail(p.at, "variable '" + v.name + "' has " + std::to_string(v.start_reals.size()) +
+                       " start values for " + std::to_string(size) + " elements");
+      }
     }
   }
 
+  // Rules of the standards that the schemas cannot express; each refusal
+  // names its rule.
+  void CheckRules(const pugi::xml_node& root, const ModelDescription& md) {
+    const auto at = [&](const FmiVariable& v) -> std::string {
+      return file_ + ":" + std::to_string(v.line) + ": variable '" + v.name + "': ";
+    };
+    const auto settable = [](const FmiVariable& v) {
+      return v.causality == "parameter" || v.causality == "input" ||
+             v.causality == "structuralParameter";
+    };
+    if (md.fmi_major == 3) {
+      // FMI 3.0 section 2.4.7: a valueReference is unique among the FMU's
+      // variables (aliases are <Alias> elements of one variable).
+      std::unordered_map<std::uint32_t, std::size_t> seen;
+      for (std::size_t i = 0; i < md.variables.size(); ++i) {
+        const FmiVariable& v = md.variables[i];
+        const auto [it, fresh] = seen.emplace(v.value_reference, i);
+        if (!fresh) {
+          throw FmuError(at(v) + "valueReference " + std::to_string(v.value_reference) +
+                         " is also variable '" + md.variables[it->second].name +
+                         "''s (FMI 3.0: every variable has a valueReference of its own)");
+        }
+      }
+    } else {
+      // FMI 2.0.4 section 2.2.7: variables with one valueReference and one
+      // base type are aliases of one value. A value set from outside can
+      // come from one variable only (two parameters, two inputs, or a
+      // parameter and an input on one reference), and an input cannot be
+      // an alias of an output or another computed variable (its value
+      // would be both set and computed).
+      std::map<std::pair<int, std::uint32_t>, std::size_t> first_set, first_computed;
+      for (std::size_t i = 0; i < md.variables.size(); ++i) {
+        const FmiVariable& v = md.variables[i];
+        const std::pair<int, std::uint32_t> key{StorageOf(v.type), v.value_reference};
+        if (settable(v)) {
+          const auto [it, fresh] = first_set.emplace(key, i);
+          if (!fresh) {
+            throw FmuError(at(v) + "valueReference " + std::to_string(v.value_reference) +
+                           " is also " + md.variables[it->second].causality + " '" +
+                           md.variables[it->second].name + "': two " + "variables set from outside " +
+                           "share a value (FMI 2.0 aliases: at most one parameter or input per "
+                           "alias set)");
+          }
+        } else if (v.causality == "output" || v.causality == "local" ||
+                   v.causality == "calculatedParameter") {
+          first_computed.emplace(key, i);
+        }
+      }
+      for (const auto& [key, i] : first_set) {
+        const FmiVariable& v = md.variables[i];
+        const auto c = first_computed.find(key);
+        if (v.causality == "input" && c != first_computed.end()) {
+          const FmiVariable& o = md.variables[c->second];
+          throw FmuError(at(v) + "the input's valueReference " + std::to_string(v.value_reference) +
+                         " is also " + o.causality + " '" + o.name +
+                         "': an input cannot alias a computed variable (FMI 2.0 aliases)");
+        }
+      }
+    }
+    for (const FmiVariable& v : md.variables) {
+      // min <= max, and a start value within them (FMI 2.0.4 section
+      // 2.2.7, FMI 3.0 section 2.4.7.4: min <= start <= max).
+      if (v.min && v.max && !(*v.min <= *v.max)) {
+        throw FmuError(at(v) + "min " + std::to_string(*v.min) + " is above max " +
+                       std::to_string(*v.max) + " (FMI: min <= max)");
+      }
+      if (!v.has_start) continue;
+      std::vector<double> starts = v.start_reals;
+      if (StorageOf(v.type) == 1) starts = {static_cast<double>(v.start_integer)};
+      for (double x : starts) {
+        if (std::isnan(x) && settable(v)) {
+          throw FmuError(at(v) + "start value NaN: a value linesim gives the FMU (" + v.causality +
+                         ") must be a number");
+        }
+        if ((v.min && x < *v.min) || (v.max && x > *v.max)) {
+          throw FmuError(at(v) + "start value " + FormatNumber(x) + " is outside [" +
+                         (v.min ? FormatNumber(*v.min) : "-inf") + ", " +
+                         (v.max ? FormatNumber(*v.max) : "inf") + "] (FMI: min <= start <= max)");
+        }
+      }
+      if (!v.items.empty() &&
+          !std::binary_search(v.items.begin(), v.items.end(),
+                              std::pair<std::int64_t, std::string>{v.start_integer, ""},
+                              [](const auto& a, const auto& b) { return a.first < b.first; })) {
+        throw FmuError(at(v) + "start value " + std::to_string(v.start_integer) +
+                       " is no item of enumeration '" + v.declared_type + "'");
+      }
+    }
+    (void)root;
+  }
+
+  static std::string FormatNumber(double x) {
+    char buf[32];
+    const auto res = std::to_chars(buf, buf + sizeof buf, x);
+    return std::string(buf, res.ptr);
+  }
+
   void ReadStructure2(const pugi::xml_node& root, ModelDescription& md) {
+    // Every index of ModelStructure names a ScalarVariable (FMI 2.0.4
+    // section 2.2.8: indices count from 1 in ModelVariables).
+    for (const char* list : {"Derivatives", "InitialUnknowns"}) {
+      for (const auto& u : root.child("ModelStructure").child(list).children("Unknown")) {
+        const std::uint32_t index = Unsigned(u, "index");
+        if (index == 0 || index > index2_.size()) {
+          Fail(u, std::string("ModelStructure/") + list + ": index " + std::to_string(index) +
+                      " names no variable (there are " + std::to_string(index2_.size()) + ")");
+        }
+        for (std::uint32_t d : UnsignedList(u, "dependencies")) {
+          if (d == 0 || d > index2_.size()) {
+            Fail(u, std::string("ModelStructure/") + list + ": dependency index " +
+                        std::to_string(d) + " names no variable");
+          }
+        }
+      }
+    }
     for (const auto& u : root.child("ModelStructure").child("Outputs").children("Unknown")) {
       const std::uint32_t index = Unsigned(u, "index");
       if (index == 0 || index > index2_.size() || index2_[index - 1] < 0) {
         Fail(u, "output index " + std::to_string(index) + " names no mapped variable");
       }
       FmiVariable& out = md.variables[static_cast<std::size_t>(index2_[index - 1])];
+      if (out.causality != "output") {
+        Fail(u, "ModelStructure/Outputs: index " + std::to_string(index) + " is '" + out.name +
+                    "', a " + out.causality + " (FMI 2.0.4 section 2.2.8: every output, and "
+                    "only outputs, are listed)");
+      }
       if (!u.attribute("dependencies")) continue;  // unknown: every input
       std::vector<std::uint32_t> refs;
       for (std::uint32_t d : UnsignedList(u, "dependencies")) {
@@ -484,16 +756,33 @@ class Parser {
     for (std::size_t i = 0; i < md.variables.size(); ++i) {
       by_vr.emplace(md.variables[i].value_reference, i);
     }
+    for (const auto& u : root.child("ModelStructure").children()) {
+      if (u.type() != pugi::node_element || std::string(u.name()) == "Output") continue;
+      const std::uint32_t vr = Unsigned(u, "valueReference");
+      if (!by_vr.count(vr) && !binary_vrs_.count(vr)) {
+        Fail(u, std::string("ModelStructure: <") + u.name() + " valueReference=\"" +
+                    std::to_string(vr) + "\"> names no variable");
+      }
+    }
     for (const auto& o : root.child("ModelStructure").children("Output")) {
       const std::uint32_t vr = Unsigned(o, "valueReference");
       const auto it = by_vr.find(vr);
       if (it == by_vr.end()) {
         Fail(o, "output valueReference " + std::to_string(vr) + " names no mapped variable");
       }
+      if (md.variables[it->second].causality != "output") {
+        Fail(o, "ModelStructure: <Output valueReference=\"" + std::to_string(vr) + "\"> is '" +
+                    md.variables[it->second].name + "', a " + md.variables[it->second].causality +
+                    " (FMI 3.0 section 2.4.8: only outputs are listed as outputs)");
+      }
       if (!o.attribute("dependencies")) continue;
       std::vector<std::uint32_t> refs;
       for (std::uint32_t d : UnsignedList(o, "dependencies")) {
         const auto dep = by_vr.find(d);
+        if (dep == by_vr.end() && !binary_vrs_.count(d)) {
+          Fail(o, "ModelStructure: output " + std::to_string(vr) + " depends on valueReference " +
+                      std::to_string(d) + ", which names no variable");
+        }
         if (dep != by_vr.end() && md.variables[dep->second].causality == "input") {
           refs.push_back(static_cast<std::uint32_t>(dep->second));
         }
@@ -506,8 +795,10 @@ class Parser {
   std::string file_;
   LineIndex lines_;
   pugi::xml_document doc_;
-  std::map<std::string, std::string> type_units_;
   std::vector<long> index2_;  // FMI 2.0: ScalarVariable index -> mapped variable, -1 if left out
+  std::map<std::string, DeclaredType> types_;
+  std::vector<PendingDimension> pending_dimensions_;
+  std::set<std::uint32_t> binary_vrs_;  // FMI 3.0 Binary variables (left out)
 };
 
 }  // namespace
@@ -518,8 +809,39 @@ const char* ToString(FmiType type) {
     case FmiType::kInt32: return "Int32";
     case FmiType::kBoolean: return "Boolean";
     case FmiType::kString: return "String";
+    case FmiType::kFloat32: return "Float32";
+    case FmiType::kInt8: return "Int8";
+    case FmiType::kUInt8: return "UInt8";
+    case FmiType::kInt16: return "Int16";
+    case FmiType::kUInt16: return "UInt16";
+    case FmiType::kUInt32: return "UInt32";
+    case FmiType::kInt64: return "Int64";
+    case FmiType::kUInt64: return "UInt64";
   }
   return "?";
+}
+
+int StorageOf(FmiType type) {
+  switch (type) {
+    case FmiType::kFloat64:
+    case FmiType::kFloat32: return 0;
+    case FmiType::kBoolean: return 2;
+    case FmiType::kString: return 3;
+    default: return 1;
+  }
+}
+
+std::pair<std::int64_t, std::int64_t> IntegerRange(FmiType type) {
+  switch (type) {
+    case FmiType::kInt8: return {INT8_MIN, INT8_MAX};
+    case FmiType::kUInt8: return {0, UINT8_MAX};
+    case FmiType::kInt16: return {INT16_MIN, INT16_MAX};
+    case FmiType::kUInt16: return {0, UINT16_MAX};
+    case FmiType::kInt32: return {INT32_MIN, INT32_MAX};
+    case FmiType::kUInt32: return {0, UINT32_MAX};
+    case FmiType::kUInt64: return {0, INT64_MAX};
+    default: return {INT64_MIN, INT64_MAX};
+  }
 }
 
 std::string LinesimUnit(const std::string& fmi_unit, const std::map<std::string, FmiUnit>& units) {
@@ -555,6 +877,12 @@ ModelDescription ParseModelDescriptionText(const std::string& text, const std::s
 }
 
 ModelDescription ParseModelDescription(const std::string& file) {
+  std::error_code ec;
+  if (const auto size = std::filesystem::file_size(file, ec); !ec && size > kMaxModelDescriptionBytes) {
+    throw FmuError(file + ": the model description is " + std::to_string(size) +
+                   " bytes, more than the " + std::to_string(kMaxModelDescriptionBytes >> 20) +
+                   " MiB linesim reads (kMaxModelDescriptionBytes)");
+  }
   std::ifstream in(file, std::ios::binary);
   if (!in) throw FmuError(file + ": cannot read the model description");
   std::ostringstream buffer;

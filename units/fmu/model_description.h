@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <utility>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -18,10 +19,28 @@ class FmuError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The variable types linesim maps (FMI 2.0 Real / Integer / Boolean /
-/// String; FMI 3.0 Float64 (also arrays of fixed dimensions) / Int32 /
-/// Boolean / String).
-enum class FmiType { kFloat64, kInt32, kBoolean, kString };
+/// The FMI variable types linesim maps: FMI 2.0 Real / Integer /
+/// Enumeration (as kInt32, with its items) / Boolean / String; FMI 3.0
+/// Float64 (also arrays, of fixed dimensions or sized by structural
+/// parameters) / Float32 / Int8 to Int64 / UInt8 to UInt64 / Enumeration
+/// (as kInt64, with its items) / Boolean / String. Floats are linesim Reals,
+/// every integer type a linesim Integer (int64) checked against the FMI
+/// type's range when given to the FMU (UInt64 above 2^63 - 1 is refused
+/// when read). FMI 3.0 Binary and Clock variables are left out (the FMU
+/// keeps their start values): one that a scenario connects or records is
+/// then no variable of the unit. The first four keep their values (the
+/// storage classes, see StorageOf).
+enum class FmiType {
+  kFloat64, kInt32, kBoolean, kString,
+  kFloat32, kInt8, kUInt8, kInt16, kUInt16, kUInt32, kInt64, kUInt64
+};
+inline constexpr int kFmiTypeCount = 12;
+
+/// Where a type's values live in linesim: 0 Real, 1 Integer, 2 Boolean,
+/// 3 String.
+int StorageOf(FmiType type);
+/// The range of an integer type as linesim's Integer can hold it.
+std::pair<std::int64_t, std::int64_t> IntegerRange(FmiType type);
 
 struct FmiVariable {
   std::string name;
@@ -37,6 +56,14 @@ struct FmiVariable {
   /// their product (1 for a scalar).
   std::vector<std::size_t> dimensions;
   std::size_t size = 1;
+  bool size_from_structural = false;  // a dimension given by a structural parameter
+  /// The declared min, max and nominal (on the variable or its declared
+  /// type), for numeric types; nothing when not declared.
+  std::optional<double> min, max, nominal;
+  /// Enumerations: the items (value, name), ascending by value; a value
+  /// given to the FMU must be one of them.
+  std::vector<std::pair<std::int64_t, std::string>> items;
+  std::string declared_type;
   bool has_start = false;
   std::vector<double> start_reals;  // Float64 (one per element)
   std::int64_t start_integer = 0;
@@ -87,6 +114,8 @@ struct ModelDescription {
   std::optional<double> fixed_internal_step;  // FMI 3.0 fixedInternalStepSize
   std::optional<double> default_start, default_stop, default_tolerance, default_step;
   std::vector<FmiVariable> variables;
+  /// Variables read but left out, "name (type)": FMI 3.0 Binary.
+  std::vector<std::string> left_out;
   std::map<std::string, FmiUnit> units;
 };
 
@@ -99,7 +128,13 @@ struct ModelDescription {
 /// limit bounds an FMU's load to some 6 s and 0.7 GB (500k measured).
 inline constexpr std::size_t kMaxVariables = 500'000;
 
-/// Reads and checks a modelDescription.xml: FMI 2.0 or 3.0, with a
+/// The largest modelDescription.xml linesim reads, checked before reading
+/// it: kMaxVariables variables at some 200 bytes each (a Modelica tool's
+/// ScalarVariable with a description) with room to spare.
+inline constexpr std::uintmax_t kMaxModelDescriptionBytes = std::uintmax_t{128} << 20;
+
+/// Reads and checks a modelDescription.xml (at most
+/// kMaxModelDescriptionBytes): FMI 2.0 or 3.0, with a
 /// co-simulation interface, variables of the mapped types. Throws FmuError
 /// naming `file` and the line of the problem: invalid XML, an FMI version
 /// other than 2.0 or 3.0, model exchange only, clocks, a variable type or
@@ -123,7 +158,8 @@ std::string LinesimUnit(const std::string& fmi_unit, const std::map<std::string,
 /// an exported FMU's units read back as they were written.
 std::optional<std::array<int, 8>> SiExponents(const std::string& unit);
 
-/// "Float64", "Int32", "Boolean", "String" (FMI 3.0 names).
+/// "Float64", "Int32", "Boolean", "String", "Float32", "UInt64", ...
+/// (FMI 3.0 names).
 const char* ToString(FmiType type);
 
 }  // namespace linesim::fmu

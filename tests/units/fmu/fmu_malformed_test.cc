@@ -2,8 +2,11 @@
 // refused with a named error, and nothing lands outside the unit's folder.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <zip.h>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -18,6 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using test::Entry;
+using test::Fmu;
 using test::MakeZip;
 using test::ReadFile;
 using test::Scratch;
@@ -172,15 +176,19 @@ TEST(FmuMalformed, UnsupportedVersionAndTypes) {
   EXPECT_NE(e.find("unsupported FMI version '1.0'"), std::string::npos) << e;
   MakeZip(s / "v.fmu",
           {{"modelDescription.xml",
-            Fmi3Xml("    <Float32 name=\"f\" valueReference=\"1\" causality=\"output\"/>\n")}});
+            Fmi3Xml("    <Float128 name=\"f\" valueReference=\"1\" causality=\"output\"/>\n")}});
   e = LoadError(s / "v.fmu");
-  EXPECT_NE(e.find("variable 'f' (output) has type Float32"), std::string::npos) << e;
+  EXPECT_NE(e.find("variable 'f' has type Float128: not an FMI 3.0 variable type"),
+            std::string::npos)
+      << e;
   MakeZip(s / "v.fmu",
           {{"modelDescription.xml",
             Fmi3Xml("    <Float64 name=\"a\" valueReference=\"1\" causality=\"output\">"
                     "<Dimension valueReference=\"2\"/></Float64>\n")}});
   e = LoadError(s / "v.fmu");
-  EXPECT_NE(e.find("dimension set by a structural parameter"), std::string::npos) << e;
+  EXPECT_NE(e.find("variable 'a': the dimension's valueReference 2 names no variable"),
+            std::string::npos)
+      << e;
 }
 
 // The FMU refuses to instantiate (its GUID is not the model description's):
@@ -203,6 +211,23 @@ TEST(FmuMalformed, InstantiationRefusedIsNamedWithTheLog) {
   }
 }
 
+// Guards issue 24: entries whose Unix attributes carry permissions but no
+// file-type bits (Python's zipfile.writestr writes 0600 << 16) were refused
+// as "not a file or a folder"; such an FMU loads and steps. A FIFO's type
+// bits are still refused.
+TEST(FmuMalformed, EntriesWithoutFileTypeBitsAreFiles) {
+  Scratch s("writestr");
+  MakeZip(s / "w.fmu", {{"modelDescription.xml", Dahlquist2Xml(), false, 0600},
+                        {"binaries/linux64/dahlquist.so", ReadFile(LINESIM_DAHLQUIST_SO), false, 0600}});
+  FmuUnit u("w", s / "w.fmu");
+  u.Setup(0, 1'000'000'000);
+  u.Initialize();
+  EXPECT_EQ(u.DoStep(0, 10'000'000), cosim::StepResult::kOk) << u.last_error();
+  MakeZip(s / "f.fmu", {{"modelDescription.xml", Dahlquist2Xml(), false, S_IFIFO | 0600}});
+  const std::string e = LoadError(s / "f.fmu");
+  EXPECT_NE(e.find("entry 'modelDescription.xml' is not a file or a folder"), std::string::npos) << e;
+}
+
 // The folder an FMU unpacks into is private and goes with the unit.
 TEST(FmuArchive, UnpacksIntoAPrivateFolderRemovedAfterwards) {
   std::string folder;
@@ -216,6 +241,80 @@ TEST(FmuArchive, UnpacksIntoAPrivateFolderRemovedAfterwards) {
     EXPECT_TRUE(fs::exists(fs::path(folder) / "binaries/linux64/dahlquist.so"));
   }
   EXPECT_FALSE(fs::exists(folder));
+}
+
+// Guards issue 24: unpacked FMUs stayed in $TMPDIR/linesim-fmu-* after
+// SIGTERM during loading, a second Ctrl-C, or a crash of the FMU's binary.
+// A child process loads an FMU, reports its folder through a pipe and dies
+// of the signal; the folder must be gone once it has died.
+std::string FolderOfAChildThatDies(int sig) {
+  int fds[2];
+  if (pipe(fds) != 0) return "pipe failed";
+  const pid_t child = fork();
+  if (child == 0) {
+    close(fds[0]);
+    // In the child: no gtest, no exit handlers of the parent's making.
+    try {
+      FmuUnit u("u", Fmu("dahlquist"));
+      // The unit's folder is the only linesim-fmu-<pid>- folder of this pid.
+      const std::string prefix = "linesim-fmu-" + std::to_string(getpid()) + "-";
+      for (const auto& e : std::filesystem::directory_iterator(std::filesystem::temp_directory_path())) {
+        const std::string name = e.path().filename().string();
+        if (name.rfind(prefix, 0) == 0) {
+          const std::string line = e.path().string() + "\n";
+          if (write(fds[1], line.data(), line.size()) < 0) _exit(3);
+        }
+      }
+      close(fds[1]);
+      raise(sig);  // with the unit (and its folder) alive
+    } catch (...) {
+      _exit(2);
+    }
+    _exit(4);  // not reached: the signal kills
+  }
+  close(fds[1]);
+  std::string text;
+  char buffer[512];
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, static_cast<std::size_t>(n));
+  close(fds[0]);
+  int status = 0;
+  waitpid(child, &status, 0);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << "status " << status;
+  return text.empty() ? "" : text.substr(0, text.size() - 1);
+}
+
+TEST(FmuArchive, NoFolderOutlivesACrashOrATermination) {
+  for (int sig : {SIGSEGV, SIGABRT, SIGTERM, SIGINT}) {
+    const std::string folder = FolderOfAChildThatDies(sig);
+    ASSERT_NE(folder.find("linesim-fmu-"), std::string::npos) << sig << ": " << folder;
+    EXPECT_FALSE(std::filesystem::exists(folder)) << sig << ": " << folder << " was left behind";
+  }
+}
+
+// Folders of processes that are gone are swept; those of a live process
+// (the test's parent) and names of another form are left alone.
+TEST(FmuArchive, StaleFoldersOfDeadProcessesAreSwept) {
+  const pid_t dead = fork();
+  if (dead == 0) _exit(0);
+  waitpid(dead, nullptr, 0);  // reaped: kill(dead, 0) fails with ESRCH
+  const auto tmp = std::filesystem::temp_directory_path();
+  const auto stale = tmp / ("linesim-fmu-" + std::to_string(dead) + "-abc123");
+  const auto live = tmp / ("linesim-fmu-" + std::to_string(getppid()) + "-abc123");
+  const auto other = tmp / ("linesim-fmu-" + std::to_string(dead) + "-toolongname");
+  for (const auto& p : {stale, live, other}) {
+    std::filesystem::create_directories(p / "binaries");
+    std::ofstream(p / "binaries" / "x.so") << "x";
+  }
+  EXPECT_GE(SweepStaleTempFolders(), 1u);
+  EXPECT_FALSE(std::filesystem::exists(stale));
+  EXPECT_TRUE(std::filesystem::exists(live));
+  EXPECT_TRUE(std::filesystem::exists(other));
+  std::filesystem::remove_all(live);
+  std::filesystem::remove_all(other);
+  // Every folder this process makes carries its pid.
+  TempFolder t;
+  EXPECT_NE(t.path().find("linesim-fmu-" + std::to_string(getpid()) + "-"), std::string::npos)
+      << t.path();
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include "config/scenario_error.h"
 #include "loader/scenario.h"
@@ -99,6 +100,40 @@ TEST(FmuScenario, InspectPrintsTheFmu) {
   EXPECT_NE(out.find("left out"), std::string::npos) << out;
   const std::string bad = RunCommand(std::string(LINESIM_CLI) + " inspect /nonexistent/x.fmu 2>&1");
   EXPECT_NE(bad.find("no such FMU file"), std::string::npos) << bad;
+}
+
+// Guards issue 24: an FMU that asks to end the simulation (terminate2:
+// fmi2Discard with fmi2Terminated at t_end = 0.355 s) stopped the run as a
+// failure. Through the command line: status ok, exit 0, the time reached
+// (the end of the master step [0.35, 0.36] s), the reason in summary.json's
+// ended_by, and its last value recorded (x = t_end, in the row at 0.36 s).
+TEST(FmuScenario, AnFmuThatAsksToTerminateEndsTheRunOk) {
+  Scratch dir("terminate");
+  const std::string file = dir / "end.yaml";
+  std::ofstream(file) << "name: fmu_end\n"
+                         "duration_s: 1\n"
+                         "master: {step_s: 0.01}\n"
+                         "units:\n"
+                         "  end:\n"
+                         "    type: fmu\n"
+                         "    parameters: {path: " + test::Fmu("terminate2") + "}\n"
+                         "recording: {interval_s: 0.01, variables: [end.x]}\n";
+  const std::string out_dir = dir / "out";
+  const std::string out = RunCommand(std::string(LINESIM_CLI) + " run " + file + " --out " +
+                                     out_dir + " 2>&1; echo exit=$?");
+  EXPECT_NE(out.find("exit=0"), std::string::npos) << out;
+  std::ifstream summary_file(out_dir + "/summary.json");
+  const std::string summary((std::istreambuf_iterator<char>(summary_file)), std::istreambuf_iterator<char>());
+  EXPECT_NE(summary.find("\"status\": \"ok\""), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"ended_by\": \"unit 'end' (fmu): fmi2DoStep returned fmi2Discard with "
+                         "fmi2Terminated = true"),
+            std::string::npos)
+      << summary;
+  EXPECT_NE(summary.find("\"simulated_s\": 0.36"), std::string::npos) << summary;
+  std::ifstream csv(out_dir + "/signals.csv");
+  std::string line, last;
+  while (std::getline(csv, line)) last = line;
+  EXPECT_EQ(last, "0.36,0.355") << last;
 }
 
 }  // namespace

@@ -183,5 +183,55 @@ TEST(FmuSystem, RetryNeedsAnFmuThatCanSaveItsState) {
   EXPECT_EQ(result.end_time, 0);
 }
 
+// An FMU that asks to end the simulation ends the run normally after that
+// step: ok, end_time the end of that master step, the FMU's last values
+// kept, the reason in RunResult::ended_by; with and without master.retry.
+// terminate2 ends at t_end = 0.355 s, inside the step [0.35, 0.36] s.
+TEST(FmuSystem, AnFmuThatAsksToTerminateEndsTheRunNormally) {
+  for (bool retry : {false, true}) {
+    cosim::System system;
+    system.Add(std::make_unique<StepSignalUnit>(
+        "rate", 1, "m/s", std::vector<StepSignalUnit::Step>{{0, {0.3}}}));
+    auto& end = system.Add(std::make_unique<FmuUnit>("end", Fmu("terminate2")));
+    auto& plant = system.Add(std::make_unique<FmuUnit>("plant", Fmu("dahlquist")));
+    system.Connect("rate.value[0]", "plant.u");
+    cosim::MasterOptions options;
+    options.base_step = 10 * kMs;
+    options.stop = 1000 * kMs;
+    options.retry.enabled = retry;
+    cosim::Master master(system, options);
+    const auto result = master.Run();
+    ASSERT_TRUE(result.ok) << result.ErrorText();
+    EXPECT_TRUE(result.errors.empty()) << result.ErrorText();
+    EXPECT_EQ(result.end_time, 360 * kMs);
+    EXPECT_EQ(result.base_steps, 36);
+    EXPECT_NE(result.ended_by.find("unit 'end' (fmu): fmi2DoStep returned fmi2Discard with "
+                                   "fmi2Terminated = true"),
+              std::string::npos)
+        << result.ended_by;
+    EXPECT_EQ(end.variables().GetReal(*end.variables().Find("x")), 0.355);
+    // The other FMU stepped to the same time (x' = -x + 0.3, x(0) = 1).
+    EXPECT_NEAR(plant.variables().GetReal(*plant.variables().Find("x")),
+                0.3 + 0.7 * std::exp(-0.36), 1e-14);
+  }
+}
+
+// A run with the staircase's early returns reaches the stop time with the
+// analytic values (y = 4 steps of 0.25 s in 1 s, area = 0.25 (1 + 2 + 3)).
+TEST(FmuSystem, EarlyReturnsRunToTheEnd) {
+  cosim::System system;
+  auto& stairs = system.Add(std::make_unique<FmuUnit>("stairs", Fmu("staircase3")));
+  cosim::MasterOptions options;
+  options.base_step = 100 * kMs;
+  options.stop = 1000 * kMs;
+  cosim::Master master(system, options);
+  const auto result = master.Run();
+  ASSERT_TRUE(result.ok) << result.ErrorText();
+  EXPECT_TRUE(result.ended_by.empty());
+  EXPECT_EQ(result.end_time, 1000 * kMs);
+  EXPECT_EQ(stairs.variables().GetReal(*stairs.variables().Find("y")), 4.0);
+  EXPECT_NEAR(stairs.variables().GetReal(*stairs.variables().Find("area")), 1.5, 1e-12);
+}
+
 }  // namespace
 }  // namespace linesim::fmu

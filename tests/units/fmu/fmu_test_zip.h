@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <zip.h>
 
+#include <cstdint>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -18,6 +19,7 @@ struct Entry {
   std::string name;
   std::string content;
   bool symlink = false;
+  std::uint32_t unix_mode = 0;  // when not 0: the entry's Unix external attributes (mode << 16)
 };
 
 inline void MakeZip(const std::string& file, const std::vector<Entry>& entries) {
@@ -29,6 +31,11 @@ inline void MakeZip(const std::string& file, const std::vector<Entry>& entries) 
     ASSERT_NE(src, nullptr);
     const zip_int64_t index = zip_file_add(z, e.name.c_str(), src, ZIP_FL_ENC_UTF_8);
     ASSERT_GE(index, 0) << e.name << ": " << zip_strerror(z);
+    if (e.unix_mode != 0) {
+      ASSERT_EQ(zip_file_set_external_attributes(z, static_cast<zip_uint64_t>(index), 0,
+                                                 ZIP_OPSYS_UNIX, e.unix_mode << 16),
+                0);
+    }
     if (e.symlink) {
       const zip_uint32_t mode = S_IFLNK | 0777;
       ASSERT_EQ(zip_file_set_external_attributes(z, static_cast<zip_uint64_t>(index), 0,

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 
@@ -182,10 +183,12 @@ TEST(FmuUnit, Fmi2FeedthroughOfEveryType) {
   SetReal(u, "offset", 0.5);  // tunable: given to the FMU before the next step
   ASSERT_EQ(u.DoStep(kMs, kMs), StepResult::kOk);
   EXPECT_EQ(Real(u, "out_a"), 1.75);
-  // An Integer beyond the FMI 2.0 range is named, not wrapped.
+  // An Integer beyond the FMI 2.0 (32-bit) range is named, not wrapped.
   t.SetInteger(*t.Find("in_count"), std::int64_t{1} << 40);
   EXPECT_EQ(u.DoStep(2 * kMs, kMs), StepResult::kError);
-  EXPECT_NE(u.last_error().find("outside the FMI 2.0 Integer range"), std::string::npos)
+  EXPECT_NE(u.last_error().find("Int32 value 1099511627776 of 'in.count' is outside the Int32 "
+                                "range [-2147483648, 2147483647]"),
+            std::string::npos)
       << u.last_error();
 }
 
@@ -245,16 +248,36 @@ TEST(FmuUnit, Fmi3ArrayOutput) {
   EXPECT_DOUBLE_EQ(t.GetRealElement(*t.Find("y"), 0), 1.5 * 2.0 * time);
 }
 
-// fixedInternalStepSize = 1 ms: a 1.5 ms communication step is refused as
-// such, before the FMU is called.
-TEST(FmuUnit, RefusesAStepSizeTheFmuCannotTake) {
+// fixedInternalStepSize = 1 ms is information: a 1.5 ms communication step
+// goes to the FMU, which refuses it (array3 returns fmi3Error, logging why),
+// and the unit reports the FMU's status and log. After that error the
+// standard allows no fmi3Terminate (FMI 3.0 section 2.2.3): Terminate()
+// calls none (the test FMU logs every fmi3Terminate), and no further step.
+TEST(FmuUnit, AStepTheFmuRefusesIsTheFmusToRefuse) {
   FmuUnit u("a", Fmu("array3"));
   u.Setup(0, 100 * kMs);
   u.Initialize();
   EXPECT_EQ(u.DoStep(0, 3 * kMs / 2), StepResult::kError);
-  EXPECT_NE(u.last_error().find("step size refused"), std::string::npos) << u.last_error();
-  EXPECT_NE(u.last_error().find("fixedInternalStepSize 0.001 s"), std::string::npos);
+  EXPECT_NE(u.last_error().find("fmi3DoStep returned fmi3Error"), std::string::npos)
+      << u.last_error();
+  EXPECT_NE(u.last_error().find("h is not a multiple of 1 ms"), std::string::npos)
+      << u.last_error();
+  u.Terminate();
+  for (const auto& m : u.messages()) EXPECT_EQ(m.find("fmi3Terminate called"), std::string::npos) << m;
+  EXPECT_EQ(u.DoStep(0, kMs), StepResult::kError);
+  EXPECT_NE(u.last_error().find("cannot be stepped again"), std::string::npos) << u.last_error();
 
+  // A whole number of internal steps is taken, and Terminate is called.
+  FmuUnit w("w", Fmu("array3"));
+  w.Setup(0, 100 * kMs);
+  w.Initialize();
+  ASSERT_EQ(w.DoStep(0, 3 * kMs), StepResult::kOk) << w.last_error();
+  w.Terminate();
+  EXPECT_NE(w.messages().back().find("fmi3Terminate called"), std::string::npos)
+      << w.messages().back();
+}
+
+TEST(FmuUnit, RefusesAVariableStepTheFmuCannotTake) {
   // canHandleVariableCommunicationStepSize = false: a changed step is refused.
   FmuUnit d("d", Fmu("discard2"));
   d.Setup(0, 100 * kMs);
@@ -449,6 +472,161 @@ TEST(FmuUnits, MapsToLinesimSpellings) {
   EXPECT_EQ(LinesimUnit("V.s/rad", defs), "V.s/rad");
   EXPECT_EQ(LinesimUnit("deg", defs), "deg");
   EXPECT_EQ(LinesimUnit("furlong", defs), "furlong");
+}
+
+// The staircase (fmus/staircase3.c): y = number of multiples of the period
+// p = 0.25 s up to t, area = its integral, sum over j p < t of (t - j p).
+// Stepped at 0.1 s, the events at 0.25 and 0.75 s fall inside steps (early
+// returns the unit continues from lastSuccessfulTime: the FMU refuses a
+// doStep that does not start there), the ones at 0.5 and 1.0 s at a step's
+// end (an early return with lastSuccessfulTime = t + h: a step that
+// succeeded). The values are the analytic ones up to rounding (1e-12:
+// sums of ten terms below 1).
+double StairArea(double t, double p) {
+  double a = 0;
+  for (int j = 1; j * p < t - 1e-9; ++j) a += t - j * p;
+  return a;
+}
+TEST(FmuUnit, EarlyReturnIsContinuedFromTheTimeReached) {
+  FmuUnit u("s", Fmu("staircase3"));
+  EXPECT_TRUE(u.description().can_return_early);
+  u.Setup(0, 1000 * kMs);
+  u.Initialize();
+  const TimeNs h = 100 * kMs;
+  for (int k = 0; k < 10; ++k) {
+    ASSERT_EQ(u.DoStep(k * h, h), StepResult::kOk) << k << ": " << u.last_error();
+    const double t = 0.1 * (k + 1);
+    EXPECT_EQ(Real(u, "y"), std::floor(t / 0.25 + 1e-9)) << t;
+    EXPECT_NEAR(Real(u, "area"), StairArea(t, 0.25), 1e-12) << t;
+    EXPECT_TRUE(u.stop_request().empty());
+  }
+  EXPECT_EQ(u.early_returns(), 2u);  // 0.25 s and 0.75 s
+  EXPECT_EQ(Real(u, "events"), 4.0);
+}
+
+// FMI 3.0 terminateSimulation: the step's values (at the time reached) are
+// read and the unit asks to end the run, naming the call; not an error.
+TEST(FmuUnit, TerminateSimulationEndsTheRunWithTheValuesReached) {
+  FmuUnit u("s", Fmu("staircase3"));
+  SetReal(u, "t_stop", 0.75);
+  u.Setup(0, 1000 * kMs);
+  u.Initialize();
+  const TimeNs h = 100 * kMs;
+  for (int k = 0; k < 7; ++k) {
+    ASSERT_EQ(u.DoStep(k * h, h), StepResult::kOk) << u.last_error();
+    EXPECT_TRUE(u.stop_request().empty()) << k;
+  }
+  ASSERT_EQ(u.DoStep(7 * h, h), StepResult::kOk) << u.last_error();
+  EXPECT_NE(u.stop_request().find("terminateSimulation = true"), std::string::npos)
+      << u.stop_request();
+  EXPECT_EQ(Real(u, "y"), 3.0);
+  EXPECT_NEAR(Real(u, "area"), StairArea(0.75, 0.25), 1e-12);
+  u.Terminate();
+  EXPECT_NE(u.messages().back().find("fmi3Terminate called"), std::string::npos);
+}
+
+// FMI 2.0: fmi2Discard with fmi2Terminated = true (terminate2 ends at
+// t_end = 0.355 s): the step's values at lastSuccessfulTime are read, the
+// unit asks to end the run (no discard), and fmi2Terminate is then allowed.
+TEST(FmuUnit, DiscardWithTerminatedEndsTheRun) {
+  FmuUnit u("e", Fmu("terminate2"));
+  u.Setup(0, 1000 * kMs);
+  u.Initialize();
+  const TimeNs h = 10 * kMs;
+  for (int k = 0; k < 35; ++k) {
+    ASSERT_EQ(u.DoStep(k * h, h), StepResult::kOk) << u.last_error();
+    EXPECT_TRUE(u.stop_request().empty());
+  }
+  ASSERT_EQ(u.DoStep(35 * h, h), StepResult::kOk) << u.last_error();
+  EXPECT_NE(u.stop_request().find("fmi2Discard with fmi2Terminated = true"), std::string::npos)
+      << u.stop_request();
+  EXPECT_NE(u.stop_request().find("last successful time 0.355 s"), std::string::npos)
+      << u.stop_request();
+  EXPECT_EQ(Real(u, "x"), 0.355);
+  u.Terminate();
+  EXPECT_NE(u.messages().back().find("fmi2Terminate called"), std::string::npos);
+}
+
+// Every FMI 3.0 scalar type (fmus/types3.c: each output is its input):
+// floats as Reals (Float32 rounds to float: 0.1 comes back as
+// double(float(0.1))), every integer type as an Integer given to the FMU
+// only within its type's range, an enumeration only as one of its items,
+// and a Float64 array sized by a UInt64 structural parameter (n = 3:
+// y = (1, 2, 3) f32_in). The Binary input is left out: no variable of the
+// unit, and the FMU keeps its own value.
+TEST(FmuUnit, MapsEveryFmi3TypeWithItsRange) {
+  FmuUnit u("t", Fmu("types3"));
+  auto& table = u.variables();
+  EXPECT_EQ(Info(u, "f32_in").type, VarType::kReal);
+  EXPECT_EQ(Info(u, "i8_in").type, VarType::kInteger);
+  EXPECT_EQ(Info(u, "u64_out").type, VarType::kInteger);
+  EXPECT_EQ(Info(u, "mode_in").type, VarType::kInteger);
+  EXPECT_NE(Info(u, "i8_in").description.find("Int8"), std::string::npos);
+  EXPECT_NE(Info(u, "mode_in").description.find("enumeration 'Mode': 1 idle 2 run 5 stop"),
+            std::string::npos)
+      << Info(u, "mode_in").description;
+  EXPECT_NE(Info(u, "f32_in").description.find("min -10, max 10, nominal 2"), std::string::npos)
+      << Info(u, "f32_in").description;
+  EXPECT_NE(Info(u, "f32_out").description.find("no start value"), std::string::npos);
+  EXPECT_EQ(Info(u, "f32_in").description.find("no start value"), std::string::npos);
+  EXPECT_FALSE(table.Find("blob"));
+  ASSERT_EQ(u.description().left_out.size(), 1u);
+  EXPECT_EQ(u.description().left_out[0], "blob (Binary)");
+  EXPECT_EQ(table.GetRealArray(*table.Find("y")).size(), 3u);
+
+  u.Setup(0, 100 * kMs);
+  u.Initialize();
+  const auto set_int = [&](const char* name, std::int64_t v) { table.SetInteger(*table.Find(name), v); };
+  const auto get_int = [&](const char* name) { return table.GetInteger(*table.Find(name)); };
+  SetReal(u, "f32_in", 0.1);
+  set_int("i8_in", -128);
+  set_int("u8_in", 255);
+  set_int("i16_in", -32768);
+  set_int("u16_in", 65535);
+  set_int("u32_in", 4294967295LL);
+  set_int("i64_in", INT64_MIN);
+  set_int("u64_in", INT64_MAX);
+  set_int("mode_in", 5);
+  ASSERT_EQ(u.DoStep(0, 10 * kMs), StepResult::kOk) << u.last_error();
+  EXPECT_EQ(Real(u, "f32_out"), static_cast<double>(0.1f));
+  EXPECT_EQ(get_int("i8_out"), -128);
+  EXPECT_EQ(get_int("u8_out"), 255);
+  EXPECT_EQ(get_int("i16_out"), -32768);
+  EXPECT_EQ(get_int("u16_out"), 65535);
+  EXPECT_EQ(get_int("u32_out"), 4294967295LL);
+  EXPECT_EQ(get_int("i64_out"), INT64_MIN);
+  EXPECT_EQ(get_int("u64_out"), INT64_MAX);
+  EXPECT_EQ(get_int("mode_out"), 5);
+  const auto y = table.GetRealArray(*table.Find("y"));
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(y[k], (k + 1) * static_cast<double>(0.1f)) << k;
+
+  // Out of range: refused before the FMU sees it, naming variable, type and range.
+  const struct {
+    const char* name;
+    std::int64_t value;
+    const char* expected;
+  } bad[] = {
+      {"i8_in", 128, "Int8 value 128 of 'i8_in' is outside the Int8 range [-128, 127]"},
+      {"u8_in", -1, "UInt8 value -1 of 'u8_in' is outside the UInt8 range [0, 255]"},
+      {"u16_in", 65536, "UInt16 value 65536 of 'u16_in' is outside the UInt16 range [0, 65535]"},
+      {"u32_in", -5, "UInt32 value -5 of 'u32_in' is outside the UInt32 range"},
+      {"u64_in", -1, "UInt64 value -1 of 'u64_in' is outside the UInt64 range"},
+      {"mode_in", 3, "value 3 of 'mode_in' is no item of enumeration 'Mode': 1 (idle), 2 (run), 5 (stop)"},
+  };
+  for (const auto& b : bad) {
+    FmuUnit w("w", Fmu("types3"));
+    w.Setup(0, 100 * kMs);
+    w.Initialize();
+    w.variables().SetInteger(*w.variables().Find(b.name), b.value);
+    EXPECT_EQ(w.DoStep(0, 10 * kMs), StepResult::kError) << b.name;
+    EXPECT_NE(w.last_error().find(b.expected), std::string::npos) << w.last_error();
+  }
+  FmuUnit w("w", Fmu("types3"));
+  w.Setup(0, 100 * kMs);
+  w.Initialize();
+  SetReal(w, "f32_in", 1e39);  // FLT_MAX is 3.4e38
+  EXPECT_EQ(w.DoStep(0, 10 * kMs), StepResult::kError);
+  EXPECT_NE(w.last_error().find("is outside the Float32 range"), std::string::npos) << w.last_error();
 }
 
 }  // namespace

@@ -4,6 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace linesim::fmu {
@@ -96,5 +100,114 @@ TEST(ModelDescription, MoreVariablesThanTheLimitAreRefused) {
       << e.substr(0, 300);
 }
 
+// FMI 2.0 and 3.0 descriptions with the given variables (and FMI 2.0
+// outputs / FMI 3.0 structure).
+std::string Fmi2(const std::string& types, const std::string& vars, const std::string& outputs = "") {
+  return "<?xml version=\"1.0\"?>\n<fmiModelDescription fmiVersion=\"2.0\" modelName=\"m\" "
+         "guid=\"g\">\n  <CoSimulation modelIdentifier=\"m\"/>\n  <TypeDefinitions>" + types +
+         "</TypeDefinitions>\n  <ModelVariables>\n" + vars +
+         "  </ModelVariables>\n  <ModelStructure><Outputs>" + outputs +
+         "</Outputs></ModelStructure>\n</fmiModelDescription>\n";
+}
+std::string Fmi3(const std::string& types, const std::string& vars, const std::string& structure = "") {
+  return "<?xml version=\"1.0\"?>\n<fmiModelDescription fmiVersion=\"3.0\" modelName=\"m\" "
+         "instantiationToken=\"t\">\n  <CoSimulation modelIdentifier=\"m\"/>\n  <TypeDefinitions>" +
+         types + "</TypeDefinitions>\n  <ModelVariables>\n" + vars +
+         "  </ModelVariables>\n  <ModelStructure>" + structure +
+         "</ModelStructure>\n</fmiModelDescription>\n";
+}
+std::string Sv(const std::string& name, int vr, const std::string& causality,
+               const std::string& body = "<Real/>", const std::string& variability = "") {
+  return "    <ScalarVariable name=\"" + name + "\" valueReference=\"" + std::to_string(vr) +
+         "\" causality=\"" + causality + "\"" +
+         (variability.empty() ? "" : " variability=\"" + variability + "\"") + ">" + body +
+         "</ScalarVariable>\n";
+}
+
+// Guards issue 24: rules of the standards that the schemas cannot express
+// were not checked, and such an FMU ran with wrong numbers. Each is refused
+// with the rule named; the lawful neighbour of each case reads.
+TEST(ModelDescription, RulesTheSchemaCannotExpressAreEnforced) {
+  const std::string p1 = Sv("a", 1, "parameter", "<Real start=\"1\"/>", "fixed");
+  const std::string p2 = Sv("b", 1, "parameter", "<Real start=\"2\"/>", "fixed");
+  const std::string in = Sv("u", 2, "input", "<Real start=\"0\"/>");
+  const std::string out = Sv("y", 2, "output");
+  const std::string out3 = Sv("y", 3, "output");
+  // FMI 2.0 aliases: two parameters on one reference; an input on an output's.
+  EXPECT_NE(ParseError(Fmi2("", p1 + p2)).find("two variables set from outside share a value"),
+            std::string::npos)
+      << ParseError(Fmi2("", p1 + p2));
+  EXPECT_NE(ParseError(Fmi2("", in + out, "<Unknown index=\"2\"/>"))
+                .find("an input cannot alias a computed variable"),
+            std::string::npos)
+      << ParseError(Fmi2("", in + out, "<Unknown index=\"2\"/>"));
+  // Another base type on the same reference is no alias; an output alias of
+  // a local is lawful.
+  EXPECT_EQ(ParseError(Fmi2("", p1 + Sv("n", 1, "parameter", "<Integer start=\"1\"/>", "fixed"))), "");
+  EXPECT_EQ(ParseError(Fmi2("", in + out3 + Sv("l", 3, "local"), "<Unknown index=\"2\"/>")), "");
+  // FMI 3.0: a valueReference is a variable's own.
+  const std::string f1 = "    <Float64 name=\"a\" valueReference=\"1\" causality=\"local\"/>\n";
+  const std::string f2 = "    <Int32 name=\"b\" valueReference=\"1\" causality=\"local\"/>\n";
+  EXPECT_NE(ParseError(Fmi3("", f1 + f2)).find("every variable has a valueReference of its own"),
+            std::string::npos)
+      << ParseError(Fmi3("", f1 + f2));
+  // ModelStructure: indices in range, naming outputs.
+  EXPECT_NE(ParseError(Fmi2("", in + out3, "<Unknown index=\"7\"/>")).find("output index 7 names no mapped variable"),
+            std::string::npos);
+  EXPECT_NE(ParseError(Fmi2("", in + out3, "<Unknown index=\"1\"/>")).find("is 'u', a input"),
+            std::string::npos)
+      << ParseError(Fmi2("", in + out3, "<Unknown index=\"1\"/>"));
+  EXPECT_NE(ParseError(Fmi2("", in + out3, "<Unknown index=\"2\" dependencies=\"9\"/>"))
+                .find("dependency index 9 names no variable"),
+            std::string::npos);
+  const std::string o3 = "    <Float64 name=\"y\" valueReference=\"2\" causality=\"output\"/>\n";
+  EXPECT_NE(ParseError(Fmi3("", f1 + o3, "<Output valueReference=\"2\" dependencies=\"8\"/>"))
+                .find("depends on valueReference 8, which names no variable"),
+            std::string::npos);
+  EXPECT_NE(ParseError(Fmi3("", f1 + o3, "<Output valueReference=\"1\"/>")).find("only outputs are listed"),
+            std::string::npos);
+  EXPECT_NE(ParseError(Fmi3("", f1 + o3, "<InitialUnknown valueReference=\"5\"/>")).find("names no variable"),
+            std::string::npos);
+  EXPECT_EQ(ParseError(Fmi3("", f1 + o3, "<Output valueReference=\"2\" dependencies=\"1\"/>")), "");
+  // Declared types exist and fit; start values within [min, max]; a NaN
+  // start of a value linesim gives the FMU; an enumeration start an item.
+  EXPECT_NE(ParseError(Fmi2("", Sv("a", 1, "local", "<Real declaredType=\"T\"/>"))).find("declaredType 'T' is not in <TypeDefinitions>"),
+            std::string::npos);
+  const std::string enum2 = "<SimpleType name=\"E\"><Enumeration><Item name=\"a\" value=\"1\"/>"
+                            "<Item name=\"b\" value=\"4\"/></Enumeration></SimpleType>";
+  EXPECT_NE(ParseError(Fmi2(enum2, Sv("a", 1, "local", "<Real declaredType=\"E\"/>"))).find("is a Enumeration, not a type for this variable"),
+            std::string::npos)
+      << ParseError(Fmi2(enum2, Sv("a", 1, "local", "<Real declaredType=\"E\"/>")));
+  EXPECT_NE(ParseError(Fmi2("", Sv("a", 1, "parameter", "<Real start=\"5\" min=\"0\" max=\"2\"/>", "fixed")))
+                .find("start value 5 is outside [0, 2] (FMI: min <= start <= max)"),
+            std::string::npos);
+  EXPECT_NE(ParseError(Fmi2("", Sv("a", 1, "parameter", "<Real start=\"NaN\"/>", "fixed"))).find("start value NaN"),
+            std::string::npos);
+  EXPECT_NE(ParseError(Fmi2(enum2, Sv("a", 1, "input", "<Enumeration declaredType=\"E\" start=\"3\"/>")))
+                .find("start value 3 is no item of enumeration 'E'"),
+            std::string::npos);
+  EXPECT_EQ(ParseError(Fmi2(enum2, Sv("a", 1, "input", "<Enumeration declaredType=\"E\" start=\"4\"/>"))), "");
+  EXPECT_NE(ParseError(Fmi3("", "    <Int8 name=\"a\" valueReference=\"1\" causality=\"input\" start=\"300\"/>\n"))
+                .find("start value '300' is not a Int8"),
+            std::string::npos);
+}
+// Guards issue 24: every file read has a size limit checked before
+// parsing. A (sparse) model description one byte above
+// kMaxModelDescriptionBytes is refused naming the file and the limit.
+TEST(ModelDescription, AFileAboveTheSizeLimitIsRefusedBeforeReading) {
+  const std::string file = ::testing::TempDir() + "md_size_" + std::to_string(::getpid()) + ".xml";
+  { std::ofstream(file) << "<"; }
+  std::filesystem::resize_file(file, kMaxModelDescriptionBytes + 1);
+  try {
+    ParseModelDescription(file);
+    ADD_FAILURE() << "read a model description above the limit";
+  } catch (const FmuError& e) {
+    EXPECT_NE(std::string(e.what()).find(file + ": the model description is 134217729 bytes, more "
+                                         "than the 128 MiB linesim reads"),
+              std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove(file);
+}
 }  // namespace
 }  // namespace linesim::fmu

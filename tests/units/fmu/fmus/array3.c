@@ -25,8 +25,16 @@ static void ModelOutputs(Model* m) {
     for (int j = 0; j < 3; ++j) m->f[Y + 3 * i + j] = m->f[SCALE] * m->f[P + j] * (i + 1) * m->f[TIME];
 }
 
-static fmi3Status ModelStep(Instance* c, double t, double h, bool* early, double* last) {
-  (void)early; (void)last;
+static fmi3Status ModelStep(Instance* c, double t, double h, bool* early, double* last,
+                            bool* terminate) {
+  (void)early; (void)last; (void)terminate;
+  /* fixedInternalStepSize = 1 ms: a step that is no whole number of them is
+   * refused, by the FMU (FMI 3.0 leaves it to the FMU). */
+  const double steps = h / 0.001;
+  if (fabs(steps - round(steps)) > 1e-9 * steps) {
+    if (c->log) c->log(c->env, fmi3Error, "logStatusError", "h is not a multiple of 1 ms");
+    return fmi3Error;
+  }
   c->m.time = t + h;
   c->m.f[TIME] = t + h;
   ModelOutputs(&c->m);

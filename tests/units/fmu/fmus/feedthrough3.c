@@ -22,8 +22,9 @@ static void ModelOutputs(Model* m) {
   strcpy(m->s[1], m->s[0]);
 }
 
-static fmi3Status ModelStep(Instance* c, double t, double h, bool* early, double* last) {
-  (void)early; (void)last;
+static fmi3Status ModelStep(Instance* c, double t, double h, bool* early, double* last,
+                            bool* terminate) {
+  (void)early; (void)last; (void)terminate;
   c->m.time = t + h;
   c->m.f[2] = t + h;
   ModelOutputs(&c->m);

@@ -53,6 +53,7 @@ typedef struct {
   char s[NS > 0 ? NS : 1][STR_LEN];
   double time;
   double last_successful_time;
+  int terminated; /* fmi2GetBooleanStatus(fmi2Terminated) */
   int started; /* set by the first doStep */
 } Model;
 
@@ -110,7 +111,11 @@ EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tol_defined, 
 }
 EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { (void)c; return fmi2OK; }
 EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { (void)c; return fmi2OK; }
-EXPORT fmi2Status fmi2Terminate(fmi2Component c) { (void)c; return fmi2OK; }
+EXPORT fmi2Status fmi2Terminate(fmi2Component c) {
+  /* Logged, so that tests see which call sequences an importer made. */
+  Say((Instance*)c, fmi2OK, "logAll", "fmi2Terminate called");
+  return fmi2OK;
+}
 EXPORT fmi2Status fmi2Reset(fmi2Component c) {
   ModelDefaults(&((Instance*)c)->m);
   return fmi2OK;
@@ -187,6 +192,12 @@ EXPORT fmi2Status fmi2CancelStep(fmi2Component c) { (void)c; return fmi2Error; }
 EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, fmi2StatusKind s, fmi2Real* v) {
   if (s != fmi2LastSuccessfulTime) return fmi2Discard;
   *v = ((Instance*)c)->m.last_successful_time;
+  return fmi2OK;
+}
+
+EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, fmi2StatusKind s, fmi2Boolean* v) {
+  if (s != fmi2Terminated) return fmi2Discard;
+  *v = ((Instance*)c)->m.terminated;
   return fmi2OK;
 }
 

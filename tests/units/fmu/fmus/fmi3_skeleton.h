@@ -5,7 +5,8 @@
  *   MODEL_TOKEN, NF, NFV (all Float64 elements), NI, NB, NS,
  *   static const size_t kSize[NF];
  *   static void ModelDefaults(Model* m); static void ModelOutputs(Model* m);
- *   static fmi3Status ModelStep(Instance* c, double t, double h, bool* early, double* last); */
+ *   static fmi3Status ModelStep(Instance* c, double t, double h, bool* early, double* last,
+ *                               bool* terminate); */
 #include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
@@ -40,17 +41,22 @@ typedef struct {
   char s[NS > 0 ? NS : 1][STR_LEN];
   double time;
   int started;
+#ifdef MODEL_EXTRA_FIELDS
+  MODEL_EXTRA_FIELDS
+#endif
 } Model;
 
 typedef struct {
   Model m;
   fmi3InstanceEnvironment env;
   fmi3LogMessageCallback log;
+  bool early_allowed; /* earlyReturnAllowed at instantiation */
 } Instance;
 
 static void ModelDefaults(Model* m);
 static void ModelOutputs(Model* m);
-static fmi3Status ModelStep(Instance* c, double t, double h, bool* early, double* last);
+static fmi3Status ModelStep(Instance* c, double t, double h, bool* early, double* last,
+                            bool* terminate);
 
 static size_t Offset(fmi3ValueReference vr) {
   size_t o = 0;
@@ -65,12 +71,13 @@ EXPORT fmi3Instance fmi3InstantiateCoSimulation(
     fmi3Boolean logging, fmi3Boolean event_mode, fmi3Boolean early_allowed,
     const fmi3ValueReference required[], size_t n_required, fmi3InstanceEnvironment env,
     fmi3LogMessageCallback log, fmi3IntermediateUpdateCallback update) {
-  (void)name; (void)resources; (void)visible; (void)logging; (void)early_allowed;
+  (void)name; (void)resources; (void)visible; (void)logging;
   (void)required; (void)n_required; (void)update;
   if (strcmp(token, MODEL_TOKEN) != 0 || event_mode) return NULL;
   Instance* c = (Instance*)calloc(1, sizeof(Instance));
   c->env = env;
   c->log = log;
+  c->early_allowed = early_allowed;
   ModelDefaults(&c->m);
   if (log) log(env, fmi3OK, "logEvents", "instantiated " MODEL_TOKEN);
   return c;
@@ -83,7 +90,12 @@ EXPORT fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean tol_de
   return fmi3OK;
 }
 EXPORT fmi3Status fmi3ExitInitializationMode(fmi3Instance c) { (void)c; return fmi3OK; }
-EXPORT fmi3Status fmi3Terminate(fmi3Instance c) { (void)c; return fmi3OK; }
+EXPORT fmi3Status fmi3Terminate(fmi3Instance c) {
+  /* Logged, so that tests see which call sequences an importer made. */
+  Instance* ci = (Instance*)c;
+  if (ci->log) ci->log(ci->env, fmi3OK, "logEvents", "fmi3Terminate called");
+  return fmi3OK;
+}
 
 EXPORT fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
                                  fmi3Float64 v[], size_t nv) {
@@ -167,7 +179,7 @@ EXPORT fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 t, fmi3Float64 h, fmi3B
   *last = t + h;
   ModelOutputs(&ci->m);
   ci->m.started = 1;
-  return ModelStep(ci, t, h, early, last);
+  return ModelStep(ci, t, h, early, last, terminate);
 }
 
 EXPORT fmi3Status fmi3GetFMUState(fmi3Instance c, fmi3FMUState* s) {
