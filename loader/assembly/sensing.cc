@@ -337,6 +337,32 @@ void AddOdometry(SystemBuilder& b, const ProviderContext& c, Signals& s) {
   s.odometry = kOdometry;
 }
 
+// The PX4Flow units' messages into a surface unit's sensor inputs (both
+// surface providers read them alike), their mounts and the wheel count
+// into its parameters `p`.
+void ConnectFlowSensors(SystemBuilder& b, const std::vector<const models::SensorMount*>& flows,
+                        const models::RobotDescription& robot, const std::string& unit,
+                        YAML::Node& p) {
+  p["sensors"] = static_cast<int>(flows.size());
+  p["wheels"] = static_cast<int>(robot.wheels.size());
+  std::vector<double> sx, sy, syaw;
+  for (std::size_t k = 0; k < flows.size(); ++k) {
+    const models::SensorMount& m = *flows[k];
+    sx.push_back(m.x_m);
+    sy.push_back(m.y_m);
+    syaw.push_back(m.yaw_rad);
+    for (std::size_t i = 0; i < 2; ++i) {
+      b.Connect(Element(m.name, "velocity", i), Element(unit, "sensor_velocity", 2 * k + i));
+    }
+    b.Connect(Signal(m.name, "valid"), Element(unit, "sensor_valid", k));
+    b.Connect(Signal(m.name, "quality"), Element(unit, "sensor_quality", k));
+    b.Connect(Signal(m.name, "message_count"), Element(unit, "sensor_message_count", k));
+  }
+  p["sensor_x"] = List(sx);
+  p["sensor_y"] = List(sy);
+  p["sensor_yaw"] = List(syaw);
+}
+
 // Who measures the velocity of the surface under each wheel (base_link).
 const std::map<std::string, Provider>& SurfaceVelocityProviders() {
   static const std::map<std::string, Provider> providers = {
@@ -356,26 +382,7 @@ const std::map<std::string, Provider>& SurfaceVelocityProviders() {
          const models::RobotDescription& robot = c.file.robot;
          b.Unit(kSurfaceEstimator, "surface_velocity_estimator");
          YAML::Node p = b.Params(kSurfaceEstimator);
-         p["sensors"] = static_cast<int>(flows.size());
-         p["wheels"] = static_cast<int>(robot.wheels.size());
-         std::vector<double> sx, sy, syaw;
-         for (std::size_t k = 0; k < flows.size(); ++k) {
-           const models::SensorMount& m = *flows[k];
-           sx.push_back(m.x_m);
-           sy.push_back(m.y_m);
-           syaw.push_back(m.yaw_rad);
-           for (std::size_t i = 0; i < 2; ++i) {
-             b.Connect(Element(m.name, "velocity", i),
-                       Element(kSurfaceEstimator, "sensor_velocity", 2 * k + i));
-           }
-           b.Connect(Signal(m.name, "valid"), Element(kSurfaceEstimator, "sensor_valid", k));
-           b.Connect(Signal(m.name, "quality"), Element(kSurfaceEstimator, "sensor_quality", k));
-           b.Connect(Signal(m.name, "message_count"),
-                     Element(kSurfaceEstimator, "sensor_message_count", k));
-         }
-         p["sensor_x"] = List(sx);
-         p["sensor_y"] = List(sy);
-         p["sensor_yaw"] = List(syaw);
+         ConnectFlowSensors(b, flows, robot, kSurfaceEstimator, p);
          // The filter's sample is the sensors' message period, when their
          // settings or model file say (else both units' default, 10 Hz).
          std::optional<double> rate;
@@ -435,26 +442,7 @@ const std::map<std::string, Provider>& SurfaceVelocityProviders() {
          const models::RobotDescription& robot = c.file.robot;
          b.Unit(kFusion, "surface_fusion");
          YAML::Node p = b.Params(kFusion);
-         p["sensors"] = static_cast<int>(flows.size());
-         p["wheels"] = static_cast<int>(robot.wheels.size());
-         std::vector<double> sx, sy, syaw;
-         for (std::size_t k = 0; k < flows.size(); ++k) {
-           const models::SensorMount& m = *flows[k];
-           sx.push_back(m.x_m);
-           sy.push_back(m.y_m);
-           syaw.push_back(m.yaw_rad);
-           for (std::size_t i = 0; i < 2; ++i) {
-             b.Connect(Element(m.name, "velocity", i),
-                       Element(kFusion, "sensor_velocity", 2 * k + i));
-           }
-           b.Connect(Signal(m.name, "valid"), Element(kFusion, "sensor_valid", k));
-           b.Connect(Signal(m.name, "quality"), Element(kFusion, "sensor_quality", k));
-           b.Connect(Signal(m.name, "message_count"),
-                     Element(kFusion, "sensor_message_count", k));
-         }
-         p["sensor_x"] = List(sx);
-         p["sensor_y"] = List(sy);
-         p["sensor_yaw"] = List(syaw);
+         ConnectFlowSensors(b, flows, robot, kFusion, p);
          SetWheelPositions(p, robot);
          if (s.odometry.empty()) AddOdometry(b, c, s);
          b.Connect(Signal(s.odometry, "wheel_velocity"), Signal(kFusion, "wheel_velocity"));

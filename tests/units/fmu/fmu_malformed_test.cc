@@ -283,8 +283,24 @@ std::string FolderOfAChildThatDies(int sig) {
   return text.empty() ? "" : text.substr(0, text.size() - 1);
 }
 
+// AddressSanitizer owns SIGSEGV (handle_segv=1 by default): the cleanup
+// handler steps aside for an installed handler so that the sanitizer's
+// report survives, and the child then exits through ASan, not the signal.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitizerOwnsSegv = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kSanitizerOwnsSegv = true;
+#else
+constexpr bool kSanitizerOwnsSegv = false;
+#endif
+#else
+constexpr bool kSanitizerOwnsSegv = false;
+#endif
+
 TEST(FmuArchive, NoFolderOutlivesACrashOrATermination) {
   for (int sig : {SIGSEGV, SIGABRT, SIGTERM, SIGINT}) {
+    if (sig == SIGSEGV && kSanitizerOwnsSegv) continue;
     const std::string folder = FolderOfAChildThatDies(sig);
     ASSERT_NE(folder.find("linesim-fmu-"), std::string::npos) << sig << ": " << folder;
     EXPECT_FALSE(std::filesystem::exists(folder)) << sig << ": " << folder << " was left behind";
@@ -305,7 +321,9 @@ TEST(FmuArchive, StaleFoldersOfDeadProcessesAreSwept) {
     std::filesystem::create_directories(p / "binaries");
     std::ofstream(p / "binaries" / "x.so") << "x";
   }
-  EXPECT_GE(SweepStaleTempFolders(), 1u);
+  // The count is not checked: a test running beside this one (ctest -j)
+  // sweeps at its first FMU load too and may take the stale folder first.
+  SweepStaleTempFolders();
   EXPECT_FALSE(std::filesystem::exists(stale));
   EXPECT_TRUE(std::filesystem::exists(live));
   EXPECT_TRUE(std::filesystem::exists(other));
