@@ -225,6 +225,34 @@ inline bool InsideRect(const Rect& r, double cos_dir, double sin_dir, double x, 
   return std::abs(along) <= 0.5 * r.length_m && std::abs(across) <= 0.5 * r.width_m;
 }
 
+/// Which belt of a scene a map point lies on, with each belt's direction
+/// cached (estimators ask this for every wheel and sensor every step).
+class BeltMap {
+ public:
+  BeltMap() = default;
+  explicit BeltMap(const std::vector<Belt>& belts) {
+    for (const Belt& b : belts) {
+      areas_.push_back({b.area, std::cos(b.area.direction_rad), std::sin(b.area.direction_rad)});
+    }
+  }
+  std::size_t size() const { return areas_.size(); }
+  /// 0 over the floor, k + 1 over belt k (the first that holds the point).
+  int At(double x, double y) const {
+    for (std::size_t k = 0; k < areas_.size(); ++k) {
+      const Area& a = areas_[k];
+      if (InsideRect(a.rect, a.cos_dir, a.sin_dir, x, y)) return static_cast<int>(k) + 1;
+    }
+    return 0;
+  }
+
+ private:
+  struct Area {
+    Rect rect;
+    double cos_dir, sin_dir;
+  };
+  std::vector<Area> areas_;
+};
+
 /// The belt travel over which an object a belt carries (its footprint at
 /// zero travel: `solid`) lies along the belt's length (`belt_area`): its
 /// footprint's extent along the belt axis within the belt's two ends.

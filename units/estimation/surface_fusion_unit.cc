@@ -26,9 +26,7 @@ SurfaceFusionUnit::SurfaceFusionUnit(std::string name, int sensors, int wheels,
   }
   n_ = static_cast<std::size_t>(sensors);
   w_ = static_cast<std::size_t>(wheels);
-  for (const models::Belt& b : scene.belts) {
-    belts_.push_back({b.area, std::cos(b.area.direction_rad), std::sin(b.area.direction_rad)});
-  }
+  belts_ = models::BeltMap(scene.belts);
   const std::size_t k = belts_.size();
 
   sensor_x_.assign(n_, kNaN);
@@ -267,15 +265,6 @@ void SurfaceFusionUnit::Initialize() {
   WriteOutputs(c, s);
 }
 
-int SurfaceFusionUnit::SurfaceAt(double x, double y) const {
-  for (std::size_t b = 0; b < belts_.size(); ++b) {
-    if (models::InsideRect(belts_[b].area, belts_[b].cos_dir, belts_[b].sin_dir, x, y)) {
-      return static_cast<int>(b) + 1;
-    }
-  }
-  return 0;
-}
-
 void SurfaceFusionUnit::Predict(double h, cosim::TimeNs t) {
   const std::size_t n = dim_, nb = belts_.size();
   // F = I + h [0 M_1 .. M_K; 0], applied as P' = F P F^T + Q.
@@ -488,7 +477,7 @@ cosim::StepResult SurfaceFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
 
   // Which surface the map puts each wheel and sensor over.
   const auto at = [&](double bx, double by) {
-    return SurfaceAt(position_[0] + c * bx - s * by, position_[1] + s * bx + c * by);
+    return belts_.At(position_[0] + c * bx - s * by, position_[1] + s * bx + c * by);
   };
   for (std::size_t j = 0; j < w_; ++j) wheel_surface_[j] = at(wheel_x_[j], wheel_y_[j]);
   for (std::size_t i = 0; i < n_; ++i) sensor_surface_[i] = at(sensor_x_[i], sensor_y_[i]);

@@ -127,12 +127,6 @@ class SurfaceFusionUnit : public cosim::Unit {
   void RestoreInternal(const cosim::UnitState& state) override;
 
  private:
-  struct BeltArea {
-    models::Rect area;
-    double cos_dir, sin_dir;
-  };
-  /// 0 over the floor, k + 1 over scene belt k.
-  int SurfaceAt(double x, double y) const;
   /// The rigid-body least-squares fit (C for each sensor point) from the
   /// wheel positions.
   void Cache();
@@ -157,7 +151,7 @@ class SurfaceFusionUnit : public cosim::Unit {
   void WriteOutputs(double c, double s);
 
   std::size_t n_, w_;
-  std::vector<BeltArea> belts_;
+  models::BeltMap belts_;  // 0 over the floor, k + 1 over scene belt k
 
   // Parameters.
   std::vector<double> sensor_x_, sensor_y_, sensor_yaw_, wheel_x_, wheel_y_;

@@ -28,9 +28,7 @@ SurfaceVelocityEstimator::SurfaceVelocityEstimator(std::string name, int sensors
   }
   n_ = static_cast<std::size_t>(sensors);
   w_ = static_cast<std::size_t>(wheels);
-  for (const models::Belt& b : scene.belts) {
-    belts_.push_back({b.area, std::cos(b.area.direction_rad), std::sin(b.area.direction_rad)});
-  }
+  belts_ = models::BeltMap(scene.belts);
 
   sensor_x_.assign(n_, kNaN);
   sensor_y_.assign(n_, kNaN);
@@ -256,15 +254,6 @@ void SurfaceVelocityEstimator::Initialize() {
   WriteOutputs(c, s);
 }
 
-int SurfaceVelocityEstimator::SurfaceAt(double x, double y) const {
-  for (std::size_t b = 0; b < belts_.size(); ++b) {
-    if (models::InsideRect(belts_[b].area, belts_[b].cos_dir, belts_[b].sin_dir, x, y)) {
-      return static_cast<int>(b) + 1;
-    }
-  }
-  return 0;
-}
-
 bool SurfaceVelocityEstimator::SurfaceMean(int surface, int status, char skip, double& vx,
                                            double& vy) const {
   double sx = 0.0, sy = 0.0;
@@ -342,7 +331,7 @@ void SurfaceVelocityEstimator::WriteOutputs(double c, double s) {
 void SurfaceVelocityEstimator::MapSurfaces(double c, double s) {
   // base_link point (x, y) in map, and the surface there.
   const auto at = [&](double x, double y) {
-    return SurfaceAt(position_[0] + c * x - s * y, position_[1] + s * x + c * y);
+    return belts_.At(position_[0] + c * x - s * y, position_[1] + s * x + c * y);
   };
   for (std::size_t i = 0; i < n_; ++i) map_surface_[i] = at(sensor_x_[i], sensor_y_[i]);
   for (std::size_t j = 0; j < w_; ++j) wheel_map_surface_[j] = at(wheel_x_[j], wheel_y_[j]);

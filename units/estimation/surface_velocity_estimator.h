@@ -108,13 +108,6 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   void RestoreInternal(const cosim::UnitState& state) override;
 
  private:
-  struct BeltArea {
-    models::Rect area;
-    double cos_dir, sin_dir;
-  };
-  /// 0 over the floor, k + 1 over scene belt k (the first that holds the
-  /// point, as the px4flow and the chassis take it).
-  int SurfaceAt(double x, double y) const;
   /// The robot's velocity relative to `surface` at base_link point (px, py)
   /// in base_link by the encoders of the wheels the map puts over it
   /// (wheel_map_surface_; the yaw rate: the localization's, a belt does not
@@ -134,7 +127,7 @@ class SurfaceVelocityEstimator : public cosim::Unit {
   void ResetState();
 
   std::size_t n_, w_;
-  std::vector<BeltArea> belts_;
+  models::BeltMap belts_;  // 0 over the floor, k + 1 over scene belt k
 
   // Parameters.
   std::vector<double> sensor_x_, sensor_y_, sensor_yaw_, wheel_x_, wheel_y_;
