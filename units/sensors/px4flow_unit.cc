@@ -442,9 +442,9 @@ void Px4FlowUnit::Frame(double t_s) {
   const double period_px = surf.texture_period_m * f_true / std::max(height_, 1e-3);
   period_px_x_ = period_px * dir_c;
   period_px_y_ = period_px * dir_s;
-  const double exposure_s = AutoExposure(cam_, Illuminance(surf)).exposure_s;
+  const Exposure exposure = AutoExposure(cam_, Illuminance(surf));
   last_brightness_ = brightness_;
-  brightness_ = Brightness(surf, t_s, exposure_s);
+  brightness_ = Brightness(surf, t_s, exposure.exposure_s);
   if (frame_index_ == 1) last_brightness_ = brightness_;
   int q = 0;
   double flow_x = 0.0, flow_y = 0.0;
@@ -459,14 +459,13 @@ void Px4FlowUnit::Frame(double t_s) {
     flow_x = r.flow_x_px;
     flow_y = r.flow_y_px;
   } else {
-    FastFrame(fx, fy, surf, q, flow_x, flow_y);
+    FastFrame(fx, fy, surf, exposure, q, flow_x, flow_y);
   }
   CommitFrame(q, flow_x, flow_y);
 }
 
-void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, int& q,
-                            double& flow_x, double& flow_y) {
-  const Exposure e = AutoExposure(cam_, Illuminance(surf));
+void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, const Exposure& e,
+                            int& q, double& flow_x, double& flow_y) {
   const double blur_px = std::sqrt(fx * fx + fy * fy) * e.exposure_s * frame_rate_;
   const double br = blur_px / kBlurScalePx;
   const double d = kNeighbourDiff * e.mean_dn * surf.texture_contrast *

@@ -135,9 +135,10 @@ class Px4FlowUnit : public cosim::Unit {
                             double& dir_s) const;
   void Frame(double t_s);
   /// The fast model's frame: quality and flow (px) of the true flow (fx, fy)
-  /// over surface `surf`; q stays 0 with 10 or fewer blocks.
-  void FastFrame(double fx, double fy, const models::Surface& surf, int& q, double& flow_x,
-                 double& flow_y);
+  /// over surface `surf` under the frame's exposure `e`; q stays 0 with 10
+  /// or fewer blocks.
+  void FastFrame(double fx, double fy, const models::Surface& surf, const Exposure& e, int& q,
+                 double& flow_x, double& flow_y);
   /// Integrates a frame of quality q (> 0: counted) into OPTICAL_FLOW_RAD.
   void CommitFrame(int q, double flow_x, double flow_y);
   /// Advances the body's shake and acceleration pitch by one frame; sets
