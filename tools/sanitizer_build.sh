@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Configures and builds ./build-asan: clang, Debug at -O1 -g with frame
+# Configures and builds ./build-asan: clang, Debug at -O1 with line tables
+# (all a sanitizer's stack trace needs; full -g compiles slower) and frame
 # pointers, AddressSanitizer + UndefinedBehaviorSanitizer on every target
 # (undefined behaviour aborts), and the libFuzzer harnesses (fuzz/). Sourced
 # by tools/sanitize.sh and tools/fuzz.sh, from the repository root, after
@@ -13,7 +14,7 @@ export LSAN_OPTIONS="suppressions=${root}/tools/sanitizers/lsan.supp:print_suppr
 cmake -S . -B build-asan -G Ninja \
   -DCMAKE_CXX_COMPILER=clang++ \
   -DCMAKE_BUILD_TYPE=Debug \
-  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" \
+  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only" \
   -DLINESIM_SANITIZE=address,undefined \
   -DLINESIM_FUZZ=ON \
   -DLINESIM_WERROR=OFF \
