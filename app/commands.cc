@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -40,12 +41,11 @@ std::string TypeLabel(const cosim::VariableInfo& v) {
 // starts with: its declared start value, or what the scenario set; "rule"
 // the values a parameter accepts ("> 0", "(0, 1]", "one of: a, b",
 // "required"), "-" for none.
-void PrintTable(const cosim::Unit& unit, std::ostream& out) {
-  constexpr int kColumns = 7;
-  struct Row {
-    std::string cells[kColumns];
-  };
-  std::vector<Row> rows{{{"name", "causality", "type", "unit", "start", "rule", "description"}}};
+constexpr int kTableColumns = 7;
+using TableRow = std::array<std::string, kTableColumns>;
+
+std::vector<TableRow> TableRows(const cosim::Unit& unit) {
+  std::vector<TableRow> rows{{"name", "causality", "type", "unit", "start", "rule", "description"}};
   const auto& table = unit.variables();
   for (const auto& v : table.infos()) {
     std::string description = v.description;
@@ -54,19 +54,44 @@ void PrintTable(const cosim::Unit& unit, std::ostream& out) {
       for (auto ref : v.depends_on) description += " " + table.info(ref).name;
       description += "]";
     }
-    rows.push_back({{v.name, std::string(cosim::ToString(v.causality)), TypeLabel(v),
-                     v.unit.empty() ? "-" : v.unit, cosim::FormatValue(table.GetValue(v.ref)),
-                     v.rule.empty() ? "-" : v.rule.Text(), description}});
+    rows.push_back({v.name, std::string(cosim::ToString(v.causality)), TypeLabel(v),
+                    v.unit.empty() ? "-" : v.unit, cosim::FormatValue(table.GetValue(v.ref)),
+                    v.rule.empty() ? "-" : v.rule.Text(), description});
   }
-  std::size_t width[kColumns - 1] = {};
+  return rows;
+}
+
+void PrintTable(const cosim::Unit& unit, std::ostream& out) {
+  const std::vector<TableRow> rows = TableRows(unit);
+  std::size_t width[kTableColumns - 1] = {};
   for (const auto& r : rows) {
-    for (int c = 0; c + 1 < kColumns; ++c) width[c] = std::max(width[c], r.cells[c].size());
+    for (int c = 0; c + 1 < kTableColumns; ++c) width[c] = std::max(width[c], r[c].size());
   }
   for (const auto& r : rows) {
     out << "  ";
-    for (int c = 0; c + 1 < kColumns; ++c)
-      out << std::left << std::setw(static_cast<int>(width[c]) + 2) << r.cells[c];
-    out << r.cells[kColumns - 1] << "\n";
+    for (int c = 0; c + 1 < kTableColumns; ++c)
+      out << std::left << std::setw(static_cast<int>(width[c]) + 2) << r[c];
+    out << r[kTableColumns - 1] << "\n";
+  }
+}
+
+// A table cell in Markdown: a '|' would end the cell.
+std::string MarkdownCell(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '|') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
+void PrintMarkdownTable(const cosim::Unit& unit, std::ostream& out) {
+  const std::vector<TableRow> rows = TableRows(unit);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    out << "|";
+    for (const auto& cell : rows[i]) out << " " << MarkdownCell(cell) << " |";
+    out << "\n";
+    if (i == 0) out << "|---|---|---|---|---|---|---|\n";
   }
 }
 
@@ -426,6 +451,36 @@ static int InspectFmu(const std::string& file) {
   if (!left_out.empty()) {
     std::cout << "left out (inside the FMU only: the independent time, non-Real locals): "
               << left_out << "\n";
+  }
+  return kExitOk;
+}
+
+int UnitReferenceCommand() {
+  std::cout << "# Unit types\n\n"
+               "Every unit type linesim registers, with its variables as `linesim inspect TYPE`\n"
+               "prints them. Generated: `build/app/linesim inspect --all > docs/units.md`\n"
+               "(test `UnitReference.DocsUnitsMdIsCurrent` fails when it is stale).\n"
+               "How units are used in scenario files: `docs/scenarios.md`.\n";
+  for (const auto& type : config::UnitTypes()) {
+    std::cout << "\n## `" << type.name << "`\n\n" << type.description << "\n";
+    if (!type.model_folder.empty()) {
+      std::cout << "\nModel files (`parameters.model`): `models/" << type.model_folder << "/`.\n";
+    }
+    if (!type.structural_keys.empty()) {
+      std::cout << "\nKeys under `parameters:` that shape the unit:\n\n";
+      for (const auto& k : type.structural_keys) {
+        std::cout << "- `" << k.name << "`: " << k.description << "\n";
+      }
+    }
+    std::unique_ptr<cosim::Unit> unit;
+    try {
+      unit = loader::CreateDefaultUnit(type);
+    } catch (const config::ScenarioError& e) {
+      std::cerr << "linesim: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+    std::cout << "\n";
+    PrintMarkdownTable(*unit, std::cout);
   }
   return kExitOk;
 }

@@ -56,6 +56,10 @@ int CompareCommand(const std::string& file, const std::string& out_dir,
 /// `linesim inspect TYPE|FILE [--set path=value ...]`.
 int InspectCommand(const std::string& what, const std::vector<std::string>& set_args);
 
+/// `linesim inspect --all`: every registered unit type with its variable
+/// table, in Markdown (the text of docs/units.md).
+int UnitReferenceCommand();
+
 /// `linesim export-fmu TYPE [--set key=value ...] [--scene S] [--fmi 2|3]
 /// --out NAME.fmu` (app/export_command.cc); fmi_version 0: automatic.
 int ExportFmuCommand(const std::string& type, const std::vector<std::string>& set_args,

@@ -67,7 +67,12 @@ int main(int argc, char** argv) {
   std::vector<std::string> inspect_sets;
   CLI::App* inspect =
       cli.add_subcommand("inspect", "print the variables of a unit type, of a scenario's units or of an FMU");
-  inspect->add_option("what", what, "unit type name, a scenario YAML file, or an FMU (.fmu)")->required();
+  bool inspect_all = false;
+  CLI::Option* what_option =
+      inspect->add_option("what", what, "unit type name, a scenario YAML file, or an FMU (.fmu)");
+  inspect->add_flag("--all", inspect_all,
+                    "every unit type with its variables, in Markdown (docs/units.md)")
+      ->excludes(what_option);
   inspect->add_option("--set", inspect_sets, "override a value: dotted.path=value (repeatable)")
       ->take_all();
 
@@ -156,6 +161,11 @@ int main(int argc, char** argv) {
       return SweepCommand(sweep_args, mpi.get());
     }
     if (export_fmu->parsed()) return ExportFmuCommand(export_type, export_sets, export_scene, export_fmi, export_out);
+    if (inspect_all) return UnitReferenceCommand();
+    if (what.empty()) {
+      std::cerr << "linesim inspect: give a unit type, a scenario file or an FMU, or --all\n";
+      return kExitBadInput;
+    }
     return InspectCommand(what, inspect_sets);
   } catch (const std::exception& e) {
     std::cerr << "linesim: " << e.what() << "\n";
