@@ -452,6 +452,16 @@ const std::map<std::string, Provider>& SurfaceVelocityProviders() {
          b.Connect(s.position, Signal(kFusion, "position"));
          b.Connect(s.yaw, Signal(kFusion, "yaw"));
          SetStep(b, kFusion);
+         // The accelerometer feels the belt carry the robot at once
+         // (surface_fusion_unit.h): the first IMU, at its rate.
+         if (const auto imus = Mounts(s, "imu"); !imus.empty()) {
+           const std::string& imu = imus.front()->name;
+           p["imu"] = true;
+           p["imu_yaw"] = Num(imus.front()->yaw_rad);
+           b.Connect(Signal(imu, "linear_acceleration"), Signal(kFusion, "imu_acceleration"));
+           const YAML::Node step = b.out()["units"][imu]["step_s"];
+           if (step.IsDefined() && step.IsScalar()) b.out()["units"][kFusion]["step_s"] = step;
+         }
          s.surface_velocity = Signal(kFusion, "wheel_surface_velocity");
          s.surface_estimate = Signal(kFusion, "sensor_surface_velocity");
          s.recorded.push_back(Signal(kFusion, "belt_velocity"));

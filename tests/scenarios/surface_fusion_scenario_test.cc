@@ -30,9 +30,9 @@ const std::vector<std::string> kOwnSensors = {"sensing.surface_velocity=fused_fl
 // corner PX4Flow see the belt before the wheels reach it, with the encoders
 // of the wheels still on the floor as the robot's motion (the flow
 // measurement's H = I): the estimate is ready when the wheels arrive.
-// max_path_deviation_m, 20 runs (--runs 20): 6.2 / 8.0 / 10.5 mm; seeds
-// 1..8: 6.0 / 7.6 / 12.6 mm (before the PX4Flow noise model of items 1-2:
-// 5.9 / 7.5 / 12.1); final_progress_m above 3.9 at every seed.
+// max_path_deviation_m with the IMU fused, 20 runs (--runs 20): 5.2 / 5.8 /
+// 6.5 mm; seeds 1..8: 4.7 / 5.4 / 5.8 mm (without the IMU: 20 runs 5.6 /
+// 7.9 / 18.0 mm); final_progress_m above 3.9 at every seed.
 TEST(SurfaceFusionScenarios, CrossLineStaysWithin4cm) {
   const auto m = RunSeeds(Shipped("cross_line"), kOwnSensors, kSeeds);
   EXPECT_LT(m["max_path_deviation_m"].max(), 0.04);
@@ -41,27 +41,33 @@ TEST(SurfaceFusionScenarios, CrossLineStaysWithin4cm) {
 
 // Position hold on the line while it switches on and off at 0.20 m/s: the
 // issue's 1 cm on the final deviation (the line steady again for 9 s at the
-// end of the run). The peak at a switch is reported in docs/results.md
-// against paper 1's 4 cm and not asserted: over 20 runs it exceeds 4 cm on
-// 10 (27.6 to 68.7 mm; seeds 1..8 up to 70 mm), so a 4 cm bound would fail.
-// final_position_drift_m, 20 runs (--runs 20): 0.3 / 0.8 / 2.0 mm;
-// seeds 1..8: 0.3 / 0.6 / 2.0 mm (peak 29 / 38 / 70 mm).
-TEST(SurfaceFusionScenarios, HoldOnBeltEndsWithin1cm) {
+// end of the run), and paper 1's 4 cm on the median of the peaks at the
+// switches. Not on every peak: over 20 runs one of 20 exceeds 4 cm (62 mm:
+// there the belt's estimate follows the start within 1-2 cm/s, as with
+// ground-truth sensing, which holds that seed within 7.7 mm; the wheels'
+// steering, left across the belt by the previous correction, has to turn
+// before it can compensate).
+// With the IMU fused, 20 runs (--runs 20): peak 10.9 / 16.4 / 62.3 mm,
+// final 0.3 / 1.0 / 1.8 mm; seeds 1..8: peak 12.1 / 14.0 / 35.6 mm, final
+// 0.2 / 0.9 / 1.4 mm. Without the IMU (laser and encoders alone), 20 runs:
+// peak 25.4 / 38.2 / 65.2 mm (8 over 4 cm).
+TEST(SurfaceFusionScenarios, HoldOnBeltHoldsWithin4cmAndEndsWithin1cm) {
   const auto m = RunSeeds(Shipped("hold_on_belt"), kOwnSensors, kSeeds);
   EXPECT_LT(m["final_position_drift_m"].max(), 0.01);
+  EXPECT_LT(m["max_position_drift_m"].median(), 0.04);
 }
 
-// Straddling the line's edge: the final deviation within paper 1's 4 cm.
-// Not 1 cm: with the PX4Flow's earlier noise one of 20 runs ended 20 mm
-// off. There the belt estimate stayed at 0.19 m/s (the belt's speed) while
-// the robot, held 8 s, started to move at 0.06 m/s 0.4 s before the end:
-// an event of the wheels on the edge, not of the estimate (paper 1's
-// px4flow provider had a 21 mm final outlier in its 20 runs too).
-// final_position_drift_m, 20 runs: 0.2 / 1.4 / 5.6 mm (earlier noise: 0.3 /
-// 1.0 / 20.1); seeds 1..8: 0.2 / 1.1 / 5.5 mm (peak 20 / 40 / 55 mm).
-TEST(SurfaceFusionScenarios, HoldStraddleEndsWithin4cm) {
+// Straddling the line's edge: the final deviation within the issue's 1 cm.
+// The peaks are reported (docs/results.md), not asserted: two wheels on the
+// belt and two on the floor make the robot turn as well, and 2 of 20 runs
+// peak above 4 cm.
+// With the IMU fused, 20 runs: final 0.7 / 3.0 / 7.5 mm, peak 7.9 / 21.8 /
+// 48.2 mm; seeds 1..8: final 0.4 / 2.0 / 3.3 mm, peak 12.5 / 28.9 / 46.2
+// mm. Without the IMU, 20 runs: final up to 16.2 mm, peak 15.5 / 29.7 /
+// 55.4 mm.
+TEST(SurfaceFusionScenarios, HoldStraddleEndsWithin1cm) {
   const auto m = RunSeeds(Shipped("hold_straddle"), kOwnSensors, kSeeds);
-  EXPECT_LT(m["final_position_drift_m"].max(), 0.04);
+  EXPECT_LT(m["final_position_drift_m"].max(), 0.01);
 }
 
 }  // namespace

@@ -32,6 +32,7 @@ std::unique_ptr<cosim::Unit> MakeSurfaceFusion(const UnitBuildContext& c) {
   const std::size_t issues_before = c.reader.issues().size();
   const std::int64_t sensors = c.reader.Integer(c.parameters, c.path, "sensors", fallback, 0, 64);
   const std::int64_t wheels = c.reader.Integer(c.parameters, c.path, "wheels", fallback, 2, 64);
+  const bool imu = c.reader.Boolean(c.parameters, c.path, "imu", false);
   if (c.reader.issues().size() != issues_before) return nullptr;
   bool ok = true;
   for (const char* key : {"sensor_x", "sensor_y", "sensor_yaw"}) {
@@ -40,18 +41,21 @@ std::unique_ptr<cosim::Unit> MakeSurfaceFusion(const UnitBuildContext& c) {
   for (const char* key : {"wheel_x", "wheel_y"}) ok = CheckListSize(c, key, wheels, "wheel") && ok;
   if (!ok) return nullptr;
   return std::make_unique<SurfaceFusionUnit>(c.name, static_cast<int>(sensors),
-                                             static_cast<int>(wheels), c.scene);
+                                             static_cast<int>(wheels), c.scene, imu);
 }
 
 const config::UnitTypeRegistrar kSurfaceFusion(
     {SurfaceFusionUnit::kTypeName,
      "paper 1's future work (Sec. VI-D): each scene belt's velocity by a Kalman filter of the "
      "laser localization's velocity minus the wheel encoders (per wheel over the belt) and the "
-     "PX4Flow messages with the encoders as the robot's motion, with switch detection; per "
+     "PX4Flow messages with the encoders as the robot's motion (and, with imu, the "
+     "accelerometer's), with switch detection; per "
      "wheel the estimate of the belt under it",
      "",
      {{"sensors", "number of PX4Flow sensors N (>= 0): the size of the per-sensor lists"},
-      {"wheels", "number of wheels W (>= 2): the size of the per-wheel lists"}},
+      {"wheels", "number of wheels W (>= 2): the size of the per-wheel lists"},
+      {"imu", "true: the IMU's acceleration is fused too (input imu_acceleration, state b and "
+              "the accelerometer bias; default false)"}},
      MakeSurfaceFusion});
 
 }  // namespace

@@ -16,8 +16,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }  // namespace
 
 SurfaceFusionUnit::SurfaceFusionUnit(std::string name, int sensors, int wheels,
-                                     const models::Scene& scene)
-    : cosim::Unit(kTypeName, std::move(name)) {
+                                     const models::Scene& scene, bool imu)
+    : cosim::Unit(kTypeName, std::move(name)), imu_(imu) {
   if (sensors < 0 || wheels < 2) {
     throw cosim::UnitError(Where() + ": needs at least 2 wheels (a rigid-body fit) and no "
                                      "negative sensor count, got " +
@@ -52,6 +52,12 @@ SurfaceFusionUnit::SurfaceFusionUnit(std::string name, int sensors, int wheels,
   mount_cos_.assign(n_, 1.0);
   mount_sin_.assign(n_, 0.0);
   dim_ = 2 + 2 * k;
+  if (imu_) {
+    imu_index_ = dim_;
+    dim_ += 4;  // b, beta
+  }
+  imu_acceleration_.assign(3, 0.0);
+  imu_run_.assign(2, 0);
   state_.assign(dim_, 0.0);
   cov_.assign(dim_ * dim_, 0.0);
   scratch_.assign(4 * dim_ * dim_, 0.0);
@@ -139,6 +145,26 @@ SurfaceFusionUnit::SurfaceFusionUnit(std::string name, int sensors, int wheels,
   v.Parameter("ramp_time", "s", &ramp_time_,
               "how long a detected switch lasts (the line's ramps: about 1 s)", Rule::Positive());
 
+  if (imu_) {
+    v.Parameter("imu_yaw", "rad", &imu_yaw_, "the IMU's x axis relative to base_link x (mount yaw)",
+                Rule::Finite());
+    v.Parameter("imu_velocity_noise", "m/s/sqrt(s)", &imu_velocity_noise_,
+                "random walk of the integrated acceleration: the accelerometer's white noise "
+                "and its quantization at 100 Hz (ADIS16470: 23 ug/sqrt(Hz) = 2.26e-4, 1.25 mg "
+                "LSB / sqrt(12) over 10 ms = 3.5e-4; together 4.2e-4)",
+                Rule::Positive());
+    v.Parameter("imu_bias_sigma", "m/s2", &imu_bias_sigma_,
+                "prior sigma of the accelerometer bias per axis (the imu unit's turn-on bias: "
+                "5 mg, models/sensors/adis16470.yaml)",
+                Rule::Positive());
+    v.Parameter("imu_bias_walk", "m/s2/sqrt(s)", &imu_bias_walk_,
+                "random walk of the accelerometer bias (ADIS16470: 13 ug in-run stability at "
+                "100 s, 1.27e-4 sqrt(3 / 100) = 2.2e-5)",
+                Rule::Positive());
+    v.Input("imu_acceleration", "m/s2", &imu_acceleration_,
+            "the IMU's linear_acceleration: specific force in the IMU frame (x, y used; the "
+            "floor taken level)");
+  }
   v.Input("sensor_velocity", "m/s", &sensor_velocity_,
           "each PX4Flow's velocity output: the surface relative to the sensor, sensor frame, vx "
           "vy per sensor");
@@ -233,7 +259,19 @@ void SurfaceFusionUnit::ResetState() {
   std::fill(state_.begin(), state_.end(), 0.0);
   std::fill(cov_.begin(), cov_.end(), 0.0);
   cov_[0] = cov_[dim_ + 1] = kInitialResidualSigma * kInitialResidualSigma;
-  for (std::size_t q = 2; q < dim_; ++q) cov_[q * dim_ + q] = initial_sigma_ * initial_sigma_;
+  const std::size_t belt_end = imu_ ? imu_index_ : dim_;
+  for (std::size_t q = 2; q < belt_end; ++q) cov_[q * dim_ + q] = initial_sigma_ * initial_sigma_;
+  if (imu_) {
+    // b = 0 with V_imu starting at the encoders' velocity (the first step
+    // sets it); beta at the device's turn-on bias.
+    cov_[imu_index_ * dim_ + imu_index_] = cov_[(imu_index_ + 1) * dim_ + imu_index_ + 1] =
+        initial_sigma_ * initial_sigma_;
+    for (std::size_t q = imu_index_ + 2; q < dim_; ++q) {
+      cov_[q * dim_ + q] = imu_bias_sigma_ * imu_bias_sigma_;
+    }
+  }
+  imu_velocity_[0] = imu_velocity_[1] = 0.0;
+  imu_run_[0] = imu_run_[1] = 0;
   run_[0] = run_[1] = 0;
   slope_run_[0] = slope_run_[1] = 0;
   for (std::size_t k = 0; k < belts_.size(); ++k) {
@@ -280,6 +318,22 @@ void SurfaceFusionUnit::Predict(double h, cosim::TimeNs t) {
     state_[0] += h * (m[0] * state_[a] + m[1] * state_[a + 1]);
     state_[1] += h * (m[2] * state_[a] + m[3] * state_[a + 1]);
   }
+  // With the IMU: b += h R beta (R: the IMU frame to map).
+  const std::size_t ib = imu_index_, ia = imu_index_ + 2;
+  double r[4] = {1.0, 0.0, 0.0, 1.0};
+  if (imu_) {
+    const double c = std::cos(yaw_ + imu_yaw_), s = std::sin(yaw_ + imu_yaw_);
+    r[0] = c;
+    r[1] = -s;
+    r[2] = s;
+    r[3] = c;
+    for (std::size_t col = 0; col < n; ++col) {
+      fp[ib * n + col] += h * (r[0] * cov_[ia * n + col] + r[1] * cov_[(ia + 1) * n + col]);
+      fp[(ib + 1) * n + col] += h * (r[2] * cov_[ia * n + col] + r[3] * cov_[(ia + 1) * n + col]);
+    }
+    state_[ib] += h * (r[0] * state_[ia] + r[1] * state_[ia + 1]);
+    state_[ib + 1] += h * (r[2] * state_[ia] + r[3] * state_[ia + 1]);
+  }
   // (F P) F^T: the same row operation on the columns.
   for (std::size_t q = 0; q < n * n; ++q) cov_[q] = fp[q];
   for (std::size_t k = 0; k < nb; ++k) {
@@ -289,6 +343,18 @@ void SurfaceFusionUnit::Predict(double h, cosim::TimeNs t) {
       cov_[row * n + 0] += h * (m[0] * fp[row * n + a] + m[1] * fp[row * n + a + 1]);
       cov_[row * n + 1] += h * (m[2] * fp[row * n + a] + m[3] * fp[row * n + a + 1]);
     }
+  }
+  if (imu_) {
+    for (std::size_t row = 0; row < n; ++row) {
+      cov_[row * n + ib] += h * (r[0] * fp[row * n + ia] + r[1] * fp[row * n + ia + 1]);
+      cov_[row * n + ib + 1] += h * (r[2] * fp[row * n + ia] + r[3] * fp[row * n + ia + 1]);
+    }
+    const double qb = imu_velocity_noise_ * imu_velocity_noise_ * h;
+    const double qa = imu_bias_walk_ * imu_bias_walk_ * h;
+    cov_[ib * n + ib] += qb;
+    cov_[(ib + 1) * n + ib + 1] += qb;
+    cov_[ia * n + ia] += qa;
+    cov_[(ia + 1) * n + ia + 1] += qa;
   }
   const double qd = dead_reckoning_noise_ * dead_reckoning_noise_ * h;
   cov_[0] += qd;
@@ -435,6 +501,43 @@ bool SurfaceFusionUnit::DeadReckoningAt(cosim::TimeNs time, double out[2]) const
   return false;  // older than the history
 }
 
+void SurfaceFusionUnit::UpdateImu(const double enc[2], double h, cosim::TimeNs t) {
+  // z = W = V_imu - R fit(e); H = [0, M_1 .. M_K, I, 0].
+  const std::size_t n = dim_, nb = belts_.size();
+  double* hm = scratch_.data() + 2 * n * n;
+  std::fill(hm, hm + 2 * n, 0.0);
+  for (std::size_t k = 0; k < nb; ++k) {
+    const double* m = &drift_[4 * k];
+    const std::size_t a = 2 + 2 * k;
+    hm[a] = m[0];
+    hm[a + 1] = m[1];
+    hm[n + a] = m[2];
+    hm[n + a + 1] = m[3];
+  }
+  hm[imu_index_] = hm[n + imu_index_ + 1] = 1.0;
+  const double z[2] = {imu_velocity_[0] - enc[0], imu_velocity_[1] - enc[1]};
+  double nu[2], sd[2];
+  const double r = dead_reckoning_noise_ * dead_reckoning_noise_ / h;
+  Update(hm, z, r, nu, sd);
+  // A run beyond the gate: the belts under the wheels switched (reopened
+  // as the match detectors do).
+  bool fired = false;
+  for (std::size_t m = 0; m < 2; ++m) {
+    const SwitchDetector detector(switch_gate_, switch_samples_, sd[m]);
+    fired = detector.Observe(nu[m], imu_run_[m]) || fired;
+  }
+  if (!fired) return;
+  imu_run_[0] = imu_run_[1] = 0;
+  for (std::size_t k = 0; k < nb; ++k) {
+    const double* m = &drift_[4 * k];
+    if (m[0] == 0.0 && m[1] == 0.0 && m[2] == 0.0 && m[3] == 0.0) continue;
+    if (t < ramp_until_[k]) continue;  // already open
+    ReopenBlock(2 + 2 * k, initial_sigma_);
+    ramp_until_[k] = t + static_cast<cosim::TimeNs>(std::llround(ramp_time_ * 1e9));
+    ++switches_[k];
+  }
+}
+
 void SurfaceFusionUnit::WriteOutputs(double c, double s) {
   for (std::size_t j = 0; j < w_; ++j) {
     const auto k = wheel_surface_[j];
@@ -482,6 +585,7 @@ cosim::StepResult SurfaceFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   for (std::size_t j = 0; j < w_; ++j) wheel_surface_[j] = at(wheel_x_[j], wheel_y_[j]);
   for (std::size_t i = 0; i < n_; ++i) sensor_surface_[i] = at(sensor_x_[i], sensor_y_[i]);
 
+  double enc[2] = {0.0, 0.0};  // the encoders' fit at the origin, map
   // 1. Dead reckoning by the encoders alone (unrectified: the wheels'
   // motion relative to the surfaces under them), the fit at base_link's
   // origin over the step that ended at t, turned to map by the estimated
@@ -494,8 +598,18 @@ cosim::StepResult SurfaceFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
       vy += origin_fit_[2 * w_ + 2 * j] * wheel_velocity_[2 * j] +
             origin_fit_[2 * w_ + 2 * j + 1] * wheel_velocity_[2 * j + 1];
     }
-    dead_reckoning_[0] += (c * vx - s * vy) * h;
-    dead_reckoning_[1] += (s * vx + c * vy) * h;
+    enc[0] = c * vx - s * vy;
+    enc[1] = s * vx + c * vy;
+    dead_reckoning_[0] += enc[0] * h;
+    dead_reckoning_[1] += enc[1] * h;
+    if (imu_) {
+      // The IMU's sample: the mean specific force over its interval, here
+      // this step's; to map by the heading and the mount.
+      const double ci = std::cos(yaw_ + imu_yaw_), si = std::sin(yaw_ + imu_yaw_);
+      const double fx = imu_acceleration_[0], fy = imu_acceleration_[1];
+      imu_velocity_[0] += (ci * fx - si * fy) * h;
+      imu_velocity_[1] += (si * fx + ci * fy) * h;
+    }
     const std::size_t slot = (first_ + size_) % kHistory;
     if (size_ == kHistory) {
       first_ = (first_ + 1) % kHistory;
@@ -526,6 +640,7 @@ cosim::StepResult SurfaceFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   }
   // Prediction over the step: D += h sum_k M_k u_k; random walks.
   Predict(h, t);
+  if (imu_) UpdateImu(enc, h, t);
 
   // 3. A new accepted match: z = the match's position minus the dead
   // reckoning at its time = D(t_m) = D(t) - (t - t_m) sum_k M_k u_k.
@@ -737,14 +852,16 @@ void SurfaceFusionUnit::SaveInternal(cosim::UnitState& state) const {
   state.reals.push_back(last_match_count_);
   state.reals.push_back(dead_reckoning_[0]);
   state.reals.push_back(dead_reckoning_[1]);
+  state.reals.push_back(imu_velocity_[0]);
+  state.reals.push_back(imu_velocity_[1]);
   state.integers = {start_,
                     static_cast<std::int64_t>(first_),
                     static_cast<std::int64_t>(size_),
                     rejected_match_,
                     static_cast<std::int64_t>(match_first_),
                     static_cast<std::int64_t>(match_size_)};
-  for (const auto* v : {&run_, &slope_run_, &ramp_until_, &switches_, &rejected_, &hist_t_, &window_surface_,
-                        &acc_ns_, &wheel_surface_, &sensor_surface_}) {
+  for (const auto* v : {&run_, &slope_run_, &imu_run_, &ramp_until_, &switches_, &rejected_,
+                        &hist_t_, &window_surface_, &acc_ns_, &wheel_surface_, &sensor_surface_}) {
     state.integers.insert(state.integers.end(), v->begin(), v->end());
   }
 }
@@ -752,8 +869,8 @@ void SurfaceFusionUnit::SaveInternal(cosim::UnitState& state) const {
 void SurfaceFusionUnit::RestoreInternal(const cosim::UnitState& state) {
   const std::size_t nb = belts_.size();
   const std::size_t reals =
-      dim_ + dim_ * dim_ + 2 * kHistory + n_ + 2 * n_ + 4 * n_ + 2 * n_ + 3 * kMatches + 3;
-  const std::size_t integers = 6 + 4 + 3 * nb + kHistory + n_ + n_ + w_ + n_;
+      dim_ + dim_ * dim_ + 2 * kHistory + n_ + 2 * n_ + 4 * n_ + 2 * n_ + 3 * kMatches + 5;
+  const std::size_t integers = 6 + 6 + 3 * nb + kHistory + n_ + n_ + w_ + n_;
   if (state.reals.size() != reals || state.integers.size() != integers) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
@@ -769,6 +886,8 @@ void SurfaceFusionUnit::RestoreInternal(const cosim::UnitState& state) {
   last_match_count_ = *r++;
   dead_reckoning_[0] = *r++;
   dead_reckoning_[1] = *r++;
+  imu_velocity_[0] = *r++;
+  imu_velocity_[1] = *r++;
   auto k = state.integers.begin();
   start_ = *k++;
   first_ = static_cast<std::size_t>(*k++);
@@ -776,8 +895,8 @@ void SurfaceFusionUnit::RestoreInternal(const cosim::UnitState& state) {
   rejected_match_ = *k++;
   match_first_ = static_cast<std::size_t>(*k++);
   match_size_ = static_cast<std::size_t>(*k++);
-  for (auto* v : {&run_, &slope_run_, &ramp_until_, &switches_, &rejected_, &hist_t_, &window_surface_,
-                  &acc_ns_, &wheel_surface_, &sensor_surface_}) {
+  for (auto* v : {&run_, &slope_run_, &imu_run_, &ramp_until_, &switches_, &rejected_, &hist_t_,
+                  &window_surface_, &acc_ns_, &wheel_surface_, &sensor_surface_}) {
     std::copy(k, k + static_cast<std::ptrdiff_t>(v->size()), v->begin());
     k += static_cast<std::ptrdiff_t>(v->size());
   }

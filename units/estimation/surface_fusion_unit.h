@@ -93,6 +93,28 @@ namespace linesim::estimation {
 /// the model error dead_reckoning_noise stands for; a gross slide shows as
 /// an outlier or as a detected switch.
 ///
+/// The IMU (structural key `imu`): the belt under the wheels carries the
+/// robot, and the accelerometer feels it at once while the laser needs
+/// 0.2-0.3 s to see the drift clear its noise. The specific force f
+/// (IMU frame; level floor: its x, y are the body's horizontal
+/// acceleration) turned to map by the estimated heading and the mount's
+/// yaw and integrated over each step gives V_imu; minus the encoders' fit
+/// at base_link's origin (map) it is
+///   W = V_imu - R fit(e) = sum_k M_k u_k + b,
+/// b (2, map) the integration's offset: its start, the bias beta (2, IMU
+/// frame) integrated, b' = R beta, white noise imu_velocity_noise. The
+/// state grows by [b, beta]; each step updates with z = W, H = [0, M_1 ..
+/// M_K, I, 0], r = dead_reckoning_noise^2 / h (the same contact creep the
+/// residual D walks by, as a velocity over one step). beta starts at the
+/// device's turn-on bias sigma and walks at its bias random walk; over the
+/// floor (M = 0) W measures b alone, and the laser ties u down, so b and
+/// beta are learnt while the line stands. A switch detector on W's
+/// innovation (switch_gate, switch_samples) reopens the belts under the
+/// wheels as the match detectors do: at 0.5 m/s^2 a ramp leaves the 3 sigma
+/// gate (about 3 cm/s with one step's creep) within about 0.07 s. The unit
+/// should step at the IMU's rate (the sample is the mean specific force
+/// over the IMU's interval: stepping slower skips samples).
+///
 /// Outputs per wheel: the estimate of the belt the map puts it over,
 /// base_link (0 over the floor); per sensor the same in map (for the
 /// flow_error evaluation); per belt its estimate, sigma and switches.
@@ -113,8 +135,10 @@ class SurfaceFusionUnit : public cosim::Unit {
   static constexpr std::size_t kHistory = 64;
 
   /// `sensors` PX4Flow (>= 0) and `wheels` (>= 2) wheels, else
-  /// cosim::UnitError; the belts are every belt of `scene`.
-  SurfaceFusionUnit(std::string name, int sensors, int wheels, const models::Scene& scene);
+  /// cosim::UnitError; the belts are every belt of `scene`; `imu`: the
+  /// accelerometer's input and state (see the class comment).
+  SurfaceFusionUnit(std::string name, int sensors, int wheels, const models::Scene& scene,
+                    bool imu = false);
 
   void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
   void Initialize() override;
@@ -149,6 +173,9 @@ class SurfaceFusionUnit : public cosim::Unit {
   /// The dead reckoning at `time` from the history; false if older.
   bool DeadReckoningAt(cosim::TimeNs time, double out[2]) const;
   void WriteOutputs(double c, double s);
+  /// The IMU's update (z = W) and its switch detector; `enc` is the
+  /// encoders' fit at the origin this step (map).
+  void UpdateImu(const double enc[2], double h, cosim::TimeNs t);
 
   std::size_t n_, w_;
   models::BeltMap belts_;  // 0 over the floor, k + 1 over scene belt k
@@ -167,6 +194,11 @@ class SurfaceFusionUnit : public cosim::Unit {
   std::int64_t slope_matches_ = 5;
   double ramp_random_walk_ = 0.1;
   double ramp_time_ = 1.0;
+  bool imu_ = false;
+  double imu_yaw_ = 0.0;
+  double imu_velocity_noise_ = 4.2e-4;
+  double imu_bias_sigma_ = 0.049;
+  double imu_bias_walk_ = 2.2e-5;
 
   // Inputs.
   std::vector<double> sensor_velocity_, sensor_valid_, sensor_quality_, sensor_message_count_;
@@ -175,6 +207,7 @@ class SurfaceFusionUnit : public cosim::Unit {
   std::vector<double> laser_position_;
   double match_time_ = 0.0, match_count_ = 0.0;
   std::vector<double> wheel_velocity_;
+  std::vector<double> imu_acceleration_;
 
   // Outputs.
   std::vector<double> wheel_surface_velocity_, wheel_on_belt_, sensor_surface_velocity_;
@@ -194,6 +227,11 @@ class SurfaceFusionUnit : public cosim::Unit {
   std::vector<double> state_, cov_;
   std::vector<std::int64_t> run_, slope_run_, ramp_until_, switches_, rejected_;
   std::int64_t rejected_match_ = 0;
+  // With the IMU: b's index in the state (beta follows), the integrated
+  // velocity V_imu (map) and the W detector's runs (2).
+  std::size_t imu_index_ = 0;
+  double imu_velocity_[2] = {0.0, 0.0};
+  std::vector<std::int64_t> imu_run_;
   // The dead reckoning (map) and its history per step (a ring of kHistory,
   // oldest at first_).
   double dead_reckoning_[2] = {0.0, 0.0};
