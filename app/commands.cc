@@ -127,6 +127,7 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat forma
   spec.belt_travel_columns = robot.belt_travel_columns;
   spec.flow_columns = robot.flow_columns;
   spec.flow_labels = robot.flow_sensor_names;
+  spec.flow_truth_columns = robot.flow_truth_columns;
   spec.flow_filtered_columns = robot.flow_filtered_columns;
   spec.flow_reference_column = robot.flow_reference_column;
   if (!robot.scan_unit.empty()) {

@@ -32,10 +32,11 @@ struct RobotInfo {
   std::vector<std::pair<std::string, std::string>> wheel_columns;
   std::string error_column;
   std::vector<std::string> belt_speed_columns, belt_on_columns, belt_travel_columns;
-  /// Optic flow against the belt's ground truth (paper 1 Fig. 4): each
-  /// PX4Flow's absolute surface speed along the belt, its sensor's name,
-  /// and the ground-truth speed; empty without both.
-  std::vector<std::string> flow_columns, flow_sensor_names;
+  /// Optic flow against the belt's ground truth (paper 1 Fig. 4): what
+  /// each PX4Flow reads along the belt (the surface relative to it), its
+  /// sensor's name, the same reading from ground truth, and the belt's
+  /// ground-truth speed; empty without both.
+  std::vector<std::string> flow_columns, flow_sensor_names, flow_truth_columns;
   std::vector<std::string> flow_filtered_columns;  // the estimate's, if any
   std::string flow_reference_column;
   /// The laser unit whose completed scan at scan_time_s the plots draw

@@ -397,6 +397,10 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   for (const auto& name : spec.belt_travel_columns) travels.push_back(column(name, "belt travel"));
   std::vector<int> flows;
   for (const auto& name : spec.flow_columns) flows.push_back(column(name, "optic flow"));
+  std::vector<int> flow_truths;
+  for (const auto& name : spec.flow_truth_columns) {
+    flow_truths.push_back(column(name, "optic flow truth"));
+  }
   std::vector<int> filtered;
   for (const auto& name : spec.flow_filtered_columns) {
     filtered.push_back(column(name, "filtered optic flow"));
@@ -738,19 +742,22 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     s += "\nset yrange [*:*]\nset y2range [*:*]\nset bmargin -1\n";
   }
   if (!flows.empty() && iref > 0) {
-    // The PX4Flow read the robot's motion relative to the surface under
-    // them; a surface speed is that reading plus the robot's own motion at
-    // the sensor (paper 1 Eq. 2), here the true motion, so that the curves
-    // show the sensor's error alone.
+    // Each PX4Flow is drawn as what it measures: the surface relative to
+    // it (pale), against the same from ground truth (dashed); the filter's
+    // estimate is a surface speed (Eq. 2 with the robot's own motion),
+    // drawn against the belt's encoder wheel (black).
     // Two title lines: gnuplot joins single-quoted text and a "\n".
     s += "\n" + SetOutput("optic_flow", spec.format, outputs) + "set title " +
          GnuplotQuote(title_prefix +
                       (filtered.empty() ? "optic flow" : "raw and filtered optic flow") +
                       " against the belt's ground truth (paper 1, Fig. 4)") +
          " . \"\\n\" . " +
-         GnuplotQuote("each PX4Flow reads the robot's motion over the surface; drawn: that "
-                      "reading + the robot's true motion (Eq. 2)") +
-         "\n" + time_plot + shading_axes + "set ylabel 'surface speed along the belt (m/s)'\n"
+         GnuplotQuote(filtered.empty()
+                          ? "raw: what each PX4Flow reads (the surface relative to it), dashed: "
+                            "the same from ground truth"
+                          : "raw: what each PX4Flow reads (the surface relative to it), dashed: "
+                            "the same from ground truth; filtered: the surface speed (Eq. 2)") +
+         "\n" + time_plot + shading_axes + "set ylabel 'speed along the belt (m/s)'\n"
          "set offsets 0, 0, graph 0.05, graph 0.05\nset key maxcols 3\nplot ";
     items.clear();
     if (const std::string shading = on_shading(); !shading.empty()) items.push_back(shading);
@@ -762,6 +769,13 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
       items.push_back(signals_file + " skip 1 using 1:" + std::to_string(flows[i]) +
                       " with lines lw 1 lc rgb '" + kColours[i % 4] + "' title " +
                       GnuplotQuote("raw, " + label));
+    }
+    static const char* kMid[] = {"#3182bd", "#e6550d", "#31a354", "#756bb1"};
+    for (std::size_t i = 0; i < flow_truths.size(); ++i) {
+      const std::string label = i < spec.flow_labels.size() ? spec.flow_labels[i] : "sensor";
+      items.push_back(signals_file + " skip 1 using 1:" + std::to_string(flow_truths[i]) +
+                      " with lines lw 1 dt 2 lc rgb '" + kMid[i % 4] + "' title " +
+                      GnuplotQuote("true reading, " + label));
     }
     // Paper 1 Fig. 4: the steady-state Kalman filter's output beside the raw.
     static const char* kDark[] = {"#08519c", "#d95f02", "#238b45", "#6a51a3"};

@@ -57,9 +57,11 @@ struct RobotPlotSpec {
   /// both are empty.
   std::vector<std::string> belt_speed_columns, belt_on_columns;
   /// Optic flow against ground truth (optic_flow.png, as paper 1 Fig. 4):
-  /// each sensor's raw surface speed along the belt (m/s) with its label,
-  /// and the belt's ground-truth speed; none when empty.
+  /// what each sensor reads along the belt (m/s: the surface relative to
+  /// it) with its label, the same from ground truth (same order; may be
+  /// empty), and the belt's ground-truth speed; none when empty.
   std::vector<std::string> flow_columns, flow_labels;
+  std::vector<std::string> flow_truth_columns;
   /// The filtered estimate per sensor (same order; empty without one).
   std::vector<std::string> flow_filtered_columns;
   std::string flow_reference_column;

@@ -130,7 +130,8 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     b.Connect(Signal(kChassis, "linear_velocity"), Signal(kFlowError, "linear_velocity"));
     b.Connect(Signal(kChassis, "yaw_rate"), Signal(kFlowError, "yaw_rate"));
     b.Connect(s.belt_ground_truth, Signal(kFlowError, "reference"));
-    s.recorded.push_back(Signal(kFlowError, "surface_speed"));
+    s.recorded.push_back(Signal(kFlowError, "reading"));
+    s.recorded.push_back(Signal(kFlowError, "true_reading"));
     add("surface_velocity_rmse_raw_mps", Signal(kFlowError, "rmse"), "final");
     add("surface_velocity_plateau_rmse_raw_mps", Signal(kFlowError, "rmse_plateau"), "final");
     if (!s.surface_estimate.empty()) {
@@ -146,7 +147,8 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     // publishing interval), over the run.
     add("optic_flow_quality_mean", Signal(flows.front()->name, "quality"), "mean");
     for (std::size_t k = 0; k < flows.size(); ++k) {
-      info.flow_columns.push_back(Element(kFlowError, "surface_speed", k));
+      info.flow_columns.push_back(Element(kFlowError, "reading", k));
+      info.flow_truth_columns.push_back(Element(kFlowError, "true_reading", k));
       info.flow_sensor_names.push_back(flows[k]->name);
       if (!s.surface_estimate.empty()) {
         info.flow_filtered_columns.push_back(Element(kFlowError, "estimated_speed", k));

@@ -363,18 +363,19 @@ TEST_F(RobotPlotsTest, ErrorPlotDrawsTheBoundTheLineStateAndTheUsersNames) {
   EXPECT_NE(error.find("set key at screen 0.5, 0.01 center bottom"), std::string::npos) << error;
 }
 
-// Guards paper 1 Fig. 4's legend: four sensors raw and filtered and the
-// ground truth (nine entries) go below the data, never over the plateau; the
-// raw curves are named as the readings they are.
+// Guards paper 1 Fig. 4's legend: four sensors raw, their true readings,
+// filtered and the ground truth (thirteen entries) go below the data, never
+// over the plateau; the raw curves are drawn as the readings they are (the
+// surface relative to the sensor), each beside its true reading.
 TEST_F(RobotPlotsTest, OpticFlowLegendIsOutsideTheData) {
   {
     std::ofstream out(dir_ / "signals.csv");
     out << "time,x,y";
-    for (int k = 0; k < 4; ++k) out << ",raw[" << k << "],filtered[" << k << "]";
+    for (int k = 0; k < 4; ++k) out << ",raw[" << k << "],filtered[" << k << "],true[" << k << "]";
     out << ",truth,on\n";
     for (int i = 0; i <= 100; ++i) {
       out << 0.1 * i << ",0,0";
-      for (int k = 0; k < 4; ++k) out << "," << 0.2 + 0.01 * (k - 2) << ",0.2";
+      for (int k = 0; k < 4; ++k) out << "," << 0.2 + 0.01 * (k - 2) << ",0.2,0.2";
       out << ",0.2,1\n";
     }
   }
@@ -384,6 +385,7 @@ TEST_F(RobotPlotsTest, OpticFlowLegendIsOutsideTheData) {
   for (int k = 0; k < 4; ++k) {
     spec.flow_columns.push_back("raw[" + std::to_string(k) + "]");
     spec.flow_filtered_columns.push_back("filtered[" + std::to_string(k) + "]");
+    spec.flow_truth_columns.push_back("true[" + std::to_string(k) + "]");
     spec.flow_labels.push_back("optic_flow_" + std::to_string(k));
   }
   spec.flow_reference_column = "truth";
@@ -395,7 +397,8 @@ TEST_F(RobotPlotsTest, OpticFlowLegendIsOutsideTheData) {
   EXPECT_NE(flow.find("set key at screen 0.5, 0.01 center bottom"), std::string::npos) << flow;
   EXPECT_NE(flow.find("title 'raw, optic_flow_3'"), std::string::npos) << flow;
   EXPECT_NE(flow.find("title 'filtered, optic_flow_3'"), std::string::npos) << flow;
-  EXPECT_NE(flow.find("reads the robot''s motion over the surface"), std::string::npos)
+  EXPECT_NE(flow.find("title 'true reading, optic_flow_3'"), std::string::npos) << flow;
+  EXPECT_NE(flow.find("what each PX4Flow reads (the surface relative to it)"), std::string::npos)
       << flow;
   EXPECT_NE(flow.find("title 'line on'"), std::string::npos) << flow;
 }

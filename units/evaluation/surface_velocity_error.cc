@@ -32,6 +32,8 @@ SurfaceVelocityErrorUnit::SurfaceVelocityErrorUnit(std::string name, int sensors
   mount_yaw_.assign(n, std::nan(""));
   measured_.assign(2 * n, 0.0);
   surface_speed_.assign(n, 0.0);
+  reading_.assign(n, 0.0);
+  true_reading_.assign(n, 0.0);
   error_.assign(n, 0.0);
   over_belt_.assign(n, 0.0);
 
@@ -53,6 +55,13 @@ SurfaceVelocityErrorUnit::SurfaceVelocityErrorUnit(std::string name, int sensors
   v.Output("surface_speed", "m/s", &surface_speed_,
            "each sensor's absolute surface velocity (Eq. 2, true robot motion) along the belt",
            {"measured", "position", "yaw", "linear_velocity", "yaw_rate"});
+  v.Output("reading", "m/s", &reading_,
+           "each sensor's raw measurement along the belt (map): the surface relative to it",
+           {"measured", "yaw"});
+  v.Output("true_reading", "m/s", &true_reading_,
+           "what each sensor would read without error: the belt's reference speed over the "
+           "belt (0 over the floor) less the point's true velocity, along the belt",
+           {"position", "yaw", "linear_velocity", "yaw_rate", "reference"});
   v.Output("error", "m/s", &error_,
            "surface_speed - reference for each sensor over the belt; 0 for the others",
            {"measured", "position", "yaw", "linear_velocity", "yaw_rate", "reference"});
@@ -108,11 +117,13 @@ void SurfaceVelocityErrorUnit::Evaluate() {
     const double a = yaw_ + mount_yaw_[k];
     const double ca = std::cos(a), sa = std::sin(a);
     const double mx = measured_[2 * k], my = measured_[2 * k + 1];
+    reading_[k] = (ca * mx - sa * my) * bx + (sa * mx + ca * my) * by;
     const double ux = ca * mx - sa * my + vx;
     const double uy = sa * mx + ca * my + vy;
     surface_speed_[k] = ux * bx + uy * by;
     const bool over = models::InsideRect(belt_area_, bx, by, px, py);
     over_belt_[k] = over ? 1.0 : 0.0;
+    true_reading_[k] = (over ? reference_ : 0.0) - (vx * bx + vy * by);
     error_[k] = over ? surface_speed_[k] - reference_ : 0.0;
     if (!estimated_.empty()) {
       estimated_speed_[k] = estimated_[2 * k] * bx + estimated_[2 * k + 1] * by;

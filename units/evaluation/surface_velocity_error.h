@@ -21,6 +21,12 @@ namespace linesim::evaluation {
 /// are compared; `rmse` is the root mean square of the error over every
 /// (sensor, step) pair compared so far.
 ///
+/// What each sensor itself measures, for the plots: `reading`, its raw
+/// measurement turned to map along the belt's direction (the surface
+/// relative to the sensor's point), and `true_reading`, the same from
+/// ground truth (the belt's reference speed where the point is over the
+/// belt, 0 over the floor, less the point's true velocity along the belt).
+///
 /// With `estimated`, the unit also compares an estimator's absolute
 /// surface velocity per sensor (map frame, e.g. the filtered value of
 /// paper 1's Kalman filter) with the same reference over the same samples:
@@ -74,6 +80,7 @@ class SurfaceVelocityErrorUnit : public cosim::Unit {
   std::vector<double> position_ = std::vector<double>(2, 0.0);
   // Outputs.
   std::vector<double> surface_speed_, error_, over_belt_, estimated_speed_;
+  std::vector<double> reading_, true_reading_;
   double rmse_ = 0.0, rmse_estimated_ = 0.0;
   // Sums of squared errors (raw, estimated) and the number of samples in them.
   double sum_squared_ = 0.0, sum_squared_estimated_ = 0.0;
