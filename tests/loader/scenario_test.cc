@@ -537,6 +537,17 @@ metrics:
   EXPECT_TRUE(Has(all, "metrics.0.reduce: 'median' is not allowed")) << all;
 }
 
+// Guards the providers' registry (loader/assembly/providers.h): each
+// provider registers itself from its own file; every one is linked in and
+// an unknown name is refused naming them.
+TEST(LoadScenario, UnknownProviderIsRefusedNamingTheRegisteredOnes) {
+  const std::string cross = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
+  std::string e = Issues(cross, {"localization.source=hector"});
+  EXPECT_TRUE(Has(e, "expected one of fused, ground_truth, laser, odometry, perfect_match")) << e;
+  e = Issues(cross, {"sensing.surface_velocity=optical"});
+  EXPECT_TRUE(Has(e, "expected one of fused_flow, ground_truth, none, px4flow")) << e;
+}
+
 // Guards `inspect TYPE`: every registered type builds with its defaults.
 // Guards issue 24: `--set sensing.surface_velocity=` (no value) ran with the
 // default (ground truth) and exit 0, since the override wrote null and the

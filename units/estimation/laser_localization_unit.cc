@@ -1,4 +1,3 @@
-#include "units/estimation/laser_beams.h"
 #include "units/estimation/laser_localization_unit.h"
 
 #include <algorithm>
@@ -6,101 +5,44 @@
 #include <cstring>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <utility>
 
 namespace linesim::estimation {
 namespace {
 
-double WrapAngle(double a) {
-  a = std::remainder(a, 2.0 * std::numbers::pi);
-  return a;
-}
+// hector's wrap: remainder() alone, [-pi, pi].
+double RemainderAngle(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
 
 }  // namespace
 
 LaserLocalizationUnit::LaserLocalizationUnit(std::string name, const models::Scene& scene,
                                              std::vector<int> beam_counts)
-    : cosim::Unit(kTypeName, std::move(name)), beam_counts_(std::move(beam_counts)) {
-  if (beam_counts_.empty() || beam_counts_.size() > static_cast<std::size_t>(kMaxLasers)) {
-    throw cosim::UnitError(Where() + ": beam_counts must list 1 to " + std::to_string(kMaxLasers) +
-                           " lasers, got " + std::to_string(beam_counts_.size()));
-  }
-  std::size_t max_beams = 0;
-  for (std::size_t k = 0; k < beam_counts_.size(); ++k) {
-    if (beam_counts_[k] < 1 || beam_counts_[k] > 100000) {
-      throw cosim::UnitError(Where() + ": beam_counts[" + std::to_string(k) +
-                             "] must be 1..100000, got " + std::to_string(beam_counts_[k]));
-    }
-    max_beams = std::max(max_beams, static_cast<std::size_t>(beam_counts_[k]));
-  }
+    : ScanLocalizer(kTypeName, std::move(name), std::move(beam_counts), RemainderAngle) {
   for (const models::Obstacle& o : scene.obstacles) solids_.push_back(o.solid);
   floor_ = scene.floor;
-
   const std::size_t L = beam_counts_.size();
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  initial_x_ = initial_y_ = initial_yaw_ = nan;
-  mount_x_.assign(L, nan);
-  mount_y_.assign(L, nan);
-  mount_z_.assign(L, nan);
-  mount_yaw_.assign(L, nan);
-  first_beam_angle_.assign(L, nan);
-  angular_step_.assign(L, nan);
-  scan_period_.assign(L, nan);
-  ranges_.resize(L);
-  for (std::size_t k = 0; k < L; ++k)
-    ranges_[k].assign(static_cast<std::size_t>(beam_counts_[k]), 0.0);
-  scan_count_.assign(L, 0.0);
-  scan_time_.assign(L, 0.0);
-  odometry_velocity_.assign(2, 0.0);
-  position_.assign(2, 0.0);
+  mount_z_.assign(L, std::numeric_limits<double>::quiet_NaN());
   velocity_.assign(2, 0.0);
-  covariance_.assign(9, 0.0);
-  hessian_.assign(9, 0.0);
-  laser_status_.assign(L, 0.0);
-  beam_cos_.resize(L);
-  beam_sin_.resize(L);
-  beam_dt_.resize(L);
-  for (std::size_t k = 0; k < L; ++k) {
-    const auto n = static_cast<std::size_t>(beam_counts_[k]);
-    beam_cos_[k].assign(n, 0.0);
-    beam_sin_[k].assign(n, 0.0);
-    beam_dt_[k].assign(n, 0.0);
-  }
-  mid_offset_ns_.assign(L, 0);
-  px_.assign(max_beams, 0.0);
-  py_.assign(max_beams, 0.0);
-  order_.assign(L, 0);
-  last_count_.assign(L, 0.0);
-  last_scan_ns_.assign(L, 0);
   mapped_.assign(L, 0);
   last_map_pose_.assign(L, Pose{});
+  // hector's defaults where the shared parameters differ from Perfect Match.
+  range_min_ = 0.4;
+  usable_range_max_ = 30.0;
+  min_points_ = 50;
+  covariance_floor_position_ = 0.01;
+  covariance_floor_yaw_ = 0.0087;
 
   using cosim::Rule;
   auto& v = variables();
-  const auto list = [&](const char* key, const char* unit, std::vector<double>* x, const char* what,
-                        Rule rule) { v.Parameter(key, unit, x, what, rule); };
-  list("mount_x", "m", &mount_x_, "per laser: its origin in base_link, x",
-       Rule::Finite().NoDefault());
-  list("mount_y", "m", &mount_y_, "per laser: its origin in base_link, y",
-       Rule::Finite().NoDefault());
-  list("mount_z", "m", &mount_z_,
-       "per laser: its height above the floor (the scan plane: which solids are in the map)",
-       Rule::Finite().NoDefault());
-  list("mount_yaw", "rad", &mount_yaw_,
-       "per laser: its yaw in base_link (roll and pitch ignored: 3-DoF like hector)",
-       Rule::Finite().NoDefault());
-  list("first_beam_angle", "rad", &first_beam_angle_, "per laser: direction of beam 0",
-       Rule::Range(-2 * std::numbers::pi, 2 * std::numbers::pi).NoDefault());
-  list("angular_step", "rad", &angular_step_, "per laser: angle between neighbouring beams",
-       Rule::Range(0, false, std::numbers::pi, true).NoDefault());
-  list("scan_period", "s", &scan_period_, "per laser: one turn of the mirror (one scan)",
-       Rule::Positive().NoDefault());
-  v.Parameter("range_min", "m", &range_min_,
-              "nearer returns are skipped (hector_mapping laser_min_dist default 0.4)",
-              Rule::NonNegative());
-  v.Parameter("usable_range_max", "m", &usable_range_max_,
-              "farther returns are skipped (hector_mapping laser_max_dist default 30)",
-              Rule::Positive());
+  DeclareMountXY();
+  v.Parameter("mount_z", "m", &mount_z_,
+              "per laser: its height above the floor (the scan plane: which solids are in the map)",
+              Rule::Finite().NoDefault());
+  DeclareBeamGeometry(
+      "per laser: its yaw in base_link (roll and pitch ignored: 3-DoF like hector)");
+  DeclareRangeLimits("nearer returns are skipped (hector_mapping laser_min_dist default 0.4)",
+                     "farther returns are skipped (hector_mapping laser_max_dist default 30)");
   v.Parameter("map_resolution", "m", &map_resolution_,
               "finest map cell (hector map_resolution default 0.025)", Rule::Range(0.005, 1.0));
   v.Parameter("map_levels", &map_levels_,
@@ -115,21 +57,14 @@ LaserLocalizationUnit::LaserLocalizationUnit(std::string name, const models::Sce
   v.Parameter("max_angle_step", "rad", &max_angle_step_,
               "each Gauss-Newton yaw update is clamped to +-this (hector: 0.2)",
               Rule::Range(0, false, 1, true));
-  v.Parameter("initial_x", "m", &initial_x_, "start pose in map, x (as an AMCL initial pose)",
-              Rule::Required());
-  v.Parameter("initial_y", "m", &initial_y_, "start pose in map, y", Rule::Required());
-  v.Parameter("initial_yaw", "rad", &initial_yaw_, "start pose in map, yaw", Rule::Required());
-  v.Parameter("motion_prediction", &motion_prediction_,
-              "none: each match starts from the last estimate (hector); odometry: moved by the "
-              "odometry twist since",
-              Rule::OneOf({"none", "odometry"}));
-  v.Parameter("deskew", &deskew_,
-              "move each beam's point from its time to the match time by the last velocity "
-              "estimate");
-  v.Parameter("scan_timeout", "s", &scan_timeout_,
-              "a laser without a new scan for this long has status 1; without an accepted "
-              "match for this long the source is 1",
-              Rule::Positive());
+  DeclareStartPose(Rule::Required(), "start pose in map, x (as an AMCL initial pose)",
+                   "start pose in map, y", "start pose in map, yaw");
+  DeclareMotionPrediction(
+      "none: each match starts from the last estimate (hector); odometry: moved by the "
+      "odometry twist since",
+      "move each beam's point from its time to the match time by the last velocity estimate",
+      "a laser without a new scan for this long has status 1; without an accepted match for "
+      "this long the source is 1");
   v.Parameter("max_cost", "1", &max_cost_,
               "a match whose mean squared residual exceeds this is rejected",
               Rule::Range(0, false, 4, true));
@@ -139,24 +74,17 @@ LaserLocalizationUnit::LaserLocalizationUnit(std::string name, const models::Sce
               Rule::Positive());
   v.Parameter("max_yaw_sigma", "rad", &max_yaw_sigma_,
               "a match whose own yaw sigma exceeds this is rejected", Rule::Positive());
-  v.Parameter("max_jump", "m", &max_jump_,
-              "a match farther than this from its start pose is rejected", Rule::Positive());
-  v.Parameter("max_jump_yaw", "rad", &max_jump_yaw_,
-              "a match turned more than this from its start pose is rejected", Rule::Positive());
+  DeclareJumpLimits("a match farther than this from its start pose is rejected",
+                    "a match turned more than this from its start pose is rejected");
   v.Parameter("velocity_window", "s", &velocity_window_,
               "velocity and yaw_rate: the pose change over the accepted matches of this long "
               "(default 0.2 s, ASSUMPTION: 10 matches of two S300, about 0.02 m/s of noise from "
               "a 3 mm pose noise, 0.1 s of lag; 0: between the last two matches, as hector)",
               Rule::Range(0.0, 1.0));
-  v.Parameter("min_points", &min_points_,
-              "a scan with fewer usable returns is not matched (laser blacked out)",
-              Rule::Range(3, 100000));
-  v.Parameter("covariance_floor_position", "m", &covariance_floor_position_,
-              "added to the position sigmas of the covariance (squared, on the diagonal)",
-              Rule::NonNegative());
-  v.Parameter("covariance_floor_yaw", "rad", &covariance_floor_yaw_,
-              "added to the yaw sigma of the covariance (squared, on the diagonal)",
-              Rule::NonNegative());
+  DeclareMinPoints();
+  DeclareCovarianceFloorPosition(
+      "added to the position sigmas of the covariance (squared, on the diagonal)");
+  DeclareCovarianceFloorYaw();
   v.Parameter("map", &map_,
               "scene: the map built from the scene's solids before time zero; mapping: learned "
               "from the scans while driving, as hector_mapping (starts unknown)",
@@ -179,19 +107,10 @@ LaserLocalizationUnit::LaserLocalizationUnit(std::string name, const models::Sce
               "(hector_mapping's parameter, 0.4 in mapping_default.launch)",
               Rule::Range(0.0, false, 0.5, false));
 
-  for (std::size_t k = 0; k < L; ++k) {
-    const std::string s = std::to_string(k);
-    v.Input("ranges_" + s, "m", &ranges_[k], "laser " + s + ": ranges of its last complete scan");
-    v.Input("scan_count_" + s, "1", &scan_count_[k], "laser " + s + ": complete scans so far");
-    v.Input("scan_time_" + s, "s", &scan_time_[k], "laser " + s + ": start time of its last scan");
-  }
-  v.Input("odometry_velocity", "m/s", &odometry_velocity_,
-          "odometry: velocity of base_link in base_link (motion_prediction odometry only)");
-  v.Input("odometry_yaw_rate", "rad/s", &odometry_yaw_rate_,
-          "odometry: yaw rate (motion_prediction odometry only)");
+  for (std::size_t k = 0; k < L; ++k) DeclareScanInputs(k);
+  DeclareOdometryInputs();
 
-  v.Output("position", "m", &position_, "base_link x, y in map (latest accepted match)", {});
-  v.Output("yaw", "rad", &yaw_, "base_link yaw in map (latest accepted match)", {});
+  DeclarePoseOutputs();
   v.Output("velocity", "m/s", &velocity_,
            "base_link velocity in map: the pose change over the accepted matches of the last "
            "velocity_window",
@@ -199,15 +118,10 @@ LaserLocalizationUnit::LaserLocalizationUnit(std::string name, const models::Sce
   v.Output("yaw_rate", "rad/s", &yaw_rate_,
            "yaw rate: the heading change over the accepted matches of the last velocity_window",
            {});
-  v.Output("covariance", "1", &covariance_,
-           "row-major 3 x 3 of x (m), y (m), yaw (rad): sigma_r^2 H^-1 + floor", {});
-  v.Output("hessian", "1", &hessian_,
-           "row-major 3 x 3 Gauss-Newton Hessian of the latest accepted match (1/m^2, 1/(m rad), "
-           "1/rad^2)",
-           {});
-  v.Output("match_time", "s", &match_time_, "time the pose refers to (middle of the matched scan)",
-           {});
-  v.Output("match_count", "1", &match_count_, "accepted matches so far", {});
+  DeclareMatchOutputs(
+      "row-major 3 x 3 of x (m), y (m), yaw (rad): sigma_r^2 H^-1 + floor",
+      "row-major 3 x 3 Gauss-Newton Hessian of the latest accepted match (1/m^2, 1/(m rad), "
+      "1/rad^2)");
   v.Output("match_cost", "1", &match_cost_,
            "mean squared residual (1 - M)^2 of the latest accepted match", {});
   v.Output("laser_status", "1", &laser_status_,
@@ -224,24 +138,9 @@ LaserLocalizationUnit::LaserLocalizationUnit(std::string name, const models::Sce
 
 LaserLocalizationUnit::~LaserLocalizationUnit() = default;
 
-std::vector<cosim::ParameterProblem> LaserLocalizationUnit::CheckParameters() const {
-  auto problems = cosim::Unit::CheckParameters();
-  AddLaserProblems(range_min_, usable_range_max_, beam_counts_, angular_step_, scan_period_,
-                   scan_timeout_, problems);
-  return problems;
-}
-
-void LaserLocalizationUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }
-
 void LaserLocalizationUnit::Derive() {
-  odometry_prediction_ = motion_prediction_ == "odometry";
+  DeriveBeams();
   mapping_ = map_ == "mapping";
-  for (std::size_t k = 0; k < beam_counts_.size(); ++k) {
-    // The middle of the sweep: the time the matched pose refers to.
-    mid_offset_ns_[k] = LaserBeams(mount_yaw_[k], first_beam_angle_[k], angular_step_[k],
-                                   scan_period_[k], beam_counts_[k], beam_cos_[k], beam_sin_[k],
-                                   beam_dt_[k]);
-  }
   // The map, once per set of the values it depends on.
   if (mapping_ && (!grid_ || grid_map_ != map_ || grid_resolution_ != map_resolution_ ||
                    grid_levels_ != map_levels_ || grid_occupied_ != update_factor_occupied_ ||
@@ -288,82 +187,27 @@ void LaserLocalizationUnit::Initialize() {
   std::fill(mapped_.begin(), mapped_.end(), 0);
   std::fill(last_map_pose_.begin(), last_map_pose_.end(), Pose{});
   map_updates_ = 0.0;
-  estimate_ = {initial_x_, initial_y_, WrapAngle(initial_yaw_)};
-  estimate_ns_ = start_;
-  odom_ = estimate_;
-  odom_ns_ = start_;
-  step_end_ns_ = start_;
-  have_match_ = false;
+  InitializeTracking();
   history_begin_ = history_size_ = 0;
-  for (std::size_t k = 0; k < beam_counts_.size(); ++k) {
-    last_count_[k] = scan_count_[k];
-    last_scan_ns_[k] = start_;
-    laser_status_[k] = 0.0;
-  }
   last_result_ = {};
-  position_ = {estimate_.x, estimate_.y};
-  yaw_ = estimate_.yaw;
   velocity_ = {0.0, 0.0};
   yaw_rate_ = 0.0;
-  std::fill(hessian_.begin(), hessian_.end(), 0.0);
-  std::fill(covariance_.begin(), covariance_.end(), 0.0);
-  match_time_ = cosim::NsToSeconds(start_);
-  match_count_ = 0.0;
   match_cost_ = 0.0;
-  source_ = 1.0;
 }
 
-LaserLocalizationUnit::Pose LaserLocalizationUnit::Predict(const Pose& p, double s) const {
-  // Constant twist in base_link over s: the heading at the middle of the
-  // interval (second order in the turn).
-  const double mid = p.yaw + 0.5 * odometry_yaw_rate_ * s;
-  const double c = std::cos(mid), sn = std::sin(mid);
-  const double vx = odometry_velocity_[0], vy = odometry_velocity_[1];
-  return {p.x + (c * vx - sn * vy) * s, p.y + (sn * vx + c * vy) * s,
-          WrapAngle(p.yaw + odometry_yaw_rate_ * s)};
-}
-
-void LaserLocalizationUnit::ProcessScan(int k) {
+void LaserLocalizationUnit::ProcessScan(int k, cosim::TimeNs match_ns) {
   const auto kk = static_cast<std::size_t>(k);
-  const cosim::TimeNs scan_ns = cosim::SecondsToNs(scan_time_[kk]);
-  const cosim::TimeNs match_ns = scan_ns + mid_offset_ns_[kk];
-  last_scan_ns_[kk] = scan_ns;
-  const std::vector<double>& r = ranges_[kk];
-  const std::vector<double>& bc = beam_cos_[kk];
-  const std::vector<double>& bs = beam_sin_[kk];
-  const double mx = mount_x_[kk], my = mount_y_[kk];
-  // Deskew: the base at beam time t_i relative to the base at the match
-  // time is displaced by v_b dt and turned by w dt (dt = t_i - t_match,
-  // v_b the velocity estimate in base_link): p_match = R(w dt) p_i + v_b dt;
-  // R to second order in w dt (w dt <= 0.02 rad for 1 rad/s over half of
-  // an S300 sweep: error below 1.5e-6 r).
+  // Deskew by the last velocity estimate, turned into base_link.
   const double cy = std::cos(estimate_.yaw), sy = std::sin(estimate_.yaw);
   const double vbx = deskew_ ? cy * velocity_[0] + sy * velocity_[1] : 0.0;
   const double vby = deskew_ ? -sy * velocity_[0] + cy * velocity_[1] : 0.0;
   const double w = deskew_ ? yaw_rate_ : 0.0;
-  const double mid_s = cosim::NsToSeconds(mid_offset_ns_[kk]);
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < r.size(); ++i) {
-    const double ri = r[i];
-    if (!(ri >= range_min_ && ri <= usable_range_max_) || ri <= 0.0) continue;
-    double x = mx + ri * bc[i], y = my + ri * bs[i];
-    if (deskew_) {
-      const double dt = beam_dt_[kk][i] - mid_s;
-      const double th = w * dt, c = 1.0 - 0.5 * th * th;
-      const double xr = c * x - th * y, yr = th * x + c * y;
-      x = xr + vbx * dt;
-      y = yr + vby * dt;
-    }
-    px_[n] = x;
-    py_[n] = y;
-    ++n;
-  }
+  const std::size_t n = CollectPoints(k, 0.0, deskew_, vbx, vby, w);
   if (n < static_cast<std::size_t>(min_points_)) {
     SetStatus(k, 2);
     return;
   }
-  Pose start = estimate_;
-  if (odometry_prediction_) start = Predict(odom_, cosim::NsToSeconds(match_ns - odom_ns_));
+  const Pose start = MatchStart(match_ns);
   if (mapping_ && !have_match_ && !mapped_[kk]) {
     // Laser k's first scan before any match: into the map at the start
     // pose, without matching (hector's first scan).
@@ -388,16 +232,13 @@ void LaserLocalizationUnit::ProcessScan(int k) {
     const double lmax = 0.5 * (a + d) + std::sqrt(0.25 * (a - d) * (a - d) + b * b);
     ok = std::sqrt(lmax) <= max_position_sigma_ && std::sqrt(var_r * inv[8]) <= max_yaw_sigma_;
   }
-  if (ok) {
-    ok = std::hypot(res.pose.x - start.x, res.pose.y - start.y) <= max_jump_ &&
-         std::abs(WrapAngle(res.pose.yaw - start.yaw)) <= max_jump_yaw_;
-  }
+  ok = ok && WithinJumpLimits(res.pose.x, res.pose.y, res.pose.yaw, start);
   if (!ok) {
     SetStatus(k, 3);
     return;
   }
   SetStatus(k, 0);
-  const Pose matched{res.pose.x, res.pose.y, WrapAngle(res.pose.yaw)};
+  const Pose matched{res.pose.x, res.pose.y, RemainderAngle(res.pose.yaw)};
   // Drop the matches older than the window but the newest of them (the
   // window's start), then the velocity from it to this match.
   const auto window_ns = static_cast<cosim::TimeNs>(std::llround(velocity_window_ * 1e9));
@@ -419,36 +260,27 @@ void LaserLocalizationUnit::ProcessScan(int k) {
       const double dt = cosim::NsToSeconds(match_ns - old_ns);
       velocity_[0] = (matched.x - old_pose.x) / dt;
       velocity_[1] = (matched.y - old_pose.y) / dt;
-      yaw_rate_ = WrapAngle(matched.yaw - old_pose.yaw) / dt;
+      yaw_rate_ = RemainderAngle(matched.yaw - old_pose.yaw) / dt;
     }
   }
   const std::size_t slot = (history_begin_ + history_size_) % kHistory;
   history_[slot] = matched;
   history_ns_[slot] = match_ns;
   ++history_size_;
-  estimate_ = matched;
-  estimate_ns_ = match_ns;
-  have_match_ = true;
-  odom_ = matched;
-  odom_ns_ = match_ns;
+  AcceptMatch(matched, match_ns);
   for (std::size_t i = 0; i < 9; ++i) {
     hessian_[i] = res.hessian[i];
     covariance_[i] = var_r * inv[i];
   }
-  const double fp = covariance_floor_position_ * covariance_floor_position_;
-  covariance_[0] += fp;
-  covariance_[4] += fp;
-  covariance_[8] += covariance_floor_yaw_ * covariance_floor_yaw_;
-  match_time_ = cosim::NsToSeconds(match_ns);
+  AddCovarianceFloors();
   match_cost_ = res.cost;
-  match_count_ += 1.0;
   if (mapping_) {
     // hector's poseDifferenceLargerThan (HectorSlamProcessor::update):
     // strictly more than either threshold.
     const Pose& last = last_map_pose_[kk];
     if (!mapped_[kk] ||
         std::hypot(matched.x - last.x, matched.y - last.y) > map_update_distance_thresh_ ||
-        std::abs(WrapAngle(matched.yaw - last.yaw)) > map_update_angle_thresh_) {
+        std::abs(RemainderAngle(matched.yaw - last.yaw)) > map_update_angle_thresh_) {
       UpdateMap(k, n, matched);
     }
   }
@@ -464,38 +296,8 @@ void LaserLocalizationUnit::UpdateMap(int k, std::size_t n, const Pose& p) {
   map_updates_ += 1.0;
 }
 
-cosim::StepResult LaserLocalizationUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
-  ClearError();
-  if (!InputsFinite(t)) return cosim::StepResult::kError;
-  const cosim::TimeNs end = t + dt;
-  // The new scans, in the order of their match times.
-  const int fresh = OrderNewScans(scan_count_, last_count_, scan_time_, mid_offset_ns_, order_);
-  for (int j = 0; j < fresh; ++j) ProcessScan(order_[static_cast<std::size_t>(j)]);
-  // Lasers silent for longer than scan_timeout.
-  const cosim::TimeNs timeout = cosim::SecondsToNs(scan_timeout_);
-  for (int k = 0; k < laser_count(); ++k) {
-    if (end - last_scan_ns_[static_cast<std::size_t>(k)] > timeout) SetStatus(k, 1);
-  }
-  // The odometry-moved pose, carried to the step's end.
-  if (odometry_prediction_) {
-    odom_ = Predict(odom_, cosim::NsToSeconds(end - odom_ns_));
-    odom_ns_ = end;
-  }
-  const bool fresh_match = have_match_ && end - estimate_ns_ <= timeout;
-  source_ = fresh_match ? 0.0 : 1.0;
-  const Pose& out = (!fresh_match && odometry_prediction_) ? odom_ : estimate_;
-  position_[0] = out.x;
-  position_[1] = out.y;
-  yaw_ = out.yaw;
-  step_end_ns_ = end;
-  return cosim::StepResult::kOk;
-}
-
 void LaserLocalizationUnit::SaveInternal(cosim::UnitState& state) const {
-  state.integers = {start_, estimate_ns_, have_match_ ? 1 : 0, odom_ns_, step_end_ns_};
-  state.integers.insert(state.integers.end(), last_scan_ns_.begin(), last_scan_ns_.end());
-  state.reals = {estimate_.x, estimate_.y, estimate_.yaw, odom_.x, odom_.y, odom_.yaw};
-  state.reals.insert(state.reals.end(), last_count_.begin(), last_count_.end());
+  SaveTracking(state);
   // The history, oldest first.
   state.integers.push_back(static_cast<std::int64_t>(history_size_));
   for (std::size_t i = 0; i < history_size_; ++i) {
@@ -526,32 +328,24 @@ void LaserLocalizationUnit::SaveInternal(cosim::UnitState& state) const {
 
 void LaserLocalizationUnit::RestoreInternal(const cosim::UnitState& state) {
   const std::size_t L = beam_counts_.size();
-  const std::size_t h = state.integers.size() > 5 + L
-                            ? static_cast<std::size_t>(state.integers[5 + L])
-                            : kHistory + 1;
-  if (h > kHistory || state.integers.size() != 6 + 2 * L + h ||
-      state.reals.size() != 6 + 4 * L + 3 * h) {
+  const std::size_t ti = tracking_integers(), tr = tracking_reals();
+  const std::size_t h =
+      state.integers.size() > ti ? static_cast<std::size_t>(state.integers[ti]) : kHistory + 1;
+  if (h > kHistory || state.integers.size() != ti + 1 + h + L ||
+      state.reals.size() != tr + 3 * h + 3 * L) {
     throw cosim::UnitError(Where() + ": saved state does not fit this unit");
   }
+  RestoreTracking(state);
   history_begin_ = 0;
   history_size_ = h;
   for (std::size_t i = 0; i < h; ++i) {
-    history_ns_[i] = state.integers[6 + L + i];
-    history_[i] = {state.reals[6 + L + 3 * i], state.reals[7 + L + 3 * i],
-                   state.reals[8 + L + 3 * i]};
+    history_ns_[i] = state.integers[ti + 1 + i];
+    history_[i] = {state.reals[tr + 3 * i], state.reals[tr + 3 * i + 1],
+                   state.reals[tr + 3 * i + 2]};
   }
-  start_ = state.integers[0];
-  estimate_ns_ = state.integers[1];
-  have_match_ = state.integers[2] != 0;
-  odom_ns_ = state.integers[3];
-  step_end_ns_ = state.integers[4];
-  for (std::size_t k = 0; k < L; ++k) last_scan_ns_[k] = state.integers[5 + k];
-  estimate_ = {state.reals[0], state.reals[1], state.reals[2]};
-  odom_ = {state.reals[3], state.reals[4], state.reals[5]};
-  for (std::size_t k = 0; k < L; ++k) last_count_[k] = state.reals[6 + k];
   for (std::size_t k = 0; k < L; ++k) {
-    mapped_[k] = state.integers[6 + L + h + k] != 0 ? 1 : 0;
-    const std::size_t r = 6 + L + 3 * h + 3 * k;
+    mapped_[k] = state.integers[ti + 1 + h + k] != 0 ? 1 : 0;
+    const std::size_t r = tr + 3 * h + 3 * k;
     last_map_pose_[k] = {state.reals[r], state.reals[r + 1], state.reals[r + 2]};
   }
   // Derived values follow the (restored) parameters.

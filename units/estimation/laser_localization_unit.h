@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "cosim/time.h"
-#include "cosim/unit.h"
 #include "models/scene.h"
 #include "units/estimation/occupancy_grid.h"
+#include "units/estimation/scan_localizer.h"
 #include "units/estimation/scan_matcher.h"
 
 namespace linesim::estimation {
@@ -83,10 +83,9 @@ namespace linesim::estimation {
 /// scan_timeout, 1 no usable laser: the pose is held (motion_prediction
 /// none) or predicted from the last accepted match by the odometry inputs
 /// (motion_prediction odometry).
-class LaserLocalizationUnit : public cosim::Unit {
+class LaserLocalizationUnit : public ScanLocalizer {
  public:
   static constexpr const char* kTypeName = "laser_localization";
-  static constexpr int kMaxLasers = 8;
 
   /// One entry of `beam_counts` per laser (1..kMaxLasers lasers, each
   /// 1..100000 beams); throws cosim::UnitError otherwise. The scene's
@@ -94,12 +93,8 @@ class LaserLocalizationUnit : public cosim::Unit {
   LaserLocalizationUnit(std::string name, const models::Scene& scene, std::vector<int> beam_counts);
   ~LaserLocalizationUnit() override;
 
-  std::vector<cosim::ParameterProblem> CheckParameters() const override;
-  void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
   void Initialize() override;
-  cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
 
-  int laser_count() const { return static_cast<int>(beam_counts_.size()); }
   /// The map (after Initialize).
   const OccupancyGrid* grid() const { return grid_.get(); }
   /// The last match tried (accepted or not).
@@ -110,17 +105,11 @@ class LaserLocalizationUnit : public cosim::Unit {
   void RestoreInternal(const cosim::UnitState& state) override;
 
  private:
-  using Pose = ScanMatcher::Pose;
   void Derive();
-  /// Matches laser k's current scan; true when accepted.
-  void ProcessScan(int k);
-  /// `p` moved by the odometry inputs over `seconds` (may be < 0).
-  Pose Predict(const Pose& p, double seconds) const;
+  void ProcessScan(int k, cosim::TimeNs match_ns) override;
   /// Enters laser k's points (px_, py_, n of them) into the learned map at `p`.
   void UpdateMap(int k, std::size_t n, const Pose& p);
-  void SetStatus(int k, int status) { laser_status_[static_cast<std::size_t>(k)] = status; }
 
-  std::vector<int> beam_counts_;
   std::vector<models::Solid> solids_;
   models::Floor floor_;
   std::vector<models::Solid> map_solids_;  // those the grid holds
@@ -133,53 +122,24 @@ class LaserLocalizationUnit : public cosim::Unit {
   std::string grid_map_;
   double grid_occupied_ = 0.0, grid_free_ = 0.0;
 
-  // Parameters (lists: one element per laser).
-  std::vector<double> mount_x_, mount_y_, mount_z_, mount_yaw_, first_beam_angle_, angular_step_,
-      scan_period_;
-  double range_min_ = 0.4, usable_range_max_ = 30.0;
+  // Parameters beside the shared ones.
+  std::vector<double> mount_z_;  // per laser
   double map_resolution_ = 0.025;
   std::int64_t map_levels_ = 3, coarse_iterations_ = 3, fine_iterations_ = 5;
   double max_angle_step_ = 0.2;
-  double initial_x_, initial_y_, initial_yaw_;
-  std::string motion_prediction_ = "none";
-  bool deskew_ = false;
-  double scan_timeout_ = 0.2;
-  double max_cost_ = 0.6, max_position_sigma_ = 0.05, max_yaw_sigma_ = 0.05, max_jump_ = 0.3,
-         max_jump_yaw_ = 0.3;
+  double max_cost_ = 0.6, max_position_sigma_ = 0.05, max_yaw_sigma_ = 0.05;
   double velocity_window_ = 0.2;
-  std::int64_t min_points_ = 50;
-  double covariance_floor_position_ = 0.01, covariance_floor_yaw_ = 0.0087;
   std::string map_ = "scene";
   double map_update_distance_thresh_ = 0.4, map_update_angle_thresh_ = 0.06;
   double update_factor_occupied_ = 0.9, update_factor_free_ = 0.4;
 
-  // Inputs.
-  std::vector<std::vector<double>> ranges_;
-  std::vector<double> scan_count_, scan_time_;
-  std::vector<double> odometry_velocity_;
-  double odometry_yaw_rate_ = 0.0;
+  // Outputs beside the shared ones.
+  std::vector<double> velocity_;
+  double yaw_rate_ = 0.0, match_cost_ = 0.0, map_updates_ = 0.0;
 
-  // Outputs.
-  std::vector<double> position_, velocity_, covariance_, hessian_, laser_status_;
-  double yaw_ = 0.0, yaw_rate_ = 0.0, match_time_ = 0.0, match_count_ = 0.0, match_cost_ = 0.0,
-         source_ = 1.0, map_updates_ = 0.0;
-
-  // Derived (Derive()): per laser and beam, cos and sin of the beam's
-  // direction in base_link, and its time after the scan's start (s).
-  std::vector<std::vector<double>> beam_cos_, beam_sin_, beam_dt_;
-  std::vector<cosim::TimeNs> mid_offset_ns_;  // the match time after the scan's start
-  bool odometry_prediction_ = false;
-  bool mapping_ = false;
-
-  // Scratch (sized in the constructor): the points of one scan.
-  std::vector<double> px_, py_;
-  std::vector<int> order_;
+  bool mapping_ = false;  // derived
   ScanMatcher::Result last_result_;
 
-  // State.
-  cosim::TimeNs start_ = 0;
-  std::vector<double> last_count_;
-  std::vector<cosim::TimeNs> last_scan_ns_;  // the last new scan's start, per laser
   // The accepted matches of the last velocity_window (a ring, oldest at
   // history_begin_): velocity and yaw rate come from the pose change over
   // the window, not between two matches (a pose's few mm over 20 ms are
@@ -188,12 +148,6 @@ class LaserLocalizationUnit : public cosim::Unit {
   std::array<Pose, kHistory> history_{};
   std::array<cosim::TimeNs, kHistory> history_ns_{};
   std::size_t history_begin_ = 0, history_size_ = 0;
-  Pose estimate_;                  // the latest accepted match (or the initial pose)
-  cosim::TimeNs estimate_ns_ = 0;  // its time
-  bool have_match_ = false;
-  Pose odom_;  // estimate_ moved by odometry up to odom_ns_
-  cosim::TimeNs odom_ns_ = 0;
-  cosim::TimeNs step_end_ns_ = 0;
   // map: mapping: per laser, whether its scans have entered the map and the
   // pose it last entered at.
   std::vector<char> mapped_;

@@ -1,10 +1,7 @@
-#include "units/estimation/laser_beams.h"
 #include "units/estimation/perfect_match_localization_unit.h"
 
-#include <algorithm>
+#include <array>
 #include <cmath>
-#include <limits>
-#include <numbers>
 #include <span>
 #include <utility>
 
@@ -16,14 +13,9 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
                                                            const models::Scene& scene,
                                                            std::vector<int> beam_counts,
                                                            std::vector<MapSpec> maps)
-    : cosim::Unit(kTypeName, std::move(name)),
-      beam_counts_(std::move(beam_counts)),
+    : ScanLocalizer(kTypeName, std::move(name), std::move(beam_counts), models::WrapAngle),
       specs_(std::move(maps)),
       scene_(scene) {
-  if (beam_counts_.empty() || beam_counts_.size() > static_cast<std::size_t>(kMaxLasers)) {
-    throw cosim::UnitError(Where() + ": beam_counts must list 1 to " + std::to_string(kMaxLasers) +
-                           " lasers, got " + std::to_string(beam_counts_.size()));
-  }
   if (specs_.empty() || specs_.size() > static_cast<std::size_t>(kMaxMaps)) {
     throw cosim::UnitError(Where() + ": maps must list 1 to " + std::to_string(kMaxMaps) +
                            " maps, got " + std::to_string(specs_.size()));
@@ -37,69 +29,21 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
           ") needs a finite height_m, cell_m in [0, 0.5] and a region with max > min");
     }
   }
-  std::size_t max_beams = 0;
-  for (std::size_t k = 0; k < beam_counts_.size(); ++k) {
-    if (beam_counts_[k] < 1 || beam_counts_[k] > 100000) {
-      throw cosim::UnitError(Where() + ": beam_counts[" + std::to_string(k) +
-                             "] must be 1..100000, got " + std::to_string(beam_counts_[k]));
-    }
-    max_beams = std::max(max_beams, static_cast<std::size_t>(beam_counts_[k]));
-  }
   const std::size_t L = beam_counts_.size();
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  initial_x_ = initial_y_ = initial_yaw_ = nan;
-  mount_x_.assign(L, nan);
-  mount_y_.assign(L, nan);
-  mount_yaw_.assign(L, nan);
-  first_beam_angle_.assign(L, nan);
-  angular_step_.assign(L, nan);
-  scan_period_.assign(L, nan);
-  ranges_.resize(L);
-  beam_cos_.resize(L);
-  beam_sin_.resize(L);
-  beam_dt_.resize(L);
-  for (std::size_t k = 0; k < L; ++k) {
-    const auto n = static_cast<std::size_t>(beam_counts_[k]);
-    ranges_[k].assign(n, 0.0);
-    beam_cos_[k].assign(n, 0.0);
-    beam_sin_[k].assign(n, 0.0);
-    beam_dt_[k].assign(n, 0.0);
-  }
-  scan_count_.assign(L, 0.0);
-  scan_time_.assign(L, 0.0);
   mapping_range_bias_.assign(L, 0.0);
-  odometry_velocity_.assign(2, 0.0);
-  position_.assign(2, 0.0);
-  covariance_.assign(9, 0.0);
-  hessian_.assign(9, 0.0);
-  laser_status_.assign(L, 0.0);
-  mid_offset_ns_.assign(L, 0);
-  px_.assign(max_beams, 0.0);
-  py_.assign(max_beams, 0.0);
-  order_.assign(L, 0);
-  last_count_.assign(L, 0.0);
-  last_scan_ns_.assign(L, 0);
+  // The LMS151's limits (paper 2's laser) where the shared parameters
+  // differ from hector's.
+  range_min_ = 0.5;
+  usable_range_max_ = 50.0;
+  min_points_ = 20;
 
   using cosim::Rule;
   auto& v = variables();
-  v.Parameter("mount_x", "m", &mount_x_, "per laser: its origin in base_link, x",
-              Rule::Finite().NoDefault());
-  v.Parameter("mount_y", "m", &mount_y_, "per laser: its origin in base_link, y",
-              Rule::Finite().NoDefault());
-  v.Parameter("mount_yaw", "rad", &mount_yaw_,
-              "per laser: its yaw in base_link (roll and pitch ignored: 3-DoF as paper 2)",
-              Rule::Finite().NoDefault());
-  v.Parameter("first_beam_angle", "rad", &first_beam_angle_, "per laser: direction of beam 0",
-              Rule::Range(-2 * std::numbers::pi, 2 * std::numbers::pi).NoDefault());
-  v.Parameter("angular_step", "rad", &angular_step_, "per laser: angle between neighbouring beams",
-              Rule::Range(0, false, std::numbers::pi, true).NoDefault());
-  v.Parameter("scan_period", "s", &scan_period_, "per laser: one turn of the mirror (one scan)",
-              Rule::Positive().NoDefault());
-  v.Parameter("range_min", "m", &range_min_,
-              "nearer returns are skipped (the LMS151's 0.5 m, operating instructions 8012471)",
-              Rule::NonNegative());
-  v.Parameter("usable_range_max", "m", &usable_range_max_,
-              "farther returns are skipped (the LMS151's 50 m, 8012471)", Rule::Positive());
+  DeclareMountXY();
+  DeclareBeamGeometry("per laser: its yaw in base_link (roll and pitch ignored: 3-DoF as paper 2)");
+  DeclareRangeLimits(
+      "nearer returns are skipped (the LMS151's 0.5 m, operating instructions 8012471)",
+      "farther returns are skipped (the LMS151's 50 m, 8012471)");
   v.Parameter("lookup_cell", "m", &lookup_cell_,
               "cell of the distance maps' lookup grid, for the maps that give no cell_m (Tribots: "
               "0.05; see distance_map.h for the interpolation error)",
@@ -130,73 +74,48 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
               "reweighted Gauss-Newton steps after RPROP (0: Tribots' RPROP alone; see "
               "perfect_match.h)",
               Rule::Range(0, 20));
-  v.Parameter("initial_x", "m", &initial_x_, "base_link x in map at the start",
-              Rule::Finite().NoDefault());
-  v.Parameter("initial_y", "m", &initial_y_, "base_link y in map at the start",
-              Rule::Finite().NoDefault());
-  v.Parameter("initial_yaw", "rad", &initial_yaw_, "base_link yaw in map at the start",
-              Rule::Finite().NoDefault());
-  v.Parameter("motion_prediction", &motion_prediction_,
-              "none: each match starts from the last; odometry: from the last moved by the "
-              "odometry inputs (Tribots)",
-              Rule::OneOf({"none", "odometry"}));
-  v.Parameter("deskew", &deskew_,
-              "with motion_prediction odometry: each point moved to the match time by the "
-              "odometry twist");
-  v.Parameter("scan_timeout", "s", &scan_timeout_,
-              "laser_status 1 when a laser's last scan started longer ago", Rule::Positive());
-  v.Parameter("min_points", &min_points_,
-              "a scan with fewer usable returns is not matched (laser blacked out)",
-              Rule::Range(3, 100000));
+  DeclareStartPose(Rule::Finite().NoDefault(), "base_link x in map at the start",
+                   "base_link y in map at the start", "base_link yaw in map at the start");
+  DeclareMotionPrediction(
+      "none: each match starts from the last; odometry: from the last moved by the odometry "
+      "inputs (Tribots)",
+      "with motion_prediction odometry: each point moved to the match time by the odometry "
+      "twist",
+      "laser_status 1 when a laser's last scan started longer ago");
+  DeclareMinPoints();
   v.Parameter("max_mean_error", "1", &max_mean_error_,
               "a match whose mean error E / n exceeds this is rejected (1: never)",
               Rule::Range(0.0, false, 1.0, true));
-  v.Parameter("max_jump", "m", &max_jump_, "a match farther than this from its start is rejected",
-              Rule::Positive());
-  v.Parameter("max_jump_yaw", "rad", &max_jump_yaw_,
-              "a match turned more than this from its start is rejected", Rule::Positive());
-  v.Parameter("covariance_floor_position", "m", &covariance_floor_position_,
-              "added to the position sigmas of the covariance (squared, on the diagonal): errors "
-              "the curvature misses (range bias, the map's own error)",
-              Rule::NonNegative());
+  DeclareJumpLimits("a match farther than this from its start is rejected",
+                    "a match turned more than this from its start is rejected");
+  DeclareCovarianceFloorPosition(
+      "added to the position sigmas of the covariance (squared, on the diagonal): errors the "
+      "curvature misses (range bias, the map's own error)");
   v.Parameter("range_bias_sigma", "m", &range_bias_sigma_,
               "sigma of a range bias common to a scan's beams (the laser model's bias_sigma: "
               "LMS151 0.015): adds range_bias_sigma^2 g g^T to the covariance, g the match's "
               "sensitivity to it",
               Rule::NonNegative());
-  v.Parameter("covariance_floor_yaw", "rad", &covariance_floor_yaw_,
-              "added to the yaw sigma of the covariance (squared, on the diagonal)",
-              Rule::NonNegative());
+  DeclareCovarianceFloorYaw();
 
   for (std::size_t k = 0; k < L; ++k) {
+    DeclareScanInputs(k);
     const std::string s = std::to_string(k);
-    v.Input("ranges_" + s, "m", &ranges_[k], "laser " + s + ": ranges of its last complete scan");
-    v.Input("scan_count_" + s, "1", &scan_count_[k], "laser " + s + ": complete scans so far");
-    v.Input("scan_time_" + s, "s", &scan_time_[k], "laser " + s + ": start time of its last scan");
     v.Input("mapping_range_bias_" + s, "m", &mapping_range_bias_[k],
-            "laser " + s + ": its device's range bias, which the maps it built by SLAM "
-            "(maps with from_own_laser) carry in their outlines (its range_bias output)");
+            "laser " + s +
+                ": its device's range bias, which the maps it built by SLAM "
+                "(maps with from_own_laser) carry in their outlines (its range_bias output)");
   }
-  v.Input("odometry_velocity", "m/s", &odometry_velocity_,
-          "odometry: velocity of base_link in base_link (motion_prediction odometry only)");
-  v.Input("odometry_yaw_rate", "rad/s", &odometry_yaw_rate_,
-          "odometry: yaw rate (motion_prediction odometry only)");
+  DeclareOdometryInputs();
   v.Input("map_index", &map_index_,
           "the map each new scan is matched against (0-based, the order of the maps key)");
 
-  v.Output("position", "m", &position_, "base_link x, y in map (latest accepted match)", {});
-  v.Output("yaw", "rad", &yaw_, "base_link yaw in map (latest accepted match)", {});
-  v.Output("covariance", "1", &covariance_,
-           "row-major 3 x 3 of x (m), y (m), yaw (rad): s^2 (2 / c^2) H^-1 + range_bias_sigma^2 "
-           "g g^T + floors",
-           {});
-  v.Output("hessian", "1", &hessian_,
-           "row-major 3 x 3 curvature H of the error at the latest accepted match (1/m^2, "
-           "1/(m rad), 1/rad^2)",
-           {});
-  v.Output("match_time", "s", &match_time_, "time the pose refers to (middle of the matched scan)",
-           {});
-  v.Output("match_count", "1", &match_count_, "accepted matches so far", {});
+  DeclarePoseOutputs();
+  DeclareMatchOutputs(
+      "row-major 3 x 3 of x (m), y (m), yaw (rad): s^2 (2 / c^2) H^-1 + range_bias_sigma^2 g "
+      "g^T + floors",
+      "row-major 3 x 3 curvature H of the error at the latest accepted match (1/m^2, 1/(m "
+      "rad), 1/rad^2)");
   v.Output("match_error", "1", &match_error_,
            "mean error E / n of the latest accepted match, in [0, 1] (0 perfect)", {});
   v.Output("match_inlier_fraction", "1", &match_inlier_fraction_,
@@ -214,23 +133,8 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
 
 PerfectMatchLocalizationUnit::~PerfectMatchLocalizationUnit() = default;
 
-std::vector<cosim::ParameterProblem> PerfectMatchLocalizationUnit::CheckParameters() const {
-  auto problems = cosim::Unit::CheckParameters();
-  AddLaserProblems(range_min_, usable_range_max_, beam_counts_, angular_step_, scan_period_,
-                   scan_timeout_, problems);
-  return problems;
-}
-
-void PerfectMatchLocalizationUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }
-
 void PerfectMatchLocalizationUnit::Derive() {
-  odometry_prediction_ = motion_prediction_ == "odometry";
-  for (std::size_t k = 0; k < beam_counts_.size(); ++k) {
-    // The middle of the sweep: the time the matched pose refers to.
-    mid_offset_ns_[k] = LaserBeams(mount_yaw_[k], first_beam_angle_[k], angular_step_[k],
-                                   scan_period_[k], beam_counts_[k], beam_cos_[k], beam_sin_[k],
-                                   beam_dt_[k]);
-  }
+  DeriveBeams();
   // The maps, once per lookup grid.
   if (maps_.size() != specs_.size() || built_cell_ != lookup_cell_ ||
       built_margin_ != map_margin_) {
@@ -268,103 +172,45 @@ void PerfectMatchLocalizationUnit::Derive() {
 void PerfectMatchLocalizationUnit::Initialize() {
   ThrowIfBadParameters();
   Derive();
-  estimate_ = {initial_x_, initial_y_, models::WrapAngle(initial_yaw_)};
-  estimate_ns_ = start_;
-  odom_ = estimate_;
-  odom_ns_ = start_;
-  have_match_ = false;
-  for (std::size_t k = 0; k < beam_counts_.size(); ++k) {
-    last_count_[k] = scan_count_[k];
-    last_scan_ns_[k] = start_;
-    laser_status_[k] = 0.0;
-  }
+  InitializeTracking();
   last_result_ = {};
-  position_ = {estimate_.x, estimate_.y};
-  yaw_ = estimate_.yaw;
-  std::fill(hessian_.begin(), hessian_.end(), 0.0);
-  std::fill(covariance_.begin(), covariance_.end(), 0.0);
-  match_time_ = cosim::NsToSeconds(start_);
-  match_count_ = 0.0;
   match_error_ = 0.0;
   match_inlier_fraction_ = 0.0;
   map_in_use_ = static_cast<double>(map_index_);
-  source_ = 1.0;
 }
 
-PerfectMatchLocalizationUnit::Pose PerfectMatchLocalizationUnit::Predict(const Pose& p,
-                                                                         double s) const {
-  // Constant twist in base_link over s: the heading at the middle of the
-  // interval (second order in the turn).
-  const double mid = p.yaw + 0.5 * odometry_yaw_rate_ * s;
-  const double c = std::cos(mid), sn = std::sin(mid);
-  const double vx = odometry_velocity_[0], vy = odometry_velocity_[1];
-  return {p.x + (c * vx - sn * vy) * s, p.y + (sn * vx + c * vy) * s,
-          models::WrapAngle(p.yaw + odometry_yaw_rate_ * s)};
-}
-
-void PerfectMatchLocalizationUnit::ProcessScan(int k) {
+void PerfectMatchLocalizationUnit::ProcessScan(int k, cosim::TimeNs match_ns) {
   const auto kk = static_cast<std::size_t>(k);
-  const cosim::TimeNs scan_ns = cosim::SecondsToNs(scan_time_[kk]);
-  const cosim::TimeNs match_ns = scan_ns + mid_offset_ns_[kk];
-  last_scan_ns_[kk] = scan_ns;
   if (map_index_ < 0 || map_index_ >= map_count()) {
     SetStatus(k, 4);
     return;
   }
-  const std::vector<double>& r = ranges_[kk];
-  const std::vector<double>& bc = beam_cos_[kk];
-  const std::vector<double>& bs = beam_sin_[kk];
-  const double mx = mount_x_[kk], my = mount_y_[kk];
-  // Deskew by the odometry twist: the base at beam time t_i relative to the
-  // base at the match time is displaced by v dt and turned by w dt
-  // (dt = t_i - t_match): p_match = R(w dt) p_i + v dt, R to second order.
-  const bool deskew = deskew_ && odometry_prediction_;
-  const double vx = odometry_velocity_[0], vy = odometry_velocity_[1], w = odometry_yaw_rate_;
-  const double mid_s = cosim::NsToSeconds(mid_offset_ns_[kk]);
   // A map this laser built by SLAM carries its bias (see the header).
-  const double map_bias = specs_[static_cast<std::size_t>(map_index_)].from_own_laser
-                              ? mapping_range_bias_[kk]
-                              : 0.0;
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < r.size(); ++i) {
-    if (!(r[i] >= range_min_ && r[i] <= usable_range_max_) || r[i] <= 0.0) continue;
-    const double ri = r[i] - map_bias;
-    double x = mx + ri * bc[i], y = my + ri * bs[i];
-    if (deskew) {
-      const double dt = beam_dt_[kk][i] - mid_s;
-      const double th = w * dt, c = 1.0 - 0.5 * th * th;
-      const double xr = c * x - th * y, yr = th * x + c * y;
-      x = xr + vx * dt;
-      y = yr + vy * dt;
-    }
-    px_[n] = x;
-    py_[n] = y;
-    ++n;
-  }
+  const double map_bias =
+      specs_[static_cast<std::size_t>(map_index_)].from_own_laser ? mapping_range_bias_[kk] : 0.0;
+  // Deskew by the odometry twist.
+  const std::size_t n =
+      CollectPoints(k, map_bias, deskew_ && odometry_prediction_, odometry_velocity_[0],
+                    odometry_velocity_[1], odometry_yaw_rate_);
   if (n < static_cast<std::size_t>(min_points_)) {
     SetStatus(k, 2);
     return;
   }
-  Pose start = estimate_;
-  if (odometry_prediction_) start = Predict(odom_, cosim::NsToSeconds(match_ns - odom_ns_));
+  const Pose start = MatchStart(match_ns);
   map_in_use_ = static_cast<double>(map_index_);
   const PerfectMatch::Result res = matcher_->Match(
       *maps_[static_cast<std::size_t>(map_index_)], std::span<const double>(px_.data(), n),
-      std::span<const double>(py_.data(), n), start, mx, my);
+      std::span<const double>(py_.data(), n), {start.x, start.y, start.yaw}, mount_x_[kk],
+      mount_y_[kk]);
   last_result_ = res;
   const bool ok = res.ok && res.mean_error <= max_mean_error_ &&
-                  std::hypot(res.pose.x - start.x, res.pose.y - start.y) <= max_jump_ &&
-                  std::abs(models::WrapAngle(res.pose.yaw - start.yaw)) <= max_jump_yaw_;
+                  WithinJumpLimits(res.pose.x, res.pose.y, res.pose.yaw, start);
   if (!ok) {
     SetStatus(k, 3);
     return;
   }
   SetStatus(k, 0);
-  estimate_ = {res.pose.x, res.pose.y, models::WrapAngle(res.pose.yaw)};
-  estimate_ns_ = match_ns;
-  have_match_ = true;
-  odom_ = estimate_;
-  odom_ns_ = match_ns;
+  AcceptMatch({res.pose.x, res.pose.y, models::WrapAngle(res.pose.yaw)}, match_ns);
   for (std::size_t i = 0; i < 9; ++i) {
     hessian_[i] = res.hessian[i];
     covariance_[i] = res.covariance[i];
@@ -375,60 +221,20 @@ void PerfectMatchLocalizationUnit::ProcessScan(int k) {
       covariance_[3 * a + b] += sb2 * res.bias_sensitivity[a] * res.bias_sensitivity[b];
     }
   }
-  const double fp = covariance_floor_position_ * covariance_floor_position_;
-  covariance_[0] += fp;
-  covariance_[4] += fp;
-  covariance_[8] += covariance_floor_yaw_ * covariance_floor_yaw_;
-  match_time_ = cosim::NsToSeconds(match_ns);
+  AddCovarianceFloors();
   match_error_ = res.mean_error;
   match_inlier_fraction_ = res.points > 0 ? res.inlier_weight / res.points : 0.0;
-  match_count_ += 1.0;
-}
-
-cosim::StepResult PerfectMatchLocalizationUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
-  ClearError();
-  if (!InputsFinite(t)) return cosim::StepResult::kError;
-  const cosim::TimeNs end = t + dt;
-  // The new scans, in the order of their match times.
-  const int fresh = OrderNewScans(scan_count_, last_count_, scan_time_, mid_offset_ns_, order_);
-  for (int j = 0; j < fresh; ++j) ProcessScan(order_[static_cast<std::size_t>(j)]);
-  const cosim::TimeNs timeout = cosim::SecondsToNs(scan_timeout_);
-  for (int k = 0; k < laser_count(); ++k) {
-    if (end - last_scan_ns_[static_cast<std::size_t>(k)] > timeout) SetStatus(k, 1);
-  }
-  if (odometry_prediction_) {
-    odom_ = Predict(odom_, cosim::NsToSeconds(end - odom_ns_));
-    odom_ns_ = end;
-  }
-  const bool fresh_match = have_match_ && end - estimate_ns_ <= timeout;
-  source_ = fresh_match ? 0.0 : 1.0;
-  const Pose& out = (!fresh_match && odometry_prediction_) ? odom_ : estimate_;
-  position_[0] = out.x;
-  position_[1] = out.y;
-  yaw_ = out.yaw;
-  return cosim::StepResult::kOk;
 }
 
 void PerfectMatchLocalizationUnit::SaveInternal(cosim::UnitState& state) const {
-  state.integers = {start_, estimate_ns_, have_match_ ? 1 : 0, odom_ns_};
-  state.integers.insert(state.integers.end(), last_scan_ns_.begin(), last_scan_ns_.end());
-  state.reals = {estimate_.x, estimate_.y, estimate_.yaw, odom_.x, odom_.y, odom_.yaw};
-  state.reals.insert(state.reals.end(), last_count_.begin(), last_count_.end());
+  SaveTracking(state);
 }
 
 void PerfectMatchLocalizationUnit::RestoreInternal(const cosim::UnitState& state) {
-  const std::size_t L = beam_counts_.size();
-  if (state.integers.size() != 4 + L || state.reals.size() != 6 + L) {
+  if (state.integers.size() != tracking_integers() || state.reals.size() != tracking_reals()) {
     throw cosim::UnitError(Where() + ": saved state does not fit this unit");
   }
-  start_ = state.integers[0];
-  estimate_ns_ = state.integers[1];
-  have_match_ = state.integers[2] != 0;
-  odom_ns_ = state.integers[3];
-  for (std::size_t k = 0; k < L; ++k) last_scan_ns_[k] = state.integers[4 + k];
-  estimate_ = {state.reals[0], state.reals[1], state.reals[2]};
-  odom_ = {state.reals[3], state.reals[4], state.reals[5]};
-  for (std::size_t k = 0; k < L; ++k) last_count_[k] = state.reals[6 + k];
+  RestoreTracking(state);
   // Derived values and maps follow the (restored) parameters.
   Derive();
 }

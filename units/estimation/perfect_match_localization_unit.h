@@ -7,10 +7,10 @@
 #include <vector>
 
 #include "cosim/time.h"
-#include "cosim/unit.h"
 #include "models/scene.h"
 #include "units/estimation/distance_map.h"
 #include "units/estimation/perfect_match.h"
+#include "units/estimation/scan_localizer.h"
 
 namespace linesim::estimation {
 
@@ -63,10 +63,9 @@ namespace linesim::estimation {
 /// blacked out, 3 rejected, 4 no such map. source: 0 the pose is from a
 /// match within scan_timeout, 1 held (or odometry-predicted with
 /// motion_prediction odometry) since.
-class PerfectMatchLocalizationUnit : public cosim::Unit {
+class PerfectMatchLocalizationUnit : public ScanLocalizer {
  public:
   static constexpr const char* kTypeName = "perfect_match_localization";
-  static constexpr int kMaxLasers = 8;
   static constexpr int kMaxMaps = 16;
 
   struct MapSpec {
@@ -88,12 +87,8 @@ class PerfectMatchLocalizationUnit : public cosim::Unit {
                                std::vector<int> beam_counts, std::vector<MapSpec> maps);
   ~PerfectMatchLocalizationUnit() override;
 
-  std::vector<cosim::ParameterProblem> CheckParameters() const override;
-  void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
   void Initialize() override;
-  cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
 
-  int laser_count() const { return static_cast<int>(beam_counts_.size()); }
   int map_count() const { return static_cast<int>(specs_.size()); }
   /// Map i (after Initialize).
   const DistanceMap& map(int i) const { return *maps_[static_cast<std::size_t>(i)]; }
@@ -106,69 +101,31 @@ class PerfectMatchLocalizationUnit : public cosim::Unit {
   void RestoreInternal(const cosim::UnitState& state) override;
 
  private:
-  using Pose = PerfectMatch::Pose;
   void Derive();
-  void ProcessScan(int k);
-  Pose Predict(const Pose& p, double seconds) const;
-  void SetStatus(int k, int status) { laser_status_[static_cast<std::size_t>(k)] = status; }
+  void ProcessScan(int k, cosim::TimeNs match_ns) override;
 
-  std::vector<int> beam_counts_;
   std::vector<MapSpec> specs_;
   models::Scene scene_;
   std::vector<std::unique_ptr<DistanceMap>> maps_;
   double built_cell_ = 0.0, built_margin_ = 0.0;  // what maps_ were built with
   std::unique_ptr<PerfectMatch> matcher_;
 
-  // Parameters (lists: one element per laser).
-  std::vector<double> mount_x_, mount_y_, mount_yaw_, first_beam_angle_, angular_step_,
-      scan_period_;
-  double range_min_ = 0.5, usable_range_max_ = 50.0;
+  // Parameters beside the shared ones.
   double lookup_cell_ = 0.02, map_margin_ = 1.0;
   double c_ = 0.25, step_position_ = 0.04, step_yaw_ = 0.1;
   std::int64_t iterations_ = 10, few_iterations_ = 20, few_points_ = 20, refine_iterations_ = 1,
                rprop_stride_ = 1;
-  double initial_x_, initial_y_, initial_yaw_;
-  std::string motion_prediction_ = "none";
-  bool deskew_ = false;
-  double scan_timeout_ = 0.2;
-  std::int64_t min_points_ = 20;
-  double max_mean_error_ = 0.5, max_jump_ = 0.3, max_jump_yaw_ = 0.3;
-  double covariance_floor_position_ = 0.0, covariance_floor_yaw_ = 0.0;
+  double max_mean_error_ = 0.5;
   double range_bias_sigma_ = 0.0;
 
-  // Inputs.
-  std::vector<std::vector<double>> ranges_;
-  std::vector<double> scan_count_, scan_time_;
+  // Inputs beside the shared ones.
   std::vector<double> mapping_range_bias_;  // per laser
-  std::vector<double> odometry_velocity_;
-  double odometry_yaw_rate_ = 0.0;
   std::int64_t map_index_ = 0;
 
-  // Outputs.
-  std::vector<double> position_, covariance_, hessian_, laser_status_;
-  double yaw_ = 0.0, match_time_ = 0.0, match_count_ = 0.0, match_error_ = 0.0,
-         match_inlier_fraction_ = 0.0, source_ = 1.0, map_in_use_ = 0.0;
+  // Outputs beside the shared ones.
+  double match_error_ = 0.0, match_inlier_fraction_ = 0.0, map_in_use_ = 0.0;
 
-  // Derived: per laser and beam, cos and sin of the beam's direction in
-  // base_link and its time after the scan's start.
-  std::vector<std::vector<double>> beam_cos_, beam_sin_, beam_dt_;
-  std::vector<cosim::TimeNs> mid_offset_ns_;
-  bool odometry_prediction_ = false;
-
-  // Scratch (sized in the constructor).
-  std::vector<double> px_, py_;
-  std::vector<int> order_;
   PerfectMatch::Result last_result_;
-
-  // State.
-  cosim::TimeNs start_ = 0;
-  std::vector<double> last_count_;
-  std::vector<cosim::TimeNs> last_scan_ns_;
-  Pose estimate_;
-  cosim::TimeNs estimate_ns_ = 0;
-  bool have_match_ = false;
-  Pose odom_;
-  cosim::TimeNs odom_ns_ = 0;
 };
 
 }  // namespace linesim::estimation

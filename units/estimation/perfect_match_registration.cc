@@ -1,5 +1,6 @@
 // Registers paper 2's Perfect Match localization (see config/unit_registry.h).
 #include "config/unit_registry.h"
+#include "units/estimation/beam_counts.h"
 #include "units/estimation/perfect_match_localization_unit.h"
 
 namespace linesim::estimation {
@@ -7,37 +8,6 @@ namespace {
 
 using config::UnitBuildContext;
 using Unit = PerfectMatchLocalizationUnit;
-
-std::optional<std::vector<int>> ReadBeams(const UnitBuildContext& c) {
-  const YAML::Node list = config::Child(c.parameters, "beam_counts");
-  const std::string path = config::JoinPath(c.path, "beam_counts");
-  if (!list.IsDefined() || list.IsNull()) {
-    c.reader.Error(c.parameters, c.path,
-                   "beam_counts is required: one entry per laser, its beam count (e.g. [541] for "
-                   "the LMS151 at 0.5 deg)");
-    return std::nullopt;
-  }
-  if (!c.reader.ExpectSequence(list, path)) return std::nullopt;
-  if (list.size() < 1 || list.size() > Unit::kMaxLasers) {
-    c.reader.Error(list, path,
-                   "beam_counts must list 1 to " + std::to_string(Unit::kMaxLasers) +
-                       " lasers, got " + std::to_string(list.size()));
-    return std::nullopt;
-  }
-  std::vector<int> beams;
-  bool ok = true;
-  for (std::size_t i = 0; i < list.size(); ++i) {
-    const auto n =
-        c.reader.AsInteger(list[i], config::JoinPath(path, std::to_string(i)), 1, 100000);
-    if (!n) {
-      ok = false;
-      continue;
-    }
-    beams.push_back(static_cast<int>(*n));
-  }
-  if (!ok) return std::nullopt;
-  return beams;
-}
 
 std::optional<std::vector<Unit::MapSpec>> ReadMaps(const UnitBuildContext& c) {
   const YAML::Node list = config::Child(c.parameters, "maps");
@@ -69,8 +39,8 @@ std::optional<std::vector<Unit::MapSpec>> ReadMaps(const UnitBuildContext& c) {
     spec.name = c.reader.String(m, mp, "name", std::nullopt);
     spec.height_m = c.reader.Real(m, mp, "height_m", std::nullopt, {-100.0, 100.0});
     spec.cell_m = c.reader.Real(m, mp, "cell_m", 0.0, {0.0, 0.5});
-    spec.from_own_laser = c.reader.String(m, mp, "source", "geometry",
-                                          {"geometry", "own_laser"}) == "own_laser";
+    spec.from_own_laser =
+        c.reader.String(m, mp, "source", "geometry", {"geometry", "own_laser"}) == "own_laser";
     for (std::size_t j = 0; j < maps.size(); ++j) {
       if (maps[j].name == spec.name) {
         c.reader.Error(m, mp, "map name '" + spec.name + "' is used twice");
@@ -110,7 +80,7 @@ std::unique_ptr<cosim::Unit> MakePerfectMatch(const UnitBuildContext& c) {
                                   std::vector<Unit::MapSpec>{{"map", 0.35, std::nullopt}});
   }
   const std::size_t issues = c.reader.issues().size();
-  const auto beams = ReadBeams(c);
+  const auto beams = ReadBeamCounts(c, "e.g. [541] for the LMS151 at 0.5 deg");
   const auto maps = ReadMaps(c);
   if (!beams || !maps || c.reader.issues().size() != issues) return nullptr;
   return std::make_unique<Unit>(c.name, c.scene, *beams, *maps);

@@ -1,5 +1,3 @@
-#include "units/evaluation/beacon_localization.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -9,6 +7,7 @@
 
 #include "cosim/seed.h"
 #include "models/angle.h"
+#include "units/evaluation/beacon_localization.h"
 
 namespace linesim::evaluation {
 namespace {
@@ -30,16 +29,27 @@ bool Inverse3(const std::array<double, 9>& a, std::array<double, 9>& inv) {
   const double scale = std::abs(a[0]) + std::abs(a[4]) + std::abs(a[8]);
   if (!(std::abs(det) > 1e-15 * scale * scale * scale) || !std::isfinite(det)) return false;
   const double d = 1.0 / det;
-  inv = {c00 * d,
-         (a[2] * a[7] - a[1] * a[8]) * d,
-         (a[1] * a[5] - a[2] * a[4]) * d,
-         c01 * d,
-         (a[0] * a[8] - a[2] * a[6]) * d,
-         (a[2] * a[3] - a[0] * a[5]) * d,
-         c02 * d,
-         (a[1] * a[6] - a[0] * a[7]) * d,
-         (a[0] * a[4] - a[1] * a[3]) * d};
+  inv = {c00 * d, (a[2] * a[7] - a[1] * a[8]) * d, (a[1] * a[5] - a[2] * a[4]) * d,
+         c01 * d, (a[0] * a[8] - a[2] * a[6]) * d, (a[2] * a[3] - a[0] * a[5]) * d,
+         c02 * d, (a[1] * a[6] - a[0] * a[7]) * d, (a[0] * a[4] - a[1] * a[3]) * d};
   return true;
+}
+
+// Row-major product of small matrices, each element summed in index order:
+// A B (A R x K, B K x C), or A B^T with `b_transposed` (B given C x K).
+template <std::size_t R, std::size_t K, std::size_t C, bool b_transposed = false>
+std::array<double, R * C> Product(const std::array<double, R * K>& a,
+                                  const std::array<double, K * C>& b) {
+  std::array<double, R * C> out{};
+  for (std::size_t r = 0; r < R; ++r) {
+    for (std::size_t c = 0; c < C; ++c) {
+      double acc = 0;
+      for (std::size_t q = 0; q < K; ++q)
+        acc += a[r * K + q] * b[b_transposed ? c * K + q : q * C + c];
+      out[r * C + c] = acc;
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -55,21 +65,18 @@ std::vector<const models::Obstacle*> BeaconLocalizationUnit::SceneBeacons(
 
 BeaconLocalizationUnit::BeaconLocalizationUnit(std::string name, std::vector<Beacon> beacons,
                                                int beam_count, std::uint64_t seed)
-    : cosim::Unit(kTypeName, std::move(name)), scene_beacons_(std::move(beacons)),
-      beacons_(scene_beacons_), beam_count_(beam_count), seed_(seed) {
+    : cosim::Unit(kTypeName, std::move(name)),
+      scene_beacons_(std::move(beacons)),
+      beacons_(scene_beacons_),
+      beam_count_(beam_count),
+      seed_(seed) {
   if (beam_count_ < 1 || beam_count_ > 100000) {
     throw cosim::UnitError(Where() + ": beam_count must be 1..100000, got " +
                            std::to_string(beam_count_));
   }
   const std::size_t nb = beacons_.size();
   if (!beacons_.empty()) radius_ = beacons_[0].radius;
-  beacon_distance_.assign(nb * nb, 0.0);
-  for (std::size_t a = 0; a < nb; ++a) {
-    for (std::size_t b = 0; b < nb; ++b) {
-      beacon_distance_[a * nb + b] =
-          std::hypot(beacons_[a].x - beacons_[b].x, beacons_[a].y - beacons_[b].y);
-    }
-  }
+  beacon_distance_.assign(nb * nb, 0.0);  // filled by Derive, from the surveyed beacons
   const auto n = static_cast<std::size_t>(beam_count_);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   mount_x_ = mount_y_ = mount_yaw_ = first_beam_angle_ = angular_step_ = nan;
@@ -89,102 +96,120 @@ BeaconLocalizationUnit::BeaconLocalizationUnit(std::string name, std::vector<Bea
 
   using cosim::Rule;
   auto& v = variables();
-  v.Parameter("mount_x", "m", &mount_x_, "the laser's origin in base_link, x",
-              Rule::Finite().NoDefault());
-  v.Parameter("mount_y", "m", &mount_y_, "the laser's origin in base_link, y",
-              Rule::Finite().NoDefault());
-  v.Parameter("mount_yaw", "rad", &mount_yaw_,
-              "the laser's yaw in base_link (scan plane taken level: 3-DoF)",
-              Rule::Finite().NoDefault());
-  v.Parameter("first_beam_angle", "rad", &first_beam_angle_, "direction of beam 0",
-              Rule::Range(-2 * std::numbers::pi, 2 * std::numbers::pi).NoDefault());
-  v.Parameter("angular_step", "rad", &angular_step_, "angle between neighbouring beams",
-              Rule::Range(0, false, std::numbers::pi, true).NoDefault());
-  v.Parameter("range_min", "m", &range_min_,
-              "nearer returns are not used (LMS151: 0.5 m, SICK 8012471)", Rule::NonNegative());
-  v.Parameter("range_max", "m", &range_max_,
-              "farther returns are not used (LMS151: 18 m at 10 % remission, SICK 8012471)",
-              Rule::Positive());
-  v.Parameter("range_sigma", "m", &range_sigma_,
-              "the range's statistical error, 1 sigma: the circle fit's point noise (LMS151: 12 "
-              "mm typical, SICK 8012471)",
-              Rule::Positive());
-  v.Parameter("systematic_sigma", "m", &systematic_sigma_,
-              "the range's systematic error per device, 1 sigma (LMS151: +-30 mm typical, taken "
-              "as 2 sigma, SICK 8012471): added to the output covariance and the gate",
-              Rule::NonNegative());
-  v.Parameter("flank_margin", "m", &flank_margin_,
-              "a beacon's silhouette: the beams nearer than its axis plus 2 range_sigma plus "
-              "this; it must end on both sides within the beacon's width (0: the van's beacons "
-              "stand 9 cm before the wall)",
-              Rule::Finite());
-  v.Parameter("edge_trim", &edge_trim_,
-              "beams dropped at either edge of a beacon's silhouette before the fit (the mixed pixels of "
-              "the spot, 15 mrad + 8 mm, SICK 8012471, at the silhouette)",
-              Rule::Range(0, 10));
-  v.Parameter("min_points", &min_points_, "a beacon's fit needs at least this many points",
-              Rule::Range(3, 100000));
-  v.Parameter("max_fit_rms", "m", &max_fit_rms_,
-              "a candidate whose circle fit leaves a larger residual RMS is no beacon "
-              "(ASSUMPTION 0.03: 2.5 range_sigma)",
-              Rule::Positive());
-  v.Parameter("outlier_sigmas", "1", &outlier_sigmas_,
-              "points farther than this many range_sigma from the first fit are dropped and the "
-              "circle fitted again",
-              Rule::Range(1.0, 100.0));
-  v.Parameter("pair_tolerance", "m", &pair_tolerance_,
-              "geometric association: a pair of detections matches a pair of beacons when their "
-              "distances agree within this (ASSUMPTION 0.06: two centres each off by up to the "
-              "LMS151's 40 mm maximum systematic error along different lines of sight, less "
-              "the common part)",
-              Rule::Positive());
-  v.Parameter("match_distance", "m", &match_distance_,
-              "geometric association: a detection joins a hypothesis within this of a beacon "
-              "(ASSUMPTION 0.1: below half the 0.95 m between the van's beacons)",
-              Rule::Positive());
-  v.Parameter("gate", "1", &gate_,
-              "association under the filter: Mahalanobis distance squared below this (13.8: "
-              "chi-square 2 dof, 99.9 %)",
-              Rule::Positive());
-  v.Parameter("min_beacons", &min_beacons_,
-              "beacons needed to start the filter and for `valid`", Rule::Range(2, kMaxBeacons));
-  v.Parameter("valid_scans", &valid_scans_,
-              "`valid` wants min_beacons distinct beacons associated within this many of the "
-              "last processed scans (a single scan may miss a beacon to noise; 5: 0.1 s at the "
-              "LMS151's 50 Hz)",
-              Rule::Range(1, 1000));
-  v.Parameter("uncover_delay", "s", &uncover_delay_,
-              "scans starting earlier than this after `active` rose are not used (ASSUMPTION 1 "
-              "s: paper 2 uncovered the beacons by hand once the robot stood inside; the filter "
-              "assumes a robot that no longer moves)",
-              Rule::NonNegative());
-  v.Parameter("heading_hint", "rad", &heading_hint_,
-              "decides between hypotheses a symmetric layout fits equally (the van's rectangle: "
-              "a pose and its half-turn): the one whose yaw is nearer wins; nothing else",
-              Rule::Finite());
-  v.Parameter("process_noise_position", "m/s^0.5", &process_noise_position_,
-              "random walk of the standing robot's position per sqrt(s) (ASSUMPTION 0.001: a "
-              "robot settling on its tyres and a van on its suspension, about 1 mm over a "
-              "second of 50 scans)",
-              Rule::NonNegative());
-  v.Parameter("process_noise_yaw", "rad/s^0.5", &process_noise_yaw_,
-              "random walk of the standing robot's yaw per sqrt(s) (ASSUMPTION 0.001)",
-              Rule::NonNegative());
-  v.Parameter("initial_sigma_position", "m", &initial_sigma_position_,
-              "the filter's position sigma at the geometric fix (ASSUMPTION 0.1: wide, the first "
-              "scan's update decides)",
-              Rule::Positive());
-  v.Parameter("initial_sigma_yaw", "rad", &initial_sigma_yaw_,
-              "the filter's yaw sigma at the geometric fix (ASSUMPTION 0.1)", Rule::Positive());
-
-  v.Parameter("survey_sigma", "m", &survey_sigma_,
-              "error of each surveyed beacon coordinate (1 sigma), drawn once per installation: "
-              "the filter knows the beacons there, not where they stand (0: exactly)",
-              Rule::Range(0.0, true, 0.1, true));
-  v.Parameter("installation_seed", &installation_seed_,
-              "which installation: >= 0 draws the survey errors from this seed, the same in "
-              "every run; -1: from the run's seed (a new installation per run)",
-              Rule::Range(-1, 4294967295.0));
+  // The parameters in the order `inspect` lists them: a real (with its
+  // unit) or an integer.
+  using Self = BeaconLocalizationUnit;
+  struct ParameterRow {
+    const char* name;
+    const char* unit;
+    double Self::*real;
+    std::int64_t Self::*integer;
+    const char* description;
+    Rule rule;
+  };
+  const ParameterRow parameters[] = {
+      {"mount_x", "m", &Self::mount_x_, nullptr, "the laser's origin in base_link, x",
+       Rule::Finite().NoDefault()},
+      {"mount_y", "m", &Self::mount_y_, nullptr, "the laser's origin in base_link, y",
+       Rule::Finite().NoDefault()},
+      {"mount_yaw", "rad", &Self::mount_yaw_, nullptr,
+       "the laser's yaw in base_link (scan plane taken level: 3-DoF)", Rule::Finite().NoDefault()},
+      {"first_beam_angle", "rad", &Self::first_beam_angle_, nullptr, "direction of beam 0",
+       Rule::Range(-2 * std::numbers::pi, 2 * std::numbers::pi).NoDefault()},
+      {"angular_step", "rad", &Self::angular_step_, nullptr, "angle between neighbouring beams",
+       Rule::Range(0, false, std::numbers::pi, true).NoDefault()},
+      {"range_min", "m", &Self::range_min_, nullptr,
+       "nearer returns are not used (LMS151: 0.5 m, SICK 8012471)", Rule::NonNegative()},
+      {"range_max", "m", &Self::range_max_, nullptr,
+       "farther returns are not used (LMS151: 18 m at 10 % remission, SICK 8012471)",
+       Rule::Positive()},
+      {"range_sigma", "m", &Self::range_sigma_, nullptr,
+       "the range's statistical error, 1 sigma: the circle fit's point noise (LMS151: 12 "
+       "mm typical, SICK 8012471)",
+       Rule::Positive()},
+      {"systematic_sigma", "m", &Self::systematic_sigma_, nullptr,
+       "the range's systematic error per device, 1 sigma (LMS151: +-30 mm typical, taken "
+       "as 2 sigma, SICK 8012471): added to the output covariance and the gate",
+       Rule::NonNegative()},
+      {"flank_margin", "m", &Self::flank_margin_, nullptr,
+       "a beacon's silhouette: the beams nearer than its axis plus 2 range_sigma plus "
+       "this; it must end on both sides within the beacon's width (0: the van's beacons "
+       "stand 9 cm before the wall)",
+       Rule::Finite()},
+      {"edge_trim", nullptr, nullptr, &Self::edge_trim_,
+       "beams dropped at either edge of a beacon's silhouette before the fit (the mixed pixels of "
+       "the spot, 15 mrad + 8 mm, SICK 8012471, at the silhouette)",
+       Rule::Range(0, 10)},
+      {"min_points", nullptr, nullptr, &Self::min_points_,
+       "a beacon's fit needs at least this many points", Rule::Range(3, 100000)},
+      {"max_fit_rms", "m", &Self::max_fit_rms_, nullptr,
+       "a candidate whose circle fit leaves a larger residual RMS is no beacon "
+       "(ASSUMPTION 0.03: 2.5 range_sigma)",
+       Rule::Positive()},
+      {"outlier_sigmas", "1", &Self::outlier_sigmas_, nullptr,
+       "points farther than this many range_sigma from the first fit are dropped and the "
+       "circle fitted again",
+       Rule::Range(1.0, 100.0)},
+      {"pair_tolerance", "m", &Self::pair_tolerance_, nullptr,
+       "geometric association: a pair of detections matches a pair of beacons when their "
+       "distances agree within this (ASSUMPTION 0.06: two centres each off by up to the "
+       "LMS151's 40 mm maximum systematic error along different lines of sight, less "
+       "the common part)",
+       Rule::Positive()},
+      {"match_distance", "m", &Self::match_distance_, nullptr,
+       "geometric association: a detection joins a hypothesis within this of a beacon "
+       "(ASSUMPTION 0.1: below half the 0.95 m between the van's beacons)",
+       Rule::Positive()},
+      {"gate", "1", &Self::gate_, nullptr,
+       "association under the filter: Mahalanobis distance squared below this (13.8: "
+       "chi-square 2 dof, 99.9 %)",
+       Rule::Positive()},
+      {"min_beacons", nullptr, nullptr, &Self::min_beacons_,
+       "beacons needed to start the filter and for `valid`", Rule::Range(2, kMaxBeacons)},
+      {"valid_scans", nullptr, nullptr, &Self::valid_scans_,
+       "`valid` wants min_beacons distinct beacons associated within this many of the "
+       "last processed scans (a single scan may miss a beacon to noise; 5: 0.1 s at the "
+       "LMS151's 50 Hz)",
+       Rule::Range(1, 1000)},
+      {"uncover_delay", "s", &Self::uncover_delay_, nullptr,
+       "scans starting earlier than this after `active` rose are not used (ASSUMPTION 1 "
+       "s: paper 2 uncovered the beacons by hand once the robot stood inside; the filter "
+       "assumes a robot that no longer moves)",
+       Rule::NonNegative()},
+      {"heading_hint", "rad", &Self::heading_hint_, nullptr,
+       "decides between hypotheses a symmetric layout fits equally (the van's rectangle: "
+       "a pose and its half-turn): the one whose yaw is nearer wins; nothing else",
+       Rule::Finite()},
+      {"process_noise_position", "m/s^0.5", &Self::process_noise_position_, nullptr,
+       "random walk of the standing robot's position per sqrt(s) (ASSUMPTION 0.001: a "
+       "robot settling on its tyres and a van on its suspension, about 1 mm over a "
+       "second of 50 scans)",
+       Rule::NonNegative()},
+      {"process_noise_yaw", "rad/s^0.5", &Self::process_noise_yaw_, nullptr,
+       "random walk of the standing robot's yaw per sqrt(s) (ASSUMPTION 0.001)",
+       Rule::NonNegative()},
+      {"initial_sigma_position", "m", &Self::initial_sigma_position_, nullptr,
+       "the filter's position sigma at the geometric fix (ASSUMPTION 0.1: wide, the first "
+       "scan's update decides)",
+       Rule::Positive()},
+      {"initial_sigma_yaw", "rad", &Self::initial_sigma_yaw_, nullptr,
+       "the filter's yaw sigma at the geometric fix (ASSUMPTION 0.1)", Rule::Positive()},
+      {"survey_sigma", "m", &Self::survey_sigma_, nullptr,
+       "error of each surveyed beacon coordinate (1 sigma), drawn once per installation: "
+       "the filter knows the beacons there, not where they stand (0: exactly)",
+       Rule::Range(0.0, true, 0.1, true)},
+      {"installation_seed", nullptr, nullptr, &Self::installation_seed_,
+       "which installation: >= 0 draws the survey errors from this seed, the same in "
+       "every run; -1: from the run's seed (a new installation per run)",
+       Rule::Range(-1, 4294967295.0)},
+  };
+  for (const ParameterRow& p : parameters) {
+    if (p.real) {
+      v.Parameter(p.name, p.unit, &(this->*p.real), p.description, p.rule);
+    } else {
+      v.Parameter(p.name, &(this->*p.integer), p.description, p.rule);
+    }
+  }
 
   v.Input("ranges", "m", &ranges_, "the laser's last complete scan (0: no return)");
   v.Input("scan_count", "1", &scan_count_, "the laser's complete scans so far");
@@ -224,9 +249,8 @@ std::vector<cosim::ParameterProblem> BeaconLocalizationUnit::CheckParameters() c
       problems.push_back({"beacons", j, "must have a finite position and a radius > 0"});
     } else if (std::abs(b.radius - radius_) > 1e-6) {
       problems.push_back({"beacons", j,
-                          "radius " + cosim::FormatValue(b.radius) +
-                              " differs from beacon 0's " + cosim::FormatValue(radius_) +
-                              ": the beacons must share one radius"});
+                          "radius " + cosim::FormatValue(b.radius) + " differs from beacon 0's " +
+                              cosim::FormatValue(radius_) + ": the beacons must share one radius"});
     }
   }
   if (!(range_min_ < range_max_)) {
@@ -247,10 +271,10 @@ void BeaconLocalizationUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ 
 void BeaconLocalizationUnit::Derive() {
   // The installation's survey: Box-Muller normals from its own generator
   // (the same draws on every Derive).
-  std::mt19937_64 survey(installation_seed_ >= 0
-                             ? cosim::DeriveSeed(static_cast<std::uint64_t>(installation_seed_),
-                                                 name() + " survey")
-                             : seed_);
+  std::mt19937_64 survey(
+      installation_seed_ >= 0
+          ? cosim::DeriveSeed(static_cast<std::uint64_t>(installation_seed_), name() + " survey")
+          : seed_);
   const auto uniform = [&survey] {
     return (static_cast<double>(survey() >> 11) + 0.5) * 0x1.0p-53;  // (0, 1)
   };
@@ -485,15 +509,7 @@ bool BeaconLocalizationUnit::AssociateByGeometry(std::array<double, 3>& laser_po
           best = j;
         }
       }
-      if (best < 0) continue;
-      const auto bj = static_cast<std::size_t>(best);
-      if (beacon_taken_[bj] >= 0) {
-        if (beacon_d2_[bj] <= best_d2) continue;
-        detections_[static_cast<std::size_t>(beacon_taken_[bj])].beacon = -1;
-      }
-      beacon_taken_[bj] = k;
-      beacon_d2_[bj] = best_d2;
-      d.beacon = best;
+      if (best >= 0) Claim(k, best, best_d2);
     }
   };
   // The least-squares rigid fit (2D Procrustes) of the assigned pairs: the
@@ -501,16 +517,13 @@ bool BeaconLocalizationUnit::AssociateByGeometry(std::array<double, 3>& laser_po
   const auto refine = [&](std::array<double, 3>& pose) {
     Assignment out;
     double dx = 0, dy = 0, bx = 0, by = 0;
-    for (int k = 0; k < nd; ++k) {
-      const Detection& d = detections_[static_cast<std::size_t>(k)];
-      if (d.beacon < 0) continue;
-      const Beacon& b = beacons_[static_cast<std::size_t>(d.beacon)];
+    ForEachPair([&](const Detection& d, const Beacon& b) {
       dx += d.x;
       dy += d.y;
       bx += b.x;
       by += b.y;
       ++out.pairs;
-    }
+    });
     if (out.pairs < 2) return out;
     const double inv = 1.0 / out.pairs;
     dx *= inv;
@@ -518,25 +531,19 @@ bool BeaconLocalizationUnit::AssociateByGeometry(std::array<double, 3>& laser_po
     bx *= inv;
     by *= inv;
     double sc = 0, sx = 0;
-    for (int k = 0; k < nd; ++k) {
-      const Detection& d = detections_[static_cast<std::size_t>(k)];
-      if (d.beacon < 0) continue;
-      const Beacon& b = beacons_[static_cast<std::size_t>(d.beacon)];
+    ForEachPair([&](const Detection& d, const Beacon& b) {
       const double ux = d.x - dx, uy = d.y - dy, vx = b.x - bx, vy = b.y - by;
       sc += ux * vx + uy * vy;
       sx += ux * vy - uy * vx;
-    }
+    });
     const double yaw = std::atan2(sx, sc);
     const double c = std::cos(yaw), s = std::sin(yaw);
     pose = {bx - (c * dx - s * dy), by - (s * dx + c * dy), yaw};
     double ss = 0;
-    for (int k = 0; k < nd; ++k) {
-      const Detection& d = detections_[static_cast<std::size_t>(k)];
-      if (d.beacon < 0) continue;
-      const Beacon& b = beacons_[static_cast<std::size_t>(d.beacon)];
+    ForEachPair([&](const Detection& d, const Beacon& b) {
       const double qx = pose[0] + c * d.x - s * d.y, qy = pose[1] + s * d.x + c * d.y;
       ss += (qx - b.x) * (qx - b.x) + (qy - b.y) * (qy - b.y);
-    }
+    });
     out.rms = std::sqrt(ss * inv);
     return out;
   };
@@ -575,14 +582,14 @@ bool BeaconLocalizationUnit::AssociateByGeometry(std::array<double, 3>& laser_po
           if (h.pairs > best.pairs) {
             better = true;
           } else if (h.pairs == best.pairs) {
-            const bool same = std::hypot(pose[0] - best_pose[0], pose[1] - best_pose[1]) <
-                                  kSamePosition &&
-                              std::abs(WrapAngle(pose[2] - best_pose[2])) < kSameYaw;
+            const bool same =
+                std::hypot(pose[0] - best_pose[0], pose[1] - best_pose[1]) < kSamePosition &&
+                std::abs(WrapAngle(pose[2] - best_pose[2])) < kSameYaw;
             if (same || std::abs(h.rms - best.rms) > kTieRms) {
               better = h.rms < best.rms;
             } else {
-              better = std::abs(WrapAngle(pose[2] - hint)) <
-                       std::abs(WrapAngle(best_pose[2] - hint));
+              better =
+                  std::abs(WrapAngle(pose[2] - hint)) < std::abs(WrapAngle(best_pose[2] - hint));
             }
           }
           if (better) {
@@ -631,21 +638,12 @@ void BeaconLocalizationUnit::AssociateByPrediction() {
     for (int j = 0; j < nb; ++j) {
       Observe(j, z, h);
       // S = H P H^T + R + sys^2 u u^T.
-      std::array<double, 6> hp{};  // H P (2 x 3)
-      for (int r = 0; r < 2; ++r) {
-        for (int col = 0; col < 3; ++col) {
-          double acc = 0;
-          for (int q = 0; q < 3; ++q) {
-            acc += h[static_cast<std::size_t>(r * 3 + q)] * p_[static_cast<std::size_t>(q * 3 + col)];
-          }
-          hp[static_cast<std::size_t>(r * 3 + col)] = acc;
-        }
-      }
+      const std::array<double, 6> hp = Product<2, 3, 3>(h, p_);  // H P
       double s00 = d.cxx, s01 = d.cxy, s11 = d.cyy;
-      for (int q = 0; q < 3; ++q) {
-        s00 += hp[static_cast<std::size_t>(q)] * h[static_cast<std::size_t>(q)];
-        s01 += hp[static_cast<std::size_t>(q)] * h[static_cast<std::size_t>(3 + q)];
-        s11 += hp[static_cast<std::size_t>(3 + q)] * h[static_cast<std::size_t>(3 + q)];
+      for (std::size_t q = 0; q < 3; ++q) {
+        s00 += hp[q] * h[q];
+        s01 += hp[q] * h[3 + q];
+        s11 += hp[3 + q] * h[3 + q];
       }
       const double zn = std::hypot(z[0], z[1]);
       if (zn > 0) {
@@ -663,21 +661,24 @@ void BeaconLocalizationUnit::AssociateByPrediction() {
         best = j;
       }
     }
-    if (best < 0) continue;
-    const auto bj = static_cast<std::size_t>(best);
-    if (beacon_taken_[bj] >= 0) {
-      if (beacon_d2_[bj] <= best_d2) continue;
-      detections_[static_cast<std::size_t>(beacon_taken_[bj])].beacon = -1;
-    }
-    beacon_taken_[bj] = k;
-    beacon_d2_[bj] = best_d2;
-    d.beacon = best;
+    if (best >= 0) Claim(k, best, best_d2);
   }
+}
+
+void BeaconLocalizationUnit::Claim(int k, int j, double d2) {
+  const auto bj = static_cast<std::size_t>(j);
+  if (beacon_taken_[bj] >= 0) {
+    if (beacon_d2_[bj] <= d2) return;
+    detections_[static_cast<std::size_t>(beacon_taken_[bj])].beacon = -1;
+  }
+  beacon_taken_[bj] = k;
+  beacon_d2_[bj] = d2;
+  detections_[static_cast<std::size_t>(k)].beacon = j;
 }
 
 int BeaconLocalizationUnit::Update() {
   int used = 0;
-  std::array<double, 9> info{};  // sum H^T R^-1 H at the prior
+  std::array<double, 9> info{};   // sum H^T R^-1 H at the prior
   std::array<double, 3> drift{};  // sum H^T R^-1 u
   std::array<double, 2> z{};
   std::array<double, 6> h{};
@@ -691,79 +692,46 @@ int BeaconLocalizationUnit::Update() {
     const double ri00 = d.cyy / rdet, ri01 = -d.cxy / rdet, ri11 = d.cxx / rdet;
     const double zn = std::hypot(z[0], z[1]);
     const double ux = zn > 0 ? z[0] / zn : 0.0, uy = zn > 0 ? z[1] / zn : 0.0;
-    for (int r = 0; r < 3; ++r) {
+    for (std::size_t r = 0; r < 3; ++r) {
       // (H^T R^-1) row r: h0r, h1r times R^-1.
-      const double h0 = h[static_cast<std::size_t>(r)], h1 = h[static_cast<std::size_t>(3 + r)];
+      const double h0 = h[r], h1 = h[3 + r];
       const double w0 = h0 * ri00 + h1 * ri01, w1 = h0 * ri01 + h1 * ri11;
-      for (int q = 0; q < 3; ++q) {
-        info[static_cast<std::size_t>(r * 3 + q)] +=
-            w0 * h[static_cast<std::size_t>(q)] + w1 * h[static_cast<std::size_t>(3 + q)];
-      }
-      drift[static_cast<std::size_t>(r)] += w0 * ux + w1 * uy;
+      for (std::size_t q = 0; q < 3; ++q) info[r * 3 + q] += w0 * h[q] + w1 * h[3 + q];
+      drift[r] += w0 * ux + w1 * uy;
     }
     // The update: S = H P H^T + R, K = P H^T S^-1, Joseph form.
-    std::array<double, 6> ph{};  // P H^T (3 x 2)
-    for (int r = 0; r < 3; ++r) {
-      for (int col = 0; col < 2; ++col) {
-        double acc = 0;
-        for (int q = 0; q < 3; ++q) {
-          acc += p_[static_cast<std::size_t>(r * 3 + q)] * h[static_cast<std::size_t>(col * 3 + q)];
-        }
-        ph[static_cast<std::size_t>(r * 2 + col)] = acc;
-      }
-    }
+    const std::array<double, 6> ph = Product<3, 3, 2, true>(p_, h);  // P H^T
     double s00 = d.cxx, s01 = d.cxy, s11 = d.cyy;
-    for (int q = 0; q < 3; ++q) {
-      s00 += h[static_cast<std::size_t>(q)] * ph[static_cast<std::size_t>(q * 2)];
-      s01 += h[static_cast<std::size_t>(q)] * ph[static_cast<std::size_t>(q * 2 + 1)];
-      s11 += h[static_cast<std::size_t>(3 + q)] * ph[static_cast<std::size_t>(q * 2 + 1)];
+    for (std::size_t q = 0; q < 3; ++q) {
+      s00 += h[q] * ph[q * 2];
+      s01 += h[q] * ph[q * 2 + 1];
+      s11 += h[3 + q] * ph[q * 2 + 1];
     }
     const double sdet = s00 * s11 - s01 * s01;
     if (!(sdet > 0)) continue;
     const double si00 = s11 / sdet, si01 = -s01 / sdet, si11 = s00 / sdet;
     std::array<double, 6> kg{};  // K (3 x 2)
-    for (int r = 0; r < 3; ++r) {
-      const double a = ph[static_cast<std::size_t>(r * 2)], b = ph[static_cast<std::size_t>(r * 2 + 1)];
-      kg[static_cast<std::size_t>(r * 2)] = a * si00 + b * si01;
-      kg[static_cast<std::size_t>(r * 2 + 1)] = a * si01 + b * si11;
+    for (std::size_t r = 0; r < 3; ++r) {
+      const double a = ph[r * 2], b = ph[r * 2 + 1];
+      kg[r * 2] = a * si00 + b * si01;
+      kg[r * 2 + 1] = a * si01 + b * si11;
     }
     const double vx = d.x - z[0], vy = d.y - z[1];
-    for (int r = 0; r < 3; ++r) {
-      x_[static_cast<std::size_t>(r)] +=
-          kg[static_cast<std::size_t>(r * 2)] * vx + kg[static_cast<std::size_t>(r * 2 + 1)] * vy;
-    }
+    for (std::size_t r = 0; r < 3; ++r) x_[r] += kg[r * 2] * vx + kg[r * 2 + 1] * vy;
     x_[2] = WrapAngle(x_[2]);
     // A = I - K H; P = A P A^T + K R K^T.
     std::array<double, 9> am{};
-    for (int r = 0; r < 3; ++r) {
-      for (int q = 0; q < 3; ++q) {
-        am[static_cast<std::size_t>(r * 3 + q)] =
-            (r == q ? 1.0 : 0.0) -
-            kg[static_cast<std::size_t>(r * 2)] * h[static_cast<std::size_t>(q)] -
-            kg[static_cast<std::size_t>(r * 2 + 1)] * h[static_cast<std::size_t>(3 + q)];
+    for (std::size_t r = 0; r < 3; ++r) {
+      for (std::size_t q = 0; q < 3; ++q) {
+        am[r * 3 + q] = (r == q ? 1.0 : 0.0) - kg[r * 2] * h[q] - kg[r * 2 + 1] * h[3 + q];
       }
     }
-    std::array<double, 9> ap{};
-    for (int r = 0; r < 3; ++r) {
-      for (int q = 0; q < 3; ++q) {
-        double acc = 0;
-        for (int m = 0; m < 3; ++m) {
-          acc += am[static_cast<std::size_t>(r * 3 + m)] * p_[static_cast<std::size_t>(m * 3 + q)];
-        }
-        ap[static_cast<std::size_t>(r * 3 + q)] = acc;
-      }
-    }
-    for (int r = 0; r < 3; ++r) {
-      for (int q = r; q < 3; ++q) {
-        double acc = 0;
-        for (int m = 0; m < 3; ++m) {
-          acc += ap[static_cast<std::size_t>(r * 3 + m)] * am[static_cast<std::size_t>(q * 3 + m)];
-        }
-        const double k0r = kg[static_cast<std::size_t>(r * 2)], k1r = kg[static_cast<std::size_t>(r * 2 + 1)];
-        const double k0q = kg[static_cast<std::size_t>(q * 2)], k1q = kg[static_cast<std::size_t>(q * 2 + 1)];
-        acc += k0r * (d.cxx * k0q + d.cxy * k1q) + k1r * (d.cxy * k0q + d.cyy * k1q);
-        p_[static_cast<std::size_t>(r * 3 + q)] = acc;
-        p_[static_cast<std::size_t>(q * 3 + r)] = acc;
+    const std::array<double, 9> apa = Product<3, 3, 3, true>(Product<3, 3, 3>(am, p_), am);
+    for (std::size_t r = 0; r < 3; ++r) {
+      for (std::size_t q = r; q < 3; ++q) {
+        const double k0r = kg[r * 2], k1r = kg[r * 2 + 1], k0q = kg[q * 2], k1q = kg[q * 2 + 1];
+        const double krk = k0r * (d.cxx * k0q + d.cxy * k1q) + k1r * (d.cxy * k0q + d.cyy * k1q);
+        p_[r * 3 + q] = p_[q * 3 + r] = apa[r * 3 + q] + krk;
       }
     }
     ++used;
@@ -771,10 +739,8 @@ int BeaconLocalizationUnit::Update() {
   // The pose's sensitivity to a common range offset under this geometry.
   std::array<double, 9> inv{};
   if (used >= 2 && Inverse3(info, inv)) {
-    for (int r = 0; r < 3; ++r) {
-      g_[static_cast<std::size_t>(r)] = inv[static_cast<std::size_t>(r * 3)] * drift[0] +
-                                        inv[static_cast<std::size_t>(r * 3 + 1)] * drift[1] +
-                                        inv[static_cast<std::size_t>(r * 3 + 2)] * drift[2];
+    for (std::size_t r = 0; r < 3; ++r) {
+      g_[r] = inv[r * 3] * drift[0] + inv[r * 3 + 1] * drift[1] + inv[r * 3 + 2] * drift[2];
     }
   }
   return used;
@@ -786,7 +752,8 @@ void BeaconLocalizationUnit::PublishOutputs() {
   yaw_ = WrapAngle(x_[2]);
   const double sys2 = systematic_sigma_ * systematic_sigma_;
   for (std::size_t r = 0; r < 3; ++r) {
-    for (std::size_t q = 0; q < 3; ++q) covariance_[r * 3 + q] = p_[r * 3 + q] + sys2 * g_[r] * g_[q];
+    for (std::size_t q = 0; q < 3; ++q)
+      covariance_[r * 3 + q] = p_[r * 3 + q] + sys2 * g_[r] * g_[q];
   }
 }
 
@@ -848,8 +815,8 @@ cosim::StepResult BeaconLocalizationUnit::DoStep(cosim::TimeNs t, cosim::TimeNs)
   was_active_ = active_;
   if (scan_count_ != last_count_) {
     last_count_ = scan_count_;
-    if (active_ && cosim::SecondsToNs(scan_time_) >=
-                       active_since_ns_ + cosim::SecondsToNs(uncover_delay_)) {
+    if (active_ &&
+        cosim::SecondsToNs(scan_time_) >= active_since_ns_ + cosim::SecondsToNs(uncover_delay_)) {
       ProcessScan();
     }
   }
@@ -858,8 +825,7 @@ cosim::StepResult BeaconLocalizationUnit::DoStep(cosim::TimeNs t, cosim::TimeNs)
 }
 
 void BeaconLocalizationUnit::SaveInternal(cosim::UnitState& state) const {
-  state.integers = {start_, was_active_ ? 1 : 0, started_ ? 1 : 0, scan_index_,
-                    active_since_ns_};
+  state.integers = {start_, was_active_ ? 1 : 0, started_ ? 1 : 0, scan_index_, active_since_ns_};
   state.integers.insert(state.integers.end(), beacon_last_scan_.begin(), beacon_last_scan_.end());
   state.reals = {last_count_, last_scan_time_};
   state.reals.insert(state.reals.end(), x_.begin(), x_.end());

@@ -124,12 +124,12 @@ class BeaconLocalizationUnit : public cosim::Unit {
   };
   /// A fitted beacon candidate of the last processed scan (laser frame).
   struct Detection {
-    double x = 0, y = 0;              // centre (m)
-    double cxx = 0, cxy = 0, cyy = 0; // its covariance (m^2)
-    double rms = 0;                   // fit residual RMS (m)
-    int points = 0;                   // points in the final fit
+    double x = 0, y = 0;               // centre (m)
+    double cxx = 0, cxy = 0, cyy = 0;  // its covariance (m^2)
+    double rms = 0;                    // fit residual RMS (m)
+    int points = 0;                    // points in the final fit
     int first_beam = 0, last_beam = 0;
-    int beacon = -1;                  // associated known beacon, -1: none
+    int beacon = -1;  // associated known beacon, -1: none
   };
 
   /// The scene's obstacles of kind `beacon` (any shape; the factory
@@ -181,6 +181,17 @@ class BeaconLocalizationUnit : public cosim::Unit {
   bool AssociateByGeometry(std::array<double, 3>& laser_pose);
   /// Gated association under the filter's prediction.
   void AssociateByPrediction();
+  /// Detection k takes beacon j at squared distance d2 unless another
+  /// detection holds it nearer (one detection per beacon: the nearer wins).
+  void Claim(int k, int j, double d2);
+  /// Calls f(detection, its beacon) for each associated detection, in order.
+  template <typename F>
+  void ForEachPair(F f) const {
+    for (int k = 0; k < detection_count_; ++k) {
+      const Detection& d = detections_[static_cast<std::size_t>(k)];
+      if (d.beacon >= 0) f(d, beacons_[static_cast<std::size_t>(d.beacon)]);
+    }
+  }
   /// The EKF update with the associated detections; their count.
   int Update();
   /// Predicted laser-frame position of beacon j and its 2 x 3 Jacobian.
@@ -242,7 +253,7 @@ class BeaconLocalizationUnit : public cosim::Unit {
   std::array<double, 9> p_{};
   std::int64_t scan_index_ = 0;                 // scans processed while active
   std::vector<std::int64_t> beacon_last_scan_;  // per beacon: its last association's scan_index_
-  std::array<double, 3> g_{};  // sensitivity of the pose to a common range offset
+  std::array<double, 3> g_{};                   // sensitivity of the pose to a common range offset
 };
 
 }  // namespace linesim::evaluation
