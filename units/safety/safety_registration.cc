@@ -34,7 +34,8 @@ std::unique_ptr<cosim::Unit> MakeSafetyField(const config::UnitBuildContext& c) 
   config::YamlReader& r = c.reader;
   const bool inspect = !c.parameters.IsDefined() || c.parameters.IsNull();
   const std::size_t issues_before = r.issues().size();
-  const auto beams = r.Integer(c.parameters, c.path, "beam_count", 541, 1, 100000);
+  // `linesim inspect`: one beam keeps the table readable.
+  const auto beams = r.Integer(c.parameters, c.path, "beam_count", inspect ? 1 : 541, 1, 100000);
   std::vector<SafetyFieldUnit::FieldSet> sets;
   if (inspect) {
     sets.push_back({1e9, {{0.0, -0.4}, {0.6, -0.4}, {0.6, 0.4}}, {}});
