@@ -17,10 +17,10 @@ using test_scenarios::Shipped;
 // positive distance, makes at least one protective stop and still finishes
 // its path.
 // Spread seen (seeds 1..8): person_collisions 0 and collisions 0 on every
-// seed; min_person_distance_m min 0.113 / median 0.128 / max 0.131 m (the
-// protective stop leaves 11-13 cm to the nearest leg); protective_stops 1
-// on every seed; time_stopped_s 8.60 / 8.70 / 8.72 s; task_time_s
-// 35.42 / 35.47 / 35.48 s (the path alone takes about 25 s). The bounds
+// seed; min_person_distance_m min 0.125 / median 0.131 / max 0.143 m (the
+// protective stop leaves 12-14 cm to the nearest leg); protective_stops 1
+// on every seed; time_stopped_s 8.68 / 8.72 / 8.80 s; task_time_s
+// 35.46 / 35.48 / 35.52 s (the path alone takes about 25 s). The bounds
 // asserted are the definition of the safety function's success, not the
 // spread: no contact, a positive distance, a stop, a finished task.
 TEST(WorkerCrossing, ProtectiveStopBeforeThePerson) {

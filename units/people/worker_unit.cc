@@ -128,8 +128,9 @@ WorkerUnit::State WorkerUnit::At(double t_s) const {
     st.segment = k;
     const double tau = t_s - s.start_s;
     double d = s.length_m;
-    double v = 0.0;
+    double v = 0.0, dv = 0.0;
     if (tau < s.ramp_s) {
+      dv = acceleration_;
       d = 0.5 * acceleration_ * tau * tau;
       v = acceleration_ * tau;
     } else if (tau < s.duration_s - s.ramp_s) {
@@ -137,11 +138,14 @@ WorkerUnit::State WorkerUnit::At(double t_s) const {
       v = s.cruise_mps;
     } else if (tau < s.duration_s) {
       const double left = s.duration_s - tau;
+      dv = -acceleration_;
       d = s.length_m - 0.5 * acceleration_ * left * left;
       v = acceleration_ * left;
     }
     st.distance_m = s.cum_m + d;
     st.speed_mps = v;
+    st.acceleration_mps2 = dv;
+    st.cruise_mps = s.cruise_mps;
     st.x_m = waypoints_[k][0] + s.ux * d;
     st.y_m = waypoints_[k][1] + s.uy * d;
   }
@@ -178,15 +182,20 @@ void WorkerUnit::Evaluate(double t_s) {
   speed_out_ = st.speed_mps;
   distance_out_ = st.distance_m;
   phase_out_ = initial_phase_ + st.distance_m / stride_length_;
+  // The steps' length follows the speed over the segment's cruise speed
+  // (w): full strides while cruising, the feet side by side standing.
+  const double w = st.cruise_mps > 0.0 ? st.speed_mps / st.cruise_mps : 0.0;
+  const double dw = st.cruise_mps > 0.0 ? st.acceleration_mps2 / st.cruise_mps : 0.0;
   for (int leg = 0; leg < 2; ++leg) {
     double offset = 0.0, rate = 0.0;
     LegOffset(phase_out_ - 0.5 * leg, offset, rate);
     const double side = leg == 0 ? 0.5 * leg_spacing_ : -0.5 * leg_spacing_;
     const std::size_t i = 2 * static_cast<std::size_t>(leg);
-    legs_[i] = st.x_m + ux * offset + nx * side;
-    legs_[i + 1] = st.y_m + uy * offset + ny * side;
-    // d offset / dt = rate * speed; a stance foot is still (rate -1).
-    const double along = st.speed_mps * (1.0 + rate);
+    legs_[i] = st.x_m + ux * w * offset + nx * side;
+    legs_[i + 1] = st.y_m + uy * w * offset + ny * side;
+    // d (w offset) / dt = w rate speed + w' offset; while cruising a stance
+    // foot is still (rate -1).
+    const double along = st.speed_mps * (1.0 + w * rate) + dw * offset;
     leg_velocities_[i] = along * ux;
     leg_velocities_[i + 1] = along * uy;
   }

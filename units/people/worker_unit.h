@@ -27,11 +27,14 @@ namespace linesim::people {
 /// body, it moves back by stance_fraction * stride_length at the walking
 /// speed (from +f/2 to -f/2 stride lengths along the heading, f the stance
 /// fraction); in swing it returns forward along a half cosine. The right
-/// leg is half a stride behind the left. Legs are vertical cylinders of
+/// leg is half a stride behind the left. The offsets scale with speed /
+/// the segment's cruise speed: while cruising a stance foot stays fixed on
+/// the floor; the steps shorten as the worker slows, and standing the feet
+/// are side by side (the stance foot slides a little over the 1 s ramps: a
+/// simplification). Legs are vertical cylinders of
 /// leg_radius (the section at a scanner's height) from the floor to
 /// crotch_height, leg_spacing apart across the heading; the torso is a
-/// cylinder of torso_radius from crotch_height to stature. Standing, the
-/// legs stay where the last step left them.
+/// cylinder of torso_radius from crotch_height to stature.
 ///
 /// Outputs: the pose, velocity, speed, the legs' positions and velocities,
 /// and `cylinders`: per cylinder (left leg, right leg, torso)
@@ -58,6 +61,8 @@ class WorkerUnit : public cosim::Unit {
   /// direction the heading is, and the position.
   struct State {
     double distance_m = 0.0, speed_mps = 0.0;
+    double acceleration_mps2 = 0.0;  // of the speed profile (0 cruising or standing)
+    double cruise_mps = 0.0;         // the segment's top speed
     std::size_t segment = 0;
     double x_m = 0.0, y_m = 0.0;
   };

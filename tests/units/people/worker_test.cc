@@ -59,6 +59,11 @@ TEST(Worker, TrapezoidDistancesAndPause) {
   RunTo(u, 1.0 + walk + 2.99, now);
   EXPECT_NEAR(Get(u, "pose")[1], 4.0, 1e-12);
   EXPECT_EQ(Get(u, "legs"), legs_at_line);
+  // Standing, the feet side by side across the heading (+y): at x = +-0.1.
+  EXPECT_NEAR(legs_at_line[0], -0.1, 1e-12);
+  EXPECT_NEAR(legs_at_line[1], 4.0, 1e-12);
+  EXPECT_NEAR(legs_at_line[2], 0.1, 1e-12);
+  EXPECT_NEAR(legs_at_line[3], 4.0, 1e-12);
   // Back: 8 m in all, heading -y, at waypoint 0.
   RunTo(u, 1.0 + 2 * walk + 3.0 + 0.5, now);
   EXPECT_NEAR(Get(u, "distance")[0], 8.0, 1e-12);
@@ -100,6 +105,31 @@ TEST(Worker, StanceFootStaysOnTheFloor) {
   EXPECT_EQ(cyl[7 + 1], Get(u, "legs")[3]);
   EXPECT_EQ(cyl[14], Get(u, "pose")[0]);
   EXPECT_EQ(cyl[4], 0.045);
+}
+
+// Guards against leg velocities (what a scanner extrapolates a leg with)
+// that are not the legs' motion: at instants in the ramp up, while
+// cruising and in the ramp down, leg_velocities equals the central
+// difference of legs over +-10 us (truncation h^2 x''' / 6 below 1e-8 m/s
+// for accelerations of order 100 m/s^2 in swing; rounding 4 m * 1e-16 /
+// 1e-5 s = 4e-11 m/s).
+TEST(Worker, LegVelocitiesAreTheLegsMotion) {
+  WorkerUnit u("w", {{0.0, 0.0}, {0.0, 4.0}});
+  u.Setup(0, 0);
+  u.Initialize();
+  const cosim::TimeNs h = 10'000;  // 10 us
+  for (const double t : {0.5, 2.0, 3.9}) {
+    const auto at = static_cast<cosim::TimeNs>(std::llround(t * 1e9));
+    ASSERT_EQ(u.DoStep(at - 2 * h, h), cosim::StepResult::kOk);  // outputs at t - h
+    const auto before = Get(u, "legs");
+    ASSERT_EQ(u.DoStep(at - h, h), cosim::StepResult::kOk);  // at t
+    const auto velocity = Get(u, "leg_velocities");
+    ASSERT_EQ(u.DoStep(at, h), cosim::StepResult::kOk);  // at t + h
+    const auto after = Get(u, "legs");
+    for (std::size_t i = 0; i < 4; ++i) {
+      EXPECT_NEAR(velocity[i], (after[i] - before[i]) / 2e-5, 1e-6) << "t " << t << " i " << i;
+    }
+  }
 }
 
 // Guards against a leg offset profile that jumps: at the end of swing the
