@@ -130,6 +130,9 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat forma
   spec.flow_truth_columns = robot.flow_truth_columns;
   spec.flow_filtered_columns = robot.flow_filtered_columns;
   spec.flow_reference_column = robot.flow_reference_column;
+  spec.worker_columns = robot.worker_columns;
+  spec.safety = {robot.velocity_x_column, robot.velocity_y_column, robot.speed_cap_column,
+                 robot.protective_column,  robot.warning_column,    robot.person_distance_column};
   if (!robot.scan_unit.empty()) {
     // The beams' geometry is the laser unit's: read its parameters.
     for (std::size_t u = 0; u < s.system->unit_count(); ++u) {

@@ -5,6 +5,7 @@
 
 #include "cosim/variable_table.h"
 #include "loader/assembly/concerns.h"
+#include "loader/assembly/people.h"
 #include "loader/robot_file.h"
 #include "models/angle.h"
 
@@ -120,7 +121,7 @@ YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
   r.CheckKeys(root, "",
               {"name", "description", "duration_s", "seed", "master", "robot", "scene", "line",
                "control", "task", "sensors", "sensing", "localization", "units", "connections",
-               "recording", "metrics", "reference"});
+               "recording", "metrics", "reference", "workers", "safety"});
   assembly::SystemBuilder b(root, r);
   for (const char* key : {"name", "description", "duration_s", "seed", "master", "reference"}) {
     if (Child(root, key).IsDefined()) b.out()[key] = Child(root, key);
@@ -150,10 +151,12 @@ YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
     assembly::AddSensors(b, *file, s);
     assembly::AddSensing(b, *file, start, scene, s);
     assembly::AddControl(b, *file, s);
+    assembly::AddSafetyFields(b, *file, s);
     assembly::AddTask(b, *file, start, s, info);
     assembly::ConnectMapSwitch(b, s);
     assembly::AddBeaconGroundTruth(b, *file, start, scene, s);
     assembly::AddEvaluation(b, file->robot, s, info);
+    assembly::AddWorkers(b, *file, s, info);
     assembly::AddRecording(b, s, info);
   }
   Passthrough(b);

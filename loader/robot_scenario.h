@@ -43,6 +43,13 @@ struct RobotInfo {
   /// (sensors.NAME.snapshot_s; its ranges and scan_time are recorded), or "".
   std::string scan_unit;
   double scan_time_s = 0.0;
+  /// Workers and the safety fields (loader/assembly/people.cc): each
+  /// worker's pose x and y columns; the robot's map velocity x and y, the
+  /// safety unit's speed cap and field states, the distance to the nearest
+  /// person ("" without them).
+  std::vector<std::pair<std::string, std::string>> worker_columns;
+  std::string velocity_x_column, velocity_y_column, speed_cap_column, protective_column,
+      warning_column, person_distance_column;
 };
 
 /// A robot scenario is written at the level of robot, scene, line, control,

@@ -408,6 +408,20 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   const int iref = spec.flow_reference_column.empty()
                        ? 0
                        : column(spec.flow_reference_column, "ground-truth surface speed");
+  std::vector<std::pair<int, int>> workers;
+  for (const auto& [wx, wy] : spec.worker_columns) {
+    workers.emplace_back(column(wx, "worker x"), column(wy, "worker y"));
+  }
+  const RobotPlotSpec::Safety& safety = spec.safety;
+  const bool has_safety = !safety.cap_column.empty();
+  const int ivx = has_safety ? column(safety.velocity_x_column, "robot vx") : 0;
+  const int ivy = has_safety ? column(safety.velocity_y_column, "robot vy") : 0;
+  const int icap = has_safety ? column(safety.cap_column, "speed cap") : 0;
+  const int iprot = has_safety ? column(safety.protective_column, "protective field") : 0;
+  const int iwarn = has_safety ? column(safety.warning_column, "warning field") : 0;
+  const int idist = has_safety && !safety.distance_column.empty()
+                        ? column(safety.distance_column, "person distance")
+                        : 0;
   column.ThrowIfUnknown();
   if (!travels.empty() && travels.size() != spec.scene.belts.size()) {
     throw std::runtime_error("robot plots: " + std::to_string(travels.size()) +
@@ -662,6 +676,11 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   if (!outlines.empty()) {
     items.push_back("$outlines using 1:2 with lines lw 1 lc rgb '#1f77b4' title 'robot outline'");
   }
+  for (std::size_t w = 0; w < workers.size(); ++w) {
+    items.push_back(signals_file + " skip 1 using " + std::to_string(workers[w].first) + ":" +
+                    std::to_string(workers[w].second) + " with lines lw 2 lc rgb '#9467bd' " +
+                    (w == 0 ? "title 'worker'" : "notitle"));
+  }
   if (!contacts.empty()) {
     items.push_back(
         "$contacts using 1:2 with points pt 7 ps 0.8 lc rgb '#2ca02c' title 'wheel contacts'");
@@ -794,6 +813,36 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     s += ScanPlot(spec, signals, row_starts, ix, iy, iyaw, travels, title_prefix, outputs);
   }
   if (iz > 0) s += SideView(spec, signals, row_starts, ix, iy, iz, title_prefix, outputs);
+  if (has_safety) {
+    // Speeds and the distance on the left axis; the fields' states as steps
+    // on the right (1 clear, 0 infringed), offset so that both show.
+    s += "\n" + SetOutput("safety", spec.format, outputs) + "set title " +
+         GnuplotQuote(title_prefix + "S300 safety fields: speed, speed cap, distance to the person") +
+         "\n" + time_plot +
+         "set ylabel 'speed (m/s), distance (m)'\nset yrange [0:*]\n"
+         "set y2label 'field clear (1) / infringed (0)'\nset y2range [-0.1:1.3]\n"
+         "set y2tics 0, 1, 1\nset ytics nomirror\nset offsets 0, 0, graph 0.05, 0\nplot ";
+    items.clear();
+    items.push_back(signals_file + " skip 1 using 1:(sqrt(column(" + std::to_string(ivx) +
+                    ")**2 + column(" + std::to_string(ivy) +
+                    ")**2)) with lines lw 2 lc rgb '#1f77b4' title 'robot speed'");
+    items.push_back(signals_file + " skip 1 using 1:(column(" + std::to_string(icap) +
+                    ") < 0 ? NaN : column(" + std::to_string(icap) +
+                    ")) with lines dt 2 lw 2 lc rgb '#ff7f0e' title 'speed cap'");
+    if (idist > 0) {
+      items.push_back(signals_file + " skip 1 using 1:(column(" + std::to_string(idist) +
+                      ") > 1.5 ? NaN : column(" + std::to_string(idist) +
+                      ")) with lines lw 1.5 lc rgb '#9467bd' "
+                      "title 'distance to the person (below 1.5 m)'");
+    }
+    items.push_back(signals_file + " skip 1 using 1:" + std::to_string(iprot) +
+                    " axes x1y2 with steps lw 2 lc rgb '#d62728' title 'protective field clear'");
+    items.push_back(signals_file + " skip 1 using 1:(column(" + std::to_string(iwarn) +
+                    ") * 1.1) axes x1y2 with steps lw 1.5 dt 3 lc rgb '#2ca02c' "
+                    "title 'warning field clear (x 1.1)'");
+    for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
+    s += "\nset yrange [*:*]\nset y2range [*:*]\nset bmargin -1\n";
+  }
   s += "unset output\n";
   return s;
 }
@@ -805,7 +854,7 @@ const std::vector<std::string>& RobotPlotFiles() {
     std::vector<std::string> names = {kScript};
     for (PlotFormat f : {PlotFormat::kPng, PlotFormat::kSvg, PlotFormat::kPdf}) {
       for (const char* name :
-           {"top_view", "error", "belt", "optic_flow", "scan", "side_view"}) {
+           {"top_view", "error", "belt", "optic_flow", "scan", "side_view", "safety"}) {
         names.push_back(PlotFile(name, f));
       }
     }

@@ -80,6 +80,18 @@ struct RobotPlotSpec {
     double first_beam_rad = 0.0, beam_step_rad = 0.0, no_return_m = 0.0;
   };
   Scan scan;
+  /// The S300's safety function against a person (safety.png): the robot's
+  /// speed (from its map velocity's x and y columns), the safety unit's
+  /// speed cap (-1: none), the protective and warning fields' states (1
+  /// clear, 0 infringed) and the distance from the body to the nearest
+  /// person. None when cap_column is empty.
+  struct Safety {
+    std::string velocity_x_column, velocity_y_column, cap_column, protective_column,
+        warning_column, distance_column;
+  };
+  Safety safety;
+  /// Each worker's track in the top view: x and y columns of its pose.
+  std::vector<std::pair<std::string, std::string>> worker_columns;
   /// Robot outlines and wheel footprints drawn at this many instants,
   /// evenly spaced over the recorded rows from first to last.
   int footprint_count = 5;
@@ -91,7 +103,8 @@ struct RobotPlotSpec {
   PlotFormat format = PlotFormat::kPng;
 };
 
-/// Writes top_view.png, and error.png, belt.png, optic_flow.png, scan.png and side_view.png when the spec asks for
+/// Writes top_view.png, and error.png, belt.png, optic_flow.png, scan.png, side_view.png and
+/// safety.png when the spec asks for
 /// them, into `dir`, from `dir`/signals.csv. The gnuplot script is left in
 /// `dir`/plots.gp with paths relative to `dir`, so `gnuplot plots.gp` run in
 /// `dir` redraws the plots. Returns the paths of the pictures written (spec.format).

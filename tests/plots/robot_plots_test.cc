@@ -157,6 +157,45 @@ TEST_F(RobotPlotsTest, SideViewDrawsTheHeightOverTheGround) {
   EXPECT_NE(script.find("\n1,0.1,0\n"), std::string::npos);
 }
 
+// Guards against the safety plot missing or drawing the wrong columns: a
+// robot at 0.3 m/s stopped by its protective field from 2 s to 4 s, with a
+// worker walking beside it. safety.png is drawn from the velocity, cap and
+// field columns, the cap of -1 (none) left out, and the top view draws the
+// worker's track.
+TEST_F(RobotPlotsTest, SafetyPlotDrawsSpeedCapAndFields) {
+  {
+    std::ofstream out(dir_ / "signals.csv");
+    out << "time,chassis.position[0],chassis.position[1],chassis.linear_velocity[0],"
+           "chassis.linear_velocity[1],safety.speed_cap,safety.protective_clear,"
+           "safety.warning_clear,person_clearance.distance,worker.pose[0],worker.pose[1]\n";
+    for (int k = 0; k <= 60; ++k) {
+      const double t = 0.1 * k;
+      const bool stopped = t >= 2.0 && t < 4.0;
+      out << t << ",0," << 0.3 * t << ",0," << (stopped ? 0.0 : 0.3) << ","
+          << (stopped ? 0.0 : -1.0) << "," << (stopped ? 0 : 1) << "," << (t >= 1.5 ? 0 : 1)
+          << "," << 1.0 - 0.1 * t << "," << -2.0 + 0.3 * t << ",1\n";
+    }
+  }
+  RobotPlotSpec spec;
+  spec.x_column = "chassis.position[0]";
+  spec.y_column = "chassis.position[1]";
+  spec.safety = {"chassis.linear_velocity[0]", "chassis.linear_velocity[1]", "safety.speed_cap",
+                 "safety.protective_clear",    "safety.warning_clear",
+                 "person_clearance.distance"};
+  spec.worker_columns = {{"worker.pose[0]", "worker.pose[1]"}};
+  const auto files = WriteRobotPlots(dir_.string(), spec);
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(fs::path(files[1]).filename(), "safety.png");
+  EXPECT_TRUE(IsPng(files[1]));
+  const std::string script = ReadAll(dir_ / "plots.gp");
+  // Columns by number: velocity 4 and 5, cap 6 (-1: NaN), fields 7 and 8,
+  // distance 9; the worker's track 10:11 in the top view.
+  EXPECT_NE(script.find("sqrt(column(4)**2 + column(5)**2)"), std::string::npos);
+  EXPECT_NE(script.find("column(6) < 0 ? NaN : column(6)"), std::string::npos);
+  EXPECT_NE(script.find("using 1:7 axes x1y2 with steps"), std::string::npos);
+  EXPECT_NE(script.find("using 10:11 with lines"), std::string::npos);
+}
+
 // Guards against output that changes from run to run (timestamps, map
 // order): the same input gives the same script and the same PNG bytes.
 TEST_F(RobotPlotsTest, IsDeterministic) {

@@ -55,9 +55,11 @@ std::unique_ptr<cosim::Unit> MakeLaserScanner(const UnitBuildContext& c) {
       }
     }
   }
+  // Only the scenario sets it (a property of the scene, not of the device).
+  const auto moving = c.reader.Integer(c.parameters, c.path, "moving_cylinders", 0, 0, 100000);
   if (c.reader.issues().size() != issues_before) return nullptr;
   return std::make_unique<LaserScannerUnit>(c.name, c.scene, static_cast<int>(beams),
-                                            std::move(field), c.seed);
+                                            std::move(field), c.seed, static_cast<int>(moving));
 }
 
 const config::UnitTypeRegistrar kLaserScanner(
@@ -71,7 +73,10 @@ const config::UnitTypeRegistrar kLaserScanner(
       {"protective_field",
        "corners [x, y] (m, scanner frame) of the protective field polygon (adds "
        "field_clear and multiple_sampling); from the model file if not given; none if "
-       "neither gives it"}},
+       "neither gives it"},
+      {"moving_cylinders",
+       "number of moving cylinders (workers' legs and torsos) the scanner sees: adds the input "
+       "moving_cylinders, 7 numbers each (default 0)"}},
      MakeLaserScanner});
 
 }  // namespace

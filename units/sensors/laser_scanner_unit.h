@@ -81,8 +81,14 @@ class LaserScannerUnit : public cosim::Unit {
   /// `protective_field`: the polygon's corners [x, y] in the scanner frame
   /// (at least 3), or empty for none. Throws cosim::UnitError if beam_count
   /// < 1 or the polygon has 1 or 2 corners.
+  /// `moving_cylinders` > 0 adds the input `moving_cylinders` (7 numbers per
+  /// cylinder: [x, y, vx, vy, radius, z_bottom, z_top] in map, m and m/s:
+  /// workers' legs and torsos, people::WorkerUnit's `cylinders`): each is
+  /// seen at a beam's time where its velocity takes it from the inputs' time
+  /// (RayScene::Cast), with no extra rays.
   LaserScannerUnit(std::string name, const models::Scene& scene, int beam_count,
-                   std::vector<std::array<double, 2>> protective_field, std::uint64_t seed);
+                   std::vector<std::array<double, 2>> protective_field, std::uint64_t seed,
+                   int moving_cylinders = 0);
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
   void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
@@ -148,7 +154,7 @@ class LaserScannerUnit : public cosim::Unit {
 
   // Inputs.
   std::vector<double> position_, orientation_, velocity_, angular_velocity_, belt_travel_,
-      belt_speed_;
+      belt_speed_, moving_;
   // Outputs.
   std::vector<double> ranges_;
   double scan_time_ = 0.0, scan_count_ = 0.0, field_clear_ = 1.0;

@@ -480,8 +480,27 @@ void RayScene::CastCarried(const Ray& ray, std::span<const int> candidates,
   }
 }
 
+void RayScene::CastMoving(const Ray& ray, std::span<const double> moving, RayHit& best) const {
+  const std::size_t count = moving.size() / kMovingValues;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double* m = moving.data() + i * kMovingValues;
+    const double t_max = std::isinf(best.range) ? ray.max_range : best.range;
+    const Cylinder cyl{m[0] + m[2] * ray.dt_s, m[1] + m[3] * ray.dt_s, m[4], m[5], m[6],
+                       ObjectOfMoving(static_cast<int>(i))};
+    double n[3] = {0.0, 0.0, 0.0};
+    const double t = IntersectCylinder(cyl, ray.origin.data(), ray.direction.data(), t_max, n);
+    if (t < t_max) {
+      best.range = t;
+      best.object = cyl.object;
+      best.cos_incidence = std::abs(n[0] * ray.direction[0] + n[1] * ray.direction[1] +
+                                    n[2] * ray.direction[2]);
+    }
+  }
+}
+
 void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
-                    std::span<const double> belt_travel, std::span<const double> belt_speed) {
+                    std::span<const double> belt_travel, std::span<const double> belt_speed,
+                    std::span<const double> moving) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   // Packets of 16 while 16 rays are left, then of 8 (a 1 ms step's 14 beams
@@ -525,6 +544,7 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
                     std::span<const int>(candidates_.data(), static_cast<std::size_t>(candidates)),
                     belt_travel, belt_speed, h);
       }
+      if (!moving.empty()) CastMoving(packet_rays[k], moving, h);
     }
     first += count;
   }

@@ -79,12 +79,22 @@ class RayScene {
   /// `belt_travel` and `belt_speed` (m, m/s; one per scene belt) are the
   /// belts' travel at the rays' reference time and their speed: a carried
   /// object is at travel + speed * dt_s along its belt. No allocation.
+  /// `moving` (7 numbers per cylinder: [x, y, vx, vy, radius, z_bottom,
+  /// z_top], m and m/s, at the rays' reference time; empty for none): other
+  /// moving things (workers' legs and torsos), each a vertical cylinder at
+  /// (x + vx dt_s, y + vy dt_s) when a ray is cast, intersected exactly
+  /// after the static and carried objects (no culling: a few cylinders).
   void Cast(std::span<const Ray> rays, std::span<RayHit> hits, std::span<const double> belt_travel,
-            std::span<const double> belt_speed);
+            std::span<const double> belt_speed, std::span<const double> moving = {});
 
   int ObjectOfObstacle(int i) const { return 1 + i; }
   int ObjectOfTerrain(int i) const { return 1 + obstacle_count_ + i; }
   int ObjectOfCarried(int i) const { return 1 + obstacle_count_ + terrain_count_ + i; }
+  /// Moving cylinder i of Cast's `moving`.
+  int ObjectOfMoving(int i) const {
+    return 1 + obstacle_count_ + terrain_count_ + static_cast<int>(carried_.size()) + i;
+  }
+  static constexpr std::size_t kMovingValues = 7;
 
   /// A vertical cylinder (an obstacle, or a carried one where its belt puts it).
   struct Cylinder {
@@ -145,6 +155,8 @@ class RayScene {
   /// times, against a cone from the middle ray's origin about the first
   /// and last rays' bisector that holds all their directions, widened by
   /// the origins' spread. Returns the count.
+  /// The moving cylinders met before `best` (updated in place).
+  void CastMoving(const Ray& ray, std::span<const double> moving, RayHit& best) const;
   int CullCarried(std::span<const Ray> rays, std::span<const double> belt_travel,
                   std::span<const double> belt_speed);
 

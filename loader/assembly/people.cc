@@ -1,0 +1,261 @@
+#include "loader/assembly/people.h"
+
+#include <cmath>
+
+#include "models/angle.h"
+
+namespace linesim::loader::assembly {
+
+namespace {
+
+constexpr int kCylindersPerWorker = 3;  // people::WorkerUnit: two legs, a torso
+constexpr int kCylinderValues = 7;
+
+// A polygon [[x, y], ...] (m, base_link) of at least 3 corners at `key` of
+// `item`, moved into the frame of a scanner mounted at (mx, my) with yaw
+// `myaw` in base_link.
+YAML::Node ReadPolygonInScanner(YamlReader& r, const YAML::Node& item, const std::string& path,
+                                const std::string& key, bool required, double mx, double my,
+                                double myaw) {
+  const YAML::Node list = Child(item, key);
+  const std::string full = JoinPath(path, key);
+  if (!list.IsDefined() || list.IsNull()) {
+    if (required) r.Error(item, full, "missing required key: a polygon [[x, y], ...] (m, base_link)");
+    return YAML::Node();
+  }
+  if (!r.ExpectSequence(list, full)) return YAML::Node();
+  if (list.size() < 3) {
+    r.Error(list, full, "a field needs at least 3 corners [x, y] (m, base_link)");
+    return YAML::Node();
+  }
+  std::vector<std::array<double, 2>> corners;
+  const double c = std::cos(myaw), s = std::sin(myaw);
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    if (auto p = r.AsPoint(list[i], JoinPath(full, std::to_string(i)), {-100.0, 100.0})) {
+      const double dx = (*p)[0] - mx, dy = (*p)[1] - my;
+      corners.push_back({c * dx + s * dy, -s * dx + c * dy});
+    }
+  }
+  return PointList(corners);
+}
+
+const models::SensorMount* FindLaser(const Signals& s, const std::string& name) {
+  for (const auto& m : s.sensors) {
+    if (m.kind == "laser_scanner" && (name.empty() || m.name == name)) return &m;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s) {
+  (void)robot;
+  YamlReader& r = b.reader();
+  const YAML::Node safety = Child(b.root(), "safety");
+  if (!safety.IsDefined() || safety.IsNull()) return;
+  if (!r.ExpectMap(safety, "safety")) return;
+  r.CheckKeys(safety, "safety", {"enabled", "scanner", "field_sets", "parameters"});
+  // enabled: false keeps the section but takes the safety function out (the
+  // same run without it, for comparison).
+  if (!r.Boolean(safety, "safety", "enabled", true)) return;
+  const std::string scanner = r.String(safety, "safety", "scanner", "");
+  const models::SensorMount* laser = FindLaser(s, scanner);
+  if (laser == nullptr) {
+    r.Error(Child(safety, "scanner").IsDefined() ? Child(safety, "scanner") : safety,
+            "safety.scanner",
+            scanner.empty() ? "the robot has no enabled laser scanner for the safety fields"
+                            : "no enabled laser scanner '" + scanner + "' on the robot");
+    return;
+  }
+  // The unit's beam geometry defaults are the S300's (the device whose field
+  // sets these are).
+  if (laser->model != "sick_s300") {
+    r.Error(safety, "safety.scanner",
+            "the safety fields are the SICK S300's: scanner '" + laser->name + "' is model '" +
+                laser->model + "', expected sick_s300");
+    return;
+  }
+  b.Unit(kSafety, "safety_field");
+  b.SetStep(kSafety, b.ControlPeriod());
+  YAML::Node p = b.Params(kSafety);
+  p["beam_count"] = 541;
+  const YAML::Node sets = Child(safety, "field_sets");
+  YAML::Node out_sets(YAML::NodeType::Sequence);
+  if (!sets.IsDefined()) {
+    r.Error(safety, "safety.field_sets",
+            "missing required key: a list of {max_speed_mps, protective, warning}");
+  } else if (r.ExpectSequence(sets, "safety.field_sets")) {
+    if (sets.size() == 0) r.Error(sets, "safety.field_sets", "expected at least one field set");
+    for (std::size_t i = 0; i < sets.size(); ++i) {
+      const std::string path = JoinPath("safety.field_sets", std::to_string(i));
+      const YAML::Node item = sets[i];
+      if (!r.ExpectMap(item, path)) continue;
+      r.CheckKeys(item, path, {"max_speed_mps", "protective", "warning"});
+      YAML::Node set;
+      set["max_speed_mps"] = Num(r.Real(item, path, "max_speed_mps", std::nullopt, {0.0, 100.0}));
+      set["protective"] = ReadPolygonInScanner(r, item, path, "protective", true, laser->x_m,
+                                               laser->y_m, laser->yaw_rad);
+      const YAML::Node warning = ReadPolygonInScanner(r, item, path, "warning", false, laser->x_m,
+                                                      laser->y_m, laser->yaw_rad);
+      if (warning.IsDefined()) set["warning"] = warning;
+      out_sets.push_back(set);
+    }
+  }
+  p["field_sets"] = out_sets;
+  const YAML::Node own = Child(safety, "parameters");
+  if (own.IsDefined() && !own.IsNull() && r.ExpectMap(own, "safety.parameters")) {
+    for (const auto& kv : own) {
+      const std::string key = kv.first.Scalar();
+      p[key] = kv.second;
+      b.Derived(JoinPath(JoinPath(JoinPath("units", kSafety), "parameters"), key), own,
+                "safety.parameters", key);
+    }
+  }
+  b.Connect(Signal(laser->name, "ranges"), Signal(kSafety, "ranges"));
+  b.Connect(Signal(laser->name, "scan_count"), Signal(kSafety, "scan_count"));
+  // The safety unit takes the wheel controller's command inputs over.
+  b.Connect(Signal(kSafety, "velocity_command_out"), s.velocity_command_input);
+  b.Connect(Signal(kSafety, "yaw_rate_command_out"), s.yaw_rate_command_input);
+  s.velocity_command_input = Signal(kSafety, "velocity_command");
+  s.yaw_rate_command_input = Signal(kSafety, "yaw_rate_command");
+}
+
+void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo& info) {
+  YamlReader& r = b.reader();
+  YAML::Node metrics = b.out()["metrics"];
+  const auto add = [&](const std::string& name, const std::string& of, const char* reduce) {
+    YAML::Node m;
+    m["name"] = name;
+    m["of"] = of;
+    m["reduce"] = reduce;
+    metrics.push_back(m);
+  };
+  if (b.HasUnit(kSafety)) {
+    b.Connect(Signal(kPathFollower, "done"), Signal(kSafety, "task_done"));
+    for (const char* v : {"protective_clear", "warning_clear", "speed_cap", "field_set"}) {
+      s.recorded.push_back(Signal(kSafety, v));
+    }
+    s.recorded.push_back(Signal(kChassis, "linear_velocity"));
+    add("protective_stops", Signal(kSafety, "protective_stops"), "final");
+    add("time_stopped_s", Signal(kSafety, "time_stopped"), "final");
+    add("task_time_s", Signal(kSafety, "task_time"), "final");
+    info.velocity_x_column = Element(kChassis, "linear_velocity", 0);
+    info.velocity_y_column = Element(kChassis, "linear_velocity", 1);
+    info.speed_cap_column = Signal(kSafety, "speed_cap");
+    info.protective_column = Signal(kSafety, "protective_clear");
+    info.warning_column = Signal(kSafety, "warning_clear");
+  }
+
+  const YAML::Node list = Child(b.root(), "workers");
+  if (!list.IsDefined() || list.IsNull()) return;
+  if (!r.ExpectSequence(list, "workers")) return;
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string path = JoinPath("workers", std::to_string(i));
+    const YAML::Node item = list[i];
+    if (!r.ExpectMap(item, path)) continue;
+    r.CheckKeys(item, path, {"name", "waypoints", "pause_s", "start_time_s", "parameters"});
+    const std::string name = r.String(item, path, "name", "worker_" + std::to_string(i));
+    if (b.HasUnit(name)) {
+      r.Error(Child(item, "name").IsDefined() ? Child(item, "name") : item, JoinPath(path, "name"),
+              "'" + name + "' is already the name of a unit");
+      continue;
+    }
+    const YAML::Node waypoints = Child(item, "waypoints");
+    const std::string wp_path = JoinPath(path, "waypoints");
+    std::vector<std::array<double, 2>> points;
+    if (!waypoints.IsDefined()) {
+      r.Error(item, wp_path, "missing required key: a list of points [x, y] (m, map)");
+      continue;
+    }
+    if (!r.ExpectSequence(waypoints, wp_path)) continue;
+    if (waypoints.size() == 0) r.Error(waypoints, wp_path, "expected at least one point [x, y]");
+    for (std::size_t k = 0; k < waypoints.size(); ++k) {
+      if (auto q = r.AsPoint(waypoints[k], JoinPath(wp_path, std::to_string(k)), {-1e6, 1e6})) {
+        points.push_back(*q);
+      }
+    }
+    b.Unit(name, "worker");
+    YAML::Node p = b.Params(name);
+    p["waypoints"] = PointList(points);
+    // pause_s: one number for every waypoint, or one per waypoint.
+    if (const YAML::Node pause = Child(item, "pause_s"); pause.IsDefined()) {
+      const std::string pause_path = JoinPath(path, "pause_s");
+      if (pause.IsSequence()) {
+        if (pause.size() != points.size()) {
+          r.Error(pause, pause_path,
+                  "expected one pause per waypoint (" + std::to_string(points.size()) + "), got " +
+                      std::to_string(pause.size()));
+        }
+        std::vector<double> v;
+        for (std::size_t k = 0; k < pause.size(); ++k) {
+          v.push_back(r.AsReal(pause[k], JoinPath(pause_path, std::to_string(k)), {0.0, 1e7})
+                          .value_or(0.0));
+        }
+        p["pause"] = List(v);
+      } else {
+        const double v = r.Real(item, path, "pause_s", 0.0, {0.0, 1e7});
+        p["pause"] = List(std::vector<double>(points.size(), v));
+      }
+    }
+    if (Child(item, "start_time_s").IsDefined()) {
+      p["start_time"] = Num(r.Real(item, path, "start_time_s", 0.0, {0.0, 1e7}));
+    }
+    const YAML::Node own = Child(item, "parameters");
+    if (own.IsDefined() && !own.IsNull() && r.ExpectMap(own, JoinPath(path, "parameters"))) {
+      for (const auto& kv : own) {
+        const std::string key = kv.first.Scalar();
+        p[key] = kv.second;
+        b.Derived(JoinPath(JoinPath(JoinPath("units", name), "parameters"), key), own,
+                  JoinPath(path, "parameters"), key);
+      }
+    }
+    names.push_back(name);
+  }
+  if (names.empty()) return;
+
+  // Every laser on the robot sees every worker's cylinders, at each beam's
+  // time (units/sensors/ray_scene.h).
+  const int per_worker = kCylindersPerWorker * kCylinderValues;
+  for (const auto& m : s.sensors) {
+    if (m.kind != "laser_scanner") continue;
+    b.Params(m.name)["moving_cylinders"] =
+        static_cast<int>(names.size()) * kCylindersPerWorker;
+    for (std::size_t w = 0; w < names.size(); ++w) {
+      for (int j = 0; j < per_worker; ++j) {
+        b.Connect(Element(names[w], "cylinders", static_cast<std::size_t>(j)),
+                  Element(m.name, "moving_cylinders", w * per_worker + static_cast<std::size_t>(j)));
+      }
+    }
+  }
+
+  // The body's distance from the people: the clearance unit's box.
+  const models::BodyDescription& body = robot.robot.body;
+  b.Unit(kPersonClearance, "person_clearance");
+  YAML::Node c = b.Params(kPersonClearance);
+  c["workers"] = static_cast<int>(names.size());
+  c["body_length"] = Num(body.length_m);
+  c["body_width"] = Num(body.width_m);
+  // The chassis centres the body box on com_height (flat floor).
+  c["body_z_min"] = Num(body.com_height_m - 0.5 * body.height_m);
+  c["body_z_max"] = Num(body.com_height_m + 0.5 * body.height_m);
+  b.Connect(Signal(kChassis, "position_3d"), Signal(kPersonClearance, "position_3d"));
+  b.Connect(Signal(kChassis, "orientation"), Signal(kPersonClearance, "orientation"));
+  for (std::size_t w = 0; w < names.size(); ++w) {
+    for (int j = 0; j < per_worker; ++j) {
+      b.Connect(Element(names[w], "cylinders", static_cast<std::size_t>(j)),
+                Element(kPersonClearance, "cylinders", w * per_worker + static_cast<std::size_t>(j)));
+    }
+    s.recorded.push_back(Signal(names[w], "pose"));
+    info.worker_columns.emplace_back(Element(names[w], "pose", 0), Element(names[w], "pose", 1));
+    s.recorded.push_back(Signal(names[w], "legs"));
+    add("robot_" + names[w] + "_collisions",
+        Element(kPersonClearance, "worker_collisions", w), "final");
+  }
+  s.recorded.push_back(Signal(kPersonClearance, "distance"));
+  if (b.HasUnit(kSafety)) info.person_distance_column = Signal(kPersonClearance, "distance");
+  add("min_person_distance_m", Signal(kPersonClearance, "min_distance"), "final");
+  add("person_collisions", Signal(kPersonClearance, "collisions"), "final");
+}
+
+}  // namespace linesim::loader::assembly

@@ -1,0 +1,78 @@
+// The `workers:` and `safety:` sections of a robot scenario: what they
+// expand into, and bad input named at its file and key path.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "tests/loader/scenario_test.h"
+
+namespace linesim::loader::testing {
+namespace {
+
+std::string Shipped() { return std::string(LINESIM_SOURCE_DIR) + "/scenarios/worker_crossing.yaml"; }
+
+// Guards against workers that the lasers or the clearance do not get: one
+// worker gives each S300 3 moving cylinders (21 numbers), and the
+// scenario's safety section adds the safety unit.
+TEST(PeopleAssembly, WorkersReachTheLasersAndTheSafetyUnit) {
+  const Scenario s = LoadScenario(Shipped(), {"duration_s=0.1"});
+  ASSERT_TRUE(s.system->FindUnit("worker").has_value());
+  ASSERT_TRUE(s.system->FindUnit("person_clearance").has_value());
+  ASSERT_TRUE(s.system->FindUnit("safety").has_value());
+  for (const char* laser : {"laser_front", "laser_rear"}) {
+    const auto& v = s.system->unit(*s.system->FindUnit(laser)).variables();
+    const auto ref = v.Find("moving_cylinders");
+    ASSERT_TRUE(ref.has_value()) << laser;
+    EXPECT_EQ(v.info(*ref).size, 21u) << laser;
+  }
+}
+
+// Guards against bad worker and safety keys passing silently: each is
+// refused naming the file and the key path.
+TEST(PeopleAssembly, BadKeysNamed) {
+  const std::string base = R"(name: t
+duration_s: 1
+robot: {model: raw3, pose: {x_m: 0, y_m: -4, yaw_deg: 90}}
+scene: {model: factory_line}
+task: {type: path, waypoints: [[0, -4], [0, 3]], speed_mps: 0.3}
+sensors: {default: false, laser_front: true}
+)";
+  const std::string bad_key = WriteScenario(
+      "bad_worker_key.yaml", base + "workers:\n  - {waypoints: [[0, 0], [1, 0]], pace_s: 3}\n");
+  std::string issues = Issues(bad_key);
+  EXPECT_TRUE(Has(issues, bad_key)) << issues;
+  EXPECT_TRUE(Has(issues, "workers.0.pace_s")) << issues;
+
+  const std::string no_points =
+      WriteScenario("worker_no_points.yaml", base + "workers:\n  - {name: w}\n");
+  issues = Issues(no_points);
+  EXPECT_TRUE(Has(issues, "workers.0.waypoints")) << issues;
+
+  const std::string pauses = WriteScenario(
+      "worker_pauses.yaml",
+      base + "workers:\n  - {waypoints: [[0, 0], [1, 0]], pause_s: [1, 2, 3]}\n");
+  issues = Issues(pauses);
+  EXPECT_TRUE(Has(issues, "workers.0.pause_s")) << issues;
+
+  const std::string param = WriteScenario(
+      "worker_param.yaml",
+      base + "workers:\n  - {waypoints: [[0, 0], [1, 0]], parameters: {walking_speed: -1}}\n");
+  issues = Issues(param);
+  EXPECT_TRUE(Has(issues, "workers.0.parameters.walking_speed")) << issues;
+
+  const std::string field = WriteScenario(
+      "safety_field.yaml",
+      base + "safety:\n  field_sets:\n    - {max_speed_mps: 1, protective: [[0, 0], [1, 0]]}\n");
+  issues = Issues(field);
+  EXPECT_TRUE(Has(issues, "safety.field_sets.0.protective")) << issues;
+
+  const std::string scanner =
+      WriteScenario("safety_scanner.yaml",
+                    base + "safety:\n  scanner: laser_rear\n  field_sets:\n    - {max_speed_mps: "
+                           "1, protective: [[0, 0], [1, 0], [0, 1]]}\n");
+  issues = Issues(scanner);
+  EXPECT_TRUE(Has(issues, "safety.scanner")) << issues;
+}
+
+}  // namespace
+}  // namespace linesim::loader::testing

@@ -1,0 +1,38 @@
+// Registers the people family's unit types (see config/unit_registry.h).
+#include "config/unit_registry.h"
+#include "units/people/person_clearance_unit.h"
+#include "units/people/worker_unit.h"
+
+namespace linesim::people {
+namespace {
+
+std::unique_ptr<cosim::Unit> MakeWorker(const config::UnitBuildContext& c) {
+  const std::size_t issues_before = c.reader.issues().size();
+  auto waypoints = config::ReadPoints(c, "waypoints", 1);
+  if (c.reader.issues().size() != issues_before || waypoints.empty()) return nullptr;
+  return std::make_unique<WorkerUnit>(c.name, std::move(waypoints));
+}
+
+const config::UnitTypeRegistrar kWorker(
+    {WorkerUnit::kTypeName,
+     "a person walking along waypoints (speed profile, pauses, gait): two legs at a "
+     "scanner's height and a torso, as moving cylinders the lasers and the clearance see",
+     "",
+     {{"waypoints", "list of points [x, y] (m, map): where the worker walks, stopping at each"}},
+     MakeWorker});
+
+std::unique_ptr<cosim::Unit> MakePersonClearance(const config::UnitBuildContext& c) {
+  const auto workers = c.reader.Integer(c.parameters, c.path, "workers", 1, 1, 10000);
+  return std::make_unique<PersonClearanceUnit>(c.name, static_cast<int>(workers));
+}
+
+const config::UnitTypeRegistrar kPersonClearance(
+    {PersonClearanceUnit::kTypeName,
+     "distance of the robot's body from the workers' legs and torsos, and robot-person "
+     "contacts counted as collisions (per worker)",
+     "",
+     {{"workers", "number of workers (the input `cylinders` holds 21 numbers each; default 1)"}},
+     MakePersonClearance});
+
+}  // namespace
+}  // namespace linesim::people

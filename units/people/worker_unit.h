@@ -1,0 +1,108 @@
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "cosim/time.h"
+#include "cosim/unit.h"
+
+namespace linesim::people {
+
+/// A person walking on the line: along waypoints, stopping at each, with a
+/// trapezoidal speed profile, pauses, and a gait whose legs a scanner at
+/// ankle height sees (docs/references.md, "Workers").
+///
+/// Schedule (closed form in time, no integration): the worker stands at
+/// waypoint 0 until start_time, then walks each segment k -> k + 1 from rest
+/// to rest: accelerating at `acceleration` to `walking_speed`, walking, decelerating
+/// at `acceleration` (a triangle when the segment is shorter than
+/// walking_speed^2 / acceleration), and stands pause_s[k + 1] at waypoint k + 1. The
+/// heading is the segment's direction (it turns on the spot while it
+/// stands). After the last waypoint it stands there.
+///
+/// Gait: the phase (strides) is the distance walked / stride_length, so a
+/// stance foot stays fixed on the floor at any speed. Each leg spends the
+/// fraction stance_fraction of a stride on the floor, where, relative to the
+/// body, it moves back by stance_fraction * stride_length at the walking
+/// speed (from +f/2 to -f/2 stride lengths along the heading, f the stance
+/// fraction); in swing it returns forward along a half cosine. The right
+/// leg is half a stride behind the left. The offsets scale with speed /
+/// the segment's cruise speed: while cruising a stance foot stays fixed on
+/// the floor; the steps shorten as the worker slows, and standing the feet
+/// are side by side (the stance foot slides a little over the 1 s ramps: a
+/// simplification). Legs are vertical cylinders of
+/// leg_radius (the section at a scanner's height) from the floor to
+/// crotch_height, leg_spacing apart across the heading; the torso is a
+/// cylinder of torso_radius from crotch_height to stature.
+///
+/// Outputs: the pose, velocity, speed, the legs' positions and velocities,
+/// and `cylinders`: per cylinder (left leg, right leg, torso)
+/// [x, y, vx, vy, radius, z_bottom, z_top]: the shapes a laser scanner and
+/// the clearance unit read (a scanner extrapolates each to a beam's time
+/// with its velocity).
+class WorkerUnit : public cosim::Unit {
+ public:
+  static constexpr const char* kTypeName = "worker";
+  /// Cylinders of `cylinders` and their numbers each.
+  static constexpr int kCylinders = 3;
+  static constexpr int kCylinderValues = 7;
+
+  /// At least one waypoint (one: a person standing there).
+  WorkerUnit(std::string name, std::vector<std::array<double, 2>> waypoints_m);
+
+  std::vector<cosim::ParameterProblem> CheckParameters() const override;
+  void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
+  void Initialize() override;
+  cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
+
+  /// Where the walk is at time t (s after the start), for the outputs and
+  /// the tests: distance walked (m), speed (m/s), the segment whose
+  /// direction the heading is, and the position.
+  struct State {
+    double distance_m = 0.0, speed_mps = 0.0;
+    double acceleration_mps2 = 0.0;  // of the speed profile (0 cruising or standing)
+    double cruise_mps = 0.0;         // the segment's top speed
+    std::size_t segment = 0;
+    double x_m = 0.0, y_m = 0.0;
+  };
+  State At(double t_s) const;
+  /// A leg's offset along the heading from the body centre (m) and its rate
+  /// per metre walked, at gait phase `phase` (strides).
+  void LegOffset(double phase, double& offset_m, double& rate) const;
+  /// The time (s after the start) at which segment k starts and ends its walk.
+  double SegmentStart(std::size_t k) const { return plan_[k].start_s; }
+  double SegmentEnd(std::size_t k) const { return plan_[k].start_s + plan_[k].duration_s; }
+
+ private:
+  struct Segment {
+    double start_s, duration_s, length_m, cruise_mps, ramp_s, cum_m;
+    double ux, uy;
+  };
+  void Plan();
+  void Evaluate(double t_s);
+
+ protected:
+  /// No state beyond the parameters: the walk is a function of time; the
+  /// plan is derived again from the restored parameters.
+  void RestoreInternal(const cosim::UnitState&) override { Plan(); }
+
+ private:
+
+  std::vector<std::array<double, 2>> waypoints_;
+  std::vector<Segment> plan_;
+  cosim::TimeNs start_ = 0;
+
+  // Parameters.
+  std::vector<double> pause_s_;
+  double start_time_s_ = 0.0;
+  double speed_ = 1.37, acceleration_ = 1.0, stride_length_ = 1.41, stance_fraction_ = 0.6,
+         initial_phase_ = 0.0, leg_radius_ = 0.045, leg_spacing_ = 0.2, crotch_height_ = 0.84,
+         torso_radius_ = 0.2, stature_ = 1.75, initial_yaw_deg_ = 0.0;
+
+  // Outputs.
+  std::vector<double> pose_, velocity_, legs_, leg_velocities_, cylinders_;
+  double speed_out_ = 0.0, distance_out_ = 0.0, phase_out_ = 0.0;
+};
+
+}  // namespace linesim::people
