@@ -206,7 +206,7 @@ class Reader {
     }
     if (!r_.ExpectSequence(list, path)) return;
     if (list.size() == 0) r_.Error(list, path, "expected at least one wheel");
-    std::set<std::string> used;
+    std::set<std::string> used, names;
     for (std::size_t i = 0; i < list.size(); ++i) {
       const std::string wp = JoinPath(path, std::to_string(i));
       const YAML::Node node = list[i];
@@ -216,6 +216,11 @@ class Reader {
                     "steer_motor", "drive_motor"});
       models::WheelDescription w;
       w.name = r_.String(node, wp, "name", std::nullopt);
+      // Messages, columns and the plots name a wheel: one name, one wheel.
+      if (!w.name.empty() && !names.insert(w.name).second) {
+        r_.Error(Child(node, "name"), JoinPath(wp, "name"),
+                 "wheel '" + w.name + "' is named twice: expected a name of its own");
+      }
       w.x_m = r_.Real(node, wp, "x_m", std::nullopt, kPositionM);
       w.y_m = r_.Real(node, wp, "y_m", std::nullopt, kPositionM);
       w.radius_m = r_.Real(node, wp, "radius_m", std::nullopt, kWheelRadiusM);
