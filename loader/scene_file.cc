@@ -150,12 +150,17 @@ class SceneParser {
     for (const char* axis : {"x", "y"}) {
       const double lo = axis[0] == 'x' ? f.min_x_m : f.min_y_m;
       const double hi = axis[0] == 'x' ? f.max_x_m : f.max_y_m;
-      const std::string key = std::string("max_") + axis + "_m";
-      if (Child(floor, key).IsDefined() && hi <= lo) {
-        r_.Error(
-            Child(floor, key), JoinPath(path, key),
-            "expected more than min_" + std::string(axis) + "_m (" + YAML::Node(lo).Scalar() + ")");
+      const std::string min_key = std::string("min_") + axis + "_m";
+      const std::string max_key = std::string("max_") + axis + "_m";
+      if (!Child(floor, min_key).IsDefined() || !Child(floor, max_key).IsDefined() || hi > lo) {
+        continue;
       }
+      // At the key the user changed (--set min_x_m), else at the max.
+      const std::string key = r_.ConflictKey(path, min_key, max_key);
+      const bool at_min = key == min_key;
+      r_.Error(Child(floor, key), JoinPath(path, key),
+               at_min ? "expected less than " + max_key + " (" + YAML::Node(hi).Scalar() + ")"
+                      : "expected more than " + min_key + " (" + YAML::Node(lo).Scalar() + ")");
     }
     f.surface = Reference(floor, path, "surface", surface_names_, "surface");
   }
@@ -594,6 +599,8 @@ models::Scene ReadScenarioScene(YamlReader& r, const YAML::Node& scene,
   const YAML::Node merged = Merge(model, scene, "scene", sources, empty);
   RefuseEmptyLists(r, empty, "the scene file's");
   YamlReader merged_reader(file);
+  // A contradiction is reported at the key the command line set.
+  merged_reader.ShareCommandLine(r);
   models::Scene out = ReadScene(merged_reader, merged, "scene", name, file);
   for (const Issue& issue : merged_reader.issues()) {
     std::string p = issue.key_path;

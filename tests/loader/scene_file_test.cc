@@ -377,5 +377,29 @@ TEST(ScenarioScene, SetOnTheCommandLine) {
       << issues;
 }
 
+// Guards issue 24 (item 5): a floor minimum set on the command line above
+// the file's maximum was reported at the maximum (scene.floor.max_x_m),
+// a key the user did not touch: it is reported at the key set
+// (factory_line's floor runs x -15 to 15 m); with neither or both set on
+// the command line, at the maximum as before.
+TEST(ScenarioScene, AContradictionIsReportedAtTheKeySetOnTheCommandLine) {
+  const std::string f = WriteScenario("floor_set.yaml", std::string(kValidScenario) +
+                                                            "scene: {model: factory_line}\n");
+  const std::string min = Issues(f, {"scene.floor.min_x_m=20"});
+  EXPECT_TRUE(Has(min, f + ": scene.floor.min_x_m (set on the command line): expected less than "
+                           "max_x_m (15)"))
+      << min;
+  EXPECT_FALSE(Has(min, "max_x_m (set")) << min;
+  const std::string max = Issues(f, {"scene.floor.max_x_m=-20"});
+  EXPECT_TRUE(Has(max, f + ": scene.floor.max_x_m (set on the command line): expected more than "
+                           "min_x_m (-15)"))
+      << max;
+  std::string bad = kSmallScene;
+  bad.replace(bad.find("max_x_m: 5"), 10, "max_x_m: -6");
+  const std::string file = WriteScenario("floor_inverted.yaml", bad);
+  EXPECT_TRUE(Has(SceneIssues(file), file + ":4: floor.max_x_m: expected more than min_x_m (-5)"))
+      << SceneIssues(file);
+}
+
 }  // namespace
 }  // namespace linesim::loader
