@@ -401,5 +401,30 @@ TEST(ScenarioScene, AContradictionIsReportedAtTheKeySetOnTheCommandLine) {
       << SceneIssues(file);
 }
 
+// Guards issue 24 (item 5): a belt 1000 m off the floor was accepted and
+// the run failed when it started. Refused at load, at the belt's key
+// (kSmallScene's floor is x, y -5 to 5 m; a belt 6 x 2 m centred at x 1000
+// has a corner at (997, -1)); one set on the command line is reported as
+// such, also through a robot scenario's line.belts (factory_line's floor
+// x -15 to 15 m, y -10 to 10 m; cross_line's 20 x 2 m belt at y 1000 has
+// its corner (-10, 999)); a belt whose edge is the floor's lies on it.
+TEST(ScenarioScene, ABeltOffTheFloorIsRefused) {
+  std::string bad = kSmallScene;
+  bad.replace(bad.find("center_x_m: 0"), 13, "center_x_m: 1000");
+  const std::string file = WriteScenario("belt_off.yaml", bad);
+  const std::string e = SceneIssues(file);
+  EXPECT_TRUE(Has(e, file + ":6: belts.0.center_x_m: belt 'line' lies off the floor: its corner "
+                            "(997, -1) m is outside the floor's x -5 to 5 m, y -5 to 5 m"))
+      << e;
+  std::string edge = kSmallScene;
+  edge.replace(edge.find("length_m: 6"), 11, "length_m: 10");
+  EXPECT_EQ(SceneIssues(WriteScenario("belt_edge.yaml", edge)), "(no error)");
+  const std::string cross = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
+  const std::string line = Issues(cross, {"line.belts.0.center_y_m=1000"});
+  EXPECT_TRUE(Has(line, "line.belts.0.center_y_m (set on the command line): belt "))
+      << line;
+  EXPECT_TRUE(Has(line, "lies off the floor: its corner (-10, 999) m")) << line;
+}
+
 }  // namespace
 }  // namespace linesim::loader
