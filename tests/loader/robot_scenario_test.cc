@@ -609,6 +609,26 @@ TEST(RobotScenario, RobotFileValuesAreReportedWhereTheUserWroteThem) {
   EXPECT_FALSE(Has(e, "units.motors")) << e;
 }
 
+// Guards issue 24 (item 5): a map's cell_m of 1e-6 m passed the load and
+// failed when the maps were built at initialization. The lookup grid holds
+// at most 2^28 cells (units/estimation/occupancy_grid.h): van_entry's van
+// map, region 3.25 x 1.865 m plus the 1 m map_margin on each side (5.25 x
+// 3.865 m), needs a cell of at least sqrt(5.25 x 3.865 / 2^28) = 2.749e-4 m.
+// 2.7e-4 m (19445 x 14315 = 2.78e8 cells) is refused at load at the map's
+// key; 3e-4 m (17500 x 12884 = 2.25e8) loads, as the shipped 0.01 m does.
+TEST(RobotScenario, AMapGridBeyondItsLimitIsRefusedAtLoad) {
+  const std::string van = LINESIM_SOURCE_DIR "/scenarios/van_entry.yaml";
+  for (const char* cell : {"1e-6", "2.7e-4"}) {
+    const std::string e = Issues(van, {std::string("localization.maps.1.cell_m=") + cell});
+    EXPECT_TRUE(Has(e, "localization.maps.1: cell_m ")) << e;
+    EXPECT_TRUE(Has(e, "m over the map's 5.25 x 3.865 m (map_margin included)")) << e;
+    EXPECT_TRUE(Has(e, "more than the lookup grid's 2^28: expected a cell_m of at least 0.000274") ||
+                Has(e, "more than the lookup grid's 2^28: expected a cell_m of at least 2.74"))
+        << e;
+  }
+  EXPECT_EQ(Issues(van, {"localization.maps.1.cell_m=3e-4"}), "(no error)");
+}
+
 // Guards the start pose against the scene (models/scenes/factory_line.yaml):
 // off the 30 x 20 m floor, or inside the car body that starts at x = -7 m on
 // the line, is refused at robot.pose; a robot scenario with no scene and no
