@@ -50,11 +50,38 @@ int YamlReader::LineOf(const YAML::Node& node) {
   return node.Mark().line + 1;
 }
 
+std::string YamlReader::ConflictKey(const std::string& path, const std::string& first,
+                                    const std::string& second) const {
+  const bool first_set = FromCommandLine(JoinPath(path, first));
+  const bool second_set = FromCommandLine(JoinPath(path, second));
+  return first_set && !second_set ? first : second;
+}
+
 bool YamlReader::FromCommandLine(const std::string& path) const {
+  // The path as given, and as the user wrote it (a generated tree's path
+  // has its origin: scene.belts.0.x of line.belts.0.x).
+  const std::string user = UserPath(path);
   for (const auto& o : overridden_) {
-    if (path == o || path.rfind(o + ".", 0) == 0) return true;
+    for (const std::string* p : {&path, &user}) {
+      if (*p == o || p->rfind(o + ".", 0) == 0) return true;
+    }
   }
   return false;
+}
+
+std::string YamlReader::UserPath(const std::string& path) const {
+  std::string rest;
+  for (std::string prefix = path;;) {
+    for (const auto* origins : {&origins_, &command_line_origins_}) {
+      if (const auto it = origins->find(prefix); it != origins->end()) {
+        return it->second.file.empty() ? it->second.path + rest : path;
+      }
+    }
+    const auto dot = prefix.rfind('.');
+    if (dot == std::string::npos) return path;
+    rest = path.substr(dot);
+    prefix.resize(dot);
+  }
 }
 
 void YamlReader::Error(const YAML::Node& at, const std::string& path, std::string message) {

@@ -122,6 +122,17 @@ class YamlReader {
 
   /// Whether `path`, or a key above it, was set with --set.
   bool FromCommandLine(const std::string& path) const;
+  /// Makes FromCommandLine (and ConflictKey) answer as `other` does: a
+  /// reader of a merged tree whose issues `other` reports again.
+  void ShareCommandLine(const YamlReader& other) {
+    overridden_ = other.overridden_;
+    command_line_origins_ = other.origins_;
+  }
+  /// Of two keys under `path` whose values contradict each other (a min
+  /// above its max), the one to report at: the one the command line set
+  /// when only one of them was (the user changed that one), else `second`.
+  std::string ConflictKey(const std::string& path, const std::string& first,
+                          const std::string& second) const;
   /// The key paths given on the command line with no value (`--set key=`).
   /// The tree holds null there, which a reader would take as absent and
   /// silently replace by its default: the typed readers (Real, Time,
@@ -130,6 +141,9 @@ class YamlReader {
   void SetGivenWithoutValue(std::set<std::string> paths) { without_value_ = std::move(paths); }
 
  private:
+  /// `path` as the user wrote it: through the origin of it or of its
+  /// longest ancestor that has one, in the reader's own file; else `path`.
+  std::string UserPath(const std::string& path) const;
   const YAML::Node Lookup(const YAML::Node& map, const std::string& path, const std::string& key,
                           bool required);
   /// Reports and returns true when `key` of `map` holds no value because
@@ -142,6 +156,8 @@ class YamlReader {
   std::set<std::string> overridden_;
   std::set<std::string> without_value_;
   std::map<std::string, Origin> origins_;
+  /// Origins seen only by FromCommandLine (ShareCommandLine).
+  std::map<std::string, Origin> command_line_origins_;
   std::vector<Issue> issues_;
 };
 

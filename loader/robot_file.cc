@@ -5,6 +5,7 @@
 #include <map>
 #include <numbers>
 #include <set>
+#include <utility>
 
 #include "cosim/system.h"
 #include "cosim/variable_table.h"
@@ -34,6 +35,7 @@ class Reader {
     robot.file = file_;
     if (!r_.ExpectMap(root, "")) return std::nullopt;
     root_ = root;
+    out.root = root;
     r_.CheckKeys(root, "",
                  {"description", "source", "body", "wheels", "motor_groups", "controller",
                   "chassis", "motors", "path_follower", "sensor_mounts", "payload"});
@@ -49,6 +51,7 @@ class Reader {
     out.chassis_settings = Settings(root, "chassis");
     out.motor_settings = Settings(root, "motors");
     out.follower_settings = Settings(root, "path_follower");
+    out.motor_models = motor_models_;
     // The robot's top speed and turn rate bound every task it is given.
     for (const char* key : {"max_speed", "max_yaw_rate"}) {
       if (!Child(out.follower_settings, key).IsDefined()) {
@@ -113,12 +116,13 @@ class Reader {
       group.gear_ratio = r_.Real(node, gp, "gear_ratio", std::nullopt, {0.0, 1000.0, true});
       group.gear_efficiency = r_.Real(node, gp, "gear_efficiency", std::nullopt, {0.0, 1.0, true});
       const std::string model = r_.String(node, gp, "model", std::nullopt);
+      YAML::Node motor;
       if (!model.empty()) {
-        const YAML::Node motor = LoadModel(r_, Child(node, "model"), JoinPath(gp, "model"),
-                                           "motor model", model, "motors", file_,
-                                           &group.model_file);
+        motor = LoadModel(r_, Child(node, "model"), JoinPath(gp, "model"), "motor model", model,
+                          "motors", file_, &group.model_file);
         if (motor.IsDefined()) Motor(motor, group);
       }
+      motor_models_.push_back(motor);
       group.motor["gear_ratio"] = group.gear_ratio;
       group.motor["gear_efficiency"] = group.gear_efficiency;
       const YAML::Node motors = Child(node, "motors");
@@ -202,7 +206,7 @@ class Reader {
     }
     if (!r_.ExpectSequence(list, path)) return;
     if (list.size() == 0) r_.Error(list, path, "expected at least one wheel");
-    std::set<std::string> used;
+    std::set<std::string> used, names;
     for (std::size_t i = 0; i < list.size(); ++i) {
       const std::string wp = JoinPath(path, std::to_string(i));
       const YAML::Node node = list[i];
@@ -212,6 +216,11 @@ class Reader {
                     "steer_motor", "drive_motor"});
       models::WheelDescription w;
       w.name = r_.String(node, wp, "name", std::nullopt);
+      // Messages, columns and the plots name a wheel: one name, one wheel.
+      if (!w.name.empty() && !names.insert(w.name).second) {
+        r_.Error(Child(node, "name"), JoinPath(wp, "name"),
+                 "wheel '" + w.name + "' is named twice: expected a name of its own");
+      }
       w.x_m = r_.Real(node, wp, "x_m", std::nullopt, kPositionM);
       w.y_m = r_.Real(node, wp, "y_m", std::nullopt, kPositionM);
       w.radius_m = r_.Real(node, wp, "radius_m", std::nullopt, kWheelRadiusM);
@@ -378,10 +387,45 @@ class Reader {
   std::string file_;
   std::set<std::string> motor_names_;
   std::map<std::string, Origin> motor_at_;
+  std::vector<YAML::Node> motor_models_;
   YAML::Node root_;
 };
 
+// The node at `path` below `root` (map keys and list indices), or the
+// nearest one above it that exists. (reset() rebinds a node; assigning one
+// would overwrite the tree's value.)
+YAML::Node NodeAt(const YAML::Node& root, const std::string& path) {
+  YAML::Node node;
+  node.reset(root);
+  std::size_t begin = 0;
+  while (!path.empty() && begin <= path.size()) {
+    const std::size_t dot = std::min(path.find('.', begin), path.size());
+    const std::string key = path.substr(begin, dot - begin);
+    const bool index = node.IsSequence() && !key.empty() && key.size() < 10 &&
+                       key.find_first_not_of("0123456789") == std::string::npos &&
+                       std::stoul(key) < node.size();
+    const YAML::Node next = node.IsMap() ? Child(node, key)
+                            : index      ? std::as_const(node)[std::stoul(key)]
+                                         : YAML::Node(YAML::NodeType::Undefined);
+    if (!next.IsDefined() || next.IsNull()) break;
+    node.reset(next);
+    begin = dot + 1;
+  }
+  return node;
+}
+
 }  // namespace
+
+Origin RobotFile::At(const std::string& path) const {
+  return {NodeAt(root, path), path, robot.file};
+}
+
+Origin RobotFile::MotorAt(std::size_t group, const std::string& key) const {
+  if (group >= motor_models.size() || group >= robot.motor_groups.size()) {
+    return At(JoinPath(JoinPath("motor_groups", std::to_string(group)), "model"));
+  }
+  return {NodeAt(motor_models[group], key), key, robot.motor_groups[group].model_file};
+}
 
 std::optional<models::PayloadDescription> ReadPayload(YamlReader& r, const YAML::Node& node,
                                                       const std::string& path) {

@@ -31,6 +31,18 @@ struct RobotFile {
   /// unit parameters its `parameters:` key gives (device options, counts
   /// per revolution), or an empty map.
   std::vector<YAML::Node> sensor_settings;
+
+  /// Where the description's values were written, so that a problem the
+  /// assembly's units find in a value derived from one is reported at the
+  /// file and key the user wrote: the robot file's tree, and each motor
+  /// group's model file tree (same order as robot.motor_groups).
+  YAML::Node root;
+  std::vector<YAML::Node> motor_models;
+  /// The robot file's key path `path` ("sensor_mounts.2.z_m"): its node,
+  /// or the nearest one above it when the key is absent (a default).
+  Origin At(const std::string& path) const;
+  /// Key `key` of motor group `group`'s model file.
+  Origin MotorAt(std::size_t group, const std::string& key) const;
 };
 
 /// Reads the robot description `model` names (a file in models/robots, or a

@@ -19,6 +19,61 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Whether `text` is valid UTF-8 (no overlong forms, surrogates or code
+// points above U+10FFFF): the scenario's path goes into summary.json and
+// results, which are UTF-8 text.
+bool IsUtf8(const std::string& text) {
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    std::size_t n = 0;
+    std::uint32_t cp = 0;
+    if (c < 0x80) {
+      ++i;
+      continue;
+    } else if (c >= 0xC2 && c <= 0xDF) {
+      n = 1;
+      cp = c & 0x1Fu;
+    } else if (c >= 0xE0 && c <= 0xEF) {
+      n = 2;
+      cp = c & 0x0Fu;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+      n = 3;
+      cp = c & 0x07u;
+    } else {
+      return false;
+    }
+    if (i + n >= text.size()) return false;  // cut short
+    for (std::size_t k = 1; k <= n; ++k) {
+      const auto d = static_cast<unsigned char>(text[i + k]);
+      if ((d & 0xC0u) != 0x80u) return false;
+      cp = (cp << 6) | (d & 0x3Fu);
+    }
+    if ((n == 2 && cp < 0x800) || (n == 3 && cp < 0x10000) || cp > 0x10FFFF ||
+        (cp >= 0xD800 && cp <= 0xDFFF)) {
+      return false;
+    }
+    i += n + 1;
+  }
+  return true;
+}
+
+// `text` with every byte outside printable ASCII as \xNN, for a message
+// about a name that is not UTF-8.
+std::string Escaped(const std::string& text) {
+  static const char* kHex = "0123456789abcdef";
+  std::string out;
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c >= 0x20 && c < 0x7F) {
+      out += ch;
+    } else {
+      out += std::string("\\x") + kHex[c >> 4] + kHex[c & 0xF];
+    }
+  }
+  return out;
+}
+
 // Where a parameter's value came from, to point at it if the unit refuses it.
 struct ParameterOrigin {
   std::string file;
@@ -413,6 +468,15 @@ static void AppendCanonical(const YAML::Node& node, std::string& out) {
 }
 
 Scenario LoadScenario(const std::string& file, const std::vector<std::string>& set_args) {
+  // Refused before anything is read or written (no --out folder).
+  if (!IsUtf8(file)) {
+    Issue issue;
+    issue.file = Escaped(file);
+    issue.message =
+        "the scenario file's path is not valid UTF-8 (summary.json and the results name it): "
+        "expected a UTF-8 path; rename the file";
+    throw ScenarioError({issue});
+  }
   Scenario s;
   s.file = file;
   std::vector<Issue> issues;

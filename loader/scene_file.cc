@@ -150,12 +150,17 @@ class SceneParser {
     for (const char* axis : {"x", "y"}) {
       const double lo = axis[0] == 'x' ? f.min_x_m : f.min_y_m;
       const double hi = axis[0] == 'x' ? f.max_x_m : f.max_y_m;
-      const std::string key = std::string("max_") + axis + "_m";
-      if (Child(floor, key).IsDefined() && hi <= lo) {
-        r_.Error(
-            Child(floor, key), JoinPath(path, key),
-            "expected more than min_" + std::string(axis) + "_m (" + YAML::Node(lo).Scalar() + ")");
+      const std::string min_key = std::string("min_") + axis + "_m";
+      const std::string max_key = std::string("max_") + axis + "_m";
+      if (!Child(floor, min_key).IsDefined() || !Child(floor, max_key).IsDefined() || hi > lo) {
+        continue;
       }
+      // At the key the user changed (--set min_x_m), else at the max.
+      const std::string key = r_.ConflictKey(path, min_key, max_key);
+      const bool at_min = key == min_key;
+      r_.Error(Child(floor, key), JoinPath(path, key),
+               at_min ? "expected less than " + max_key + " (" + YAML::Node(hi).Scalar() + ")"
+                      : "expected more than " + min_key + " (" + YAML::Node(lo).Scalar() + ")");
     }
     f.surface = Reference(floor, path, "surface", surface_names_, "surface");
   }
@@ -187,7 +192,43 @@ class SceneParser {
       belt.variation_period_s = r_.Real(b, p, "variation_period_s", 20.0, {0.0, 1e6, true});
       belt.acceleration_mps2 = r_.Real(b, p, "acceleration_mps2", 0.5, {0.0, 100.0, true});
       Schedule(Child(b, "schedule"), JoinPath(p, "schedule"), belt);
+      OnTheFloor(b, p, belt);
       s_.belts.push_back(belt);
+    }
+  }
+
+  // A belt lies on the floor: every corner of its area within the floor's
+  // bounds (the robot, the maps and the plots live there; a belt beyond
+  // them would fail when the run starts, or never be reached). Reported at
+  // the belt's key the command line changed, else at its centre.
+  void OnTheFloor(const YAML::Node& b, const std::string& path, const models::Belt& belt) {
+    const models::Floor& f = s_.floor;
+    if (!(f.max_x_m > f.min_x_m && f.max_y_m > f.min_y_m)) return;  // reported with the floor
+    const models::Rect& a = belt.area;
+    const double c = std::cos(a.direction_rad), s = std::sin(a.direction_rad);
+    // Rounding of the rotation: a belt whose edge is the floor's is on it.
+    const double slack = 1e-9 * (1.0 + std::abs(a.center_x_m) + std::abs(a.center_y_m) + a.length_m);
+    for (const double u : {-0.5, 0.5}) {
+      for (const double v : {-0.5, 0.5}) {
+        const double x = a.center_x_m + c * u * a.length_m - s * v * a.width_m;
+        const double y = a.center_y_m + s * u * a.length_m + c * v * a.width_m;
+        if (x >= f.min_x_m - slack && x <= f.max_x_m + slack && y >= f.min_y_m - slack &&
+            y <= f.max_y_m + slack) {
+          continue;
+        }
+        std::string key = "center_x_m";
+        for (const char* k : {"center_y_m", "length_m", "width_m", "direction_deg"}) {
+          if (r_.FromCommandLine(JoinPath(path, k))) key = k;
+        }
+        if (r_.FromCommandLine(JoinPath(path, "center_x_m"))) key = "center_x_m";
+        r_.Error(Child(b, key).IsDefined() ? Child(b, key) : b, JoinPath(path, key),
+                 "belt '" + belt.name + "' lies off the floor: its corner (" +
+                     cosim::FormatValue(x) + ", " + cosim::FormatValue(y) +
+                     ") m is outside the floor's x " + cosim::FormatValue(f.min_x_m) + " to " +
+                     cosim::FormatValue(f.max_x_m) + " m, y " + cosim::FormatValue(f.min_y_m) +
+                     " to " + cosim::FormatValue(f.max_y_m) + " m: expected a belt within them");
+        return;
+      }
     }
   }
 
@@ -594,6 +635,8 @@ models::Scene ReadScenarioScene(YamlReader& r, const YAML::Node& scene,
   const YAML::Node merged = Merge(model, scene, "scene", sources, empty);
   RefuseEmptyLists(r, empty, "the scene file's");
   YamlReader merged_reader(file);
+  // A contradiction is reported at the key the command line set.
+  merged_reader.ShareCommandLine(r);
   models::Scene out = ReadScene(merged_reader, merged, "scene", name, file);
   for (const Issue& issue : merged_reader.issues()) {
     std::string p = issue.key_path;

@@ -53,6 +53,8 @@ void AddSwerve(SystemBuilder& b, const RobotFile& file, bool compensation, Signa
   SetWheelPositions(p, robot);
   const models::WheelDescription& w0 = robot.wheels.front();
   p["wheel_radius"] = Num(w0.radius_m);
+  b.Origin(JoinPath(JoinPath(JoinPath("units", kWheelController), "parameters"), "wheel_radius"),
+           file.At("wheels.0.radius_m"));
   // Feedforwards from the motor files: the steering module's own inertia,
   // and for a drive wheel its share of the robot's mass at the rim.
   const Feedforward steer =
@@ -103,12 +105,18 @@ void AddDifferential(SystemBuilder& b, const RobotFile& file, const YAML::Node& 
   // Left (y > 0) and right drive joints; the robot file checked one each.
   std::vector<int> joints(2, 0);
   const models::WheelDescription* left = nullptr;
+  std::size_t left_index = 0;
   for (std::size_t i = 0; i < robot.wheels.size(); ++i) {
     const bool is_left = robot.wheels[i].y_m > 0.0;
     joints[is_left ? 0 : 1] = s.wheel_drive_joint[i];
-    if (is_left) left = &robot.wheels[i];
+    if (is_left) {
+      left = &robot.wheels[i];
+      left_index = i;
+    }
   }
   p["wheel_radius"] = Num(left->radius_m);
+  b.Origin(JoinPath(JoinPath(JoinPath("units", kWheelController), "parameters"), "wheel_radius"),
+           file.At(JoinPath(JoinPath("wheels", std::to_string(left_index)), "radius_m")));
   // Each side's motor moves half the robot (its wheels' share at the rim).
   const Feedforward drive =
       JointFeedforward(GroupOf(robot, left->drive_motor),

@@ -28,7 +28,24 @@ void AddMotors(SystemBuilder& b, const RobotFile& file) {
     }
   }
   // The robot file checked that every group's model sets the same keys.
-  for (const auto& [key, values] : arrays) p[key] = List(values);
+  // Each element's value is reported, when a problem is found in it, at its
+  // group's model file (the gear at the group in the robot file).
+  const std::string prefix = "units.motors.parameters";
+  for (const auto& [key, values] : arrays) {
+    p[key] = List(values);
+    b.Origin(JoinPath(prefix, key), key == "gear_ratio" || key == "gear_efficiency"
+                                        ? file.At(JoinPath("motor_groups.0", key))
+                                        : file.MotorAt(0, key));
+    for (std::size_t e = 0; e < motors.size(); ++e) {
+      const std::size_t g = motors[e].first;
+      const std::string expanded = JoinPath(JoinPath(prefix, key), std::to_string(e));
+      if (key == "gear_ratio" || key == "gear_efficiency") {
+        b.Origin(expanded, file.At(JoinPath(JoinPath("motor_groups", std::to_string(g)), key)));
+      } else {
+        b.Origin(expanded, file.MotorAt(g, key));
+      }
+    }
+  }
   b.MergeSettings(kMotors, file.motor_settings, robot.file, "motors");
 }
 
@@ -95,12 +112,42 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
     c["payload_mass"] = Num(p->mass_kg);
     c["payload_position"] = List({p->x_m, p->y_m, p->z_m});
     c["payload_size"] = List({p->length_m, p->width_m, p->height_m});
-    const YAML::Node scenario = Child(Child(b.root(), "robot"), "payload");
-    if (scenario.IsDefined()) {
-      b.Derived("units.chassis.parameters.payload_mass", scenario, "robot.payload", "mass_kg");
-      b.Derived("units.chassis.parameters.payload_position", scenario, "robot.payload", "x_m");
-      b.Derived("units.chassis.parameters.payload_size", scenario, "robot.payload", "length_m");
+  }
+  // Each value at the robot file's key it comes from.
+  const std::string cp = "units.chassis.parameters";
+  for (const auto& [param, key] :
+       {std::pair{"body_length", "body.length_m"}, std::pair{"body_width", "body.width_m"},
+        std::pair{"body_height", "body.height_m"}, std::pair{"mass", "body.mass_kg"},
+        std::pair{"com_height", "body.com_height_m"}, std::pair{"module_mass", "wheels.0.mass_kg"}}) {
+    b.Origin(JoinPath(cp, param), file.At(key));
+  }
+  for (const char* param : {"wheel_x", "wheel_y", "wheel_radius"}) {
+    b.Origin(JoinPath(cp, param), file.At("wheels"));
+  }
+  for (std::size_t k = 0; k < robot.wheels.size(); ++k) {
+    const std::string wheel = JoinPath("wheels", std::to_string(k));
+    for (const auto& [param, key] : {std::pair{"wheel_x", "x_m"}, std::pair{"wheel_y", "y_m"},
+                                     std::pair{"wheel_radius", "radius_m"}}) {
+      b.Origin(JoinPath(JoinPath(cp, param), std::to_string(k)), file.At(JoinPath(wheel, key)));
     }
+  }
+  if (robot.payload && robot.payload->mass_kg > 0.0) {
+    // The scenario's robot.payload, or else the robot file's payload.
+    const YAML::Node scenario = Child(Child(b.root(), "robot"), "payload");
+    const auto at = [&](const std::string& key) {
+      if (!scenario.IsDefined()) return file.At(JoinPath("payload", key));
+      const YAML::Node node = Child(scenario, key);
+      return loader::Origin{node.IsDefined() ? node : scenario, JoinPath("robot.payload", key), ""};
+    };
+    b.Origin(JoinPath(cp, "payload_mass"), at("mass_kg"));
+    const char* position[] = {"x_m", "y_m", "z_m"};
+    const char* size[] = {"length_m", "width_m", "height_m"};
+    for (std::size_t d = 0; d < 3; ++d) {
+      b.Origin(JoinPath(JoinPath(cp, "payload_position"), std::to_string(d)), at(position[d]));
+      b.Origin(JoinPath(JoinPath(cp, "payload_size"), std::to_string(d)), at(size[d]));
+    }
+    b.Origin(JoinPath(cp, "payload_position"), at("x_m"));
+    b.Origin(JoinPath(cp, "payload_size"), at("length_m"));
   }
   c["initial_x"] = Num(start.x_m);
   c["initial_y"] = Num(start.y_m);

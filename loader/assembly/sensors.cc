@@ -59,23 +59,31 @@ cosim::TimeNs WholeMasterSteps(cosim::TimeNs period, cosim::TimeNs master_step) 
   return std::max<cosim::TimeNs>(1, (period + master_step - 1) / master_step) * master_step;
 }
 
-// The mount's pose as the sensor unit's parameters.
-void SetMountParameters(YAML::Node params, const models::SensorMount& m) {
+// The mount's pose as the sensor unit's parameters, each reported at the
+// robot file's key it comes from (mount `index` of sensor_mounts) when a
+// problem is found in it.
+void SetMountParameters(SystemBuilder& b, const RobotFile& file, std::size_t index) {
+  const models::SensorMount& m = file.robot.sensor_mounts[index];
+  YAML::Node params = b.Params(m.name);
+  const std::string prefix = JoinPath(JoinPath("units", m.name), "parameters");
+  const std::string mount = JoinPath("sensor_mounts", std::to_string(index));
+  const auto set = [&](const char* param, double value, const char* key) {
+    params[param] = Num(value);
+    b.Origin(JoinPath(prefix, param), file.At(JoinPath(mount, key)));
+  };
+  set("mount_x", m.x_m, "x_m");
+  set("mount_y", m.y_m, "y_m");
   if (m.kind == "px4flow") {
     // Looks straight down: only its place on the planform, its height and
     // its heading about the vertical matter.
-    params["mount_x"] = Num(m.x_m);
-    params["mount_y"] = Num(m.y_m);
-    params["mount_height"] = Num(m.z_m);
-    params["mount_yaw"] = Num(m.yaw_rad);
+    set("mount_height", m.z_m, "z_m");
+    set("mount_yaw", m.yaw_rad, "yaw_deg");
     return;
   }
-  params["mount_x"] = Num(m.x_m);
-  params["mount_y"] = Num(m.y_m);
-  params["mount_z"] = Num(m.z_m);
-  params["mount_roll"] = Num(m.roll_rad);
-  params["mount_pitch"] = Num(m.pitch_rad);
-  params["mount_yaw"] = Num(m.yaw_rad);
+  set("mount_z", m.z_m, "z_m");
+  set("mount_roll", m.roll_rad, "roll_deg");
+  set("mount_pitch", m.pitch_rad, "pitch_deg");
+  set("mount_yaw", m.yaw_rad, "yaw_deg");
 }
 
 // A wheel encoder reads every steering joint, then every drive joint, of
@@ -190,7 +198,7 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
     if (m.kind == "wheel_encoder") {
       WireEncoder(b, m.name, s);
     } else {
-      SetMountParameters(params, m);
+      SetMountParameters(b, file, i);
     }
     std::set<std::string> derived;
     for (const auto& kv : params) {

@@ -1,4 +1,7 @@
 #include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
 #include <numbers>
 
 #include "loader/assembly/concerns.h"
@@ -23,6 +26,22 @@ const std::vector<std::string> kRouteGains = {"k_p_distance",
                                               "max_distance_integral_rate",
                                               "max_orientation_integral_rate",
                                               "stop_tolerance"};
+
+// The robot's top speed (its description's path_follower.max_speed), when
+// it is a positive number. Another value bounds nothing here: the path
+// follower's parameter check reports it where it was written (the robot
+// file's key), not at task.speed_mps, which was not wrong.
+std::optional<double> TopSpeed(const RobotFile& file) {
+  const auto top = YamlReader::DecodeReal(Child(file.follower_settings, "max_speed"));
+  if (top && std::isfinite(*top) && *top > 0.0) return top;
+  return std::nullopt;
+}
+// task.speed_mps: at most the top speed; 0.3 m/s by default, or the top
+// speed when lower.
+Range SpeedRange(const RobotFile& file) {
+  return {0.0, TopSpeed(file).value_or(std::numeric_limits<double>::infinity()), true};
+}
+double DefaultSpeed(const RobotFile& file) { return std::min(0.3, TopSpeed(file).value_or(0.3)); }
 
 // task.type route: paper 2's parametric trajectory controller (the
 // `route_follower` unit, under the follower's unit name) along a route
@@ -65,12 +84,8 @@ void AddRoute(SystemBuilder& b, const RobotFile& file, const YAML::Node& task, S
     }
   }
 
-  // Speed: the constant V of Eq. 5, up to the robot's top speed (its
-  // description's path_follower.max_speed).
-  const double top_mps =
-      YamlReader::DecodeReal(Child(file.follower_settings, "max_speed")).value_or(0.0);
-  const double speed =
-      r.Real(task, "task", "speed_mps", std::min(0.3, top_mps), {0.0, top_mps, true});
+  // Speed: the constant V of Eq. 5, up to the robot's top speed.
+  const double speed = r.Real(task, "task", "speed_mps", DefaultSpeed(file), SpeedRange(file));
   p["speed"] = Num(speed);
   b.Derived("units.path_follower.parameters.speed", task, "task", "speed_mps");
   // The robot's yaw-rate limit (its description's path_follower.max_yaw_rate).
@@ -178,11 +193,8 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
       }
     }
     p["mode"] = "path";
-    // Up to the robot's top speed (its description's path_follower.max_speed).
-    const double top_mps =
-        YamlReader::DecodeReal(Child(file.follower_settings, "max_speed")).value_or(0.0);
-    p["speed"] =
-        Num(r.Real(task, "task", "speed_mps", std::min(0.3, top_mps), {0.0, top_mps, true}));
+    // Up to the robot's top speed.
+    p["speed"] = Num(r.Real(task, "task", "speed_mps", DefaultSpeed(file), SpeedRange(file)));
   } else if (info.task == "hold") {
     std::array<double, 2> point{start.x_m, start.y_m};
     if (Child(task, "point").IsDefined()) {

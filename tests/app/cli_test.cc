@@ -148,6 +148,26 @@ TEST(Cli, BadInputExitsTwoAndWritesNothing) {
 
 const std::string kCrossLine = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
 
+// Guards issue 24 (item 5): a scenario whose path is not UTF-8 (a byte
+// 0xff in its name, valid as a Linux file name) ended in the JSON library's
+// exception with no file named, after creating an empty --out folder. It is
+// bad input: exit 2, a message naming the file (the byte written \xff),
+// and nothing written.
+TEST(Cli, AScenarioPathThatIsNotUtf8IsBadInputNamingTheFile) {
+  const std::string text = ReadFile(kMotorStep);
+  const std::string file = WriteScenario("latin1_\xff_motor.yaml", text);
+  const std::string out = Fresh("not_utf8");
+  const Result r = Linesim("run " + file + " --out " + out);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("latin1_\\xff_motor.yaml"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("not valid UTF-8"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  // The same scenario under a UTF-8 name (U+00FF) runs.
+  const std::string utf8 = WriteScenario("latin1_\xc3\xbf_motor.yaml", text);
+  EXPECT_EQ(Linesim("run " + utf8 + " --out " + out).status, 0);
+}
+
+
 // Guards the README's main job, shortened: a robot scenario runs, prints its
 // metric and writes the four plots as PNG files (signature bytes) beside
 // the summary, which lists them.

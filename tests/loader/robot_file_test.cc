@@ -91,6 +91,20 @@ TEST(RobotFile, MissingRequiredValueNamesFileLineAndKey) {
   EXPECT_TRUE(Has(read.issues, "missing required key")) << read.issues;
 }
 
+// Guards issue 24 (item 5): two wheels with one name were accepted (the
+// columns, plots and messages that name a wheel would mix them): refused
+// at the second one's name, in the file, with its line (the Robot() text's
+// line 4).
+TEST(RobotFile, TwoWheelsWithOneNameAreRefused) {
+  const std::string file = WriteScenario(
+      "robot_twin_wheels.yaml",
+      Robot("{name: r, x_m: 0, y_m: 0.3, radius_m: 0.1, width_m: 0.05, mass_kg: 2, "
+            "drive_motor: left}"));
+  const Read read = ReadModel(file);
+  EXPECT_FALSE(read.file);
+  EXPECT_TRUE(Has(read.issues, file + ":4: wheels.1.name: wheel 'r' is named twice")) << read.issues;
+}
+
 // Guards the topology checks: a wheel naming no motor of the groups, a
 // motor that moves nothing, a differential base with a steered wheel, and
 // an unknown key in the file.

@@ -545,6 +545,90 @@ TEST(RobotScenario, RobotFileSettingsAreReportedInTheRobotFile) {
   EXPECT_TRUE(Has(e, "controller.drive_kp: missing required key")) << e;
 }
 
+// Guards issue 24 (item 5): a value of the robot file that the assembly
+// turns into a unit parameter is reported in the robot file at the key the
+// user wrote, with its line: path_follower.max_speed -1.2 (it was reported
+// at task.speed_mps, a key the scenario never wrote, because that key's
+// bound is the top speed), a PX4Flow's z_m 0 (its mount_height must be
+// positive: it was reported at units.flow_front_left.parameters.
+// mount_height), a wheel radius the chassis refuses (element k of the
+// chassis's wheel_radius is wheels.k.radius_m), and a motor model's value
+// (reported in the motor model file, at its key). The numbers are the
+// shipped raw3.yaml's lines changed to values the units' rules refuse.
+TEST(RobotScenario, RobotFileValuesAreReportedWhereTheUserWroteThem) {
+  std::ifstream in(LINESIM_SOURCE_DIR "/models/robots/raw3.yaml");
+  const std::string original((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
+  const auto edited = [&](const std::string& from, const std::string& to) {
+    std::string text = original;
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    return WriteScenario("raw3_edited.yaml", text);
+  };
+  // The line of `needle` in `text` (1-based).
+  const auto line_of = [&](const std::string& needle) {
+    const auto at = original.find(needle);
+    return std::to_string(1 + std::count(original.begin(), original.begin() + at, '\n'));
+  };
+  std::string model = edited("max_speed: 1.2", "max_speed: -1.2");
+  std::string e = Issues(kCross, {"robot.model=" + model});
+  EXPECT_TRUE(Has(e, model + ":" + line_of("max_speed: 1.2") + ": path_follower.max_speed: ")) << e;
+  EXPECT_FALSE(Has(e, "task.speed_mps")) << e;
+  EXPECT_FALSE(Has(e, "units.path_follower")) << e;
+
+  const std::string flow = "x_m: 0.465, y_m: 0.235, z_m: 0.1841";
+  model = edited(flow, "x_m: 0.465, y_m: 0.235, z_m: 0");
+  e = Issues(kCross, {"robot.model=" + model});
+  EXPECT_TRUE(Has(e, model + ":" + line_of(flow) + ": sensor_mounts.0.z_m: ")) << e;
+  EXPECT_FALSE(Has(e, "mount_height")) << e;
+
+  // The chassis's rule across values: four wheels of 5 kg weigh less than
+  // the robot; with mass_kg 10 the wheels' mass is refused, at the first
+  // wheel's mass_kg (the chassis lumps one module mass from it).
+  model = edited("mass_kg: 120", "mass_kg: 10");
+  e = Issues(kCross, {"robot.model=" + model});
+  EXPECT_TRUE(Has(e, model + ":" + line_of("{name: w1") +
+                         ": wheels.0.mass_kg: times 4 wheels must be less than mass 10")) << e;
+  EXPECT_FALSE(Has(e, "units.chassis")) << e;
+
+  // A motor model's value the dc_motor refuses (a negative resistance):
+  // in the motor model file the steering group names, at its key.
+  std::ifstream motor_in(LINESIM_SOURCE_DIR "/models/motors/maxon_re40_148877.yaml");
+  std::string motor_text((std::istreambuf_iterator<char>(motor_in)),
+                         std::istreambuf_iterator<char>());
+  const auto at = motor_text.find("resistance: 0.299");
+  ASSERT_NE(at, std::string::npos);
+  const std::string motor_line =
+      std::to_string(1 + std::count(motor_text.begin(), motor_text.begin() + at, '\n'));
+  motor_text.replace(at, 17, "resistance: -0.299");
+  const std::string motor = WriteScenario("re40_edited.yaml", motor_text);
+  model = edited("name: steer, model: maxon_re40_148877", "name: steer, model: " + motor);
+  e = Issues(kCross, {"robot.model=" + model});
+  EXPECT_TRUE(Has(e, motor + ":" + motor_line + ": resistance: ")) << e;
+  EXPECT_FALSE(Has(e, "units.motors")) << e;
+}
+
+// Guards issue 24 (item 5): a map's cell_m of 1e-6 m passed the load and
+// failed when the maps were built at initialization. The lookup grid holds
+// at most 2^28 cells (units/estimation/occupancy_grid.h): van_entry's van
+// map, region 3.25 x 1.865 m plus the 1 m map_margin on each side (5.25 x
+// 3.865 m), needs a cell of at least sqrt(5.25 x 3.865 / 2^28) = 2.749e-4 m.
+// 2.7e-4 m (19445 x 14315 = 2.78e8 cells) is refused at load at the map's
+// key; 3e-4 m (17500 x 12884 = 2.25e8) loads, as the shipped 0.01 m does.
+TEST(RobotScenario, AMapGridBeyondItsLimitIsRefusedAtLoad) {
+  const std::string van = LINESIM_SOURCE_DIR "/scenarios/van_entry.yaml";
+  for (const char* cell : {"1e-6", "2.7e-4"}) {
+    const std::string e = Issues(van, {std::string("localization.maps.1.cell_m=") + cell});
+    EXPECT_TRUE(Has(e, "localization.maps.1: cell_m ")) << e;
+    EXPECT_TRUE(Has(e, "m over the map's 5.25 x 3.865 m (map_margin included)")) << e;
+    EXPECT_TRUE(Has(e, "more than the lookup grid's 2^28: expected a cell_m of at least 0.000274") ||
+                Has(e, "more than the lookup grid's 2^28: expected a cell_m of at least 2.74"))
+        << e;
+  }
+  EXPECT_EQ(Issues(van, {"localization.maps.1.cell_m=3e-4"}), "(no error)");
+}
+
 // Guards the start pose against the scene (models/scenes/factory_line.yaml):
 // off the 30 x 20 m floor, or inside the car body that starts at x = -7 m on
 // the line, is refused at robot.pose; a robot scenario with no scene and no

@@ -377,5 +377,54 @@ TEST(ScenarioScene, SetOnTheCommandLine) {
       << issues;
 }
 
+// Guards issue 24 (item 5): a floor minimum set on the command line above
+// the file's maximum was reported at the maximum (scene.floor.max_x_m),
+// a key the user did not touch: it is reported at the key set
+// (factory_line's floor runs x -15 to 15 m); with neither or both set on
+// the command line, at the maximum as before.
+TEST(ScenarioScene, AContradictionIsReportedAtTheKeySetOnTheCommandLine) {
+  const std::string f = WriteScenario("floor_set.yaml", std::string(kValidScenario) +
+                                                            "scene: {model: factory_line}\n");
+  const std::string min = Issues(f, {"scene.floor.min_x_m=20"});
+  EXPECT_TRUE(Has(min, f + ": scene.floor.min_x_m (set on the command line): expected less than "
+                           "max_x_m (15)"))
+      << min;
+  EXPECT_FALSE(Has(min, "max_x_m (set")) << min;
+  const std::string max = Issues(f, {"scene.floor.max_x_m=-20"});
+  EXPECT_TRUE(Has(max, f + ": scene.floor.max_x_m (set on the command line): expected more than "
+                           "min_x_m (-15)"))
+      << max;
+  std::string bad = kSmallScene;
+  bad.replace(bad.find("max_x_m: 5"), 10, "max_x_m: -6");
+  const std::string file = WriteScenario("floor_inverted.yaml", bad);
+  EXPECT_TRUE(Has(SceneIssues(file), file + ":4: floor.max_x_m: expected more than min_x_m (-5)"))
+      << SceneIssues(file);
+}
+
+// Guards issue 24 (item 5): a belt 1000 m off the floor was accepted and
+// the run failed when it started. Refused at load, at the belt's key
+// (kSmallScene's floor is x, y -5 to 5 m; a belt 6 x 2 m centred at x 1000
+// has a corner at (997, -1)); one set on the command line is reported as
+// such, also through a robot scenario's line.belts (factory_line's floor
+// x -15 to 15 m, y -10 to 10 m; cross_line's 20 x 2 m belt at y 1000 has
+// its corner (-10, 999)); a belt whose edge is the floor's lies on it.
+TEST(ScenarioScene, ABeltOffTheFloorIsRefused) {
+  std::string bad = kSmallScene;
+  bad.replace(bad.find("center_x_m: 0"), 13, "center_x_m: 1000");
+  const std::string file = WriteScenario("belt_off.yaml", bad);
+  const std::string e = SceneIssues(file);
+  EXPECT_TRUE(Has(e, file + ":6: belts.0.center_x_m: belt 'line' lies off the floor: its corner "
+                            "(997, -1) m is outside the floor's x -5 to 5 m, y -5 to 5 m"))
+      << e;
+  std::string edge = kSmallScene;
+  edge.replace(edge.find("length_m: 6"), 11, "length_m: 10");
+  EXPECT_EQ(SceneIssues(WriteScenario("belt_edge.yaml", edge)), "(no error)");
+  const std::string cross = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
+  const std::string line = Issues(cross, {"line.belts.0.center_y_m=1000"});
+  EXPECT_TRUE(Has(line, "line.belts.0.center_y_m (set on the command line): belt "))
+      << line;
+  EXPECT_TRUE(Has(line, "lies off the floor: its corner (-10, 999) m")) << line;
+}
+
 }  // namespace
 }  // namespace linesim::loader

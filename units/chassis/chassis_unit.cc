@@ -530,13 +530,28 @@ void ChassisUnit::Build() {
     dMassTranslate(&m, -com[0], -com[1], com_height_ - com[2]);
     dMass mp;
     const double* size = payload_size_.data();
+    const double d[3] = {payload_position_[0] - com[0], payload_position_[1] - com[1],
+                         payload_position_[2] - com[2]};
     if (size[0] > 0.0 && size[1] > 0.0 && size[2] > 0.0) {
       dMassSetBoxTotal(&mp, payload_mass_, size[0], size[1], size[2]);
+      dMassTranslate(&mp, d[0], d[1], d[2]);
     } else {
-      dMassSetParameters(&mp, payload_mass_, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+      // A point mass at d: about c only the parallel-axis inertia
+      // m (|d|^2 1 - d d^T), which is singular (nothing about the axis
+      // through it). Written directly: dMassSetParameters and
+      // dMassTranslate check each part for a positive-definite inertia and
+      // print ODE's "inertia must be positive definite"; the sum with the
+      // body box, which dBodySetMass checks, is positive definite.
+      dMassSetZero(&mp);
+      mp.mass = payload_mass_;
+      const double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+      for (int r = 0; r < 3; ++r) {
+        mp.c[r] = d[r];
+        for (int k = 0; k < 3; ++k) {
+          mp.I[4 * r + k] = payload_mass_ * ((r == k ? d2 : 0.0) - d[r] * d[k]);
+        }
+      }
     }
-    dMassTranslate(&mp, payload_position_[0] - com[0], payload_position_[1] - com[1],
-                   payload_position_[2] - com[2]);
     dMassAdd(&m, &mp);
     // The sum's centre is 0 up to rounding; ODE requires it exactly there.
     for (int d = 0; d < 3; ++d) m.c[d] = 0.0;

@@ -213,7 +213,7 @@ void OccupancyGrid::Build(const models::Floor& floor, const Options& o) {
     const double span_x = floor.max_x_m - floor.min_x_m + 2.0 * o.margin;
     const double span_y = floor.max_y_m - floor.min_y_m + 2.0 * o.margin;
     const double nx = std::ceil(span_x / l.cell), ny = std::ceil(span_y / l.cell);
-    if (!(nx * ny <= double(1 << 28)) || nx < 2 || ny < 2) {
+    if (!(nx * ny <= kMaxCells) || nx < 2 || ny < 2) {
       throw std::invalid_argument("occupancy grid: the floor gives " + std::to_string(nx) + " x " +
                                   std::to_string(ny) + " cells at " + std::to_string(l.cell) +
                                   " m (at most 2^28, at least 2 x 2)");

@@ -90,6 +90,8 @@ class OccupancyGrid {
     double free = 0.4;
   };
   static constexpr float kLogOddsBound = 50.0f;
+  /// The most cells a level may have (a float each, several arrays: 1 GiB).
+  static constexpr double kMaxCells = double(1 << 28);
 
   /// Builds every level (throws std::invalid_argument for a resolution <= 0,
   /// levels < 1, or a grid beyond 2^28 cells).

@@ -5,7 +5,9 @@
 #include <span>
 #include <utility>
 
+#include "cosim/variable_table.h"
 #include "models/angle.h"
+#include "units/estimation/occupancy_grid.h"
 
 namespace linesim::estimation {
 
@@ -132,6 +134,35 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
 }
 
 PerfectMatchLocalizationUnit::~PerfectMatchLocalizationUnit() = default;
+
+std::vector<cosim::ParameterProblem> PerfectMatchLocalizationUnit::CheckParameters() const {
+  auto problems = ScanLocalizer::CheckParameters();
+  // Each map's lookup grid (its region, or the floor, and the margin, at its
+  // cell) within the grid's limit: refused here, at load, rather than when
+  // the maps are built at initialization.
+  for (std::size_t i = 0; i < specs_.size(); ++i) {
+    const MapSpec& m = specs_[i];
+    const double cell = m.cell_m > 0.0 ? m.cell_m : lookup_cell_;
+    const double span_x = (m.region ? m.region->max_x - m.region->min_x
+                                    : scene_.floor.max_x_m - scene_.floor.min_x_m) +
+                          2.0 * map_margin_;
+    const double span_y = (m.region ? m.region->max_y - m.region->min_y
+                                    : scene_.floor.max_y_m - scene_.floor.min_y_m) +
+                          2.0 * map_margin_;
+    const double cells = std::ceil(span_x / cell) * std::ceil(span_y / cell);
+    if (cell > 0.0 && std::isfinite(span_x * span_y) && !(cells <= OccupancyGrid::kMaxCells)) {
+      problems.push_back(
+          {"maps", i,
+           "cell_m " + cosim::FormatValue(cell) + " m over the map's " +
+               cosim::FormatValue(span_x) + " x " + cosim::FormatValue(span_y) +
+               " m (map_margin included) makes " + cosim::FormatValue(cells) +
+               " cells, more than the lookup grid's 2^28: expected a cell_m of at least " +
+               cosim::FormatValue(std::sqrt(span_x * span_y / OccupancyGrid::kMaxCells)) +
+               " m, or a smaller region"});
+    }
+  }
+  return problems;
+}
 
 void PerfectMatchLocalizationUnit::Derive() {
   DeriveBeams();

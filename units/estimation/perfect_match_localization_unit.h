@@ -87,6 +87,9 @@ class PerfectMatchLocalizationUnit : public ScanLocalizer {
                                std::vector<int> beam_counts, std::vector<MapSpec> maps);
   ~PerfectMatchLocalizationUnit() override;
 
+  /// The base's checks, and each map's lookup grid within
+  /// OccupancyGrid::kMaxCells (refused at load, not when the maps are built).
+  std::vector<cosim::ParameterProblem> CheckParameters() const override;
   void Initialize() override;
 
   int map_count() const { return static_cast<int>(specs_.size()); }

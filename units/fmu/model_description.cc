@@ -667,6 +667,26 @@ class Parser {
         }
       }
     }
+    // A unit names a <Unit> of <UnitDefinitions> (FMI 2.0.4 section 2.2.2,
+    // Definition of Units, and FMI 3.0's: the unit attribute references a
+    // unit defined there). An FMU without UnitDefinitions is still read, its unit
+    // names understood as SI expressions (see LinesimUnit).
+    const bool has_unit_definitions = static_cast<bool>(root.child("UnitDefinitions"));
+    for (const FmiVariable& v : md.variables) {
+      if (has_unit_definitions && !v.fmi_unit.empty() && !md.units.contains(v.fmi_unit)) {
+        throw FmuError(at(v) + "unit '" + v.fmi_unit +
+                       "' is not in <UnitDefinitions> (FMI: a variable's unit names a unit "
+                       "defined there)");
+      }
+      // A value linesim gives the FMU has a start value: a parameter's
+      // initial is exact, and initial exact or approx or causality input
+      // needs a start (FMI 2.0.4 section 2.2.7, FMI 3.0 section 2.4.7.5).
+      // Without it, linesim would have no value of the FMU's to give.
+      if (settable(v) && !v.has_start) {
+        throw FmuError(at(v) + v.causality +
+                       " without a start value (FMI: a parameter or input must have one)");
+      }
+    }
     for (const FmiVariable& v : md.variables) {
       // min <= max, and a start value within them (FMI 2.0.4 section
       // 2.2.7, FMI 3.0 section 2.4.7.4: min <= start <= max).
@@ -696,7 +716,6 @@ class Parser {
                        " is no item of enumeration '" + v.declared_type + "'");
       }
     }
-    (void)root;
   }
 
   static std::string FormatNumber(double x) {

@@ -145,6 +145,35 @@ TEST(Terrain, BrakedHuskyWithArmOnAnInclineIsCoulomb) {
   }
 }
 
+// Guards against a payload without a box (a point mass, as README's
+// robot.payload documents it: the box is optional) being built with an
+// inertia ODE refuses: dMassSetParameters with a zero inertia printed ODE's
+// "inertia must be positive definite" while the run went on. The point mass
+// must still weigh and sit where it is given: braked on the incline of 20
+// deg with mu 0.25 the robot slides down with a = g (sin p - mu cos p) =
+// 1.050 m/s^2 (Coulomb, whatever the mass and its distribution, as above).
+TEST(Terrain, PointMassPayloadIsAValidBody) {
+  const double pitch = 20.0 * kPi / 180.0;
+  const double mu = 0.25;
+  auto robot = HuskyWithArm(Incline(pitch, mu));
+  ChassisUnit& u = *robot;
+  test_robots::Set(u, "payload_size", std::vector<double>{0.0, 0.0, 0.0});
+  testing::internal::CaptureStderr();
+  u.Initialize();
+  u.variables().SetBoolean(*u.variables().Find("brake"), true);
+  TimeNs t = 0;
+  double v_start = 0.0;
+  for (int i = 1; i <= 1000; ++i) {
+    StepOk(u, t);
+    if (i == 200) v_start = Get(u, "velocity_3d")[0];
+  }
+  const std::string printed = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(printed.find("positive definite"), std::string::npos) << printed;
+  const double a = kGravityMps2 * (std::sin(pitch) - mu * std::cos(pitch));
+  const double measured = -(Get(u, "velocity_3d")[0] - v_start) / std::cos(pitch) / 0.8;
+  EXPECT_NEAR(measured, a, 0.02 * a);
+}
+
 // Guards against a robot built sunk into a terrain piece's side (the
 // contacts would throw it out): refused, naming the piece.
 TEST(Terrain, StartAgainstAPiecesSideIsRefused) {

@@ -46,14 +46,15 @@ TEST(ModelDescription, FmiVersionMustBeExactlyASupportedOne) {
 }
 
 // An FMI 3.0 description with `n` Float64 variables, every fourth an input
-// and every fourth an output depending on the input before it, one per line.
+// (with its start value, which inputs need) and every fourth an output depending on the input before it, one per line.
 std::string Fmi3WithVariables(std::size_t n) {
   std::string vars, outputs;
   vars.reserve(n * 80);
   for (std::size_t i = 0; i < n; ++i) {
     const char* causality = i % 4 == 0 ? "input" : i % 4 == 1 ? "output" : "local";
     vars += "    <Float64 name=\"v" + std::to_string(i) + "\" valueReference=\"" +
-            std::to_string(i) + "\" causality=\"" + causality + "\"/>\n";
+            std::to_string(i) + "\" causality=\"" + causality + "\"" +
+            (i % 4 == 0 ? " start=\"0\"" : "") + "/>\n";
     if (i % 4 == 1) {
       outputs += "    <Output valueReference=\"" + std::to_string(i) + "\" dependencies=\"" +
                  std::to_string(i - 1) + "\"/>\n";
@@ -191,6 +192,77 @@ TEST(ModelDescription, RulesTheSchemaCannotExpressAreEnforced) {
                 .find("start value '300' is not a Int8"),
             std::string::npos);
 }
+// `text` with `units` as its <UnitDefinitions>, before <TypeDefinitions>
+// (where the schemas put it).
+std::string WithUnits(std::string text, const std::string& units) {
+  const std::size_t at = text.find("  <TypeDefinitions>");
+  text.insert(at, "  <UnitDefinitions>" + units + "</UnitDefinitions>\n");
+  return text;
+}
+
+// Guards issue 24: a parameter or input without a start value was read and
+// linesim gave the FMU 0 for it, a value the FMU never declared. The
+// standards require one (FMI 2.0.4 section 2.2.7, FMI 3.0 section 2.4.7.5:
+// a parameter's initial is exact; initial exact or approx, or causality
+// input, needs a start): refused naming the rule. An output, a local and a
+// calculated parameter need none.
+TEST(ModelDescription, ParameterOrInputWithoutStartIsRefused) {
+  for (const char* causality : {"parameter", "input"}) {
+    SCOPED_TRACE(causality);
+    const std::string e = ParseError(Fmi2("", Sv("a", 1, causality, "<Real/>",
+                                                 causality[0] == 'p' ? "fixed" : "")));
+    EXPECT_NE(e.find(std::string("variable 'a': ") + causality +
+                     " without a start value (FMI: a parameter or input must have one)"),
+              std::string::npos)
+        << e;
+  }
+  EXPECT_NE(ParseError(Fmi2("", Sv("n", 1, "parameter", "<Integer/>", "tunable")))
+                .find("parameter without a start value"),
+            std::string::npos);
+  EXPECT_NE(ParseError(Fmi3("", "    <Float64 name=\"a\" valueReference=\"1\" "
+                                "causality=\"parameter\" variability=\"fixed\"/>\n"))
+                .find("parameter without a start value"),
+            std::string::npos);
+  EXPECT_NE(ParseError(Fmi3("", "    <Int32 name=\"s\" valueReference=\"1\" "
+                                "causality=\"structuralParameter\" variability=\"fixed\"/>\n"))
+                .find("structuralParameter without a start value"),
+            std::string::npos);
+  EXPECT_EQ(ParseError(Fmi2("", Sv("y", 1, "output") + Sv("l", 2, "local") +
+                                    Sv("c", 3, "calculatedParameter", "<Real/>", "fixed"),
+                            "<Unknown index=\"1\"/>")),
+            "");
+}
+
+// Guards issue 24: a variable's unit that its FMU's <UnitDefinitions> does
+// not define was read as if it were an SI expression. The unit attribute
+// references a unit definition (FMI 2.0.4 section 2.2.2; FMI 3.0 likewise):
+// with UnitDefinitions present, a unit not among them is refused, naming
+// it, on the variable and through its declared type. Without
+// UnitDefinitions the FMU is read and the name understood as an SI
+// expression (README, FMUs as units).
+TEST(ModelDescription, AUnitMustBeInUnitDefinitionsWhenTheFmuHasThem) {
+  const std::string units = "<Unit name=\"m\"><BaseUnit m=\"1\"/></Unit>";
+  const std::string in_m = Sv("u", 1, "input", "<Real unit=\"m\" start=\"0\"/>");
+  const std::string in_s = Sv("v", 2, "input", "<Real unit=\"s\" start=\"0\"/>");
+  EXPECT_EQ(ParseError(WithUnits(Fmi2("", in_m), units)), "");
+  const std::string e = ParseError(WithUnits(Fmi2("", in_m + in_s), units));
+  EXPECT_NE(e.find("variable 'v': unit 's' is not in <UnitDefinitions>"), std::string::npos) << e;
+  const std::string type = "<SimpleType name=\"T\"><Real unit=\"m/s\"/></SimpleType>";
+  const std::string typed = Sv("w", 3, "input", "<Real declaredType=\"T\" start=\"0\"/>");
+  EXPECT_NE(ParseError(WithUnits(Fmi2(type, in_m + typed), units))
+                .find("variable 'w': unit 'm/s' is not in <UnitDefinitions>"),
+            std::string::npos);
+  const std::string f3 = "    <Float64 name=\"y\" valueReference=\"1\" causality=\"output\" "
+                         "unit=\"rad\"/>\n";
+  const std::string out3 = "<Output valueReference=\"1\"/>";
+  EXPECT_NE(ParseError(WithUnits(Fmi3("", f3, out3), units))
+                .find("variable 'y': unit 'rad' is not in <UnitDefinitions>"),
+            std::string::npos);
+  // No UnitDefinitions: the names are read as SI expressions.
+  EXPECT_EQ(ParseError(Fmi2("", in_m + in_s)), "");
+  EXPECT_EQ(ParseError(Fmi3("", f3, out3)), "");
+}
+
 // Guards issue 24: every file read has a size limit checked before
 // parsing. A (sparse) model description one byte above
 // kMaxModelDescriptionBytes is refused naming the file and the limit.
