@@ -13,34 +13,52 @@ namespace linesim::replay {
 
 namespace {
 
-// Numbers in fixed notation with a set number of decimals, trailing zeros
-// dropped: std::to_chars is locale-independent and exact, so the same
-// double gives the same text everywhere. Not finite: null.
-void AppendFixed(std::string& out, double v, int decimals) {
-  if (!std::isfinite(v)) {
-    out += "null";
-    return;
-  }
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, decimals);
-  if (r.ec != std::errc()) {
-    out += "null";  // beyond 1e40 or so: nothing a replay draws
-    return;
-  }
-  char* end = r.ptr;
-  if (std::memchr(buf, '.', static_cast<std::size_t>(end - buf)) != nullptr) {
-    while (end[-1] == '0') --end;
-    if (end[-1] == '.') --end;
-  }
-  std::string_view text(buf, static_cast<std::size_t>(end - buf));
-  if (text == "-0") text = "0";
-  out += text;
-}
-
 void AppendInt(std::string& out, std::int64_t v) {
   char buf[32];
   const auto r = std::to_chars(buf, buf + sizeof buf, v);
   out.append(buf, r.ptr);
+}
+
+// Numbers in fixed notation with a set number of decimals, trailing zeros
+// dropped: the value scaled by 10^decimals and rounded to an integer
+// (llround: exact, the same on every CPU), written as digits; the same
+// double gives the same text everywhere, whatever the locale. Not finite:
+// null. Beyond 9e15 after scaling (nothing a replay draws): std::to_chars.
+void AppendFixed(std::string& out, double v, int decimals) {
+  static constexpr double kScale[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9};
+  static constexpr std::int64_t kPower[] = {1,       10,       100,       1000,       10000,
+                                            100000,  1000000,  10000000,  100000000,  1000000000};
+  if (!std::isfinite(v)) {
+    out += "null";
+    return;
+  }
+  const double scaled = v * kScale[decimals];
+  if (!(std::abs(scaled) < 9e15)) {
+    char buf[400];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, 0);
+    out.append(buf, r.ptr);
+    return;
+  }
+  std::int64_t n = std::llround(scaled);
+  if (n < 0) {
+    out += '-';
+    n = -n;
+  }
+  AppendInt(out, n / kPower[decimals]);
+  std::int64_t fraction = n % kPower[decimals];
+  if (fraction == 0) return;
+  int digits = decimals;
+  while (fraction % 10 == 0) {
+    fraction /= 10;
+    --digits;
+  }
+  out += '.';
+  char buf[16];
+  for (int i = digits - 1; i >= 0; --i) {
+    buf[i] = static_cast<char>('0' + fraction % 10);
+    fraction /= 10;
+  }
+  out.append(buf, static_cast<std::size_t>(digits));
 }
 
 // A JSON string; <, > and & escaped too, so that no text inside the page's
