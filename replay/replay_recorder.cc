@@ -16,7 +16,7 @@ namespace {
 void AppendInt(std::string& out, std::int64_t v) {
   char buf[32];
   const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  out.append(buf, r.ptr);
+  out.append(buf, static_cast<std::size_t>(r.ptr - buf));
 }
 
 // Numbers in fixed notation with a set number of decimals, trailing zeros
@@ -280,7 +280,7 @@ void ReplayRecorder::OnSample(cosim::TimeNs t, const cosim::System& system) {
 
 std::string ReplayRecorder::DataJson() const {
   std::string out;
-  out.reserve(1 << 20);
+  out.reserve(std::size_t{2} << 20);  // a 20 s cross_line: 1.5 MB
   out += '{';
   Key(out, "format");
   out += "1,";
