@@ -11,6 +11,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "app/console.h"
@@ -21,6 +22,7 @@
 #include "loader/scenario.h"
 #include "platform/provenance.h"
 #include "plots/robot_plots.h"
+#include "replay/replay_recorder.h"
 #include "units/fmu/fmu_unit.h"
 
 namespace linesim::app {
@@ -165,7 +167,7 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat forma
 
 int RunCommand(const std::string& file, const std::string& out_dir,
                const std::vector<std::string>& set_args, double max_output_mb,
-               plots::PlotFormat format, RunColumns* plot_columns) {
+               plots::PlotFormat format, RunColumns* plot_columns, bool replay) {
   if (IsComparisonFile(file)) {
     return CompareCommand(file, out_dir, set_args, max_output_mb, format);
   }
@@ -205,6 +207,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   {
     std::vector<std::string> previous = plots::RobotPlotFiles();
     previous.push_back("summary.json");
+    previous.push_back("replay.html");
     for (const auto& name : previous) {
       std::error_code ec;
       fs::remove(dir / name, ec);
@@ -241,6 +244,13 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   cosim::MetricsObserver metrics(s.metrics);
   s.master->AddObserver(&recorder);
   s.master->AddObserver(&metrics);
+  // The replay page of a robot run (replay/): sampled by an observer.
+  std::unique_ptr<replay::ReplayRecorder> replayer;
+  if (s.robot && replay) {
+    replayer = std::make_unique<replay::ReplayRecorder>(
+        replay::ReplaySpecFor(s, kPaperBoundM, kPaperBoundLabel));
+    s.master->AddObserver(replayer.get());
+  }
 
   // Ctrl-C or SIGTERM: stop at the next communication point, keep what was
   // recorded and write the summary (status interrupted); again to quit.
@@ -371,6 +381,16 @@ int RunCommand(const std::string& file, const std::string& out_dir,
       // The run itself is fine: say why there are no pictures, do not fail.
       summary["plots"] = {{"error", e.what()}};
       std::cerr << "linesim: no plots: " << e.what() << "\n";
+    }
+  }
+  if (replayer && replayer->frames() > 0) {
+    try {
+      replayer->Write((dir / "replay.html").string());
+      pictures.push_back("replay.html");
+      summary["replay"] = {{"file", "replay.html"}};
+    } catch (const std::exception& e) {
+      summary["replay"] = {{"error", e.what()}};  // as for the plots: the run stands
+      std::cerr << "linesim: no replay: " << e.what() << "\n";
     }
   }
   try {

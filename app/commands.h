@@ -35,11 +35,13 @@ struct RunColumns {
 /// number takes) is refused before it starts (exit 2, nothing written). A
 /// file with a top-level `compare` key is a comparison of runs
 /// (CompareCommand). `columns`, when given, receives what the plots read.
+/// A robot run also writes DIR/replay.html (replay/) unless `replay` is
+/// false (`--no-replay`).
 int RunCommand(const std::string& file, const std::string& out_dir,
                const std::vector<std::string>& set_args,
                double max_output_mb = kDefaultMaxOutputMb,
                plots::PlotFormat format = plots::PlotFormat::kPng,
-               RunColumns* columns = nullptr);
+               RunColumns* columns = nullptr, bool replay = true);
 
 /// `linesim run COMPARE.yaml --out DIR`: every run the file lists, its base
 /// scenario with the run's settings (and `set_args`), into DIR/FOLDER as

@@ -48,6 +48,10 @@ int main(int argc, char** argv) {
                   "the plots' file format: png (default), or svg or pdf (vector, for papers)")
       ->check(CLI::IsMember({"png", "svg", "pdf"}));
   std::int64_t runs = 1;
+  bool no_replay = false;
+  run->add_flag("--no-replay", no_replay,
+                "do not write replay.html (a robot run writes it: its top view and plots, "
+                "animated in a browser)");
   double max_output_mb = linesim::app::kDefaultMaxOutputMb;
   run->add_option("--max-output-mb", max_output_mb,
                   "refuse a run whose signals.csv could exceed this many MB (default 1024)")
@@ -151,7 +155,7 @@ int main(int argc, char** argv) {
     }
     if (run->parsed()) {
       return RunCommand(run_file, out_dir, run_sets, max_output_mb,
-                        *linesim::plots::ParsePlotFormat(run_format));
+                        *linesim::plots::ParsePlotFormat(run_format), nullptr, !no_replay);
     }
     if (sweep->parsed()) {
       if (linesim::sweep::LaunchedByMpi()) {

@@ -30,6 +30,10 @@ struct RobotInfo {
   /// base_link's height, over a scene with terrain ("" otherwise).
   std::string z_column;
   std::vector<std::pair<std::string, std::string>> wheel_columns;
+  /// The surface under each wheel (chassis wheel_surface: -1 no contact, 0
+  /// floor, k + 1 belt k, belts + 1 + j terrain piece j) and the motors'
+  /// armature currents, whole arrays (the replay reads them).
+  std::string wheel_surface_column, motor_current_column;
   std::string error_column;
   std::vector<std::string> belt_speed_columns, belt_on_columns, belt_travel_columns;
   /// Optic flow against the belt's ground truth (paper 1 Fig. 4): what

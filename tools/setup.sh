@@ -17,6 +17,9 @@ packages=(
   # clang and its runtimes (libFuzzer, ASan, UBSan; libclang-rt-14-dev is only
   # recommended by clang): the sanitizer and fuzz build (tools/sanitize.sh).
   clang libclang-rt-14-dev
+  # Headless Chromium: the browser test of replay.html (tests/replay) loads
+  # the page from file:// and drives it over the DevTools protocol.
+  chromium
 )
 
 missing=()

@@ -170,6 +170,8 @@ void AddRecording(SystemBuilder& b, const Signals& s, RobotInfo& info) {
     info.wheel_columns.emplace_back(Element(kChassis, "wheel_contact", 2 * w),
                                     Element(kChassis, "wheel_contact", 2 * w + 1));
   }
+  info.wheel_surface_column = Signal(kChassis, "wheel_surface");
+  info.motor_current_column = Signal(kMotors, "current");
   info.scan_unit = s.scan_unit;
   info.scan_time_s = s.scan_time_s;
   for (std::size_t k = 0; k < s.belt_count; ++k) {

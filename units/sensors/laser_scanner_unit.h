@@ -104,6 +104,21 @@ class LaserScannerUnit : public cosim::Unit {
   /// Whether the point (x, y) of the scanner frame is inside the field.
   bool InField(double x, double y) const;
 
+  /// What an observer needs to draw the scans (replay/): the mount in
+  /// base_link (x, y, yaw), the beams' angles in the scanner frame (first +
+  /// i * step) and the range that means no echo; the parameters as the
+  /// scenario set them.
+  struct BeamGeometry {
+    double mount_x_m, mount_y_m, mount_yaw_rad, first_beam_rad, beam_step_rad, no_return_m;
+  };
+  BeamGeometry beam_geometry() const {
+    return {mount_x_, mount_y_, mount_yaw_, first_beam_angle_, angular_step_, no_return_value_};
+  }
+  /// The last complete scan (the outputs ranges, scan_time, scan_count).
+  const std::vector<double>& ranges() const { return ranges_; }
+  double scan_time_s() const { return scan_time_; }
+  double scan_count() const { return scan_count_; }
+
  protected:
   void SaveInternal(cosim::UnitState& state) const override;
   void RestoreInternal(const cosim::UnitState& state) override;
