@@ -1,0 +1,113 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "cosim/master.h"
+#include "cosim/observers.h"
+#include "loader/scenario.h"
+#include "mcap/writer.h"
+
+/// A linesim run as an MCAP log for Foxglove and PlotJuggler (run.mcap):
+/// the mapping of a run onto Foxglove's channels, gathered during the run
+/// by an observer on the master. JSON messages on Foxglove's JSON schemas:
+///   /tf            foxglove.FrameTransforms at every recorded row: map ->
+///                  base_link (the robot's pose as recorded), base_link ->
+///                  every sensor unit's mount (units with mount_x, mount_y)
+///   /scan/UNIT     foxglove.LaserScan of every laser_scanner unit: its last
+///                  complete scan, at most one per scan_period
+///   /scene         foxglove.SceneUpdate: floor, belts (colour by on state),
+///                  obstacles, terrain, the desired path, the robot (body and
+///                  wheels, in base_link); belts and carried objects again
+///                  every scene_period, everything every full_scene_period
+///   /signals/UNIT  one message per recorded row of signals.csv: the unit's
+///                  recorded variables as fields (an array for elements
+///                  0..n-1 of a Real array, else NAME_i), the same numbers
+/// Times are simulation times (log_time = publish_time = t in ns): the same
+/// scenario and seed give the same bytes.
+namespace linesim::mcap {
+
+struct RunLogOptions {
+  /// The lasers' messages: a new complete scan at most this often (10 Hz:
+  /// every second or third scan of a 25 Hz LMS151 or S300).
+  cosim::TimeNs scan_period = 100'000'000;
+  /// Belts' on state and carried objects' positions (10 Hz).
+  cosim::TimeNs scene_period = 100'000'000;
+  /// The whole scene again (a viewer that seeks finds it within 1 s).
+  cosim::TimeNs full_scene_period = 1'000'000'000;
+  WriterOptions writer;
+};
+
+class RunLog : public cosim::Observer {
+ public:
+  /// Reads what it needs of `scenario` (scene, robot, recorded probes,
+  /// units); `out` receives the file and must outlive the log.
+  RunLog(std::ostream& out, const loader::Scenario& scenario, RunLogOptions options = {});
+  ~RunLog() override;
+
+  void OnStart(const cosim::Master& master) override;
+  void OnSample(cosim::TimeNs t, const cosim::System& system) override;
+  /// Closes the file (summary, footer).
+  void OnEnd(cosim::TimeNs t, bool ok) override;
+
+  std::uint64_t bytes() const { return writer_.bytes_written(); }
+  std::uint64_t messages() const { return writer_.message_count(); }
+
+ private:
+  struct Signals {  // one channel per unit
+    std::uint16_t channel = 0;
+    struct Field {
+      std::string name;
+      bool array = false;
+      std::vector<std::size_t> probes;  // indices into probes_
+    };
+    std::vector<Field> fields;
+  };
+  struct Laser {
+    std::uint16_t channel = 0;
+    std::size_t unit = 0;
+    cosim::ValueRef ranges{}, scan_count{}, scan_time{};
+    std::string head;  // the message's text from "frame_id" to "ranges":[
+    double last_count = 0;
+    cosim::TimeNs next = 0;
+  };
+  struct Frame {  // a sensor's fixed mount in base_link, as JSON text
+    std::string text;  // ,"parent_frame_id":...}  (after the timestamp)
+  };
+  struct Dynamic {  // a belt's travel and on state
+    std::optional<cosim::Probe> travel, on;
+  };
+
+  void WriteScene(cosim::TimeNs t, const cosim::System* system, bool full);
+  void WriteTransforms(cosim::TimeNs t, const cosim::System& system);
+  void WriteSignals(cosim::TimeNs t, const cosim::System& system);
+  void WriteScans(cosim::TimeNs t, const cosim::System& system);
+
+  Writer writer_;
+  RunLogOptions options_;
+  const loader::Scenario& scenario_;
+  std::vector<cosim::Probe> probes_;
+  cosim::TimeNs record_interval_ = 0;
+  cosim::TimeNs start_ = 0;
+  std::vector<Signals> signals_;
+  std::vector<Laser> lasers_;
+  std::vector<Frame> frames_;
+  std::vector<Dynamic> belts_;
+  // The robot: its recorded pose columns, and its chassis's 3D outputs.
+  bool has_robot_ = false;
+  std::optional<cosim::Probe> x_, y_, yaw_;
+  std::optional<std::size_t> chassis_;
+  std::optional<cosim::ValueRef> orientation_, position_3d_;
+  std::string static_entities_;  // the scene's fixed entities, as JSON text
+  std::uint16_t tf_channel_ = 0, scene_channel_ = 0;
+  cosim::TimeNs next_scene_ = 0, next_full_scene_ = 0;
+  std::string text_;  // a message being written
+  bool ended_ = false;
+};
+
+}  // namespace linesim::mcap
