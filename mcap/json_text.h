@@ -28,6 +28,32 @@ inline void Integer(std::string& out, std::int64_t v) {
   out.append(buf, res.ptr);
 }
 
+/// `v` rounded to 1e-4 (|v| < 9e14), trailing zeros dropped: "2.35",
+/// "-0.0012", "3". A few times cheaper than the shortest round-trip text,
+/// for bulk data whose precision is coarser (laser ranges).
+inline void TenthMillimetres(std::string& out, double v) {
+  if (!std::isfinite(v) || std::abs(v) >= 9e14) {
+    Number(out, v);
+    return;
+  }
+  std::int64_t n = std::llround(v * 1e4);
+  if (n < 0) {
+    out += '-';
+    n = -n;
+  }
+  Integer(out, n / 10000);
+  int frac = static_cast<int>(n % 10000);
+  if (frac == 0) return;
+  char digits[5] = {'.', '0', '0', '0', '0'};
+  int end = 5;
+  for (int k = 4; k >= 1; --k) {
+    digits[k] = static_cast<char>('0' + frac % 10);
+    frac /= 10;
+  }
+  while (digits[end - 1] == '0') --end;
+  out.append(digits, static_cast<std::size_t>(end));
+}
+
 /// A quoted string with JSON's escapes.
 void String(std::string& out, std::string_view s);
 

@@ -248,6 +248,7 @@ RunLog::RunLog(std::ostream& out, const loader::Scenario& scenario, RunLogOption
     }
   }
   belts_.resize(scenario.scene.belts.size());
+  for (std::size_t k = 0; k < belts_.size(); ++k) belts_[k].frame = "belt/" + scenario.scene.belts[k].name;
 
   // Sensor frames: every unit mounted on the robot (mount_x, mount_y).
   for (std::size_t u = 0; u < system.unit_count(); ++u) {
@@ -273,12 +274,16 @@ RunLog::RunLog(std::ostream& out, const loader::Scenario& scenario, RunLogOption
   if (has_robot_ || !frames_.empty()) {
     const auto schema = writer_.AddSchema("foxglove.FrameTransforms", "jsonschema",
                                           FrameTransformsSchema());
-    tf_channel_ = writer_.AddChannel(schema, "/tf", "json");
+    if (has_robot_) tf_channel_ = writer_.AddChannel(schema, "/tf", "json");
+    if (!frames_.empty()) mounts_channel_ = writer_.AddChannel(schema, "/tf/mounts", "json");
   }
   {
     const auto schema =
         writer_.AddSchema("foxglove.SceneUpdate", "jsonschema", SceneUpdateSchema());
-    scene_channel_ = writer_.AddChannel(schema, "/scene", "json");
+    static_channel_ = writer_.AddChannel(schema, "/scene/static", "json");
+    if (!scenario.scene.belts.empty()) {
+      scene_channel_ = writer_.AddChannel(schema, "/scene", "json");
+    }
   }
 
   // Lasers: every laser_scanner unit, its beams' bearings from its
@@ -392,33 +397,33 @@ RunLog::~RunLog() = default;
 void RunLog::OnStart(const cosim::Master& master) {
   start_ = master.options().start;
   if (record_interval_ <= 0) record_interval_ = master.options().base_step;
-  next_scene_ = next_full_scene_ = start_;
+  next_scene_ = next_signals_ = start_;
   for (Laser& l : lasers_) l.next = start_;
+}
 
-  // The fixed entities, stamped with the start time.
+void RunLog::WriteStatic(TimeNs now) {
   const models::Scene& scene = scenario_.scene;
   const cosim::System& system = *scenario_.system;
-  std::string& o = static_entities_;
-  o.clear();
+  std::string o;
   const models::Floor& f = scene.floor;
   if (f.max_x_m - f.min_x_m <= kLargestFloorM && f.max_y_m - f.min_y_m <= kLargestFloorM) {
     Primitives p;
     // A slab whose top is the floor (z = 0).
     Box(p.cubes, 0.5 * (f.min_x_m + f.max_x_m), 0.5 * (f.min_y_m + f.max_y_m), -0.005, Quat{},
         f.max_x_m - f.min_x_m, f.max_y_m - f.min_y_m, 0.01, kFloor);
-    Entity(o, start_, "map", "floor", false, "floor", p);
+    Entity(o, now, "map", "floor", false, "floor", p);
   }
   for (const models::Obstacle& ob : scene.obstacles) {
     Primitives p;
     AddSolid(p, ob.solid, 0, 0, ObstacleColor(ob.kind));
-    Entity(o, start_, "map", "obstacle/" + ob.name, false, ob.kind, p);
+    Entity(o, now, "map", "obstacle/" + ob.name, false, ob.kind, p);
   }
   for (const models::TerrainPiece& t : scene.terrain) {
     Primitives p;
     Box(p.cubes, t.center_x_m, t.center_y_m, t.center_z_m,
         FromRollPitchYaw(t.roll_rad, -t.pitch_rad, t.yaw_rad), t.length_m, t.width_m,
         t.thickness_m, kTerrain);
-    Entity(o, start_, "map", "terrain/" + t.name, false, "terrain", p);
+    Entity(o, now, "map", "terrain/" + t.name, false, "terrain", p);
   }
   if (scenario_.robot && !scenario_.robot->path.empty()) {
     Primitives p;
@@ -437,7 +442,7 @@ void RunLog::OnStart(const cosim::Master& master) {
       Color(p.lines, kPath);
       p.lines += ",\"colors\":[],\"indices\":[]}";
     }
-    Entity(o, start_, "map", "path", false, "desired path", p);
+    Entity(o, now, "map", "path", false, "desired path", p);
   }
   if (has_robot_) {
     // The chassis's body box and its wheels' contact spheres, in base_link.
@@ -455,18 +460,48 @@ void RunLog::OnStart(const cosim::Master& master) {
     for (std::size_t k = 0; k < wx.size() && k < wy.size() && k < wr.size(); ++k) {
       Ball(p.spheres, wx[k], wy[k], wr[k], 2.0 * wr[k], kWheel);
     }
-    Entity(o, start_, "base_link", "robot", true, "robot", p);
+    Entity(o, now, "base_link", "robot", true, "robot", p);
+  }
+  text_ = "{\"deletions\":[],\"entities\":[" + o + "]}";
+  writer_.WriteMessage(static_channel_, LogTime(now), LogTime(now), text_);
+  if (!frames_.empty()) {
+    text_ = "{\"transforms\":[";
+    for (std::size_t k = 0; k < frames_.size(); ++k) {
+      if (k) text_ += ',';
+      text_ += "{\"timestamp\":";
+      json::Time(text_, now);
+      text_ += frames_[k].text;
+    }
+    text_ += "]}";
+    writer_.WriteMessage(mounts_channel_, LogTime(now), LogTime(now), text_);
   }
 }
 
-void RunLog::WriteScene(TimeNs t, const cosim::System* system, bool full) {
+void RunLog::WriteScene(TimeNs t, const cosim::System& system) {
   const models::Scene& scene = scenario_.scene;
-  std::string entities = full ? static_entities_ : std::string();
-  std::string deletions;
+  // What the scene shows: each belt on or off, each object on its belt or
+  // lifted off; a message only when that changed.
+  std::string state;
+  for (std::size_t k = 0; k < scene.belts.size(); ++k) {
+    bool on = scene.belts[k].initially_on;
+    if (belts_[k].on) on = cosim::ReadProbe(system, *belts_[k].on) > 0.5;
+    state += on ? '1' : '0';
+  }
+  for (const models::CarriedObject& c : scene.carried) {
+    const auto k = static_cast<std::size_t>(c.belt);
+    if (k >= scene.belts.size()) continue;
+    const double d = belts_[k].travel ? cosim::ReadProbe(system, *belts_[k].travel) : 0.0;
+    const auto range = models::CarriedTravelRange(scene.belts[k].area, c.solid);
+    state += d < range[0] || d > range[1] ? '0' : '1';
+  }
+  if (state == scene_state_) return;
+  scene_state_ = state;
+
+  std::string entities, deletions;
+  std::size_t s = 0;
   for (std::size_t k = 0; k < scene.belts.size(); ++k) {
     const models::Belt& b = scene.belts[k];
-    bool on = b.initially_on;
-    if (system && belts_[k].on) on = cosim::ReadProbe(*system, *belts_[k].on) > 0.5;
+    const bool on = state[s++] == '1';
     Primitives p;
     // Flush with the floor, drawn a millimetre above it to be seen.
     Box(p.cubes, b.area.center_x_m, b.area.center_y_m, 0.001,
@@ -477,12 +512,8 @@ void RunLog::WriteScene(TimeNs t, const cosim::System* system, bool full) {
   for (const models::CarriedObject& c : scene.carried) {
     const auto k = static_cast<std::size_t>(c.belt);
     if (k >= scene.belts.size()) continue;
-    const models::Belt& b = scene.belts[k];
-    const double d = system && belts_[k].travel ? cosim::ReadProbe(*system, *belts_[k].travel)
-                                                : 0.0;
-    const auto range = models::CarriedTravelRange(b.area, c.solid);
     const std::string id = "carried/" + c.name;
-    if (d < range[0] || d > range[1]) {  // lifted off the line
+    if (state[s++] == '0') {  // lifted off the line
       Separate(deletions);
       deletions += "{\"timestamp\":";
       json::Time(deletions, t);
@@ -491,12 +522,11 @@ void RunLog::WriteScene(TimeNs t, const cosim::System* system, bool full) {
       deletions += '}';
       continue;
     }
+    // Where it was at time zero, in its belt's frame: it rides with it.
     Primitives p;
-    AddSolid(p, c.solid, d * std::cos(b.area.direction_rad), d * std::sin(b.area.direction_rad),
-             kCarried);
-    Entity(entities, t, "map", id, false, "carried", p);
+    AddSolid(p, c.solid, 0.0, 0.0, kCarried);
+    Entity(entities, t, belts_[k].frame, id, true, "carried", p);
   }
-  if (entities.empty() && deletions.empty()) return;
   text_ = "{\"deletions\":[" + deletions + "],\"entities\":[" + entities + "]}";
   writer_.WriteMessage(scene_channel_, LogTime(t), LogTime(t), text_);
 }
@@ -504,8 +534,7 @@ void RunLog::WriteScene(TimeNs t, const cosim::System* system, bool full) {
 void RunLog::WriteTransforms(TimeNs t, const cosim::System& system) {
   std::string& o = text_;
   o = "{\"transforms\":[";
-  bool first = true;
-  if (has_robot_) {
+  {
     const double x = cosim::ReadProbe(system, *x_), y = cosim::ReadProbe(system, *y_);
     const cosim::VariableTable& v = system.unit(*chassis_).variables();
     double z = 0.0;
@@ -524,15 +553,19 @@ void RunLog::WriteTransforms(TimeNs t, const cosim::System& system) {
     o += ",\"rotation\":";
     Rotation(o, q);
     o += '}';
-    first = false;
   }
-  // The mounts again in every message: a viewer that seeks has them.
-  for (const Frame& f : frames_) {
-    if (!first) o += ',';
-    first = false;
-    o += "{\"timestamp\":";
+  const models::Scene& scene = scenario_.scene;
+  for (std::size_t k = 0; k < belts_.size(); ++k) {
+    if (!belts_[k].travel) continue;
+    const double d = cosim::ReadProbe(system, *belts_[k].travel);
+    const double dir = scene.belts[k].area.direction_rad;
+    o += ",{\"timestamp\":";
     json::Time(o, t);
-    o += f.text;
+    o += ",\"parent_frame_id\":\"map\",\"child_frame_id\":";
+    json::String(o, belts_[k].frame);
+    o += ",\"translation\":";
+    Xyz(o, d * std::cos(dir), d * std::sin(dir), 0.0);
+    o += ",\"rotation\":{\"x\":0,\"y\":0,\"z\":0,\"w\":1}}";
   }
   o += "]}";
   writer_.WriteMessage(tf_channel_, LogTime(t), LogTime(t), o);
@@ -578,7 +611,7 @@ void RunLog::WriteScans(TimeNs t, const cosim::System& system) {
     const auto ranges = v.GetRealArray(l.ranges);
     for (std::size_t k = 0; k < ranges.size(); ++k) {
       if (k) o += ',';
-      json::Number(o, ranges[k]);
+      json::TenthMillimetres(o, ranges[k]);
     }
     o += "]}";
     writer_.WriteMessage(l.channel, LogTime(t), LogTime(t), o);
@@ -587,17 +620,18 @@ void RunLog::WriteScans(TimeNs t, const cosim::System& system) {
 
 void RunLog::OnSample(TimeNs t, const cosim::System& system) {
   if (ended_) return;
-  if (t >= next_full_scene_) {
-    WriteScene(t, &system, true);
-    while (next_full_scene_ <= t) next_full_scene_ += options_.full_scene_period;
-    while (next_scene_ <= t) next_scene_ += options_.scene_period;
-  } else if (t >= next_scene_) {
-    if (!scenario_.scene.belts.empty()) WriteScene(t, &system, false);
-    while (next_scene_ <= t) next_scene_ += options_.scene_period;
+  if (!started_) {
+    WriteStatic(t);
+    started_ = true;
   }
-  if ((t - start_) % record_interval_ == 0) {
-    if (has_robot_ || !frames_.empty()) WriteTransforms(t, system);
+  if ((t - start_) % record_interval_ == 0 && t >= next_signals_) {
+    if (has_robot_) WriteTransforms(t, system);
     WriteSignals(t, system);
+    while (next_signals_ <= t) next_signals_ += options_.signal_period;
+  }
+  if (t >= next_scene_) {
+    if (!scenario_.scene.belts.empty()) WriteScene(t, system);
+    while (next_scene_ <= t) next_scene_ += options_.scene_period;
   }
   WriteScans(t, system);
 }

@@ -16,16 +16,26 @@
 /// A linesim run as an MCAP log for Foxglove and PlotJuggler (run.mcap):
 /// the mapping of a run onto Foxglove's channels, gathered during the run
 /// by an observer on the master. JSON messages on Foxglove's JSON schemas:
-///   /tf            foxglove.FrameTransforms at every recorded row: map ->
-///                  base_link (the robot's pose as recorded), base_link ->
-///                  every sensor unit's mount (units with mount_x, mount_y)
+///   /tf            foxglove.FrameTransforms at recorded rows (at most every
+///                  signal_period): map -> base_link, the robot's pose as
+///                  recorded; map -> belt/NAME, each belt's travel along it
+///   /tf/mounts     once at the start: base_link -> every sensor unit's
+///                  mount (units with mount_x, mount_y), frames named after
+///                  the units
 ///   /scan/UNIT     foxglove.LaserScan of every laser_scanner unit: its last
-///                  complete scan, at most one per scan_period
-///   /scene         foxglove.SceneUpdate: floor, belts (colour by on state),
-///                  obstacles, terrain, the desired path, the robot (body and
-///                  wheels, in base_link); belts and carried objects again
-///                  every scene_period, everything every full_scene_period
-///   /signals/UNIT  one message per recorded row of signals.csv: the unit's
+///                  complete scan, at most one per scan_period, ranges to
+///                  0.1 mm (coarser than any scanner's reporting step)
+///   /scene/static  foxglove.SceneUpdate once at the start: floor, obstacles,
+///                  terrain, the desired path, the robot (body and wheels, in
+///                  base_link, following it)
+///   /scene         foxglove.SceneUpdate at the start and when a belt starts
+///                  or stops or an object leaves its belt (looked at every
+///                  scene_period): the belts (colour by on state) and the
+///                  objects on them, in their belt's frame (riding with it)
+/// What is written once is on a topic of its own: a viewer that seeks shows
+/// the last message of each topic before the new time.
+///   /signals/UNIT  one message per recorded row of signals.csv (at most
+///                  every signal_period): the unit's
 ///                  recorded variables as fields (an array for elements
 ///                  0..n-1 of a Real array, else NAME_i), the same numbers
 /// Times are simulation times (log_time = publish_time = t in ns): the same
@@ -33,13 +43,15 @@
 namespace linesim::mcap {
 
 struct RunLogOptions {
-  /// The lasers' messages: a new complete scan at most this often (10 Hz:
-  /// every second or third scan of a 25 Hz LMS151 or S300).
-  cosim::TimeNs scan_period = 100'000'000;
-  /// Belts' on state and carried objects' positions (10 Hz).
+  /// /tf and /signals: every recorded row at most this often (25 Hz:
+  /// every fourth row of a 100 Hz signals.csv); signals.csv keeps them all.
+  cosim::TimeNs signal_period = 40'000'000;
+  /// The lasers' messages: a new complete scan at most this often (5 Hz:
+  /// every fifth scan of a 25 Hz LMS151 or S300).
+  cosim::TimeNs scan_period = 200'000'000;
+  /// How often the belts' on state and the carried objects' being on their
+  /// belt are looked at (10 Hz).
   cosim::TimeNs scene_period = 100'000'000;
-  /// The whole scene again (a viewer that seeks finds it within 1 s).
-  cosim::TimeNs full_scene_period = 1'000'000'000;
   WriterOptions writer;
 };
 
@@ -81,9 +93,11 @@ class RunLog : public cosim::Observer {
   };
   struct Dynamic {  // a belt's travel and on state
     std::optional<cosim::Probe> travel, on;
+    std::string frame;  // "belt/NAME": moved by the travel along the belt
   };
 
-  void WriteScene(cosim::TimeNs t, const cosim::System* system, bool full);
+  void WriteStatic(cosim::TimeNs t);
+  void WriteScene(cosim::TimeNs t, const cosim::System& system);
   void WriteTransforms(cosim::TimeNs t, const cosim::System& system);
   void WriteSignals(cosim::TimeNs t, const cosim::System& system);
   void WriteScans(cosim::TimeNs t, const cosim::System& system);
@@ -103,9 +117,10 @@ class RunLog : public cosim::Observer {
   std::optional<cosim::Probe> x_, y_, yaw_;
   std::optional<std::size_t> chassis_;
   std::optional<cosim::ValueRef> orientation_, position_3d_;
-  std::string static_entities_;  // the scene's fixed entities, as JSON text
-  std::uint16_t tf_channel_ = 0, scene_channel_ = 0;
-  cosim::TimeNs next_scene_ = 0, next_full_scene_ = 0;
+  std::uint16_t tf_channel_ = 0, mounts_channel_ = 0, static_channel_ = 0, scene_channel_ = 0;
+  bool started_ = false;
+  std::string scene_state_;  // belts on and objects on their belts, at the last /scene
+  cosim::TimeNs next_scene_ = 0, next_signals_ = 0;
   std::string text_;  // a message being written
   bool ended_ = false;
 };

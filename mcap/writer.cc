@@ -1,5 +1,6 @@
 #include "mcap/writer.h"
 
+#include <lz4frame.h>
 #include <zstd.h>
 
 #include <algorithm>
@@ -53,7 +54,16 @@ void PutU16U64Map(std::string& out, const std::map<std::uint16_t, std::uint64_t>
   }
 }
 
-const char* CompressionName(Compression c) { return c == Compression::kZstd ? "zstd" : ""; }
+const char* CompressionName(Compression c) {
+  switch (c) {
+    case Compression::kZstd:
+      return "zstd";
+    case Compression::kLz4:
+      return "lz4";
+    default:
+      return "";
+  }
+}
 
 }  // namespace
 
@@ -172,6 +182,19 @@ void Writer::FlushChunk() {
                                         chunk_.size(), options_.zstd_level);
     if (ZSTD_isError(n)) {
       throw std::runtime_error(std::string("mcap: zstd: ") + ZSTD_getErrorName(n));
+    }
+    compressed_.resize(n);
+    records = compressed_;
+  } else if (options_.compression == Compression::kLz4) {
+    // The frame's defaults (64 KiB linked blocks, no checksums: the chunk
+    // has its CRC), its content size recorded.
+    LZ4F_preferences_t prefs{};
+    prefs.frameInfo.contentSize = chunk_.size();
+    compressed_.resize(LZ4F_compressFrameBound(chunk_.size(), &prefs));
+    const std::size_t n = LZ4F_compressFrame(compressed_.data(), compressed_.size(),
+                                             chunk_.data(), chunk_.size(), &prefs);
+    if (LZ4F_isError(n)) {
+      throw std::runtime_error(std::string("mcap: lz4: ") + LZ4F_getErrorName(n));
     }
     compressed_.resize(n);
     records = compressed_;

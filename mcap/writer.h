@@ -38,12 +38,16 @@ enum class Opcode : std::uint8_t {
 /// major version '0', then "\r\n".
 inline constexpr std::string_view kMagic{"\x89MCAP0\r\n", 8};
 
-enum class Compression { kNone, kZstd };
+/// A chunk's compression: none, zstd (a zstd frame), or lz4 (an LZ4 frame,
+/// the specification's "lz4").
+enum class Compression { kNone, kZstd, kLz4 };
 
 struct WriterOptions {
   std::string profile;            // header profile ("" : none of the well-known ones)
   std::string library = "linesim";  // header library: what wrote the file
-  Compression compression = Compression::kZstd;
+  /// lz4: about four times cheaper than zstd's level 1 on linesim's JSON,
+  /// for files about 1.5 times larger (measured on cross_line's run.mcap).
+  Compression compression = Compression::kLz4;
   /// A chunk is closed once its uncompressed records reach this size.
   std::size_t chunk_size = 1 << 20;
   /// zstd's level: 1 is its fastest standard level (ratio about 3 on

@@ -2,16 +2,19 @@
 // @mcap/core (Foxglove's TypeScript implementation, from npm) with fzstd's
 // zstd decompressor reads the file two ways (streamed record by record, and
 // through its summary and indexes), validates every CRC, and compares what
-// it reads with the run's signals.csv.
+// it reads with the run's signals.csv. Chunks in lz4 are decompressed by
+// lz4js, in zstd by fzstd.
 //   node check_mcap.mjs RUN.mcap signals.csv expect.json
 // expect.json (written by tests/mcap/mcap_test.cc from the loaded scenario):
-//   {beams: {UNIT: n}, angular_step: {UNIT: rad}, x, y, yaw: CSV columns,
-//    carried: {ID: [x0, y0, belt travel column, direction rad]}, scan_period_ns}
+//   {compression, beams: {UNIT: n}, angular_step: {UNIT: rad}, x, y, yaw: CSV
+//    columns, carried: {ID: [x0, y0, belt travel column, direction rad, belt frame]},
+//    entities: [static entity ids], scan_period_ns, signal_period_ns}
 // Exit 0 with "mcap check: ok ..." or 1 with the first failure.
 import fs from "node:fs";
 import { McapIndexedReader, McapStreamReader } from "@mcap/core";
 import { crc32 } from "@foxglove/crc";
 import { decompress } from "fzstd";
+import lz4 from "lz4js";
 
 const [mcapFile, csvFile, expectFile] = process.argv.slice(2);
 const fail = (message) => {
@@ -26,6 +29,7 @@ const bytes = new Uint8Array(fs.readFileSync(mcapFile));
 const expect = JSON.parse(fs.readFileSync(expectFile, "utf8"));
 const decompressHandlers = {
   zstd: (buffer, size) => decompress(buffer, new Uint8Array(Number(size))),
+  lz4: (buffer, size) => lz4.decompress(buffer, Number(size)),
 };
 
 // 1. Streamed: every record in file order, chunk CRCs validated.
@@ -42,7 +46,8 @@ for (let r; (r = stream.nextRecord()); ) {
   if (r.type === "Footer") footer = r;
   if (r.type === "Chunk") {
     chunks++;
-    check(r.compression === "zstd", `chunk compression '${r.compression}', expected zstd`);
+    check(r.compression === expect.compression,
+          `chunk compression '${r.compression}', expected ${expect.compression}`);
     check(r.uncompressedCrc !== 0, "a chunk without its CRC");
   }
 }
@@ -115,7 +120,7 @@ for (const line of lines.slice(1)) {
 const nsOf = (t) => BigInt(t.sec) * 1000000000n + BigInt(t.nsec);
 const same = (json, csv) => (json === null ? !Number.isFinite(csv) : json === csv);
 
-let tf = 0, scans = 0, signals = 0, scenes = 0;
+let tf = 0, scans = 0, signals = 0, scenes = 0, statics = 0, mounts = 0;
 const lastScan = {};
 const carriedSeen = new Set();
 for (const m of indexed) {
@@ -137,11 +142,24 @@ for (const m of indexed) {
     // apart (1e-9 rad is 1e6 times a double's resolution at pi).
     check(Math.abs(yaw - row[column[expect.yaw]]) < 1e-9,
           `/tf at ${m.logTime} ns: yaw ${yaw}, signals.csv ${row[column[expect.yaw]]}`);
-    for (const unit of Object.keys(expect.beams)) {
-      check(msg.transforms.some((t) => t.child_frame_id === unit && t.parent_frame_id === "base_link"),
-            `/tf has no base_link -> ${unit}`);
+    // Each belt's frame: moved by the belt's recorded travel along it.
+    for (const c of Object.values(expect.carried)) {
+      const belt = msg.transforms.find((t) => t.child_frame_id === c[4]);
+      check(belt !== undefined && belt.parent_frame_id === "map", `/tf has no map -> ${c[4]}`);
+      const d = row[column[c[2]]];
+      check(Math.abs(belt.translation.x - d * Math.cos(c[3])) < 1e-12 &&
+            Math.abs(belt.translation.y - d * Math.sin(c[3])) < 1e-12,
+            `/tf at ${m.logTime} ns: ${c[4]} at (${belt.translation.x}, ${belt.translation.y}), ` +
+            `travel ${d} m`);
     }
     tf++;
+  } else if (topic === "/tf/mounts") {
+    check(schemaOf(m).name === "foxglove.FrameTransforms", "/tf/mounts schema");
+    for (const unit of Object.keys(expect.beams)) {
+      check(msg.transforms.some((t) => t.child_frame_id === unit && t.parent_frame_id === "base_link"),
+            `/tf/mounts has no base_link -> ${unit}`);
+    }
+    mounts++;
   } else if (topic.startsWith("/scan/")) {
     const unit = topic.slice(6);
     check(schemaOf(m).name === "foxglove.LaserScan", `${topic} schema`);
@@ -173,37 +191,44 @@ for (const m of indexed) {
       }
     }
     signals++;
+  } else if (topic === "/scene/static") {
+    check(schemaOf(m).name === "foxglove.SceneUpdate", "/scene/static schema");
+    const ids = msg.entities.map((e) => e.id);
+    for (const id of ["floor", "robot", ...expect.entities]) {
+      check(ids.includes(id), `/scene/static has no entity '${id}'`);
+    }
+    statics++;
   } else if (topic === "/scene") {
     check(schemaOf(m).name === "foxglove.SceneUpdate", "/scene schema");
-    if (scenes === 0) {
-      const ids = msg.entities.map((e) => e.id);
-      for (const id of ["floor", "robot", ...expect.entities]) {
-        check(ids.includes(id), `the first /scene has no entity '${id}'`);
-      }
-    }
+    const ids = msg.entities.map((e) => e.id);
+    for (const id of expect.belts) check(ids.includes(id), `/scene has no entity '${id}'`);
     for (const e of msg.entities) {
       const c = expect.carried[e.id];
-      if (c === undefined || row === undefined) continue;
-      // A car body rides its belt: where it was at time zero, moved by the
-      // belt's recorded travel along the belt's direction.
-      const d = row[column[c[2]]];
+      if (c === undefined) continue;
+      // A car body rides its belt: drawn where it was at time zero, in the
+      // belt's frame, locked to it.
       const p = e.cubes[0].pose.position;
-      check(Math.abs(p.x - (c[0] + d * Math.cos(c[3]))) < 1e-9 &&
-            Math.abs(p.y - (c[1] + d * Math.sin(c[3]))) < 1e-9,
-            `${e.id} at ${m.logTime} ns: (${p.x}, ${p.y}), travel ${d} m`);
+      check(e.frame_id === c[4] && e.frame_locked === true && p.x === c[0] && p.y === c[1],
+            `${e.id}: at (${p.x}, ${p.y}) in ${e.frame_id}, expected (${c[0]}, ${c[1]}) in ${c[4]}`);
       carriedSeen.add(e.id);
     }
     scenes++;
   }
 }
-check(tf === rows.size, `${tf} /tf messages for ${rows.size} signals.csv rows`);
+// /tf and /signals at every signals.csv row at most every signal period
+// (a multiple of the rows' interval in cross_line).
+const interval = [...rows.keys()][1] - [...rows.keys()][0];
+const every = (BigInt(expect.signal_period_ns) + interval - 1n) / interval;
+const logged = BigInt(rows.size - 1) / every + 1n;
+check(BigInt(tf) === logged, `${tf} /tf messages for ${rows.size} rows, one in ${every}`);
 const units = new Set(header.slice(1).map((h) => h.split(".")[0]));
-check(signals === rows.size * units.size,
-      `${signals} signal messages for ${rows.size} rows of ${units.size} units`);
+check(BigInt(signals) === logged * BigInt(units.size),
+      `${signals} signal messages for ${logged} rows of ${units.size} units`);
+check(statics === 1 && mounts === 1, `${statics} /scene/static, ${mounts} /tf/mounts: one each`);
 for (const unit of Object.keys(expect.beams)) {
   check(lastScan[unit] !== undefined, `no scan of ${unit}`);
 }
 check(carriedSeen.size === Object.keys(expect.carried).length, "a carried object never drawn");
 console.log(`mcap check: ok, ${indexed.length} messages in ${chunks} chunks: ${tf} /tf, ` +
-            `${scans} scans, ${scenes} /scene, ${signals} signals; CRCs of data, summary and ` +
+            `${scans} scans, ${scenes} /scene, ${signals} signals, ${statics} /scene/static, ${mounts} /tf/mounts; CRCs of data, summary and ` +
             `every chunk valid`);

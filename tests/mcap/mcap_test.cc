@@ -190,6 +190,22 @@ TEST(Writer, ZstdChunkNamesItsCompressionAndSizes) {
   const std::string plain = SmallFile(Compression::kNone);
   EXPECT_EQ(U(b, at + 25, 8), U(plain, at + 25, 8));
   EXPECT_EQ(U(b, at + 33, 4), U(plain, at + 33, 4));  // the CRC is of the uncompressed records
+  // A zstd frame: its magic number 0xFD2FB528, little-endian (RFC 8878,
+  // 3.1.1).
+  EXPECT_EQ(U(b, at + 41 + 4 + 8, 4), 0xFD2FB528u);  // after "zstd" and the records' length
+}
+
+TEST(Writer, Lz4ChunkNamesItsCompressionAndSizes) {
+  const std::string b = SmallFile(Compression::kLz4);
+  const std::size_t at = 8 + 9 + 15;
+  ASSERT_EQ(U(b, at, 1), 0x06u);
+  EXPECT_EQ(Str(b, at + 37), "lz4");
+  const std::string plain = SmallFile(Compression::kNone);
+  EXPECT_EQ(U(b, at + 25, 8), U(plain, at + 25, 8));
+  EXPECT_EQ(U(b, at + 33, 4), U(plain, at + 33, 4));
+  // An LZ4 frame: its magic number 0x184D2204, little-endian (LZ4 frame
+  // format description, "General Structure of LZ4 Frame format").
+  EXPECT_EQ(U(b, at + 41 + 3 + 8, 4), 0x184D2204u);  // after "lz4" and the records' length
 }
 
 TEST(Writer, ChunkClosesAtItsSize) {
@@ -234,8 +250,8 @@ std::string Fresh(const std::string& name) {
 }
 
 const std::string kCrossLine = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
-// 3 s of the crossing: the robot on its way, both car bodies riding, 2 x 30
-// scans of each LMS151 at 10 Hz, the belt recorded.
+// 3 s of the crossing: the robot on its way, both car bodies riding, 15
+// scans of each LMS151 at 5 Hz, the belt recorded.
 const std::string kShort = " --set duration_s=3";
 
 // What the reader's content checks compare with, from the loaded scenario
@@ -246,7 +262,10 @@ nlohmann::json Expectations(const std::string& scenario, const std::vector<std::
   e["x"] = s.robot->x_column;
   e["y"] = s.robot->y_column;
   e["yaw"] = s.robot->yaw_column;
-  e["scan_period_ns"] = 100'000'000;
+  e["compression"] = "lz4";
+  // The rates mcap::RunLogOptions states: scans at 5 Hz, rows at 25 Hz.
+  e["scan_period_ns"] = 200'000'000;
+  e["signal_period_ns"] = 40'000'000;
   e["beams"] = nlohmann::json::object();
   e["angular_step"] = nlohmann::json::object();
   for (std::size_t u = 0; u < s.system->unit_count(); ++u) {
@@ -257,7 +276,8 @@ nlohmann::json Expectations(const std::string& scenario, const std::vector<std::
     e["angular_step"][unit.name()] = v.GetReal(*v.Find("angular_step"));
   }
   e["entities"] = nlohmann::json::array();
-  for (const auto& b : s.scene.belts) e["entities"].push_back("belt/" + b.name);
+  e["belts"] = nlohmann::json::array();
+  for (const auto& b : s.scene.belts) e["belts"].push_back("belt/" + b.name);
   for (const auto& o : s.scene.obstacles) e["entities"].push_back("obstacle/" + o.name);
   e["carried"] = nlohmann::json::object();
   for (const auto& c : s.scene.carried) {
@@ -267,7 +287,7 @@ nlohmann::json Expectations(const std::string& scenario, const std::vector<std::
     e["carried"]["carried/" + c.name] = {c.solid.x_m, c.solid.y_m,
                                          s.robot->belt_travel_columns.at(
                                              static_cast<std::size_t>(c.belt)),
-                                         belt.area.direction_rad};
+                                         belt.area.direction_rad, "belt/" + belt.name};
   }
   return e;
 }
