@@ -139,6 +139,12 @@ int RunCommand(const std::string& file, const std::string& out_dir,
                const std::vector<std::string>& set_args, double max_output_mb,
                plots::PlotFormat format, RunColumns* plot_columns, bool write_mcap) {
   if (IsComparisonFile(file)) {
+    if (write_mcap) {
+      std::cerr << "linesim: " << file
+                << ": --mcap writes the log of one run; a comparison file (compare:) runs "
+                   "several: run the one you want to see as a scenario with --mcap\n";
+      return kExitBadInput;
+    }
     return CompareCommand(file, out_dir, set_args, max_output_mb, format);
   }
   loader::Scenario s;

@@ -356,5 +356,15 @@ TEST(RunMcap, UnwritableFileIsBadInputNamingIt) {
   EXPECT_NE(run.err.find(dir + "/run.mcap"), std::string::npos) << run.err;
 }
 
+TEST(RunMcap, ComparisonFileIsBadInputNamingIt) {
+  // A comparison runs several scenarios: --mcap logs one run.
+  const std::string file = LINESIM_SOURCE_DIR "/scenarios/nominal_vs_modified.yaml";
+  const Result run =
+      Shell(std::string(LINESIM_CLI) + " run " + file + " --mcap --out " + Fresh("mcap_compare"));
+  EXPECT_EQ(run.status, 2);
+  EXPECT_NE(run.err.find(file), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("--mcap"), std::string::npos) << run.err;
+}
+
 }  // namespace
 }  // namespace linesim::mcap
