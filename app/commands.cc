@@ -20,6 +20,7 @@
 #include "cosim/observers.h"
 #include "cosim/run_error_json.h"
 #include "loader/scenario.h"
+#include "mcap/run_log.h"
 #include "platform/provenance.h"
 #include "plots/robot_plots.h"
 #include "replay/replay_recorder.h"
@@ -167,8 +168,15 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat forma
 
 int RunCommand(const std::string& file, const std::string& out_dir,
                const std::vector<std::string>& set_args, double max_output_mb,
-               plots::PlotFormat format, RunColumns* plot_columns, bool replay) {
+               plots::PlotFormat format, RunColumns* plot_columns, bool replay,
+               bool write_mcap) {
   if (IsComparisonFile(file)) {
+    if (write_mcap) {
+      std::cerr << "linesim: " << file
+                << ": --mcap writes the log of one run; a comparison file (compare:) runs "
+                   "several: run the one you want to see as a scenario with --mcap\n";
+      return kExitBadInput;
+    }
     return CompareCommand(file, out_dir, set_args, max_output_mb, format);
   }
   loader::Scenario s;
@@ -208,6 +216,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
     std::vector<std::string> previous = plots::RobotPlotFiles();
     previous.push_back("summary.json");
     previous.push_back("replay.html");
+    previous.push_back("run.mcap");
     for (const auto& name : previous) {
       std::error_code ec;
       fs::remove(dir / name, ec);
@@ -251,6 +260,19 @@ int RunCommand(const std::string& file, const std::string& out_dir,
         replay::ReplaySpecFor(s, kPaperBoundM, kPaperBoundLabel));
     s.master->AddObserver(replayer.get());
   }
+  // --mcap: the run for Foxglove and PlotJuggler, gathered as it runs.
+  const fs::path mcap_path = dir / "run.mcap";
+  std::ofstream mcap_file;
+  std::unique_ptr<mcap::RunLog> mcap_log;
+  if (write_mcap) {
+    mcap_file.open(mcap_path, std::ios::binary | std::ios::trunc);
+    if (!mcap_file) {
+      std::cerr << "linesim: cannot write " << mcap_path.string() << "\n";
+      return kExitBadInput;
+    }
+    mcap_log = std::make_unique<mcap::RunLog>(mcap_file, s);
+    s.master->AddObserver(mcap_log.get());
+  }
 
   // Ctrl-C or SIGTERM: stop at the next communication point, keep what was
   // recorded and write the summary (status interrupted); again to quit.
@@ -283,6 +305,18 @@ int RunCommand(const std::string& file, const std::string& out_dir,
     e.message = e.cause;
     e.time = result.end_time;
     outcome.errors.push_back(std::move(e));
+  }
+  if (mcap_log) {
+    mcap_file.close();
+    if (mcap_file.fail()) {
+      outcome.ok = false;
+      cosim::RunError e = cosim::MakeRunError(
+          std::nullopt, cosim::RunPhase::kRecording, "",
+          "cannot write " + mcap_path.string() + " (disk full or not writable)");
+      e.message = e.cause;
+      e.time = result.end_time;
+      outcome.errors.push_back(std::move(e));
+    }
   }
 
   // A metric that overflowed fails the run, naming the metric.
@@ -369,6 +403,11 @@ int RunCommand(const std::string& file, const std::string& out_dir,
                           {"rows", recorder.rows()},
                           {"interval_s", cosim::NsToSeconds(s.record_interval)},
                           {"columns", columns}};
+  if (mcap_log) {
+    summary["mcap"] = {{"file", "run.mcap"},
+                       {"bytes", mcap_log->bytes()},
+                       {"messages", mcap_log->messages()}};
+  }
   // Robot runs are drawn (also a failed one: the plots show how it failed).
   std::vector<std::string> pictures;
   if (s.robot && recorder.rows() > 0 && csv_written) {
@@ -418,6 +457,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   std::cout << "  wrote " << (dir / "summary.json").string() << ", " << csv_path.string() << " ("
             << recorder.rows() << " rows)";
   for (const auto& p : pictures) std::cout << ", " << p;
+  if (mcap_log) std::cout << ", run.mcap";
   std::cout << "\n";
   for (const auto& e : outcome.errors) std::cerr << "linesim: " << e.message << "\n";
   if (plot_columns && s.robot) {

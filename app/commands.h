@@ -37,11 +37,14 @@ struct RunColumns {
 /// (CompareCommand). `columns`, when given, receives what the plots read.
 /// A robot run also writes DIR/replay.html (replay/) unless `replay` is
 /// false (`--no-replay`).
+/// `write_mcap` (--mcap): also DIR/run.mcap, the run for Foxglove and
+/// PlotJuggler (mcap/run_log.h).
 int RunCommand(const std::string& file, const std::string& out_dir,
                const std::vector<std::string>& set_args,
                double max_output_mb = kDefaultMaxOutputMb,
                plots::PlotFormat format = plots::PlotFormat::kPng,
-               RunColumns* columns = nullptr, bool replay = true);
+               RunColumns* columns = nullptr, bool replay = true,
+               bool write_mcap = false);
 
 /// `linesim run COMPARE.yaml --out DIR`: every run the file lists, its base
 /// scenario with the run's settings (and `set_args`), into DIR/FOLDER as
@@ -82,6 +85,7 @@ struct SweepArgs {
   std::vector<std::string> sets;
   double max_output_mb = kDefaultMaxOutputMb;  // for the repeats' run_0
   plots::PlotFormat format = plots::PlotFormat::kPng;  // run_0's pictures
+  bool mcap = false;  // run_0 also writes run.mcap (--mcap)
 };
 
 /// `linesim sweep FILE --out DIR [--jobs N] [--resume|--force]`; under

@@ -47,6 +47,10 @@ int main(int argc, char** argv) {
   run->add_option("--format", run_format,
                   "the plots' file format: png (default), or svg or pdf (vector, for papers)")
       ->check(CLI::IsMember({"png", "svg", "pdf"}));
+  bool run_mcap = false;
+  run->add_flag("--mcap", run_mcap,
+                "also write run.mcap (frames, laser scans, scene, every recorded signal) for "
+                "Foxglove and PlotJuggler; with --runs, for run_0");
   std::int64_t runs = 1;
   bool no_replay = false;
   run->add_flag("--no-replay", no_replay,
@@ -151,11 +155,13 @@ int main(int argc, char** argv) {
       repeats.sets = run_sets;
       repeats.max_output_mb = max_output_mb;
       repeats.format = *linesim::plots::ParsePlotFormat(run_format);
+      repeats.mcap = run_mcap;
       return SweepCommand(repeats, mpi.get());
     }
     if (run->parsed()) {
       return RunCommand(run_file, out_dir, run_sets, max_output_mb,
-                        *linesim::plots::ParsePlotFormat(run_format), nullptr, !no_replay);
+                        *linesim::plots::ParsePlotFormat(run_format), nullptr, !no_replay,
+                        run_mcap);
     }
     if (sweep->parsed()) {
       if (linesim::sweep::LaunchedByMpi()) {

@@ -238,7 +238,7 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
               << (dir / "run_0").string() << ":\n"
               << std::flush;
     one_run = RunCommand(args.file, (dir / "run_0").string(), sets, args.max_output_mb,
-                         args.format);
+                         args.format, nullptr, /*replay=*/true, args.mcap);
   }
   if (one_run == kExitInterrupted) return kExitInterrupted;
   return results->failed_count() == 0 && one_run == kExitOk ? kExitOk : kExitRunFailed;

@@ -20,6 +20,10 @@ packages=(
   # Headless Chromium: the browser test of replay.html (tests/replay) loads
   # the page from file:// and drives it over the DevTools protocol.
   chromium
+  # lz4 and zstd: the compression of run.mcap's chunks, zlib its CRC-32
+  # (mcap/writer.cc); Node.js: the independent MCAP reader of the run.mcap
+  # test (tests/mcap/check_mcap.mjs).
+  liblz4-dev libzstd-dev zlib1g-dev nodejs
 )
 
 missing=()
@@ -31,12 +35,22 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#packages[@]} packages present"
-  exit 0
+else
+  echo "setup: installing ${missing[*]}"
+  sudo_cmd=()
+  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo_cmd[@]}" apt-get update -qq
+  "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-echo "setup: installing ${missing[*]}"
-sudo_cmd=()
-[ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
-export DEBIAN_FRONTEND=noninteractive
-"${sudo_cmd[@]}" apt-get update -qq
-"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# The MCAP reader the run.mcap test uses (@mcap/core and fzstd from the npm
+# registry, the versions of tests/mcap/package-lock.json), into
+# tests/mcap/node_modules; nothing when it is there already.
+mcap_check="$(cd "$(dirname "$0")/.." && pwd)/tests/mcap"
+if [ ! -f "$mcap_check/node_modules/@mcap/core/package.json" ] ||
+   [ ! -f "$mcap_check/node_modules/fzstd/package.json" ] ||
+   [ ! -f "$mcap_check/node_modules/lz4js/package.json" ]; then
+  echo "setup: installing the MCAP reader into $mcap_check/node_modules"
+  (cd "$mcap_check" && npm ci --ignore-scripts --no-audit --no-fund)
+fi
