@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <utility>
 
 #include "mcap/foxglove_schemas.h"
 #include "mcap/json_text.h"
@@ -34,26 +36,24 @@ struct Rgba {
   double r, g, b, a;
 };
 
-void Xyz(std::string& o, double x, double y, double z) {
-  o += "{\"x\":";
-  json::Number(o, x);
-  o += ",\"y\":";
-  json::Number(o, y);
-  o += ",\"z\":";
-  json::Number(o, z);
+// A JSON object of numbers, {"k0":v0,"k1":v1,...}, in the given order.
+void Fields(std::string& o, std::initializer_list<std::pair<const char*, double>> fields) {
+  char separator = '{';
+  for (const auto& [key, value] : fields) {
+    o += separator;
+    o += '"';
+    o += key;
+    o += "\":";
+    json::Number(o, value);
+    separator = ',';
+  }
   o += '}';
 }
 
+void Xyz(std::string& o, double x, double y, double z) { Fields(o, {{"x", x}, {"y", y}, {"z", z}}); }
+
 void Rotation(std::string& o, const Quat& q) {
-  o += "{\"x\":";
-  json::Number(o, q.x);
-  o += ",\"y\":";
-  json::Number(o, q.y);
-  o += ",\"z\":";
-  json::Number(o, q.z);
-  o += ",\"w\":";
-  json::Number(o, q.w);
-  o += '}';
+  Fields(o, {{"x", q.x}, {"y", q.y}, {"z", q.z}, {"w", q.w}});
 }
 
 void Pose(std::string& o, double x, double y, double z, const Quat& q) {
@@ -65,15 +65,7 @@ void Pose(std::string& o, double x, double y, double z, const Quat& q) {
 }
 
 void Color(std::string& o, const Rgba& c) {
-  o += "{\"r\":";
-  json::Number(o, c.r);
-  o += ",\"g\":";
-  json::Number(o, c.g);
-  o += ",\"b\":";
-  json::Number(o, c.b);
-  o += ",\"a\":";
-  json::Number(o, c.a);
-  o += '}';
+  Fields(o, {{"r", c.r}, {"g", c.g}, {"b", c.b}, {"a", c.a}});
 }
 
 // Primitives, each appended to a list's text (comma-separated).
