@@ -320,13 +320,8 @@ void SurfaceFusionUnit::Predict(double h, cosim::TimeNs t) {
   }
   // With the IMU: b += h R beta (R: the IMU frame to map).
   const std::size_t ib = imu_index_, ia = imu_index_ + 2;
-  double r[4] = {1.0, 0.0, 0.0, 1.0};
   if (imu_) {
-    const double c = std::cos(yaw_ + imu_yaw_), s = std::sin(yaw_ + imu_yaw_);
-    r[0] = c;
-    r[1] = -s;
-    r[2] = s;
-    r[3] = c;
+    const double r[4] = {imu_cos_, -imu_sin_, imu_sin_, imu_cos_};
     for (std::size_t col = 0; col < n; ++col) {
       fp[ib * n + col] += h * (r[0] * cov_[ia * n + col] + r[1] * cov_[(ia + 1) * n + col]);
       fp[(ib + 1) * n + col] += h * (r[2] * cov_[ia * n + col] + r[3] * cov_[(ia + 1) * n + col]);
@@ -345,6 +340,7 @@ void SurfaceFusionUnit::Predict(double h, cosim::TimeNs t) {
     }
   }
   if (imu_) {
+    const double r[4] = {imu_cos_, -imu_sin_, imu_sin_, imu_cos_};
     for (std::size_t row = 0; row < n; ++row) {
       cov_[row * n + ib] += h * (r[0] * fp[row * n + ia] + r[1] * fp[row * n + ia + 1]);
       cov_[row * n + ib + 1] += h * (r[2] * fp[row * n + ia] + r[3] * fp[row * n + ia + 1]);
@@ -605,10 +601,11 @@ cosim::StepResult SurfaceFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     if (imu_) {
       // The IMU's sample: the mean specific force over its interval, here
       // this step's; to map by the heading and the mount.
-      const double ci = std::cos(yaw_ + imu_yaw_), si = std::sin(yaw_ + imu_yaw_);
+      imu_cos_ = std::cos(yaw_ + imu_yaw_);
+      imu_sin_ = std::sin(yaw_ + imu_yaw_);
       const double fx = imu_acceleration_[0], fy = imu_acceleration_[1];
-      imu_velocity_[0] += (ci * fx - si * fy) * h;
-      imu_velocity_[1] += (si * fx + ci * fy) * h;
+      imu_velocity_[0] += (imu_cos_ * fx - imu_sin_ * fy) * h;
+      imu_velocity_[1] += (imu_sin_ * fx + imu_cos_ * fy) * h;
     }
     const std::size_t slot = (first_ + size_) % kHistory;
     if (size_ == kHistory) {

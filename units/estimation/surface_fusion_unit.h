@@ -231,6 +231,9 @@ class SurfaceFusionUnit : public cosim::Unit {
   // velocity V_imu (map) and the W detector's runs (2).
   std::size_t imu_index_ = 0;
   double imu_velocity_[2] = {0.0, 0.0};
+  // This step's rotation of the IMU frame to map (yaw + imu_yaw), taken
+  // once in DoStep for the integration and the prediction.
+  double imu_cos_ = 1.0, imu_sin_ = 0.0;
   std::vector<std::int64_t> imu_run_;
   // The dead reckoning (map) and its history per step (a ring of kHistory,
   // oldest at first_).
