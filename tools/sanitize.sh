@@ -15,6 +15,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
+# Sourced with no arguments (every target): a sourced script sees this
+# script's own arguments otherwise, and would take `-R X` for targets.
+ctest_args=("$@")
+set --
 source tools/sanitizer_build.sh
 # The golden hashes pin the Release (GCC) build's bytes: another compiler and
 # optimisation level round differently. The CPU-feature-mask test runs the
@@ -23,4 +27,4 @@ source tools/sanitizer_build.sh
 # minute of the sanitizer run).
 selection=(-E 'SweepCli\..*Mpi|determinism\.')
 [ "${LINESIM_SANITIZE_ALL:-0}" = 1 ] && selection=()
-ctest --test-dir build-asan --output-on-failure -j"$(nproc)" "${selection[@]}" "$@"
+ctest --test-dir build-asan --output-on-failure -j"$(nproc)" "${selection[@]}" "${ctest_args[@]}"
