@@ -92,8 +92,9 @@ void YamlReader::Add(const std::vector<Issue>& issues) {
   issues_.insert(issues_.end(), issues.begin(), issues.end());
 }
 
-void YamlReader::Error(const std::string& file, const YAML::Node& at, const std::string& path,
-                       std::string message) {
+void YamlReader::Error(const std::string& file, const YAML::Node& at,
+                       const std::string& read_path, std::string message) {
+  const std::string path = file == own_file_ ? Scoped(read_path) : read_path;
   // The origin of the path, or of the longest of its ancestors that has one
   // (a value below a derived map keeps its place under the user's key).
   auto origin = origins_.end();
@@ -121,12 +122,21 @@ void YamlReader::Error(const std::string& file, const YAML::Node& at, const std:
   if (translated && issue.line == 0 && !issue.from_command_line) {
     issue.line = LineOf(origin->second.node);
   }
+  // A part of the file read more than once (a fleet's shared line, read
+  // with every robot) reports a problem once.
+  for (const Issue& i : issues_) {
+    if (i.file == issue.file && i.line == issue.line && i.key_path == issue.key_path &&
+        i.message == issue.message) {
+      return;
+    }
+  }
   issues_.push_back(std::move(issue));
 }
 
 void YamlReader::UnknownPath(const YAML::Node& at, const std::string& path, std::string message) {
+  const std::size_t before = issues_.size();
   Error(at, path, std::move(message));
-  issues_.back().unknown_path = true;
+  if (issues_.size() > before) issues_.back().unknown_path = true;
 }
 
 bool YamlReader::ExpectMap(const YAML::Node& node, const std::string& path) {
@@ -150,7 +160,7 @@ void YamlReader::CheckKeys(const YAML::Node& map, const std::string& path,
     for (const auto& a : allowed) known |= (a == key);
     if (known) continue;
     UnknownPath(kv.first, JoinPath(path, key),
-                "unknown key" + ClosestPathsHint(path, key, allowed) +
+                "unknown key" + ClosestPathsHint(Scoped(path), key, allowed) +
                     "; expected one of: " + JoinNames(allowed));
   }
 }
@@ -169,9 +179,9 @@ bool YamlReader::RefuseNoValue(const YAML::Node& map, const std::string& path,
                                bool has_default) {
   const std::string p = JoinPath(path, key);
   const YAML::Node node = Child(map, key);
-  if ((node.IsDefined() && !node.IsNull()) || !without_value_.count(p)) return false;
+  if ((node.IsDefined() && !node.IsNull()) || !without_value_.count(Scoped(p))) return false;
   Error(map, p,
-        "no value given (--set " + p + "=): expected " + expected +
+        "no value given (--set " + Scoped(p) + "=): expected " + expected +
             (has_default ? "; to keep the default, leave the --set out" : ""));
   return true;
 }

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <map>
 #include <optional>
@@ -81,6 +82,26 @@ class YamlReader {
     YamlReader& r_;
     std::string saved_;
   };
+  /// While it exists, the key paths of the reader's own file are read as
+  /// `scope` maps them: the paths a concern reads at ("task.speed_mps") are
+  /// reported where the user wrote them ("robots.1.task.speed_mps") when a
+  /// part of the file is read as if it were a whole one.
+  class PathScope {
+   public:
+    PathScope(YamlReader& r, std::function<std::string(const std::string&)> scope)
+        : r_(r), saved_(std::move(r.scope_)) {
+      r_.scope_ = std::move(scope);
+    }
+    ~PathScope() { r_.scope_ = std::move(saved_); }
+    PathScope(const PathScope&) = delete;
+    PathScope& operator=(const PathScope&) = delete;
+
+   private:
+    YamlReader& r_;
+    std::function<std::string(const std::string&)> saved_;
+  };
+  /// `path` of the reader's own file as the current PathScope maps it.
+  std::string Scoped(const std::string& path) const { return scope_ ? scope_(path) : path; }
   static int LineOf(const YAML::Node& node);
   /// A scalar that reads as a number other than NaN, without reporting.
   static std::optional<double> DecodeReal(const YAML::Node& node);
@@ -156,6 +177,7 @@ class YamlReader {
   std::set<std::string> overridden_;
   std::set<std::string> without_value_;
   std::map<std::string, Origin> origins_;
+  std::function<std::string(const std::string&)> scope_;
   /// Origins seen only by FromCommandLine (ShareCommandLine).
   std::map<std::string, Origin> command_line_origins_;
   std::vector<Issue> issues_;

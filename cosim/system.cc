@@ -18,6 +18,15 @@ bool IsIdentifier(std::string_view s) {
   });
 }
 
+bool IsUnitName(std::string_view s) {
+  for (;;) {
+    const auto dot = s.find('.');
+    if (!IsIdentifier(s.substr(0, dot))) return false;
+    if (dot == std::string_view::npos) return true;
+    s.remove_prefix(dot + 1);
+  }
+}
+
 namespace {
 
 std::string JoinProblems(const std::vector<Problem>& problems) {
@@ -37,7 +46,9 @@ Endpoint Endpoint::Parse(std::string_view text) {
                                 "' is not an endpoint: expected unit.variable or "
                                 "unit.variable[index]");
   };
-  const auto dot = text.find('.');
+  // The variable is after the unit's last '.' (a scoped unit has several);
+  // an index's brackets hold no '.'.
+  const auto dot = text.substr(0, text.find('[')).rfind('.');
   if (dot == std::string_view::npos) return fail();
   Endpoint e;
   e.unit = std::string(text.substr(0, dot));
@@ -58,7 +69,7 @@ Endpoint Endpoint::Parse(std::string_view text) {
     rest = rest.substr(0, open);
   }
   e.variable = std::string(rest);
-  if (!IsIdentifier(e.unit) || !IsIdentifier(e.variable)) return fail();
+  if (!IsUnitName(e.unit) || !IsIdentifier(e.variable)) return fail();
   return e;
 }
 
@@ -354,9 +365,10 @@ void System::Build() {
   std::vector<Problem> problems;
   std::set<std::string> seen;
   for (const auto& e : units_) {
-    if (!IsIdentifier(e.unit->name())) {
+    if (!IsUnitName(e.unit->name())) {
       problems.push_back(
-          {"unit name '" + e.unit->name() + "' is not valid: use letters, digits and '_'",
+          {"unit name '" + e.unit->name() +
+               "' is not valid: use letters, digits and '_' (and '.' after a scope)",
            std::nullopt});
     }
     if (!seen.insert(e.unit->name()).second) {

@@ -15,8 +15,13 @@ namespace linesim::cosim {
 
 /// True for a valid unit or variable name: letters, digits and '_'.
 bool IsIdentifier(std::string_view s);
+/// True for a valid unit name: identifiers joined by '.', the scope first
+/// (a fleet's `raw3_a.chassis`; most units have no scope).
+bool IsUnitName(std::string_view s);
 
 /// One end of a connection: `unit.variable` or `unit.variable[index]` for
+/// (the unit's name may be scoped: the variable is after the last '.')
+///
 /// one element of a real array.
 struct Endpoint {
   std::string unit;

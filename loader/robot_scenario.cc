@@ -1,13 +1,18 @@
 #include "loader/robot_scenario.h"
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numbers>
+#include <set>
 
+#include "cosim/system.h"
 #include "cosim/variable_table.h"
 #include "loader/assembly/concerns.h"
 #include "loader/assembly/people.h"
 #include "loader/robot_file.h"
 #include "models/angle.h"
+#include "models/moving_solids.h"
 
 namespace linesim::loader {
 
@@ -63,9 +68,9 @@ void Passthrough(assembly::SystemBuilder& b) {
 
 // A positive number the chassis will get, for the plots; nothing otherwise
 // (the chassis unit reports a bad one).
-std::optional<double> PositiveChassisValue(assembly::SystemBuilder& b, const std::string& key) {
-  const YAML::Node n =
-      Child(Child(Child(Child(b.out(), "units"), assembly::kChassis), "parameters"), key);
+std::optional<double> PositiveChassisValue(assembly::SystemBuilder& b, const std::string& chassis,
+                                           const std::string& key) {
+  const YAML::Node n = Child(Child(Child(Child(b.out(), "units"), chassis), "parameters"), key);
   const auto value = YamlReader::DecodeReal(n);
   if (value && std::isfinite(*value) && *value > 0.0) return value;
   return std::nullopt;
@@ -111,23 +116,17 @@ void CheckStartPose(assembly::SystemBuilder& b, const models::Scene& scene,
   }
 }
 
-}  // namespace
+// The sections of a robot scenario that describe one robot: the shorthand's
+// top-level keys, each robot's keys in `robots:`.
+const std::vector<std::string> kRobotSections = {"task",         "control", "sensing",
+                                                 "localization", "sensors", "safety"};
 
-bool IsRobotScenario(const YAML::Node& root) {
-  return root.IsMap() && Child(root, "robot").IsDefined();
-}
-
-YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
-  r.CheckKeys(root, "",
-              {"name", "description", "duration_s", "seed", "master", "robot", "scene", "line",
-               "control", "task", "sensors", "sensing", "localization", "units", "connections",
-               "recording", "metrics", "reference", "workers", "safety"});
-  assembly::SystemBuilder b(root, r);
-  for (const char* key : {"name", "description", "duration_s", "seed", "master", "reference"}) {
-    if (Child(root, key).IsDefined()) b.out()[key] = Child(root, key);
-  }
-
-  const YAML::Node robot = b.Section(root, "", "robot", {"model", "pose", "payload"});
+// The concerns, one after another, for the robot at `robot` of b.root()
+// (whose keys are `robot_keys`) on `scene`.
+void AssembleRobot(assembly::SystemBuilder& b, const std::vector<std::string>& robot_keys,
+                   const models::Scene& scene, RobotInfo& info) {
+  YamlReader& r = b.reader();
+  const YAML::Node robot = b.Section(b.root(), "", "robot", robot_keys);
   const YAML::Node pose = b.Section(robot, "robot", "pose", {"x_m", "y_m", "yaw_deg"});
   assembly::StartPose start;
   start.x_m = r.Real(pose, "robot.pose", "x_m", 0.0, {-1e6, 1e6});
@@ -142,9 +141,8 @@ YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
     const auto payload = ReadPayload(r, p, "robot.payload");
     if (file && payload) file->robot.payload = payload;
   }
-
-  const models::Scene scene = assembly::AddScene(b);
   CheckStartPose(b, scene, start);
+  info.start_pose = {start.x_m, start.y_m, start.yaw_rad};
   if (file) {
     assembly::Signals s = assembly::AddDriveTrain(b, *file, start, info);
     assembly::AddLine(b, scene, s);
@@ -159,9 +157,295 @@ YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
     assembly::AddWorkers(b, *file, s, info);
     assembly::AddRecording(b, s, info);
   }
+}
+
+// The body as the chassis unit `chassis` will get it (after `units:`).
+void ReadBody(assembly::SystemBuilder& b, const std::string& chassis, RobotInfo& info) {
+  info.body_length_m = PositiveChassisValue(b, chassis, "body_length");
+  info.body_width_m = PositiveChassisValue(b, chassis, "body_width");
+}
+
+// Every "unit.variable" column of `info` through `scope`.
+void ScopeColumns(RobotInfo& info, const std::function<std::string(const std::string&)>& scope) {
+  const auto one = [&](std::string& c) {
+    if (!c.empty()) c = scope(c);
+  };
+  const auto all = [&](std::vector<std::string>& v) {
+    for (auto& c : v) one(c);
+  };
+  for (std::string* c : {&info.x_column, &info.y_column, &info.yaw_column, &info.z_column,
+                         &info.wheel_surface_column, &info.motor_current_column,
+                         &info.error_column, &info.flow_reference_column, &info.velocity_x_column,
+                         &info.velocity_y_column, &info.speed_cap_column, &info.protective_column,
+                         &info.warning_column, &info.person_distance_column}) {
+    one(*c);
+  }
+  for (auto& [x, y] : info.wheel_columns) one(x), one(y);
+  for (auto& [x, y] : info.worker_columns) one(x), one(y);
+  for (auto* v : {&info.belt_speed_columns, &info.belt_on_columns, &info.belt_travel_columns,
+                  &info.flow_columns, &info.flow_truth_columns, &info.flow_filtered_columns}) {
+    all(*v);
+  }
+  // A unit name, not a column: scoped the same way.
+  if (!info.scan_unit.empty()) info.scan_unit = scope(info.scan_unit + ".x");
+  if (!info.scan_unit.empty()) info.scan_unit.resize(info.scan_unit.size() - 2);
+}
+
+// Whether two robots' bodies (rectangles length x width at their start
+// poses) overlap: separating axes of two rectangles.
+bool BodiesOverlap(const RobotInfo& a, const RobotInfo& b) {
+  if (!a.body_length_m || !a.body_width_m || !b.body_length_m || !b.body_width_m) return false;
+  const auto axes = [](const RobotInfo& i) {
+    const double c = std::cos(i.start_pose[2]), s = std::sin(i.start_pose[2]);
+    return std::array<std::array<double, 2>, 2>{{{c, s}, {-s, c}}};
+  };
+  const auto half = [](const RobotInfo& i) {
+    return std::array<double, 2>{0.5 * *i.body_length_m, 0.5 * *i.body_width_m};
+  };
+  const auto aa = axes(a), ba = axes(b);
+  const auto ah = half(a), bh = half(b);
+  const double dx = b.start_pose[0] - a.start_pose[0], dy = b.start_pose[1] - a.start_pose[1];
+  for (const auto& axis : {aa[0], aa[1], ba[0], ba[1]}) {
+    const auto radius = [&](const std::array<std::array<double, 2>, 2>& ax,
+                            const std::array<double, 2>& h) {
+      return h[0] * std::abs(ax[0][0] * axis[0] + ax[0][1] * axis[1]) +
+             h[1] * std::abs(ax[1][0] * axis[0] + ax[1][1] * axis[1]);
+    };
+    if (std::abs(dx * axis[0] + dy * axis[1]) >= radius(aa, ah) + radius(ba, bh)) return false;
+  }
+  return true;
+}
+
+// One world: every robot's chassis, lasers and robot clearance see every
+// other robot's body (its chassis' body_box), through connections.
+void ConnectFleet(assembly::SystemBuilder& b, const std::vector<RobotInfo>& robots,
+                  const std::vector<std::vector<std::string>>& lasers, YAML::Node metrics,
+                  std::vector<std::string>& recorded) {
+  constexpr std::size_t kBox = models::MovingBox::kValues;
+  const auto add = [&](const std::string& name, const std::string& of, const char* reduce) {
+    YAML::Node m;
+    m["name"] = name;
+    m["of"] = of;
+    m["reduce"] = reduce;
+    metrics.push_back(m);
+  };
+  const auto body_box = [&](const RobotInfo& r) {
+    return assembly::Signal(r.name + "." + assembly::kChassis, "body_box");
+  };
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    const std::string& name = robots[i].name;
+    const std::string chassis = name + "." + assembly::kChassis;
+    const std::string clearance = name + "." + assembly::kRobotClearance;
+    const int others = static_cast<int>(robots.size()) - 1;
+    b.Unit(clearance, "robot_clearance");
+    b.Params(clearance)["others"] = others;
+    b.Connect(body_box(robots[i]), assembly::Signal(clearance, "body_box"));
+    std::vector<std::pair<std::string, std::string>> takers = {{chassis, "moving_boxes"},
+                                                               {clearance, "others"}};
+    for (const auto& laser : lasers[i]) takers.emplace_back(laser, "moving_boxes");
+    for (const auto& [unit, input] : takers) {
+      if (input == "moving_boxes") b.Params(unit)["moving_boxes"] = others;
+    }
+    std::size_t slot = 0;
+    for (std::size_t j = 0; j < robots.size(); ++j) {
+      if (j == i) continue;
+      for (std::size_t k = 0; k < kBox; ++k) {
+        for (const auto& [unit, input] : takers) {
+          b.Connect(assembly::Element(robots[j].name + "." + assembly::kChassis, "body_box", k),
+                    assembly::Element(unit, input, slot * kBox + k));
+        }
+      }
+      add(name + ".robot_" + robots[j].name + "_collisions",
+          assembly::Element(clearance, "robot_collisions", slot), "final");
+      ++slot;
+    }
+    add(name + ".min_robot_distance_m", assembly::Signal(clearance, "min_distance"), "final");
+    add(name + ".robot_collisions", assembly::Signal(clearance, "collisions"), "final");
+    recorded.push_back(assembly::Signal(clearance, "distance"));
+  }
+}
+
+// A fleet: `robots:` is a list of robots, each expanded by the concerns as
+// the one-robot shorthand is (its sections read as if they were the file's
+// top-level ones), its units then scoped by its name (raw3_a.chassis).
+// Belts and workers are the scene's: one unit each, shared.
+YAML::Node ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
+  r.CheckKeys(root, "",
+              {"name", "description", "duration_s", "seed", "master", "robots", "scene", "line",
+               "units", "connections", "recording", "metrics", "reference", "workers"});
+  assembly::SystemBuilder top(root, r);
+  for (const char* key : {"name", "description", "duration_s", "seed", "master", "reference"}) {
+    if (Child(root, key).IsDefined()) top.out()[key] = Child(root, key);
+  }
+  const models::Scene scene = assembly::AddScene(top);
+  YAML::Node metrics(YAML::NodeType::Sequence);
+  const YAML::Node extra = Child(root, "metrics");
+  if (extra.IsDefined() && !extra.IsNull() && r.ExpectSequence(extra, "metrics")) {
+    for (const auto& m : extra) metrics.push_back(m);
+  }
+  std::vector<std::string> recorded;
+  std::vector<RobotInfo> robots;
+  std::vector<std::size_t> list_index;  // each robot's item of `robots:`
+  std::vector<std::vector<std::string>> lasers;  // each robot's laser units
+
+  const YAML::Node list = Child(root, "robots");
+  if (r.ExpectSequence(list, "robots") && list.size() == 0) {
+    r.Error(list, "robots", "expected at least one robot {name, model, pose, task, ...}");
+  }
+  for (std::size_t i = 0; list.IsSequence() && i < list.size(); ++i) {
+    const YAML::Node entry = list[i];
+    const std::string path = JoinPath("robots", std::to_string(i));
+    if (!r.ExpectMap(entry, path)) continue;
+    const std::string name = r.String(entry, path, "name", std::nullopt);
+    if (name.empty()) continue;
+    if (!cosim::IsIdentifier(name)) {
+      r.Error(Child(entry, "name"), JoinPath(path, "name"),
+              "robot name '" + name + "' is not valid: expected letters, digits and _ (it "
+              "scopes the robot's units: " + name + ".chassis)");
+      continue;
+    }
+    if (std::any_of(robots.begin(), robots.end(),
+                    [&](const RobotInfo& o) { return o.name == name; })) {
+      r.Error(Child(entry, "name"), JoinPath(path, "name"),
+              "robot name '" + name + "' is given twice");
+      continue;
+    }
+    // The robot's part of the file as a one-robot scenario: its keys are
+    // read at their shorthand paths and reported at robots.I's.
+    YAML::Node one(YAML::NodeType::Map);
+    one["robot"] = entry;
+    for (const auto& key : kRobotSections) {
+      if (Child(entry, key).IsDefined()) one[key] = Child(entry, key);
+    }
+    for (const char* key : {"scene", "line", "master", "workers"}) {
+      if (Child(root, key).IsDefined()) one[key] = Child(root, key);
+    }
+    const YamlReader::PathScope scope(r, [path](const std::string& p) -> std::string {
+      if (p == "robot") return path;
+      if (p.starts_with("robot.")) return path + p.substr(5);
+      for (const auto& key : kRobotSections) {
+        if (p == key || p.starts_with(key + ".")) return JoinPath(path, p);
+      }
+      return p;
+    });
+    assembly::SystemBuilder b(one, r);
+    RobotInfo robot;
+    robot.name = name;
+    std::vector<std::string> keys = {"name", "model", "pose", "payload"};
+    keys.insert(keys.end(), kRobotSections.begin(), kRobotSections.end());
+    AssembleRobot(b, keys, scene, robot);
+
+    // The robot's own units get its name as scope; the scene's (belt,
+    // workers) stay one.
+    std::set<std::string> own;
+    const YAML::Node units = Child(b.out(), "units");
+    for (const auto& kv : units) {
+      const std::string type = Child(kv.second, "type").as<std::string>("");
+      if (type != "belt" && type != "worker") own.insert(kv.first.Scalar());
+    }
+    const auto scoped = [&](const std::string& column) {
+      const std::string unit = column.substr(0, column.find('.'));
+      return own.count(unit) ? name + "." + column : column;
+    };
+    lasers.emplace_back();
+    for (const auto& kv : units) {
+      const std::string unit = kv.first.Scalar();
+      if (own.count(unit) && Child(kv.second, "type").as<std::string>("") == "laser_scanner") {
+        lasers.back().push_back(name + "." + unit);
+      }
+      if (own.count(unit)) {
+        top.out()["units"][name + "." + unit] = kv.second;
+      } else if (!top.HasUnit(unit)) {
+        top.out()["units"][unit] = kv.second;
+      }
+    }
+    for (const auto& c : b.connections()) {
+      const std::string from = scoped(c["from"].as<std::string>()),
+                        to = scoped(c["to"].as<std::string>());
+      if (i > 0 && from == c["from"].as<std::string>() && to == c["to"].as<std::string>()) {
+        continue;  // between shared units: the first robot made it
+      }
+      top.Connect(from, to);
+    }
+    for (const auto& v : Child(Child(b.out(), "recording"), "variables")) {
+      const std::string column = scoped(v.as<std::string>());
+      if (std::find(recorded.begin(), recorded.end(), column) == recorded.end()) {
+        recorded.push_back(column);
+      }
+    }
+    for (const auto& m : Child(b.out(), "metrics")) {
+      YAML::Node scoped_metric;
+      scoped_metric["name"] = name + "." + m["name"].as<std::string>();
+      scoped_metric["of"] = scoped(m["of"].as<std::string>());
+      scoped_metric["reduce"] = m["reduce"];
+      metrics.push_back(scoped_metric);
+    }
+    for (const auto& [expanded, from] : b.origins()) {
+      std::string key = expanded;
+      Origin origin = from;
+      // units.UNIT.rest, UNIT one of the robot's
+      if (key.starts_with("units.")) {
+        const std::string rest = key.substr(6);
+        if (own.count(rest.substr(0, rest.find('.')))) key = "units." + name + "." + rest;
+      }
+      if (origin.file.empty()) origin.path = r.Scoped(origin.path);
+      top.origins().emplace(key, origin);
+    }
+    ScopeColumns(robot, scoped);
+    robots.push_back(std::move(robot));
+    list_index.push_back(i);
+  }
+  if (robots.size() > 1 && r.ok()) ConnectFleet(top, robots, lasers, metrics, recorded);
+  top.out()["metrics"] = metrics;
+  assembly::AddRecordingSection(top, recorded);
+  Passthrough(top);
+  for (auto& robot : robots) ReadBody(top, robot.name + "." + assembly::kChassis, robot);
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    for (std::size_t j = i + 1; j < robots.size(); ++j) {
+      if (BodiesOverlap(robots[i], robots[j])) {
+        const YAML::Node entry = list[list_index[j]];
+        const YAML::Node pose = Child(entry, "pose");
+        r.Error(pose.IsDefined() ? pose : entry,
+                JoinPath(JoinPath("robots", std::to_string(list_index[j])), "pose"),
+                "robot '" + robots[j].name + "' would start inside robot '" + robots[i].name +
+                    "' (their bodies overlap at their start poses)");
+      }
+    }
+  }
+  if (!robots.empty()) {
+    info = robots.front();
+    info.fleet.assign(robots.begin() + 1, robots.end());
+  }
+  r.SetOrigins(std::move(top.origins()));
+  return top.out();
+}
+
+}  // namespace
+
+bool IsRobotScenario(const YAML::Node& root) {
+  return root.IsMap() && (Child(root, "robot").IsDefined() || Child(root, "robots").IsDefined());
+}
+
+YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
+  if (Child(root, "robots").IsDefined()) {
+    if (Child(root, "robot").IsDefined()) {
+      r.Error(Child(root, "robot"), "robot",
+              "give either robot (one robot) or robots (a list), not both");
+    }
+    return ExpandFleet(root, r, info);
+  }
+  r.CheckKeys(root, "",
+              {"name", "description", "duration_s", "seed", "master", "robot", "scene", "line",
+               "control", "task", "sensors", "sensing", "localization", "units", "connections",
+               "recording", "metrics", "reference", "workers", "safety"});
+  assembly::SystemBuilder b(root, r);
+  for (const char* key : {"name", "description", "duration_s", "seed", "master", "reference"}) {
+    if (Child(root, key).IsDefined()) b.out()[key] = Child(root, key);
+  }
+  const models::Scene scene = assembly::AddScene(b);
+  AssembleRobot(b, {"model", "pose", "payload"}, scene, info);
   Passthrough(b);
-  info.body_length_m = PositiveChassisValue(b, "body_length");
-  info.body_width_m = PositiveChassisValue(b, "body_width");
+  ReadBody(b, assembly::kChassis, info);
   r.SetOrigins(std::move(b.origins()));
   return b.out();
 }

@@ -15,6 +15,11 @@ namespace linesim::loader {
 /// What a robot scenario adds to a run beyond its system: what the plots
 /// draw besides the scene, and the columns they read.
 struct RobotInfo {
+  /// The robot's name in a fleet (`robots:`), which scopes its units and
+  /// metrics (raw3_a.chassis); "" for the one-robot shorthand.
+  std::string name;
+  /// robot.pose at time zero: x (m), y (m), yaw (rad).
+  std::array<double, 3> start_pose{};
   std::string task;                         // "path" or "hold"
   std::vector<std::array<double, 2>> path;  // desired path; one point for a hold
   /// The chassis body as the chassis unit gets it; nothing when the value
@@ -54,11 +59,16 @@ struct RobotInfo {
   std::vector<std::pair<std::string, std::string>> worker_columns;
   std::string velocity_x_column, velocity_y_column, speed_cap_column, protective_column,
       warning_column, person_distance_column;
+  /// A fleet's other robots (the first robot is this one), their columns
+  /// scoped by their names.
+  std::vector<RobotInfo> fleet;
 };
 
 /// A robot scenario is written at the level of robot, scene, line, control,
-/// task, sensing and localization (see README "Scenario files"); it is
-/// recognised by its top-level `robot` key.
+/// task, sensing and localization (docs/scenarios.md); it is recognised by
+/// its top-level `robot` key, or `robots` for a fleet (a list of robots,
+/// each with its own model, pose, task, control, sensing, localization,
+/// sensors and safety, on one scene with its line and workers).
 bool IsRobotScenario(const YAML::Node& root);
 
 /// Expands a robot scenario into a system-level tree (scene, units,

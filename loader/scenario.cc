@@ -260,8 +260,11 @@ class Builder {
 
   void BuildUnit(const std::string& name, const YAML::Node& key, const YAML::Node& spec) {
     const std::string path = JoinPath("units", name);
-    if (!cosim::IsIdentifier(name)) {
-      r_.Error(key, path, "unit name '" + name + "' is not valid: expected letters, digits and _");
+    if (!cosim::IsUnitName(name)) {
+      r_.Error(key, path,
+               "unit name '" + name +
+                   "' is not valid: expected letters, digits and _ (a fleet's robot scopes its "
+                   "units' names: robot.unit)");
       return;
     }
     if (!r_.ExpectMap(spec, path)) return;

@@ -22,6 +22,8 @@ inline constexpr const char* kWheelController = "wheel_controller";
 inline constexpr const char* kPathFollower = "path_follower";
 inline constexpr const char* kDeviation = "deviation";
 inline constexpr const char* kClearance = "clearance";
+/// A fleet's robot's distance from the other robots (loader/robot_scenario.cc).
+inline constexpr const char* kRobotClearance = "robot_clearance";
 inline constexpr const char* kFlowError = "flow_error";
 /// The estimators (units/estimation) and the localization's evaluation.
 inline constexpr const char* kSurfaceEstimator = "surface_estimator";

@@ -134,5 +134,8 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
 /// recording: what signals.csv holds (unless the scenario says), at about
 /// 100 Hz; and the columns the plots read.
 void AddRecording(SystemBuilder& b, const Signals& s, RobotInfo& info);
+/// The expansion's `recording:`: the scenario's own with `recorded` added to
+/// a list it gives, or `recorded` at about 100 Hz.
+void AddRecordingSection(SystemBuilder& b, const std::vector<std::string>& recorded);
 
 }  // namespace linesim::loader::assembly

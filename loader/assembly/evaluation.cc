@@ -179,7 +179,10 @@ void AddRecording(SystemBuilder& b, const Signals& s, RobotInfo& info) {
     info.belt_on_columns.push_back(Element(kBelt, "on", k));
     info.belt_travel_columns.push_back(Element(kBelt, "travel", k));
   }
+  AddRecordingSection(b, s.recorded);
+}
 
+void AddRecordingSection(SystemBuilder& b, const std::vector<std::string>& recorded) {
   const YAML::Node own = Child(b.root(), "recording");
   if (own.IsDefined()) {
     // The scenario's recording, with the columns the plots read added to a
@@ -187,14 +190,14 @@ void AddRecording(SystemBuilder& b, const Signals& s, RobotInfo& info) {
     // everything anyway.
     YAML::Node rec = YAML::Clone(own);
     if (rec.IsMap() && Child(rec, "variables").IsSequence()) {
-      for (const auto& v : s.recorded) rec["variables"].push_back(v);
+      for (const auto& v : recorded) rec["variables"].push_back(v);
     }
     b.out()["recording"] = rec;
     return;
   }
   YAML::Node vars(YAML::NodeType::Sequence);
   vars.SetStyle(YAML::EmitterStyle::Flow);
-  for (const auto& v : s.recorded) vars.push_back(v);
+  for (const auto& v : recorded) vars.push_back(v);
   b.out()["recording"]["variables"] = vars;
   // About 100 Hz is enough for the plots and keeps signals.csv small; it
   // must be a whole number of master steps (the master refuses bad steps).

@@ -215,16 +215,18 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
   if (names.empty()) return;
 
   // Every laser on the robot sees every worker's cylinders, at each beam's
-  // time (units/sensors/ray_scene.h).
+  // time (units/sensors/ray_scene.h), and the body meets them (the chassis).
   const int per_worker = kCylindersPerWorker * kCylinderValues;
+  std::vector<std::string> takers = {kChassis};
   for (const auto& m : s.sensors) {
-    if (m.kind != "laser_scanner") continue;
-    b.Params(m.name)["moving_cylinders"] =
-        static_cast<int>(names.size()) * kCylindersPerWorker;
+    if (m.kind == "laser_scanner") takers.push_back(m.name);
+  }
+  for (const auto& unit : takers) {
+    b.Params(unit)["moving_cylinders"] = static_cast<int>(names.size()) * kCylindersPerWorker;
     for (std::size_t w = 0; w < names.size(); ++w) {
       for (int j = 0; j < per_worker; ++j) {
         b.Connect(Element(names[w], "cylinders", static_cast<std::size_t>(j)),
-                  Element(m.name, "moving_cylinders", w * per_worker + static_cast<std::size_t>(j)));
+                  Element(unit, "moving_cylinders", w * per_worker + static_cast<std::size_t>(j)));
       }
     }
   }

@@ -36,6 +36,13 @@ TEST(Endpoint, ParsesUnitVariableAndIndex) {
   EXPECT_EQ(b.ToString(), "laser_1.ranges[12]");
 
   EXPECT_EQ(Endpoint::Parse("u.v[0]").index, 0u);
+
+  // A fleet's robot scopes its units: the variable is after the last '.'.
+  const Endpoint c = Endpoint::Parse("raw3_a.chassis.body_box[3]");
+  EXPECT_EQ(c.unit, "raw3_a.chassis");
+  EXPECT_EQ(c.variable, "body_box");
+  EXPECT_EQ(c.index, 3u);
+  EXPECT_EQ(c.ToString(), "raw3_a.chassis.body_box[3]");
 }
 
 // Guards against: accepting malformed endpoints (which would later fail as
@@ -44,7 +51,8 @@ TEST(Endpoint, ParsesUnitVariableAndIndex) {
 // std::out_of_range).
 TEST(Endpoint, RefusesMalformedText) {
   for (const char* bad :
-       {"", "nodot", ".v", "u.", "u.v[", "u.v[]", "u.v[x]", "u.v[-1]", "u.v[1]x", "u.v]", "a.b.c",
+       {"", "nodot", ".v", "u.", "u.v[", "u.v[]", "u.v[x]", "u.v[-1]", "u.v[1]x", "u.v]", "a..c",
+        "a.b.c[1].d", ".a.b",
         "u v.x", "u.v[1][2]", "u.v[99999999999999999999999999]"}) {
     try {
       Endpoint::Parse(bad);
@@ -192,7 +200,8 @@ TEST(SystemBuild, BadUnitNamesAndSteps) {
     FAIL() << "expected ConfigError";
   } catch (const ConfigError& e) {
     ASSERT_EQ(e.problems().size(), 3u) << e.what();
-    EXPECT_EQ(e.problems()[0].message, "unit name 'a b' is not valid: use letters, digits and '_'");
+    EXPECT_EQ(e.problems()[0].message,
+              "unit name 'a b' is not valid: use letters, digits and '_' (and '.' after a scope)");
     EXPECT_EQ(e.problems()[1].message, "two units are named 'twin'");
     EXPECT_EQ(e.problems()[2].message, "unit 'late' has a negative step");
   }

@@ -48,7 +48,12 @@ std::unique_ptr<cosim::Unit> MakeChassis(const UnitBuildContext& c) {
     c.reader.Error(c.parameters, c.path, bad);
     return nullptr;
   }
-  return std::make_unique<chassis::ChassisUnit>(c.name, steer, drive, c.scene);
+  // Only the scenario sets them (what else moves in the scene).
+  const auto boxes = c.reader.Integer(c.parameters, c.path, "moving_boxes", 0, 0, 10000);
+  const auto cylinders = c.reader.Integer(c.parameters, c.path, "moving_cylinders", 0, 0, 10000);
+  return std::make_unique<chassis::ChassisUnit>(c.name, steer, drive, c.scene,
+                                                static_cast<int>(boxes),
+                                                static_cast<int>(cylinders));
 }
 
 const config::UnitTypeRegistrar kChassis(
@@ -63,7 +68,13 @@ const config::UnitTypeRegistrar kChassis(
        "motor k)"},
       {"drive_motor",
        "per wheel: index of its drive motor; wheels with one index are coupled (default: "
-       "wheel k on motor k)"}},
+       "wheel k on motor k)"},
+      {"moving_boxes",
+       "number of moving boxes (other robots' bodies) the body collides with: adds the input "
+       "moving_boxes, 10 numbers each (default 0)"},
+      {"moving_cylinders",
+       "number of moving cylinders (workers' legs and torsos) the body collides with: adds the "
+       "input moving_cylinders, 7 numbers each (default 0)"}},
      MakeChassis});
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "units/chassis/chassis_unit.h"
 
+#include "models/moving_solids.h"
+
 #include <ode/ode.h>
 
 #include <algorithm>
@@ -197,7 +199,8 @@ std::string ChassisUnit::TopologyProblem(const std::vector<int>& steer_motor,
 }
 
 ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
-                         std::vector<int> drive_motor, models::Scene scene)
+                         std::vector<int> drive_motor, models::Scene scene, int moving_boxes,
+                         int moving_cylinders)
     : cosim::Unit(kTypeName, std::move(name)),
       wheel_count_(static_cast<int>(steer_motor.size())),
       belt_count_(static_cast<int>(scene.belts.size())),
@@ -288,6 +291,18 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   drive_torque_.assign(md, 0.0);
   belt_velocity_.assign(2 * b, 0.0);
   belt_travel_.assign(b, 0.0);
+  if (moving_boxes < 0 || moving_cylinders < 0) {
+    throw cosim::UnitError(Where() + ": moving_boxes and moving_cylinders must be >= 0");
+  }
+  // Absent until connected (length 0; a cylinder far below the floor).
+  moving_boxes_.assign(models::MovingBox::kValues * static_cast<std::size_t>(moving_boxes), 0.0);
+  moving_cylinders_.assign(
+      models::MovingCylinder::kValues * static_cast<std::size_t>(moving_cylinders), 0.0);
+  for (std::size_t i = 0; i < moving_cylinders_.size(); i += models::MovingCylinder::kValues) {
+    moving_cylinders_[i + models::MovingCylinder::kZBottom] = -2.0;
+    moving_cylinders_[i + models::MovingCylinder::kZTop] = -1.0;
+  }
+  body_box_.assign(models::MovingBox::kValues, 0.0);
   steer_angle_.assign(ms, 0.0);
   steer_rate_.assign(ms, 0.0);
   drive_rate_.assign(md, 0.0);
@@ -409,6 +424,16 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
     v.Input("belt_travel", "m", &belt_travel_,
             "distance each scene belt's surface has moved since t = 0 (places carried objects)");
   }
+  if (!moving_boxes_.empty()) {
+    v.Input("moving_boxes", "m, rad, m/s, rad/s", &moving_boxes_,
+            "per moving box (another robot's body: its chassis' body_box) [x, y, yaw, vx, vy, "
+            "yaw_rate, length, width, z_bottom, z_top] in map; the body collides with them");
+  }
+  if (!moving_cylinders_.empty()) {
+    v.Input("moving_cylinders", "m, m/s", &moving_cylinders_,
+            "per moving cylinder (a worker's leg or torso) [x, y, vx, vy, radius, z_bottom, "
+            "z_top] in map; the body collides with them");
+  }
   v.Input("brake", &brake_, "true: every wheel joint held (velocity 0, up to brake_torque)");
 
   if (ms > 0) {
@@ -451,6 +476,11 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
            {});
   v.Output("wheel_contact", "m", &wheel_contact_,
            "contact point of each wheel in map (x, y), or the wheel centre without contact", {});
+  v.Output("body_box", "m, rad, m/s, rad/s", &body_box_,
+           "the body box as others see it (another robot's lasers, chassis and clearance): [x, "
+           "y, yaw, vx, vy, yaw_rate, length, width, z_bottom, z_top] in map, heights its "
+           "bounds",
+           {});
 }
 
 ChassisUnit::~ChassisUnit() = default;
@@ -886,6 +916,9 @@ void ChassisUnit::SetBeltInputs() {
     f.SetBeltVelocity(k, belt_velocity_[2 * kk], belt_velocity_[2 * kk + 1]);
     f.SetBeltTravel(k, belt_travel_[kk]);
   }
+  if (!moving_boxes_.empty() || !moving_cylinders_.empty()) {
+    f.SetMovingSolids(moving_boxes_, moving_cylinders_);
+  }
 }
 
 double ChassisUnit::WheelRate(int k) const {
@@ -1003,6 +1036,19 @@ void ChassisUnit::ComputeOutputs() {
     wheel_contact_[2 * k] = gc.x_m;
     wheel_contact_[2 * k + 1] = gc.y_m;
   }
+  using models::MovingBox;
+  dReal bounds[6];
+  dGeomGetAABB(o.body_geom, bounds);
+  body_box_[MovingBox::kX] = position_3d_[0];
+  body_box_[MovingBox::kY] = position_3d_[1];
+  body_box_[MovingBox::kYaw] = yaw_;
+  body_box_[MovingBox::kVx] = velocity_3d_[0];
+  body_box_[MovingBox::kVy] = velocity_3d_[1];
+  body_box_[MovingBox::kYawRate] = yaw_rate_;
+  body_box_[MovingBox::kLength] = body_length_;
+  body_box_[MovingBox::kWidth] = body_width_;
+  body_box_[MovingBox::kZBottom] = bounds[4];
+  body_box_[MovingBox::kZTop] = bounds[5];
 }
 
 cosim::StepResult ChassisUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {

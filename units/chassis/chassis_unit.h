@@ -100,8 +100,11 @@ class ChassisUnit : public cosim::Unit {
   /// topology or scene: a surface index out of range, a terrain piece
   /// without a positive size, or a carried object not lying along its belt's
   /// length at zero travel.
+  /// `moving_boxes` and `moving_cylinders` other things that move in the
+  /// scene (other robots' bodies, workers' legs and torsos) add the inputs
+  /// of those names; the body collides with them (FloorWorld::SetMovingSolids).
   ChassisUnit(std::string name, std::vector<int> steer_motor, std::vector<int> drive_motor,
-              models::Scene scene);
+              models::Scene scene, int moving_boxes = 0, int moving_cylinders = 0);
   ~ChassisUnit() override;
 
   /// The declared rules, and: the wheels (wheel_count x module_mass) weigh
@@ -197,6 +200,7 @@ class ChassisUnit : public cosim::Unit {
 
   // Inputs.
   std::vector<double> steer_torque_, drive_torque_, belt_velocity_, belt_travel_;
+  std::vector<double> moving_boxes_, moving_cylinders_;
   bool brake_ = false;
 
   // Outputs.
@@ -208,6 +212,7 @@ class ChassisUnit : public cosim::Unit {
   double yaw_ = 0.0;
   double yaw_rate_ = 0.0;
   std::vector<double> wheel_surface_, wheel_surface_velocity_, wheel_contact_;
+  std::vector<double> body_box_;
 
   bool initialized_ = false;
   // The parameter values the world was last built and settled with, and

@@ -1,5 +1,7 @@
 #include "units/chassis/floor_world.h"
 
+#include "models/moving_solids.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdarg>
@@ -62,6 +64,8 @@ FloorWorld::~FloorWorld() {
   for (dGeomID g : obstacles_) dGeomDestroy(g);
   for (const Terrain& t : terrain_) dGeomDestroy(t.geom);
   for (const Carried& c : carried_) dGeomDestroy(c.geom);
+  for (dGeomID g : moving_box_geoms_) dGeomDestroy(g);
+  for (dGeomID g : moving_cylinder_geoms_) dGeomDestroy(g);
   dWorldDestroy(world_);
   dThreadingFreeImplementation(threading_);
 }
@@ -278,8 +282,9 @@ void FloorWorld::UpdateNear() {
 }
 
 void FloorWorld::CollideObjects(double erp, double cfm) {
-  if (body_geoms_.empty() ||
-      (near_obstacles_.empty() && near_terrain_.empty() && carried_.empty())) {
+  if (body_geoms_.empty() || (near_obstacles_.empty() && near_terrain_.empty() &&
+                              carried_.empty() && moving_box_geoms_.empty() &&
+                              moving_cylinder_geoms_.empty())) {
     return;
   }
   object_erp_ = erp;
@@ -309,6 +314,64 @@ void FloorWorld::CollideObjects(double erp, double cfm) {
       const double v[3] = {speed * belt_axes_[b][0], speed * belt_axes_[b][1], 0.0};
       CollideObject(body_geom, c.geom, v);
     }
+    CollideMoving(body_geom, body);
+  }
+}
+
+void FloorWorld::SetMovingSolids(std::span<const double> boxes,
+                                 std::span<const double> cylinders) {
+  using models::MovingBox;
+  using models::MovingCylinder;
+  const std::size_t nb = boxes.size() / MovingBox::kValues;
+  const std::size_t nc = cylinders.size() / MovingCylinder::kValues;
+  while (moving_box_geoms_.size() < nb) moving_box_geoms_.push_back(dCreateBox(nullptr, 1, 1, 1));
+  while (moving_cylinder_geoms_.size() < nc) {
+    // ODE's cylinder stands along its local z, the map's vertical here.
+    moving_cylinder_geoms_.push_back(dCreateCylinder(nullptr, 1, 1));
+  }
+  moving_boxes_.assign(boxes.begin(), boxes.begin() + static_cast<std::ptrdiff_t>(nb * MovingBox::kValues));
+  moving_cylinders_.assign(cylinders.begin(),
+                           cylinders.begin() + static_cast<std::ptrdiff_t>(nc * MovingCylinder::kValues));
+  moving_elapsed_s_ = 0.0;
+}
+
+void FloorWorld::CollideMoving(dGeomID body_geom, const Aabb& body) {
+  using models::MovingBox;
+  using models::MovingCylinder;
+  const double t = moving_elapsed_s_;
+  for (std::size_t i = 0; i < moving_boxes_.size() / MovingBox::kValues; ++i) {
+    const double* m = moving_boxes_.data() + i * MovingBox::kValues;
+    const double length = m[MovingBox::kLength], width = m[MovingBox::kWidth];
+    const double z0 = m[MovingBox::kZBottom], z1 = m[MovingBox::kZTop];
+    if (!(length > 0.0 && width > 0.0 && z1 > z0)) continue;
+    const double x = m[MovingBox::kX] + m[MovingBox::kVx] * t;
+    const double y = m[MovingBox::kY] + m[MovingBox::kVy] * t;
+    const double r = 0.5 * std::hypot(length, width);
+    const Aabb bound = {x - r, x + r, y - r, y + r, z0, z1};
+    if (!Overlap(bound, body)) continue;
+    const dGeomID g = moving_box_geoms_[i];
+    dGeomBoxSetLengths(g, length, width, z1 - z0);
+    dGeomSetPosition(g, x, y, 0.5 * (z0 + z1));
+    dMatrix3 rotation;
+    dRFromAxisAndAngle(rotation, 0, 0, 1, m[MovingBox::kYaw] + m[MovingBox::kYawRate] * t);
+    dGeomSetRotation(g, rotation);
+    const double v[3] = {m[MovingBox::kVx], m[MovingBox::kVy], 0.0};
+    CollideObject(body_geom, g, v);
+  }
+  for (std::size_t i = 0; i < moving_cylinders_.size() / MovingCylinder::kValues; ++i) {
+    const double* m = moving_cylinders_.data() + i * MovingCylinder::kValues;
+    const double radius = m[MovingCylinder::kRadius];
+    const double z0 = m[MovingCylinder::kZBottom], z1 = m[MovingCylinder::kZTop];
+    if (!(radius > 0.0 && z1 > z0)) continue;
+    const double x = m[MovingCylinder::kX] + m[MovingCylinder::kVx] * t;
+    const double y = m[MovingCylinder::kY] + m[MovingCylinder::kVy] * t;
+    const Aabb bound = {x - radius, x + radius, y - radius, y + radius, z0, z1};
+    if (!Overlap(bound, body)) continue;
+    const dGeomID g = moving_cylinder_geoms_[i];
+    dGeomCylinderSetParams(g, radius, z1 - z0);
+    dGeomSetPosition(g, x, y, 0.5 * (z0 + z1));
+    const double v[3] = {m[MovingCylinder::kVx], m[MovingCylinder::kVy], 0.0};
+    CollideObject(body_geom, g, v);
   }
 }
 
@@ -487,6 +550,7 @@ bool FloorWorld::Step(double h_s) {
     CollideObjects(erp, cfm);
     ok = dWorldStep(world_, h_s);
     travel_elapsed_s_ += h_s;
+    moving_elapsed_s_ += h_s;
     dJointGroupEmpty(group_);
     // At the new positions: for contact(i) now and the next step's joints.
     if (ok != 0) Probe();

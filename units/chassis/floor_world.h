@@ -7,6 +7,7 @@
 #include <ode/ode.h>
 
 #include <array>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -216,6 +217,15 @@ class FloorWorld {
   /// are placed at it (and move on at the belt velocity along the belt
   /// direction within the step).
   void SetBeltTravel(int k, double travel_m);
+  /// Other things that move in the scene and that the body meets: other
+  /// robots' bodies (models::MovingBox values) and workers' legs and
+  /// torsos (models::MovingCylinder values), at the step's start; each moves
+  /// on at its velocity within the step. Like a carried object, each is a
+  /// geom without a body (it is not pushed: it moves as its own simulation
+  /// says), collided with the body geoms when the AABBs overlap, its
+  /// contacts moving with it. The count follows the spans' sizes; a box of
+  /// length 0 is absent.
+  void SetMovingSolids(std::span<const double> boxes, std::span<const double> cylinders);
 
   /// Surface of the floor plane at map point (x, y): 0 floor, k + 1 for the
   /// first belt k that contains it (edges included). (A contact on terrain
@@ -274,6 +284,9 @@ class FloorWorld {
 
   // ODE's AABB layout: min x, max x, min y, max y, min z, max z.
   using Aabb = std::array<dReal, 6>;
+  /// Contact joints between `body_geom` (whose AABB is `body`) and the
+  /// moving solids that reach it.
+  void CollideMoving(dGeomID body_geom, const Aabb& body);
   static bool Overlap(const Aabb& a, const Aabb& b) {
     return a[0] <= b[1] && b[0] <= a[1] && a[2] <= b[3] && b[2] <= a[3] && a[4] <= b[5] &&
            b[4] <= a[5];
@@ -321,6 +334,10 @@ class FloorWorld {
   std::vector<std::size_t> near_obstacles_;
   std::vector<std::size_t> near_terrain_;
   std::vector<Carried> carried_;
+  // SetMovingSolids: their geoms, values and the time since they were given.
+  std::vector<dGeomID> moving_box_geoms_, moving_cylinder_geoms_;
+  std::vector<double> moving_boxes_, moving_cylinders_;
+  double moving_elapsed_s_ = 0.0;
   std::vector<double> belt_travel_m_;
   // Time since the last SetBeltTravel (substeps of one step).
   double travel_elapsed_s_ = 0.0;

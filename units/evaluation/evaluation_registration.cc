@@ -3,6 +3,7 @@
 #include "units/evaluation/clearance.h"
 #include "units/evaluation/path_deviation.h"
 #include "units/evaluation/pose_error.h"
+#include "units/evaluation/robot_clearance.h"
 #include "units/evaluation/surface_velocity_error.h"
 
 namespace linesim::evaluation {
@@ -14,6 +15,19 @@ using config::UnitBuildContext;
 std::unique_ptr<cosim::Unit> MakePathDeviation(const UnitBuildContext& c) {
   return std::make_unique<evaluation::PathDeviationUnit>(c.name, ReadPoints(c, "path", 1));
 }
+
+std::unique_ptr<cosim::Unit> MakeRobotClearance(const UnitBuildContext& c) {
+  const auto others = c.reader.Integer(c.parameters, c.path, "others", 1, 1, 10000);
+  return std::make_unique<RobotClearanceUnit>(c.name, static_cast<int>(others));
+}
+
+const config::UnitTypeRegistrar kRobotClearance(
+    {RobotClearanceUnit::kTypeName,
+     "distance of a robot's body from the other robots' bodies in a fleet, and robot-robot "
+     "contacts counted as collisions (per pair)",
+     "",
+     {{"others", "number of other robots (the input `others` holds 10 numbers each; default 1)"}},
+     MakeRobotClearance});
 
 const config::UnitTypeRegistrar kPathDeviation(
     {evaluation::PathDeviationUnit::kTypeName,

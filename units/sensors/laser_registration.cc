@@ -57,9 +57,11 @@ std::unique_ptr<cosim::Unit> MakeLaserScanner(const UnitBuildContext& c) {
   }
   // Only the scenario sets it (a property of the scene, not of the device).
   const auto moving = c.reader.Integer(c.parameters, c.path, "moving_cylinders", 0, 0, 100000);
+  const auto boxes = c.reader.Integer(c.parameters, c.path, "moving_boxes", 0, 0, 100000);
   if (c.reader.issues().size() != issues_before) return nullptr;
   return std::make_unique<LaserScannerUnit>(c.name, c.scene, static_cast<int>(beams),
-                                            std::move(field), c.seed, static_cast<int>(moving));
+                                            std::move(field), c.seed, static_cast<int>(moving),
+                                            static_cast<int>(boxes));
 }
 
 const config::UnitTypeRegistrar kLaserScanner(
@@ -76,7 +78,10 @@ const config::UnitTypeRegistrar kLaserScanner(
        "neither gives it"},
       {"moving_cylinders",
        "number of moving cylinders (workers' legs and torsos) the scanner sees: adds the input "
-       "moving_cylinders, 7 numbers each (default 0)"}},
+       "moving_cylinders, 7 numbers each (default 0)"},
+      {"moving_boxes",
+       "number of moving boxes (other robots' bodies) the scanner sees: adds the input "
+       "moving_boxes, 10 numbers each (default 0)"}},
      MakeLaserScanner});
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "units/sensors/laser_scanner_unit.h"
 
+#include "models/moving_solids.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -66,7 +68,7 @@ double RoundHalfEven(double x) {
 
 LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene, int beam_count,
                                    std::vector<std::array<double, 2>> protective_field,
-                                   std::uint64_t seed, int moving_cylinders)
+                                   std::uint64_t seed, int moving_cylinders, int moving_boxes)
     : cosim::Unit(kTypeName, std::move(name)),
       beam_count_(beam_count),
       has_field_(!protective_field.empty()),
@@ -91,10 +93,13 @@ LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene,
   angular_velocity_.assign(3, 0.0);
   belt_travel_.assign(scene.belts.size(), 0.0);
   belt_speed_.assign(scene.belts.size(), 0.0);
-  if (moving_cylinders < 0) {
-    throw cosim::UnitError(Where() + ": moving_cylinders must be >= 0, got " +
-                           std::to_string(moving_cylinders));
+  if (moving_cylinders < 0 || moving_boxes < 0) {
+    throw cosim::UnitError(Where() + ": moving_cylinders and moving_boxes must be >= 0, got " +
+                           std::to_string(moving_cylinders) + " and " +
+                           std::to_string(moving_boxes));
   }
+  // Length 0 until connected: absent.
+  moving_boxes_.assign(models::MovingBox::kValues * static_cast<std::size_t>(moving_boxes), 0.0);
   // Far below the floor until connected: seen by no beam.
   moving_.assign(RayScene::kMovingValues * static_cast<std::size_t>(moving_cylinders), 0.0);
   for (std::size_t i = 0; i < moving_.size(); i += RayScene::kMovingValues) {
@@ -187,6 +192,11 @@ LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene,
     v.Input("moving_cylinders", "m, m/s", &moving_,
             "per moving cylinder (a worker's leg or torso) [x, y, vx, vy, radius, z_bottom, "
             "z_top] in map");
+  }
+  if (!moving_boxes_.empty()) {
+    v.Input("moving_boxes", "m, rad, m/s, rad/s", &moving_boxes_,
+            "per moving box (another robot's body, its chassis' body_box) [x, y, yaw, vx, vy, "
+            "yaw_rate, length, width, z_bottom, z_top] in map");
   }
   v.Output("ranges", "m", &ranges_,
            "range of each beam of the last complete scan (no_return_value: no echo)", {});
@@ -422,7 +432,7 @@ void LaserScannerUnit::CastBeams(int first, int end, cosim::TimeNs t) {
     BeamRay(i, step_s_[k], step_sin_[k], step_vers_[k]);
   }
   rays_.Cast(std::span<const Ray>(beam_rays_.data() + first, n),
-             std::span<RayHit>(centre_.data() + first, n), belt_travel_, belt_speed_, moving_);
+             std::span<RayHit>(centre_.data() + first, n), belt_travel_, belt_speed_, moving_, moving_boxes_);
   for (int i = first; i < end; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const RayHit& h = centre_[k];
@@ -447,7 +457,7 @@ void LaserScannerUnit::CastBeams(int first, int end, cosim::TimeNs t) {
   if (edges > 0) {
     const auto m = 4 * static_cast<std::size_t>(edges);
     rays_.Cast(std::span<const Ray>(edge_rays_.data(), m), std::span<RayHit>(edge_hits_.data(), m),
-               belt_travel_, belt_speed_, moving_);
+               belt_travel_, belt_speed_, moving_, moving_boxes_);
     for (int e = 0; e < edges; ++e) {
       ApplyEdge(edge_beam_[static_cast<std::size_t>(e)], &edge_hits_[4 * static_cast<std::size_t>(e)]);
     }

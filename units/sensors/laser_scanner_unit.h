@@ -88,7 +88,7 @@ class LaserScannerUnit : public cosim::Unit {
   /// (RayScene::Cast), with no extra rays.
   LaserScannerUnit(std::string name, const models::Scene& scene, int beam_count,
                    std::vector<std::array<double, 2>> protective_field, std::uint64_t seed,
-                   int moving_cylinders = 0);
+                   int moving_cylinders = 0, int moving_boxes = 0);
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
   void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
@@ -169,7 +169,7 @@ class LaserScannerUnit : public cosim::Unit {
 
   // Inputs.
   std::vector<double> position_, orientation_, velocity_, angular_velocity_, belt_travel_,
-      belt_speed_, moving_;
+      belt_speed_, moving_, moving_boxes_;
   // Outputs.
   std::vector<double> ranges_;
   double scan_time_ = 0.0, scan_count_ = 0.0, field_clear_ = 1.0;

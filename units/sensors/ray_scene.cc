@@ -1,5 +1,7 @@
 #include "units/sensors/ray_scene.h"
 
+#include "models/moving_solids.h"
+
 #include <embree3/rtcore.h>
 
 #include <algorithm>
@@ -498,9 +500,36 @@ void RayScene::CastMoving(const Ray& ray, std::span<const double> moving, RayHit
   }
 }
 
+void RayScene::CastMovingBoxes(const Ray& ray, std::span<const double> boxes, int first_object,
+                               RayHit& best) const {
+  using models::MovingBox;
+  const std::size_t count = boxes.size() / MovingBox::kValues;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double* m = boxes.data() + i * MovingBox::kValues;
+    const double length = m[MovingBox::kLength], width = m[MovingBox::kWidth];
+    const double z0 = m[MovingBox::kZBottom], z1 = m[MovingBox::kZTop];
+    if (!(length > 0.0 && width > 0.0 && z1 > z0)) continue;  // absent
+    const double t_max = std::isinf(best.range) ? ray.max_range : best.range;
+    const double yaw = m[MovingBox::kYaw] + m[MovingBox::kYawRate] * ray.dt_s;
+    double n[3] = {0.0, 0.0, 0.0};
+    const double t = IntersectYawedBox(
+        m[MovingBox::kX] + m[MovingBox::kVx] * ray.dt_s,
+        m[MovingBox::kY] + m[MovingBox::kVy] * ray.dt_s, 0.5 * (z0 + z1), 0.5 * length,
+        0.5 * width, 0.5 * (z1 - z0), std::cos(yaw), std::sin(yaw), ray.origin.data(),
+        ray.direction.data(), t_max, n);
+    if (t < t_max) {
+      best.range = t;
+      best.object = ObjectOfMoving(first_object + static_cast<int>(i));
+      best.cos_incidence = std::abs(n[0] * ray.direction[0] + n[1] * ray.direction[1] +
+                                    n[2] * ray.direction[2]);
+    }
+  }
+}
+
 void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
                     std::span<const double> belt_travel, std::span<const double> belt_speed,
-                    std::span<const double> moving) {
+                    std::span<const double> moving, std::span<const double> moving_boxes) {
+  const int cylinders = static_cast<int>(moving.size() / kMovingValues);
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   // Packets of 16 while 16 rays are left, then of 8 (a 1 ms step's 14 beams
@@ -545,6 +574,7 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
                     belt_travel, belt_speed, h);
       }
       if (!moving.empty()) CastMoving(packet_rays[k], moving, h);
+      if (!moving_boxes.empty()) CastMovingBoxes(packet_rays[k], moving_boxes, cylinders, h);
     }
     first += count;
   }

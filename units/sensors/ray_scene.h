@@ -84,13 +84,18 @@ class RayScene {
   /// moving things (workers' legs and torsos), each a vertical cylinder at
   /// (x + vx dt_s, y + vy dt_s) when a ray is cast, intersected exactly
   /// after the static and carried objects (no culling: a few cylinders).
+  /// `moving_boxes` (models::MovingBox values: other robots' bodies) the
+  /// same, each a yawed box at its pose moved on by its velocity and yaw
+  /// rate to the ray's time.
   void Cast(std::span<const Ray> rays, std::span<RayHit> hits, std::span<const double> belt_travel,
-            std::span<const double> belt_speed, std::span<const double> moving = {});
+            std::span<const double> belt_speed, std::span<const double> moving = {},
+            std::span<const double> moving_boxes = {});
 
   int ObjectOfObstacle(int i) const { return 1 + i; }
   int ObjectOfTerrain(int i) const { return 1 + obstacle_count_ + i; }
   int ObjectOfCarried(int i) const { return 1 + obstacle_count_ + terrain_count_ + i; }
-  /// Moving cylinder i of Cast's `moving`.
+  /// Moving cylinder i of Cast's `moving`; its moving box j is
+  /// ObjectOfMoving(cylinders + j).
   int ObjectOfMoving(int i) const {
     return 1 + obstacle_count_ + terrain_count_ + static_cast<int>(carried_.size()) + i;
   }
@@ -157,6 +162,10 @@ class RayScene {
   /// the origins' spread. Returns the count.
   /// The moving cylinders met before `best` (updated in place).
   void CastMoving(const Ray& ray, std::span<const double> moving, RayHit& best) const;
+  /// The moving boxes met before `best` (updated in place); box i is object
+  /// ObjectOfMoving(first_object + i).
+  void CastMovingBoxes(const Ray& ray, std::span<const double> boxes, int first_object,
+                       RayHit& best) const;
   int CullCarried(std::span<const Ray> rays, std::span<const double> belt_travel,
                   std::span<const double> belt_speed);
 

@@ -922,7 +922,8 @@ TEST(ChassisUnit, VariableTable) {
                                         {"angular_velocity", C::kOutput, "rad/s", 3},
                                         {"wheel_surface", C::kOutput, "1", 4},
                                         {"wheel_surface_velocity", C::kOutput, "m/s", 8},
-                                        {"wheel_contact", C::kOutput, "m", 8}};
+                                        {"wheel_contact", C::kOutput, "m", 8},
+                                        {"body_box", C::kOutput, "m, rad, m/s, rad/s", 10}};
   expected.insert(expected.end(), swerve.begin(), swerve.end());
   test_helpers::ExpectTable(*robot, expected);
 
@@ -938,7 +939,7 @@ TEST(ChassisUnit, VariableTable) {
       {"orientation", C::kOutput, "1", 4},    {"velocity_3d", C::kOutput, "m/s", 3},
       {"angular_velocity", C::kOutput, "rad/s", 3},
       {"wheel_surface", C::kOutput, "1", 4},  {"wheel_surface_velocity", C::kOutput, "m/s", 8},
-      {"wheel_contact", C::kOutput, "m", 8}};
+      {"wheel_contact", C::kOutput, "m", 8},  {"body_box", C::kOutput, "m, rad, m/s, rad/s", 10}};
   expected.insert(expected.end(), skid.begin(), skid.end());
   test_helpers::ExpectTable(*husky, expected);
 }

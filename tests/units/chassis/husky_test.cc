@@ -297,6 +297,68 @@ TEST(Obstacles, CarBodyPushesABrakedRobot) {
   EXPECT_LT(Get(u, "position")[0] - rear, belt_end + 0.01);
 }
 
+// Guards against a body that passes through other robots and workers (a
+// fleet's moving boxes and cylinders, which the chassis meets as it meets a
+// pillar): a Husky driven at 0.5 m/s towards a still Rob@Work 3 body (1.03 x
+// 0.57 x 0.40 m, paper 1 Table I) centred 2 m ahead, and towards a still
+// leg (radius 0.06 m, DIN 33402-2 calf, as people::WorkerUnit) 1.5 m
+// ahead, stops with its front face at it, pressed in by no more than a few
+// mm as at the pillar.
+TEST(MovingSolids, OtherRobotAndLegStopTheRobot) {
+  for (const bool box : {true, false}) {
+    SCOPED_TRACE(box ? "box" : "cylinder");
+    auto robot = Husky(Floor(kHuskyMu), "husky", box ? 1 : 0, box ? 0 : 1);
+    ChassisUnit& u = *robot;
+    u.Initialize();
+    if (box) {
+      SetArray(u, "moving_boxes", {2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.03, 0.57, 0.0, 0.4});
+    } else {
+      SetArray(u, "moving_cylinders", {1.5, 0.0, 0.0, 0.0, 0.06, 0.0, 0.5});
+    }
+    const double face = box ? 2.0 - 0.5 * 1.03 : 1.5 - 0.06;
+    const double stop_x = face - 0.5 * kHuskyBodyM[0];
+    const double rate = 0.5 / kHuskyWheelRadiusM;
+    SpeedLoop loop;
+    TimeNs t = 0;
+    double max_x = 0.0;
+    for (int i = 0; i < 5000; ++i) {
+      loop.Step(u, {rate, rate});
+      StepOk(u, t);
+      max_x = std::max(max_x, Get(u, "position")[0]);
+    }
+    EXPECT_LT(max_x, stop_x + 0.003);
+    EXPECT_GT(Get(u, "position")[0], stop_x - 0.01);
+    EXPECT_NEAR(Get(u, "body_linear_velocity")[0], 0.0, 1e-3);
+    EXPECT_GT(Get(u, "drive_rate")[0], 0.5 * rate);
+  }
+}
+
+// Guards against a moving box that does not push: another robot's body
+// coming at 0.3 m/s (its pose given every step, as a fleet's connections
+// give it) pushes a braked Husky along at its speed, its rear face at the
+// box's front face to a few mm (the box moves on within the step at its
+// velocity).
+TEST(MovingSolids, OtherRobotPushesABrakedRobot) {
+  const double v = 0.3;
+  auto robot = Husky(Floor(kHuskyMu), "husky", 1, 0);
+  ChassisUnit& u = *robot;
+  u.variables().SetBoolean(*u.variables().Find("brake"), true);
+  u.Initialize();
+  const double rear = 0.5 * kHuskyBodyM[0];
+  const double start = -rear - 0.3 - 0.5 * 1.03;  // 0.3 m behind at t = 0
+  TimeNs t = 0;
+  double min_gap = 1e9;
+  for (int i = 0; i < 4000; ++i) {
+    const double x = start + v * cosim::NsToSeconds(t);
+    SetArray(u, "moving_boxes", {x, 0.0, 0.0, v, 0.0, 0.0, 1.03, 0.57, 0.0, 0.4});
+    StepOk(u, t);
+    if (i > 1500) min_gap = std::min(min_gap, Get(u, "position")[0] - rear - (x + 0.5 * 1.03));
+  }
+  EXPECT_NEAR(Get(u, "linear_velocity")[0], v, 0.01 * v);
+  EXPECT_GT(min_gap, -0.003);
+  EXPECT_LT(min_gap, 0.003);
+}
+
 // Guards against the Husky's robot description and the test robot
 // drifting apart: models/robots/husky.yaml's body (its com_height_m the
 // derived 0.13 m clearance + 0.2475 / 2 m) is the test robot's.

@@ -99,9 +99,13 @@ inline std::unique_ptr<ChassisUnit> Raw3(models::Scene scene = models::OpenFloor
 
 /// Husky A200: four fixed wheels, order front-left, rear-left, front-right,
 /// rear-right; the left pair on drive motor 0, the right pair on 1.
-inline std::unique_ptr<ChassisUnit> Husky(models::Scene scene, const std::string& name = "husky") {
+/// `moving_boxes` and `moving_cylinders` add those inputs (other robots,
+/// workers).
+inline std::unique_ptr<ChassisUnit> Husky(models::Scene scene, const std::string& name = "husky",
+                                          int moving_boxes = 0, int moving_cylinders = 0) {
   auto u = std::make_unique<ChassisUnit>(name, std::vector<int>{-1, -1, -1, -1},
-                                         std::vector<int>{0, 0, 1, 1}, std::move(scene));
+                                         std::vector<int>{0, 0, 1, 1}, std::move(scene),
+                                         moving_boxes, moving_cylinders);
   const double a = kHuskyHalfBaseM, b = kHuskyHalfTrackM;
   Set(*u, "body_length", kHuskyBodyM[0]);
   Set(*u, "body_width", kHuskyBodyM[1]);

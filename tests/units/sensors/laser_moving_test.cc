@@ -26,11 +26,12 @@ constexpr double kHalfStep = 0.005 + 1e-9;
 
 // The S300 of models/sensors/sick_s300.yaml, exact (no noise, one ray per
 // beam), with `cylinders` moving cylinders.
-std::unique_ptr<LaserScannerUnit> S300(const models::Scene& scene, int cylinders) {
+std::unique_ptr<LaserScannerUnit> S300(const models::Scene& scene, int cylinders, int boxes = 0) {
   const YAML::Node m =
       YAML::LoadFile(std::string(LINESIM_SOURCE_DIR) + "/models/sensors/sick_s300.yaml");
   auto u = std::make_unique<LaserScannerUnit>("laser", scene, m["beam_count"].as<int>(),
-                                              std::vector<std::array<double, 2>>{}, 1, cylinders);
+                                              std::vector<std::array<double, 2>>{}, 1, cylinders,
+                                              boxes);
   for (const auto& kv : m) {
     const std::string key = kv.first.as<std::string>();
     if (key == "beam_count" || key == "protective_field" || key == "source" ||
@@ -112,11 +113,45 @@ TEST(LaserMoving, MovingLegSeenAtTheBeamsTime) {
   EXPECT_NEAR(r[270], 1.94, 1e-9);
 }
 
+// Guards against other robots not seen, or seen where they were at the
+// step's start: another Rob@Work 3's body (1.03 x 0.57 m, 0 to 0.4 m high,
+// paper 1 Table I) centred 2 m ahead, coming at 1 m/s, and a second robot
+// box that is absent (length 0). Beam 270 (straight ahead, t = 15 ms) sees
+// the front face at 2 - 0.515 - 1.0 x 0.015 = 1.47 m; a beam 20 deg off
+// sees the face's plane at 1.485 / cos 20 deg less the motion, or passes
+// the box (its half width 0.285 m at 1.485 m is 10.9 deg): nothing there.
+TEST(LaserMoving, OtherRobotSeenAtTheBeamsTime) {
+  auto u = S300(models::OpenFloor(), 0, 2);
+  SetArray(*u, "moving_boxes", {2.0, 0.0, 0.0, -1.0, 0.0, 0.0, 1.03, 0.57, 0.0, 0.4,  //
+                                0.7, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.4});
+  u->Setup(0, 1000 * kMs);
+  u->Initialize();
+  ASSERT_EQ(u->DoStep(0, 40 * kMs), cosim::StepResult::kOk) << u->last_error();
+  const auto r = Get(*u, "ranges");
+  for (int i = 250; i <= 290; ++i) {
+    const double a = BeamAngle(i);
+    const double face = 2.0 - 0.515 - 1.0 * BeamTime(i);
+    const double y = face * std::tan(a);
+    if (std::abs(y) < 0.285 - 0.01) {
+      EXPECT_NEAR(r[static_cast<std::size_t>(i)], face / std::cos(a), kHalfStep) << "beam " << i;
+    } else if (std::abs(y) > 0.285 + 0.01) {
+      EXPECT_EQ(r[static_cast<std::size_t>(i)], 0.0) << "beam " << i;
+    }
+  }
+  EXPECT_NEAR(r[270], 1.47, 1e-9);
+  // Lifted above the scanner's 0.18 m, the body is not seen.
+  SetArray(*u, "moving_boxes", {2.0, 0.0, 0.0, -1.0, 0.0, 0.0, 1.03, 0.57, 0.2, 0.6,  //
+                                0.7, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.4});
+  ASSERT_EQ(u->DoStep(40 * kMs, 40 * kMs), cosim::StepResult::kOk) << u->last_error();
+  EXPECT_EQ(Get(*u, "ranges")[270], 0.0);
+}
+
 // Guards against moving cylinders changing anything when there are none:
 // without the structural key the unit has no such input.
 TEST(LaserMoving, NoInputWithoutCylinders) {
   auto u = S300(models::OpenFloor(), 0);
   EXPECT_FALSE(u->variables().Find("moving_cylinders").has_value());
+  EXPECT_FALSE(u->variables().Find("moving_boxes").has_value());
 }
 
 }  // namespace

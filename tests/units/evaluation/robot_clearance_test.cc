@@ -1,0 +1,83 @@
+// The distance between robots' bodies in a fleet, and their contacts.
+#include "units/evaluation/robot_clearance.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "tests/units/test_helpers.h"
+
+namespace linesim::evaluation {
+namespace {
+
+using test_helpers::Get;
+using test_helpers::SetArray;
+
+constexpr cosim::TimeNs kStep = 5'000'000;
+
+std::vector<double> Box(double x, double y, double yaw, double length, double width) {
+  return {x, y, yaw, 0.0, 0.0, 0.0, length, width, 0.0, 0.4};
+}
+
+// Guards the footprint distance against its closed forms: two axis-aligned
+// 1 x 1 boxes 2 m apart are 1 m apart; one turned by 45 deg (a diamond,
+// half diagonal sqrt(0.5)) at 2 m is 2 - 0.5 - sqrt(0.5) from the other's
+// face; side by side 1.2 m apart diagonally (0.2 m along x and y) their
+// corners are sqrt(0.2^2 + 0.2^2) apart; overlapping boxes are at 0; the
+// distance is symmetric.
+TEST(RobotClearance, FootprintDistanceClosedForms) {
+  const auto d = [](const std::vector<double>& a, const std::vector<double>& b) {
+    EXPECT_DOUBLE_EQ(RobotClearanceUnit::FootprintDistance(a.data(), b.data()),
+                     RobotClearanceUnit::FootprintDistance(b.data(), a.data()));
+    return RobotClearanceUnit::FootprintDistance(a.data(), b.data());
+  };
+  const double quarter = std::numbers::pi / 4.0;
+  EXPECT_NEAR(d(Box(0, 0, 0, 1, 1), Box(2, 0, 0, 1, 1)), 1.0, 1e-12);
+  EXPECT_NEAR(d(Box(0, 0, 0, 1, 1), Box(2, 0, quarter, 1, 1)), 1.5 - std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(d(Box(0, 0, 0, 1, 1), Box(1.2, 1.2, 0, 1, 1)), std::hypot(0.2, 0.2), 1e-12);
+  EXPECT_EQ(d(Box(0, 0, 0, 1, 1), Box(0.9, 0.3, 0.4, 1, 1)), 0.0);
+  // A long box across a short one's end (a T): the gap along x.
+  EXPECT_NEAR(d(Box(0, 0, 0, 1, 0.5), Box(1.0, 0, std::numbers::pi / 2, 2, 0.2)), 0.4, 1e-12);
+}
+
+// Guards the contact events: a collision is counted when the bodies come
+// within contact_distance (default 5 mm) and not again while they stay;
+// leaving and touching again counts again; a body above the other (no
+// height in common) is never in contact; an absent one (length 0) is
+// ignored.
+TEST(RobotClearance, CountsContactEventsPerPair) {
+  RobotClearanceUnit u("c", 2);
+  u.Initialize();
+  const auto step = [&](double x_other, double z_bottom) {
+    SetArray(u, "body_box", Box(0, 0, 0, 1, 1));
+    std::vector<double> others = Box(x_other, 0, 0, 1, 1);
+    others[8] = z_bottom;
+    others[9] = z_bottom + 0.4;
+    const auto absent = Box(0, 0, 0, 0, 0);
+    others.insert(others.end(), absent.begin(), absent.end());
+    SetArray(u, "others", others);
+    static cosim::TimeNs t = 0;
+    ASSERT_EQ(u.DoStep(t, kStep), cosim::StepResult::kOk) << u.last_error();
+    t += kStep;
+  };
+  step(2.0, 0.0);
+  EXPECT_NEAR(Get(u, "distance")[0], 1.0, 1e-12);
+  EXPECT_EQ(Get(u, "nearest")[0], 0.0);
+  EXPECT_EQ(Get(u, "collisions")[0], 0.0);
+  step(1.003, 0.0);  // 3 mm: in contact
+  step(1.0, 0.0);    // still
+  EXPECT_EQ(Get(u, "collisions")[0], 1.0);
+  step(1.1, 0.0);  // apart
+  step(0.9, 0.0);  // overlapping: again
+  EXPECT_EQ(Get(u, "robot_collisions")[0], 2.0);
+  EXPECT_EQ(Get(u, "robot_collisions")[1], 0.0);
+  step(0.9, 0.5);  // above it
+  step(0.9, 0.0);
+  EXPECT_EQ(Get(u, "collisions")[0], 3.0);
+  EXPECT_EQ(Get(u, "min_distance")[0], 0.0);
+}
+
+}  // namespace
+}  // namespace linesim::evaluation

@@ -1,0 +1,152 @@
+#include "units/evaluation/robot_clearance.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "models/moving_solids.h"
+
+namespace linesim::evaluation {
+
+namespace {
+
+using models::MovingBox;
+
+using Corners = std::array<std::array<double, 2>, 4>;
+
+Corners CornersOf(const double* box) {
+  const double c = std::cos(box[MovingBox::kYaw]), s = std::sin(box[MovingBox::kYaw]);
+  const double hx = 0.5 * box[MovingBox::kLength], hy = 0.5 * box[MovingBox::kWidth];
+  Corners out;
+  const double signs[4][2] = {{1, 1}, {-1, 1}, {-1, -1}, {1, -1}};
+  for (std::size_t k = 0; k < 4; ++k) {
+    const double x = signs[k][0] * hx, y = signs[k][1] * hy;
+    out[k] = {box[MovingBox::kX] + c * x - s * y, box[MovingBox::kY] + s * x + c * y};
+  }
+  return out;
+}
+
+// Distance of point p from the footprint of `box` (0 inside).
+double PointToBox(const std::array<double, 2>& p, const double* box) {
+  const double c = std::cos(box[MovingBox::kYaw]), s = std::sin(box[MovingBox::kYaw]);
+  const double dx = p[0] - box[MovingBox::kX], dy = p[1] - box[MovingBox::kY];
+  const double x = std::abs(c * dx + s * dy) - 0.5 * box[MovingBox::kLength];
+  const double y = std::abs(-s * dx + c * dy) - 0.5 * box[MovingBox::kWidth];
+  return std::hypot(std::max(x, 0.0), std::max(y, 0.0));
+}
+
+// Whether the footprints' projections on the axis (ux, uy) are disjoint.
+bool Separates(const Corners& a, const Corners& b, double ux, double uy) {
+  double a0 = std::numeric_limits<double>::max(), a1 = -a0, b0 = a0, b1 = -a0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const double pa = a[k][0] * ux + a[k][1] * uy, pb = b[k][0] * ux + b[k][1] * uy;
+    a0 = std::min(a0, pa), a1 = std::max(a1, pa);
+    b0 = std::min(b0, pb), b1 = std::max(b1, pb);
+  }
+  return a1 < b0 || b1 < a0;
+}
+
+}  // namespace
+
+double RobotClearanceUnit::FootprintDistance(const double* a, const double* b) {
+  const Corners ca = CornersOf(a), cb = CornersOf(b);
+  bool separated = false;
+  for (const double* box : {a, b}) {
+    const double c = std::cos(box[MovingBox::kYaw]), s = std::sin(box[MovingBox::kYaw]);
+    separated = separated || Separates(ca, cb, c, s) || Separates(ca, cb, -s, c);
+  }
+  if (!separated) return 0.0;
+  double best = std::numeric_limits<double>::max();
+  for (std::size_t k = 0; k < 4; ++k) {
+    best = std::min({best, PointToBox(ca[k], b), PointToBox(cb[k], a)});
+  }
+  return best;
+}
+
+RobotClearanceUnit::RobotClearanceUnit(std::string name, int others)
+    : cosim::Unit(kTypeName, std::move(name)), others_(others) {
+  if (others_ < 1) throw cosim::UnitError(Where() + ": needs at least one other robot");
+  const auto n = static_cast<std::size_t>(others_);
+  body_box_.assign(MovingBox::kValues, 0.0);
+  others_boxes_.assign(n * MovingBox::kValues, 0.0);
+  robot_distance_.assign(n, 0.0);
+  robot_collisions_.assign(n, 0.0);
+  contact_before_.assign(n, 0);
+  auto& v = variables();
+  v.Parameter("contact_distance", "m", &contact_distance_,
+              "bodies closer than this are in contact (the gap two pushing bodies keep: their "
+              "relative speed times the master step)",
+              cosim::Rule::NonNegative());
+  v.Input("body_box", "m, rad, m/s, rad/s", &body_box_,
+          "this robot's body (its chassis' body_box: [x, y, yaw, vx, vy, yaw_rate, length, "
+          "width, z_bottom, z_top] in map)");
+  v.Input("others", "m, rad, m/s, rad/s", &others_boxes_,
+          "the other robots' bodies (their chassis' body_box), one after another");
+  v.Output("distance", "m", &distance_, "distance from the body to the nearest other robot",
+           {});
+  v.Output("min_distance", "m", &min_distance_, "smallest distance so far", {});
+  v.Output("nearest", "1", &nearest_, "index of the nearest other robot (-1: none)", {});
+  v.Output("collisions", "1", &collisions_, "robot-robot contact events so far", {});
+  v.Output("robot_distance", "m", &robot_distance_, "distance to each other robot", {});
+  v.Output("robot_collisions", "1", &robot_collisions_,
+           "contact events with each other robot so far (the pair this robot - robot k)", {});
+}
+
+void RobotClearanceUnit::Evaluate() {
+  const double* own = body_box_.data();
+  distance_ = std::numeric_limits<double>::max();
+  nearest_ = -1.0;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(others_); ++k) {
+    const double* other = others_boxes_.data() + k * MovingBox::kValues;
+    const bool absent = !(other[MovingBox::kLength] > 0.0 && other[MovingBox::kWidth] > 0.0);
+    const bool apart_in_height = other[MovingBox::kZTop] < own[MovingBox::kZBottom] ||
+                                 other[MovingBox::kZBottom] > own[MovingBox::kZTop];
+    const double d = absent || apart_in_height ? std::numeric_limits<double>::max()
+                                               : FootprintDistance(own, other);
+    robot_distance_[k] = d;
+    if (d < distance_) {
+      distance_ = d;
+      nearest_ = static_cast<double>(k);
+    }
+    const bool contact = d <= contact_distance_;
+    if (contact && !contact_before_[k]) {
+      robot_collisions_[k] += 1.0;
+      collisions_ += 1.0;
+    }
+    contact_before_[k] = contact ? 1 : 0;
+  }
+  min_distance_ = std::min(min_distance_, distance_);
+}
+
+void RobotClearanceUnit::Initialize() {
+  ThrowIfBadParameters();
+  std::fill(contact_before_.begin(), contact_before_.end(), 0);
+  std::fill(robot_collisions_.begin(), robot_collisions_.end(), 0.0);
+  collisions_ = 0.0;
+  min_distance_ = std::numeric_limits<double>::max();
+  Evaluate();
+}
+
+cosim::StepResult RobotClearanceUnit::DoStep(cosim::TimeNs t, cosim::TimeNs) {
+  if (!InputsFinite(t)) return cosim::StepResult::kError;
+  Evaluate();
+  return cosim::StepResult::kOk;
+}
+
+void RobotClearanceUnit::SaveInternal(cosim::UnitState& state) const {
+  state.integers.assign(contact_before_.begin(), contact_before_.end());
+}
+
+void RobotClearanceUnit::RestoreInternal(const cosim::UnitState& state) {
+  if (state.integers.size() != contact_before_.size()) {
+    throw cosim::UnitError(Where() + ": saved state has " +
+                           std::to_string(state.integers.size()) + " contact flags, expected " +
+                           std::to_string(contact_before_.size()));
+  }
+  for (std::size_t k = 0; k < contact_before_.size(); ++k) {
+    contact_before_[k] = static_cast<std::uint8_t>(state.integers[k]);
+  }
+}
+
+}  // namespace linesim::evaluation
