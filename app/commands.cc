@@ -134,6 +134,12 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat forma
   spec.flow_filtered_columns = robot.flow_filtered_columns;
   spec.flow_reference_column = robot.flow_reference_column;
   spec.worker_columns = robot.worker_columns;
+  // A fleet: the first robot's plots, with the others in the top view.
+  spec.robot_name = robot.name;
+  for (const loader::RobotInfo& other : robot.fleet) {
+    spec.others.push_back({other.name, other.x_column, other.y_column, other.yaw_column,
+                           other.body_length_m.value_or(0.0), other.body_width_m.value_or(0.0)});
+  }
   spec.safety = {robot.velocity_x_column, robot.velocity_y_column, robot.speed_cap_column,
                  robot.protective_column,  robot.warning_column,    robot.person_distance_column};
   if (!robot.scan_unit.empty()) {

@@ -6,6 +6,8 @@
 // profile, two clock reads per unit step); the rest is the master itself.
 #include <benchmark/benchmark.h>
 
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -50,6 +52,42 @@ void BM_Scenario(benchmark::State& state, const std::string& file,
       ->MeasureProcessCPUTime()                                                            \
       ->UseRealTime()
 
+// A fleet of N Rob@Work 3 on the factory line, every sensor on, each on
+// ground-truth control following its own 1.5 m path (two rows of five along
+// the line, 5 m apart): the cost per simulated second grows with N (each
+// chassis, laser and clearance meets the N - 1 others). Issue 22: at most
+// N x 1.15 of one robot's.
+std::string FleetFile(int n) {
+  std::string text =
+      "name: fleet_bench\nduration_s: 5\nseed: 1\n"
+      "master: {algorithm: gauss_seidel, step_s: 0.005}\nscene: {model: factory_line}\n"
+      "robots:\n";
+  for (int k = 0; k < n; ++k) {
+    const std::string x = std::to_string(-10 + 5 * (k % 5)), y = k < 5 ? "-5" : "-3";
+    const std::string x1 = std::to_string(-10 + 5 * (k % 5) + 1.5);
+    text += "  - {name: r" + std::to_string(k) + ", model: raw3, pose: {x_m: " + x + ", y_m: " +
+            y + ", yaw_deg: 0}, task: {type: path, waypoints: [[" + x + ", " + y + "], [" + x1 +
+            ", " + y + "]], speed_mps: 0.3}, sensing: {surface_velocity: ground_truth}, "
+            "localization: {source: ground_truth}}\n";
+  }
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("linesim_fleet_bench_" + std::to_string(n) + ".yaml");
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+void BM_Fleet(benchmark::State& state) {
+  BM_Scenario(state, FleetFile(static_cast<int>(state.range(0))), {});
+  state.counters["robots"] = static_cast<double>(state.range(0));
+}
+BENCHMARK(BM_Fleet)
+    ->Arg(1)
+    ->Arg(3)
+    ->Arg(10)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+
 LINESIM_SCENARIO(motor_step, "motor_step.yaml");
 LINESIM_SCENARIO(cross_line, "cross_line.yaml");
 // Side by side: the same crossing without any sensor (the ground-truth loop
@@ -79,6 +117,15 @@ LINESIM_SCENARIO(optic_flow_profile, "optic_flow_profile.yaml");
 // EKF, the beacons, the route follower, the Husky on the ramp), beside the
 // same route on the ground truth without sensors.
 LINESIM_SCENARIO(van_entry, "van_entry.yaml");
+// The fleet on the line with the Rob@Work 3s on their own sensors (fused
+// flow and fused localization; the Husky on the ground truth, it has no
+// PX4Flow), beside one robot's closed loop (cross_line_closed_loop).
+LINESIM_SCENARIO(fleet_line, "fleet_line.yaml");
+LINESIM_SCENARIO(fleet_line_closed_loop, "fleet_line.yaml",
+                 "robots.0.sensing.surface_velocity=fused_flow",
+                 "robots.0.localization.source=fused",
+                 "robots.1.sensing.surface_velocity=fused_flow",
+                 "robots.1.localization.source=fused");
 LINESIM_SCENARIO(van_entry_ground_truth, "van_entry.yaml", "sensors.default=false",
                  "localization.source=ground_truth");
 

@@ -412,6 +412,14 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   for (const auto& [wx, wy] : spec.worker_columns) {
     workers.emplace_back(column(wx, "worker x"), column(wy, "worker y"));
   }
+  struct OtherColumns {
+    int x, y, yaw;
+  };
+  std::vector<OtherColumns> others;
+  for (const auto& o : spec.others) {
+    others.push_back({column(o.x_column, "other robot x"), column(o.y_column, "other robot y"),
+                      column(o.yaw_column, "other robot yaw")});
+  }
   const RobotPlotSpec::Safety& safety = spec.safety;
   const bool has_safety = !safety.cap_column.empty();
   const int ivx = has_safety ? column(safety.velocity_x_column, "robot vx") : 0;
@@ -455,7 +463,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
 
   // Outlines (with a heading tick from the centre to the front), wheel
   // contact points and time labels at the chosen instants.
-  std::string outlines, contacts, labels;
+  std::string outlines, contacts, labels, other_outlines;
   Bounds view;
   for (const auto& p : spec.path_m) view.Add(p[0], p[1]);
   // One pass over the rows: the track's extent, and where each row starts
@@ -468,6 +476,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     std::string line;
     int last_column = std::max(ix, iy);
     for (int col : travels) last_column = std::max(last_column, col);
+    for (const auto& o : others) last_column = std::max({last_column, o.x, o.y});
     const auto needed = static_cast<std::size_t>(last_column);
     while (true) {
       const std::streamoff start = signals.in.tellg();
@@ -477,6 +486,10 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
       SplitCsv(line, fields, needed);
       const auto x = Column(fields, ix), y = Column(fields, iy);
       if (x && y) view.Add(*x, *y);
+      for (const auto& o : others) {
+        const auto ox = Column(fields, o.x), oy = Column(fields, o.y);
+        if (ox && oy) view.Add(*ox, *oy);
+      }
       for (std::size_t b = 0; b < travels.size(); ++b) {
         if (const auto d = Column(fields, travels[b])) travel[b] = d;
       }
@@ -514,6 +527,17 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
         } else {
           placed.push_back({{*x, *y}, Num(*t)});
         }
+      }
+      for (std::size_t k = 0; k < others.size(); ++k) {
+        const auto ox = get(others[k].x), oy = get(others[k].y), oyaw = get(others[k].yaw);
+        if (!ox || !oy || !oyaw || !std::isfinite(*ox + *oy + *oyaw)) continue;
+        const auto& o = spec.others[k];
+        const auto c = Rectangle(*ox, *oy, *oyaw, o.body_length_m, o.body_width_m);
+        for (const Point& p : c) view.Add(p.x, p.y);
+        AppendPolygon(other_outlines, c);
+        other_outlines += Num(*ox) + "," + Num(*oy) + "\n" +
+                          Num(*ox + 0.5 * o.body_length_m * std::cos(*oyaw)) + "," +
+                          Num(*oy + 0.5 * o.body_length_m * std::sin(*oyaw)) + "\n\n";
       }
       for (const auto& [wx, wy] : wheels) {
         const auto px = get(wx), py = get(wy);
@@ -595,6 +619,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   if (!arrows.empty()) AppendBlock(s, "belt_direction", arrows);
   if (!path.empty()) AppendBlock(s, "path", path);
   if (!outlines.empty()) AppendBlock(s, "outlines", outlines);
+  if (!other_outlines.empty()) AppendBlock(s, "other_outlines", other_outlines);
   if (!contacts.empty()) AppendBlock(s, "contacts", contacts);
   if (!labels.empty()) AppendBlock(s, "labels", labels);
 
@@ -674,7 +699,17 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   items.push_back(signals_file + " skip 1 using " + std::to_string(ix) + ":" + std::to_string(iy) +
                   " with lines lw 2 lc rgb '#d62728' title 'actual path'");
   if (!outlines.empty()) {
-    items.push_back("$outlines using 1:2 with lines lw 1 lc rgb '#1f77b4' title 'robot outline'");
+    items.push_back("$outlines using 1:2 with lines lw 1 lc rgb '#1f77b4' title " +
+                    GnuplotQuote(spec.others.empty() ? "robot outline"
+                                                     : spec.robot_name + " outline"));
+  }
+  for (std::size_t k = 0; k < others.size(); ++k) {
+    items.push_back(signals_file + " skip 1 using " + std::to_string(others[k].x) + ":" +
+                    std::to_string(others[k].y) + " with lines lw 2 lc rgb '#17becf' " +
+                    (k == 0 ? "title 'other robots (path, outline)'" : "notitle"));
+  }
+  if (!other_outlines.empty()) {
+    items.push_back("$other_outlines using 1:2 with lines lw 1 lc rgb '#17becf' notitle");
   }
   for (std::size_t w = 0; w < workers.size(); ++w) {
     items.push_back(signals_file + " skip 1 using " + std::to_string(workers[w].first) + ":" +

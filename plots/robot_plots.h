@@ -92,6 +92,15 @@ struct RobotPlotSpec {
   Safety safety;
   /// Each worker's track in the top view: x and y columns of its pose.
   std::vector<std::pair<std::string, std::string>> worker_columns;
+  /// A fleet's other robots in the top view: their tracks, and their
+  /// outlines at the same instants as the robot's.
+  struct OtherRobot {
+    std::string name, x_column, y_column, yaw_column;
+    double body_length_m = 0.0, body_width_m = 0.0;
+  };
+  std::vector<OtherRobot> others;
+  /// The robot's name in a fleet ("" for one robot).
+  std::string robot_name;
   /// Robot outlines and wheel footprints drawn at this many instants,
   /// evenly spaced over the recorded rows from first to last.
   int footprint_count = 5;

@@ -199,11 +199,34 @@ ReplaySpec ReplaySpecFor(const loader::Scenario& s, double bound_m,
     }
     spec.plots.push_back(std::move(p));
   }
-  // Every laser scanner of the system, found by its type.
+  // Every laser scanner of the robot, found by its type (in a fleet, of
+  // the robot's scope: the others' are drawn from their own poses nowhere).
+  const std::string scope = r.name.empty() ? "" : r.name + ".";
   for (std::size_t u = 0; u < system.unit_count(); ++u) {
     if (const auto* laser = dynamic_cast<const sensors::LaserScannerUnit*>(&system.unit(u))) {
-      spec.lasers.push_back({laser->name(), laser});
+      if (laser->name().starts_with(scope)) spec.lasers.push_back({laser->name(), laser});
     }
+  }
+  for (const loader::RobotInfo& other : r.fleet) {
+    ReplaySpec::Mover m;
+    m.name = other.name;
+    m.robot = true;
+    m.x = one(other.x_column);
+    m.y = one(other.y_column);
+    m.yaw = one(other.yaw_column);
+    m.length_m = other.body_length_m.value_or(0.0);
+    m.width_m = other.body_width_m.value_or(0.0);
+    spec.movers.push_back(std::move(m));
+  }
+  for (const auto& [wx, wy] : r.worker_columns) {
+    ReplaySpec::Mover m;
+    m.name = wx.substr(0, wx.find('.'));
+    m.x = one(wx);
+    m.y = one(wy);
+    // Half the shoulder breadth of an adult man (DIN 33402-2: about 0.48 m,
+    // as people::WorkerUnit's torso).
+    m.radius_m = 0.24;
+    spec.movers.push_back(std::move(m));
   }
   return spec;
 }
@@ -220,6 +243,7 @@ ReplayRecorder::ReplayRecorder(ReplaySpec spec) : spec_(std::move(spec)) {
   last_count_.assign(spec_.lasers.size(), 0.0);
   next_scan_.assign(spec_.lasers.size(), 0);
   scans_.resize(spec_.lasers.size());
+  movers_.resize(spec_.movers.size());
 }
 
 void ReplayRecorder::OnStart(const cosim::Master& master) {
@@ -258,6 +282,12 @@ void ReplayRecorder::OnSample(cosim::TimeNs t, const cosim::System& system) {
       for (std::size_t c = 0; c < curves.size(); ++c) {
         curves_[p][c].push_back(cosim::ReadProbe(system, curves[c].probe));
       }
+    }
+    for (std::size_t m = 0; m < spec_.movers.size(); ++m) {
+      const ReplaySpec::Mover& mover = spec_.movers[m];
+      movers_[m][0].push_back(cosim::ReadProbe(system, mover.x));
+      movers_[m][1].push_back(cosim::ReadProbe(system, mover.y));
+      if (mover.robot) movers_[m][2].push_back(cosim::ReadProbe(system, mover.yaw));
     }
   }
 
@@ -479,6 +509,31 @@ std::string ReplayRecorder::DataJson() const {
       out += '}';
     }
     out += "]}";
+  }
+  out += "],";
+  Key(out, "movers");
+  out += '[';
+  for (std::size_t m = 0; m < spec_.movers.size(); ++m) {
+    const ReplaySpec::Mover& mover = spec_.movers[m];
+    if (m > 0) out += ',';
+    out += '{';
+    Key(out, "name");
+    AppendString(out, mover.name);
+    out += ',';
+    Key(out, "robot");
+    out += mover.robot ? "true," : "false,";
+    Member(out, "length", mover.length_m, kMetres);
+    Member(out, "width", mover.width_m, kMetres);
+    Member(out, "radius", mover.radius_m, kMetres);
+    Key(out, "x");
+    AppendArray(out, movers_[m][0], kMetres);
+    out += ',';
+    Key(out, "y");
+    AppendArray(out, movers_[m][1], kMetres);
+    out += ',';
+    Key(out, "yaw");
+    AppendArray(out, movers_[m][2], kRadians);
+    out += '}';
   }
   out += "],";
   // Ranges in whole millimetres (the S300 and LMS151 report in mm), -1 for

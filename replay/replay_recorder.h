@@ -64,6 +64,15 @@ struct ReplaySpec {
     const sensors::LaserScannerUnit* unit = nullptr;
   };
   std::vector<Laser> lasers;
+  /// What else moves on the floor: a fleet's other robots (a box, with
+  /// yaw) and the workers (a circle of `radius_m`), drawn at their poses.
+  struct Mover {
+    std::string name;
+    bool robot = false;
+    cosim::Probe x, y, yaw;  // yaw: robots only
+    double length_m = 0.0, width_m = 0.0, radius_m = 0.0;
+  };
+  std::vector<Mover> movers;
   ReplayRates rates;
 };
 
@@ -111,6 +120,7 @@ class ReplayRecorder : public cosim::Observer {
   std::vector<double> x_, y_, yaw_;
   std::vector<std::vector<double>> wheel_xy_, wheel_surface_, belt_travel_, belt_on_;
   std::vector<std::vector<std::vector<double>>> curves_;  // [plot][curve][frame]
+  std::vector<std::array<std::vector<double>, 3>> movers_;  // [mover]{x, y, yaw}[frame]
   // Lasers: their last seen scan count, the time after which a scan is
   // kept, and the kept scans.
   std::vector<double> last_count_;

@@ -1,0 +1,70 @@
+// Issue 22: the shipped fleet_line scenario end to end (three robots on
+// ODE and CVODE, every laser casting against the factory, the other robots,
+// the workers and the car bodies; each robot's safety and clearances in
+// the loop), over seeds.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "tests/scenarios/run_scenario.h"
+
+namespace linesim {
+namespace {
+
+using test_scenarios::RunFile;
+using test_scenarios::RunSeeds;
+using test_scenarios::Shipped;
+
+// Guards the fleet's run: over 8 seeds (belt speed variation, laser and
+// flow noise) nobody touches anybody, raw3_a stops for worker_1 and still
+// crosses, raw3_b holds on the running line within paper 1's 4 cm while
+// worker_2 takes a part, and the Husky finishes its floor path.
+// Spread seen (seeds 1..8): every collision count 0; raw3_a
+// protective_stops 1 (7 seeds) to 5 (one stop-and-go in the warning
+// field), min_person_distance_m 0.129 / 0.140 / 0.153 m (min / mean /
+// max), task_time_s 31.80 / 31.84 / 31.88 s; raw3_b max_position_drift_m
+// 5.8 / 6.4 / 7.1 mm; min_robot_distance_m 1.197 m (raw3_a passing
+// raw3_b) and 2.24-2.26 m (the Husky). The bounds asserted are the
+// scenario's success (no contact, a stop, a finished crossing, paper 1's
+// 4 cm hold), not the spread.
+TEST(FleetLine, NobodyTouchesAnybody) {
+  const auto runs = RunSeeds(Shipped("fleet_line"), {}, 8);
+  for (std::size_t i = 0; i < runs.seeds.size(); ++i) {
+    const auto seed = "seed " + std::to_string(runs.seeds[i]);
+    for (const char* robot : {"raw3_a", "raw3_b", "husky"}) {
+      const std::string r = robot;
+      EXPECT_EQ(runs[r + ".collisions"].values[i], 0.0) << r << " " << seed;
+      EXPECT_EQ(runs[r + ".person_collisions"].values[i], 0.0) << r << " " << seed;
+      EXPECT_EQ(runs[r + ".robot_collisions"].values[i], 0.0) << r << " " << seed;
+      EXPECT_GT(runs[r + ".min_robot_distance_m"].values[i], 0.0) << r << " " << seed;
+    }
+    EXPECT_GE(runs["raw3_a.protective_stops"].values[i], 1.0) << seed;
+    EXPECT_GT(runs["raw3_a.task_time_s"].values[i], 0.0) << seed;
+    EXPECT_LT(runs["raw3_b.max_position_drift_m"].values[i], 0.04) << seed;
+    EXPECT_GT(runs["husky.final_progress_m"].values[i], 17.9) << seed;  // of its 18 m path
+  }
+}
+
+// Guards against robots that do not see or touch each other: raw3_b
+// standing in raw3_a's way (beyond the line, at y = 1.9 m). With its S300
+// fields raw3_a stops for raw3_b (a second protective stop, no contact,
+// its front field's depth of clearance left); without them it drives into
+// raw3_b, the pair's collision is counted on both sides and raw3_b is
+// pushed along (its drift over a metre).
+TEST(FleetLine, RobotsSeeAndTouchEachOther) {
+  const std::vector<std::string> in_the_way = {"robots.1.pose.x_m=-0.5", "robots.1.pose.y_m=1.9"};
+  const auto with = RunFile(Shipped("fleet_line"), in_the_way);
+  EXPECT_GE(with.at("raw3_a.protective_stops"), 2.0);
+  EXPECT_EQ(with.at("raw3_a.robot_raw3_b_collisions"), 0.0);
+  EXPECT_GT(with.at("raw3_a.min_robot_distance_m"), 0.1);
+
+  auto without_safety = in_the_way;
+  without_safety.push_back("robots.0.safety.enabled=false");
+  const auto without = RunFile(Shipped("fleet_line"), without_safety);
+  EXPECT_GE(without.at("raw3_a.robot_raw3_b_collisions"), 1.0);
+  EXPECT_GE(without.at("raw3_b.robot_raw3_a_collisions"), 1.0);
+  EXPECT_GT(without.at("raw3_b.max_position_drift_m"), 1.0);
+}
+
+}  // namespace
+}  // namespace linesim
