@@ -217,7 +217,9 @@ bool BodiesOverlap(const RobotInfo& a, const RobotInfo& b) {
 }
 
 // One world: every robot's chassis, lasers and robot clearance see every
-// other robot's body (its chassis' body_box), through connections.
+// other robot's body: the chassis' body_box, gathered by one moving_bodies
+// unit (units/world) into an array each of them reads whole, skipping its
+// own robot's box.
 void ConnectFleet(assembly::SystemBuilder& b, const std::vector<RobotInfo>& robots,
                   const std::vector<std::vector<std::string>>& lasers, YAML::Node metrics,
                   std::vector<std::string>& recorded) {
@@ -229,35 +231,35 @@ void ConnectFleet(assembly::SystemBuilder& b, const std::vector<RobotInfo>& robo
     m["reduce"] = reduce;
     metrics.push_back(m);
   };
-  const auto body_box = [&](const RobotInfo& r) {
-    return assembly::Signal(r.name + "." + assembly::kChassis, "body_box");
-  };
+  const int count = static_cast<int>(robots.size());
+  b.Unit(assembly::kMovingBodies, "moving_bodies");
+  b.Params(assembly::kMovingBodies)["count"] = count;
+  const std::string bodies = assembly::Signal(assembly::kMovingBodies, "bodies");
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    const std::string chassis = robots[i].name + "." + assembly::kChassis;
+    for (std::size_t k = 0; k < kBox; ++k) {
+      b.Connect(assembly::Element(chassis, "body_box", k),
+                assembly::Element(assembly::kMovingBodies, "bodies_in", i * kBox + k));
+    }
+  }
   for (std::size_t i = 0; i < robots.size(); ++i) {
     const std::string& name = robots[i].name;
-    const std::string chassis = name + "." + assembly::kChassis;
     const std::string clearance = name + "." + assembly::kRobotClearance;
-    const int others = static_cast<int>(robots.size()) - 1;
     b.Unit(clearance, "robot_clearance");
-    b.Params(clearance)["others"] = others;
-    b.Connect(body_box(robots[i]), assembly::Signal(clearance, "body_box"));
-    std::vector<std::pair<std::string, std::string>> takers = {{chassis, "moving_boxes"},
-                                                               {clearance, "others"}};
-    for (const auto& laser : lasers[i]) takers.emplace_back(laser, "moving_boxes");
-    for (const auto& [unit, input] : takers) {
-      if (input == "moving_boxes") b.Params(unit)["moving_boxes"] = others;
+    b.Params(clearance)["bodies"] = count;
+    b.Params(clearance)["own"] = static_cast<int>(i);
+    b.Connect(bodies, assembly::Signal(clearance, "bodies"));
+    std::vector<std::string> takers = {name + "." + assembly::kChassis};
+    takers.insert(takers.end(), lasers[i].begin(), lasers[i].end());
+    for (const auto& unit : takers) {
+      b.Params(unit)["moving_boxes"] = count;
+      b.Params(unit)["own_box"] = static_cast<int>(i);
+      b.Connect(bodies, assembly::Signal(unit, "moving_boxes"));
     }
-    std::size_t slot = 0;
     for (std::size_t j = 0; j < robots.size(); ++j) {
       if (j == i) continue;
-      for (std::size_t k = 0; k < kBox; ++k) {
-        for (const auto& [unit, input] : takers) {
-          b.Connect(assembly::Element(robots[j].name + "." + assembly::kChassis, "body_box", k),
-                    assembly::Element(unit, input, slot * kBox + k));
-        }
-      }
       add(name + ".robot_" + robots[j].name + "_collisions",
-          assembly::Element(clearance, "robot_collisions", slot), "final");
-      ++slot;
+          assembly::Element(clearance, "robot_collisions", j), "final");
     }
     add(name + ".min_robot_distance_m", assembly::Signal(clearance, "min_distance"), "final");
     add(name + ".robot_collisions", assembly::Signal(clearance, "collisions"), "final");

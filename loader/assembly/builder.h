@@ -24,6 +24,8 @@ inline constexpr const char* kDeviation = "deviation";
 inline constexpr const char* kClearance = "clearance";
 /// A fleet's robot's distance from the other robots (loader/robot_scenario.cc).
 inline constexpr const char* kRobotClearance = "robot_clearance";
+/// A fleet's robots' bodies in one array (units/world), the scene's: unscoped.
+inline constexpr const char* kMovingBodies = "moving_bodies";
 inline constexpr const char* kFlowError = "flow_error";
 /// The estimators (units/estimation) and the localization's evaluation.
 inline constexpr const char* kSurfaceEstimator = "surface_estimator";

@@ -57,9 +57,10 @@ TEST(FleetAssembly, RobotsAreScopedByTheirNames) {
   EXPECT_TRUE(Connected(s, "belt.velocity", "raw3_b.chassis.belt_velocity"));
 }
 
-// Guards the one world: each robot's chassis, lasers and robot clearance
-// take the two others' bodies (10 numbers each) and the workers' legs and
-// torsos (2 workers x 3 cylinders x 7 numbers).
+// Guards the one world: the moving_bodies unit gathers the three chassis'
+// bodies (10 numbers each); each robot's chassis, lasers and robot
+// clearance read them whole, leaving out their own robot's, and take the
+// workers' legs and torsos (2 workers x 3 cylinders x 7 numbers).
 TEST(FleetAssembly, EveryRobotSeesTheOthersAndTheWorkers) {
   const Scenario s = LoadScenario(Shipped(), {"duration_s=0.1"});
   for (const char* unit : {"raw3_a.chassis", "raw3_a.laser_front", "raw3_a.laser_rear",
@@ -69,13 +70,20 @@ TEST(FleetAssembly, EveryRobotSeesTheOthersAndTheWorkers) {
     const auto cylinders = v.Find("moving_cylinders");
     ASSERT_TRUE(boxes.has_value()) << unit;
     ASSERT_TRUE(cylinders.has_value()) << unit;
-    EXPECT_EQ(v.info(*boxes).size, 20u) << unit;
+    EXPECT_EQ(v.info(*boxes).size, 30u) << unit;
     EXPECT_EQ(v.info(*cylinders).size, 42u) << unit;
   }
-  // raw3_a's slots: raw3_b first, then husky.
-  EXPECT_TRUE(Connected(s, "raw3_b.chassis.body_box[0]", "raw3_a.laser_front.moving_boxes[0]"));
-  EXPECT_TRUE(Connected(s, "husky.chassis.body_box[9]", "raw3_a.chassis.moving_boxes[19]"));
-  EXPECT_TRUE(Connected(s, "raw3_a.chassis.body_box[3]", "husky.robot_clearance.others[3]"));
+  EXPECT_TRUE(Connected(s, "raw3_b.chassis.body_box[0]", "moving_bodies.bodies_in[10]"));
+  EXPECT_TRUE(Connected(s, "husky.chassis.body_box[9]", "moving_bodies.bodies_in[29]"));
+  EXPECT_TRUE(Connected(s, "moving_bodies.bodies", "raw3_a.laser_front.moving_boxes"));
+  EXPECT_TRUE(Connected(s, "moving_bodies.bodies", "husky.chassis.moving_boxes"));
+  EXPECT_TRUE(Connected(s, "moving_bodies.bodies", "husky.robot_clearance.bodies"));
+  const auto own_box = [&](const std::string& unit) {
+    const auto& v = s.system->unit(*s.system->FindUnit(unit)).variables();
+    return v.GetInteger(*v.Find("own_box"));
+  };
+  EXPECT_EQ(own_box("husky.laser_front"), 2);
+  EXPECT_EQ(own_box("raw3_b.chassis"), 1);
   EXPECT_TRUE(Connected(s, "worker_2.cylinders[0]", "husky.laser_front.moving_cylinders[21]"));
 }
 

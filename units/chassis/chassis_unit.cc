@@ -425,8 +425,11 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
             "distance each scene belt's surface has moved since t = 0 (places carried objects)");
   }
   if (!moving_boxes_.empty()) {
+    v.Parameter("own_box", &own_box_,
+                "the box of moving_boxes that is this robot's own body (left out); -1: none",
+                cosim::Rule::Range(-1, 10000));
     v.Input("moving_boxes", "m, rad, m/s, rad/s", &moving_boxes_,
-            "per moving box (another robot's body: its chassis' body_box) [x, y, yaw, vx, vy, "
+            "per moving box (a robot's body: its chassis' body_box) [x, y, yaw, vx, vy, "
             "yaw_rate, length, width, z_bottom, z_top] in map; the body collides with them");
   }
   if (!moving_cylinders_.empty()) {
@@ -917,7 +920,7 @@ void ChassisUnit::SetBeltInputs() {
     f.SetBeltTravel(k, belt_travel_[kk]);
   }
   if (!moving_boxes_.empty() || !moving_cylinders_.empty()) {
-    f.SetMovingSolids(moving_boxes_, moving_cylinders_);
+    f.SetMovingSolids(moving_boxes_, moving_cylinders_, static_cast<int>(own_box_));
   }
 }
 

@@ -201,6 +201,7 @@ class ChassisUnit : public cosim::Unit {
   // Inputs.
   std::vector<double> steer_torque_, drive_torque_, belt_velocity_, belt_travel_;
   std::vector<double> moving_boxes_, moving_cylinders_;
+  std::int64_t own_box_ = -1;
   bool brake_ = false;
 
   // Outputs.

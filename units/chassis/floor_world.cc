@@ -319,7 +319,8 @@ void FloorWorld::CollideObjects(double erp, double cfm) {
 }
 
 void FloorWorld::SetMovingSolids(std::span<const double> boxes,
-                                 std::span<const double> cylinders) {
+                                 std::span<const double> cylinders, int own_box) {
+  own_box_ = own_box;
   using models::MovingBox;
   using models::MovingCylinder;
   const std::size_t nb = boxes.size() / MovingBox::kValues;
@@ -343,7 +344,7 @@ void FloorWorld::CollideMoving(dGeomID body_geom, const Aabb& body) {
     const double* m = moving_boxes_.data() + i * MovingBox::kValues;
     const double length = m[MovingBox::kLength], width = m[MovingBox::kWidth];
     const double z0 = m[MovingBox::kZBottom], z1 = m[MovingBox::kZTop];
-    if (!(length > 0.0 && width > 0.0 && z1 > z0)) continue;
+    if (!(length > 0.0 && width > 0.0 && z1 > z0) || static_cast<int>(i) == own_box_) continue;
     const double x = m[MovingBox::kX] + m[MovingBox::kVx] * t;
     const double y = m[MovingBox::kY] + m[MovingBox::kVy] * t;
     const double r = 0.5 * std::hypot(length, width);

@@ -225,7 +225,9 @@ class FloorWorld {
   /// says), collided with the body geoms when the AABBs overlap, its
   /// contacts moving with it. The count follows the spans' sizes; a box of
   /// length 0 is absent.
-  void SetMovingSolids(std::span<const double> boxes, std::span<const double> cylinders);
+  /// Box `own_box` (the robot's own body; -1: none) is left out.
+  void SetMovingSolids(std::span<const double> boxes, std::span<const double> cylinders,
+                       int own_box = -1);
 
   /// Surface of the floor plane at map point (x, y): 0 floor, k + 1 for the
   /// first belt k that contains it (edges included). (A contact on terrain
@@ -338,6 +340,7 @@ class FloorWorld {
   std::vector<dGeomID> moving_box_geoms_, moving_cylinder_geoms_;
   std::vector<double> moving_boxes_, moving_cylinders_;
   double moving_elapsed_s_ = 0.0;
+  int own_box_ = -1;
   std::vector<double> belt_travel_m_;
   // Time since the last SetBeltTravel (substeps of one step).
   double travel_elapsed_s_ = 0.0;

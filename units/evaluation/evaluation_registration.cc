@@ -17,8 +17,8 @@ std::unique_ptr<cosim::Unit> MakePathDeviation(const UnitBuildContext& c) {
 }
 
 std::unique_ptr<cosim::Unit> MakeRobotClearance(const UnitBuildContext& c) {
-  const auto others = c.reader.Integer(c.parameters, c.path, "others", 1, 1, 10000);
-  return std::make_unique<RobotClearanceUnit>(c.name, static_cast<int>(others));
+  const auto bodies = c.reader.Integer(c.parameters, c.path, "bodies", 2, 2, 10000);
+  return std::make_unique<RobotClearanceUnit>(c.name, static_cast<int>(bodies));
 }
 
 const config::UnitTypeRegistrar kRobotClearance(
@@ -26,7 +26,8 @@ const config::UnitTypeRegistrar kRobotClearance(
      "distance of a robot's body from the other robots' bodies in a fleet, and robot-robot "
      "contacts counted as collisions (per pair)",
      "",
-     {{"others", "number of other robots (the input `others` holds 10 numbers each; default 1)"}},
+     {{"bodies", "number of robots in the fleet, this one included (the input `bodies` holds 10 "
+                 "numbers each; default 2)"}},
      MakeRobotClearance});
 
 const config::UnitTypeRegistrar kPathDeviation(

@@ -15,26 +15,33 @@ using models::MovingBox;
 
 using Corners = std::array<std::array<double, 2>, 4>;
 
-Corners CornersOf(const double* box) {
-  const double c = std::cos(box[MovingBox::kYaw]), s = std::sin(box[MovingBox::kYaw]);
-  const double hx = 0.5 * box[MovingBox::kLength], hy = 0.5 * box[MovingBox::kWidth];
-  Corners out;
-  const double signs[4][2] = {{1, 1}, {-1, 1}, {-1, -1}, {1, -1}};
-  for (std::size_t k = 0; k < 4; ++k) {
-    const double x = signs[k][0] * hx, y = signs[k][1] * hy;
-    out[k] = {box[MovingBox::kX] + c * x - s * y, box[MovingBox::kY] + s * x + c * y};
-  }
-  return out;
-}
+// A footprint with its yaw's cos and sin (taken once).
+struct Footprint {
+  explicit Footprint(const double* box)
+      : x(box[MovingBox::kX]),
+        y(box[MovingBox::kY]),
+        c(std::cos(box[MovingBox::kYaw])),
+        s(std::sin(box[MovingBox::kYaw])),
+        hx(0.5 * box[MovingBox::kLength]),
+        hy(0.5 * box[MovingBox::kWidth]) {}
+  double x, y, c, s, hx, hy;
 
-// Distance of point p from the footprint of `box` (0 inside).
-double PointToBox(const std::array<double, 2>& p, const double* box) {
-  const double c = std::cos(box[MovingBox::kYaw]), s = std::sin(box[MovingBox::kYaw]);
-  const double dx = p[0] - box[MovingBox::kX], dy = p[1] - box[MovingBox::kY];
-  const double x = std::abs(c * dx + s * dy) - 0.5 * box[MovingBox::kLength];
-  const double y = std::abs(-s * dx + c * dy) - 0.5 * box[MovingBox::kWidth];
-  return std::hypot(std::max(x, 0.0), std::max(y, 0.0));
-}
+  Corners CornersOf() const {
+    Corners out;
+    const double signs[4][2] = {{1, 1}, {-1, 1}, {-1, -1}, {1, -1}};
+    for (std::size_t k = 0; k < 4; ++k) {
+      const double px = signs[k][0] * hx, py = signs[k][1] * hy;
+      out[k] = {x + c * px - s * py, y + s * px + c * py};
+    }
+    return out;
+  }
+  // Distance of point p from the footprint (0 inside).
+  double DistanceTo(const std::array<double, 2>& p) const {
+    const double dx = p[0] - x, dy = p[1] - y;
+    const double ex = std::abs(c * dx + s * dy) - hx, ey = std::abs(-s * dx + c * dy) - hy;
+    return std::hypot(std::max(ex, 0.0), std::max(ey, 0.0));
+  }
+};
 
 // Whether the footprints' projections on the axis (ux, uy) are disjoint.
 bool Separates(const Corners& a, const Corners& b, double ux, double uy) {
@@ -50,26 +57,27 @@ bool Separates(const Corners& a, const Corners& b, double ux, double uy) {
 }  // namespace
 
 double RobotClearanceUnit::FootprintDistance(const double* a, const double* b) {
-  const Corners ca = CornersOf(a), cb = CornersOf(b);
-  bool separated = false;
-  for (const double* box : {a, b}) {
-    const double c = std::cos(box[MovingBox::kYaw]), s = std::sin(box[MovingBox::kYaw]);
-    separated = separated || Separates(ca, cb, c, s) || Separates(ca, cb, -s, c);
-  }
+  const Footprint fa(a), fb(b);
+  // Far apart (centres further than the half diagonals): the corners
+  // decide without the separating axes.
+  const double reach = std::hypot(fa.hx, fa.hy) + std::hypot(fb.hx, fb.hy);
+  const Corners ca = fa.CornersOf(), cb = fb.CornersOf();
+  const bool separated = std::hypot(fb.x - fa.x, fb.y - fa.y) > reach ||
+                         Separates(ca, cb, fa.c, fa.s) || Separates(ca, cb, -fa.s, fa.c) ||
+                         Separates(ca, cb, fb.c, fb.s) || Separates(ca, cb, -fb.s, fb.c);
   if (!separated) return 0.0;
   double best = std::numeric_limits<double>::max();
   for (std::size_t k = 0; k < 4; ++k) {
-    best = std::min({best, PointToBox(ca[k], b), PointToBox(cb[k], a)});
+    best = std::min({best, fb.DistanceTo(ca[k]), fa.DistanceTo(cb[k])});
   }
   return best;
 }
 
-RobotClearanceUnit::RobotClearanceUnit(std::string name, int others)
-    : cosim::Unit(kTypeName, std::move(name)), others_(others) {
-  if (others_ < 1) throw cosim::UnitError(Where() + ": needs at least one other robot");
-  const auto n = static_cast<std::size_t>(others_);
-  body_box_.assign(MovingBox::kValues, 0.0);
-  others_boxes_.assign(n * MovingBox::kValues, 0.0);
+RobotClearanceUnit::RobotClearanceUnit(std::string name, int bodies)
+    : cosim::Unit(kTypeName, std::move(name)), bodies_(bodies) {
+  if (bodies_ < 2) throw cosim::UnitError(Where() + ": needs at least two robots");
+  const auto n = static_cast<std::size_t>(bodies_);
+  boxes_.assign(n * MovingBox::kValues, 0.0);
   robot_distance_.assign(n, 0.0);
   robot_collisions_.assign(n, 0.0);
   contact_before_.assign(n, 0);
@@ -78,27 +86,36 @@ RobotClearanceUnit::RobotClearanceUnit(std::string name, int others)
               "bodies closer than this are in contact (the gap two pushing bodies keep: their "
               "relative speed times the master step)",
               cosim::Rule::NonNegative());
-  v.Input("body_box", "m, rad, m/s, rad/s", &body_box_,
-          "this robot's body (its chassis' body_box: [x, y, yaw, vx, vy, yaw_rate, length, "
-          "width, z_bottom, z_top] in map)");
-  v.Input("others", "m, rad, m/s, rad/s", &others_boxes_,
-          "the other robots' bodies (their chassis' body_box), one after another");
+  v.Parameter("own", &own_, "index of this robot's body in `bodies`",
+              cosim::Rule::Range(0, static_cast<double>(bodies_ - 1)));
+  v.Input("bodies", "m, rad, m/s, rad/s", &boxes_,
+          "every robot's body (its chassis' body_box: [x, y, yaw, vx, vy, yaw_rate, length, "
+          "width, z_bottom, z_top] in map), one after another");
   v.Output("distance", "m", &distance_, "distance from the body to the nearest other robot",
            {});
   v.Output("min_distance", "m", &min_distance_, "smallest distance so far", {});
-  v.Output("nearest", "1", &nearest_, "index of the nearest other robot (-1: none)", {});
+  v.Output("nearest", "1", &nearest_, "index in `bodies` of the nearest other robot (-1: none)",
+           {});
   v.Output("collisions", "1", &collisions_, "robot-robot contact events so far", {});
-  v.Output("robot_distance", "m", &robot_distance_, "distance to each other robot", {});
+  v.Output("robot_distance", "m", &robot_distance_,
+           "distance to each robot of `bodies` (-1 for its own)", {});
   v.Output("robot_collisions", "1", &robot_collisions_,
-           "contact events with each other robot so far (the pair this robot - robot k)", {});
+           "contact events with each robot of `bodies` so far (the pair this robot - robot k)",
+           {});
 }
 
 void RobotClearanceUnit::Evaluate() {
-  const double* own = body_box_.data();
+  const auto self = static_cast<std::size_t>(own_);
+  const double* own = boxes_.data() + self * MovingBox::kValues;
   distance_ = std::numeric_limits<double>::max();
   nearest_ = -1.0;
-  for (std::size_t k = 0; k < static_cast<std::size_t>(others_); ++k) {
-    const double* other = others_boxes_.data() + k * MovingBox::kValues;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(bodies_); ++k) {
+    if (k == self) {
+      robot_distance_[k] = -1.0;
+      contact_before_[k] = 0;
+      continue;
+    }
+    const double* other = boxes_.data() + k * MovingBox::kValues;
     const bool absent = !(other[MovingBox::kLength] > 0.0 && other[MovingBox::kWidth] > 0.0);
     const bool apart_in_height = other[MovingBox::kZTop] < own[MovingBox::kZBottom] ||
                                  other[MovingBox::kZBottom] > own[MovingBox::kZTop];

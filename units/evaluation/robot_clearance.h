@@ -13,8 +13,9 @@ namespace linesim::evaluation {
 /// a fleet, and robot-robot contacts counted as collisions, per pair.
 ///
 /// Each body is its chassis' `body_box` (models::MovingBox: a box yawed
-/// about the vertical, with the heights it spans): this robot's (`body_box`)
-/// and the others' (`others`, one after another). Two boxes whose height
+/// about the vertical, with the heights it spans), all of the fleet's in
+/// `bodies` (world::MovingBodiesUnit's), this robot's at index `own`. Two
+/// boxes whose height
 /// ranges overlap are at the distance of their footprint rectangles (0 when
 /// the rectangles overlap: separating axes; otherwise, for two disjoint
 /// convex polygons, the smallest distance of a corner of one from the
@@ -25,13 +26,15 @@ namespace linesim::evaluation {
 /// up to their relative speed times the master step (1 m/s x 5 ms; 0.65 mm
 /// measured for a 0.5 m/s push at 5 ms, where the footprints never touch).
 /// A collision is one contact event (in contact now, not at the previous step), counted
-/// per other robot (`robot_collisions`: the pair this robot - robot k) and
+/// per robot of `bodies` (`robot_collisions`: the pair this robot - robot k;
+/// its own entry stays 0) and
 /// in all (`collisions`). Each of the pair's units counts it, once each.
 class RobotClearanceUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "robot_clearance";
 
-  RobotClearanceUnit(std::string name, int others);
+  /// `bodies` robots in the fleet (at least 2).
+  RobotClearanceUnit(std::string name, int bodies);
 
   void Initialize() override;
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
@@ -47,14 +50,15 @@ class RobotClearanceUnit : public cosim::Unit {
  private:
   void Evaluate();
 
-  int others_;
+  int bodies_;
   double contact_distance_ = 0.005;
+  std::int64_t own_ = 0;
   // Inputs.
-  std::vector<double> body_box_, others_boxes_;
+  std::vector<double> boxes_;
   // Outputs.
   double distance_ = 0.0, min_distance_ = 0.0, nearest_ = -1.0, collisions_ = 0.0;
   std::vector<double> robot_distance_, robot_collisions_;
-  // State: per other robot, in contact at the last step.
+  // State: per robot, in contact at the last step.
   std::vector<std::uint8_t> contact_before_;
 };
 

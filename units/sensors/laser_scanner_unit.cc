@@ -194,8 +194,11 @@ LaserScannerUnit::LaserScannerUnit(std::string name, const models::Scene& scene,
             "z_top] in map");
   }
   if (!moving_boxes_.empty()) {
+    v.Parameter("own_box", &own_box_,
+                "the box of moving_boxes that is the scanner's own robot (not seen); -1: none",
+                cosim::Rule::Range(-1, 100000));
     v.Input("moving_boxes", "m, rad, m/s, rad/s", &moving_boxes_,
-            "per moving box (another robot's body, its chassis' body_box) [x, y, yaw, vx, vy, "
+            "per moving box (a robot's body, its chassis' body_box) [x, y, yaw, vx, vy, "
             "yaw_rate, length, width, z_bottom, z_top] in map");
   }
   v.Output("ranges", "m", &ranges_,
@@ -432,7 +435,8 @@ void LaserScannerUnit::CastBeams(int first, int end, cosim::TimeNs t) {
     BeamRay(i, step_s_[k], step_sin_[k], step_vers_[k]);
   }
   rays_.Cast(std::span<const Ray>(beam_rays_.data() + first, n),
-             std::span<RayHit>(centre_.data() + first, n), belt_travel_, belt_speed_, moving_, moving_boxes_);
+             std::span<RayHit>(centre_.data() + first, n), belt_travel_, belt_speed_, moving_, moving_boxes_,
+             static_cast<int>(own_box_));
   for (int i = first; i < end; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const RayHit& h = centre_[k];
@@ -457,7 +461,8 @@ void LaserScannerUnit::CastBeams(int first, int end, cosim::TimeNs t) {
   if (edges > 0) {
     const auto m = 4 * static_cast<std::size_t>(edges);
     rays_.Cast(std::span<const Ray>(edge_rays_.data(), m), std::span<RayHit>(edge_hits_.data(), m),
-               belt_travel_, belt_speed_, moving_, moving_boxes_);
+               belt_travel_, belt_speed_, moving_, moving_boxes_,
+             static_cast<int>(own_box_));
     for (int e = 0; e < edges; ++e) {
       ApplyEdge(edge_beam_[static_cast<std::size_t>(e)], &edge_hits_[4 * static_cast<std::size_t>(e)]);
     }

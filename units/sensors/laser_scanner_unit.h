@@ -170,6 +170,7 @@ class LaserScannerUnit : public cosim::Unit {
   // Inputs.
   std::vector<double> position_, orientation_, velocity_, angular_velocity_, belt_travel_,
       belt_speed_, moving_, moving_boxes_;
+  std::int64_t own_box_ = -1;
   // Outputs.
   std::vector<double> ranges_;
   double scan_time_ = 0.0, scan_count_ = 0.0, field_clear_ = 1.0;

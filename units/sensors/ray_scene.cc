@@ -357,77 +357,116 @@ void RayScene::IntersectLaneOf(unsigned prim, unsigned lane_index, float& tfar) 
   }
 }
 
-int RayScene::CullCarried(std::span<const Ray> rays, std::span<const double> belt_travel,
-                          std::span<const double> belt_speed) {
-  // The bundle, in one pass over the rays: apex a the middle ray's origin,
-  // axis the bisector of the first and last rays' directions (any apex and
-  // axis bound the rays: the half angle is the widest ray from the axis and
-  // rho the farthest origin from a), times in [s0, s1].
+RayScene::Bundle RayScene::Bundle::Of(std::span<const Ray> rays) {
+  // In one pass over the rays: apex a the middle ray's origin, axis the
+  // bisector of the first and last rays' directions (any apex and axis
+  // bound the rays: the half angle is the widest ray from the axis and rho
+  // the farthest origin from a), times in [s0, s1].
+  Bundle b;
   const Ray& mid = rays[rays.size() / 2];
-  const double a[3] = {mid.origin[0], mid.origin[1], mid.origin[2]};
-  double ax[3] = {rays.front().direction[0] + rays.back().direction[0],
-                  rays.front().direction[1] + rays.back().direction[1],
-                  rays.front().direction[2] + rays.back().direction[2]};
-  const double axn = std::sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+  for (int i = 0; i < 3; ++i) {
+    b.a[i] = mid.origin[static_cast<std::size_t>(i)];
+    b.ax[i] = rays.front().direction[static_cast<std::size_t>(i)] +
+              rays.back().direction[static_cast<std::size_t>(i)];
+  }
+  const double axn = std::sqrt(b.ax[0] * b.ax[0] + b.ax[1] * b.ax[1] + b.ax[2] * b.ax[2]);
   const bool cone = axn > 1e-6;
   if (cone) {
     // (Not exactly unit after the reciprocal's rounding: the cone's 1e-6
     // widening below covers that.)
     const double inv = 1.0 / axn;
-    for (double& x : ax) x *= inv;
+    for (double& x : b.ax) x *= inv;
   }
-  double s0 = rays[0].dt_s, s1 = rays[0].dt_s, t_far = 0.0;
-  // The heights the rays pass through within their reach.
-  double z_lo = kInf, z_hi = -kInf;
+  double s0 = rays[0].dt_s, s1 = rays[0].dt_s;
   double cos_th = 1.0, rho = 0.0;
   for (const Ray& r : rays) {
     const double z_end = r.origin[2] + r.max_range * r.direction[2];
-    z_lo = std::min(z_lo, std::min(r.origin[2], z_end));
-    z_hi = std::max(z_hi, std::max(r.origin[2], z_end));
+    b.z_lo = std::min(b.z_lo, std::min(r.origin[2], z_end));
+    b.z_hi = std::max(b.z_hi, std::max(r.origin[2], z_end));
     s0 = std::min(s0, r.dt_s);
     s1 = std::max(s1, r.dt_s);
-    t_far = std::max(t_far, r.max_range);
-    const double dx = r.origin[0] - a[0], dy = r.origin[1] - a[1], dz = r.origin[2] - a[2];
+    b.t_far = std::max(b.t_far, r.max_range);
+    const double dx = r.origin[0] - b.a[0], dy = r.origin[1] - b.a[1], dz = r.origin[2] - b.a[2];
     rho = std::max(rho, dx * dx + dy * dy + dz * dz);
-    cos_th = std::min(cos_th, ax[0] * r.direction[0] + ax[1] * r.direction[1] +
-                                  ax[2] * r.direction[2]);
+    cos_th = std::min(cos_th, b.ax[0] * r.direction[0] + b.ax[1] * r.direction[1] +
+                                  b.ax[2] * r.direction[2]);
   }
-  rho = std::sqrt(rho);
+  b.rho = std::sqrt(rho);
   // Rounding of the unit directions: only ever widens the cone.
-  cos_th = cone ? cos_th - 1e-6 : -1.0;
-  const double sin_th = std::sqrt(std::max(0.0, 1.0 - cos_th * cos_th));
-  const double s_mid = 0.5 * (s0 + s1), s_half = 0.5 * (s1 - s0);
-  const double z_pad = 1e-9 * (1.0 + std::abs(z_lo) + std::abs(z_hi));
+  b.cos_th = cone ? cos_th - 1e-6 : -1.0;
+  b.sin_th = std::sqrt(std::max(0.0, 1.0 - b.cos_th * b.cos_th));
+  b.s_mid = 0.5 * (s0 + s1);
+  b.s_half = 0.5 * (s1 - s0);
+  b.z_pad = 1e-9 * (1.0 + std::abs(b.z_lo) + std::abs(b.z_hi));
+  return b;
+}
+
+bool RayScene::Bundle::MayMeet(double cx, double cy, double cz, double radius, double z_bottom,
+                               double z_top) const {
+  // Above or below all the rays (a level scan under a car body).
+  if (z_bottom > z_hi + z_pad || z_top < z_lo - z_pad) return false;
+  const double r = (radius + rho) * (1.0 + 1e-9) + 1e-9;
+  if (cos_th < 0.0) return true;
+  const double vx = cx - a[0], vy = cy - a[1], vz = cz - a[2];
+  const double l2 = vx * vx + vy * vy + vz * vz;
+  if (l2 <= r * r) return true;
+  // Beyond the rays' reach, or off the cone by more than the sphere's
+  // angular radius b (sin b = r / L): cos(angle to the axis) < cos(th + b)
+  // = (cos th sqrt(L^2 - r^2) - sin th r) / L.
+  const double t = t_far + r;
+  if (l2 > t * t) return false;
+  // Without the square root: along + sin th r < cos th sqrt(L^2 - r^2)
+  // (both sides' signs known: cos th >= 0).
+  const double lhs = (vx * ax[0] + vy * ax[1] + vz * ax[2]) + sin_th * r;
+  return !(lhs < 0.0 || lhs * lhs < cos_th * cos_th * (l2 - r * r));
+}
+
+int RayScene::CullCarried(const Bundle& bundle, std::span<const double> belt_travel,
+                          std::span<const double> belt_speed) {
   int n = 0;
   for (std::size_t i = 0; i < carried_.size(); ++i) {
     const Carried& c = carried_[i];
-    // Above or below all the rays (a level scan under a car body).
-    if (c.solid.bottom_m > z_hi + z_pad || c.solid.bottom_m + c.solid.height_m < z_lo - z_pad) {
-      continue;
-    }
     const auto b = static_cast<std::size_t>(c.belt);
-    const double travel = belt_travel[b] + belt_speed[b] * s_mid;
-    const double sweep = std::abs(belt_speed[b]) * s_half;
+    const double travel = belt_travel[b] + belt_speed[b] * bundle.s_mid;
+    const double sweep = std::abs(belt_speed[b]) * bundle.s_half;
     // Lifted off over all the bundle's times.
     if (travel + sweep < c.travel_min || travel - sweep > c.travel_max) continue;
-    const double r = (c.sphere_radius + sweep + rho) * (1.0 + 1e-9) + 1e-9;
-    if (cos_th >= 0.0) {
-      const double vx = c.solid.x_m + travel * c.ux - a[0], vy = c.solid.y_m + travel * c.uy - a[1],
-                   vz = c.center_z - a[2];
-      const double l2 = vx * vx + vy * vy + vz * vz;
-      if (l2 > r * r) {
-        // Beyond the rays' reach, or off the cone by more than the
-        // sphere's angular radius b (sin b = r / L): cos(angle to the
-        // axis) < cos(th + b) = (cos th sqrt(L^2 - r^2) - sin th r) / L.
-        const double t = t_far + r;
-        if (l2 > t * t) continue;
-        // Without the square root: along + sin th r < cos th sqrt(L^2 - r^2)
-        // (both sides' signs known: cos th >= 0).
-        const double lhs = (vx * ax[0] + vy * ax[1] + vz * ax[2]) + sin_th * r;
-        if (lhs < 0.0 || lhs * lhs < cos_th * cos_th * (l2 - r * r)) continue;
-      }
+    if (!bundle.MayMeet(c.solid.x_m + travel * c.ux, c.solid.y_m + travel * c.uy, c.center_z,
+                        c.sphere_radius + sweep, c.solid.bottom_m,
+                        c.solid.bottom_m + c.solid.height_m)) {
+      continue;
     }
     candidates_[static_cast<std::size_t>(n++)] = static_cast<int>(i);
+  }
+  return n;
+}
+
+int RayScene::CullMovingBoxes(const Bundle& bundle, std::span<const double> boxes, int own_box) {
+  using models::MovingBox;
+  const std::size_t count = boxes.size() / MovingBox::kValues;
+  if (box_candidates_.size() < count) {  // once per size
+    box_candidates_.resize(count);
+    box_trig_.resize(count);
+    box_radius_.resize(count);
+  }
+  int n = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double* m = boxes.data() + i * MovingBox::kValues;
+    const double length = m[MovingBox::kLength], width = m[MovingBox::kWidth];
+    const double z0 = m[MovingBox::kZBottom], z1 = m[MovingBox::kZTop];
+    if (!(length > 0.0 && width > 0.0 && z1 > z0)) continue;  // absent
+    if (static_cast<int>(i) == own_box) continue;
+    const double sweep = std::hypot(m[MovingBox::kVx], m[MovingBox::kVy]) * bundle.s_half;
+    const double radius = 0.5 * std::sqrt(length * length + width * width + (z1 - z0) * (z1 - z0));
+    if (!bundle.MayMeet(m[MovingBox::kX] + m[MovingBox::kVx] * bundle.s_mid,
+                        m[MovingBox::kY] + m[MovingBox::kVy] * bundle.s_mid, 0.5 * (z0 + z1),
+                        radius + sweep, z0, z1)) {
+      continue;
+    }
+    box_candidates_[static_cast<std::size_t>(n++)] = static_cast<int>(i);
+    box_trig_[i] = {std::cos(m[MovingBox::kYaw]), std::sin(m[MovingBox::kYaw])};
+    // Its bounding sphere, padded for rounding (the exact test decides).
+    box_radius_[i] = radius * (1.0 + 1e-9) + 1e-9;
   }
   return n;
 }
@@ -500,26 +539,41 @@ void RayScene::CastMoving(const Ray& ray, std::span<const double> moving, RayHit
   }
 }
 
-void RayScene::CastMovingBoxes(const Ray& ray, std::span<const double> boxes, int first_object,
+void RayScene::CastMovingBoxes(const Ray& ray, std::span<const double> boxes,
+                               std::span<const int> candidates, int first_object,
                                RayHit& best) const {
   using models::MovingBox;
-  const std::size_t count = boxes.size() / MovingBox::kValues;
-  for (std::size_t i = 0; i < count; ++i) {
-    const double* m = boxes.data() + i * MovingBox::kValues;
-    const double length = m[MovingBox::kLength], width = m[MovingBox::kWidth];
+  for (const int i : candidates) {
+    const double* m = boxes.data() + static_cast<std::size_t>(i) * MovingBox::kValues;
     const double z0 = m[MovingBox::kZBottom], z1 = m[MovingBox::kZTop];
-    if (!(length > 0.0 && width > 0.0 && z1 > z0)) continue;  // absent
     const double t_max = std::isinf(best.range) ? ray.max_range : best.range;
-    const double yaw = m[MovingBox::kYaw] + m[MovingBox::kYawRate] * ray.dt_s;
+    const double cx = m[MovingBox::kX] + m[MovingBox::kVx] * ray.dt_s;
+    const double cy = m[MovingBox::kY] + m[MovingBox::kVy] * ray.dt_s;
+    const double cz = 0.5 * (z0 + z1);
+    // The box's bounding sphere first (a group's cone is wider than the
+    // box: most of its rays pass by): off the ray's line, behind its origin
+    // or beyond t_max, the box cannot be met.
+    {
+      const double r = box_radius_[static_cast<std::size_t>(i)];
+      const double vx = cx - ray.origin[0], vy = cy - ray.origin[1], vz = cz - ray.origin[2];
+      const double along = vx * ray.direction[0] + vy * ray.direction[1] + vz * ray.direction[2];
+      const double off2 = vx * vx + vy * vy + vz * vz - along * along;
+      if (off2 > r * r || along < -r || along - r > t_max) continue;
+    }
+    // The yaw at the ray's time: the box's cos and sin (once per group of
+    // rays, box_trig_) turned by a = yaw_rate dt through its series (|a| <
+    // 0.1 rad within a scan: the terms left out are below 1e-8 rad).
+    const double a = m[MovingBox::kYawRate] * ray.dt_s, a2 = a * a;
+    const double ca = 1.0 - a2 / 2.0 + a2 * a2 / 24.0, sa = a * (1.0 - a2 / 6.0 + a2 * a2 / 120.0);
+    const auto& cs = box_trig_[static_cast<std::size_t>(i)];
     double n[3] = {0.0, 0.0, 0.0};
-    const double t = IntersectYawedBox(
-        m[MovingBox::kX] + m[MovingBox::kVx] * ray.dt_s,
-        m[MovingBox::kY] + m[MovingBox::kVy] * ray.dt_s, 0.5 * (z0 + z1), 0.5 * length,
-        0.5 * width, 0.5 * (z1 - z0), std::cos(yaw), std::sin(yaw), ray.origin.data(),
-        ray.direction.data(), t_max, n);
+    const double t = IntersectYawedBox(cx, cy, cz, 0.5 * m[MovingBox::kLength],
+                                       0.5 * m[MovingBox::kWidth], 0.5 * (z1 - z0),
+                                       cs[0] * ca - cs[1] * sa, cs[1] * ca + cs[0] * sa,
+                                       ray.origin.data(), ray.direction.data(), t_max, n);
     if (t < t_max) {
       best.range = t;
-      best.object = ObjectOfMoving(first_object + static_cast<int>(i));
+      best.object = ObjectOfMoving(first_object + i);
       best.cos_incidence = std::abs(n[0] * ray.direction[0] + n[1] * ray.direction[1] +
                                     n[2] * ray.direction[2]);
     }
@@ -528,7 +582,8 @@ void RayScene::CastMovingBoxes(const Ray& ray, std::span<const double> boxes, in
 
 void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
                     std::span<const double> belt_travel, std::span<const double> belt_speed,
-                    std::span<const double> moving, std::span<const double> moving_boxes) {
+                    std::span<const double> moving, std::span<const double> moving_boxes,
+                    int own_box) {
   const int cylinders = static_cast<int>(moving.size() / kMovingValues);
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
@@ -539,7 +594,7 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
   // AVX2 and AVX-512 kernels but not SSE: walls vanished on some machines
   // (tests/units/sensors/ray_scene_test.cc catches it).
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-  int candidates = 0;
+  int candidates = 0, box_count = 0;
   for (std::size_t first = 0; first < rays.size();) {
     const std::size_t count =
         rays.size() - first >= 16 ? 16 : std::min<std::size_t>(8, rays.size() - first);
@@ -557,13 +612,11 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
     // The carried objects are culled once per group of kCullGroup rays (a
     // 1 ms step's beams are one group): a group's cone is a few degrees
     // wide, and the cull's fixed cost is paid once instead of per packet.
-    if (first % kCullGroup == 0) {
-      candidates =
-          carried_.empty()
-              ? 0
-              : CullCarried(
-                    rays.subspan(first, std::min<std::size_t>(kCullGroup, rays.size() - first)),
-                    belt_travel, belt_speed);
+    if (first % kCullGroup == 0 && (!carried_.empty() || !moving_boxes.empty())) {
+      const Bundle bundle = Bundle::Of(
+          rays.subspan(first, std::min<std::size_t>(kCullGroup, rays.size() - first)));
+      candidates = carried_.empty() ? 0 : CullCarried(bundle, belt_travel, belt_speed);
+      box_count = moving_boxes.empty() ? 0 : CullMovingBoxes(bundle, moving_boxes, own_box);
     }
     for (std::size_t k = 0; k < count; ++k) {
       RayHit& h = hits[first + k];
@@ -574,7 +627,12 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
                     belt_travel, belt_speed, h);
       }
       if (!moving.empty()) CastMoving(packet_rays[k], moving, h);
-      if (!moving_boxes.empty()) CastMovingBoxes(packet_rays[k], moving_boxes, cylinders, h);
+      if (box_count > 0) {
+        CastMovingBoxes(packet_rays[k], moving_boxes,
+                        std::span<const int>(box_candidates_.data(),
+                                             static_cast<std::size_t>(box_count)),
+                        cylinders, h);
+      }
     }
     first += count;
   }

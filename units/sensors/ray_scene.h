@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -84,12 +85,13 @@ class RayScene {
   /// moving things (workers' legs and torsos), each a vertical cylinder at
   /// (x + vx dt_s, y + vy dt_s) when a ray is cast, intersected exactly
   /// after the static and carried objects (no culling: a few cylinders).
-  /// `moving_boxes` (models::MovingBox values: other robots' bodies) the
-  /// same, each a yawed box at its pose moved on by its velocity and yaw
-  /// rate to the ray's time.
+  /// `moving_boxes` (models::MovingBox values: robots' bodies) the same,
+  /// each a yawed box at its pose moved on by its velocity and yaw rate to
+  /// the ray's time, except box `own_box` (the scanner's own robot; -1:
+  /// none).
   void Cast(std::span<const Ray> rays, std::span<RayHit> hits, std::span<const double> belt_travel,
             std::span<const double> belt_speed, std::span<const double> moving = {},
-            std::span<const double> moving_boxes = {});
+            std::span<const double> moving_boxes = {}, int own_box = -1);
 
   int ObjectOfObstacle(int i) const { return 1 + i; }
   int ObjectOfTerrain(int i) const { return 1 + obstacle_count_ + i; }
@@ -155,18 +157,35 @@ class RayScene {
   void CastCarried(const Ray& ray, std::span<const int> candidates,
                    std::span<const double> belt_travel, std::span<const double> belt_speed,
                    RayHit& best) const;
-  /// The carried objects a bundle of rays may meet (into candidates_):
-  /// their bounding spheres, where their belts put them over the rays'
-  /// times, against a cone from the middle ray's origin about the first
-  /// and last rays' bisector that holds all their directions, widened by
-  /// the origins' spread. Returns the count.
   /// The moving cylinders met before `best` (updated in place).
   void CastMoving(const Ray& ray, std::span<const double> moving, RayHit& best) const;
-  /// The moving boxes met before `best` (updated in place); box i is object
-  /// ObjectOfMoving(first_object + i).
-  void CastMovingBoxes(const Ray& ray, std::span<const double> boxes, int first_object,
-                       RayHit& best) const;
-  int CullCarried(std::span<const Ray> rays, std::span<const double> belt_travel,
+  /// The moving boxes of `candidates` (indices into `boxes`) met before
+  /// `best` (updated in place); box i is object ObjectOfMoving(first_object + i).
+  void CastMovingBoxes(const Ray& ray, std::span<const double> boxes,
+                       std::span<const int> candidates, int first_object, RayHit& best) const;
+  /// A group of rays as a cone (CullCarried, CullMovingBoxes): apex a,
+  /// unit axis ax, half angle th, origins within rho of a, times
+  /// s_mid +- s_half, reach t_far, heights [z_lo, z_hi] within the reach.
+  struct Bundle {
+    double a[3] = {0, 0, 0}, ax[3] = {0, 0, 0};
+    double cos_th = -1.0, sin_th = 0.0, rho = 0.0, t_far = 0.0, s_mid = 0.0, s_half = 0.0;
+    double z_lo = std::numeric_limits<double>::infinity();
+    double z_hi = -std::numeric_limits<double>::infinity();
+    double z_pad = 0.0;
+    static Bundle Of(std::span<const Ray> rays);
+    /// Whether a sphere of `radius` about (cx, cy, cz), of a solid spanning
+    /// the heights [z_bottom, z_top], may meet a ray of the bundle
+    /// (conservative).
+    bool MayMeet(double cx, double cy, double cz, double radius, double z_bottom,
+                 double z_top) const;
+  };
+  /// The moving boxes a bundle may meet (into box_candidates_, their spheres
+  /// swept over the bundle's times); returns the count.
+  int CullMovingBoxes(const Bundle& bundle, std::span<const double> boxes, int own_box);
+  /// The carried objects a bundle of rays may meet (into candidates_):
+  /// their bounding spheres, where their belts put them over the rays'
+  /// times, against the bundle's cone. Returns the count.
+  int CullCarried(const Bundle& bundle, std::span<const double> belt_travel,
                   std::span<const double> belt_speed);
 
   RTCDeviceTy* device_ = nullptr;
@@ -176,6 +195,9 @@ class RayScene {
   std::array<Lane, 16> lanes_{};  // the packet being cast
   std::vector<Carried> carried_;
   std::vector<int> candidates_;  // CullCarried's answer (carried_.size() long)
+  std::vector<int> box_candidates_;  // CullMovingBoxes' answer
+  std::vector<std::array<double, 2>> box_trig_;  // cos, sin of each candidate's yaw
+  std::vector<double> box_radius_;               // its bounding sphere's radius
 };
 
 /// Exact first intersection (t > 1e-9, t < t_max) of a ray with a vertical

@@ -48,23 +48,27 @@ TEST(RobotClearance, FootprintDistanceClosedForms) {
 // height in common) is never in contact; an absent one (length 0) is
 // ignored.
 TEST(RobotClearance, CountsContactEventsPerPair) {
-  RobotClearanceUnit u("c", 2);
+  // Three robots: this one is body 1; body 0 comes and goes, body 2 is
+  // absent.
+  RobotClearanceUnit u("c", 3);
+  u.variables().SetInteger(*u.variables().Find("own"), 1);
   u.Initialize();
+  cosim::TimeNs t = 0;
   const auto step = [&](double x_other, double z_bottom) {
-    SetArray(u, "body_box", Box(0, 0, 0, 1, 1));
-    std::vector<double> others = Box(x_other, 0, 0, 1, 1);
-    others[8] = z_bottom;
-    others[9] = z_bottom + 0.4;
-    const auto absent = Box(0, 0, 0, 0, 0);
-    others.insert(others.end(), absent.begin(), absent.end());
-    SetArray(u, "others", others);
-    static cosim::TimeNs t = 0;
+    std::vector<double> bodies = Box(x_other, 0, 0, 1, 1);
+    bodies[8] = z_bottom;
+    bodies[9] = z_bottom + 0.4;
+    for (const auto& b : {Box(0, 0, 0, 1, 1), Box(0, 0, 0, 0, 0)}) {
+      bodies.insert(bodies.end(), b.begin(), b.end());
+    }
+    SetArray(u, "bodies", bodies);
     ASSERT_EQ(u.DoStep(t, kStep), cosim::StepResult::kOk) << u.last_error();
     t += kStep;
   };
   step(2.0, 0.0);
   EXPECT_NEAR(Get(u, "distance")[0], 1.0, 1e-12);
   EXPECT_EQ(Get(u, "nearest")[0], 0.0);
+  EXPECT_EQ(Get(u, "robot_distance")[1], -1.0);  // its own
   EXPECT_EQ(Get(u, "collisions")[0], 0.0);
   step(1.003, 0.0);  // 3 mm: in contact
   step(1.0, 0.0);    // still
@@ -73,6 +77,7 @@ TEST(RobotClearance, CountsContactEventsPerPair) {
   step(0.9, 0.0);  // overlapping: again
   EXPECT_EQ(Get(u, "robot_collisions")[0], 2.0);
   EXPECT_EQ(Get(u, "robot_collisions")[1], 0.0);
+  EXPECT_EQ(Get(u, "robot_collisions")[2], 0.0);
   step(0.9, 0.5);  // above it
   step(0.9, 0.0);
   EXPECT_EQ(Get(u, "collisions")[0], 3.0);
