@@ -242,6 +242,12 @@ void ConnectFleet(assembly::SystemBuilder& b, const std::vector<RobotInfo>& robo
                 assembly::Element(assembly::kMovingBodies, "bodies_in", i * kBox + k));
     }
   }
+  // The workers yield to every robot.
+  for (const auto& kv : Child(b.out(), "units")) {
+    if (Child(kv.second, "type").as<std::string>("") != "worker") continue;
+    b.Params(kv.first.Scalar())["robots"] = count;
+    b.Connect(bodies, assembly::Signal(kv.first.Scalar(), "robots"));
+  }
   for (std::size_t i = 0; i < robots.size(); ++i) {
     const std::string& name = robots[i].name;
     const std::string clearance = name + "." + assembly::kRobotClearance;
@@ -364,6 +370,11 @@ YAML::Node ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
     for (const auto& c : b.connections()) {
       const std::string from = scoped(c["from"].as<std::string>()),
                         to = scoped(c["to"].as<std::string>());
+      // A worker yields to every robot of the fleet (ConnectFleet), not to
+      // the one robot it was assembled with.
+      if (list.size() > 1 && !own.count(to.substr(0, to.find('.'))) && to.ends_with(".robots")) {
+        continue;
+      }
       if (i > 0 && from == c["from"].as<std::string>() && to == c["to"].as<std::string>()) {
         continue;  // between shared units: the first robot made it
       }
@@ -376,6 +387,12 @@ YAML::Node ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
       }
     }
     for (const auto& m : Child(b.out(), "metrics")) {
+      const std::string of = m["of"].as<std::string>();
+      if (!own.count(of.substr(0, of.find('.')))) {
+        // Of the scene's units (a worker's): once, unscoped.
+        if (i == 0) metrics.push_back(m);
+        continue;
+      }
       YAML::Node scoped_metric;
       scoped_metric["name"] = name + "." + m["name"].as<std::string>();
       scoped_metric["of"] = scoped(m["of"].as<std::string>());

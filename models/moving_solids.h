@@ -1,5 +1,7 @@
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 
 /// Moving solids as units exchange them through connections, one array of
@@ -23,5 +25,15 @@ struct MovingCylinder {
   enum Index : std::size_t { kX, kY, kVx, kVy, kRadius, kZBottom, kZTop };
   static constexpr std::size_t kValues = 7;
 };
+
+/// Distance of map point (x, y) from the footprint of a MovingBox (0
+/// inside it).
+inline double FootprintDistance(const double* box, double x, double y) {
+  const double c = std::cos(box[MovingBox::kYaw]), s = std::sin(box[MovingBox::kYaw]);
+  const double dx = x - box[MovingBox::kX], dy = y - box[MovingBox::kY];
+  const double ex = std::abs(c * dx + s * dy) - 0.5 * box[MovingBox::kLength];
+  const double ey = std::abs(-s * dx + c * dy) - 0.5 * box[MovingBox::kWidth];
+  return std::hypot(std::max(ex, 0.0), std::max(ey, 0.0));
+}
 
 }  // namespace linesim::models

@@ -178,6 +178,10 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
     b.Unit(name, "worker");
     YAML::Node p = b.Params(name);
     p["waypoints"] = PointList(points);
+    // The worker knows where the robot is (it yields to it with a
+    // stop_distance; a fleet's are connected by the fleet).
+    p["robots"] = 1;
+    b.Connect(Signal(kChassis, "body_box"), Signal(name, "robots"));
     // pause_s: one number for every waypoint, or one per waypoint.
     if (const YAML::Node pause = Child(item, "pause_s"); pause.IsDefined()) {
       const std::string pause_path = JoinPath(path, "pause_s");
@@ -251,6 +255,7 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
     s.recorded.push_back(Signal(names[w], "pose"));
     info.worker_columns.emplace_back(Element(names[w], "pose", 0), Element(names[w], "pose", 1));
     s.recorded.push_back(Signal(names[w], "legs"));
+    add(names[w] + "_time_waited_s", Signal(names[w], "time_waited"), "final");
     add("robot_" + names[w] + "_collisions",
         Element(kPersonClearance, "worker_collisions", w), "final");
   }

@@ -10,7 +10,8 @@ std::unique_ptr<cosim::Unit> MakeWorker(const config::UnitBuildContext& c) {
   const std::size_t issues_before = c.reader.issues().size();
   auto waypoints = config::ReadPoints(c, "waypoints", 1);
   if (c.reader.issues().size() != issues_before || waypoints.empty()) return nullptr;
-  return std::make_unique<WorkerUnit>(c.name, std::move(waypoints));
+  const auto robots = c.reader.Integer(c.parameters, c.path, "robots", 0, 0, 10000);
+  return std::make_unique<WorkerUnit>(c.name, std::move(waypoints), static_cast<int>(robots));
 }
 
 const config::UnitTypeRegistrar kWorker(
@@ -18,7 +19,10 @@ const config::UnitTypeRegistrar kWorker(
      "a person walking along waypoints (speed profile, pauses, gait): two legs at a "
      "scanner's height and a torso, as moving cylinders the lasers and the clearance see",
      "",
-     {{"waypoints", "list of points [x, y] (m, map): where the worker walks, stopping at each"}},
+     {{"waypoints", "list of points [x, y] (m, map): where the worker walks, stopping at each"},
+      {"robots",
+       "number of robots the worker yields to (adds the input robots, 10 numbers each, and "
+       "stop_distance; default 0)"}},
      MakeWorker});
 
 std::unique_ptr<cosim::Unit> MakePersonClearance(const config::UnitBuildContext& c) {

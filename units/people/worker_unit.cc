@@ -4,10 +4,14 @@
 #include <cmath>
 #include <numbers>
 
+#include "models/moving_solids.h"
+
 namespace linesim::people {
 
-WorkerUnit::WorkerUnit(std::string name, std::vector<std::array<double, 2>> waypoints_m)
+WorkerUnit::WorkerUnit(std::string name, std::vector<std::array<double, 2>> waypoints_m,
+                       int robots)
     : cosim::Unit(kTypeName, std::move(name)), waypoints_(std::move(waypoints_m)) {
+  if (robots < 0) throw cosim::UnitError(Where() + ": robots must be >= 0");
   if (waypoints_.empty()) throw cosim::UnitError(Where() + ": needs at least one waypoint");
   pause_s_.assign(waypoints_.size(), 0.0);
   pose_.assign(3, 0.0);
@@ -68,6 +72,18 @@ WorkerUnit::WorkerUnit(std::string name, std::vector<std::array<double, 2>> wayp
   v.Parameter("initial_yaw", "deg", &initial_yaw_deg_,
               "heading of a worker with one waypoint (more: the first segment's)",
               Rule::Finite());
+  if (robots > 0) {
+    robots_.assign(models::MovingBox::kValues * static_cast<std::size_t>(robots), 0.0);
+    // Hall (1966), The Hidden Dimension: personal distance begins at 0.45 m;
+    // 0 by default (see the class comment).
+    v.Parameter("stop_distance", "m", &stop_distance_,
+                "the worker waits while walking on would bring the torso closer than this to a "
+                "moving robot's body (e.g. 0.5 m: Hall 1966's personal distance); 0: never",
+                Rule::NonNegative());
+    v.Input("robots", "m, rad, m/s, rad/s", &robots_,
+            "the robots' bodies (chassis body_box: [x, y, yaw, vx, vy, yaw_rate, length, width, "
+            "z_bottom, z_top] in map), one after another");
+  }
   v.Output("pose", "m, m, rad", &pose_, "[x, y, yaw] of the body centre (map)", {});
   v.Output("velocity", "m/s", &velocity_, "[vx, vy] (map)", {});
   v.Output("speed", "m/s", &speed_out_, "walking speed", {});
@@ -79,6 +95,10 @@ WorkerUnit::WorkerUnit(std::string name, std::vector<std::array<double, 2>> wayp
   v.Output("cylinders", "m, m/s", &cylinders_,
            "per cylinder (left leg, right leg, torso) [x, y, vx, vy, radius, z_bottom, z_top]",
            {});
+  if (robots > 0) {
+    v.Output("waiting", &waiting_, "true while the worker waits for a robot", {});
+    v.Output("time_waited", "s", &waited_s_, "time spent waiting for robots so far", {});
+  }
 }
 
 std::vector<cosim::ParameterProblem> WorkerUnit::CheckParameters() const {
@@ -214,12 +234,66 @@ void WorkerUnit::Evaluate(double t_s) {
 void WorkerUnit::Initialize() {
   ThrowIfBadParameters();
   Plan();
+  waited_ = 0;
+  waited_s_ = 0.0;
+  waiting_ = false;
   Evaluate(0.0);
 }
 
+bool WorkerUnit::Blocked(double t0_s, double t1_s) const {
+  using models::MovingBox;
+  if (stop_distance_ <= 0.0) return false;
+  const State now = At(t0_s), next = At(t1_s);
+  if (next.x_m == now.x_m && next.y_m == now.y_m) return false;  // standing anyway
+  for (std::size_t k = 0; k + MovingBox::kValues <= robots_.size(); k += MovingBox::kValues) {
+    const double* box = robots_.data() + k;
+    if (!(box[MovingBox::kLength] > 0.0 && box[MovingBox::kWidth] > 0.0)) continue;  // absent
+    if (std::hypot(box[MovingBox::kVx], box[MovingBox::kVy]) <= 0.05) continue;  // not moving
+    const double d_next = models::FootprintDistance(box, next.x_m, next.y_m) - torso_radius_;
+    if (d_next >= stop_distance_) continue;
+    if (d_next < models::FootprintDistance(box, now.x_m, now.y_m) - torso_radius_) return true;
+  }
+  return false;
+}
+
 cosim::StepResult WorkerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
-  Evaluate(cosim::NsToSeconds(t + dt - start_));
+  if (robots_.empty()) {
+    // Without robots the clock is the time (the same numbers as always).
+    Evaluate(cosim::NsToSeconds(t + dt - start_));
+    return cosim::StepResult::kOk;
+  }
+  if (!InputsFinite(t)) return cosim::StepResult::kError;
+  waiting_ = Blocked(cosim::NsToSeconds(t - start_ - waited_),
+                     cosim::NsToSeconds(t + dt - start_ - waited_));
+  if (waiting_) waited_ += dt;
+  waited_s_ = cosim::NsToSeconds(waited_);
+  Evaluate(cosim::NsToSeconds(t + dt - start_ - waited_));
+  if (waiting_) {
+    // Standing where the plan left off: nothing moves.
+    velocity_ = {0.0, 0.0};
+    speed_out_ = 0.0;
+    std::fill(leg_velocities_.begin(), leg_velocities_.end(), 0.0);
+    for (int c = 0; c < kCylinders; ++c) {
+      cylinders_[static_cast<std::size_t>(c * kCylinderValues + 2)] = 0.0;
+      cylinders_[static_cast<std::size_t>(c * kCylinderValues + 3)] = 0.0;
+    }
+  }
   return cosim::StepResult::kOk;
+}
+
+void WorkerUnit::SaveInternal(cosim::UnitState& state) const {
+  state.integers = {waited_, waiting_ ? 1 : 0};
+}
+
+void WorkerUnit::RestoreInternal(const cosim::UnitState& state) {
+  Plan();
+  if (state.integers.size() != 2) {
+    throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.integers.size()) +
+                           " integers, expected 2");
+  }
+  waited_ = state.integers[0];
+  waited_s_ = cosim::NsToSeconds(waited_);
+  waiting_ = state.integers[1] != 0;
 }
 
 }  // namespace linesim::people

@@ -36,6 +36,16 @@ namespace linesim::people {
 /// crotch_height, leg_spacing apart across the heading; the torso is a
 /// cylinder of torso_radius from crotch_height to stature.
 ///
+/// Yielding to robots (`robots` > 0: the input `robots`, the robots' bodies
+/// as models::MovingBox values): the walk above runs on the worker's own
+/// clock, which stops while a moving robot (faster than 0.05 m/s) is in
+/// the way: the next step would bring the torso closer to its body than
+/// `stop_distance` and closer than it is now. The worker then stands (speed
+/// 0, the gait held) until the robot has passed or stopped, and walks on
+/// where the plan left off; `waiting` says it, `time_waited` sums it.
+/// stop_distance 0 (the default): the worker never yields (a person who
+/// does not look: the worst case a safety function must handle).
+///
 /// Outputs: the pose, velocity, speed, the legs' positions and velocities,
 /// and `cylinders`: per cylinder (left leg, right leg, torso)
 /// [x, y, vx, vy, radius, z_bottom, z_top]: the shapes a laser scanner and
@@ -48,8 +58,9 @@ class WorkerUnit : public cosim::Unit {
   static constexpr int kCylinders = 3;
   static constexpr int kCylinderValues = 7;
 
-  /// At least one waypoint (one: a person standing there).
-  WorkerUnit(std::string name, std::vector<std::array<double, 2>> waypoints_m);
+  /// At least one waypoint (one: a person standing there); `robots` robots'
+  /// bodies to yield to.
+  WorkerUnit(std::string name, std::vector<std::array<double, 2>> waypoints_m, int robots = 0);
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
   void Setup(cosim::TimeNs start, cosim::TimeNs stop) override;
@@ -81,11 +92,15 @@ class WorkerUnit : public cosim::Unit {
   };
   void Plan();
   void Evaluate(double t_s);
+  /// Whether walking on from walk time t0 to t1 (s) brings the worker
+  /// closer than stop_distance to a moving robot, and closer than now.
+  bool Blocked(double t0_s, double t1_s) const;
 
  protected:
-  /// No state beyond the parameters: the walk is a function of time; the
-  /// plan is derived again from the restored parameters.
-  void RestoreInternal(const cosim::UnitState&) override { Plan(); }
+  /// The state is the time waited (the worker's own clock is the time less
+  /// it); the plan is derived again from the restored parameters.
+  void SaveInternal(cosim::UnitState& state) const override;
+  void RestoreInternal(const cosim::UnitState& state) override;
 
  private:
 
@@ -100,8 +115,17 @@ class WorkerUnit : public cosim::Unit {
          initial_phase_ = 0.0, leg_radius_ = 0.045, leg_spacing_ = 0.2, crotch_height_ = 0.84,
          torso_radius_ = 0.2, stature_ = 1.75, initial_yaw_deg_ = 0.0;
 
+  double stop_distance_ = 0.0;
+  // Inputs: the robots' bodies (empty without robots).
+  std::vector<double> robots_;
+  // State: the time spent waiting (ns, exact: without waiting the walk's
+  // clock is the time itself, to the bit).
+  cosim::TimeNs waited_ = 0;
+
   // Outputs.
   std::vector<double> pose_, velocity_, legs_, leg_velocities_, cylinders_;
+  bool waiting_ = false;
+  double waited_s_ = 0.0;
   double speed_out_ = 0.0, distance_out_ = 0.0, phase_out_ = 0.0;
 };
 

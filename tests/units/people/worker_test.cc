@@ -4,7 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+
+#include "models/moving_solids.h"
 
 #include "../test_helpers.h"
 
@@ -163,6 +166,50 @@ TEST(Worker, RefusesRepeatedWaypoint) {
   const auto p = u.CheckParameters();
   ASSERT_EQ(p.size(), 1u);
   EXPECT_EQ(p[0].variable, "waypoints");
+}
+
+// Guards the yielding: a worker walking along +x (from x = 0 to 10 m) and
+// a robot (a 1 x 0.6 m body) driving across its way at x = 4 m along +y at
+// 0.5 m/s. With stop_distance 0.5 m the worker stops where walking on would
+// bring its torso (radius 0.2 m) within 0.5 m of the moving body, waits
+// while the robot passes, and walks on where its plan left off (it reaches
+// the end later by the time it waited); never closer than stop_distance
+// less one step's walk. Without stop_distance (0) it does not wait, and a
+// robot that stands (speed 0) does not stop it either.
+TEST(Worker, WaitsForAPassingRobot) {
+  const auto run = [](double stop_distance, double robot_speed, double& waited,
+                      double& closest) {
+    WorkerUnit u("w", {{0.0, 0.0}, {10.0, 0.0}}, 1);
+    SetAll(u, "stop_distance", stop_distance);
+    u.Setup(0, 0);
+    u.Initialize();
+    closest = 1e9;
+    cosim::TimeNs now = 0;
+    for (int k = 0; k < 2000; ++k) {
+      const double t = k * 0.01;
+      // The robot's centre at x = 4 m crosses y = 0 at 3 s.
+      const double y = robot_speed > 0.0 ? robot_speed * (t - 3.0) : -0.9;
+      test_helpers::SetArray(u, "robots", {4.0, y, 1.5707963267948966, 0.0, robot_speed, 0.0,
+                                           1.0, 0.6, 0.0, 0.5});
+      ASSERT_EQ(u.DoStep(now, kStep), cosim::StepResult::kOk);
+      now += kStep;
+      const auto pose = Get(u, "pose");
+      const double box[10] = {4.0, y, 1.5707963267948966, 0.0, 0.0, 0.0, 1.0, 0.6, 0.0, 0.5};
+      closest = std::min(closest, models::FootprintDistance(box, pose[0], pose[1]) - 0.2);
+    }
+    waited = Get(u, "time_waited")[0];
+    EXPECT_NEAR(Get(u, "pose")[0], 10.0, 1e-9);  // it arrives all the same
+  };
+  double waited = 0.0, closest = 0.0;
+  run(0.5, 0.5, waited, closest);
+  EXPECT_GT(waited, 0.5);
+  // One 10 ms step at 1.37 m/s is 13.7 mm.
+  EXPECT_GT(closest, 0.5 - 0.014);
+  run(0.0, 0.5, waited, closest);
+  EXPECT_EQ(waited, 0.0);
+  EXPECT_LT(closest, 0.0 + 1e-9);  // it walks into the robot's way
+  run(0.5, 0.0, waited, closest);
+  EXPECT_EQ(waited, 0.0);
 }
 
 }  // namespace
