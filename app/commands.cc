@@ -106,8 +106,10 @@ constexpr const char* kPaperBoundLabel = "4 cm (paper 1, Sec. VI-B)";
 
 // What the plots of a robot run draw, by the columns the robot expansion
 // names.
-plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat format) {
-  const loader::RobotInfo& robot = *s.robot;
+// `robot` is the scenario's robot, or in a fleet any of its robots (the
+// others drawn in its top view).
+plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat format,
+                              const loader::RobotInfo& robot, const loader::RobotInfo* first) {
   plots::RobotPlotSpec spec;
   spec.title = s.name;
   spec.scene = s.scene;
@@ -134,12 +136,19 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat forma
   spec.flow_filtered_columns = robot.flow_filtered_columns;
   spec.flow_reference_column = robot.flow_reference_column;
   spec.worker_columns = robot.worker_columns;
-  // A fleet: the first robot's plots, with the others in the top view.
+  // A fleet: each robot's plots, with the others in the top view; the
+  // first robot's files have no prefix, the others' their name.
   spec.robot_name = robot.name;
-  for (const loader::RobotInfo& other : robot.fleet) {
+  const loader::RobotInfo& lead = first != nullptr ? *first : robot;
+  const auto add_other = [&](const loader::RobotInfo& other) {
+    if (other.name == robot.name) return;
     spec.others.push_back({other.name, other.x_column, other.y_column, other.yaw_column,
                            other.body_length_m.value_or(0.0), other.body_width_m.value_or(0.0)});
-  }
+  };
+  add_other(lead);
+  for (const loader::RobotInfo& other : lead.fleet) add_other(other);
+  if (first != nullptr && robot.name != first->name) spec.file_prefix = robot.name + "_";
+  if (!robot.name.empty()) spec.title = s.name + " (" + robot.name + ")";
   spec.safety = {robot.velocity_x_column, robot.velocity_y_column, robot.speed_cap_column,
                  robot.protective_column,  robot.warning_column,    robot.person_distance_column};
   if (!robot.scan_unit.empty()) {
@@ -220,6 +229,11 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   // runs (a summary that fails to write must not leave the old one behind).
   {
     std::vector<std::string> previous = plots::RobotPlotFiles();
+    if (s.robot) {
+      for (const auto& other : s.robot->fleet) {
+        for (auto& name : plots::RobotPlotFiles(other.name + "_")) previous.push_back(name);
+      }
+    }
     previous.push_back("summary.json");
     previous.push_back("replay.html");
     previous.push_back("run.mcap");
@@ -418,8 +432,15 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   std::vector<std::string> pictures;
   if (s.robot && recorder.rows() > 0 && csv_written) {
     try {
-      for (const auto& p : plots::WriteRobotPlots(dir.string(), PlotSpec(s, format))) {
+      for (const auto& p :
+           plots::WriteRobotPlots(dir.string(), PlotSpec(s, format, *s.robot, &*s.robot))) {
         pictures.push_back(fs::path(p).filename().string());
+      }
+      for (const loader::RobotInfo& other : s.robot->fleet) {
+        for (const auto& p :
+             plots::WriteRobotPlots(dir.string(), PlotSpec(s, format, other, &*s.robot))) {
+          pictures.push_back(fs::path(p).filename().string());
+        }
       }
       summary["plots"] = {{"files", pictures}};
     } catch (const std::exception& e) {

@@ -293,7 +293,7 @@ std::string ScanPlot(const RobotPlotSpec& spec, Signals& signals,
   if (!obstacles.polygons.empty()) AppendBlock(s, "scan_obstacles", obstacles.polygons);
   if (!obstacles.circles.empty()) AppendBlock(s, "scan_obstacles_circles", obstacles.circles);
   if (!carried.polygons.empty()) AppendBlock(s, "scan_carried", carried.polygons);
-  s += SetOutput("scan", spec.format, outputs) + "set title " +
+  s += SetOutput(spec.file_prefix + "scan", spec.format, outputs) + "set title " +
        GnuplotQuote(title_prefix + scan.sensor + ", the scan started at t = " + Num(start_s) +
                     " s (" + std::to_string(range.size()) + " beams, every 4th ray drawn)") +
        "\nset xlabel 'x (m)'\nset ylabel 'y (m)'\nset size ratio -1\nset key outside bottom "
@@ -364,7 +364,7 @@ std::string SideView(const RobotPlotSpec& spec, Signals& signals,
   if (data.empty()) return {};
   std::string s;
   AppendBlock(s, "side", data);
-  return s + SetOutput("side_view", spec.format, outputs) + "set title " +
+  return s + SetOutput(spec.file_prefix + "side_view", spec.format, outputs) + "set title " +
          GnuplotQuote(title_prefix + "side view: height along the track") +
          "\nset xlabel 'distance travelled in the plane (m)'\nset ylabel 'height (m)'\n"
          "unset y2label\nunset y2tics\nset ytics mirror\n"
@@ -628,7 +628,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
 
   // Top view of the robot's neighbourhood (path, track, outlines), not of
   // the whole line: belts are clipped to it.
-  s += "\n" + SetOutput("top_view", spec.format, outputs) +
+  s += "\n" + SetOutput(spec.file_prefix + "top_view", spec.format, outputs) +
        "set title " +
        GnuplotQuote(title_prefix + "top view (map frame)") +
        "\n"
@@ -752,7 +752,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
       any_on.empty() ? "" : "set y2range [0:1]\nunset y2tics\nset grid front\n";
 
   if (ierr > 0) {
-    s += "\n" + SetOutput("error", spec.format, outputs) + "set title " +
+    s += "\n" + SetOutput(spec.file_prefix + "error", spec.format, outputs) + "set title " +
          GnuplotQuote(title_prefix + spec.error_label) + "\n" + time_plot + shading_axes +
          "set ylabel " + GnuplotQuote(spec.error_label) + "\nset yrange [0:*]\n";
     items.clear();
@@ -775,7 +775,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   }
 
   if (!speeds.empty() || !ons.empty()) {
-    s += "\n" + SetOutput("belt", spec.format, outputs) + "set title " +
+    s += "\n" + SetOutput(spec.file_prefix + "belt", spec.format, outputs) + "set title " +
          GnuplotQuote(title_prefix + "belts") + "\n" + time_plot +
          "set ylabel 'belt speed (m/s)'\n"
          "set y2label 'scheduled on (1) / off (0)'\n"
@@ -801,7 +801,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     // estimate is a surface speed (Eq. 2 with the robot's own motion),
     // drawn against the belt's encoder wheel (black).
     // Two title lines: gnuplot joins single-quoted text and a "\n".
-    s += "\n" + SetOutput("optic_flow", spec.format, outputs) + "set title " +
+    s += "\n" + SetOutput(spec.file_prefix + "optic_flow", spec.format, outputs) + "set title " +
          GnuplotQuote(title_prefix +
                       (filtered.empty() ? "optic flow" : "raw and filtered optic flow") +
                       " against the belt's ground truth (paper 1, Fig. 4)") +
@@ -851,7 +851,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   if (has_safety) {
     // Speeds and the distance on the left axis; the fields' states as steps
     // on the right (1 clear, 0 infringed), offset so that both show.
-    s += "\n" + SetOutput("safety", spec.format, outputs) + "set title " +
+    s += "\n" + SetOutput(spec.file_prefix + "safety", spec.format, outputs) + "set title " +
          GnuplotQuote(title_prefix + "S300 safety fields: speed, speed cap, distance to the person") +
          "\n" + time_plot +
          "set ylabel 'speed (m/s), distance (m)'\nset yrange [0:*]\n"
@@ -884,18 +884,15 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
 
 }  // namespace
 
-const std::vector<std::string>& RobotPlotFiles() {
-  static const std::vector<std::string> files = [] {
-    std::vector<std::string> names = {kScript};
-    for (PlotFormat f : {PlotFormat::kPng, PlotFormat::kSvg, PlotFormat::kPdf}) {
-      for (const char* name :
-           {"top_view", "error", "belt", "optic_flow", "scan", "side_view", "safety"}) {
-        names.push_back(PlotFile(name, f));
-      }
+std::vector<std::string> RobotPlotFiles(const std::string& prefix) {
+  std::vector<std::string> names = {prefix + kScript};
+  for (PlotFormat f : {PlotFormat::kPng, PlotFormat::kSvg, PlotFormat::kPdf}) {
+    for (const char* name :
+         {"top_view", "error", "belt", "optic_flow", "scan", "side_view", "safety"}) {
+      names.push_back(PlotFile(prefix + name, f));
     }
-    return names;
-  }();
-  return files;
+  }
+  return names;
 }
 
 std::vector<std::string> WriteRobotPlots(const std::string& dir, const RobotPlotSpec& spec) {
@@ -904,7 +901,7 @@ std::vector<std::string> WriteRobotPlots(const std::string& dir, const RobotPlot
   Signals signals = OpenSignals(csv);
   std::vector<std::string> names;
   const std::string script = Script(spec, signals, &names);
-  return DrawWithGnuplot(dir, kScript, script, names);
+  return DrawWithGnuplot(dir, spec.file_prefix + kScript, script, names);
 }
 
 }  // namespace linesim::plots

@@ -101,6 +101,9 @@ struct RobotPlotSpec {
   std::vector<OtherRobot> others;
   /// The robot's name in a fleet ("" for one robot).
   std::string robot_name;
+  /// Put before every file's name (a fleet's other robots: "raw3_b_",
+  /// giving raw3_b_top_view.png and raw3_b_plots.gp).
+  std::string file_prefix;
   /// Robot outlines and wheel footprints drawn at this many instants,
   /// evenly spaced over the recorded rows from first to last.
   int footprint_count = 5;
@@ -122,9 +125,9 @@ struct RobotPlotSpec {
 /// gnuplot is missing or fails (with gnuplot's error text).
 std::vector<std::string> WriteRobotPlots(const std::string& dir, const RobotPlotSpec& spec);
 
-/// Every file WriteRobotPlots may write (the script and each picture in
-/// every format), so that a new run can clear a previous run's before it
-/// starts.
-const std::vector<std::string>& RobotPlotFiles();
+/// Every file WriteRobotPlots may write with `prefix` (the script and each
+/// picture in every format), so that a new run can clear a previous run's
+/// before it starts.
+std::vector<std::string> RobotPlotFiles(const std::string& prefix = "");
 
 }  // namespace linesim::plots

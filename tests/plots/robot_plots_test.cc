@@ -484,9 +484,14 @@ TEST(PlotFormat, NamesAndExtensions) {
   EXPECT_EQ(ParsePlotFormat("jpeg"), std::nullopt);
   EXPECT_EQ(PlotFile("error", PlotFormat::kPdf), "error.pdf");
   // Every format's pictures are among the files a new run clears.
-  const auto& all = RobotPlotFiles();
+  const auto all = RobotPlotFiles();
   for (const char* name : {"plots.gp", "error.png", "error.svg", "optic_flow.pdf"}) {
     EXPECT_NE(std::find(all.begin(), all.end(), name), all.end()) << name;
+  }
+  // A fleet's other robot's, by its prefix.
+  const auto raw3_b = RobotPlotFiles("raw3_b_");
+  for (const char* name : {"raw3_b_plots.gp", "raw3_b_top_view.png", "raw3_b_safety.svg"}) {
+    EXPECT_NE(std::find(raw3_b.begin(), raw3_b.end(), name), raw3_b.end()) << name;
   }
 }
 
