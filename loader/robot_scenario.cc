@@ -225,11 +225,7 @@ void ConnectFleet(assembly::SystemBuilder& b, const std::vector<RobotInfo>& robo
                   std::vector<std::string>& recorded) {
   constexpr std::size_t kBox = models::MovingBox::kValues;
   const auto add = [&](const std::string& name, const std::string& of, const char* reduce) {
-    YAML::Node m;
-    m["name"] = name;
-    m["of"] = of;
-    m["reduce"] = reduce;
-    metrics.push_back(m);
+    assembly::AddMetric(metrics, name, of, reduce);
   };
   const int count = static_cast<int>(robots.size());
   b.Unit(assembly::kMovingBodies, "moving_bodies");
@@ -273,6 +269,84 @@ void ConnectFleet(assembly::SystemBuilder& b, const std::vector<RobotInfo>& robo
   }
 }
 
+// What the robots' expansions give the fleet's.
+struct FleetParts {
+  std::vector<RobotInfo> robots;
+  std::vector<std::size_t> list_index;           // each robot's item of `robots:`
+  std::vector<std::vector<std::string>> lasers;  // each robot's laser units
+  YAML::Node metrics{YAML::NodeType::Sequence};
+  std::vector<std::string> recorded;
+};
+
+// Adds robot `robot`'s expansion `b` to the fleet's `top`: its own units
+// get its name as scope (in units, connections, recording, metrics,
+// origins and plot columns); the scene's (belt, workers) stay one, taken
+// from the first robot. `several`: the fleet has more than one robot (the
+// workers then yield to all of them, ConnectFleet).
+void MergeRobot(assembly::SystemBuilder& top, assembly::SystemBuilder& b, YamlReader& r,
+                bool several, RobotInfo robot, std::size_t list_item, FleetParts& fleet) {
+  const std::string name = robot.name;
+  const bool first = fleet.robots.empty();
+  std::set<std::string> own;
+  const YAML::Node units = Child(b.out(), "units");
+  for (const auto& kv : units) {
+    const std::string type = Child(kv.second, "type").as<std::string>("");
+    if (type != "belt" && type != "worker") own.insert(kv.first.Scalar());
+  }
+  const auto unit_of = [](const std::string& column) { return column.substr(0, column.find('.')); };
+  const auto scoped = [&](const std::string& column) {
+    return own.count(unit_of(column)) ? name + "." + column : column;
+  };
+  fleet.lasers.emplace_back();
+  for (const auto& kv : units) {
+    const std::string unit = kv.first.Scalar();
+    if (!own.count(unit)) {
+      if (!top.HasUnit(unit)) top.out()["units"][unit] = kv.second;
+      continue;
+    }
+    top.out()["units"][name + "." + unit] = kv.second;
+    if (Child(kv.second, "type").as<std::string>("") == "laser_scanner") {
+      fleet.lasers.back().push_back(name + "." + unit);
+    }
+  }
+  for (const auto& c : b.connections()) {
+    const std::string from = c["from"].as<std::string>(), to = c["to"].as<std::string>();
+    // A worker yields to every robot of the fleet, not to the one robot it
+    // was assembled with.
+    if (several && !own.count(unit_of(to)) && to.ends_with(".robots")) continue;
+    // Between the scene's units: the first robot made it.
+    if (!first && !own.count(unit_of(from)) && !own.count(unit_of(to))) continue;
+    top.Connect(scoped(from), scoped(to));
+  }
+  for (const auto& v : Child(Child(b.out(), "recording"), "variables")) {
+    const std::string column = scoped(v.as<std::string>());
+    if (std::find(fleet.recorded.begin(), fleet.recorded.end(), column) == fleet.recorded.end()) {
+      fleet.recorded.push_back(column);
+    }
+  }
+  for (const auto& m : Child(b.out(), "metrics")) {
+    const std::string of = m["of"].as<std::string>();
+    if (!own.count(unit_of(of))) {
+      if (first) fleet.metrics.push_back(m);  // of a scene's unit (a worker): once, unscoped
+      continue;
+    }
+    assembly::AddMetric(fleet.metrics, name + "." + m["name"].as<std::string>(), scoped(of),
+                        m["reduce"].as<std::string>().c_str());
+  }
+  for (const auto& [expanded, from] : b.origins()) {
+    std::string key = expanded;
+    Origin origin = from;
+    if (key.starts_with("units.") && own.count(unit_of(key.substr(6)))) {
+      key = "units." + name + "." + key.substr(6);
+    }
+    if (origin.file.empty()) origin.path = r.Scoped(origin.path);
+    top.origins().emplace(key, origin);
+  }
+  ScopeColumns(robot, scoped);
+  fleet.robots.push_back(std::move(robot));
+  fleet.list_index.push_back(list_item);
+}
+
 // A fleet: `robots:` is a list of robots, each expanded by the concerns as
 // the one-robot shorthand is (its sections read as if they were the file's
 // top-level ones), its units then scoped by its name (raw3_a.chassis).
@@ -286,15 +360,12 @@ YAML::Node ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
     if (Child(root, key).IsDefined()) top.out()[key] = Child(root, key);
   }
   const models::Scene scene = assembly::AddScene(top);
-  YAML::Node metrics(YAML::NodeType::Sequence);
+  FleetParts fleet;
   const YAML::Node extra = Child(root, "metrics");
   if (extra.IsDefined() && !extra.IsNull() && r.ExpectSequence(extra, "metrics")) {
-    for (const auto& m : extra) metrics.push_back(m);
+    for (const auto& m : extra) fleet.metrics.push_back(m);
   }
-  std::vector<std::string> recorded;
-  std::vector<RobotInfo> robots;
-  std::vector<std::size_t> list_index;  // each robot's item of `robots:`
-  std::vector<std::vector<std::string>> lasers;  // each robot's laser units
+  const std::vector<RobotInfo>& robots = fleet.robots;
 
   const YAML::Node list = Child(root, "robots");
   if (r.ExpectSequence(list, "robots") && list.size() == 0) {
@@ -343,89 +414,22 @@ YAML::Node ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
     keys.insert(keys.end(), kRobotSections.begin(), kRobotSections.end());
     AssembleRobot(b, keys, scene, robot);
 
-    // The robot's own units get its name as scope; the scene's (belt,
-    // workers) stay one.
-    std::set<std::string> own;
-    const YAML::Node units = Child(b.out(), "units");
-    for (const auto& kv : units) {
-      const std::string type = Child(kv.second, "type").as<std::string>("");
-      if (type != "belt" && type != "worker") own.insert(kv.first.Scalar());
-    }
-    const auto scoped = [&](const std::string& column) {
-      const std::string unit = column.substr(0, column.find('.'));
-      return own.count(unit) ? name + "." + column : column;
-    };
-    lasers.emplace_back();
-    for (const auto& kv : units) {
-      const std::string unit = kv.first.Scalar();
-      if (own.count(unit) && Child(kv.second, "type").as<std::string>("") == "laser_scanner") {
-        lasers.back().push_back(name + "." + unit);
-      }
-      if (own.count(unit)) {
-        top.out()["units"][name + "." + unit] = kv.second;
-      } else if (!top.HasUnit(unit)) {
-        top.out()["units"][unit] = kv.second;
-      }
-    }
-    for (const auto& c : b.connections()) {
-      const std::string from = scoped(c["from"].as<std::string>()),
-                        to = scoped(c["to"].as<std::string>());
-      // A worker yields to every robot of the fleet (ConnectFleet), not to
-      // the one robot it was assembled with.
-      if (list.size() > 1 && !own.count(to.substr(0, to.find('.'))) && to.ends_with(".robots")) {
-        continue;
-      }
-      if (i > 0 && from == c["from"].as<std::string>() && to == c["to"].as<std::string>()) {
-        continue;  // between shared units: the first robot made it
-      }
-      top.Connect(from, to);
-    }
-    for (const auto& v : Child(Child(b.out(), "recording"), "variables")) {
-      const std::string column = scoped(v.as<std::string>());
-      if (std::find(recorded.begin(), recorded.end(), column) == recorded.end()) {
-        recorded.push_back(column);
-      }
-    }
-    for (const auto& m : Child(b.out(), "metrics")) {
-      const std::string of = m["of"].as<std::string>();
-      if (!own.count(of.substr(0, of.find('.')))) {
-        // Of the scene's units (a worker's): once, unscoped.
-        if (i == 0) metrics.push_back(m);
-        continue;
-      }
-      YAML::Node scoped_metric;
-      scoped_metric["name"] = name + "." + m["name"].as<std::string>();
-      scoped_metric["of"] = scoped(m["of"].as<std::string>());
-      scoped_metric["reduce"] = m["reduce"];
-      metrics.push_back(scoped_metric);
-    }
-    for (const auto& [expanded, from] : b.origins()) {
-      std::string key = expanded;
-      Origin origin = from;
-      // units.UNIT.rest, UNIT one of the robot's
-      if (key.starts_with("units.")) {
-        const std::string rest = key.substr(6);
-        if (own.count(rest.substr(0, rest.find('.')))) key = "units." + name + "." + rest;
-      }
-      if (origin.file.empty()) origin.path = r.Scoped(origin.path);
-      top.origins().emplace(key, origin);
-    }
-    ScopeColumns(robot, scoped);
-    robots.push_back(std::move(robot));
-    list_index.push_back(i);
+    MergeRobot(top, b, r, list.size() > 1, std::move(robot), i, fleet);
   }
-  if (robots.size() > 1 && r.ok()) ConnectFleet(top, robots, lasers, metrics, recorded);
-  top.out()["metrics"] = metrics;
-  assembly::AddRecordingSection(top, recorded);
+  if (robots.size() > 1 && r.ok()) {
+    ConnectFleet(top, robots, fleet.lasers, fleet.metrics, fleet.recorded);
+  }
+  top.out()["metrics"] = fleet.metrics;
+  assembly::AddRecordingSection(top, fleet.recorded);
   Passthrough(top);
-  for (auto& robot : robots) ReadBody(top, robot.name + "." + assembly::kChassis, robot);
+  for (auto& robot : fleet.robots) ReadBody(top, robot.name + "." + assembly::kChassis, robot);
   for (std::size_t i = 0; i < robots.size(); ++i) {
     for (std::size_t j = i + 1; j < robots.size(); ++j) {
       if (BodiesOverlap(robots[i], robots[j])) {
-        const YAML::Node entry = list[list_index[j]];
+        const YAML::Node entry = list[fleet.list_index[j]];
         const YAML::Node pose = Child(entry, "pose");
         r.Error(pose.IsDefined() ? pose : entry,
-                JoinPath(JoinPath("robots", std::to_string(list_index[j])), "pose"),
+                JoinPath(JoinPath("robots", std::to_string(fleet.list_index[j])), "pose"),
                 "robot '" + robots[j].name + "' would start inside robot '" + robots[i].name +
                     "' (their bodies overlap at their start poses)");
       }

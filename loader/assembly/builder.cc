@@ -41,6 +41,15 @@ void MergeInto(YAML::Node to, const YAML::Node& from) {
   for (const auto& kv : from) to[kv.first.Scalar()] = kv.second;
 }
 
+void AddMetric(YAML::Node metrics, const std::string& name, const std::string& of,
+               const char* reduce) {
+  YAML::Node m;
+  m["name"] = name;
+  m["of"] = of;
+  m["reduce"] = reduce;
+  metrics.push_back(m);
+}
+
 YAML::Node SystemBuilder::Unit(const std::string& name, const std::string& type) {
   YAML::Node unit = out_["units"][name];
   unit["type"] = type;

@@ -56,6 +56,9 @@ YAML::Node IntList(const std::vector<int>& values);
 YAML::Node PointList(const std::vector<std::array<double, 2>>& points);
 /// Copies every key of `from` into `to` (both maps), the later one winning.
 void MergeInto(YAML::Node to, const YAML::Node& from);
+/// Appends the metric {name, of, reduce} to the list `metrics`.
+void AddMetric(YAML::Node metrics, const std::string& name, const std::string& of,
+               const char* reduce);
 
 /// The system-level tree under construction. Every concern adds its units
 /// and connections here; what a unit's value was derived from is recorded

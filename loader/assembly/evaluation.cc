@@ -17,12 +17,8 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
   if (extra.IsDefined() && !extra.IsNull() && b.reader().ExpectSequence(extra, "metrics")) {
     for (const auto& m : extra) metrics.push_back(m);
   }
-  const auto add = [&](const char* name, const std::string& of, const char* reduce) {
-    YAML::Node m;
-    m["name"] = name;
-    m["of"] = of;
-    m["reduce"] = reduce;
-    metrics.push_back(m);
+  const auto add = [&](const std::string& name, const std::string& of, const char* reduce) {
+    AddMetric(metrics, name, of, reduce);
   };
   const std::string deviation = Signal(kDeviation, "deviation");
   if (info.task != "hold") {  // a path or a route
@@ -96,7 +92,7 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     // The share of the run the localization spent on its fallback (source 1).
     for (const auto& source : s.localization_sources) {
       const std::string unit = source.substr(0, source.find('.'));
-      add((unit + "_fallback_fraction").c_str(), source, "mean");
+      add(unit + "_fallback_fraction", source, "mean");
     }
   }
 

@@ -124,11 +124,7 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
   YamlReader& r = b.reader();
   YAML::Node metrics = b.out()["metrics"];
   const auto add = [&](const std::string& name, const std::string& of, const char* reduce) {
-    YAML::Node m;
-    m["name"] = name;
-    m["of"] = of;
-    m["reduce"] = reduce;
-    metrics.push_back(m);
+    AddMetric(metrics, name, of, reduce);
   };
   if (b.HasUnit(kSafety)) {
     b.Connect(Signal(kPathFollower, "done"), Signal(kSafety, "task_done"));
