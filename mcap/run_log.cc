@@ -232,6 +232,15 @@ RunLog::RunLog(std::ostream& out, const loader::Scenario& scenario, RunLogOption
       orientation_ = ArrayOutput(chassis, "orientation", 4);
       position_3d_ = ArrayOutput(chassis, "position_3d", 3);
     }
+    for (const loader::RobotInfo& other : robot.fleet) {
+      const auto chassis = system.FindUnit(other.name + ".chassis");
+      if (!chassis) continue;
+      const auto p3 = ArrayOutput(system.unit(*chassis), "position_3d", 3);
+      const auto q = ArrayOutput(system.unit(*chassis), "orientation", 4);
+      if (!p3 || !q) continue;
+      others_.push_back({other.name, other.name + "/base_link", *chassis, *p3, *q,
+                         other.body_length_m.value_or(0.0), other.body_width_m.value_or(0.0)});
+    }
     for (std::size_t k = 0; k < scenario.scene.belts.size(); ++k) {
       Dynamic d;
       if (k < robot.belt_travel_columns.size()) d.travel = probe_of(robot.belt_travel_columns[k]);
@@ -252,8 +261,15 @@ RunLog::RunLog(std::ostream& out, const loader::Scenario& scenario, RunLogOption
     const Quat q = FromRollPitchYaw(Parameter(unit, "mount_roll").value_or(0.0),
                                     Parameter(unit, "mount_pitch").value_or(0.0),
                                     Parameter(unit, "mount_yaw").value_or(0.0));
+    // A fleet's other robot's sensor hangs from its own base_link.
+    std::string parent = "base_link";
+    for (const OtherRobot& other : others_) {
+      if (unit.name().starts_with(other.name + ".")) parent = other.frame;
+    }
     Frame f;
-    f.text = ",\"parent_frame_id\":\"base_link\",\"child_frame_id\":";
+    f.text = ",\"parent_frame_id\":";
+    json::String(f.text, parent);
+    f.text += ",\"child_frame_id\":";
     json::String(f.text, unit.name());
     f.text += ",\"translation\":";
     Xyz(f.text, *mx, *my, mz.value_or(0.0));
@@ -454,6 +470,15 @@ void RunLog::WriteStatic(TimeNs now) {
     }
     Entity(o, now, "base_link", "robot", true, "robot", p);
   }
+  for (const OtherRobot& other : others_) {
+    const cosim::Unit& chassis = system.unit(other.chassis);
+    const double height = Parameter(chassis, "body_height").value_or(0.0);
+    const double com = Parameter(chassis, "com_height").value_or(0.5 * height);
+    if (other.length <= 0 || other.width <= 0 || height <= 0) continue;
+    Primitives p;
+    Box(p.cubes, 0, 0, com, Quat{}, other.length, other.width, height, kBody);
+    Entity(o, now, other.frame, "robot/" + other.name, true, other.name, p);
+  }
   text_ = "{\"deletions\":[],\"entities\":[" + o + "]}";
   writer_.WriteMessage(static_channel_, LogTime(now), LogTime(now), text_);
   if (!frames_.empty()) {
@@ -544,6 +569,20 @@ void RunLog::WriteTransforms(TimeNs t, const cosim::System& system) {
     Xyz(o, x, y, z);
     o += ",\"rotation\":";
     Rotation(o, q);
+    o += '}';
+  }
+  for (const OtherRobot& other : others_) {
+    const cosim::VariableTable& v = system.unit(other.chassis).variables();
+    const auto p = v.GetRealArray(other.position_3d);
+    const auto w = v.GetRealArray(other.orientation);  // w, x, y, z
+    o += ",{\"timestamp\":";
+    json::Time(o, t);
+    o += ",\"parent_frame_id\":\"map\",\"child_frame_id\":";
+    json::String(o, other.frame);
+    o += ",\"translation\":";
+    Xyz(o, p[0], p[1], p[2]);
+    o += ",\"rotation\":";
+    Rotation(o, Quat{w[1], w[2], w[3], w[0]});
     o += '}';
   }
   const models::Scene& scene = scenario_.scene;

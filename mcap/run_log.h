@@ -117,6 +117,14 @@ class RunLog : public cosim::Observer {
   std::optional<cosim::Probe> x_, y_, yaw_;
   std::optional<std::size_t> chassis_;
   std::optional<cosim::ValueRef> orientation_, position_3d_;
+  // A fleet's other robots: frame NAME/base_link, moved by their chassis.
+  struct OtherRobot {
+    std::string name, frame;
+    std::size_t chassis = 0;
+    cosim::ValueRef position_3d = 0, orientation = 0;
+    double length = 0.0, width = 0.0;
+  };
+  std::vector<OtherRobot> others_;
   std::uint16_t tf_channel_ = 0, mounts_channel_ = 0, static_channel_ = 0, scene_channel_ = 0;
   bool started_ = false;
   std::string scene_state_;  // belts on and objects on their belts, at the last /scene
