@@ -38,7 +38,7 @@ class Reader {
     out.root = root;
     r_.CheckKeys(root, "",
                  {"description", "source", "body", "wheels", "motor_groups", "controller",
-                  "chassis", "motors", "path_follower", "sensor_mounts", "payload"});
+                  "chassis", "motors", "path_follower", "sensor_mounts", "payload", "safety"});
     robot.description = r_.String(root, "", "description", "");
     Body(Child(root, "body"), robot.body);
     MotorGroups(Child(root, "motor_groups"), robot);
@@ -51,6 +51,11 @@ class Reader {
     out.chassis_settings = Settings(root, "chassis");
     out.motor_settings = Settings(root, "motors");
     out.follower_settings = Settings(root, "path_follower");
+    // The S300's field sets as configured on the vehicle: checked where a
+    // scenario switches the safety function on (loader/assembly/people.cc).
+    if (const YAML::Node s = Child(root, "safety"); s.IsDefined() && !s.IsNull()) {
+      if (r_.ExpectMap(s, "safety")) out.safety = s;
+    }
     out.motor_models = motor_models_;
     // The robot's top speed and turn rate bound every task it is given.
     for (const char* key : {"max_speed", "max_yaw_rate"}) {

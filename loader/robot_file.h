@@ -31,6 +31,10 @@ struct RobotFile {
   /// unit parameters its `parameters:` key gives (device options, counts
   /// per revolution), or an empty map.
   std::vector<YAML::Node> sensor_settings;
+  /// The vehicle's safety configuration (`safety:` {scanner, field_sets,
+  /// parameters}: the S300's field sets and the reaction), used when a
+  /// scenario switches the safety function on; undefined when absent.
+  YAML::Node safety;
 
   /// Where the description's values were written, so that a problem the
   /// assembly's units find in a value derived from one is reported at the

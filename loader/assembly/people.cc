@@ -1,6 +1,7 @@
 #include "loader/assembly/people.h"
 
 #include <cmath>
+#include <optional>
 
 #include "models/angle.h"
 
@@ -49,7 +50,6 @@ const models::SensorMount* FindLaser(const Signals& s, const std::string& name) 
 }  // namespace
 
 void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s) {
-  (void)robot;
   YamlReader& r = b.reader();
   const YAML::Node safety = Child(b.root(), "safety");
   if (!safety.IsDefined() || safety.IsNull()) return;
@@ -58,57 +58,101 @@ void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s) {
   // enabled: false keeps the section but takes the safety function out (the
   // same run without it, for comparison).
   if (!r.Boolean(safety, "safety", "enabled", true)) return;
-  const std::string scanner = r.String(safety, "safety", "scanner", "");
-  const models::SensorMount* laser = FindLaser(s, scanner);
-  if (laser == nullptr) {
-    r.Error(Child(safety, "scanner").IsDefined() ? Child(safety, "scanner") : safety,
-            "safety.scanner",
-            scanner.empty() ? "the robot has no enabled laser scanner for the safety fields"
-                            : "no enabled laser scanner '" + scanner + "' on the robot");
-    return;
+  // The vehicle's configuration is the robot file's `safety:`; a key the
+  // scenario's section gives replaces it (parameters key by key). A
+  // problem is reported in the file the value is in.
+  const YAML::Node vehicle = robot.safety;
+  if (vehicle.IsMap()) {
+    const YamlReader::InFile in(r, robot.robot.file);
+    r.CheckKeys(vehicle, "safety", {"scanner", "field_sets", "parameters"});
   }
-  // The unit's beam geometry defaults are the S300's (the device whose field
-  // sets these are).
-  if (laser->model != "sick_s300") {
-    r.Error(safety, "safety.scanner",
-            "the safety fields are the SICK S300's: scanner '" + laser->name + "' is model '" +
-                laser->model + "', expected sick_s300");
-    return;
+  struct Source {
+    YAML::Node section;
+    std::optional<YamlReader::InFile> in;  // while reading the robot file's
+  };
+  const auto from = [&](const char* key, Source& src) {
+    const bool robot_file = !Child(safety, key).IsDefined() && vehicle.IsMap() &&
+                            Child(vehicle, key).IsDefined();
+    src.section = robot_file ? vehicle : safety;
+    if (robot_file) src.in.emplace(r, robot.robot.file);
+  };
+
+  const models::SensorMount* laser = nullptr;
+  {
+    Source src;
+    from("scanner", src);
+    const YAML::Node section = src.section;
+    const std::string scanner = r.String(section, "safety", "scanner", "");
+    laser = FindLaser(s, scanner);
+    const YAML::Node at = Child(section, "scanner").IsDefined() ? Child(section, "scanner") : section;
+    if (laser == nullptr) {
+      r.Error(at, "safety.scanner",
+              scanner.empty() ? "the robot has no enabled laser scanner for the safety fields"
+                              : "no enabled laser scanner '" + scanner + "' on the robot");
+      return;
+    }
+    // The unit's beam geometry defaults are the S300's (the device whose
+    // field sets these are).
+    if (laser->model != "sick_s300") {
+      r.Error(at, "safety.scanner",
+              "the safety fields are the SICK S300's: scanner '" + laser->name + "' is model '" +
+                  laser->model + "', expected sick_s300");
+      return;
+    }
   }
   b.Unit(kSafety, "safety_field");
   b.SetStep(kSafety, b.ControlPeriod());
   YAML::Node p = b.Params(kSafety);
   p["beam_count"] = 541;
-  const YAML::Node sets = Child(safety, "field_sets");
   YAML::Node out_sets(YAML::NodeType::Sequence);
-  if (!sets.IsDefined()) {
-    r.Error(safety, "safety.field_sets",
-            "missing required key: a list of {max_speed_mps, protective, warning}");
-  } else if (r.ExpectSequence(sets, "safety.field_sets")) {
-    if (sets.size() == 0) r.Error(sets, "safety.field_sets", "expected at least one field set");
-    for (std::size_t i = 0; i < sets.size(); ++i) {
-      const std::string path = JoinPath("safety.field_sets", std::to_string(i));
-      const YAML::Node item = sets[i];
-      if (!r.ExpectMap(item, path)) continue;
-      r.CheckKeys(item, path, {"max_speed_mps", "protective", "warning"});
-      YAML::Node set;
-      set["max_speed_mps"] = Num(r.Real(item, path, "max_speed_mps", std::nullopt, {0.0, 100.0}));
-      set["protective"] = ReadPolygonInScanner(r, item, path, "protective", true, laser->x_m,
-                                               laser->y_m, laser->yaw_rad);
-      const YAML::Node warning = ReadPolygonInScanner(r, item, path, "warning", false, laser->x_m,
-                                                      laser->y_m, laser->yaw_rad);
-      if (warning.IsDefined()) set["warning"] = warning;
-      out_sets.push_back(set);
+  {
+    Source src;
+    from("field_sets", src);
+    const YAML::Node sets = Child(src.section, "field_sets");
+    if (!sets.IsDefined()) {
+      r.Error(safety, "safety.field_sets",
+              "missing required key: a list of {max_speed_mps, protective, warning} (here or in "
+              "the robot file's safety section)");
+    } else if (r.ExpectSequence(sets, "safety.field_sets")) {
+      if (sets.size() == 0) r.Error(sets, "safety.field_sets", "expected at least one field set");
+      for (std::size_t i = 0; i < sets.size(); ++i) {
+        const std::string path = JoinPath("safety.field_sets", std::to_string(i));
+        const YAML::Node item = sets[i];
+        if (!r.ExpectMap(item, path)) continue;
+        r.CheckKeys(item, path, {"max_speed_mps", "protective", "warning"});
+        YAML::Node set;
+        set["max_speed_mps"] =
+            Num(r.Real(item, path, "max_speed_mps", std::nullopt, {0.0, 100.0}));
+        set["protective"] = ReadPolygonInScanner(r, item, path, "protective", true, laser->x_m,
+                                                 laser->y_m, laser->yaw_rad);
+        const YAML::Node warning = ReadPolygonInScanner(r, item, path, "warning", false,
+                                                        laser->x_m, laser->y_m, laser->yaw_rad);
+        if (warning.IsDefined()) set["warning"] = warning;
+        out_sets.push_back(set);
+      }
     }
   }
   p["field_sets"] = out_sets;
+  // The robot file's parameters, then the scenario's over them.
+  const std::string prefix = JoinPath(JoinPath("units", kSafety), "parameters");
+  const YAML::Node vehicle_params = Child(vehicle, "parameters");
+  if (vehicle_params.IsDefined() && !vehicle_params.IsNull()) {
+    const YamlReader::InFile in(r, robot.robot.file);
+    if (r.ExpectMap(vehicle_params, "safety.parameters")) {
+      for (const auto& kv : vehicle_params) {
+        const std::string key = kv.first.Scalar();
+        p[key] = kv.second;
+        b.Origin(JoinPath(prefix, key),
+                 {kv.second, JoinPath("safety.parameters", key), robot.robot.file});
+      }
+    }
+  }
   const YAML::Node own = Child(safety, "parameters");
   if (own.IsDefined() && !own.IsNull() && r.ExpectMap(own, "safety.parameters")) {
     for (const auto& kv : own) {
       const std::string key = kv.first.Scalar();
       p[key] = kv.second;
-      b.Derived(JoinPath(JoinPath(JoinPath("units", kSafety), "parameters"), key), own,
-                "safety.parameters", key);
+      b.Derived(JoinPath(prefix, key), own, "safety.parameters", key);
     }
   }
   b.Connect(Signal(laser->name, "ranges"), Signal(kSafety, "ranges"));

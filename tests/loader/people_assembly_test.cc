@@ -2,6 +2,8 @@
 // expand into, and bad input named at its file and key path.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "tests/loader/scenario_test.h"
@@ -72,6 +74,32 @@ sensors: {default: false, laser_front: true}
                            "1, protective: [[0, 0], [1, 0], [0, 1]]}\n");
   issues = Issues(scanner);
   EXPECT_TRUE(Has(issues, "safety.scanner")) << issues;
+}
+
+// Guards the vehicle's configuration: `safety: {enabled: true}` takes the
+// field sets of the robot file (models/robots/raw3.yaml: three speed
+// cases), a scenario's key replaces the file's, and a bad value in the
+// robot file's section is reported there, at its key path.
+TEST(PeopleAssembly, FieldSetsComeFromTheRobotFile) {
+  const Scenario s = LoadScenario(Shipped(), {"duration_s=0.1"});
+  EXPECT_EQ(s.expanded["units"]["safety"]["parameters"]["field_sets"].size(), 3u);
+  EXPECT_EQ(Param(s, "safety", "restart_delay"), 2.0);  // the robot file's
+  const Scenario t =
+      LoadScenario(Shipped(), {"duration_s=0.1", "safety.parameters={restart_delay: 0.5}"});
+  EXPECT_EQ(Param(t, "safety", "restart_delay"), 0.5);
+
+  std::ifstream in(LINESIM_SOURCE_DIR "/models/robots/raw3.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string good = "- max_speed_mps: 0.4";
+  text.replace(text.find(good), good.size(), "- max_speed_mps: -0.4");
+  const std::string robot = WriteScenario("raw3_bad_field_set.yaml", text);
+  const std::string issues = Issues(Shipped(), {"robot.model=" + robot});
+  EXPECT_TRUE(Has(issues, robot)) << issues;
+  EXPECT_TRUE(Has(issues, "safety.field_sets.1.max_speed_mps")) << issues;
+
+  // The Husky has no safety section and no S300.
+  const std::string husky = Issues(Shipped(), {"robot.model=husky"});
+  EXPECT_TRUE(Has(husky, "safety.scanner")) << husky;
 }
 
 }  // namespace
