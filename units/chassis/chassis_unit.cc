@@ -1,7 +1,5 @@
 #include "units/chassis/chassis_unit.h"
 
-#include "models/moving_solids.h"
-
 #include <ode/ode.h>
 
 #include <algorithm>
@@ -12,6 +10,7 @@
 #include <utility>
 
 #include "models/angle.h"
+#include "models/moving_solids.h"
 #include "units/chassis/floor_world.h"
 
 namespace linesim::chassis {

@@ -1,7 +1,5 @@
 #include "units/chassis/floor_world.h"
 
-#include "models/moving_solids.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdarg>
@@ -10,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#include "models/moving_solids.h"
 
 namespace linesim::chassis {
 
@@ -330,9 +330,13 @@ void FloorWorld::SetMovingSolids(std::span<const double> boxes,
     // ODE's cylinder stands along its local z, the map's vertical here.
     moving_cylinder_geoms_.push_back(dCreateCylinder(nullptr, 1, 1));
   }
-  moving_boxes_.assign(boxes.begin(), boxes.begin() + static_cast<std::ptrdiff_t>(nb * MovingBox::kValues));
-  moving_cylinders_.assign(cylinders.begin(),
-                           cylinders.begin() + static_cast<std::ptrdiff_t>(nc * MovingCylinder::kValues));
+  const auto whole = [](std::span<const double> values, std::size_t count, std::size_t size) {
+    return values.first(count * size);
+  };
+  const auto b = whole(boxes, nb, MovingBox::kValues);
+  const auto c = whole(cylinders, nc, MovingCylinder::kValues);
+  moving_boxes_.assign(b.begin(), b.end());
+  moving_cylinders_.assign(c.begin(), c.end());
   moving_elapsed_s_ = 0.0;
 }
 

@@ -1,7 +1,5 @@
 #include "units/sensors/laser_scanner_unit.h"
 
-#include "models/moving_solids.h"
-
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -11,6 +9,7 @@
 #include <utility>
 
 #include "cosim/seed.h"
+#include "models/moving_solids.h"
 #include "models/rotation.h"
 
 namespace linesim::sensors {
@@ -435,8 +434,8 @@ void LaserScannerUnit::CastBeams(int first, int end, cosim::TimeNs t) {
     BeamRay(i, step_s_[k], step_sin_[k], step_vers_[k]);
   }
   rays_.Cast(std::span<const Ray>(beam_rays_.data() + first, n),
-             std::span<RayHit>(centre_.data() + first, n), belt_travel_, belt_speed_, moving_, moving_boxes_,
-             static_cast<int>(own_box_));
+             std::span<RayHit>(centre_.data() + first, n), belt_travel_, belt_speed_, moving_,
+             moving_boxes_, static_cast<int>(own_box_));
   for (int i = first; i < end; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const RayHit& h = centre_[k];

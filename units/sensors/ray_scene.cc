@@ -1,7 +1,5 @@
 #include "units/sensors/ray_scene.h"
 
-#include "models/moving_solids.h"
-
 #include <embree3/rtcore.h>
 
 #include <algorithm>
@@ -13,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "models/moving_solids.h"
 #include "platform/provenance.h"
 
 namespace linesim::sensors {
