@@ -59,7 +59,10 @@ TEST(FleetLine, NobodyTouchesAnybody) {
 // hold pushing back; each chassis meets the other's body as unmovable, so
 // who yields is the two controllers' and contacts' matter).
 TEST(FleetLine, RobotsSeeAndTouchEachOther) {
-  const std::vector<std::string> in_the_way = {"robots.1.pose.x_m=-0.5", "robots.1.pose.y_m=1.9"};
+  // 32 s: raw3_a meets raw3_b at about 27 s (the rest of the run adds
+  // nothing here, and the sanitized build runs this test too).
+  const std::vector<std::string> in_the_way = {"robots.1.pose.x_m=-0.5", "robots.1.pose.y_m=1.9",
+                                               "duration_s=32"};
   const auto with = RunFile(Shipped("fleet_line"), in_the_way);
   EXPECT_GE(with.at("raw3_a.protective_stops"), 2.0);
   EXPECT_EQ(with.at("raw3_a.robot_raw3_b_collisions"), 0.0);
@@ -67,7 +70,9 @@ TEST(FleetLine, RobotsSeeAndTouchEachOther) {
   EXPECT_LT(with.at("raw3_b.max_position_drift_m"), 1e-3);
 
   // Without the wait, worker_2 walks into the Husky.
-  const auto no_wait = RunFile(Shipped("fleet_line"), {"workers.1.parameters.stop_distance=0"});
+  // (The Husky meets worker_2 at about 17 s.)
+  const auto no_wait = RunFile(Shipped("fleet_line"),
+                               {"workers.1.parameters.stop_distance=0", "duration_s=20"});
   EXPECT_GE(no_wait.at("husky.robot_worker_2_collisions"), 1.0);
 
   auto without_safety = in_the_way;
