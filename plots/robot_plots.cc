@@ -471,12 +471,18 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   std::vector<std::streamoff> row_starts;
   // Each belt's travel at the last row that gives one.
   std::vector<std::optional<double>> travel(travels.size());
+  // The other robots' and the workers' tracks, drawn from data blocks
+  // (thinned below) rather than by gnuplot reading signals.csv once more
+  // for each: in a fleet of N, N - 1 more passes over a row of some 60 N
+  // columns, for each of the N robots' top views.
+  std::vector<std::vector<Point>> other_tracks(others.size()), worker_tracks(workers.size());
   {
     std::vector<std::string_view> fields;
     std::string line;
     int last_column = std::max(ix, iy);
     for (int col : travels) last_column = std::max(last_column, col);
     for (const auto& o : others) last_column = std::max({last_column, o.x, o.y});
+    for (const auto& [wx, wy] : workers) last_column = std::max({last_column, wx, wy});
     const auto needed = static_cast<std::size_t>(last_column);
     while (true) {
       const std::streamoff start = signals.in.tellg();
@@ -486,9 +492,15 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
       SplitCsv(line, fields, needed);
       const auto x = Column(fields, ix), y = Column(fields, iy);
       if (x && y) view.Add(*x, *y);
-      for (const auto& o : others) {
-        const auto ox = Column(fields, o.x), oy = Column(fields, o.y);
-        if (ox && oy) view.Add(*ox, *oy);
+      for (std::size_t k = 0; k < others.size(); ++k) {
+        const auto ox = Column(fields, others[k].x), oy = Column(fields, others[k].y);
+        if (!ox || !oy) continue;
+        view.Add(*ox, *oy);
+        other_tracks[k].push_back({*ox, *oy});
+      }
+      for (std::size_t k = 0; k < workers.size(); ++k) {
+        const auto wx = Column(fields, workers[k].first), wy = Column(fields, workers[k].second);
+        if (wx && wy) worker_tracks[k].push_back({*wx, *wy});
       }
       for (std::size_t b = 0; b < travels.size(); ++b) {
         if (const auto d = Column(fields, travels[b])) travel[b] = d;
@@ -496,6 +508,26 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     }
   }
   if (row_starts.empty()) throw std::runtime_error(signals.file.string() + " has no data rows");
+  // At most about 1,000 points a track (the last one kept): at the usual
+  // 100 Hz recording a 10 s stretch stays whole, and a robot at 1 m/s
+  // moves 1 cm between points; tracks separated by a blank line.
+  const auto tracks_block = [](const std::vector<std::vector<Point>>& tracks) {
+    std::string block;
+    for (const auto& track : tracks) {
+      if (track.empty()) continue;
+      const std::size_t step = (track.size() + 999) / 1000;
+      for (std::size_t i = 0; i < track.size(); i += step) {
+        block += Num(track[i].x) + "," + Num(track[i].y) + "\n";
+      }
+      if ((track.size() - 1) % step != 0) {
+        block += Num(track.back().x) + "," + Num(track.back().y) + "\n";
+      }
+      block += "\n";
+    }
+    return block;
+  };
+  const std::string other_track_block = tracks_block(other_tracks);
+  const std::string worker_track_block = tracks_block(worker_tracks);
   if (iyaw > 0) {
     // A robot standing still would get its labels printed over each other:
     // an instant closer than a quarter body length to the last label joins
@@ -620,6 +652,8 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   if (!path.empty()) AppendBlock(s, "path", path);
   if (!outlines.empty()) AppendBlock(s, "outlines", outlines);
   if (!other_outlines.empty()) AppendBlock(s, "other_outlines", other_outlines);
+  if (!other_track_block.empty()) AppendBlock(s, "other_tracks", other_track_block);
+  if (!worker_track_block.empty()) AppendBlock(s, "worker_tracks", worker_track_block);
   if (!contacts.empty()) AppendBlock(s, "contacts", contacts);
   if (!labels.empty()) AppendBlock(s, "labels", labels);
 
@@ -703,18 +737,16 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
                     GnuplotQuote(spec.others.empty() ? "robot outline"
                                                      : spec.robot_name + " outline"));
   }
-  for (std::size_t k = 0; k < others.size(); ++k) {
-    items.push_back(signals_file + " skip 1 using " + std::to_string(others[k].x) + ":" +
-                    std::to_string(others[k].y) + " with lines lw 2 lc rgb '#17becf' " +
-                    (k == 0 ? "title 'other robots (path, outline)'" : "notitle"));
+  if (!other_track_block.empty()) {
+    items.push_back(
+        "$other_tracks using 1:2 with lines lw 2 lc rgb '#17becf' title 'other robots (path, "
+        "outline)'");
   }
   if (!other_outlines.empty()) {
     items.push_back("$other_outlines using 1:2 with lines lw 1 lc rgb '#17becf' notitle");
   }
-  for (std::size_t w = 0; w < workers.size(); ++w) {
-    items.push_back(signals_file + " skip 1 using " + std::to_string(workers[w].first) + ":" +
-                    std::to_string(workers[w].second) + " with lines lw 2 lc rgb '#9467bd' " +
-                    (w == 0 ? "title 'worker'" : "notitle"));
+  if (!worker_track_block.empty()) {
+    items.push_back("$worker_tracks using 1:2 with lines lw 2 lc rgb '#9467bd' title 'worker'");
   }
   if (!contacts.empty()) {
     items.push_back(

@@ -189,11 +189,13 @@ TEST_F(RobotPlotsTest, SafetyPlotDrawsSpeedCapAndFields) {
   EXPECT_TRUE(IsPng(files[1]));
   const std::string script = ReadAll(dir_ / "plots.gp");
   // Columns by number: velocity 4 and 5, cap 6 (-1: NaN), fields 7 and 8,
-  // distance 9; the worker's track 10:11 in the top view.
+  // distance 9; the worker's track (columns 10 and 11) in the top view, from
+  // a data block the script carries.
   EXPECT_NE(script.find("sqrt(column(4)**2 + column(5)**2)"), std::string::npos);
   EXPECT_NE(script.find("column(6) < 0 ? NaN : column(6)"), std::string::npos);
   EXPECT_NE(script.find("using 1:7 axes x1y2 with steps"), std::string::npos);
-  EXPECT_NE(script.find("using 10:11 with lines"), std::string::npos);
+  EXPECT_NE(script.find("$worker_tracks using 1:2 with lines"), std::string::npos);
+  EXPECT_NE(script.find("$worker_tracks << EOD"), std::string::npos);
 }
 
 // Guards against output that changes from run to run (timestamps, map
