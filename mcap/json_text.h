@@ -6,6 +6,8 @@
 #include <string>
 #include <string_view>
 
+#include "json_text/json_string.h"
+
 /// Appending JSON text by hand, fast and the same on every machine: numbers
 /// as std::to_chars writes them (the shortest text that reads back to the
 /// same double, independent of the locale, as signals.csv has them), a
@@ -55,7 +57,7 @@ inline void TenthMillimetres(std::string& out, double v) {
 }
 
 /// A quoted string with JSON's escapes.
-void String(std::string& out, std::string_view s);
+inline void String(std::string& out, std::string_view s) { json_text::AppendString(out, s); }
 
 /// A Foxglove time or duration: {"sec":S,"nsec":N} of `ns` nanoseconds
 /// (ns >= 0).

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "cosim/files.h"
+#include "json_text/json_string.h"
 #include "loader/scenario.h"
 #include "units/sensors/laser_scanner_unit.h"
 
@@ -61,25 +62,9 @@ void AppendFixed(std::string& out, double v, int decimals) {
   out.append(buf, static_cast<std::size_t>(digits));
 }
 
-// A JSON string; <, > and & escaped too, so that no text inside the page's
-// <script> element can close it.
+// A JSON string inside the page's <script> element.
 void AppendString(std::string& out, const std::string& s) {
-  out += '"';
-  for (const char c : s) {
-    const auto u = static_cast<unsigned char>(c);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (u < 0x20 || c == '<' || c == '>' || c == '&') {
-      static const char* hex = "0123456789abcdef";
-      out += "\\u00";
-      out += hex[u >> 4];
-      out += hex[u & 15];
-    } else {
-      out += c;
-    }
-  }
-  out += '"';
+  json_text::AppendString(out, s, /*inside_html_script=*/true);
 }
 
 void AppendArray(std::string& out, const std::vector<double>& values, int decimals) {

@@ -1,8 +1,8 @@
-#include "mcap/json_text.h"
+#include "json_text/json_string.h"
 
-namespace linesim::mcap::json {
+namespace linesim::json_text {
 
-void String(std::string& out, std::string_view s) {
+void AppendString(std::string& out, std::string_view s, bool inside_html_script) {
   static constexpr char kHex[] = "0123456789abcdef";
   out += '"';
   for (const char c : s) {
@@ -10,7 +10,7 @@ void String(std::string& out, std::string_view s) {
     if (c == '"' || c == '\\') {
       out += '\\';
       out += c;
-    } else if (u < 0x20) {
+    } else if (u < 0x20 || (inside_html_script && (c == '<' || c == '>' || c == '&'))) {
       out += "\\u00";
       out += kHex[u >> 4];
       out += kHex[u & 0xF];
@@ -21,4 +21,4 @@ void String(std::string& out, std::string_view s) {
   out += '"';
 }
 
-}  // namespace linesim::mcap::json
+}  // namespace linesim::json_text

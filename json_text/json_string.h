@@ -1,0 +1,16 @@
+#pragma once
+
+#include <string>
+#include <string_view>
+
+/// JSON text written by hand where the writers need it fast (run.mcap's
+/// messages, replay.html's data): the one place strings are escaped.
+namespace linesim::json_text {
+
+/// Appends `s` as a quoted JSON string: '"' and '\' escaped, control
+/// characters as \u00XX. With `inside_html_script` also '<', '>' and '&'
+/// as \u00XX, so that no text inside a page's <script> element can close
+/// it.
+void AppendString(std::string& out, std::string_view s, bool inside_html_script = false);
+
+}  // namespace linesim::json_text
