@@ -58,6 +58,20 @@ void StepOk(ChassisUnit& u, TimeNs& t) {
   t += kMs;
 }
 
+// Drives both sides at `rate` (rad/s, the speed loop) for `steps` 1 ms steps
+// from t = 0; returns the largest x base_link reached.
+double DriveStraight(ChassisUnit& u, double rate, int steps) {
+  SpeedLoop loop;
+  TimeNs t = 0;
+  double max_x = 0.0;
+  for (int i = 0; i < steps; ++i) {
+    loop.Step(u, {rate, rate});
+    StepOk(u, t);
+    max_x = std::max(max_x, Get(u, "position")[0]);
+  }
+  return max_x;
+}
+
 // Guards the coupling of a side's two wheels (a belt in the real robot):
 // they must turn together by a constraint, also when the torque acts on one
 // of them only and the pair straddles a belt edge (front wheel on a running
@@ -218,14 +232,7 @@ TEST(Obstacles, PillarStopsTheRobot) {
   u.Initialize();
   const double rate = 0.5 / kHuskyWheelRadiusM;
   const double stop_x = 1.5 - 0.2 - 0.5 * kHuskyBodyM[0];
-  SpeedLoop loop;
-  TimeNs t = 0;
-  double max_x = 0.0;
-  for (int i = 0; i < 5000; ++i) {
-    loop.Step(u, {rate, rate});
-    StepOk(u, t);
-    max_x = std::max(max_x, Get(u, "position")[0]);
-  }
+  const double max_x = DriveStraight(u, rate, 5000);
   EXPECT_LT(max_x, stop_x + 0.003);
   RecordProperty("pillar_overshoot_m", std::to_string(max_x - stop_x));
   EXPECT_NEAR(Get(u, "position")[0], stop_x, 0.003);
@@ -318,14 +325,7 @@ TEST(MovingSolids, OtherRobotAndLegStopTheRobot) {
     const double face = box ? 2.0 - 0.5 * 1.03 : 1.5 - 0.06;
     const double stop_x = face - 0.5 * kHuskyBodyM[0];
     const double rate = 0.5 / kHuskyWheelRadiusM;
-    SpeedLoop loop;
-    TimeNs t = 0;
-    double max_x = 0.0;
-    for (int i = 0; i < 5000; ++i) {
-      loop.Step(u, {rate, rate});
-      StepOk(u, t);
-      max_x = std::max(max_x, Get(u, "position")[0]);
-    }
+    const double max_x = DriveStraight(u, rate, 5000);
     EXPECT_LT(max_x, stop_x + 0.003);
     EXPECT_GT(Get(u, "position")[0], stop_x - 0.01);
     EXPECT_NEAR(Get(u, "body_linear_velocity")[0], 0.0, 1e-3);
