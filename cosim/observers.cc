@@ -119,6 +119,11 @@ bool ParseReduction(const std::string& text, Reduction* out) {
   return false;
 }
 
+std::string ToString(Reduction reduction) {
+  const auto names = ReductionNames();
+  return names[static_cast<std::size_t>(reduction)];
+}
+
 std::vector<std::string> ReductionNames() {
   return {"final", "min", "max", "max_abs", "mean", "rms"};
 }

@@ -51,6 +51,8 @@ enum class Reduction { kFinal, kMin, kMax, kMaxAbs, kMean, kRms };
 /// Parses "final", "min", "max", "max_abs", "mean", "rms"; false if unknown.
 bool ParseReduction(const std::string& text, Reduction* out);
 std::vector<std::string> ReductionNames();
+/// The name ParseReduction reads.
+std::string ToString(Reduction reduction);
 
 struct MetricSpec {
   std::string name;

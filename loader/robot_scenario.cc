@@ -25,54 +25,22 @@ using models::kDegToRad;
 // connections come before the expansion's, so that a problem found in them
 // keeps the index it has in the file.
 void Passthrough(assembly::SystemBuilder& b) {
-  YamlReader& r = b.reader();
-  const YAML::Node units = Child(b.root(), "units");
-  if (units.IsDefined() && !units.IsNull() && r.ExpectMap(units, "units")) {
-    for (const auto& kv : units) {
-      const std::string name = kv.first.Scalar();
-      const std::string path = JoinPath("units", name);
-      if (!kv.second.IsMap()) {
-        r.ExpectMap(kv.second, path);
-        continue;
-      }
-      YAML::Node target = b.out()["units"][name];
-      for (const auto& item : kv.second) {
-        const std::string key = item.first.Scalar();
-        // What the file sets here is no longer derived from robot-level keys.
-        std::vector<std::string> written = {JoinPath(path, key)};
-        if (key == "parameters" && item.second.IsMap()) {
-          written.clear();
-          for (const auto& p : item.second) {
-            written.push_back(JoinPath(JoinPath(path, key), p.first.Scalar()));
-          }
-          assembly::MergeInto(target["parameters"], item.second);
-        } else {
-          target[key] = item.second;
-        }
-        for (const auto& w : written) {
-          std::erase_if(b.origins(), [&](const auto& o) {
-            return o.first == w || o.first.starts_with(w + ".");
-          });
-        }
-      }
-    }
-  }
-  const YAML::Node own = Child(b.root(), "connections");
-  YAML::Node connections(YAML::NodeType::Sequence);
-  if (own.IsDefined() && !own.IsNull() && r.ExpectSequence(own, "connections")) {
-    for (const auto& c : own) connections.push_back(c);
-  }
-  for (const auto& c : b.connections()) connections.push_back(c);
-  b.out()["connections"] = connections;
+  SystemSpec& spec = b.spec();
+  ReadUnits(Child(b.root(), "units"), b.reader(), spec, false);
+  std::vector<ConnectionSpec> expansion = std::move(spec.connections);
+  spec.connections.clear();
+  ReadConnections(Child(b.root(), "connections"), b.reader(), spec);
+  spec.connections.insert(spec.connections.end(), expansion.begin(), expansion.end());
 }
 
 // A positive number the chassis will get, for the plots; nothing otherwise
 // (the chassis unit reports a bad one).
 std::optional<double> PositiveChassisValue(assembly::SystemBuilder& b, const std::string& chassis,
                                            const std::string& key) {
-  const YAML::Node n = Child(Child(Child(Child(b.out(), "units"), chassis), "parameters"), key);
-  const auto value = YamlReader::DecodeReal(n);
-  if (value && std::isfinite(*value) && *value > 0.0) return value;
+  const UnitSpec* unit = b.spec().FindUnit(chassis);
+  const ParameterValue* value = unit ? unit->parameters.Find(key) : nullptr;
+  const auto number = value ? value->Number() : std::nullopt;
+  if (number && std::isfinite(*number) && *number > 0.0) return number;
   return std::nullopt;
 }
 
@@ -221,11 +189,13 @@ bool BodiesOverlap(const RobotInfo& a, const RobotInfo& b) {
 // unit (units/world) into an array each of them reads whole, skipping its
 // own robot's box.
 void ConnectFleet(assembly::SystemBuilder& b, const std::vector<RobotInfo>& robots,
-                  const std::vector<std::vector<std::string>>& lasers, YAML::Node metrics,
+                  const std::vector<std::vector<std::string>>& lasers,
                   std::vector<std::string>& recorded) {
   constexpr std::size_t kBox = models::MovingBox::kValues;
   const auto add = [&](const std::string& name, const std::string& of, const char* reduce) {
-    assembly::AddMetric(metrics, name, of, reduce);
+    cosim::Reduction reduction = cosim::Reduction::kFinal;
+    cosim::ParseReduction(reduce, &reduction);
+    b.Metric(name, of, reduction);
   };
   const int count = static_cast<int>(robots.size());
   b.Unit(assembly::kMovingBodies, "moving_bodies");
@@ -239,10 +209,10 @@ void ConnectFleet(assembly::SystemBuilder& b, const std::vector<RobotInfo>& robo
     }
   }
   // The workers yield to every robot.
-  for (const auto& kv : Child(b.out(), "units")) {
-    if (Child(kv.second, "type").as<std::string>("") != "worker") continue;
-    b.Params(kv.first.Scalar())["robots"] = count;
-    b.Connect(bodies, assembly::Signal(kv.first.Scalar(), "robots"));
+  for (auto& unit : b.spec().units) {
+    if (unit.type != "worker") continue;
+    unit.parameters["robots"] = count;
+    b.Connect(bodies, assembly::Signal(unit.name, "robots"));
   }
   for (std::size_t i = 0; i < robots.size(); ++i) {
     const std::string& name = robots[i].name;
@@ -274,7 +244,6 @@ struct FleetParts {
   std::vector<RobotInfo> robots;
   std::vector<std::size_t> list_index;           // each robot's item of `robots:`
   std::vector<std::vector<std::string>> lasers;  // each robot's laser units
-  YAML::Node metrics{YAML::NodeType::Sequence};
   std::vector<std::string> recorded;
 };
 
@@ -287,60 +256,57 @@ void MergeRobot(assembly::SystemBuilder& top, assembly::SystemBuilder& b, YamlRe
                 bool several, RobotInfo robot, std::size_t list_item, FleetParts& fleet) {
   const std::string name = robot.name;
   const bool first = fleet.robots.empty();
+  SystemSpec& one = b.spec();
+  SystemSpec& all = top.spec();
   std::set<std::string> own;
-  const YAML::Node units = Child(b.out(), "units");
-  for (const auto& kv : units) {
-    const std::string type = Child(kv.second, "type").as<std::string>("");
-    if (type != "belt" && type != "worker") own.insert(kv.first.Scalar());
+  for (const auto& unit : one.units) {
+    if (unit.type != "belt" && unit.type != "worker") own.insert(unit.name);
   }
   const auto unit_of = [](const std::string& column) { return column.substr(0, column.find('.')); };
   const auto scoped = [&](const std::string& column) {
     return own.count(unit_of(column)) ? name + "." + column : column;
   };
   fleet.lasers.emplace_back();
-  for (const auto& kv : units) {
-    const std::string unit = kv.first.Scalar();
-    if (!own.count(unit)) {
-      if (!top.HasUnit(unit)) top.out()["units"][unit] = kv.second;
+  for (auto& unit : one.units) {
+    if (!own.count(unit.name)) {
+      if (!top.HasUnit(unit.name)) all.units.push_back(std::move(unit));
       continue;
     }
-    top.out()["units"][name + "." + unit] = kv.second;
-    if (Child(kv.second, "type").as<std::string>("") == "laser_scanner") {
-      fleet.lasers.back().push_back(name + "." + unit);
-    }
+    unit.name = name + "." + unit.name;
+    if (unit.type == "laser_scanner") fleet.lasers.back().push_back(unit.name);
+    all.units.push_back(std::move(unit));
   }
-  for (const auto& c : b.connections()) {
-    const std::string from = c["from"].as<std::string>(), to = c["to"].as<std::string>();
+  for (const auto& c : one.connections) {
     // A worker yields to every robot of the fleet, not to the one robot it
     // was assembled with.
-    if (several && !own.count(unit_of(to)) && to.ends_with(".robots")) continue;
+    if (several && !own.count(unit_of(c.to)) && c.to.ends_with(".robots")) continue;
     // Between the scene's units: the first robot made it.
-    if (!first && !own.count(unit_of(from)) && !own.count(unit_of(to))) continue;
-    top.Connect(scoped(from), scoped(to));
+    if (!first && !own.count(unit_of(c.from)) && !own.count(unit_of(c.to))) continue;
+    top.Connect(scoped(c.from), scoped(c.to));
   }
-  for (const auto& v : Child(Child(b.out(), "recording"), "variables")) {
-    const std::string column = scoped(v.as<std::string>());
-    if (std::find(fleet.recorded.begin(), fleet.recorded.end(), column) == fleet.recorded.end()) {
-      fleet.recorded.push_back(column);
+  if (one.recording && one.recording->variables) {
+    for (const auto& v : *one.recording->variables) {
+      const std::string column = scoped(v.text);
+      if (std::find(fleet.recorded.begin(), fleet.recorded.end(), column) == fleet.recorded.end()) {
+        fleet.recorded.push_back(column);
+      }
     }
   }
-  for (const auto& m : Child(b.out(), "metrics")) {
-    const std::string of = m["of"].as<std::string>();
-    if (!own.count(unit_of(of))) {
-      if (first) fleet.metrics.push_back(m);  // of a scene's unit (a worker): once, unscoped
+  for (const auto& m : one.metrics) {
+    if (!own.count(unit_of(m.of))) {
+      if (first) all.metrics.push_back(m);  // of a scene's unit (a worker): once, unscoped
       continue;
     }
-    assembly::AddMetric(fleet.metrics, name + "." + m["name"].as<std::string>(), scoped(of),
-                        m["reduce"].as<std::string>().c_str());
+    top.Metric(name + "." + m.name, scoped(m.of), m.reduction);
   }
-  for (const auto& [expanded, from] : b.origins()) {
+  for (const auto& [expanded, from] : one.origins) {
     std::string key = expanded;
     Origin origin = from;
     if (key.starts_with("units.") && own.count(unit_of(key.substr(6)))) {
       key = "units." + name + "." + key.substr(6);
     }
     if (origin.file.empty()) origin.path = r.Scoped(origin.path);
-    top.origins().emplace(key, origin);
+    all.origins.emplace(key, origin);
   }
   ScopeColumns(robot, scoped);
   fleet.robots.push_back(std::move(robot));
@@ -351,20 +317,16 @@ void MergeRobot(assembly::SystemBuilder& top, assembly::SystemBuilder& b, YamlRe
 // the one-robot shorthand is (its sections read as if they were the file's
 // top-level ones), its units then scoped by its name (raw3_a.chassis).
 // Belts and workers are the scene's: one unit each, shared.
-YAML::Node ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
+SystemSpec ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
   r.CheckKeys(root, "",
               {"name", "description", "duration_s", "seed", "master", "robots", "scene", "line",
                "units", "connections", "recording", "metrics", "reference", "workers"});
   assembly::SystemBuilder top(root, r);
-  for (const char* key : {"name", "description", "duration_s", "seed", "master", "reference"}) {
-    if (Child(root, key).IsDefined()) top.out()[key] = Child(root, key);
-  }
+  ReadSystemHead(root, r, top.spec());
   const models::Scene scene = assembly::AddScene(top);
   FleetParts fleet;
-  const YAML::Node extra = Child(root, "metrics");
-  if (extra.IsDefined() && !extra.IsNull() && r.ExpectSequence(extra, "metrics")) {
-    for (const auto& m : extra) fleet.metrics.push_back(m);
-  }
+  // The scenario's own metrics first.
+  ReadMetrics(Child(root, "metrics"), r, top.spec());
   const std::vector<RobotInfo>& robots = fleet.robots;
 
   const YAML::Node list = Child(root, "robots");
@@ -417,9 +379,8 @@ YAML::Node ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
     MergeRobot(top, b, r, list.size() > 1, std::move(robot), i, fleet);
   }
   if (robots.size() > 1 && r.ok()) {
-    ConnectFleet(top, robots, fleet.lasers, fleet.metrics, fleet.recorded);
+    ConnectFleet(top, robots, fleet.lasers, fleet.recorded);
   }
-  top.out()["metrics"] = fleet.metrics;
   assembly::AddRecordingSection(top, fleet.recorded);
   Passthrough(top);
   for (auto& robot : fleet.robots) ReadBody(top, robot.name + "." + assembly::kChassis, robot);
@@ -439,8 +400,7 @@ YAML::Node ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
     info = robots.front();
     info.fleet.assign(robots.begin() + 1, robots.end());
   }
-  r.SetOrigins(std::move(top.origins()));
-  return top.out();
+  return std::move(top.spec());
 }
 
 }  // namespace
@@ -449,7 +409,7 @@ bool IsRobotScenario(const YAML::Node& root) {
   return root.IsMap() && (Child(root, "robot").IsDefined() || Child(root, "robots").IsDefined());
 }
 
-YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
+SystemSpec ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
   if (Child(root, "robots").IsDefined()) {
     if (Child(root, "robot").IsDefined()) {
       r.Error(Child(root, "robot"), "robot",
@@ -462,15 +422,12 @@ YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
                "control", "task", "sensors", "sensing", "localization", "units", "connections",
                "recording", "metrics", "reference", "workers", "safety"});
   assembly::SystemBuilder b(root, r);
-  for (const char* key : {"name", "description", "duration_s", "seed", "master", "reference"}) {
-    if (Child(root, key).IsDefined()) b.out()[key] = Child(root, key);
-  }
+  ReadSystemHead(root, r, b.spec());
   const models::Scene scene = assembly::AddScene(b);
   AssembleRobot(b, {"model", "pose", "payload"}, scene, info);
   Passthrough(b);
   ReadBody(b, assembly::kChassis, info);
-  r.SetOrigins(std::move(b.origins()));
-  return b.out();
+  return std::move(b.spec());
 }
 
 }  // namespace linesim::loader

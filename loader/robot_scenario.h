@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "loader/config_names.h"
+#include "loader/system_spec.h"
 
 namespace linesim::loader {
 
@@ -71,12 +72,12 @@ struct RobotInfo {
 /// sensors and safety, on one scene with its line and workers).
 bool IsRobotScenario(const YAML::Node& root);
 
-/// Expands a robot scenario into a system-level tree (scene, units,
-/// connections, recording, metrics) that the system loader builds, one
+/// Expands a robot scenario into a system description (scene, units,
+/// connections, recording, metrics) that the scenario builder builds, one
 /// concern after another (loader/assembly/concerns.h). Problems are
 /// reported through `reader` at the robot-level key paths; `info` receives
 /// what the plots need. A robot.model given as a path is relative to the
 /// folder of `reader`'s file, the scenario.
-YAML::Node ExpandRobotScenario(const YAML::Node& root, YamlReader& reader, RobotInfo& info);
+SystemSpec ExpandRobotScenario(const YAML::Node& root, YamlReader& reader, RobotInfo& info);
 
 }  // namespace linesim::loader

@@ -1,7 +1,5 @@
 #include "loader/scenario.h"
 
-#include "platform/sha256.h"
-
 #include <algorithm>
 #include <filesystem>
 #include <map>
@@ -11,7 +9,9 @@
 #include "cosim/seed.h"
 #include "loader/config_names.h"
 #include "loader/scene_file.h"
+#include "loader/system_spec.h"
 #include "loader/yaml_files.h"
+#include "platform/sha256.h"
 
 namespace linesim::loader {
 
@@ -162,132 +162,149 @@ void ApplyParameters(cosim::Unit& unit, const YAML::Node& map, const std::string
   }
 }
 
+// Sets a typed value the assembly derived when it is of the variable's
+// type; true if done. Anything else goes through the YAML conversion, which
+// names what was expected.
+bool ApplyTyped(cosim::Unit& unit, const cosim::VariableInfo& info, const ParameterValue& value,
+                const std::string& path, YamlReader& r) {
+  std::optional<cosim::Value> v;
+  const auto& typed = value.value();
+  switch (info.type) {
+    case cosim::VarType::kReal:
+      if (const auto* x = std::get_if<double>(&typed)) v = *x;
+      if (const auto* n = std::get_if<std::int64_t>(&typed)) v = static_cast<double>(*n);
+      break;
+    case cosim::VarType::kInteger:
+      if (const auto* n = std::get_if<std::int64_t>(&typed)) v = *n;
+      break;
+    case cosim::VarType::kBoolean:
+      if (const auto* b = std::get_if<bool>(&typed)) v = *b;
+      break;
+    case cosim::VarType::kString:
+      if (const auto* t = std::get_if<std::string>(&typed)) v = *t;
+      break;
+    case cosim::VarType::kRealArray:
+      if (const auto* list = std::get_if<std::vector<double>>(&typed);
+          list && list->size() == info.size) {
+        v = *list;
+      }
+      break;
+  }
+  if (!v) return false;
+  try {
+    unit.variables().SetValue(info.ref, *v);
+  } catch (const std::exception& e) {
+    r.Error(YAML::Node(), path, e.what());
+  }
+  return true;
+}
+
+// Applies a description's parameters (typed, or as a file wrote them) to the
+// unit, skipping `skip`.
+void ApplyParameters(cosim::Unit& unit, const Parameters& params, const std::string& path,
+                     const std::vector<std::string>& skip, YamlReader& r,
+                     std::map<std::string, ParameterOrigin>& origins) {
+  std::vector<std::string> allowed = skip;
+  for (const auto& info : unit.variables().infos()) {
+    if (info.causality == cosim::Causality::kParameter) allowed.push_back(info.name);
+  }
+  for (const auto& [key, value] : params) {
+    if (std::find(skip.begin(), skip.end(), key) != skip.end()) continue;
+    const std::string key_path = JoinPath(path, key);
+    const YAML::Node* written = value.written();
+    const YAML::Node node = written ? *written : YAML::Node();
+    const auto ref = unit.variables().Find(key);
+    if (!ref || unit.variables().info(*ref).causality != cosim::Causality::kParameter) {
+      r.UnknownPath(node, key_path,
+                    "unknown parameter of a " + unit.type_name() + " unit" +
+                        ClosestPathsHint(path, key, allowed) + " (linesim inspect " +
+                        unit.type_name() + " lists them)");
+      continue;
+    }
+    const cosim::VariableInfo& info = unit.variables().info(*ref);
+    if (written || !ApplyTyped(unit, info, value, key_path, r)) {
+      ApplyParameter(unit, info, written ? node : value.ToYaml(), key_path, r);
+    }
+    origins[key] = {r.file(), node, key_path};
+  }
+}
+
+// Builds the system a description describes: creates and parameterizes its
+// units, connects them, makes the master and resolves what is recorded and
+// measured. Problems are reported where the description says its values
+// came from.
 class Builder {
  public:
   Builder(Scenario& s, YamlReader& r) : s_(s), r_(r) {}
 
-  void Build(const YAML::Node& root) {
-    if (!r_.ExpectMap(root, "(top)")) return;
-    r_.CheckKeys(root, "",
-                 {"name", "description", "duration_s", "seed", "master", "units", "connections",
-                  "recording", "metrics", "scene", "reference"});
-    s_.name = r_.String(root, "", "name", fs::path(s_.file).stem().string());
-    s_.description = r_.String(root, "", "description", "");
-    cosim::MasterOptions options;
-    options.start = 0;
-    options.stop = r_.Time(root, "", "duration_s", std::nullopt, {0.0, 1e7, true});
-    s_.duration_s = cosim::NsToSeconds(options.stop);
-    s_.seed = static_cast<std::uint64_t>(
-        r_.Integer(root, "", "seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
-
-    const std::size_t issues_before_master = r_.issues().size();
-    const YAML::Node master = Child(root, "master");
-    if (master.IsDefined() && !master.IsNull() && r_.ExpectMap(master, "master")) {
-      r_.CheckKeys(master, "master", {"algorithm", "step_s", "threads", "retry"});
-    }
-    const YAML::Node master_map = master.IsMap() ? master : YAML::Node(YAML::NodeType::Map);
-    const std::string algorithm = r_.String(
-        master_map, "master", "algorithm",
-        std::string(cosim::ToString(cosim::Algorithm::kGaussSeidel)), cosim::AlgorithmNames());
-    cosim::ParseAlgorithm(algorithm, &options.algorithm);
-    options.base_step = ReadMasterStep(r_, master_map);
-    options.threads = static_cast<int>(r_.Integer(master_map, "master", "threads", 1, 1, 256));
-    options.retry = ReadMasterRetry(r_, master_map, options.base_step);
-    if (options.base_step > 0 && options.stop > 0 && options.stop % options.base_step != 0) {
-      r_.Error(Child(root, "duration_s"), "duration_s",
-               "duration " + cosim::FormatSeconds(options.stop) +
-                   " s is not a whole number of master steps (master.step_s = " +
-                   cosim::FormatSeconds(options.base_step) + " s)");
-    }
-    const bool master_ok = r_.issues().size() == issues_before_master;
-
-    // The scene first: units that need geometry build from it.
-    const std::size_t issues_before_scene = r_.issues().size();
-    s_.scene = ReadScenarioScene(r_, Child(root, "scene"), s_.file);
+  void Build(const SystemSpec& spec) {
+    s_.name = spec.name;
+    s_.description = spec.description;
+    s_.seed = spec.seed;
+    s_.duration_s = cosim::NsToSeconds(spec.master.stop);
+    s_.scene = spec.scene;
+    s_.reference = spec.reference;
     // A scene problem would only echo as problems of the units built on it.
-    if (r_.issues().size() != issues_before_scene) return;
+    if (!spec.scene_ok) return;
+    if (!spec.origins.empty()) r_.SetOrigins(spec.origins);
 
     s_.system = std::make_unique<cosim::System>();
     const std::size_t issues_before_units = r_.issues().size();
-    BuildUnits(Child(root, "units"));
-    const bool units_ok = r_.issues().size() == issues_before_units;
-    const auto connection_nodes = BuildConnections(Child(root, "connections"));
+    for (const auto& unit : spec.units) BuildUnit(unit);
+    const bool units_ok = spec.units_ok && r_.issues().size() == issues_before_units;
+    const auto connections = BuildConnections(spec.connections);
     // With a unit missing, every connection to it would be reported again.
     if (!units_ok) return;
 
     try {
       s_.system->Build();
-      // Bad master settings were reported above; the master would only
+      // Bad master settings were reported when read; the master would only
       // report them again.
-      if (!master_ok) return;
-      s_.master = std::make_unique<cosim::Master>(*s_.system, options);
-      if (!r_.ok()) return;
+      if (!spec.master_ok) return;
+      s_.master = std::make_unique<cosim::Master>(*s_.system, spec.master);
     } catch (const cosim::ConfigError& e) {
       for (const auto& p : e.problems()) {
-        if (p.connection && *p.connection < connection_nodes.size()) {
-          const auto& [index, node] = connection_nodes[*p.connection];
-          r_.Error(node, "connections." + std::to_string(index), p.message);
-        } else if (p.unit && *p.unit < unit_nodes_.size()) {
-          const auto& [name, node] = unit_nodes_[*p.unit];
-          const YAML::Node step = Child(node, "step_s");
-          const std::string unit_path = JoinPath("units", name);
-          r_.Error(step.IsDefined() ? step : node,
-                   step.IsDefined() ? JoinPath(unit_path, "step_s") : unit_path, p.message);
+        if (p.connection && *p.connection < connections.size()) {
+          const std::size_t index = connections[*p.connection];
+          r_.Error(spec.connections[index].node, "connections." + std::to_string(index), p.message);
+        } else if (p.unit && *p.unit < built_.size()) {
+          // At its step where one is given (the assembly's is derived from
+          // control.period_s, say), else at the unit.
+          const UnitSpec& unit = *built_[*p.unit];
+          const YAML::Node step = Child(unit.node, "step_s");
+          const std::string unit_path = JoinPath("units", unit.name);
+          r_.Error(step.IsDefined() ? step : unit.node,
+                   unit.step ? JoinPath(unit_path, "step_s") : unit_path, p.message);
         } else {
-          r_.Error(root, "", p.message);
+          r_.Error(spec.root, "", p.message);
         }
       }
       return;
     }
-    BuildRecording(Child(root, "recording"), options);
-    BuildMetrics(Child(root, "metrics"));
-    s_.reference = ReadReference(Child(root, "reference"), r_);
+    BuildRecording(spec);
+    BuildMetrics(spec.metrics);
     std::vector<std::string> names;
     for (const auto& m : s_.metrics) names.push_back(m.name);
-    CheckReferenceMetrics(s_.reference, names, root, "of this scenario", r_);
+    CheckReferenceMetrics(s_.reference, names, spec.root, "of this scenario", r_);
   }
 
  private:
-  void BuildUnits(const YAML::Node& units) {
-    if (!units.IsDefined() || units.IsNull()) {
-      r_.Error(YAML::Node(), "units", "missing required key: a map of unit name -> {type, ...}");
-      return;
-    }
-    if (!r_.ExpectMap(units, "units")) return;
-    if (units.size() == 0) r_.Error(units, "units", "expected at least one unit");
-    for (const auto& kv : units) BuildUnit(kv.first.Scalar(), kv.first, kv.second);
-  }
-
-  void BuildUnit(const std::string& name, const YAML::Node& key, const YAML::Node& spec) {
-    const std::string path = JoinPath("units", name);
-    if (!cosim::IsUnitName(name)) {
-      r_.Error(key, path,
-               "unit name '" + name +
-                   "' is not valid: expected letters, digits and _ (a fleet's robot scopes its "
-                   "units' names: robot.unit)");
-      return;
-    }
-    if (!r_.ExpectMap(spec, path)) return;
-    r_.CheckKeys(spec, path, {"type", "step_s", "parameters"});
-    const std::string type_name = r_.String(spec, path, "type", std::nullopt);
-    if (type_name.empty()) return;
-    const UnitType* type = FindUnitType(type_name);
+  void BuildUnit(const UnitSpec& spec) {
+    const std::string path = JoinPath("units", spec.name);
+    const UnitType* type = FindUnitType(spec.type);
     if (!type) {
-      r_.Error(Child(spec, "type"), JoinPath(path, "type"), UnknownTypeMessage(type_name));
+      r_.Error(Child(spec.node, "type"), JoinPath(path, "type"), UnknownTypeMessage(spec.type));
       return;
     }
-    // 0: the master step.
-    const cosim::TimeNs step = r_.Time(spec, path, "step_s", 0.0, {0.0, 1e6, true});
-    const YAML::Node params = Child(spec, "parameters");
+    const YAML::Node params = spec.parameters.ToYaml();
     const std::string params_path = JoinPath(path, "parameters");
-    if (params.IsDefined() && !params.IsNull() && !r_.ExpectMap(params, params_path)) return;
 
     const std::size_t issues_before = r_.issues().size();
     // The model file (`parameters.model`) is read before the unit is made:
     // its structural keys (a laser's beam count) shape the variable table.
     YAML::Node model;
     std::string model_file;
-    if (params.IsMap() && Child(params, "model").IsDefined() && !type->model_folder.empty()) {
+    if (spec.parameters.Has("model") && !type->model_folder.empty()) {
       const std::string model_path = JoinPath(params_path, "model");
       if (const auto value = r_.AsString(Child(params, "model"), model_path)) {
         model = LoadModel(r_, Child(params, "model"), model_path, "model", *value,
@@ -301,10 +318,10 @@ class Builder {
     }
     std::unique_ptr<cosim::Unit> unit;
     try {
-      unit = type->create({name, cosim::DeriveSeed(s_.seed, name), r_, params, params_path,
-                           s_.scene, model, model_file});
+      unit = type->create({spec.name, cosim::DeriveSeed(s_.seed, spec.name), r_, params,
+                           params_path, s_.scene, model, model_file});
     } catch (const std::exception& e) {
-      r_.Error(spec, path, std::string("cannot create the unit: ") + e.what());
+      r_.Error(spec.node, path, std::string("cannot create the unit: ") + e.what());
       return;
     }
     if (!unit || r_.issues().size() != issues_before) return;
@@ -313,15 +330,15 @@ class Builder {
     for (const auto& k : type->structural_keys) structural.push_back(k.name);
     std::map<std::string, ParameterOrigin> origins;
 
-    // Model file first, then the scenario's own values on top. The model's
-    // structural keys were the factory's.
+    // Model file first, then the description's own values on top. The
+    // model's structural keys were the factory's.
     if (model.IsMap()) {
       const YamlReader::InFile in_model(r_, model_file);
       std::vector<std::string> skipped = structural;
       skipped.insert(skipped.end(), {"source", "description"});
       ApplyParameters(*unit, model, "", skipped, r_, origins);
     }
-    if (params.IsMap()) ApplyParameters(*unit, params, params_path, structural, r_, origins);
+    ApplyParameters(*unit, spec.parameters, params_path, structural, r_, origins);
 
     for (const auto& p : unit->CheckParameters()) {
       const std::string suffix = p.index ? "." + std::to_string(*p.index) : "";
@@ -329,117 +346,95 @@ class Builder {
         const ParameterOrigin& origin = it->second;
         r_.Error(origin.file, origin.node, origin.path + suffix, p.message);
       } else {
-        r_.Error(params.IsDefined() ? params : spec, JoinPath(params_path, p.variable) + suffix,
-                 p.message);
+        r_.Error(params.IsDefined() ? params : spec.node,
+                 JoinPath(params_path, p.variable) + suffix, p.message);
       }
     }
     if (r_.issues().size() == issues_before) {
-      s_.system->Add(std::move(unit), step);
-      unit_nodes_.emplace_back(name, spec);
+      s_.system->Add(std::move(unit), spec.step.value_or(0));
+      built_.push_back(&spec);
     }
   }
 
-  // The YAML index and node of each connection added to the system.
-  std::vector<std::pair<std::size_t, YAML::Node>> BuildConnections(const YAML::Node& list) {
-    std::vector<std::pair<std::size_t, YAML::Node>> nodes;
-    if (!list.IsDefined() || list.IsNull()) return nodes;
-    if (!r_.ExpectSequence(list, "connections")) return nodes;
+  // The index in `list` of each connection added to the system.
+  std::vector<std::size_t> BuildConnections(const std::vector<ConnectionSpec>& list) {
+    std::vector<std::size_t> added;
     for (std::size_t i = 0; i < list.size(); ++i) {
-      const std::string path = "connections." + std::to_string(i);
-      const YAML::Node item = list[i];
-      if (!r_.ExpectMap(item, path)) continue;
-      r_.CheckKeys(item, path, {"from", "to"});
-      const std::string from = r_.String(item, path, "from", std::nullopt);
-      const std::string to = r_.String(item, path, "to", std::nullopt);
-      if (from.empty() || to.empty()) continue;
+      const ConnectionSpec& c = list[i];
+      if (c.from.empty() || c.to.empty()) continue;
       try {
-        s_.system->Connect(cosim::Endpoint::Parse(from), cosim::Endpoint::Parse(to));
-        nodes.emplace_back(i, item);
+        s_.system->Connect(cosim::Endpoint::Parse(c.from), cosim::Endpoint::Parse(c.to));
+        added.push_back(i);
       } catch (const std::invalid_argument& e) {
-        r_.Error(item, path, e.what());
+        r_.Error(c.node, "connections." + std::to_string(i), e.what());
       }
     }
-    return nodes;
+    return added;
   }
 
-  void BuildRecording(const YAML::Node& rec, const cosim::MasterOptions& options) {
+  void BuildRecording(const SystemSpec& spec) {
     std::vector<cosim::Probe> probes;
-    s_.record_interval = options.base_step;
-    if (!rec.IsDefined() || rec.IsNull()) {
-      std::vector<std::string> names;
-      for (const auto& n : s_.system->UnitNames()) names.push_back(n + ".*");
-      probes = cosim::ResolveProbes(*s_.system, names);
-    } else if (r_.ExpectMap(rec, "recording")) {
-      r_.CheckKeys(rec, "recording", {"variables", "interval_s"});
-      if (Child(rec, "interval_s").IsDefined()) {
-        s_.record_interval = r_.Time(rec, "recording", "interval_s",
-                                     cosim::NsToSeconds(options.base_step), {0.0, 1e7, true});
-        if (s_.record_interval % options.base_step != 0) {
-          r_.Error(Child(rec, "interval_s"), "recording.interval_s",
-                   "expected a whole multiple of master.step_s (" +
-                       cosim::FormatSeconds(options.base_step) + " s)");
-        }
+    s_.record_interval = spec.master.base_step;
+    if (!spec.recording || !spec.recording->variables) {
+      if (spec.recording && spec.recording->interval) {
+        s_.record_interval = *spec.recording->interval;
       }
-      const YAML::Node vars = Child(rec, "variables");
-      if (vars.IsDefined() && r_.ExpectSequence(vars, "recording.variables")) {
-        // A column is recorded once, however many items cover it.
-        std::set<std::string> labels;
-        for (std::size_t i = 0; i < vars.size(); ++i) {
-          if (auto v = r_.AsString(vars[i], "recording.variables." + std::to_string(i))) {
-            try {
-              for (auto& p : cosim::ResolveProbes(*s_.system, {*v})) {
-                if (labels.insert(p.label).second) probes.push_back(std::move(p));
-              }
-            } catch (const cosim::ConfigError& e) {
-              r_.Error(vars[i], "recording.variables." + std::to_string(i), e.what());
-            }
+      if (!spec.recording) {
+        std::vector<std::string> names;
+        for (const auto& n : s_.system->UnitNames()) names.push_back(n + ".*");
+        probes = cosim::ResolveProbes(*s_.system, names);
+      }
+    } else {
+      if (spec.recording->interval) s_.record_interval = *spec.recording->interval;
+      // A column is recorded once, however many items cover it.
+      std::set<std::string> labels;
+      const auto& vars = *spec.recording->variables;
+      for (std::size_t i = 0; i < vars.size(); ++i) {
+        try {
+          for (auto& p : cosim::ResolveProbes(*s_.system, {vars[i].text})) {
+            if (labels.insert(p.label).second) probes.push_back(std::move(p));
           }
+        } catch (const cosim::ConfigError& e) {
+          r_.Error(vars[i].node, "recording.variables." + std::to_string(i), e.what());
         }
       }
     }
     if (r_.ok()) s_.recorded = std::move(probes);
   }
 
-  void BuildMetrics(const YAML::Node& list) {
-    if (!list.IsDefined() || list.IsNull()) return;
-    if (!r_.ExpectSequence(list, "metrics")) return;
-    std::vector<std::string> seen;
+  void BuildMetrics(const std::vector<MetricDefinition>& list) {
+    std::set<std::string> seen;
     for (std::size_t i = 0; i < list.size(); ++i) {
+      const MetricDefinition& m = list[i];
       const std::string path = "metrics." + std::to_string(i);
-      const YAML::Node item = list[i];
-      if (!r_.ExpectMap(item, path)) continue;
-      r_.CheckKeys(item, path, {"name", "of", "reduce"});
-      cosim::MetricSpec spec;
-      spec.name = r_.String(item, path, "name", std::nullopt);
-      const std::string of = r_.String(item, path, "of", std::nullopt);
-      const std::string reduce = r_.String(item, path, "reduce", "final", cosim::ReductionNames());
-      cosim::ParseReduction(reduce, &spec.reduction);
-      if (std::find(seen.begin(), seen.end(), spec.name) != seen.end()) {
-        r_.Error(Child(item, "name"), JoinPath(path, "name"),
-                 "metric '" + spec.name + "' defined twice");
+      if (!seen.insert(m.name).second) {
+        r_.Error(Child(m.node, "name"), JoinPath(path, "name"),
+                 "metric '" + m.name + "' defined twice");
       }
-      seen.push_back(spec.name);
-      if (of.empty()) continue;
+      if (m.of.empty()) continue;
+      cosim::MetricSpec spec;
+      spec.name = m.name;
+      spec.reduction = m.reduction;
       try {
-        const auto probes = cosim::ResolveProbes(*s_.system, {of});
+        const auto probes = cosim::ResolveProbes(*s_.system, {m.of});
         if (probes.size() != 1) {
-          r_.Error(Child(item, "of"), JoinPath(path, "of"),
-                   "'" + of + "' is " + std::to_string(probes.size()) +
+          r_.Error(Child(m.node, "of"), JoinPath(path, "of"),
+                   "'" + m.of + "' is " + std::to_string(probes.size()) +
                        " values: expected one, e.g. " + probes.front().label);
           continue;
         }
         spec.probe = probes.front();
         s_.metrics.push_back(spec);
       } catch (const cosim::ConfigError& e) {
-        r_.Error(Child(item, "of"), JoinPath(path, "of"), e.what());
+        r_.Error(Child(m.node, "of"), JoinPath(path, "of"), e.what());
       }
     }
   }
 
   Scenario& s_;
   YamlReader& r_;
-  // Name and YAML node of each unit added to the system, in system order.
-  std::vector<std::pair<std::string, YAML::Node>> unit_nodes_;
+  // The description of each unit added to the system, in system order.
+  std::vector<const UnitSpec*> built_;
 };
 
 }  // namespace
@@ -523,18 +518,22 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
                        "the --set out for the default (" + path + "=null is an explicit null)");
     }
   };
+  SystemSpec spec;
   if (IsRobotScenario(tree)) {
     RobotInfo info;
-    s.expanded = ExpandRobotScenario(tree, reader, info);
+    spec = ExpandRobotScenario(tree, reader, info);
     // A robot-level problem would only echo as problems of the expansion.
     if (!reader.ok()) {
       refuse_unread_without_value();
       throw ScenarioError(reader.issues());
     }
     s.robot = std::move(info);
+    s.expanded = ToYaml(spec);
     tree = s.expanded;
+  } else {
+    spec = ReadSystemFile(tree, reader);
   }
-  Builder(s, reader).Build(tree);
+  Builder(s, reader).Build(spec);
   refuse_unread_without_value();
   if (!reader.ok()) throw ScenarioError(reader.issues());
   std::string canonical;

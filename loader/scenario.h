@@ -46,7 +46,8 @@ struct Scenario {
   /// Published figures repeated runs print beside their own (`reference:`).
   Reference reference;
 
-  /// Robot scenarios only: the system-level tree they expanded into (what
+  /// Robot scenarios only: the system description they expanded into, as a
+  /// system-level file (ToYaml of loader/system_spec.h: what
   /// `linesim inspect` prints) and the geometry for the plots.
   std::optional<RobotInfo> robot;
   YAML::Node expanded;

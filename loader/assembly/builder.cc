@@ -22,11 +22,8 @@ YAML::Node List(const std::vector<double>& values) {
   return list;
 }
 
-YAML::Node IntList(const std::vector<int>& values) {
-  YAML::Node list(YAML::NodeType::Sequence);
-  list.SetStyle(YAML::EmitterStyle::Flow);
-  for (int v : values) list.push_back(v);
-  return list;
+std::vector<std::int64_t> IntList(const std::vector<int>& values) {
+  return {values.begin(), values.end()};
 }
 
 YAML::Node PointList(const std::vector<std::array<double, 2>>& points) {
@@ -36,89 +33,86 @@ YAML::Node PointList(const std::vector<std::array<double, 2>>& points) {
   return list;
 }
 
-void MergeInto(YAML::Node to, const YAML::Node& from) {
-  if (!from.IsMap()) return;
-  for (const auto& kv : from) to[kv.first.Scalar()] = kv.second;
+UnitSpec& SystemBuilder::Unit(const std::string& name, const std::string& type) {
+  UnitSpec* unit = spec_.FindUnit(name);
+  if (!unit) {
+    unit = &spec_.units.emplace_back();
+    unit->name = name;
+  }
+  unit->type = type;
+  return *unit;
 }
 
-void AddMetric(YAML::Node metrics, const std::string& name, const std::string& of,
-               const char* reduce) {
-  YAML::Node m;
-  m["name"] = name;
-  m["of"] = of;
-  m["reduce"] = reduce;
-  metrics.push_back(m);
-}
+bool SystemBuilder::HasUnit(const std::string& name) const { return spec_.FindUnit(name); }
 
-YAML::Node SystemBuilder::Unit(const std::string& name, const std::string& type) {
-  YAML::Node unit = out_["units"][name];
-  unit["type"] = type;
-  return unit;
-}
-
-bool SystemBuilder::HasUnit(const std::string& name) const {
-  const YAML::Node units = Child(out_, "units");
-  return Child(units, name).IsDefined();
-}
-
-YAML::Node SystemBuilder::Params(const std::string& name) {
-  return out_["units"][name]["parameters"];
+Parameters& SystemBuilder::Params(const std::string& name) {
+  UnitSpec* unit = spec_.FindUnit(name);
+  if (!unit) {
+    unit = &spec_.units.emplace_back();
+    unit->name = name;
+  }
+  return unit->parameters;
 }
 
 void SystemBuilder::SetStep(const std::string& name, cosim::TimeNs step) {
-  out_["units"][name]["step_s"] = Num(cosim::NsToSeconds(step));
+  UnitSpec* unit = spec_.FindUnit(name);
+  if (!unit) {
+    unit = &spec_.units.emplace_back();
+    unit->name = name;
+  }
+  unit->step = step;
 }
 
 void SystemBuilder::Connect(const std::string& from, const std::string& to) {
-  YAML::Node c;
-  c.SetStyle(YAML::EmitterStyle::Flow);
-  c["from"] = from;
-  c["to"] = to;
-  connections_.push_back(c);
+  spec_.connections.push_back({from, to, YAML::Node()});
+}
+
+void SystemBuilder::Metric(const std::string& name, const std::string& of,
+                           cosim::Reduction reduce) {
+  spec_.metrics.push_back({name, of, reduce, YAML::Node()});
 }
 
 void SystemBuilder::Derived(const std::string& expanded, const YAML::Node& parent,
                             const std::string& path, const std::string& key) {
   const YAML::Node node = Child(parent, key);
-  origins_[expanded] = {node.IsDefined() ? node : parent, JoinPath(path, key), ""};
+  spec_.origins[expanded] = {node.IsDefined() ? node : parent, JoinPath(path, key), ""};
 }
 
 void SystemBuilder::Origin(const std::string& expanded, loader::Origin origin) {
-  origins_[expanded] = std::move(origin);
+  spec_.origins[expanded] = std::move(origin);
 }
 
 void SystemBuilder::MergeSettings(const std::string& unit, const YAML::Node& settings,
                                   const std::string& file, const std::string& section) {
-  YAML::Node params = Params(unit);
+  Parameters& params = Params(unit);
   const std::string prefix = JoinPath(JoinPath("units", unit), "parameters");
   if (settings.IsMap()) {
     for (const auto& kv : settings) {
       const std::string key = kv.first.Scalar();
       // What the assembly derives (geometry, feedforwards, counts) has one
       // source; a second one here would silently lose or win.
-      if (Child(params, key).IsDefined()) {
+      if (params.Has(key)) {
         r_.Error(file, kv.second, JoinPath(section, key),
                  "the assembly derives " + unit + "'s '" + key +
                      "' from the robot's description (body, wheels, motor groups): leave it out "
                      "here");
         continue;
       }
-      params[key] = kv.second;
-      origins_[JoinPath(prefix, key)] = {kv.second, JoinPath(section, key), file};
+      params[key] = ParameterValue(kv.second);
+      spec_.origins[JoinPath(prefix, key)] = {kv.second, JoinPath(section, key), file};
     }
   }
 }
 
 void SystemBuilder::RequireParameters(const std::string& unit, const YAML::Node& settings,
                                       const std::string& file, const std::string& section) {
-  const YAML::Node params = Params(unit);
-  const YAML::Node type = Child(Child(Child(out_, "units"), unit), "type");
-  const config::UnitType* unit_type = type.IsScalar() ? FindUnitType(type.Scalar()) : nullptr;
+  const UnitSpec* spec = spec_.FindUnit(unit);
+  const config::UnitType* unit_type = spec ? FindUnitType(spec->type) : nullptr;
   if (!unit_type) return;
   const auto defaults = CreateDefaultUnit(*unit_type);
   for (const auto& info : defaults->variables().infos()) {
     if (info.causality != cosim::Causality::kParameter || !info.rule.required()) continue;
-    if (Child(params, info.name).IsDefined()) continue;
+    if (spec->parameters.Has(info.name)) continue;
     r_.Error(file, settings.IsMap() && settings.size() > 0 ? settings.begin()->second : YAML::Node(),
              JoinPath(section, info.name),
              "missing required key: the " + unit_type->name + " parameter '" + info.name +

@@ -9,8 +9,9 @@
 
 #include "cosim/time.h"
 #include "loader/config_names.h"
+#include "loader/system_spec.h"
 
-/// The assembly of a robot scenario into a system-level tree: a builder the
+/// The assembly of a robot scenario into a system description: a builder the
 /// concerns add units and connections to, and the names of the units the
 /// expansion makes (recording, metrics, plots and --set refer to these).
 namespace linesim::loader::assembly {
@@ -47,23 +48,20 @@ std::string Signal(const std::string& unit, const std::string& variable);
 /// "unit.variable[k]".
 std::string Element(const std::string& unit, const std::string& variable, std::size_t k);
 
-/// A number as the shortest text that reads back to it, so that the
-/// expansion `linesim inspect` prints shows 0.9 rather than 0.90000000000000002.
+/// YAML for the structured parameters the assembly builds (a route's
+/// segments, field sets): numbers as the shortest text that reads back to
+/// them, so that `linesim inspect` shows 0.9 rather than 0.90000000000000002.
 YAML::Node Num(double x);
 YAML::Node List(const std::vector<double>& values);
-YAML::Node IntList(const std::vector<int>& values);
 /// Points [x, y] as a flow list of flow pairs (a path).
 YAML::Node PointList(const std::vector<std::array<double, 2>>& points);
-/// Copies every key of `from` into `to` (both maps), the later one winning.
-void MergeInto(YAML::Node to, const YAML::Node& from);
-/// Appends the metric {name, of, reduce} to the list `metrics`.
-void AddMetric(YAML::Node metrics, const std::string& name, const std::string& of,
-               const char* reduce);
+/// Integers as a parameter's typed list.
+std::vector<std::int64_t> IntList(const std::vector<int>& values);
 
-/// The system-level tree under construction. Every concern adds its units
-/// and connections here; what a unit's value was derived from is recorded
-/// so that a problem found in the expansion is reported at the robot-level
-/// key the user wrote.
+/// The system description under construction (loader/system_spec.h). Every
+/// concern adds its units and connections here; what a unit's value was
+/// derived from is recorded so that a problem found in the description is
+/// reported at the robot-level key the user wrote.
 class SystemBuilder {
  public:
   SystemBuilder(const YAML::Node& root, YamlReader& reader) : root_(root), r_(reader) {}
@@ -72,13 +70,16 @@ class SystemBuilder {
   YamlReader& reader() { return r_; }
 
   /// Adds (or returns) unit `name` of `type`.
-  YAML::Node Unit(const std::string& name, const std::string& type);
+  UnitSpec& Unit(const std::string& name, const std::string& type);
   bool HasUnit(const std::string& name) const;
-  YAML::Node Params(const std::string& name);
+  /// Unit `name`'s parameters (the unit is added, typeless, when absent).
+  Parameters& Params(const std::string& name);
   void SetStep(const std::string& name, cosim::TimeNs step);
   void Connect(const std::string& from, const std::string& to);
+  /// Adds the metric {name, of, reduce}.
+  void Metric(const std::string& name, const std::string& of, cosim::Reduction reduce);
 
-  /// Records that the expansion's `expanded` path holds a value derived
+  /// Records that the description's `expanded` path holds a value derived
   /// from the robot-level key `key` of `parent` (at `path`).
   void Derived(const std::string& expanded, const YAML::Node& parent, const std::string& path,
                const std::string& key);
@@ -105,16 +106,12 @@ class SystemBuilder {
   /// AddControl reads it and reports its problems.
   cosim::TimeNs ControlPeriod() const;
 
-  YAML::Node& out() { return out_; }
-  std::vector<YAML::Node>& connections() { return connections_; }
-  std::map<std::string, loader::Origin>& origins() { return origins_; }
+  SystemSpec& spec() { return spec_; }
 
  private:
   const YAML::Node& root_;
   YamlReader& r_;
-  YAML::Node out_{YAML::NodeType::Map};
-  std::vector<YAML::Node> connections_;
-  std::map<std::string, loader::Origin> origins_;
+  SystemSpec spec_;
 };
 
 }  // namespace linesim::loader::assembly

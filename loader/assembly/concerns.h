@@ -112,7 +112,7 @@ void AddSensing(SystemBuilder& b, const RobotFile& robot, const StartPose& start
 /// The robot's wheel positions in base_link as a unit's list parameters
 /// wheel_x and wheel_y (the controller's, the odometry's and the surface
 /// estimator's wheels).
-void SetWheelPositions(YAML::Node params, const models::RobotDescription& robot);
+void SetWheelPositions(Parameters& params, const models::RobotDescription& robot);
 /// Whether the robot description mounts a sensor of `kind`.
 bool RobotHas(const models::RobotDescription& robot, const std::string& kind);
 

@@ -47,12 +47,12 @@ void ConnectJoints(SystemBuilder& b, const std::string& variable, const std::vec
 void AddSwerve(SystemBuilder& b, const RobotFile& file, bool compensation, Signals& s) {
   const models::RobotDescription& robot = file.robot;
   b.Unit(kWheelController, "wheel_controller");
-  YAML::Node p = b.Params(kWheelController);
+  Parameters& p = b.Params(kWheelController);
   const std::size_t n = robot.wheels.size();
   p["wheel_count"] = n;
   SetWheelPositions(p, robot);
   const models::WheelDescription& w0 = robot.wheels.front();
-  p["wheel_radius"] = Num(w0.radius_m);
+  p["wheel_radius"] = w0.radius_m;
   b.Origin(JoinPath(JoinPath(JoinPath("units", kWheelController), "parameters"), "wheel_radius"),
            file.At("wheels.0.radius_m"));
   // Feedforwards from the motor files: the steering module's own inertia,
@@ -62,10 +62,10 @@ void AddSwerve(SystemBuilder& b, const RobotFile& file, bool compensation, Signa
   const double share_kg = robot.body.mass_kg / static_cast<double>(n);
   const Feedforward drive =
       JointFeedforward(GroupOf(robot, w0.drive_motor), share_kg * w0.radius_m * w0.radius_m);
-  p["steer_feedforward"] = Num(steer.rate_v_per_rad_s);
-  p["steer_acceleration_feedforward"] = Num(steer.acceleration_v_per_rad_s2);
-  p["drive_feedforward"] = Num(drive.rate_v_per_rad_s);
-  p["drive_acceleration_feedforward"] = Num(drive.acceleration_v_per_rad_s2);
+  p["steer_feedforward"] = steer.rate_v_per_rad_s;
+  p["steer_acceleration_feedforward"] = steer.acceleration_v_per_rad_s2;
+  p["drive_feedforward"] = drive.rate_v_per_rad_s;
+  p["drive_acceleration_feedforward"] = drive.acceleration_v_per_rad_s2;
   p["compensation"] = compensation;
   b.MergeSettings(kWheelController, file.controller_settings, robot.file, "controller");
   b.RequireParameters(kWheelController, file.controller_settings, robot.file, "controller");
@@ -101,7 +101,7 @@ void AddDifferential(SystemBuilder& b, const RobotFile& file, const YAML::Node& 
                          "set control.compensation: false");
   }
   b.Unit(kWheelController, "diff_drive_controller");
-  YAML::Node p = b.Params(kWheelController);
+  Parameters& p = b.Params(kWheelController);
   // Left (y > 0) and right drive joints; the robot file checked one each.
   std::vector<int> joints(2, 0);
   const models::WheelDescription* left = nullptr;
@@ -114,15 +114,15 @@ void AddDifferential(SystemBuilder& b, const RobotFile& file, const YAML::Node& 
       left_index = i;
     }
   }
-  p["wheel_radius"] = Num(left->radius_m);
+  p["wheel_radius"] = left->radius_m;
   b.Origin(JoinPath(JoinPath(JoinPath("units", kWheelController), "parameters"), "wheel_radius"),
            file.At(JoinPath(JoinPath("wheels", std::to_string(left_index)), "radius_m")));
   // Each side's motor moves half the robot (its wheels' share at the rim).
   const Feedforward drive =
       JointFeedforward(GroupOf(robot, left->drive_motor),
                        0.5 * robot.body.mass_kg * left->radius_m * left->radius_m);
-  p["drive_feedforward"] = Num(drive.rate_v_per_rad_s);
-  p["drive_acceleration_feedforward"] = Num(drive.acceleration_v_per_rad_s2);
+  p["drive_feedforward"] = drive.rate_v_per_rad_s;
+  p["drive_acceleration_feedforward"] = drive.acceleration_v_per_rad_s2;
   b.MergeSettings(kWheelController, file.controller_settings, robot.file, "controller");
   b.RequireParameters(kWheelController, file.controller_settings, robot.file, "controller");
   for (std::size_t side = 0; side < 2; ++side) {

@@ -15,7 +15,7 @@ void AddMotors(SystemBuilder& b, const RobotFile& file) {
   const models::RobotDescription& robot = file.robot;
   const auto motors = robot.Motors();
   b.Unit(kMotors, "dc_motor");
-  YAML::Node p = b.Params(kMotors);
+  Parameters& p = b.Params(kMotors);
   p["count"] = motors.size();
   // The chassis owns the mechanics; the motors get its joint rates.
   p["mode"] = "current_only";
@@ -32,7 +32,7 @@ void AddMotors(SystemBuilder& b, const RobotFile& file) {
   // group's model file (the gear at the group in the robot file).
   const std::string prefix = "units.motors.parameters";
   for (const auto& [key, values] : arrays) {
-    p[key] = List(values);
+    p[key] = values;
     b.Origin(JoinPath(prefix, key), key == "gear_ratio" || key == "gear_efficiency"
                                         ? file.At(JoinPath("motor_groups.0", key))
                                         : file.MotorAt(0, key));
@@ -84,34 +84,34 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
   }
 
   b.Unit(kChassis, "chassis");
-  YAML::Node c = b.Params(kChassis);
+  Parameters& c = b.Params(kChassis);
   c["wheel_count"] = robot.wheels.size();
   c["steer_motor"] = IntList(s.wheel_steer_joint);
   c["drive_motor"] = IntList(s.wheel_drive_joint);
-  c["body_length"] = Num(robot.body.length_m);
-  c["body_width"] = Num(robot.body.width_m);
-  c["body_height"] = Num(robot.body.height_m);
-  c["mass"] = Num(robot.body.mass_kg);
-  c["com_height"] = Num(robot.body.com_height_m);
+  c["body_length"] = robot.body.length_m;
+  c["body_width"] = robot.body.width_m;
+  c["body_height"] = robot.body.height_m;
+  c["mass"] = robot.body.mass_kg;
+  c["com_height"] = robot.body.com_height_m;
   // One mass for every wheel module (the robot file checked that the wheels
   // agree): the chassis lumps it into each wheel.
-  c["module_mass"] = Num(robot.wheels.front().mass_kg);
-  c["wheel_x"] = List(x);
-  c["wheel_y"] = List(y);
-  c["wheel_radius"] = List(radius);
+  c["module_mass"] = robot.wheels.front().mass_kg;
+  c["wheel_x"] = x;
+  c["wheel_y"] = y;
+  c["wheel_radius"] = radius;
   // The rotor inertia each joint sees through its gear (eta N^2 J).
   for (const auto& [joint, joints] :
        {std::pair{"steer", &s.steer_motor_element}, std::pair{"drive", &s.drive_motor_element}}) {
     if (joints->empty()) continue;
     const auto& group = robot.motor_groups[motors[joints->front()].first];
-    c[std::string(joint) + "_rotor_inertia"] = Num(group.Joint().reflected_inertia_kgm2);
+    c[std::string(joint) + "_rotor_inertia"] = group.Joint().reflected_inertia_kgm2;
   }
   // A payload on the body (the robot file's, or the scenario's
   // robot.payload in its place).
   if (const auto& p = robot.payload; p && p->mass_kg > 0.0) {
-    c["payload_mass"] = Num(p->mass_kg);
-    c["payload_position"] = List({p->x_m, p->y_m, p->z_m});
-    c["payload_size"] = List({p->length_m, p->width_m, p->height_m});
+    c["payload_mass"] = p->mass_kg;
+    c["payload_position"] = std::vector<double>{p->x_m, p->y_m, p->z_m};
+    c["payload_size"] = std::vector<double>{p->length_m, p->width_m, p->height_m};
   }
   // Each value at the robot file's key it comes from.
   const std::string cp = "units.chassis.parameters";
@@ -149,9 +149,9 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
     b.Origin(JoinPath(cp, "payload_position"), at("x_m"));
     b.Origin(JoinPath(cp, "payload_size"), at("length_m"));
   }
-  c["initial_x"] = Num(start.x_m);
-  c["initial_y"] = Num(start.y_m);
-  c["initial_yaw"] = Num(start.yaw_rad);
+  c["initial_x"] = start.x_m;
+  c["initial_y"] = start.y_m;
+  c["initial_yaw"] = start.yaw_rad;
   b.MergeSettings(kChassis, file.chassis_settings, robot.file, "chassis");
   const YAML::Node pose = Child(Child(b.root(), "robot"), "pose");
   b.Derived("units.chassis.parameters.initial_x", pose, "robot.pose", "x_m");

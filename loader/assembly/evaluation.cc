@@ -8,70 +8,68 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
   // The deviation is measured on the ground truth, whatever the robot
   // believes.
   b.Unit(kDeviation, "path_deviation");
-  b.Params(kDeviation)["path"] = PointList(info.path);
+  b.Params(kDeviation)["path"] = info.path;
   b.Connect(s.true_position, Signal(kDeviation, "position"));
   s.recorded.push_back(Signal(kDeviation, "deviation"));
 
-  YAML::Node metrics(YAML::NodeType::Sequence);
-  const YAML::Node extra = Child(b.root(), "metrics");
-  if (extra.IsDefined() && !extra.IsNull() && b.reader().ExpectSequence(extra, "metrics")) {
-    for (const auto& m : extra) metrics.push_back(m);
-  }
-  const auto add = [&](const std::string& name, const std::string& of, const char* reduce) {
-    AddMetric(metrics, name, of, reduce);
+  // The scenario's own metrics first.
+  ReadMetrics(Child(b.root(), "metrics"), b.reader(), b.spec());
+  const auto add = [&](const std::string& name, const std::string& of, cosim::Reduction reduce) {
+    b.Metric(name, of, reduce);
   };
   const std::string deviation = Signal(kDeviation, "deviation");
   if (info.task != "hold") {  // a path or a route
-    add("max_path_deviation_m", deviation, "max");
-    add("final_path_deviation_m", deviation, "final");
-    add("final_progress_m", Signal(kDeviation, "progress"), "final");
+    add("max_path_deviation_m", deviation, cosim::Reduction::kMax);
+    add("final_path_deviation_m", deviation, cosim::Reduction::kFinal);
+    add("final_progress_m", Signal(kDeviation, "progress"), cosim::Reduction::kFinal);
   } else {
-    add("max_position_drift_m", deviation, "max");
-    add("final_position_drift_m", deviation, "final");
+    add("max_position_drift_m", deviation, cosim::Reduction::kMax);
+    add("final_position_drift_m", deviation, cosim::Reduction::kFinal);
   }
-  add("final_yaw_rad", s.true_yaw, "final");
+  add("final_yaw_rad", s.true_yaw, cosim::Reduction::kFinal);
 
   // Clearance of the robot's body from everything in the scene (FCL).
   const models::BodyDescription& body = robot.body;
   b.Unit(kClearance, "clearance");
-  YAML::Node c = b.Params(kClearance);
-  c["body_length"] = Num(body.length_m);
-  c["body_width"] = Num(body.width_m);
-  c["body_height"] = Num(body.height_m);
+  Parameters& c = b.Params(kClearance);
+  c["body_length"] = body.length_m;
+  c["body_width"] = body.width_m;
+  c["body_height"] = body.height_m;
   // The chassis centres the body box on com_height.
-  c["body_bottom"] = Num(body.com_height_m - 0.5 * body.height_m);
+  c["body_bottom"] = body.com_height_m - 0.5 * body.height_m;
   b.Connect(Signal(kChassis, "position_3d"), Signal(kClearance, "position_3d"));
   b.Connect(Signal(kChassis, "orientation"), Signal(kClearance, "orientation"));
   if (s.belt_count > 0) b.Connect(Signal(kBelt, "travel"), Signal(kClearance, "belt_travel"));
   s.recorded.push_back(Signal(kClearance, "clearance"));
-  add("min_clearance_m", Signal(kClearance, "min_clearance"), "final");
-  add("collisions", Signal(kClearance, "collisions"), "final");
+  add("min_clearance_m", Signal(kClearance, "min_clearance"), cosim::Reduction::kFinal);
+  add("collisions", Signal(kClearance, "collisions"), cosim::Reduction::kFinal);
 
   // Paper 2 Table 1: the final pose against the route's end (the work
   // pose), from the truth and from the beacons.
   if (!s.route_end.empty()) {
     b.Unit(kFinalPose, "final_pose_error");
-    YAML::Node f = b.Params(kFinalPose);
-    f["target_x"] = Num(s.route_end[0]);
-    f["target_y"] = Num(s.route_end[1]);
-    f["target_yaw"] = Num(s.route_end[2]);
+    Parameters& f = b.Params(kFinalPose);
+    f["target_x"] = s.route_end[0];
+    f["target_y"] = s.route_end[1];
+    f["target_yaw"] = s.route_end[2];
     f["beacons"] = !s.beacon_unit.empty();
     b.Connect(s.true_position, Signal(kFinalPose, "position"));
     b.Connect(s.true_yaw, Signal(kFinalPose, "yaw"));
     b.Connect(s.route_done, Signal(kFinalPose, "done"));
-    add("final_error_x_m", Signal(kFinalPose, "error_x"), "final");
-    add("final_error_y_m", Signal(kFinalPose, "error_y"), "final");
-    add("final_error_yaw_deg", Signal(kFinalPose, "error_yaw"), "final");
+    add("final_error_x_m", Signal(kFinalPose, "error_x"), cosim::Reduction::kFinal);
+    add("final_error_y_m", Signal(kFinalPose, "error_y"), cosim::Reduction::kFinal);
+    add("final_error_yaw_deg", Signal(kFinalPose, "error_yaw"), cosim::Reduction::kFinal);
     if (!s.beacon_unit.empty()) {
       b.Connect(Signal(s.beacon_unit, "position"), Signal(kFinalPose, "beacon_position"));
       b.Connect(Signal(s.beacon_unit, "yaw"), Signal(kFinalPose, "beacon_yaw"));
       b.Connect(Signal(s.beacon_unit, "valid"), Signal(kFinalPose, "beacon_valid"));
-      add("beacon_error_x_m", Signal(kFinalPose, "beacon_error_x"), "final");
-      add("beacon_error_y_m", Signal(kFinalPose, "beacon_error_y"), "final");
-      add("beacon_error_yaw_deg", Signal(kFinalPose, "beacon_error_yaw"), "final");
+      add("beacon_error_x_m", Signal(kFinalPose, "beacon_error_x"), cosim::Reduction::kFinal);
+      add("beacon_error_y_m", Signal(kFinalPose, "beacon_error_y"), cosim::Reduction::kFinal);
+      add("beacon_error_yaw_deg", Signal(kFinalPose, "beacon_error_yaw"), cosim::Reduction::kFinal);
       add("beacon_self_error_position_m", Signal(kFinalPose, "beacon_self_error_position"),
-          "final");
-      add("beacon_self_error_yaw_deg", Signal(kFinalPose, "beacon_self_error_yaw"), "final");
+          cosim::Reduction::kFinal);
+      add("beacon_self_error_yaw_deg", Signal(kFinalPose, "beacon_self_error_yaw"),
+          cosim::Reduction::kFinal);
     }
   }
 
@@ -85,14 +83,18 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     b.Connect(s.yaw, Signal(kLocalizationError, "estimated_yaw"));
     s.recorded.push_back(Signal(kLocalizationError, "position_error"));
     s.recorded.push_back(Signal(kLocalizationError, "yaw_error"));
-    add("localization_error_max_m", Signal(kLocalizationError, "max_position_error"), "final");
-    add("localization_error_rms_m", Signal(kLocalizationError, "rms_position_error"), "final");
-    add("localization_yaw_error_max_rad", Signal(kLocalizationError, "max_yaw_error"), "final");
-    add("localization_yaw_error_rms_rad", Signal(kLocalizationError, "rms_yaw_error"), "final");
+    add("localization_error_max_m", Signal(kLocalizationError, "max_position_error"),
+        cosim::Reduction::kFinal);
+    add("localization_error_rms_m", Signal(kLocalizationError, "rms_position_error"),
+        cosim::Reduction::kFinal);
+    add("localization_yaw_error_max_rad", Signal(kLocalizationError, "max_yaw_error"),
+        cosim::Reduction::kFinal);
+    add("localization_yaw_error_rms_rad", Signal(kLocalizationError, "rms_yaw_error"),
+        cosim::Reduction::kFinal);
     // The share of the run the localization spent on its fallback (source 1).
     for (const auto& source : s.localization_sources) {
       const std::string unit = source.substr(0, source.find('.'));
-      add(unit + "_fallback_fraction", source, "mean");
+      add(unit + "_fallback_fraction", source, cosim::Reduction::kMean);
     }
   }
 
@@ -104,7 +106,7 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
   }
   if (!flows.empty() && !s.belt_ground_truth.empty()) {
     b.Unit(kFlowError, "surface_velocity_error");
-    YAML::Node p = b.Params(kFlowError);
+    Parameters& p = b.Params(kFlowError);
     p["sensors"] = static_cast<int>(flows.size());
     p["belt"] = s.belt_ground_truth_belt;
     if (!s.surface_estimate.empty()) p["estimated"] = true;
@@ -118,9 +120,9 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
                   Element(kFlowError, "measured", 2 * k + i));
       }
     }
-    p["mount_x"] = List(x);
-    p["mount_y"] = List(y);
-    p["mount_yaw"] = List(yaw);
+    p["mount_x"] = x;
+    p["mount_y"] = y;
+    p["mount_yaw"] = yaw;
     b.Connect(s.true_position, Signal(kFlowError, "position"));
     b.Connect(s.true_yaw, Signal(kFlowError, "yaw"));
     b.Connect(Signal(kChassis, "linear_velocity"), Signal(kFlowError, "linear_velocity"));
@@ -128,20 +130,23 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     b.Connect(s.belt_ground_truth, Signal(kFlowError, "reference"));
     s.recorded.push_back(Signal(kFlowError, "reading"));
     s.recorded.push_back(Signal(kFlowError, "true_reading"));
-    add("surface_velocity_rmse_raw_mps", Signal(kFlowError, "rmse"), "final");
-    add("surface_velocity_plateau_rmse_raw_mps", Signal(kFlowError, "rmse_plateau"), "final");
+    add("surface_velocity_rmse_raw_mps", Signal(kFlowError, "rmse"), cosim::Reduction::kFinal);
+    add("surface_velocity_plateau_rmse_raw_mps", Signal(kFlowError, "rmse_plateau"),
+        cosim::Reduction::kFinal);
     if (!s.surface_estimate.empty()) {
       // The surface estimator's filtered value per sensor, the same order.
       b.Connect(s.surface_estimate, Signal(kFlowError, "estimated"));
       s.recorded.push_back(Signal(kFlowError, "estimated_speed"));
-      add("surface_velocity_rmse_filtered_mps", Signal(kFlowError, "rmse_estimated"), "final");
+      add("surface_velocity_rmse_filtered_mps", Signal(kFlowError, "rmse_estimated"),
+          cosim::Reduction::kFinal);
       add("surface_velocity_plateau_rmse_filtered_mps",
-          Signal(kFlowError, "rmse_plateau_estimated"), "final");
-      add("surface_velocity_settling_time_s", Signal(kFlowError, "settling_time"), "final");
+          Signal(kFlowError, "rmse_plateau_estimated"), cosim::Reduction::kFinal);
+      add("surface_velocity_settling_time_s", Signal(kFlowError, "settling_time"),
+          cosim::Reduction::kFinal);
     }
     // The first sensor's quality (0..255, OPTICAL_FLOW_RAD's mean over its
     // publishing interval), over the run.
-    add("optic_flow_quality_mean", Signal(flows.front()->name, "quality"), "mean");
+    add("optic_flow_quality_mean", Signal(flows.front()->name, "quality"), cosim::Reduction::kMean);
     for (std::size_t k = 0; k < flows.size(); ++k) {
       info.flow_columns.push_back(Element(kFlowError, "reading", k));
       info.flow_truth_columns.push_back(Element(kFlowError, "true_reading", k));
@@ -152,7 +157,6 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     }
     info.flow_reference_column = s.belt_ground_truth;
   }
-  b.out()["metrics"] = metrics;
   info.error_column = deviation;
 }
 
@@ -179,28 +183,26 @@ void AddRecording(SystemBuilder& b, const Signals& s, RobotInfo& info) {
 }
 
 void AddRecordingSection(SystemBuilder& b, const std::vector<std::string>& recorded) {
+  SystemSpec& spec = b.spec();
   const YAML::Node own = Child(b.root(), "recording");
   if (own.IsDefined()) {
     // The scenario's recording, with the columns the plots read added to a
     // list it gives (a column is recorded once); without a list it records
     // everything anyway.
-    YAML::Node rec = YAML::Clone(own);
-    if (rec.IsMap() && Child(rec, "variables").IsSequence()) {
-      for (const auto& v : recorded) rec["variables"].push_back(v);
+    ReadRecording(own, b.reader(), spec);
+    if (spec.recording && spec.recording->variables) {
+      for (const auto& v : recorded) spec.recording->variables->push_back({v, YAML::Node()});
     }
-    b.out()["recording"] = rec;
     return;
   }
-  YAML::Node vars(YAML::NodeType::Sequence);
-  vars.SetStyle(YAML::EmitterStyle::Flow);
-  for (const auto& v : recorded) vars.push_back(v);
-  b.out()["recording"]["variables"] = vars;
+  RecordingSpec& rec = spec.recording.emplace();
+  rec.variables.emplace();
+  for (const auto& v : recorded) rec.variables->push_back({v, YAML::Node()});
   // About 100 Hz is enough for the plots and keeps signals.csv small; it
   // must be a whole number of master steps (the master refuses bad steps).
   constexpr cosim::TimeNs kInterval = cosim::kNsPerSecond / 100;
   const cosim::TimeNs step = b.MasterStep();
-  const cosim::TimeNs interval = step < kInterval ? (kInterval + step - 1) / step * step : step;
-  b.out()["recording"]["interval_s"] = Num(cosim::NsToSeconds(interval));
+  rec.interval = step < kInterval ? (kInterval + step - 1) / step * step : step;
 }
 
 }  // namespace linesim::loader::assembly

@@ -102,7 +102,7 @@ void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s) {
   }
   b.Unit(kSafety, "safety_field");
   b.SetStep(kSafety, b.ControlPeriod());
-  YAML::Node p = b.Params(kSafety);
+  Parameters& p = b.Params(kSafety);
   p["beam_count"] = 541;
   YAML::Node out_sets(YAML::NodeType::Sequence);
   {
@@ -132,7 +132,7 @@ void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s) {
       }
     }
   }
-  p["field_sets"] = out_sets;
+  p["field_sets"] = ParameterValue(out_sets);
   // The robot file's parameters, then the scenario's over them.
   const std::string prefix = JoinPath(JoinPath("units", kSafety), "parameters");
   const YAML::Node vehicle_params = Child(vehicle, "parameters");
@@ -141,7 +141,7 @@ void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s) {
     if (r.ExpectMap(vehicle_params, "safety.parameters")) {
       for (const auto& kv : vehicle_params) {
         const std::string key = kv.first.Scalar();
-        p[key] = kv.second;
+        p[key] = ParameterValue(kv.second);
         b.Origin(JoinPath(prefix, key),
                  {kv.second, JoinPath("safety.parameters", key), robot.robot.file});
       }
@@ -151,7 +151,7 @@ void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s) {
   if (own.IsDefined() && !own.IsNull() && r.ExpectMap(own, "safety.parameters")) {
     for (const auto& kv : own) {
       const std::string key = kv.first.Scalar();
-      p[key] = kv.second;
+      p[key] = ParameterValue(kv.second);
       b.Derived(JoinPath(prefix, key), own, "safety.parameters", key);
     }
   }
@@ -166,9 +166,8 @@ void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s) {
 
 void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo& info) {
   YamlReader& r = b.reader();
-  YAML::Node metrics = b.out()["metrics"];
-  const auto add = [&](const std::string& name, const std::string& of, const char* reduce) {
-    AddMetric(metrics, name, of, reduce);
+  const auto add = [&](const std::string& name, const std::string& of, cosim::Reduction reduce) {
+    b.Metric(name, of, reduce);
   };
   if (b.HasUnit(kSafety)) {
     b.Connect(Signal(kPathFollower, "done"), Signal(kSafety, "task_done"));
@@ -176,9 +175,9 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
       s.recorded.push_back(Signal(kSafety, v));
     }
     s.recorded.push_back(Signal(kChassis, "linear_velocity"));
-    add("protective_stops", Signal(kSafety, "protective_stops"), "final");
-    add("time_stopped_s", Signal(kSafety, "time_stopped"), "final");
-    add("task_time_s", Signal(kSafety, "task_time"), "final");
+    add("protective_stops", Signal(kSafety, "protective_stops"), cosim::Reduction::kFinal);
+    add("time_stopped_s", Signal(kSafety, "time_stopped"), cosim::Reduction::kFinal);
+    add("task_time_s", Signal(kSafety, "task_time"), cosim::Reduction::kFinal);
     info.velocity_x_column = Element(kChassis, "linear_velocity", 0);
     info.velocity_y_column = Element(kChassis, "linear_velocity", 1);
     info.speed_cap_column = Signal(kSafety, "speed_cap");
@@ -216,8 +215,8 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
       }
     }
     b.Unit(name, "worker");
-    YAML::Node p = b.Params(name);
-    p["waypoints"] = PointList(points);
+    Parameters& p = b.Params(name);
+    p["waypoints"] = points;
     // The worker knows where the robot is (it yields to it with a
     // stop_distance; a fleet's are connected by the fleet).
     p["robots"] = 1;
@@ -236,20 +235,20 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
           v.push_back(r.AsReal(pause[k], JoinPath(pause_path, std::to_string(k)), {0.0, 1e7})
                           .value_or(0.0));
         }
-        p["pause"] = List(v);
+        p["pause"] = v;
       } else {
         const double v = r.Real(item, path, "pause_s", 0.0, {0.0, 1e7});
-        p["pause"] = List(std::vector<double>(points.size(), v));
+        p["pause"] = std::vector<double>(points.size(), v);
       }
     }
     if (Child(item, "start_time_s").IsDefined()) {
-      p["start_time"] = Num(r.Real(item, path, "start_time_s", 0.0, {0.0, 1e7}));
+      p["start_time"] = r.Real(item, path, "start_time_s", 0.0, {0.0, 1e7});
     }
     const YAML::Node own = Child(item, "parameters");
     if (own.IsDefined() && !own.IsNull() && r.ExpectMap(own, JoinPath(path, "parameters"))) {
       for (const auto& kv : own) {
         const std::string key = kv.first.Scalar();
-        p[key] = kv.second;
+        p[key] = ParameterValue(kv.second);
         b.Derived(JoinPath(JoinPath(JoinPath("units", name), "parameters"), key), own,
                   JoinPath(path, "parameters"), key);
       }
@@ -278,13 +277,13 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
   // The body's distance from the people: the clearance unit's box.
   const models::BodyDescription& body = robot.robot.body;
   b.Unit(kPersonClearance, "person_clearance");
-  YAML::Node c = b.Params(kPersonClearance);
+  Parameters& c = b.Params(kPersonClearance);
   c["workers"] = static_cast<int>(names.size());
-  c["body_length"] = Num(body.length_m);
-  c["body_width"] = Num(body.width_m);
+  c["body_length"] = body.length_m;
+  c["body_width"] = body.width_m;
   // The chassis centres the body box on com_height (flat floor).
-  c["body_z_min"] = Num(body.com_height_m - 0.5 * body.height_m);
-  c["body_z_max"] = Num(body.com_height_m + 0.5 * body.height_m);
+  c["body_z_min"] = body.com_height_m - 0.5 * body.height_m;
+  c["body_z_max"] = body.com_height_m + 0.5 * body.height_m;
   b.Connect(Signal(kChassis, "position_3d"), Signal(kPersonClearance, "position_3d"));
   b.Connect(Signal(kChassis, "orientation"), Signal(kPersonClearance, "orientation"));
   for (std::size_t w = 0; w < names.size(); ++w) {
@@ -295,14 +294,14 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
     s.recorded.push_back(Signal(names[w], "pose"));
     info.worker_columns.emplace_back(Element(names[w], "pose", 0), Element(names[w], "pose", 1));
     s.recorded.push_back(Signal(names[w], "legs"));
-    add(names[w] + "_time_waited_s", Signal(names[w], "time_waited"), "final");
-    add("robot_" + names[w] + "_collisions",
-        Element(kPersonClearance, "worker_collisions", w), "final");
+    add(names[w] + "_time_waited_s", Signal(names[w], "time_waited"), cosim::Reduction::kFinal);
+    add("robot_" + names[w] + "_collisions", Element(kPersonClearance, "worker_collisions", w),
+        cosim::Reduction::kFinal);
   }
   s.recorded.push_back(Signal(kPersonClearance, "distance"));
   if (b.HasUnit(kSafety)) info.person_distance_column = Signal(kPersonClearance, "distance");
-  add("min_person_distance_m", Signal(kPersonClearance, "min_distance"), "final");
-  add("person_collisions", Signal(kPersonClearance, "collisions"), "final");
+  add("min_person_distance_m", Signal(kPersonClearance, "min_distance"), cosim::Reduction::kFinal);
+  add("person_collisions", Signal(kPersonClearance, "collisions"), cosim::Reduction::kFinal);
 }
 
 }  // namespace linesim::loader::assembly

@@ -64,7 +64,7 @@ bool Require(SystemBuilder& b, const ProviderContext& c, const Signals& s, const
 void SetStep(SystemBuilder& b, const std::string& unit);
 
 /// initial_x, initial_y, initial_yaw of a unit's parameters `p`.
-void SetInitialPose(YAML::Node p, const StartPose& start);
+void SetInitialPose(Parameters& p, const StartPose& start);
 
 /// The numbers of one sensor unit's parameters as the unit will get them:
 /// the scenario's or the robot's setting if the expansion has one, else the
@@ -114,6 +114,6 @@ void AddOdometry(SystemBuilder& b, const ProviderContext& c, Signals& s);
 /// into its parameters `p`.
 void ConnectFlowSensors(SystemBuilder& b, const std::vector<const models::SensorMount*>& flows,
                         const models::RobotDescription& robot, const std::string& unit,
-                        YAML::Node& p);
+                        Parameters& p);
 
 }  // namespace linesim::loader::assembly

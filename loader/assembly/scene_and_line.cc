@@ -61,12 +61,13 @@ models::Scene AddScene(SystemBuilder& b) {
     scene["belts"] = merged;
   }
   if (scene.size() == 0) return models::OpenFloor();
-  b.out()["scene"] = scene;
-  // The scene as the system loader will read it; its problems are reported
-  // now, at the keys the user wrote (the expansion stops on them, so they
-  // are not reported twice).
-  r.SetOrigins(b.origins());
-  return ReadScenarioScene(r, scene, r.file());
+  // The scene read once, here; its problems are reported at the keys the
+  // user wrote.
+  SystemSpec& spec = b.spec();
+  spec.scene_node = scene;
+  r.SetOrigins(spec.origins);
+  spec.scene = ReadScenarioScene(r, scene, r.file());
+  return spec.scene;
 }
 
 void AddLine(SystemBuilder& b, const models::Scene& scene, Signals& s) {

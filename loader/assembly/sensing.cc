@@ -70,15 +70,15 @@ void SetStep(SystemBuilder& b, const std::string& unit) {
             "period_s");
 }
 
-void SetInitialPose(YAML::Node p, const StartPose& start) {
-  p["initial_x"] = Num(start.x_m);
-  p["initial_y"] = Num(start.y_m);
-  p["initial_yaw"] = Num(start.yaw_rad);
+void SetInitialPose(Parameters& p, const StartPose& start) {
+  p["initial_x"] = start.x_m;
+  p["initial_y"] = start.y_m;
+  p["initial_yaw"] = start.yaw_rad;
 }
 
 DeviceNumbers::DeviceNumbers(SystemBuilder& b, const ProviderContext& c,
                              const models::SensorMount& m)
-    : b_(b), c_(c), m_(m), params_(b.Params(m.name)) {
+    : b_(b), c_(c), m_(m), params_(b.Params(m.name).ToYaml()) {
   const YAML::Node model_name = Child(params_, "model");
   if (model_name.IsDefined() && model_name.IsScalar()) {
     model_ = LoadModel(b.reader(), c.at, c.path, "sensor model", model_name.Scalar(), "sensors",
@@ -136,15 +136,15 @@ void WireLasers(SystemBuilder& b, const ProviderContext& c, const Signals& s, co
     b.Connect(Signal(m.name, "scan_count"), Signal(unit, "scan_count" + suffix));
     b.Connect(Signal(m.name, "scan_time"), Signal(unit, "scan_time" + suffix));
   }
-  YAML::Node p = b.Params(unit);
+  Parameters& p = b.Params(unit);
   p["beam_counts"] = IntList(beams);
-  p["mount_x"] = List(x);
-  p["mount_y"] = List(y);
-  if (with_z) p["mount_z"] = List(z);
-  p["mount_yaw"] = List(yaw);
-  p["first_beam_angle"] = List(first);
-  p["angular_step"] = List(step);
-  p["scan_period"] = List(period);
+  p["mount_x"] = x;
+  p["mount_y"] = y;
+  if (with_z) p["mount_z"] = z;
+  p["mount_yaw"] = yaw;
+  p["first_beam_angle"] = first;
+  p["angular_step"] = step;
+  p["scan_period"] = period;
 }
 
 void AddLaserLocalization(SystemBuilder& b, const ProviderContext& c, Signals& s) {
@@ -159,7 +159,7 @@ void AddLaserLocalization(SystemBuilder& b, const ProviderContext& c, Signals& s
     return;
   }
   b.Unit(kLaserLocalization, "laser_localization");
-  YAML::Node p = b.Params(kLaserLocalization);
+  Parameters& p = b.Params(kLaserLocalization);
   WireLasers(b, c, s, kLaserLocalization, true);
   // localization.map: the scene's map (default) or one learned while
   // driving, as hector_mapping does.
@@ -203,16 +203,17 @@ void AddPoseFusion(SystemBuilder& b, const ProviderContext& c, Signals& s, const
 void AddOdometry(SystemBuilder& b, const ProviderContext& c, Signals& s) {
   const models::RobotDescription& robot = c.file.robot;
   const models::SensorMount& encoders = *Mounts(s, "wheel_encoder").front();
-  const YAML::Node enc = b.Params(encoders.name);
+  const Parameters& enc = b.Params(encoders.name);
   const std::size_t steer = s.steer_motor_element.size();
   b.Unit(kOdometry, "wheel_odometry");
-  YAML::Node p = b.Params(kOdometry);
+  Parameters& p = b.Params(kOdometry);
   const bool swerve = robot.controller == models::ControllerKind::kSwerve;
   p["kind"] = swerve ? "swerve" : "differential";
   p["wheels"] = static_cast<int>(robot.wheels.size());
   SetWheelPositions(p, robot);
-  p["wheel_radius"] = Num(robot.wheels.front().radius_m);
-  const YAML::Node cpr = Child(enc, "counts_per_revolution");
+  p["wheel_radius"] = robot.wheels.front().radius_m;
+  const ParameterValue* cpr_value = enc.Find("counts_per_revolution");
+  const YAML::Node cpr = cpr_value ? cpr_value->ToYaml() : YAML::Node();
   // The odometry's channels in its order: swerve, each wheel's steering
   // joint then each wheel's drive joint; differential, the left side's
   // drive joint then the right side's. The encoder counts every steering
@@ -234,7 +235,7 @@ void AddOdometry(SystemBuilder& b, const ProviderContext& c, Signals& s) {
     }
     channels = {steer + static_cast<std::size_t>(left), steer + static_cast<std::size_t>(right)};
     const YAML::Node track = Child(c.file.controller_settings, "effective_track");
-    if (track.IsDefined()) p["effective_track"] = track;
+    if (track.IsDefined()) p["effective_track"] = ParameterValue(track);
     b.Origin(JoinPath(JoinPath(JoinPath("units", kOdometry), "parameters"), "effective_track"),
              {YAML::Node(), "controller.effective_track", robot.file});
   }
@@ -248,9 +249,9 @@ void AddOdometry(SystemBuilder& b, const ProviderContext& c, Signals& s) {
     b.Connect(Element(encoders.name, "counts", channels[k]), Element(kOdometry, "counts", k));
   }
   if (counts.size() == channels.size()) {
-    p["counts_per_revolution"] = List(counts);
+    p["counts_per_revolution"] = counts;
     // A problem with them is reported where the encoder's came from.
-    const auto& origins = b.origins();
+    const auto& origins = b.spec().origins;
     const auto from = origins.find(JoinPath(
         JoinPath(JoinPath("units", encoders.name), "parameters"), "counts_per_revolution"));
     if (from != origins.end()) {
@@ -266,7 +267,7 @@ void AddOdometry(SystemBuilder& b, const ProviderContext& c, Signals& s) {
 
 void ConnectFlowSensors(SystemBuilder& b, const std::vector<const models::SensorMount*>& flows,
                         const models::RobotDescription& robot, const std::string& unit,
-                        YAML::Node& p) {
+                        Parameters& p) {
   p["sensors"] = static_cast<int>(flows.size());
   p["wheels"] = static_cast<int>(robot.wheels.size());
   std::vector<double> sx, sy, syaw;
@@ -282,9 +283,9 @@ void ConnectFlowSensors(SystemBuilder& b, const std::vector<const models::Sensor
     b.Connect(Signal(m.name, "quality"), Element(unit, "sensor_quality", k));
     b.Connect(Signal(m.name, "message_count"), Element(unit, "sensor_message_count", k));
   }
-  p["sensor_x"] = List(sx);
-  p["sensor_y"] = List(sy);
-  p["sensor_yaw"] = List(syaw);
+  p["sensor_x"] = sx;
+  p["sensor_y"] = sy;
+  p["sensor_yaw"] = syaw;
 }
 
 void AddBeaconGroundTruth(SystemBuilder& b, const RobotFile& file, const StartPose& start,
@@ -297,21 +298,21 @@ void AddBeaconGroundTruth(SystemBuilder& b, const RobotFile& file, const StartPo
   const ProviderContext c{file, start, scene, Child(b.root(), "sensors"), "sensors"};
   const DeviceNumbers device(b, c, m);
   b.Unit(kBeacons, "beacon_localization");
-  YAML::Node p = b.Params(kBeacons);
+  Parameters& p = b.Params(kBeacons);
   p["beam_count"] = static_cast<int>(device.Required("beam_count"));
-  p["mount_x"] = Num(m.x_m);
-  p["mount_y"] = Num(m.y_m);
-  p["mount_yaw"] = Num(m.yaw_rad);
-  p["first_beam_angle"] = Num(device.Required("first_beam_angle"));
-  p["angular_step"] = Num(device.Required("angular_step"));
+  p["mount_x"] = m.x_m;
+  p["mount_y"] = m.y_m;
+  p["mount_yaw"] = m.yaw_rad;
+  p["first_beam_angle"] = device.Required("first_beam_angle");
+  p["angular_step"] = device.Required("angular_step");
   // The laser's own figures: its nearest range, its statistical error and
   // its per-device systematic error.
-  if (const auto v = device.Get("range_min")) p["range_min"] = Num(*v);
-  if (const auto v = device.Get("noise_sigma")) p["range_sigma"] = Num(*v);
-  if (const auto v = device.Get("bias_sigma")) p["systematic_sigma"] = Num(*v);
+  if (const auto v = device.Get("range_min")) p["range_min"] = *v;
+  if (const auto v = device.Get("noise_sigma")) p["range_sigma"] = *v;
+  if (const auto v = device.Get("bias_sigma")) p["systematic_sigma"] = *v;
   // Which way the robot faces, for the symmetric beacon layouts: the
   // route's last node (only a half turn away would mislead it).
-  if (!s.route_end.empty()) p["heading_hint"] = Num(s.route_end[2]);
+  if (!s.route_end.empty()) p["heading_hint"] = s.route_end[2];
   b.Connect(Signal(m.name, "ranges"), Signal(kBeacons, "ranges"));
   b.Connect(Signal(m.name, "scan_count"), Signal(kBeacons, "scan_count"));
   b.Connect(Signal(m.name, "scan_time"), Signal(kBeacons, "scan_time"));
@@ -347,14 +348,14 @@ void ConnectMapSwitch(SystemBuilder& b, const Signals& s) {
   b.Connect(s.map_index_output, s.map_index_input);
 }
 
-void SetWheelPositions(YAML::Node params, const models::RobotDescription& robot) {
+void SetWheelPositions(Parameters& params, const models::RobotDescription& robot) {
   std::vector<double> x, y;
   for (const auto& w : robot.wheels) {
     x.push_back(w.x_m);
     y.push_back(w.y_m);
   }
-  params["wheel_x"] = List(x);
-  params["wheel_y"] = List(y);
+  params["wheel_x"] = x;
+  params["wheel_y"] = y;
 }
 
 bool RobotHas(const models::RobotDescription& robot, const std::string& kind) {
@@ -398,7 +399,7 @@ void AddSensing(SystemBuilder& b, const RobotFile& file, const StartPose& start,
   // under it) would be surface knowledge learnt on the way. A scenario's
   // units.pose_fusion.parameters still override this.
   if (surface == "none" && b.HasUnit(kPoseFusion)) {
-    YAML::Node f = b.Params(kPoseFusion);
+    Parameters& f = b.Params(kPoseFusion);
     f["offset_random_walk"] = 0;
     f["initial_offset_sigma"] = 0;
   }

@@ -64,11 +64,11 @@ cosim::TimeNs WholeMasterSteps(cosim::TimeNs period, cosim::TimeNs master_step) 
 // problem is found in it.
 void SetMountParameters(SystemBuilder& b, const RobotFile& file, std::size_t index) {
   const models::SensorMount& m = file.robot.sensor_mounts[index];
-  YAML::Node params = b.Params(m.name);
+  Parameters& params = b.Params(m.name);
   const std::string prefix = JoinPath(JoinPath("units", m.name), "parameters");
   const std::string mount = JoinPath("sensor_mounts", std::to_string(index));
   const auto set = [&](const char* param, double value, const char* key) {
-    params[param] = Num(value);
+    params[param] = value;
     b.Origin(JoinPath(prefix, param), file.At(JoinPath(mount, key)));
   };
   set("mount_x", m.x_m, "x_m");
@@ -139,7 +139,7 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
     const std::string path = JoinPath("sensors", name);
     if (c.node.IsMap()) {
       if (Child(c.node, "model").IsDefined()) {
-        b.Params(name)["model"] = Child(c.node, "model");
+        b.Params(name)["model"] = ParameterValue(Child(c.node, "model"));
         b.Derived(JoinPath(JoinPath(JoinPath("units", name), "parameters"), "model"), c.node, path,
                   "model");
       }
@@ -152,7 +152,7 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
           r.ExpectMap(params, JoinPath(path, "parameters"))) {
         // The scenario may override what the robot file says, but not what
         // the assembly derives (the mount's pose, channels, connections).
-        YAML::Node merged = b.Params(name);
+        Parameters& merged = b.Params(name);
         const std::string prefix = JoinPath(JoinPath("units", name), "parameters");
         for (const auto& kv : params) {
           const std::string key = kv.first.Scalar();
@@ -162,7 +162,7 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
                     "joints): change the mount in " + file.robot.file + " instead");
             continue;
           }
-          merged[key] = kv.second;
+          merged[key] = ParameterValue(kv.second);
           b.Origin(JoinPath(prefix, key), {kv.second, JoinPath(JoinPath(path, "parameters"), key),
                                            ""});
         }
@@ -188,7 +188,7 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
     const auto wiring = Wiring().find(m.kind);
     if (wiring == Wiring().end()) continue;  // the robot file checked the kind
     b.Unit(m.name, m.kind);
-    YAML::Node params = b.Params(m.name);
+    Parameters& params = b.Params(m.name);
     const std::string mount_path = JoinPath("sensor_mounts", std::to_string(i));
     if (!m.model.empty()) {
       params["model"] = m.model;
@@ -201,8 +201,8 @@ void AddSensors(SystemBuilder& b, const RobotFile& file, Signals& s) {
       SetMountParameters(b, file, i);
     }
     std::set<std::string> derived;
-    for (const auto& kv : params) {
-      if (kv.first.Scalar() != "model") derived.insert(kv.first.Scalar());
+    for (const auto& [key, value] : params) {
+      if (key != "model") derived.insert(key);
     }
     b.MergeSettings(m.name, file.sensor_settings[i], robot.file,
                     JoinPath(mount_path, "parameters"));

@@ -59,7 +59,7 @@ void AddRoute(SystemBuilder& b, const RobotFile& file, const YAML::Node& task, S
                 : "only for task.type path or hold: a route's path is task.graph and task.route");
   }
   b.Unit(kPathFollower, "route_follower");
-  YAML::Node p = b.Params(kPathFollower);
+  Parameters& p = b.Params(kPathFollower);
 
   // The graph and the route through it.
   std::vector<models::PolynomialSegment> segments;
@@ -86,11 +86,11 @@ void AddRoute(SystemBuilder& b, const RobotFile& file, const YAML::Node& task, S
 
   // Speed: the constant V of Eq. 5, up to the robot's top speed.
   const double speed = r.Real(task, "task", "speed_mps", DefaultSpeed(file), SpeedRange(file));
-  p["speed"] = Num(speed);
+  p["speed"] = speed;
   b.Derived("units.path_follower.parameters.speed", task, "task", "speed_mps");
   // The robot's yaw-rate limit (its description's path_follower.max_yaw_rate).
   if (const YAML::Node limit = Child(file.follower_settings, "max_yaw_rate"); limit.IsDefined()) {
-    p["max_yaw_rate"] = limit;
+    p["max_yaw_rate"] = ParameterValue(limit);
     b.Origin("units.path_follower.parameters.max_yaw_rate",
              {limit, "path_follower.max_yaw_rate", file.robot.file});
   }
@@ -98,18 +98,18 @@ void AddRoute(SystemBuilder& b, const RobotFile& file, const YAML::Node& task, S
   // double pole at 1.5 rad/s of e'' + K_P,theta e' + V K_P,D e = 0) at this
   // speed: K_P,D = 1.5^2 / V, unless task.gains gives it.
   if (speed > 0.0) {
-    p["k_p_distance"] = Num(1.5 * 1.5 / speed);
+    p["k_p_distance"] = 1.5 * 1.5 / speed;
     b.Derived("units.path_follower.parameters.k_p_distance", task, "task", "speed_mps");
   }
   const YAML::Node gains = b.Section(task, "task", "gains", kRouteGains);
   for (const std::string& key : kRouteGains) {
     const YAML::Node value = Child(gains, key);
     if (!value.IsDefined()) continue;
-    p[key] = value;
+    p[key] = ParameterValue(value);
     b.Derived(JoinPath("units.path_follower.parameters", key), gains, "task.gains", key);
   }
   if (Child(task, "deceleration_mps2").IsDefined()) {
-    p["deceleration"] = Num(r.Real(task, "task", "deceleration_mps2", 0.25, {0.0, 10.0, true}));
+    p["deceleration"] = r.Real(task, "task", "deceleration_mps2", 0.25, {0.0, 10.0, true});
     b.Derived("units.path_follower.parameters.deceleration", task, "task", "deceleration_mps2");
   }
 
@@ -127,7 +127,7 @@ void AddRoute(SystemBuilder& b, const RobotFile& file, const YAML::Node& task, S
     list.push_back(item);
     length_m += models::SegmentArcLength(segment, 0.0, 1.0);
   }
-  p["segments"] = list;
+  p["segments"] = ParameterValue(list);
   b.Derived("units.path_follower.parameters.segments", task, "task", "route");
   if (!segments.empty()) {
     info.path = models::SamplePolynomialPath(segments, std::max(0.02, length_m / 9000.0),
@@ -167,7 +167,7 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
   // The robot's follower settings first: the task's own values (speed,
   // acceleration) override them.
   b.MergeSettings(kPathFollower, file.follower_settings, file.robot.file, "path_follower");
-  YAML::Node p = b.Params(kPathFollower);
+  Parameters& p = b.Params(kPathFollower);
   const bool differential = file.robot.controller == models::ControllerKind::kDifferential;
   if (info.task == "path") {
     const YAML::Node waypoints = Child(task, "waypoints");
@@ -194,7 +194,7 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
     }
     p["mode"] = "path";
     // Up to the robot's top speed.
-    p["speed"] = Num(r.Real(task, "task", "speed_mps", DefaultSpeed(file), SpeedRange(file)));
+    p["speed"] = r.Real(task, "task", "speed_mps", DefaultSpeed(file), SpeedRange(file));
   } else if (info.task == "hold") {
     std::array<double, 2> point{start.x_m, start.y_m};
     if (Child(task, "point").IsDefined()) {
@@ -204,7 +204,7 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
     p["mode"] = "hold";
   }
   if (Child(task, "acceleration_mps2").IsDefined()) {
-    p["acceleration"] = Num(r.Real(task, "task", "acceleration_mps2", 0.3, {0.0, 10.0, true}));
+    p["acceleration"] = r.Real(task, "task", "acceleration_mps2", 0.3, {0.0, 10.0, true});
     b.Derived("units.path_follower.parameters.acceleration", task, "task", "acceleration_mps2");
   }
   if (differential) {
@@ -218,11 +218,11 @@ void AddTask(SystemBuilder& b, const RobotFile& file, const StartPose& start, Si
     }
   } else {
     // An omnidirectional base keeps this heading while it moves.
-    p["heading"] = Num(Child(task, "yaw_deg").IsDefined()
-                           ? r.Real(task, "task", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad
-                           : start.yaw_rad);
+    p["heading"] = Child(task, "yaw_deg").IsDefined()
+                       ? r.Real(task, "task", "yaw_deg", 0.0, {-360.0, 360.0}) * kDegToRad
+                       : start.yaw_rad;
   }
-  p["waypoints"] = PointList(info.path);
+  p["waypoints"] = info.path;
   // A problem the follower finds with a waypoint (one that repeats the one
   // before it) is reported at the point the user wrote.
   if (const YAML::Node written = Child(task, "waypoints");

@@ -200,14 +200,15 @@ TEST(RobotScenario, RecordingIntervalIsAWholeNumberOfMasterSteps) {
     root["master"]["step_s"] = step;
     YamlReader reader("robot.yaml");
     RobotInfo info;
-    const YAML::Node expanded = ExpandRobotScenario(root, reader, info);
+    const YAML::Node expanded = ToYaml(ExpandRobotScenario(root, reader, info));
     EXPECT_EQ(expanded["recording"]["interval_s"].Scalar(), interval) << step;
   }
   YAML::Node root = YAML::Load(text);
   root.remove("master");
   YamlReader reader("robot.yaml");
   RobotInfo info;
-  EXPECT_EQ(ExpandRobotScenario(root, reader, info)["recording"]["interval_s"].Scalar(), "0.01");
+  EXPECT_EQ(ToYaml(ExpandRobotScenario(root, reader, info))["recording"]["interval_s"].Scalar(),
+            "0.01");
 }
 
 // Guards `linesim inspect`'s promise that the expansion is a system-level

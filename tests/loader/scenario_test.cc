@@ -162,13 +162,16 @@ units:
 recording: {interval_s: 2.0e-10}
 )");
   const std::string all = Issues(f);
-  for (const char* key : {":2: master.step_s", ":6: units.supply.step_s",
-                          ":7: units.supply.parameters.steps.0.time_s"}) {
+  // The recording's interval is read with the rest of the file, before any
+  // unit is built: all four at once.
+  for (const char* key :
+       {":2: master.step_s", ":6: units.supply.step_s",
+        ":7: units.supply.parameters.steps.0.time_s", ":8: recording.interval_s"}) {
     EXPECT_TRUE(Has(all, f + std::string(key) + ": value ")) << key << "\n" << all;
   }
-  EXPECT_EQ(std::count(all.begin(), all.end(), '\n') + 1, 3) << all;
+  EXPECT_EQ(std::count(all.begin(), all.end(), '\n') + 1, 4) << all;
   EXPECT_TRUE(Has(all, "below one nanosecond")) << all;
-  // The recording is checked once the units are built.
+  // Alone, too.
   const std::vector<std::string> good = {"master.step_s=0.001", "units.supply.step_s=0.001",
                                          "units.supply.parameters.steps.0.time_s=0"};
   const std::string rec = Issues(f, good);

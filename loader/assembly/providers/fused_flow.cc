@@ -25,7 +25,7 @@ void SurfaceFusedFlow(SystemBuilder& b, const ProviderContext& c, Signals& s) {
   const auto flows = Mounts(s, "px4flow");
   const models::RobotDescription& robot = c.file.robot;
   b.Unit(kFusion, "surface_fusion");
-  YAML::Node p = b.Params(kFusion);
+  Parameters& p = b.Params(kFusion);
   ConnectFlowSensors(b, flows, robot, kFusion, p);
   SetWheelPositions(p, robot);
   if (s.odometry.empty()) AddOdometry(b, c, s);
@@ -41,10 +41,10 @@ void SurfaceFusedFlow(SystemBuilder& b, const ProviderContext& c, Signals& s) {
   if (const auto imus = Mounts(s, "imu"); !imus.empty()) {
     const std::string& imu = imus.front()->name;
     p["imu"] = true;
-    p["imu_yaw"] = Num(imus.front()->yaw_rad);
+    p["imu_yaw"] = imus.front()->yaw_rad;
     b.Connect(Signal(imu, "linear_acceleration"), Signal(kFusion, "imu_acceleration"));
-    const YAML::Node step = b.out()["units"][imu]["step_s"];
-    if (step.IsDefined() && step.IsScalar()) b.out()["units"][kFusion]["step_s"] = step;
+    const UnitSpec* imu_unit = b.spec().FindUnit(imu);
+    if (imu_unit && imu_unit->step) b.SetStep(kFusion, *imu_unit->step);
   }
   s.surface_velocity = Signal(kFusion, "wheel_surface_velocity");
   s.surface_estimate = Signal(kFusion, "sensor_surface_velocity");

@@ -17,7 +17,7 @@ void AddPerfectMatch(SystemBuilder& b, const ProviderContext& c, Signals& s) {
   YamlReader& r = b.reader();
   const auto lasers = Mounts(s, "laser_scanner");
   b.Unit(kPerfectMatch, "perfect_match_localization");
-  YAML::Node p = b.Params(kPerfectMatch);
+  Parameters& p = b.Params(kPerfectMatch);
   // The nearest usable range of all lasers, and the largest per-device
   // range bias (the LMS151's systematic error) for the match covariance.
   std::optional<double> range_min, bias_sigma;
@@ -32,8 +32,8 @@ void AddPerfectMatch(SystemBuilder& b, const ProviderContext& c, Signals& s) {
     b.Connect(Signal(lasers[k]->name, "range_bias"),
               Signal(kPerfectMatch, "mapping_range_bias_" + std::to_string(k)));
   }
-  if (range_min) p["range_min"] = Num(*range_min);
-  if (bias_sigma) p["range_bias_sigma"] = Num(*bias_sigma);
+  if (range_min) p["range_min"] = *range_min;
+  if (bias_sigma) p["range_bias_sigma"] = *bias_sigma;
   // 3 DoF as paper 2's matcher: every map is a slice at the first laser's
   // height above the map's floor.
   const double scan_z = lasers.empty() ? 0.0 : lasers.front()->z_m;
@@ -62,7 +62,7 @@ void AddPerfectMatch(SystemBuilder& b, const ProviderContext& c, Signals& s) {
       s.localization_maps.push_back(name);
     }
   }
-  p["maps"] = maps;
+  p["maps"] = ParameterValue(maps);
   b.Origin(JoinPath(JoinPath(JoinPath("units", kPerfectMatch), "parameters"), "maps"),
            {given.IsDefined() ? given : c.at, given.IsDefined() ? "localization.maps" : c.path,
             r.file()});
@@ -88,7 +88,7 @@ void LocalizationPerfectMatch(SystemBuilder& b, const ProviderContext& c, Signal
   b.Params(kPerfectMatch)["motion_prediction"] = "odometry";
   ConnectOdometryToMatcher(b, kPerfectMatch);
   AddPoseFusion(b, c, s, kPerfectMatch);
-  YAML::Node f = b.Params(kPoseFusion);
+  Parameters& f = b.Params(kPoseFusion);
   f["offset_random_walk"] = 0;
   f["initial_offset_sigma"] = 0;
 }

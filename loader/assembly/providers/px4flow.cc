@@ -15,7 +15,7 @@ void SurfacePx4flow(SystemBuilder& b, const ProviderContext& c, Signals& s) {
   const auto flows = Mounts(s, "px4flow");
   const models::RobotDescription& robot = c.file.robot;
   b.Unit(kSurfaceEstimator, "surface_velocity_estimator");
-  YAML::Node p = b.Params(kSurfaceEstimator);
+  Parameters& p = b.Params(kSurfaceEstimator);
   ConnectFlowSensors(b, flows, robot, kSurfaceEstimator, p);
   // The filter's sample is the sensors' message period, when their
   // settings or model file say (else both units' default, 10 Hz).
@@ -31,7 +31,7 @@ void SurfacePx4flow(SystemBuilder& b, const ProviderContext& c, Signals& s) {
     }
     rate = r;
   }
-  if (rate && *rate > 0.0) p["sample_period"] = Num(1.0 / *rate);
+  if (rate && *rate > 0.0) p["sample_period"] = 1.0 / *rate;
   SetWheelPositions(p, robot);
   // The encoders' check of each message (a dark image passes the
   // firmware's quality test with noise matches): with the wheel
