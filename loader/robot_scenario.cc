@@ -192,15 +192,13 @@ void ConnectFleet(assembly::SystemBuilder& b, const std::vector<RobotInfo>& robo
                   const std::vector<std::vector<std::string>>& lasers,
                   std::vector<std::string>& recorded) {
   constexpr std::size_t kBox = models::MovingBox::kValues;
-  const auto add = [&](const std::string& name, const std::string& of, const char* reduce) {
-    cosim::Reduction reduction = cosim::Reduction::kFinal;
-    cosim::ParseReduction(reduce, &reduction);
-    b.Metric(name, of, reduction);
+  const auto add = [&](const std::string& name, const assembly::Port& of) {
+    b.Metric(name, of, cosim::Reduction::kFinal);
   };
   const int count = static_cast<int>(robots.size());
   b.Unit(assembly::kMovingBodies, "moving_bodies");
   b.Params(assembly::kMovingBodies)["count"] = count;
-  const std::string bodies = assembly::Signal(assembly::kMovingBodies, "bodies");
+  const assembly::Port bodies = assembly::Signal(assembly::kMovingBodies, "bodies");
   for (std::size_t i = 0; i < robots.size(); ++i) {
     const std::string chassis = robots[i].name + "." + assembly::kChassis;
     for (std::size_t k = 0; k < kBox; ++k) {
@@ -231,11 +229,11 @@ void ConnectFleet(assembly::SystemBuilder& b, const std::vector<RobotInfo>& robo
     for (std::size_t j = 0; j < robots.size(); ++j) {
       if (j == i) continue;
       add(name + ".robot_" + robots[j].name + "_collisions",
-          assembly::Element(clearance, "robot_collisions", j), "final");
+          assembly::Element(clearance, "robot_collisions", j));
     }
-    add(name + ".min_robot_distance_m", assembly::Signal(clearance, "min_distance"), "final");
-    add(name + ".robot_collisions", assembly::Signal(clearance, "collisions"), "final");
-    recorded.push_back(assembly::Signal(clearance, "distance"));
+    add(name + ".min_robot_distance_m", assembly::Signal(clearance, "min_distance"));
+    add(name + ".robot_collisions", assembly::Signal(clearance, "collisions"));
+    recorded.push_back(assembly::Signal(clearance, "distance").Name());
   }
 }
 
@@ -282,7 +280,7 @@ void MergeRobot(assembly::SystemBuilder& top, assembly::SystemBuilder& b, YamlRe
     if (several && !own.count(unit_of(c.to)) && c.to.ends_with(".robots")) continue;
     // Between the scene's units: the first robot made it.
     if (!first && !own.count(unit_of(c.from)) && !own.count(unit_of(c.to))) continue;
-    top.Connect(scoped(c.from), scoped(c.to));
+    all.connections.push_back({scoped(c.from), scoped(c.to), YAML::Node()});
   }
   if (one.recording && one.recording->variables) {
     for (const auto& v : *one.recording->variables) {
@@ -297,7 +295,7 @@ void MergeRobot(assembly::SystemBuilder& top, assembly::SystemBuilder& b, YamlRe
       if (first) all.metrics.push_back(m);  // of a scene's unit (a worker): once, unscoped
       continue;
     }
-    top.Metric(name + "." + m.name, scoped(m.of), m.reduction);
+    all.metrics.push_back({name + "." + m.name, scoped(m.of), m.reduction, YAML::Node()});
   }
   for (const auto& [expanded, from] : one.origins) {
     std::string key = expanded;

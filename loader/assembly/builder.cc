@@ -5,12 +5,18 @@
 
 namespace linesim::loader::assembly {
 
-std::string Signal(const std::string& unit, const std::string& variable) {
-  return unit + "." + variable;
+std::string Port::Name() const {
+  std::string name = unit + "." + variable;
+  if (element) name += "[" + std::to_string(*element) + "]";
+  return name;
 }
 
-std::string Element(const std::string& unit, const std::string& variable, std::size_t k) {
-  return Signal(unit, variable) + "[" + std::to_string(k) + "]";
+Port Signal(const std::string& unit, const std::string& variable) {
+  return {unit, variable, std::nullopt};
+}
+
+Port Element(const std::string& unit, const std::string& variable, std::size_t k) {
+  return {unit, variable, k};
 }
 
 YAML::Node Num(double x) { return YAML::Node(cosim::FormatValue(x)); }
@@ -63,13 +69,12 @@ void SystemBuilder::SetStep(const std::string& name, cosim::TimeNs step) {
   unit->step = step;
 }
 
-void SystemBuilder::Connect(const std::string& from, const std::string& to) {
-  spec_.connections.push_back({from, to, YAML::Node()});
+void SystemBuilder::Connect(const Port& from, const Port& to) {
+  spec_.connections.push_back({from.Name(), to.Name(), YAML::Node()});
 }
 
-void SystemBuilder::Metric(const std::string& name, const std::string& of,
-                           cosim::Reduction reduce) {
-  spec_.metrics.push_back({name, of, reduce, YAML::Node()});
+void SystemBuilder::Metric(const std::string& name, const Port& of, cosim::Reduction reduce) {
+  spec_.metrics.push_back({name, of.Name(), reduce, YAML::Node()});
 }
 
 void SystemBuilder::Derived(const std::string& expanded, const YAML::Node& parent,

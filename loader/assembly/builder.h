@@ -4,6 +4,7 @@
 
 #include <array>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,10 +44,23 @@ inline constexpr cosim::TimeNs kControlPeriod = cosim::kNsPerSecond / 50;
 /// Paper 1's encoder wheel on the belt, off the robot.
 inline constexpr const char* kBeltGroundTruth = "belt_ground_truth";
 
-/// "unit.variable".
-std::string Signal(const std::string& unit, const std::string& variable);
-/// "unit.variable[k]".
-std::string Element(const std::string& unit, const std::string& variable, std::size_t k);
+/// A variable of a unit the assembly adds, or one element of an array
+/// variable: what a role (Signals) holds and a connection, a recorded column
+/// or a metric names.
+struct Port {
+  std::string unit, variable;
+  std::optional<std::size_t> element;
+
+  /// "unit.variable" or "unit.variable[k]", as the description writes it.
+  std::string Name() const;
+  bool empty() const { return unit.empty(); }
+  friend bool operator==(const Port&, const Port&) = default;
+};
+
+/// unit.variable.
+Port Signal(const std::string& unit, const std::string& variable);
+/// unit.variable[k].
+Port Element(const std::string& unit, const std::string& variable, std::size_t k);
 
 /// YAML for the structured parameters the assembly builds (a route's
 /// segments, field sets): numbers as the shortest text that reads back to
@@ -75,9 +89,9 @@ class SystemBuilder {
   /// Unit `name`'s parameters (the unit is added, typeless, when absent).
   Parameters& Params(const std::string& name);
   void SetStep(const std::string& name, cosim::TimeNs step);
-  void Connect(const std::string& from, const std::string& to);
+  void Connect(const Port& from, const Port& to);
   /// Adds the metric {name, of, reduce}.
-  void Metric(const std::string& name, const std::string& of, cosim::Reduction reduce);
+  void Metric(const std::string& name, const Port& of, cosim::Reduction reduce);
 
   /// Records that the description's `expanded` path holds a value derived
   /// from the robot-level key `key` of `parent` (at `path`).

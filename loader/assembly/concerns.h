@@ -16,19 +16,21 @@
 /// never to a literal unit of another concern.
 namespace linesim::loader::assembly {
 
-/// What the assembled units provide, by role, as "unit.variable" names.
+/// What the assembled units provide, by role: the unit variable that plays
+/// it (empty when none does).
 struct Signals {
   /// Ground truth of the robot: evaluation reads these, never estimates.
-  std::string true_position, true_yaw, true_surface_velocity;
+  Port true_position, true_yaw, true_surface_velocity;
   /// What the controllers use: localization's and sensing's choice (the
   /// robot's velocity in map and yaw rate too: Eq. 2 needs them).
-  std::string position, yaw, velocity, yaw_rate, surface_velocity;
+  Port position, yaw, velocity, yaw_rate, surface_velocity;
   /// The estimators, when the scenario closes the loop through them: the
   /// odometry unit ("" for none), the surface estimator's filtered value
   /// per PX4Flow in map ("" for none), and each localization's source
   /// output (which source it is using: the fallbacks).
-  std::string odometry, surface_estimate;
-  std::vector<std::string> localization_sources;
+  std::string odometry;
+  Port surface_estimate;
+  std::vector<Port> localization_sources;
 
   /// Joints of the drive train: the chassis's index of each wheel's
   /// steering joint (-1: fixed wheel) and drive joint, and the dc_motor
@@ -37,14 +39,14 @@ struct Signals {
   std::vector<std::size_t> steer_motor_element, drive_motor_element;
 
   /// The wheel controller's command inputs, which the task drives.
-  std::string velocity_command_input, yaw_rate_command_input;
+  Port velocity_command_input, yaw_rate_command_input;
 
   /// Map switching (paper 2): the localization's maps by name and its map
   /// index input (empty without one); a route's maps by name (its graph's),
   /// the follower's map index output, its done output and the route's end
   /// pose {x, y, yaw} (empty without a route).
   std::vector<std::string> localization_maps, route_maps;
-  std::string map_index_input, map_index_output, route_done;
+  Port map_index_input, map_index_output, route_done;
   std::vector<double> route_end;
   /// The beacon system measuring the final pose ("" for none).
   std::string beacon_unit;
@@ -58,14 +60,14 @@ struct Signals {
   /// named after the mount, its type is the mount's kind), and the belt's
   /// ground-truth speed ("" when there is none).
   std::vector<models::SensorMount> sensors;
-  std::string belt_ground_truth;
+  Port belt_ground_truth;
   int belt_ground_truth_belt = 0;  // the scene belt it measures
   /// The laser whose scan at scan_time_s the plots draw ("" for none).
   std::string scan_unit;
   double scan_time_s = 0.0;
 
   /// What each concern wants recorded, in order.
-  std::vector<std::string> recorded;
+  std::vector<Port> recorded;
 };
 
 /// The robot's pose at time zero (robot.pose).

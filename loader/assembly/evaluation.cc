@@ -14,10 +14,10 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
 
   // The scenario's own metrics first.
   ReadMetrics(Child(b.root(), "metrics"), b.reader(), b.spec());
-  const auto add = [&](const std::string& name, const std::string& of, cosim::Reduction reduce) {
+  const auto add = [&](const std::string& name, const Port& of, cosim::Reduction reduce) {
     b.Metric(name, of, reduce);
   };
-  const std::string deviation = Signal(kDeviation, "deviation");
+  const Port deviation = Signal(kDeviation, "deviation");
   if (info.task != "hold") {  // a path or a route
     add("max_path_deviation_m", deviation, cosim::Reduction::kMax);
     add("final_path_deviation_m", deviation, cosim::Reduction::kFinal);
@@ -92,9 +92,8 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     add("localization_yaw_error_rms_rad", Signal(kLocalizationError, "rms_yaw_error"),
         cosim::Reduction::kFinal);
     // The share of the run the localization spent on its fallback (source 1).
-    for (const auto& source : s.localization_sources) {
-      const std::string unit = source.substr(0, source.find('.'));
-      add(unit + "_fallback_fraction", source, cosim::Reduction::kMean);
+    for (const Port& source : s.localization_sources) {
+      add(source.unit + "_fallback_fraction", source, cosim::Reduction::kMean);
     }
   }
 
@@ -148,38 +147,40 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     // publishing interval), over the run.
     add("optic_flow_quality_mean", Signal(flows.front()->name, "quality"), cosim::Reduction::kMean);
     for (std::size_t k = 0; k < flows.size(); ++k) {
-      info.flow_columns.push_back(Element(kFlowError, "reading", k));
-      info.flow_truth_columns.push_back(Element(kFlowError, "true_reading", k));
+      info.flow_columns.push_back(Element(kFlowError, "reading", k).Name());
+      info.flow_truth_columns.push_back(Element(kFlowError, "true_reading", k).Name());
       info.flow_sensor_names.push_back(flows[k]->name);
       if (!s.surface_estimate.empty()) {
-        info.flow_filtered_columns.push_back(Element(kFlowError, "estimated_speed", k));
+        info.flow_filtered_columns.push_back(Element(kFlowError, "estimated_speed", k).Name());
       }
     }
-    info.flow_reference_column = s.belt_ground_truth;
+    info.flow_reference_column = s.belt_ground_truth.Name();
   }
-  info.error_column = deviation;
+  info.error_column = deviation.Name();
 }
 
 void AddRecording(SystemBuilder& b, const Signals& s, RobotInfo& info) {
   // The columns the plots read, as the recorder names them.
-  info.x_column = Element(kChassis, "position", 0);
-  info.y_column = Element(kChassis, "position", 1);
-  info.yaw_column = Signal(kChassis, "yaw");
-  if (s.terrain) info.z_column = Element(kChassis, "position_3d", 2);
+  info.x_column = Element(kChassis, "position", 0).Name();
+  info.y_column = Element(kChassis, "position", 1).Name();
+  info.yaw_column = Signal(kChassis, "yaw").Name();
+  if (s.terrain) info.z_column = Element(kChassis, "position_3d", 2).Name();
   for (std::size_t w = 0; w < static_cast<std::size_t>(info.wheel_count); ++w) {
-    info.wheel_columns.emplace_back(Element(kChassis, "wheel_contact", 2 * w),
-                                    Element(kChassis, "wheel_contact", 2 * w + 1));
+    info.wheel_columns.emplace_back(Element(kChassis, "wheel_contact", 2 * w).Name(),
+                                    Element(kChassis, "wheel_contact", 2 * w + 1).Name());
   }
-  info.wheel_surface_column = Signal(kChassis, "wheel_surface");
-  info.motor_current_column = Signal(kMotors, "current");
+  info.wheel_surface_column = Signal(kChassis, "wheel_surface").Name();
+  info.motor_current_column = Signal(kMotors, "current").Name();
   info.scan_unit = s.scan_unit;
   info.scan_time_s = s.scan_time_s;
   for (std::size_t k = 0; k < s.belt_count; ++k) {
-    info.belt_speed_columns.push_back(Element(kBelt, "speed", k));
-    info.belt_on_columns.push_back(Element(kBelt, "on", k));
-    info.belt_travel_columns.push_back(Element(kBelt, "travel", k));
+    info.belt_speed_columns.push_back(Element(kBelt, "speed", k).Name());
+    info.belt_on_columns.push_back(Element(kBelt, "on", k).Name());
+    info.belt_travel_columns.push_back(Element(kBelt, "travel", k).Name());
   }
-  AddRecordingSection(b, s.recorded);
+  std::vector<std::string> recorded;
+  for (const Port& p : s.recorded) recorded.push_back(p.Name());
+  AddRecordingSection(b, recorded);
 }
 
 void AddRecordingSection(SystemBuilder& b, const std::vector<std::string>& recorded) {

@@ -166,7 +166,7 @@ void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s) {
 
 void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo& info) {
   YamlReader& r = b.reader();
-  const auto add = [&](const std::string& name, const std::string& of, cosim::Reduction reduce) {
+  const auto add = [&](const std::string& name, const Port& of, cosim::Reduction reduce) {
     b.Metric(name, of, reduce);
   };
   if (b.HasUnit(kSafety)) {
@@ -178,11 +178,11 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
     add("protective_stops", Signal(kSafety, "protective_stops"), cosim::Reduction::kFinal);
     add("time_stopped_s", Signal(kSafety, "time_stopped"), cosim::Reduction::kFinal);
     add("task_time_s", Signal(kSafety, "task_time"), cosim::Reduction::kFinal);
-    info.velocity_x_column = Element(kChassis, "linear_velocity", 0);
-    info.velocity_y_column = Element(kChassis, "linear_velocity", 1);
-    info.speed_cap_column = Signal(kSafety, "speed_cap");
-    info.protective_column = Signal(kSafety, "protective_clear");
-    info.warning_column = Signal(kSafety, "warning_clear");
+    info.velocity_x_column = Element(kChassis, "linear_velocity", 0).Name();
+    info.velocity_y_column = Element(kChassis, "linear_velocity", 1).Name();
+    info.speed_cap_column = Signal(kSafety, "speed_cap").Name();
+    info.protective_column = Signal(kSafety, "protective_clear").Name();
+    info.warning_column = Signal(kSafety, "warning_clear").Name();
   }
 
   const YAML::Node list = Child(b.root(), "workers");
@@ -292,14 +292,15 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
                 Element(kPersonClearance, "cylinders", w * per_worker + static_cast<std::size_t>(j)));
     }
     s.recorded.push_back(Signal(names[w], "pose"));
-    info.worker_columns.emplace_back(Element(names[w], "pose", 0), Element(names[w], "pose", 1));
+    info.worker_columns.emplace_back(Element(names[w], "pose", 0).Name(),
+                                     Element(names[w], "pose", 1).Name());
     s.recorded.push_back(Signal(names[w], "legs"));
     add(names[w] + "_time_waited_s", Signal(names[w], "time_waited"), cosim::Reduction::kFinal);
     add("robot_" + names[w] + "_collisions", Element(kPersonClearance, "worker_collisions", w),
         cosim::Reduction::kFinal);
   }
   s.recorded.push_back(Signal(kPersonClearance, "distance"));
-  if (b.HasUnit(kSafety)) info.person_distance_column = Signal(kPersonClearance, "distance");
+  if (b.HasUnit(kSafety)) info.person_distance_column = Signal(kPersonClearance, "distance").Name();
   add("min_person_distance_m", Signal(kPersonClearance, "min_distance"), cosim::Reduction::kFinal);
   add("person_collisions", Signal(kPersonClearance, "collisions"), cosim::Reduction::kFinal);
 }
