@@ -18,12 +18,10 @@
 #include "config/unit_registry.h"
 #include "cosim/files.h"
 #include "cosim/observers.h"
-#include "cosim/run_error_json.h"
 #include "loader/scenario.h"
 #include "mcap/run_log.h"
-#include "platform/provenance.h"
-#include "plots/robot_plots.h"
 #include "replay/replay_recorder.h"
+#include "session/session.h"
 #include "units/fmu/fmu_unit.h"
 
 namespace linesim::app {
@@ -32,8 +30,6 @@ namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
 namespace {
-
-Json Number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
 std::string TypeLabel(const cosim::VariableInfo& v) {
   if (v.type == cosim::VarType::kRealArray) return "Real[" + std::to_string(v.size) + "]";
@@ -98,87 +94,6 @@ void PrintMarkdownTable(const cosim::Unit& unit, std::ostream& out) {
   }
 }
 
-// Paper 1, Sec. VI-B: with the modified system the maximum deviation
-// crossing the line at 0.10 m/s is under 4 cm; the robot-level plots draw
-// it as the bound the deviation and the holds' drift are judged by.
-constexpr double kPaperBoundM = 0.04;
-constexpr const char* kPaperBoundLabel = "4 cm (paper 1, Sec. VI-B)";
-
-// What the plots of a robot run draw, by the columns the robot expansion
-// names.
-// `robot` is the scenario's robot, or in a fleet any of its robots (the
-// others drawn in its top view).
-plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat format,
-                              const loader::RobotInfo& robot, const loader::RobotInfo* first) {
-  plots::RobotPlotSpec spec;
-  spec.title = s.name;
-  spec.scene = s.scene;
-  spec.path_m = robot.path;
-  spec.x_column = robot.x_column;
-  spec.y_column = robot.y_column;
-  spec.yaw_column = robot.yaw_column;
-  spec.z_column = robot.z_column;
-  spec.wheel_columns = robot.wheel_columns;
-  spec.error_column = robot.error_column;
-  spec.error_label =
-      robot.task != "hold" ? "deviation from the path (m)" : "drift from the held position (m)";
-  spec.error_name = robot.task != "hold" ? "deviation of the robot's centre from the desired path"
-                                         : "drift of the robot's centre from the held position";
-  spec.error_bound_m = kPaperBoundM;
-  spec.error_bound_label = kPaperBoundLabel;
-  spec.format = format;
-  spec.belt_speed_columns = robot.belt_speed_columns;
-  spec.belt_on_columns = robot.belt_on_columns;
-  spec.belt_travel_columns = robot.belt_travel_columns;
-  spec.flow_columns = robot.flow_columns;
-  spec.flow_labels = robot.flow_sensor_names;
-  spec.flow_truth_columns = robot.flow_truth_columns;
-  spec.flow_filtered_columns = robot.flow_filtered_columns;
-  spec.flow_reference_column = robot.flow_reference_column;
-  spec.worker_columns = robot.worker_columns;
-  // A fleet: each robot's plots, with the others in the top view; the
-  // first robot's files have no prefix, the others' their name.
-  spec.robot_name = robot.name;
-  const loader::RobotInfo& lead = first != nullptr ? *first : robot;
-  const auto add_other = [&](const loader::RobotInfo& other) {
-    if (other.name == robot.name) return;
-    spec.others.push_back({other.name, other.x_column, other.y_column, other.yaw_column,
-                           other.body_length_m.value_or(0.0), other.body_width_m.value_or(0.0)});
-  };
-  add_other(lead);
-  for (const loader::RobotInfo& other : lead.fleet) add_other(other);
-  if (first != nullptr && robot.name != first->name) spec.file_prefix = robot.name + "_";
-  if (!robot.name.empty()) spec.title = s.name + " (" + robot.name + ")";
-  spec.safety = {robot.velocity_x_column, robot.velocity_y_column, robot.speed_cap_column,
-                 robot.protective_column,  robot.warning_column,    robot.person_distance_column};
-  if (!robot.scan_unit.empty()) {
-    // The beams' geometry is the laser unit's: read its parameters.
-    for (std::size_t u = 0; u < s.system->unit_count(); ++u) {
-      const cosim::Unit& unit = s.system->unit(u);
-      if (unit.name() != robot.scan_unit) continue;
-      const cosim::VariableTable& v = unit.variables();
-      const auto real = [&](const char* name) { return v.GetReal(*v.Find(name)); };
-      plots::RobotPlotSpec::Scan& scan = spec.scan;
-      scan.sensor = robot.scan_unit;
-      scan.time_s = robot.scan_time_s;
-      scan.mount_x_m = real("mount_x");
-      scan.mount_y_m = real("mount_y");
-      scan.mount_yaw_rad = real("mount_yaw");
-      scan.first_beam_rad = real("first_beam_angle");
-      scan.beam_step_rad = real("angular_step");
-      scan.no_return_m = real("no_return_value");
-      const std::size_t beams = v.info(*v.Find("ranges")).size;
-      for (std::size_t k = 0; k < beams; ++k) {
-        scan.range_columns.push_back(robot.scan_unit + ".ranges[" + std::to_string(k) + "]");
-      }
-      scan.scan_time_column = robot.scan_unit + ".scan_time";
-    }
-  }
-  if (robot.body_length_m) spec.body_length_m = *robot.body_length_m;
-  if (robot.body_width_m) spec.body_width_m = *robot.body_width_m;
-  return spec;
-}
-
 }  // namespace
 
 int RunCommand(const std::string& file, const std::string& out_dir,
@@ -194,13 +109,14 @@ int RunCommand(const std::string& file, const std::string& out_dir,
     }
     return CompareCommand(file, out_dir, set_args, max_output_mb, format);
   }
-  loader::Scenario s;
+  std::optional<session::Session> run;
   try {
-    s = loader::LoadScenario(file, set_args);
+    run.emplace(file, set_args);
   } catch (const config::ScenarioError& e) {
     PrintIssues(e, "scenario", std::cerr);
     return kExitBadInput;
   }
+  const loader::Scenario& s = run->scenario();
   // The recording's size, said before anything runs: rows from the
   // duration and the interval, each column at most 24 characters and its
   // comma (a double's shortest round-trip text, sign and exponent included).
@@ -270,15 +186,13 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   }
 
   cosim::CsvRecorder recorder(csv, s.recorded, s.record_interval);
-  cosim::MetricsObserver metrics(s.metrics);
-  s.master->AddObserver(&recorder);
-  s.master->AddObserver(&metrics);
+  run->AddObserver(&recorder);
   // The replay page of a robot run (replay/): sampled by an observer.
   std::unique_ptr<replay::ReplayRecorder> replayer;
   if (s.robot && replay) {
     replayer = std::make_unique<replay::ReplayRecorder>(
-        replay::ReplaySpecFor(s, kPaperBoundM, kPaperBoundLabel));
-    s.master->AddObserver(replayer.get());
+        replay::ReplaySpecFor(s, session::kPaperBoundM, session::kPaperBoundLabel));
+    run->AddObserver(replayer.get());
   }
   // --mcap: the run for Foxglove and PlotJuggler, gathered as it runs.
   const fs::path mcap_path = dir / "run.mcap";
@@ -291,7 +205,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
       return kExitBadInput;
     }
     mcap_log = std::make_unique<mcap::RunLog>(mcap_file, s);
-    s.master->AddObserver(mcap_log.get());
+    run->AddObserver(mcap_log.get());
   }
 
   // Ctrl-C or SIGTERM: stop at the next communication point, keep what was
@@ -299,124 +213,26 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   std::atomic<bool>& stop = InstallStopSignals(
       "\nlinesim: interrupted: stopping at the next communication point (again to quit at "
       "once)\n");
-  const auto wall0 = std::chrono::steady_clock::now();
-  s.master->Start();
-  bool interrupted = false;
-  while (s.master->Step()) {
-    if (stop.load(std::memory_order_relaxed)) {
-      interrupted = true;
-      break;
-    }
-  }
-  const cosim::RunResult result = s.master->Finish();
-  const double wall_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  session::RunReport report = run->Run(&stop);
+  const cosim::RunResult& result = report.result;
   csv.close();
   // A full disk shows only here (buffered writes fail late): a run whose
   // signals were lost has failed, whatever the units did.
-  cosim::RunResult outcome = result;
   const bool csv_written = !csv.fail();
   if (!csv_written) {
-    outcome.ok = false;
-    cosim::RunError e = cosim::MakeRunError(
-        std::nullopt, cosim::RunPhase::kRecording, "",
-        "cannot write " + csv_path.string() + " (disk full or not writable): the signals are " +
-            "incomplete");
-    e.message = e.cause;
-    e.time = result.end_time;
-    outcome.errors.push_back(std::move(e));
+    report.AddFailure("cannot write " + csv_path.string() +
+                      " (disk full or not writable): the signals are incomplete");
   }
   if (mcap_log) {
     mcap_file.close();
     if (mcap_file.fail()) {
-      outcome.ok = false;
-      cosim::RunError e = cosim::MakeRunError(
-          std::nullopt, cosim::RunPhase::kRecording, "",
-          "cannot write " + mcap_path.string() + " (disk full or not writable)");
-      e.message = e.cause;
-      e.time = result.end_time;
-      outcome.errors.push_back(std::move(e));
+      report.AddFailure("cannot write " + mcap_path.string() + " (disk full or not writable)");
     }
-  }
-
-  // A metric that overflowed fails the run, naming the metric.
-  for (auto& e : metrics.NonFiniteErrors(result.end_time)) {
-    outcome.ok = false;
-    outcome.errors.push_back(std::move(e));
   }
 
   const cosim::MasterOptions& options = s.master->options();
   const double simulated_s = cosim::NsToSeconds(result.end_time - options.start);
-  Json summary;
-  summary["scenario"] = s.name;
-  summary["file"] = file;
-  summary["status"] = interrupted ? "interrupted" : outcome.ok ? "ok" : "failed";
-  // The first failure as data ({"unit", "time_s", "phase", "variable",
-  // "cause", "message"}), null when the run is ok; every message in
-  // "errors".
-  summary["error"] = outcome.errors.empty() ? Json(nullptr) : cosim::RunErrorJson(outcome.errors[0]);
-  Json messages = Json::array();
-  for (const auto& e : outcome.errors) messages.push_back(e.message);
-  summary["errors"] = messages;
-  // A unit that asked to end the run early (an FMU's terminate request):
-  // which and why; absent when the run reached its stop time.
-  if (!result.ended_by.empty()) summary["ended_by"] = result.ended_by;
-  Json settings;
-  settings["duration_s"] = s.duration_s;
-  settings["seed"] = s.seed;
-  settings["master"] = {{"algorithm", cosim::ToString(options.algorithm)},
-                        {"step_s", cosim::NsToSeconds(options.base_step)},
-                        {"threads", options.threads}};
-  if (options.retry.enabled) {
-    settings["master"]["retry"] = {{"min_step_s", cosim::NsToSeconds(options.retry.min_step)},
-                                   {"shrink", options.retry.shrink},
-                                   {"grow", options.retry.grow},
-                                   {"rejected_steps", result.rejected_steps},
-                                   {"smallest_step_s", cosim::NsToSeconds(result.smallest_step)}};
-  }
-  Json overrides = Json::array();
-  for (const auto& o : s.overrides) overrides.push_back(o.path + "=" + o.value);
-  settings["overrides"] = overrides;
-  Json units = Json::object();
-  const cosim::System& system = *s.system;
-  for (std::size_t u = 0; u < system.unit_count(); ++u) {
-    units[system.unit(u).name()] = {
-        {"type", system.unit(u).type_name()},
-        {"step_s", cosim::NsToSeconds(options.base_step * s.master->decimation(u))}};
-  }
-  settings["units"] = units;
-  summary["settings"] = settings;
-  summary["provenance"] = platform::ProvenanceJson(s.sha256, s.seed);
-
-  Json metric_values = Json::object();
-  for (const auto& [name, value] : metrics.Results()) metric_values[name] = Number(value);
-  summary["metrics"] = metric_values;
-
-  Json timing;
-  timing["simulated_s"] = simulated_s;
-  timing["wall_s"] = wall_s;
-  timing["real_time_factor"] = Number(simulated_s / wall_s);
-  // Shares of the stepping time, from the timed base steps alone (measured
-  // whole, unscaled): each unit's own time in them, and what of them no
-  // unit was running for. The estimate wall_s of a unit (its sampled steps
-  // scaled by 31, with Setup and Initialize) could exceed the run's wall
-  // time when the costly steps fell on sampled ones (hold_straddle on own
-  // sensors: -0.067 as wall_s - sum / wall_s); these shares are in [0, 1]
-  // by construction.
-  const cosim::Master& master = *s.master;
-  const double sampled_s = master.sampled_step_seconds();
-  const auto share_of_steps = [&](double seconds) {
-    return sampled_s > 0.0 ? Number(seconds / sampled_s) : Json(nullptr);
-  };
-  Json shares = Json::object();
-  for (std::size_t u = 0; u < system.unit_count(); ++u) {
-    shares[system.unit(u).name()] = {{"wall_s", master.unit_wall_seconds()[u]},
-                                     {"share", share_of_steps(master.sampled_unit_seconds()[u])}};
-  }
-  timing["units"] = shares;
-  timing["master_and_observers_share"] =
-      share_of_steps(sampled_s - std::min(master.sampled_busy_seconds(), sampled_s));
-  summary["timing"] = timing;
+  Json summary = session::Summary(s, file, report);
   Json columns = Json::array();
   for (const auto& p : s.recorded) columns.push_back(p.label);
   summary["recording"] = {{"file", "signals.csv"},
@@ -432,15 +248,8 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   std::vector<std::string> pictures;
   if (s.robot && recorder.rows() > 0 && csv_written) {
     try {
-      for (const auto& p :
-           plots::WriteRobotPlots(dir.string(), PlotSpec(s, format, *s.robot, &*s.robot))) {
+      for (const auto& p : session::WriteRobotPlots(s, dir.string(), format)) {
         pictures.push_back(fs::path(p).filename().string());
-      }
-      for (const loader::RobotInfo& other : s.robot->fleet) {
-        for (const auto& p :
-             plots::WriteRobotPlots(dir.string(), PlotSpec(s, format, other, &*s.robot))) {
-          pictures.push_back(fs::path(p).filename().string());
-        }
       }
       summary["plots"] = {{"files", pictures}};
     } catch (const std::exception& e) {
@@ -467,17 +276,16 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   }
 
   std::cout << s.name << ": "
-            << (interrupted  ? "INTERRUPTED"
-                : outcome.ok ? "ok"
-                             : "FAILED")
+            << (report.interrupted ? "INTERRUPTED"
+                : report.ok()      ? "ok"
+                                   : "FAILED")
             << ", " << cosim::FormatSeconds(result.end_time - options.start) << " s simulated in "
-            << std::setprecision(3) << wall_s << " s wall (" << std::setprecision(4)
-            << simulated_s / wall_s << "x real time)\n";
+            << std::setprecision(3) << report.wall_s << " s wall (" << std::setprecision(4)
+            << simulated_s / report.wall_s << "x real time)\n";
   if (!result.ended_by.empty()) std::cout << "  ended early by " << result.ended_by << "\n";
   std::size_t name_width = 0;
-  for (const auto& [name, value] : metrics.Results())
-    name_width = std::max(name_width, name.size());
-  for (const auto& [name, value] : metrics.Results()) {
+  for (const auto& [name, value] : report.metrics) name_width = std::max(name_width, name.size());
+  for (const auto& [name, value] : report.metrics) {
     std::cout << "  " << std::left << std::setw(static_cast<int>(name_width)) << name << " = "
               << std::setprecision(6) << value << "\n";
   }
@@ -486,14 +294,14 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   for (const auto& p : pictures) std::cout << ", " << p;
   if (mcap_log) std::cout << ", run.mcap";
   std::cout << "\n";
-  for (const auto& e : outcome.errors) std::cerr << "linesim: " << e.message << "\n";
+  for (const auto& e : report.errors) std::cerr << "linesim: " << e.message << "\n";
   if (plot_columns && s.robot) {
     plot_columns->error_column = s.robot->error_column;
     plot_columns->belt_on_columns = s.robot->belt_on_columns;
     plot_columns->task = s.robot->task;
   }
-  if (interrupted) return kExitInterrupted;
-  return outcome.ok ? kExitOk : kExitRunFailed;
+  if (report.interrupted) return kExitInterrupted;
+  return report.ok() ? kExitOk : kExitRunFailed;
 }
 
 // `linesim inspect X.fmu`: what the FMU declares and what the `fmu` unit

@@ -16,6 +16,7 @@
 #include "cosim/files.h"
 #include "loader/scenario.h"
 #include "plots/compare_plots.h"
+#include "session/session.h"
 
 namespace linesim::app {
 
@@ -23,10 +24,6 @@ namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
 namespace {
-
-// Paper 1, Sec. VI-B (as the robot plots draw it, app/commands.cc).
-constexpr double kPaperBoundM = 0.04;
-constexpr const char* kPaperBoundLabel = "4 cm (paper 1, Sec. VI-B)";
 
 struct CompareRun {
   std::string name, label;
@@ -177,8 +174,8 @@ int CompareCommand(const std::string& file, const std::string& out_dir,
   const fs::path dir(out_dir);
   plots::ComparisonPlotSpec spec;
   spec.title = c.name + (c.description.empty() ? "" : ": " + c.description);
-  spec.bound_m = kPaperBoundM;
-  spec.bound_label = kPaperBoundLabel;
+  spec.bound_m = session::kPaperBoundM;
+  spec.bound_label = session::kPaperBoundLabel;
   spec.format = format;
   Json summary;
   summary["comparison"] = c.name;

@@ -12,8 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "cosim/observers.h"
-#include "loader/scenario.h"
+#include "session/session.h"
 
 namespace {
 
@@ -24,15 +23,14 @@ void BM_Scenario(benchmark::State& state, const std::string& file,
   std::map<std::string, double> unit_wall_s;
   for (auto _ : state) {
     state.PauseTiming();
-    linesim::loader::Scenario s = linesim::loader::LoadScenario(file, sets);
-    linesim::cosim::MetricsObserver metrics(s.metrics);
-    s.master->AddObserver(&metrics);
+    linesim::session::Session run(file, sets);
     state.ResumeTiming();
-    const auto result = s.master->Run();
+    const auto result = run.Run().result;
     if (!result.ok) {
       state.SkipWithError(result.ErrorText().c_str());
       break;
     }
+    const linesim::loader::Scenario& s = run.scenario();
     simulated_s += linesim::cosim::NsToSeconds(result.end_time);
     total_wall_s += s.master->total_wall_seconds();
     for (std::size_t u = 0; u < s.system->unit_count(); ++u) {

@@ -3,8 +3,7 @@
 #include <chrono>
 #include <limits>
 
-#include "cosim/observers.h"
-#include "loader/scenario.h"
+#include "session/session.h"
 
 namespace linesim::sweep {
 
@@ -37,43 +36,26 @@ RunOutcome ExecuteRun(const SweepSpec& spec, const RunSpec& run, const std::atom
     return out;
   };
   try {
-    loader::Scenario s = loader::LoadScenario(spec.scenario, RunOverrides(spec, run));
-    out.seed = s.seed;
-    std::vector<cosim::MetricSpec> wanted;
-    for (const auto& name : spec.metrics) {
-      for (const auto& m : s.metrics) {
-        if (m.name == name) wanted.push_back(m);
-      }
-    }
-    if (wanted.size() != spec.metrics.size()) {
+    session::Session session(spec.scenario, RunOverrides(spec, run));
+    out.seed = session.scenario().seed;
+    if (!session.Measure(spec.metrics)) {
       const std::string text = "the scenario with this run's overrides lacks a metric of the sweep";
       return finish(RunStatus::kFailed, text,
                     cosim::MakeRunError(std::nullopt, cosim::RunPhase::kScenario, "", text));
     }
-    cosim::MetricsObserver metrics(wanted);
-    s.master->AddObserver(&metrics);
-    s.master->Start();
-    bool interrupted = false;
-    while (s.master->Step()) {
-      if (stop && stop->load(std::memory_order_relaxed)) {
-        interrupted = true;
-        break;
-      }
+    const session::RunReport report = session.Run(stop);
+    if (report.interrupted) return finish(RunStatus::kInterrupted, "interrupted");
+    if (!report.result.ok) {
+      return finish(RunStatus::kFailed, report.result.ErrorText(),
+                    report.errors.empty() ? cosim::RunError{} : report.errors.front());
     }
-    const cosim::RunResult result = s.master->Finish();
-    if (interrupted) return finish(RunStatus::kInterrupted, "interrupted");
-    if (!result.ok) {
-      return finish(RunStatus::kFailed, result.ErrorText(),
-                    result.errors.empty() ? cosim::RunError{} : result.errors.front());
-    }
-    const auto values = metrics.Results();
-    for (std::size_t i = 0; i < values.size(); ++i) out.metrics[i] = values[i].second;
+    for (std::size_t i = 0; i < report.metrics.size(); ++i)
+      out.metrics[i] = report.metrics[i].second;
     // A metric that overflowed fails the run, naming the metric.
-    const auto overflow = metrics.NonFiniteErrors(result.end_time);
-    if (!overflow.empty()) {
+    if (!report.errors.empty()) {
       std::string text;
-      for (const auto& e : overflow) text += (text.empty() ? "" : "; ") + e.message;
-      return finish(RunStatus::kFailed, text, overflow.front());
+      for (const auto& e : report.errors) text += (text.empty() ? "" : "; ") + e.message;
+      return finish(RunStatus::kFailed, text, report.errors.front());
     }
     return finish(RunStatus::kOk, "");
   } catch (const std::exception& e) {
