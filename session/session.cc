@@ -145,6 +145,24 @@ RunReport Session::Run(const std::atomic<bool>* stop) {
   return report;
 }
 
+SignalRecorder::SignalRecorder(std::vector<cosim::Probe> probes, cosim::TimeNs interval)
+    : probes_(std::move(probes)), interval_(interval), columns_(probes_.size()) {}
+
+void SignalRecorder::OnStart(const cosim::Master& master) {
+  start_ = master.options().start;
+  // As signals.csv: every base step unless an interval is given (the
+  // loader makes it a whole number of base steps).
+  if (interval_ <= 0) interval_ = master.options().base_step;
+}
+
+void SignalRecorder::OnSample(cosim::TimeNs t, const cosim::System& system) {
+  if ((t - start_) % interval_ != 0) return;
+  time_s_.push_back(cosim::NsToSeconds(t));
+  for (std::size_t i = 0; i < probes_.size(); ++i) {
+    columns_[i].push_back(cosim::ReadProbe(system, probes_[i]));
+  }
+}
+
 nlohmann::ordered_json Summary(const loader::Scenario& s, const std::string& file,
                                const RunReport& report) {
   const cosim::RunResult& result = report.result;

@@ -71,6 +71,26 @@ class Session {
   std::unique_ptr<cosim::MetricsObserver> metrics_;  // the master's observer from Run on
 };
 
+/// The recorded signals kept in memory (what signals.csv holds, as numbers):
+/// a row every `interval` from the start, one column per probe.
+class SignalRecorder : public cosim::Observer {
+ public:
+  SignalRecorder(std::vector<cosim::Probe> probes, cosim::TimeNs interval);
+  void OnStart(const cosim::Master& master) override;
+  void OnSample(cosim::TimeNs t, const cosim::System& system) override;
+
+  const std::vector<cosim::Probe>& probes() const { return probes_; }
+  /// The rows' times (s), and each probe's column.
+  const std::vector<double>& time_s() const { return time_s_; }
+  const std::vector<std::vector<double>>& columns() const { return columns_; }
+
+ private:
+  std::vector<cosim::Probe> probes_;
+  cosim::TimeNs interval_, start_ = 0;
+  std::vector<double> time_s_;
+  std::vector<std::vector<double>> columns_;
+};
+
 /// summary.json of a run of `scenario` (the scenario `file` as given):
 /// scenario, status, errors, settings, provenance, metrics and timing; the
 /// caller adds what it wrote (recording, plots, replay, mcap).

@@ -24,6 +24,10 @@ packages=(
   # (mcap/writer.cc); Node.js: the independent MCAP reader of the run.mcap
   # test (tests/mcap/check_mcap.mjs).
   liblz4-dev libzstd-dev zlib1g-dev nodejs
+  # The Python package (python/): pybind11 for its native part, built for
+  # Debian's python3 (python3-dev), numpy for the signals, pytest for its
+  # tests (tests/python).
+  python3-dev pybind11-dev python3-numpy python3-pytest
 )
 
 missing=()
