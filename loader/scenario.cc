@@ -466,6 +466,40 @@ static void AppendCanonical(const YAML::Node& node, std::string& out) {
 }
 
 Scenario LoadScenario(const std::string& file, const std::vector<std::string>& set_args) {
+  return LoadScenario(file, set_args, {});
+}
+
+// Gives the units of `unit_types` their new types, keeping the parameters
+// each new type declares (the others were derived for the type replaced).
+static void ReplaceUnitTypes(SystemSpec& spec, const std::map<std::string, std::string>& unit_types,
+                             YamlReader& r) {
+  for (const auto& [name, type] : unit_types) {
+    UnitSpec* unit = spec.FindUnit(name);
+    const UnitType* found = FindUnitType(type);
+    if (unit == nullptr) {
+      r.Error(YAML::Node(), JoinPath("units", name),
+              "no unit '" + name + "' to give the type '" + type + "'");
+      continue;
+    }
+    if (found == nullptr) {
+      r.Error(YAML::Node(), JoinPath(JoinPath("units", name), "type"), UnknownTypeMessage(type));
+      continue;
+    }
+    const auto declared = CreateDefaultUnit(*found);
+    Parameters kept;
+    for (const auto& [key, value] : unit->parameters) {
+      const auto ref = declared->variables().Find(key);
+      if (ref && declared->variables().info(*ref).causality == cosim::Causality::kParameter) {
+        kept[key] = value;
+      }
+    }
+    unit->type = type;
+    unit->parameters = std::move(kept);
+  }
+}
+
+Scenario LoadScenario(const std::string& file, const std::vector<std::string>& set_args,
+                      const std::map<std::string, std::string>& unit_types) {
   // Refused before anything is read or written (no --out folder).
   if (!IsUtf8(file)) {
     Issue issue;
@@ -532,6 +566,12 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
     tree = s.expanded;
   } else {
     spec = ReadSystemFile(tree, reader);
+  }
+  if (!unit_types.empty()) {
+    ReplaceUnitTypes(spec, unit_types, reader);
+    // The hash (provenance) is of what is built.
+    tree = ToYaml(spec);
+    if (s.robot) s.expanded = tree;
   }
   Builder(s, reader).Build(spec);
   refuse_unread_without_value();

@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -12,8 +13,8 @@
 #include "cosim/observers.h"
 #include "cosim/system.h"
 #include "loader/config_names.h"
-#include "loader/reference.h"
 #include "loader/overrides.h"
+#include "loader/reference.h"
 #include "loader/robot_scenario.h"
 #include "models/scene.h"
 
@@ -57,6 +58,13 @@ struct Scenario {
 /// everything and builds the system. Throws ScenarioError listing every
 /// problem (file, line, key path, bad value, what was expected).
 Scenario LoadScenario(const std::string& file, const std::vector<std::string>& set_args = {});
+
+/// The same, with units of the description given another type before it
+/// is built (unit name -> type: a controller written in Python in place of
+/// the shipped one). The unit keeps the parameters the new type declares
+/// and its connections; a unit or type that does not exist is refused.
+Scenario LoadScenario(const std::string& file, const std::vector<std::string>& set_args,
+                      const std::map<std::string, std::string>& unit_types);
 
 /// `master.step_s` of the map `master` as every loader reads it: within
 /// (0, 10] s, 1 ms when absent. A bad value is reported through `r` and

@@ -2,16 +2,18 @@
 // run session in the Python process. The package's Python code
 // (linesim/__init__.py) shapes what this returns into Result objects and
 // exceptions.
-#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <deque>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "config/scenario_error.h"
+#include "config/unit_registry.h"
 #include "cosim/run_error_json.h"
 #include "loader/scenario.h"
 #include "platform/platform.h"
@@ -44,10 +46,172 @@ py::dict RunErrorDict(const cosim::RunError& e) {
   return d;
 }
 
+// A unit written in Python: a class with `inputs`, `outputs` and
+// `parameters` (dicts of name -> (unit of measure, size or default)), and
+// `setup(self)`, `do_step(self, t, dt)` (seconds); the variables are the
+// object's attributes (a float, or a list for size > 1). Each call takes
+// the GIL for its duration only: native units step without it.
+class PythonUnit : public cosim::Unit {
+ public:
+  PythonUnit(const std::string& type, const std::string& name, PyObject* cls)
+      : cosim::Unit(type, name) {
+    py::gil_scoped_acquire gil;
+    object_ = py::reinterpret_borrow<py::object>(cls)();
+    const auto declared = [&](const char* what) {
+      return py::hasattr(object_, what) ? py::dict(object_.attr(what)) : py::dict();
+    };
+    const auto declare = [&](const char* what, auto&& bind) {
+      for (const auto& [key, spec] : declared(what)) {
+        const std::string var = py::str(key);
+        const py::tuple t = py::reinterpret_borrow<py::tuple>(spec);
+        const std::string unit = py::str(t[0]);
+        bind(var, unit, t[1]);
+      }
+    };
+    // Inputs and outputs: (unit, size); parameters: (unit, default).
+    declare("inputs", [&](const std::string& var, const std::string& unit, py::handle size) {
+      const auto n = size.cast<std::size_t>();
+      Slot& slot = slots_.emplace_back(Slot{var, n > 1, 0.0, std::vector<double>(n, 0.0)});
+      if (slot.array) {
+        variables().Input(var, unit, &slot.values, "Python input");
+      } else {
+        variables().Input(var, unit, &slot.value, "Python input");
+      }
+      inputs_.push_back(&slot);
+    });
+    declare("outputs", [&](const std::string& var, const std::string& unit, py::handle size) {
+      const auto n = size.cast<std::size_t>();
+      Slot& slot = slots_.emplace_back(Slot{var, n > 1, 0.0, std::vector<double>(n, 0.0)});
+      if (slot.array) {
+        variables().Output(var, unit, &slot.values, "Python output", {});
+      } else {
+        variables().Output(var, unit, &slot.value, "Python output", {});
+      }
+      outputs_.push_back(&slot);
+    });
+    declare("parameters", [&](const std::string& var, const std::string& unit, py::handle value) {
+      Slot slot{var, py::isinstance<py::sequence>(value), 0.0, {}};
+      if (slot.array) {
+        slot.values = value.cast<std::vector<double>>();
+      } else {
+        slot.value = value.cast<double>();
+      }
+      Slot& kept = slots_.emplace_back(std::move(slot));
+      if (kept.array) {
+        variables().Parameter(var, unit, &kept.values, "Python parameter");
+      } else {
+        variables().Parameter(var, unit, &kept.value, "Python parameter");
+      }
+      parameters_.push_back(&kept);
+    });
+  }
+
+  ~PythonUnit() override {
+    py::gil_scoped_acquire gil;
+    object_ = py::object();
+  }
+
+  void Setup(cosim::TimeNs, cosim::TimeNs) override {
+    py::gil_scoped_acquire gil;
+    // Every declared variable is an attribute from the start (outputs at
+    // their start value, 0).
+    Give(parameters_);
+    Give(inputs_);
+    Give(outputs_);
+    Call("setup");
+  }
+
+  void Initialize() override {
+    py::gil_scoped_acquire gil;
+    Give(inputs_);
+    Call("initialize");
+    Take();
+  }
+
+  cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override {
+    ClearError();
+    py::gil_scoped_acquire gil;
+    try {
+      Give(inputs_);
+      if (py::hasattr(object_, "do_step")) {
+        object_.attr("do_step")(cosim::NsToSeconds(t), cosim::NsToSeconds(dt));
+      }
+      Take();
+    } catch (const std::exception& e) {
+      return Fail(std::string("the Python unit raised: ") + e.what());
+    }
+    return cosim::StepResult::kOk;
+  }
+
+ private:
+  struct Slot {
+    std::string name;
+    bool array;
+    double value;
+    std::vector<double> values;
+  };
+
+  void Give(const std::vector<Slot*>& slots) {
+    for (const Slot* s : slots) {
+      if (s->array) {
+        object_.attr(s->name.c_str()) = py::cast(s->values);
+      } else {
+        object_.attr(s->name.c_str()) = s->value;
+      }
+    }
+  }
+  void Take() {
+    for (Slot* s : outputs_) {
+      const py::object v = object_.attr(s->name.c_str());
+      if (s->array) {
+        const auto values = v.cast<std::vector<double>>();
+        if (values.size() != s->values.size()) {
+          throw cosim::UnitError("output '" + s->name + "' has " + std::to_string(values.size()) +
+                                     " values, declared " + std::to_string(s->values.size()),
+                                 s->name);
+        }
+        s->values = values;
+      } else {
+        s->value = v.cast<double>();
+      }
+    }
+  }
+  void Call(const char* method) {
+    if (!py::hasattr(object_, method)) return;
+    try {
+      object_.attr(method)();
+    } catch (const std::exception& e) {
+      throw cosim::UnitError(std::string(method) + " raised: " + e.what());
+    }
+  }
+
+  py::object object_;
+  std::deque<Slot> slots_;  // stable addresses: the variable table points into them
+  std::vector<Slot*> inputs_, outputs_, parameters_;
+};
+
+// Registers the class `cls` as unit type `type` (once per type name).
+void RegisterPythonUnit(const std::string& type, py::object cls) {
+  if (config::FindUnitType(type) != nullptr) {
+    throw py::value_error("a unit type '" + type + "' is registered already");
+  }
+  // The registry lives until the process ends, after the interpreter: the
+  // class is kept for good (never released).
+  PyObject* kept = cls.release().ptr();
+  config::UnitType t;
+  t.name = type;
+  t.description = "a unit written in Python (" + std::string(py::str(py::handle(kept))) + ")";
+  t.create = [type, kept](const config::UnitBuildContext& c) -> std::unique_ptr<cosim::Unit> {
+    return std::make_unique<PythonUnit>(type, c.name, kept);
+  };
+  config::RegisterUnitType(std::move(t));
+}
+
 // One run: {"issues": [...]} when the scenario is refused; else status,
 // metrics, signals (time_s and one array per recorded column), units of
 // measure, errors and summary.json's text.
-py::dict Run(const std::string& file, const std::vector<std::string>& set) {
+py::dict Run(const std::string& file, const std::vector<std::string>& set,
+             const std::map<std::string, std::string>& unit_types) {
   std::optional<session::Session> run;
   std::optional<config::ScenarioError> refused;
   {
@@ -55,7 +219,7 @@ py::dict Run(const std::string& file, const std::vector<std::string>& set) {
     // Python threads go on.
     py::gil_scoped_release release;
     try {
-      run.emplace(file, set);
+      run.emplace(file, set, unit_types);
     } catch (const config::ScenarioError& e) {
       refused = e;
     }
@@ -83,8 +247,10 @@ py::dict Run(const std::string& file, const std::vector<std::string>& set) {
   for (const auto& e : report.errors) errors.append(RunErrorDict(e));
   out["errors"] = errors;
 
+  // Each column as the bytes of its doubles: the package makes numpy arrays
+  // of them where numpy is installed, array.array('d') otherwise.
   const auto array = [](const std::vector<double>& v) {
-    return py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
+    return py::bytes(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(double));
   };
   py::list names, columns, units;
   names.append("time_s");
@@ -134,7 +300,8 @@ py::list Inspect(const std::string& type) {
 
 PYBIND11_MODULE(_linesim, m) {
   m.doc() = "linesim's native part: run sessions and the unit registry";
-  m.def("run", &linesim::python::Run, py::arg("file"), py::arg("set"));
+  m.def("run", &linesim::python::Run, py::arg("file"), py::arg("set"), py::arg("unit_types"));
+  m.def("register_unit", &linesim::python::RegisterPythonUnit, py::arg("type"), py::arg("cls"));
   m.def("inspect", &linesim::python::Inspect, py::arg("type"));
   m.def("unit_types", &linesim::config::UnitTypeNames);
   m.def("math_library", &linesim::platform::MathLibrary);

@@ -102,8 +102,9 @@ void RunReport::AddFailure(const std::string& cause) {
   errors.push_back(std::move(e));
 }
 
-Session::Session(const std::string& file, const std::vector<std::string>& set)
-    : Session(loader::LoadScenario(file, set)) {}
+Session::Session(const std::string& file, const std::vector<std::string>& set,
+                 const std::map<std::string, std::string>& unit_types)
+    : Session(loader::LoadScenario(file, set, unit_types)) {}
 
 Session::Session(loader::Scenario scenario) : s_(std::move(scenario)), measured_(s_.metrics) {}
 

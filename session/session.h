@@ -1,6 +1,7 @@
 #pragma once
 
 #include <atomic>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -51,7 +52,8 @@ class Session {
  public:
   /// Loads `file` with the `--set` overrides; throws config::ScenarioError
   /// listing every problem (nothing has run or been written).
-  explicit Session(const std::string& file, const std::vector<std::string>& set = {});
+  explicit Session(const std::string& file, const std::vector<std::string>& set = {},
+                   const std::map<std::string, std::string>& unit_types = {});
   explicit Session(loader::Scenario scenario);
 
   const loader::Scenario& scenario() const { return s_; }

@@ -13,24 +13,82 @@ the run goes through the same session (session/session.h) with the same
 math library.
 """
 
+import array
+import glob
+import importlib.machinery
+import importlib.util
 import json
 import os
 import sys
 
-import numpy  # noqa: F401  (the native part returns numpy arrays)
-
-# The native part brings its own transcendental functions (SLEEF, as every
-# linesim executable): loaded with RTLD_DEEPBIND, it and the libraries it
-# loads (ODE, SUNDIALS, FCL, Embree) bind to them before the libm the Python
-# process has already loaded, whose results depend on the CPU.
-_flags = sys.getdlopenflags()
-sys.setdlopenflags(_flags | os.RTLD_DEEPBIND)
 try:
-    from . import _linesim
-finally:
-    sys.setdlopenflags(_flags)
+    import numpy
+except ImportError:  # signals as array.array('d') then
+    numpy = None
 
-__all__ = ["run", "inspect", "unit_types", "Result", "ScenarioError", "RunError"]
+
+def _load_native():
+    # Next to this file (an installed package, or the copy in build/python),
+    # else in the build tree of the repository this file is in.
+    here = os.path.dirname(os.path.abspath(__file__))
+    for folder in (here, os.path.join(here, "..", "build", "python", "linesim")):
+        found = glob.glob(os.path.join(folder, "_linesim*" + importlib.machinery.EXTENSION_SUFFIXES[0]))
+        if found:
+            break
+    else:
+        raise ImportError("linesim's native part (_linesim) is not built: run tools/build.sh")
+    # It brings its own transcendental functions (SLEEF, as every linesim
+    # executable): loaded with RTLD_DEEPBIND, it and the libraries it loads
+    # (ODE, SUNDIALS, FCL, Embree) bind to them before the libm the Python
+    # process has already loaded, whose results depend on the CPU.
+    flags = sys.getdlopenflags()
+    sys.setdlopenflags(flags | os.RTLD_DEEPBIND)
+    try:
+        spec = importlib.util.spec_from_file_location(__name__ + "._linesim", found[0])
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    finally:
+        sys.setdlopenflags(flags)
+    return module
+
+
+_linesim = _load_native()
+
+__all__ = ["run", "inspect", "unit_types", "Unit", "Result", "ScenarioError", "RunError"]
+
+
+class Unit:
+    """A unit written in Python, to put in a scenario in place of a shipped
+    one (run(..., units={"path_follower": MyFollower})). Declare
+
+        inputs = {"position": ("m", 2), "yaw": ("rad", 1)}    # name: (unit, size)
+        outputs = {"velocity_command": ("m/s", 2)}            # name: (unit, size)
+        parameters = {"speed": ("m/s", 0.3)}                  # name: (unit, default)
+
+    and define setup(self) (optional), initialize(self) (optional) and
+    do_step(self, t, dt) (seconds). Variables are attributes: a float, or a
+    list of `size` floats; inputs are set before each call, outputs read
+    after. Each call holds the GIL; the native units step without it. The
+    unit replaced keeps its connections and those of its parameters this
+    class declares; a master.retry restores its declared variables, not
+    the object's other attributes."""
+
+    inputs = {}
+    outputs = {}
+    parameters = {}
+
+
+_registered = {}
+
+
+def _unit_type(cls):
+    # One registered type per class object (a class defined again in a
+    # notebook is another type).
+    if cls not in _registered:
+        name = "python.%s.%s_%x" % (cls.__module__, cls.__qualname__, id(cls))
+        _linesim.register_unit(name, cls)
+        _registered[cls] = name
+    return _registered[cls]
 
 
 class ScenarioError(Exception):
@@ -69,13 +127,15 @@ class RunError(Exception):
 
 class Result:
     """What a run gave: `status` ("ok", "failed"), `metrics` (name -> value),
-    `signals` (column -> numpy array, with "time_s"), `units` (column -> unit
-    of measure), `errors` (dicts), `summary` (summary.json as a dict)."""
+    `signals` (column -> numpy array, or array.array('d') without numpy;
+    with "time_s"), `units` (column -> unit of measure), `errors` (dicts),
+    `summary` (summary.json as a dict)."""
 
     def __init__(self, raw):
         self.status = raw["status"]
         self.metrics = dict(raw["metrics"])
-        self.signals = dict(zip(raw["signal_names"], raw["signal_columns"]))
+        self.signals = {name: _column(data)
+                        for name, data in zip(raw["signal_names"], raw["signal_columns"])}
         self.units = dict(zip(raw["signal_names"], raw["signal_units"]))
         self.errors = raw["errors"]
         self.summary = json.loads(raw["summary"])
@@ -83,6 +143,14 @@ class Result:
     def __repr__(self):
         return "linesim.Result(status=%r, %d metrics, %d signals of %d rows)" % (
             self.status, len(self.metrics), len(self.signals), len(self.signals["time_s"]))
+
+
+def _column(data):
+    if numpy is not None:
+        return numpy.frombuffer(data, dtype=numpy.float64)
+    column = array.array("d")
+    column.frombytes(data)
+    return column
 
 
 def _text(value):
@@ -96,16 +164,19 @@ def _text(value):
     return json.dumps(value)
 
 
-def run(path, set=None, duration_s=None, seed=None):  # noqa: A002 (the CLI's --set)
+def run(path, set=None, duration_s=None, seed=None, units=None):  # noqa: A002 (the CLI's --set)
     """Runs the scenario file `path` with the overrides `set` ({"key.path":
-    value}, as --set key.path=value), and `duration_s` and `seed` when given.
-    Returns a Result; raises ScenarioError or RunError."""
+    value}, as --set key.path=value), and `duration_s` and `seed` when given;
+    `units` ({unit name: Unit subclass}) puts units written in Python in
+    place of the scenario's. Returns a Result; raises ScenarioError or
+    RunError."""
     sets = ["%s=%s" % (k, _text(v)) for k, v in (set or {}).items()]
     if duration_s is not None:
         sets.append("duration_s=%s" % _text(duration_s))
     if seed is not None:
         sets.append("seed=%s" % _text(seed))
-    raw = _linesim.run(os.fspath(path), sets)
+    types = {name: _unit_type(cls) for name, cls in (units or {}).items()}
+    raw = _linesim.run(os.fspath(path), sets, types)
     if "issues" in raw:
         raise ScenarioError(raw["issues"])
     result = Result(raw)
