@@ -20,6 +20,7 @@ import importlib.util
 import json
 import os
 import sys
+import tempfile
 
 try:
     import numpy
@@ -54,7 +55,8 @@ def _load_native():
 
 _linesim = _load_native()
 
-__all__ = ["run", "inspect", "unit_types", "Unit", "Result", "ScenarioError", "RunError"]
+__all__ = ["run", "runs", "sweep", "inspect", "unit_types", "Unit", "Result", "ScenarioError",
+           "RunError"]
 
 
 class Unit:
@@ -183,6 +185,58 @@ def run(path, set=None, duration_s=None, seed=None, units=None):  # noqa: A002 (
     if result.status != "ok":
         raise RunError(result)
     return result
+
+
+def _progress(show):
+    if not show:
+        return None
+
+    def report(done, total):
+        sys.stderr.write("\rlinesim: %d of %d runs" % (done, total) + ("\n" if done == total else ""))
+        sys.stderr.flush()
+    return report
+
+
+def _table(raw):
+    # A pandas DataFrame where pandas is installed, else a dict of columns
+    # (numpy arrays where numpy is, lists otherwise), in run order.
+    if "issues" in raw:
+        raise ScenarioError(raw["issues"])
+    try:
+        import pandas
+        return pandas.DataFrame(raw)
+    except ImportError:
+        pass
+    if numpy is None:
+        return dict(raw)
+    return {k: numpy.asarray(v) for k, v in raw.items()}
+
+
+def runs(path, n, jobs=1, set=None, progress=True):  # noqa: A002
+    """`n` runs of the scenario (`linesim run --runs N`: each its own seed
+    derived from the scenario's), on `jobs` threads. A table, one row per
+    run: id, seed, status, every metric, error, wall_s. Failed runs are rows
+    with their error; a refused scenario raises ScenarioError."""
+    sets = ["%s=%s" % (k, _text(v)) for k, v in (set or {}).items()]
+    return _table(_linesim.runs(os.fspath(path), sets, int(n), int(jobs), _progress(progress)))
+
+
+def sweep(path_or_dict, jobs=1, progress=True):
+    """A sweep (a sweep file, or a dict with the same keys; its `scenario`
+    relative to the current folder) on `jobs` threads: a table, one row per
+    run, as `linesim sweep` writes results.csv."""
+    if isinstance(path_or_dict, dict):
+        spec = dict(path_or_dict)
+        if "scenario" in spec:
+            spec["scenario"] = os.path.abspath(os.fspath(spec["scenario"]))
+        with tempfile.NamedTemporaryFile("w", suffix=".yaml", prefix="linesim_sweep_",
+                                         delete=False) as f:
+            json.dump(spec, f)  # JSON is YAML
+        try:
+            return _table(_linesim.sweep(f.name, int(jobs), _progress(progress)))
+        finally:
+            os.unlink(f.name)
+    return _table(_linesim.sweep(os.fspath(path_or_dict), int(jobs), _progress(progress)))
 
 
 def inspect(unit_type):

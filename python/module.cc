@@ -18,6 +18,9 @@
 #include "loader/scenario.h"
 #include "platform/platform.h"
 #include "session/session.h"
+#include "sweep/executor.h"
+#include "sweep/run_plan.h"
+#include "sweep/sweep_spec.h"
 
 namespace py = pybind11;
 
@@ -270,6 +273,93 @@ py::dict Run(const std::string& file, const std::vector<std::string>& set,
   return out;
 }
 
+// Runs every run of `spec` on `jobs` threads: a table as columns (id,
+// point, sample, repeat, seed, status, each parameter, each metric, error,
+// wall_s), in run order. `progress(done, total)` is called after each run
+// (with the GIL; None: not called). Ctrl-C stops the runs not yet started
+// and raises KeyboardInterrupt.
+py::dict RunSweep(const sweep::SweepSpec& spec, int jobs, const py::object& progress) {
+  const std::int64_t total = sweep::RunCount(spec);
+  std::vector<std::int64_t> ids(static_cast<std::size_t>(total));
+  for (std::int64_t i = 0; i < total; ++i) ids[static_cast<std::size_t>(i)] = i;
+  std::vector<sweep::RunSpec> runs(ids.size());
+  std::vector<sweep::RunOutcome> outcomes(ids.size());
+  std::atomic<bool> stop{false};
+  bool interrupted = false;
+  std::int64_t done = 0;
+  {
+    py::gil_scoped_release release;
+    sweep::RunOnThreads(spec, ids, jobs, stop,
+                        [&](const sweep::RunSpec& run, const sweep::RunOutcome& outcome) {
+                          runs[static_cast<std::size_t>(run.id)] = run;
+                          outcomes[static_cast<std::size_t>(run.id)] = outcome;
+                          ++done;
+                          py::gil_scoped_acquire gil;
+                          if (PyErr_CheckSignals() != 0) {
+                            PyErr_Clear();
+                            interrupted = true;
+                            stop = true;
+                            return;
+                          }
+                          if (!progress.is_none()) progress(done, total);
+                        });
+  }
+  if (interrupted) {
+    PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
+  }
+  py::dict table;
+  const auto column = [&](auto&& of) {
+    py::list values;
+    for (std::size_t i = 0; i < runs.size(); ++i) values.append(of(runs[i], outcomes[i]));
+    return values;
+  };
+  using R = const sweep::RunSpec&;
+  using O = const sweep::RunOutcome&;
+  table["id"] = column([](R r, O) { return r.id; });
+  table["point"] = column([](R r, O) { return r.point; });
+  table["sample"] = column([](R r, O) { return r.sample; });
+  table["repeat"] = column([](R r, O) { return r.repeat; });
+  table["seed"] = column([](R, O o) { return o.seed; });
+  table["status"] = column(
+      [](R, O o) { return std::string(o.status == sweep::RunStatus::kOk ? "ok" : "failed"); });
+  for (std::size_t p = 0; p < spec.parameters.size(); ++p) {
+    table[py::str(spec.parameters[p].path)] =
+        column([p](R r, O) { return p < r.values.size() ? r.values[p] : std::string(); });
+  }
+  for (std::size_t m = 0; m < spec.metrics.size(); ++m) {
+    table[py::str(spec.metrics[m])] = column([m](R, O o) { return o.metrics[m]; });
+  }
+  table["error"] = column([](R, O o) { return o.error; });
+  table["wall_s"] = column([](R, O o) { return o.wall_s; });
+  return table;
+}
+
+template <typename F>
+py::object Refusing(F&& load) {
+  try {
+    return load();
+  } catch (const config::ScenarioError& e) {
+    py::list issues;
+    for (const auto& i : e.issues()) issues.append(IssueDict(i));
+    py::dict out;
+    out["issues"] = issues;
+    return out;
+  }
+}
+
+py::object Runs(const std::string& file, const std::vector<std::string>& set, std::int64_t n,
+                int jobs, const py::object& progress) {
+  return Refusing([&]() -> py::object {
+    return RunSweep(sweep::RepeatSweepSpec(file, set, n), jobs, progress);
+  });
+}
+
+py::object Sweep(const std::string& file, int jobs, const py::object& progress) {
+  return Refusing(
+      [&]() -> py::object { return RunSweep(sweep::LoadSweepSpec(file), jobs, progress); });
+}
+
 // A unit type's variable table: one dict per variable.
 py::list Inspect(const std::string& type) {
   std::unique_ptr<cosim::Unit> unit;
@@ -303,6 +393,9 @@ PYBIND11_MODULE(_linesim, m) {
   m.def("run", &linesim::python::Run, py::arg("file"), py::arg("set"), py::arg("unit_types"));
   m.def("register_unit", &linesim::python::RegisterPythonUnit, py::arg("type"), py::arg("cls"));
   m.def("inspect", &linesim::python::Inspect, py::arg("type"));
+  m.def("runs", &linesim::python::Runs, py::arg("file"), py::arg("set"), py::arg("n"),
+        py::arg("jobs"), py::arg("progress"));
+  m.def("sweep", &linesim::python::Sweep, py::arg("file"), py::arg("jobs"), py::arg("progress"));
   m.def("unit_types", &linesim::config::UnitTypeNames);
   m.def("math_library", &linesim::platform::MathLibrary);
 }
