@@ -5,29 +5,21 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <memory>
-#include <nlohmann/json.hpp>
 
 #include "app/console.h"
 #include "config/unit_registry.h"
-#include "cosim/files.h"
-#include "cosim/observers.h"
 #include "loader/scenario.h"
-#include "mcap/run_log.h"
-#include "replay/replay_recorder.h"
+#include "session/run_folder.h"
 #include "session/session.h"
 #include "units/fmu/fmu_unit.h"
 
 namespace linesim::app {
 
 namespace fs = std::filesystem;
-using Json = nlohmann::ordered_json;
 
 namespace {
 
@@ -117,169 +109,39 @@ int RunCommand(const std::string& file, const std::string& out_dir,
     return kExitBadInput;
   }
   const loader::Scenario& s = run->scenario();
-  // The recording's size, said before anything runs: rows from the
-  // duration and the interval, each column at most 24 characters and its
-  // comma (a double's shortest round-trip text, sign and exponent included).
-  {
-    const cosim::MasterOptions& o = s.master->options();
-    const double rows =
-        std::floor(static_cast<double>(o.stop - o.start) /
-                   static_cast<double>(std::max<cosim::TimeNs>(1, s.record_interval))) +
-        2.0;
-    const double bytes = rows * 25.0 * static_cast<double>(s.recorded.size() + 1);
-    if (bytes > max_output_mb * 1024.0 * 1024.0) {
-      std::cerr << "linesim: " << file << ": the recording would take up to "
-                << cosim::FormatValue(std::ceil(bytes / (1024.0 * 1024.0))) << " MB ("
-                << cosim::FormatValue(rows) << " rows of " << s.recorded.size() + 1
-                << " columns), more than the " << cosim::FormatValue(max_output_mb)
-                << " MB allowed: record fewer variables or at a longer recording.interval_s, "
-                   "or raise the limit with --max-output-mb\n";
-      return kExitBadInput;
-    }
-  }
-
-  // Everything is checked: only now is anything written.
-  const fs::path dir(out_dir);
-  if (!CreateOutputFolder(out_dir)) return kExitBadInput;
-  // A previous run's outputs go first: the folder never holds files of two
-  // runs (a summary that fails to write must not leave the old one behind).
-  {
-    std::vector<std::string> previous = plots::RobotPlotFiles();
-    if (s.robot) {
-      for (const auto& other : s.robot->fleet) {
-        for (auto& name : plots::RobotPlotFiles(other.name + "_")) previous.push_back(name);
-      }
-    }
-    previous.push_back("summary.json");
-    previous.push_back("replay.html");
-    previous.push_back("run.mcap");
-    for (const auto& name : previous) {
-      std::error_code ec;
-      fs::remove(dir / name, ec);
-      if (ec) {
-        std::cerr << "linesim: cannot remove the previous run's " << (dir / name).string() << ": "
-                  << ec.message() << "\n";
-        return kExitBadInput;
-      }
-    }
-  }
-  // A summary from the start, saying the run failed: the final one replaces
-  // it; a run killed on the way, or whose final summary cannot be written,
-  // still leaves a summary.json, and one that says what happened.
-  try {
-    Json started;
-    started["scenario"] = s.name;
-    started["file"] = file;
-    started["status"] = "failed";
-    started["errors"] = {"the run started but did not finish writing its summary (killed, or "
-                         "its final summary.json could not be written)"};
-    cosim::WriteFileAtomically((dir / "summary.json").string(), started.dump(2) + "\n");
-  } catch (const std::exception& e) {
-    std::cerr << "linesim: " << e.what() << "\n";
-    return kExitBadInput;
-  }
-  const fs::path csv_path = dir / "signals.csv";
-  std::ofstream csv(csv_path, std::ios::binary | std::ios::trunc);
-  if (!csv) {
-    std::cerr << "linesim: cannot write " << csv_path.string() << "\n";
-    return kExitBadInput;
-  }
-
-  cosim::CsvRecorder recorder(csv, s.recorded, s.record_interval);
-  run->AddObserver(&recorder);
-  // The replay page of a robot run (replay/): sampled by an observer.
-  std::unique_ptr<replay::ReplayRecorder> replayer;
-  if (s.robot && replay) {
-    replayer = std::make_unique<replay::ReplayRecorder>(
-        replay::ReplaySpecFor(s, session::kPaperBoundM, session::kPaperBoundLabel));
-    run->AddObserver(replayer.get());
-  }
-  // --mcap: the run for Foxglove and PlotJuggler, gathered as it runs.
-  const fs::path mcap_path = dir / "run.mcap";
-  std::ofstream mcap_file;
-  std::unique_ptr<mcap::RunLog> mcap_log;
-  if (write_mcap) {
-    mcap_file.open(mcap_path, std::ios::binary | std::ios::trunc);
-    if (!mcap_file) {
-      std::cerr << "linesim: cannot write " << mcap_path.string() << "\n";
-      return kExitBadInput;
-    }
-    mcap_log = std::make_unique<mcap::RunLog>(mcap_file, s);
-    run->AddObserver(mcap_log.get());
-  }
-
+  session::FolderOptions options;
+  options.max_output_mb = max_output_mb;
+  options.format = format;
+  options.replay = replay;
+  options.mcap = write_mcap;
   // Ctrl-C or SIGTERM: stop at the next communication point, keep what was
   // recorded and write the summary (status interrupted); again to quit.
   std::atomic<bool>& stop = InstallStopSignals(
       "\nlinesim: interrupted: stopping at the next communication point (again to quit at "
       "once)\n");
-  session::RunReport report = run->Run(&stop);
-  const cosim::RunResult& result = report.result;
-  csv.close();
-  // A full disk shows only here (buffered writes fail late): a run whose
-  // signals were lost has failed, whatever the units did.
-  const bool csv_written = !csv.fail();
-  if (!csv_written) {
-    report.AddFailure("cannot write " + csv_path.string() +
-                      " (disk full or not writable): the signals are incomplete");
-  }
-  if (mcap_log) {
-    mcap_file.close();
-    if (mcap_file.fail()) {
-      report.AddFailure("cannot write " + mcap_path.string() + " (disk full or not writable)");
-    }
-  }
-
-  const cosim::MasterOptions& options = s.master->options();
-  const double simulated_s = cosim::NsToSeconds(result.end_time - options.start);
-  Json summary = session::Summary(s, file, report);
-  Json columns = Json::array();
-  for (const auto& p : s.recorded) columns.push_back(p.label);
-  summary["recording"] = {{"file", "signals.csv"},
-                          {"rows", recorder.rows()},
-                          {"interval_s", cosim::NsToSeconds(s.record_interval)},
-                          {"columns", columns}};
-  if (mcap_log) {
-    summary["mcap"] = {{"file", "run.mcap"},
-                       {"bytes", mcap_log->bytes()},
-                       {"messages", mcap_log->messages()}};
-  }
-  // Robot runs are drawn (also a failed one: the plots show how it failed).
-  std::vector<std::string> pictures;
-  if (s.robot && recorder.rows() > 0 && csv_written) {
-    try {
-      for (const auto& p : session::WriteRobotPlots(s, dir.string(), format)) {
-        pictures.push_back(fs::path(p).filename().string());
-      }
-      summary["plots"] = {{"files", pictures}};
-    } catch (const std::exception& e) {
-      // The run itself is fine: say why there are no pictures, do not fail.
-      summary["plots"] = {{"error", e.what()}};
-      std::cerr << "linesim: no plots: " << e.what() << "\n";
-    }
-  }
-  if (replayer && replayer->frames() > 0) {
-    try {
-      replayer->Write((dir / "replay.html").string());
-      pictures.push_back("replay.html");
-      summary["replay"] = {{"file", "replay.html"}};
-    } catch (const std::exception& e) {
-      summary["replay"] = {{"error", e.what()}};  // as for the plots: the run stands
-      std::cerr << "linesim: no replay: " << e.what() << "\n";
-    }
-  }
+  session::FolderRun written;
   try {
-    cosim::WriteFileAtomically((dir / "summary.json").string(), summary.dump(2) + "\n");
-  } catch (const std::exception& e) {
+    written = session::RunIntoFolder(*run, file, out_dir, options, &stop);
+  } catch (const session::OutputError& e) {
     std::cerr << "linesim: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  for (const auto& w : written.warnings) std::cerr << "linesim: " << w << "\n";
+  if (!written.summary_error.empty()) {
+    std::cerr << "linesim: " << written.summary_error << "\n";
     return kExitRunFailed;
   }
+  const session::RunReport& report = written.report;
+  const cosim::RunResult& result = report.result;
+  const fs::path dir(out_dir);
+  const cosim::MasterOptions& master = s.master->options();
+  const double simulated_s = cosim::NsToSeconds(result.end_time - master.start);
 
   std::cout << s.name << ": "
             << (report.interrupted ? "INTERRUPTED"
                 : report.ok()      ? "ok"
                                    : "FAILED")
-            << ", " << cosim::FormatSeconds(result.end_time - options.start) << " s simulated in "
+            << ", " << cosim::FormatSeconds(result.end_time - master.start) << " s simulated in "
             << std::setprecision(3) << report.wall_s << " s wall (" << std::setprecision(4)
             << simulated_s / report.wall_s << "x real time)\n";
   if (!result.ended_by.empty()) std::cout << "  ended early by " << result.ended_by << "\n";
@@ -289,10 +151,10 @@ int RunCommand(const std::string& file, const std::string& out_dir,
     std::cout << "  " << std::left << std::setw(static_cast<int>(name_width)) << name << " = "
               << std::setprecision(6) << value << "\n";
   }
-  std::cout << "  wrote " << (dir / "summary.json").string() << ", " << csv_path.string() << " ("
-            << recorder.rows() << " rows)";
-  for (const auto& p : pictures) std::cout << ", " << p;
-  if (mcap_log) std::cout << ", run.mcap";
+  std::cout << "  wrote " << (dir / "summary.json").string() << ", "
+            << (dir / "signals.csv").string() << " (" << written.rows << " rows)";
+  for (const auto& p : written.files) std::cout << ", " << p;
+  if (written.mcap) std::cout << ", run.mcap";
   std::cout << "\n";
   for (const auto& e : report.errors) std::cerr << "linesim: " << e.message << "\n";
   if (plot_columns && s.robot) {

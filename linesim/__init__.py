@@ -131,7 +131,7 @@ class Result:
     """What a run gave: `status` ("ok", "failed"), `metrics` (name -> value),
     `signals` (column -> numpy array, or array.array('d') without numpy;
     with "time_s"), `units` (column -> unit of measure), `errors` (dicts),
-    `summary` (summary.json as a dict)."""
+    `summary` (summary.json as a dict), `out` (the folder written, or None)."""
 
     def __init__(self, raw):
         self.status = raw["status"]
@@ -166,22 +166,25 @@ def _text(value):
     return json.dumps(value)
 
 
-def run(path, set=None, duration_s=None, seed=None, units=None):  # noqa: A002 (the CLI's --set)
+def run(path, set=None, duration_s=None, seed=None, units=None, out=None):  # noqa: A002
     """Runs the scenario file `path` with the overrides `set` ({"key.path":
     value}, as --set key.path=value), and `duration_s` and `seed` when given;
     `units` ({unit name: Unit subclass}) puts units written in Python in
-    place of the scenario's. Returns a Result; raises ScenarioError or
-    RunError."""
+    place of the scenario's; `out` (a folder) writes there what `linesim run
+    --out` writes (summary.json, signals.csv, the plots, replay.html).
+    Returns a Result; raises ScenarioError or RunError (ValueError when the
+    folder cannot be written: nothing ran)."""
     sets = ["%s=%s" % (k, _text(v)) for k, v in (set or {}).items()]
     if duration_s is not None:
         sets.append("duration_s=%s" % _text(duration_s))
     if seed is not None:
         sets.append("seed=%s" % _text(seed))
     types = {name: _unit_type(cls) for name, cls in (units or {}).items()}
-    raw = _linesim.run(os.fspath(path), sets, types)
+    raw = _linesim.run(os.fspath(path), sets, types, os.fspath(out) if out is not None else "")
     if "issues" in raw:
         raise ScenarioError(raw["issues"])
     result = Result(raw)
+    result.out = os.fspath(out) if out is not None else None
     if result.status != "ok":
         raise RunError(result)
     return result

@@ -17,6 +17,7 @@
 #include "cosim/run_error_json.h"
 #include "loader/scenario.h"
 #include "platform/platform.h"
+#include "session/run_folder.h"
 #include "session/session.h"
 #include "sweep/executor.h"
 #include "sweep/run_plan.h"
@@ -214,7 +215,7 @@ void RegisterPythonUnit(const std::string& type, py::object cls) {
 // metrics, signals (time_s and one array per recorded column), units of
 // measure, errors and summary.json's text.
 py::dict Run(const std::string& file, const std::vector<std::string>& set,
-             const std::map<std::string, std::string>& unit_types) {
+             const std::map<std::string, std::string>& unit_types, const std::string& out_dir) {
   std::optional<session::Session> run;
   std::optional<config::ScenarioError> refused;
   {
@@ -238,9 +239,25 @@ py::dict Run(const std::string& file, const std::vector<std::string>& set,
   session::SignalRecorder recorder(s.recorded, s.record_interval);
   run->AddObserver(&recorder);
   session::RunReport report;
-  {
+  if (out_dir.empty()) {
     py::gil_scoped_release release;
     report = run->Run();
+  } else {
+    // The command line's files too (linesim run --out), with its defaults.
+    session::FolderRun written;
+    std::string refused_output;
+    {
+      py::gil_scoped_release release;
+      try {
+        written = session::RunIntoFolder(*run, file, out_dir, session::FolderOptions{});
+      } catch (const session::OutputError& e) {
+        refused_output = e.what();
+      }
+    }
+    if (!refused_output.empty()) throw py::value_error(refused_output);
+    if (!written.summary_error.empty()) written.report.AddFailure(written.summary_error);
+    report = std::move(written.report);
+    out["warnings"] = written.warnings;
   }
   out["status"] = report.status();
   py::list metrics;
@@ -390,7 +407,8 @@ py::list Inspect(const std::string& type) {
 
 PYBIND11_MODULE(_linesim, m) {
   m.doc() = "linesim's native part: run sessions and the unit registry";
-  m.def("run", &linesim::python::Run, py::arg("file"), py::arg("set"), py::arg("unit_types"));
+  m.def("run", &linesim::python::Run, py::arg("file"), py::arg("set"), py::arg("unit_types"),
+        py::arg("out"));
   m.def("register_unit", &linesim::python::RegisterPythonUnit, py::arg("type"), py::arg("cls"));
   m.def("inspect", &linesim::python::Inspect, py::arg("type"));
   m.def("runs", &linesim::python::Runs, py::arg("file"), py::arg("set"), py::arg("n"),

@@ -282,3 +282,20 @@ def test_sweep_example_reproduces_the_figure(tmp_path):
     assert at_paper_speed["max_deviation_compensated_m"] < 0.04
     for r in rows:
         assert r["max_deviation_compensated_m"] < r["max_deviation_nominal_m"]
+
+
+# Guards out=: the command line's files (summary.json, signals.csv, the
+# plots, replay.html), the same summary as the Result's and the same rows
+# as its signals.
+def test_run_writes_the_command_lines_files_when_asked(tmp_path):
+    r = linesim.run(scenario("cross_line.yaml"), duration_s=1, out=tmp_path)
+    assert r.out == str(tmp_path)
+    for name in ("summary.json", "signals.csv", "top_view.png", "replay.html"):
+        assert (tmp_path / name).stat().st_size > 0, name
+    with open(tmp_path / "summary.json") as f:
+        written = json.load(f)
+    assert written["metrics"] == r.metrics
+    assert written["recording"]["rows"] == len(r.signals["time_s"])
+    with pytest.raises(ValueError):
+        linesim.run(scenario("cross_line.yaml"), duration_s=1,
+                    out=tmp_path / "summary.json")  # a file, not a folder
