@@ -10,6 +10,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import zipfile
 
 import numpy as np
 import pytest
@@ -299,3 +300,29 @@ def test_run_writes_the_command_lines_files_when_asked(tmp_path):
     with pytest.raises(ValueError):
         linesim.run(scenario("cross_line.yaml"), duration_s=1,
                     out=tmp_path / "summary.json")  # a file, not a folder
+
+
+# Guards `pip install .`: the in-tree backend (python/build_backend.py, no
+# build requirement from an index) packs the package and its native part
+# into a wheel that, unpacked anywhere, imports and runs with the same math.
+def test_wheel_installs_and_runs(tmp_path):
+    sys.path.insert(0, os.path.join(SOURCE, "python"))
+    try:
+        import build_backend
+    finally:
+        sys.path.pop(0)
+    assert build_backend.get_requires_for_build_wheel() == []
+    name = build_backend.build_wheel(str(tmp_path))
+    assert name.startswith("linesim-0.1.0-cp3")
+    site = tmp_path / "site"
+    with zipfile.ZipFile(tmp_path / name) as z:
+        z.extractall(site)
+        assert any(n.startswith("linesim/_linesim") for n in z.namelist())
+    check = ("import linesim, sys; r = linesim.run(sys.argv[1], duration_s=0.5); "
+             "print(linesim.__file__, linesim.math_library(), r.status)")
+    done = subprocess.run([sys.executable, "-c", check, scenario("cross_line.yaml")],
+                          cwd=tmp_path, env=dict(os.environ, PYTHONPATH=str(site)),
+                          check=True, capture_output=True, text=True)
+    installed, math_library, status = done.stdout.split()[0], done.stdout.split()[1], done.stdout.split()[-1]
+    assert installed.startswith(str(site))
+    assert math_library == "sleef" and status == "ok"
