@@ -166,8 +166,32 @@ def _text(value):
     return json.dumps(value)
 
 
+class _scenario_file:
+    # A scenario given as a dict (the files' schema: a system's units and
+    # connections, or a robot scenario) goes to the loader as a file of its
+    # own: JSON, which is YAML. Named models (raw3, factory_line) are found
+    # as from any file; a path in it should be absolute.
+    def __init__(self, path_or_dict):
+        self.given = path_or_dict
+        self.temp = None
+
+    def __enter__(self):
+        if not isinstance(self.given, dict):
+            return os.fspath(self.given)
+        with tempfile.NamedTemporaryFile("w", suffix=".yaml", prefix="linesim_",
+                                         delete=False) as f:
+            json.dump(self.given, f)
+        self.temp = f.name
+        return f.name
+
+    def __exit__(self, *exc):
+        if self.temp:
+            os.unlink(self.temp)
+
+
 def run(path, set=None, duration_s=None, seed=None, units=None, out=None):  # noqa: A002
-    """Runs the scenario file `path` with the overrides `set` ({"key.path":
+    """Runs the scenario file `path` (or a dict of the same schema) with the
+    overrides `set` ({"key.path":
     value}, as --set key.path=value), and `duration_s` and `seed` when given;
     `units` ({unit name: Unit subclass}) puts units written in Python in
     place of the scenario's; `out` (a folder) writes there what `linesim run
@@ -180,7 +204,8 @@ def run(path, set=None, duration_s=None, seed=None, units=None, out=None):  # no
     if seed is not None:
         sets.append("seed=%s" % _text(seed))
     types = {name: _unit_type(cls) for name, cls in (units or {}).items()}
-    raw = _linesim.run(os.fspath(path), sets, types, os.fspath(out) if out is not None else "")
+    with _scenario_file(path) as file:
+        raw = _linesim.run(file, sets, types, os.fspath(out) if out is not None else "")
     if "issues" in raw:
         raise ScenarioError(raw["issues"])
     result = Result(raw)

@@ -53,6 +53,17 @@ struct RobotInfo {
   /// (sensors.NAME.snapshot_s; its ranges and scan_time are recorded), or "".
   std::string scan_unit;
   double scan_time_s = 0.0;
+  /// That laser's geometry from the system description (its mount, and its
+  /// device's numbers: the scenario's or robot file's setting, else its
+  /// model file's): mount in base_link (x, y, yaw), the beams' angles in the
+  /// scanner frame first + k * step, k < beams, and the range meaning no
+  /// echo. Nothing when a number is missing (the laser unit reports it).
+  struct ScanGeometry {
+    double mount_x_m = 0.0, mount_y_m = 0.0, mount_yaw_rad = 0.0;
+    double first_beam_rad = 0.0, beam_step_rad = 0.0, no_return_m = 0.0;
+    int beams = 0;
+  };
+  std::optional<ScanGeometry> scan_geometry;
   /// Workers and the safety fields (loader/assembly/people.cc): each
   /// worker's pose x and y columns; the robot's map velocity x and y, the
   /// safety unit's speed cap and field states, the distance to the nearest

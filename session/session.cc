@@ -61,28 +61,22 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat forma
   if (!robot.name.empty()) spec.title = s.name + " (" + robot.name + ")";
   spec.safety = {robot.velocity_x_column, robot.velocity_y_column, robot.speed_cap_column,
                  robot.protective_column, robot.warning_column,    robot.person_distance_column};
-  if (!robot.scan_unit.empty()) {
-    // The beams' geometry is the laser unit's: read its parameters.
-    for (std::size_t u = 0; u < s.system->unit_count(); ++u) {
-      const cosim::Unit& unit = s.system->unit(u);
-      if (unit.name() != robot.scan_unit) continue;
-      const cosim::VariableTable& v = unit.variables();
-      const auto real = [&](const char* name) { return v.GetReal(*v.Find(name)); };
-      plots::RobotPlotSpec::Scan& scan = spec.scan;
-      scan.sensor = robot.scan_unit;
-      scan.time_s = robot.scan_time_s;
-      scan.mount_x_m = real("mount_x");
-      scan.mount_y_m = real("mount_y");
-      scan.mount_yaw_rad = real("mount_yaw");
-      scan.first_beam_rad = real("first_beam_angle");
-      scan.beam_step_rad = real("angular_step");
-      scan.no_return_m = real("no_return_value");
-      const std::size_t beams = v.info(*v.Find("ranges")).size;
-      for (std::size_t k = 0; k < beams; ++k) {
-        scan.range_columns.push_back(robot.scan_unit + ".ranges[" + std::to_string(k) + "]");
-      }
-      scan.scan_time_column = robot.scan_unit + ".scan_time";
+  if (!robot.scan_unit.empty() && robot.scan_geometry) {
+    // The beams' geometry as the system description gives it.
+    const loader::RobotInfo::ScanGeometry& g = *robot.scan_geometry;
+    plots::RobotPlotSpec::Scan& scan = spec.scan;
+    scan.sensor = robot.scan_unit;
+    scan.time_s = robot.scan_time_s;
+    scan.mount_x_m = g.mount_x_m;
+    scan.mount_y_m = g.mount_y_m;
+    scan.mount_yaw_rad = g.mount_yaw_rad;
+    scan.first_beam_rad = g.first_beam_rad;
+    scan.beam_step_rad = g.beam_step_rad;
+    scan.no_return_m = g.no_return_m;
+    for (int k = 0; k < g.beams; ++k) {
+      scan.range_columns.push_back(robot.scan_unit + ".ranges[" + std::to_string(k) + "]");
     }
+    scan.scan_time_column = robot.scan_unit + ".scan_time";
   }
   if (robot.body_length_m) spec.body_length_m = *robot.body_length_m;
   if (robot.body_width_m) spec.body_width_m = *robot.body_width_m;

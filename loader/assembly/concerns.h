@@ -65,6 +65,7 @@ struct Signals {
   /// The laser whose scan at scan_time_s the plots draw ("" for none).
   std::string scan_unit;
   double scan_time_s = 0.0;
+  std::optional<RobotInfo::ScanGeometry> scan_geometry;
 
   /// What each concern wants recorded, in order.
   std::vector<Port> recorded;

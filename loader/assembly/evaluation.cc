@@ -173,6 +173,7 @@ void AddRecording(SystemBuilder& b, const Signals& s, RobotInfo& info) {
   info.motor_current_column = Signal(kMotors, "current").Name();
   info.scan_unit = s.scan_unit;
   info.scan_time_s = s.scan_time_s;
+  info.scan_geometry = s.scan_geometry;
   for (std::size_t k = 0; k < s.belt_count; ++k) {
     info.belt_speed_columns.push_back(Element(kBelt, "speed", k).Name());
     info.belt_on_columns.push_back(Element(kBelt, "on", k).Name());

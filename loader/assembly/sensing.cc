@@ -403,6 +403,20 @@ void AddSensing(SystemBuilder& b, const RobotFile& file, const StartPose& start,
     f["offset_random_walk"] = 0;
     f["initial_offset_sigma"] = 0;
   }
+  // The geometry of the laser whose scan the plots draw, from the
+  // description: its mount and its device's numbers.
+  for (const auto& m : s.sensors) {
+    if (m.name != s.scan_unit) continue;
+    const ProviderContext c{file, start, scene, Child(b.root(), "sensors"),
+                            JoinPath("sensors", m.name)};
+    const DeviceNumbers device(b, c, m);
+    const auto first = device.Get("first_beam_angle"), step = device.Get("angular_step"),
+               no_return = device.Get("no_return_value"), beams = device.Get("beam_count");
+    if (first && step && no_return && beams && *beams >= 1.0) {
+      s.scan_geometry = RobotInfo::ScanGeometry{
+          m.x_m, m.y_m, m.yaw_rad, *first, *step, *no_return, static_cast<int>(*beams)};
+    }
+  }
 }
 
 }  // namespace linesim::loader::assembly

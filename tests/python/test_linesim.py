@@ -326,3 +326,27 @@ def test_wheel_installs_and_runs(tmp_path):
     installed, math_library, status = done.stdout.split()[0], done.stdout.split()[1], done.stdout.split()[-1]
     assert installed.startswith(str(site))
     assert math_library == "sleef" and status == "ok"
+
+
+# Guards systems from Python dicts (the files' schema): a step of 12 V on a
+# dc_motor with its default parameters runs as the same system written to a
+# file does, and a bad type is refused at its key.
+def test_run_a_system_given_as_a_dict(tmp_path):
+    system = {
+        "duration_s": 0.2,
+        "units": {
+            "supply": {"type": "step_signal",
+                       "parameters": {"unit": "V", "steps": [{"time_s": 0.0, "value": 12.0}]}},
+            "motor": {"type": "dc_motor"},
+        },
+        "connections": [{"from": "supply.value", "to": "motor.voltage"}],
+        "metrics": [{"name": "final_current_a", "of": "motor.current[0]", "reduce": "final"}],
+    }
+    r = linesim.run(system)
+    f = tmp_path / "motor.yaml"
+    f.write_text(json.dumps(system))
+    assert r.metrics == linesim.run(f).metrics
+    assert r.metrics["final_current_a"] > 0.0
+    with pytest.raises(linesim.ScenarioError) as e:
+        linesim.run(dict(system, units={"motor": {"type": "no_such_type"}}))
+    assert e.value.key == "units.motor.type"

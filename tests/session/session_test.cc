@@ -109,3 +109,32 @@ TEST(Session, FailureAfterTheRunFailsIt) {
 
 }  // namespace
 }  // namespace linesim::session
+
+namespace linesim::session {
+namespace {
+
+// Guards the plot description's scan geometry: it comes from the system
+// description (the mount, the device's numbers from the robot file and the
+// model file) and agrees with what the built laser unit holds.
+TEST(Session, ScanGeometryOfThePlotsIsTheLasers) {
+  const Session session(Scenario("scan_factory.yaml"), {"duration_s=0.1"});
+  const loader::Scenario& s = session.scenario();
+  ASSERT_TRUE(s.robot.has_value());
+  ASSERT_FALSE(s.robot->scan_unit.empty());
+  ASSERT_TRUE(s.robot->scan_geometry.has_value());
+  const auto& g = *s.robot->scan_geometry;
+  const auto index = s.system->FindUnit(s.robot->scan_unit);
+  ASSERT_TRUE(index.has_value());
+  const cosim::VariableTable& v = s.system->unit(*index).variables();
+  const auto real = [&](const char* name) { return v.GetReal(*v.Find(name)); };
+  EXPECT_EQ(g.mount_x_m, real("mount_x"));
+  EXPECT_EQ(g.mount_y_m, real("mount_y"));
+  EXPECT_EQ(g.mount_yaw_rad, real("mount_yaw"));
+  EXPECT_EQ(g.first_beam_rad, real("first_beam_angle"));
+  EXPECT_EQ(g.beam_step_rad, real("angular_step"));
+  EXPECT_EQ(g.no_return_m, real("no_return_value"));
+  EXPECT_EQ(static_cast<std::size_t>(g.beams), v.info(*v.Find("ranges")).size);
+}
+
+}  // namespace
+}  // namespace linesim::session
