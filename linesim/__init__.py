@@ -267,10 +267,23 @@ def sweep(path_or_dict, jobs=1, progress=True):
     return _table(_linesim.sweep(os.fspath(path_or_dict), int(jobs), _progress(progress)))
 
 
-def inspect(unit_type):
-    """A unit type's variables (name, causality, type, size, unit, start, rule,
-    description), as `linesim inspect TYPE` prints them."""
-    return _linesim.inspect(unit_type)
+def inspect(type_or_path, set=None):  # noqa: A002
+    """A unit type's variables (a list of dicts: name, causality, type, size,
+    unit, start, rule, description), as `linesim inspect TYPE` prints them;
+    or, for a scenario (a path, or a dict of the files' schema), the system
+    it builds: {"name", "units": {name: {"type", "step_s", "variables"}},
+    "connections": [(from, to)], "step_order"}."""
+    if isinstance(type_or_path, str) and not os.path.exists(type_or_path) and \
+            type_or_path in unit_types():
+        return _linesim.inspect(type_or_path)
+    if isinstance(type_or_path, (dict, os.PathLike)) or os.path.exists(type_or_path):
+        sets = ["%s=%s" % (k, _text(v)) for k, v in (set or {}).items()]
+        with _scenario_file(type_or_path) as file:
+            raw = _linesim.inspect_scenario(file, sets)
+        if "issues" in raw:
+            raise ScenarioError(raw["issues"])
+        return raw
+    return _linesim.inspect(type_or_path)  # an unknown type: ValueError naming the closest
 
 
 def unit_types():

@@ -377,16 +377,11 @@ py::object Sweep(const std::string& file, int jobs, const py::object& progress) 
       [&]() -> py::object { return RunSweep(sweep::LoadSweepSpec(file), jobs, progress); });
 }
 
-// A unit type's variable table: one dict per variable.
-py::list Inspect(const std::string& type) {
-  std::unique_ptr<cosim::Unit> unit;
-  try {
-    unit = loader::CreateDefaultUnit(type);
-  } catch (const config::ScenarioError& e) {
-    throw py::value_error(e.what());
-  }
+// A unit's variable table: one dict per variable (its start value as
+// `linesim inspect` prints it: declared, or as the scenario set it).
+py::list VariableRows(const cosim::Unit& unit) {
   py::list rows;
-  const cosim::VariableTable& table = unit->variables();
+  const cosim::VariableTable& table = unit.variables();
   for (const auto& v : table.infos()) {
     py::dict d;
     d["name"] = v.name;
@@ -402,6 +397,47 @@ py::list Inspect(const std::string& type) {
   return rows;
 }
 
+// A unit type's variable table.
+py::list Inspect(const std::string& type) {
+  std::unique_ptr<cosim::Unit> unit;
+  try {
+    unit = loader::CreateDefaultUnit(type);
+  } catch (const config::ScenarioError& e) {
+    throw py::value_error(e.what());
+  }
+  return VariableRows(*unit);
+}
+
+// The system a scenario builds: each unit with its type, step and variable
+// table, the connections, and the step order; {"issues": [...]} when the
+// scenario is refused.
+py::object InspectScenario(const std::string& file, const std::vector<std::string>& set) {
+  return Refusing([&]() -> py::object {
+    const loader::Scenario s = loader::LoadScenario(file, set);
+    const cosim::System& system = *s.system;
+    py::dict units;
+    for (std::size_t u = 0; u < system.unit_count(); ++u) {
+      py::dict unit;
+      unit["type"] = system.unit(u).type_name();
+      unit["step_s"] = cosim::NsToSeconds(s.master->options().base_step * s.master->decimation(u));
+      unit["variables"] = VariableRows(system.unit(u));
+      units[py::str(system.unit(u).name())] = unit;
+    }
+    py::list connections;
+    for (const auto& c : system.connections()) {
+      connections.append(py::make_tuple(c.from.ToString(), c.to.ToString()));
+    }
+    py::list order;
+    for (std::size_t u : system.dependency_order()) order.append(system.unit(u).name());
+    py::dict out;
+    out["name"] = s.name;
+    out["units"] = units;
+    out["connections"] = connections;
+    out["step_order"] = order;
+    return out;
+  });
+}
+
 }  // namespace
 }  // namespace linesim::python
 
@@ -411,6 +447,7 @@ PYBIND11_MODULE(_linesim, m) {
         py::arg("out"));
   m.def("register_unit", &linesim::python::RegisterPythonUnit, py::arg("type"), py::arg("cls"));
   m.def("inspect", &linesim::python::Inspect, py::arg("type"));
+  m.def("inspect_scenario", &linesim::python::InspectScenario, py::arg("file"), py::arg("set"));
   m.def("runs", &linesim::python::Runs, py::arg("file"), py::arg("set"), py::arg("n"),
         py::arg("jobs"), py::arg("progress"));
   m.def("sweep", &linesim::python::Sweep, py::arg("file"), py::arg("jobs"), py::arg("progress"));

@@ -350,3 +350,19 @@ def test_run_a_system_given_as_a_dict(tmp_path):
     with pytest.raises(linesim.ScenarioError) as e:
         linesim.run(dict(system, units={"motor": {"type": "no_such_type"}}))
     assert e.value.key == "units.motor.type"
+
+
+# Guards inspect of a scenario: the system it builds as data (the units of
+# cross_line's expansion with their tables, its connections, its order).
+def test_inspect_a_scenario():
+    system = linesim.inspect(scenario("cross_line.yaml"))
+    assert system["name"] == "cross_line"
+    assert system["units"]["chassis"]["type"] == "chassis"
+    assert system["units"]["path_follower"]["step_s"] == 0.02
+    start = {v["name"]: v["start"] for v in system["units"]["chassis"]["variables"]}
+    assert start["initial_y"] == "-2"  # cross_line.yaml: robot.pose.y_m
+    assert ("path_follower.velocity_command", "wheel_controller.velocity_command") in \
+        [tuple(c) for c in system["connections"]]
+    assert system["step_order"].index("chassis") < system["step_order"].index("deviation")
+    with pytest.raises(linesim.ScenarioError):
+        linesim.inspect(scenario("cross_line.yaml"), set={"task.speed_mps": -1})
