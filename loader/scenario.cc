@@ -375,17 +375,13 @@ class Builder {
   void BuildRecording(const SystemSpec& spec) {
     std::vector<cosim::Probe> probes;
     s_.record_interval = spec.master.base_step;
+    if (spec.recording && spec.recording->interval) s_.record_interval = *spec.recording->interval;
     if (!spec.recording || !spec.recording->variables) {
-      if (spec.recording && spec.recording->interval) {
-        s_.record_interval = *spec.recording->interval;
-      }
-      if (!spec.recording) {
-        std::vector<std::string> names;
-        for (const auto& n : s_.system->UnitNames()) names.push_back(n + ".*");
-        probes = cosim::ResolveProbes(*s_.system, names);
-      }
+      // Without a list: every output of every unit (docs/scenarios.md).
+      std::vector<std::string> names;
+      for (const auto& n : s_.system->UnitNames()) names.push_back(n + ".*");
+      probes = cosim::ResolveProbes(*s_.system, names);
     } else {
-      if (spec.recording->interval) s_.record_interval = *spec.recording->interval;
       // A column is recorded once, however many items cover it.
       std::set<std::string> labels;
       const auto& vars = *spec.recording->variables;

@@ -32,12 +32,6 @@ std::optional<double> ParameterValue::Number() const {
   return std::nullopt;
 }
 
-std::optional<std::string> ParameterValue::Text() const {
-  if (const auto* s = std::get_if<std::string>(&value_)) return *s;
-  if (const auto* node = written(); node && node->IsScalar()) return node->Scalar();
-  return std::nullopt;
-}
-
 YAML::Node ParameterValue::ToYaml() const {
   return std::visit(
       [](const auto& v) -> YAML::Node {

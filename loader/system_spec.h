@@ -56,8 +56,6 @@ class ParameterValue {
   /// The number it holds (a typed number, or a written one that reads as
   /// one); nullopt otherwise.
   std::optional<double> Number() const;
-  /// The text it holds (a string, or a written scalar); nullopt otherwise.
-  std::optional<std::string> Text() const;
   /// As YAML: numbers as the shortest text that reads back to them, so that
   /// `linesim inspect` shows 0.9 rather than 0.90000000000000002.
   YAML::Node ToYaml() const;
@@ -104,8 +102,8 @@ struct WrittenText {
 };
 
 struct RecordingSpec {
-  /// "unit.variable", "unit.variable[i]", "unit.*"; nullopt: every output
-  /// of every unit.
+  /// "unit.variable", "unit.variable[i]", "unit.*"; nullopt (no list
+  /// given): every output of every unit.
   std::optional<std::vector<WrittenText>> variables;
   /// nullopt: every master step.
   std::optional<cosim::TimeNs> interval;

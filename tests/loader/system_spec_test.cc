@@ -117,5 +117,24 @@ recording: {interval_s: 0.003}
   EXPECT_EQ(spec.FindUnit("b")->step, cosim::kNsPerSecond / 250);
 }
 
+// Guards the recording without a list: every output of every unit at the
+// interval given (docs/scenarios.md: "default: every output of every
+// unit"), not the time column alone.
+TEST(SystemSpec, RecordingWithoutAListRecordsEveryOutput) {
+  const std::string f = WriteScenario("interval_only.yaml", R"(duration_s: 0.01
+units:
+  m: {type: dc_motor}
+recording: {interval_s: 0.002}
+)");
+  const Scenario s = LoadScenario(f);
+  const Scenario all = LoadScenario(f, {"recording=null"});
+  EXPECT_EQ(s.record_interval, 2'000'000);
+  ASSERT_FALSE(s.recorded.empty());
+  ASSERT_EQ(s.recorded.size(), all.recorded.size());
+  for (std::size_t i = 0; i < s.recorded.size(); ++i) {
+    EXPECT_EQ(s.recorded[i].label, all.recorded[i].label);
+  }
+}
+
 }  // namespace
 }  // namespace linesim::loader::testing

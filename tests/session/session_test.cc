@@ -107,12 +107,6 @@ TEST(Session, FailureAfterTheRunFailsIt) {
   EXPECT_EQ(report.errors.front().phase, cosim::RunPhase::kRecording);
 }
 
-}  // namespace
-}  // namespace linesim::session
-
-namespace linesim::session {
-namespace {
-
 // Guards the plot description's scan geometry: it comes from the system
 // description (the mount, the device's numbers from the robot file and the
 // model file) and agrees with what the built laser unit holds.
