@@ -17,8 +17,10 @@ import pytest
 
 import linesim
 
-SOURCE = os.environ["LINESIM_SOURCE_DIR"]
-CLI = os.environ["LINESIM_CLI"]
+# ctest sets both; by hand they default to this repository and its build/.
+SOURCE = os.environ.get("LINESIM_SOURCE_DIR",
+                        os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+CLI = os.environ.get("LINESIM_CLI", os.path.join(SOURCE, "build", "app", "linesim"))
 
 
 def scenario(name):
