@@ -481,7 +481,14 @@ static void ReplaceUnitTypes(SystemSpec& spec, const std::map<std::string, std::
       r.Error(YAML::Node(), JoinPath(JoinPath("units", name), "type"), UnknownTypeMessage(type));
       continue;
     }
-    const auto declared = CreateDefaultUnit(*found);
+    std::unique_ptr<cosim::Unit> declared;
+    try {
+      declared = CreateDefaultUnit(*found);
+    } catch (const std::exception& e) {
+      r.Error(YAML::Node(), JoinPath("units", name),
+              std::string("cannot create the unit: ") + e.what());
+      continue;
+    }
     Parameters kept;
     for (const auto& [key, value] : unit->parameters) {
       const auto ref = declared->variables().Find(key);

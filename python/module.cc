@@ -60,54 +60,15 @@ class PythonUnit : public cosim::Unit {
   PythonUnit(const std::string& type, const std::string& name, PyObject* cls)
       : cosim::Unit(type, name) {
     py::gil_scoped_acquire gil;
-    object_ = py::reinterpret_borrow<py::object>(cls)();
-    const auto declared = [&](const char* what) {
-      return py::hasattr(object_, what) ? py::dict(object_.attr(what)) : py::dict();
-    };
-    const auto declare = [&](const char* what, auto&& bind) {
-      for (const auto& [key, spec] : declared(what)) {
-        const std::string var = py::str(key);
-        const py::tuple t = py::reinterpret_borrow<py::tuple>(spec);
-        const std::string unit = py::str(t[0]);
-        bind(var, unit, t[1]);
-      }
-    };
-    // Inputs and outputs: (unit, size); parameters: (unit, default).
-    declare("inputs", [&](const std::string& var, const std::string& unit, py::handle size) {
-      const auto n = size.cast<std::size_t>();
-      Slot& slot = slots_.emplace_back(Slot{var, n > 1, 0.0, std::vector<double>(n, 0.0)});
-      if (slot.array) {
-        variables().Input(var, unit, &slot.values, "Python input");
-      } else {
-        variables().Input(var, unit, &slot.value, "Python input");
-      }
-      inputs_.push_back(&slot);
-    });
-    declare("outputs", [&](const std::string& var, const std::string& unit, py::handle size) {
-      const auto n = size.cast<std::size_t>();
-      Slot& slot = slots_.emplace_back(Slot{var, n > 1, 0.0, std::vector<double>(n, 0.0)});
-      if (slot.array) {
-        variables().Output(var, unit, &slot.values, "Python output", {});
-      } else {
-        variables().Output(var, unit, &slot.value, "Python output", {});
-      }
-      outputs_.push_back(&slot);
-    });
-    declare("parameters", [&](const std::string& var, const std::string& unit, py::handle value) {
-      Slot slot{var, py::isinstance<py::sequence>(value), 0.0, {}};
-      if (slot.array) {
-        slot.values = value.cast<std::vector<double>>();
-      } else {
-        slot.value = value.cast<double>();
-      }
-      Slot& kept = slots_.emplace_back(std::move(slot));
-      if (kept.array) {
-        variables().Parameter(var, unit, &kept.values, "Python parameter");
-      } else {
-        variables().Parameter(var, unit, &kept.value, "Python parameter");
-      }
-      parameters_.push_back(&kept);
-    });
+    try {
+      Declare(cls);
+    } catch (const std::exception& e) {
+      // Said and let go while the GIL is held: a Python error's objects
+      // and the instance must not outlive it.
+      const std::string what = e.what();
+      object_ = py::object();
+      throw std::runtime_error("the Python class " + type + " cannot be used: " + what);
+    }
   }
 
   ~PythonUnit() override {
@@ -116,20 +77,22 @@ class PythonUnit : public cosim::Unit {
   }
 
   void Setup(cosim::TimeNs, cosim::TimeNs) override {
-    py::gil_scoped_acquire gil;
-    // Every declared variable is an attribute from the start (outputs at
-    // their start value, 0).
-    Give(parameters_);
-    Give(inputs_);
-    Give(outputs_);
-    Call("setup");
+    WithPython([&] {
+      // Every declared variable is an attribute from the start (outputs at
+      // their start value, 0).
+      Give(parameters_);
+      Give(inputs_);
+      Give(outputs_);
+      Call("setup");
+    });
   }
 
   void Initialize() override {
-    py::gil_scoped_acquire gil;
-    Give(inputs_);
-    Call("initialize");
-    Take();
+    WithPython([&] {
+      Give(inputs_);
+      Call("initialize");
+      Take();
+    });
   }
 
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override {
@@ -154,6 +117,68 @@ class PythonUnit : public cosim::Unit {
     double value;
     std::vector<double> values;
   };
+
+  // The instance and its declared variables, bound into the table.
+  void Declare(PyObject* cls) {
+    object_ = py::reinterpret_borrow<py::object>(cls)();
+    const auto declared = [&](const char* what) {
+      return py::hasattr(object_, what) ? py::dict(object_.attr(what)) : py::dict();
+    };
+    const auto declare = [&](const char* what, auto&& bind) {
+      for (const auto& [key, spec] : declared(what)) {
+        const std::string var = py::str(key);
+        if (!py::isinstance<py::tuple>(spec) || py::len(spec) != 2 ||
+            !py::isinstance<py::str>(py::reinterpret_borrow<py::tuple>(spec)[0])) {
+          throw std::invalid_argument(std::string(what) + "['" + var + "'] must be (unit, " +
+                                      (std::string(what) == "parameters" ? "default" : "size") +
+                                      "), got " + std::string(py::repr(spec)));
+        }
+        const py::tuple t = py::reinterpret_borrow<py::tuple>(spec);
+        bind(var, py::str(t[0]).cast<std::string>(), t[1]);
+      }
+    };
+    // Inputs and outputs: (unit, size); parameters: (unit, default).
+    const auto size_of = [](const std::string& var, py::handle size) {
+      const auto n = size.cast<std::int64_t>();
+      if (n < 1) throw std::invalid_argument("'" + var + "' must have a size of at least 1");
+      return static_cast<std::size_t>(n);
+    };
+    declare("inputs", [&](const std::string& var, const std::string& unit, py::handle size) {
+      const std::size_t n = size_of(var, size);
+      Slot& slot = slots_.emplace_back(Slot{var, n > 1, 0.0, std::vector<double>(n, 0.0)});
+      if (slot.array) {
+        variables().Input(var, unit, &slot.values, "Python input");
+      } else {
+        variables().Input(var, unit, &slot.value, "Python input");
+      }
+      inputs_.push_back(&slot);
+    });
+    declare("outputs", [&](const std::string& var, const std::string& unit, py::handle size) {
+      const std::size_t n = size_of(var, size);
+      Slot& slot = slots_.emplace_back(Slot{var, n > 1, 0.0, std::vector<double>(n, 0.0)});
+      if (slot.array) {
+        variables().Output(var, unit, &slot.values, "Python output", {});
+      } else {
+        variables().Output(var, unit, &slot.value, "Python output", {});
+      }
+      outputs_.push_back(&slot);
+    });
+    declare("parameters", [&](const std::string& var, const std::string& unit, py::handle value) {
+      Slot slot{var, py::isinstance<py::sequence>(value), 0.0, {}};
+      if (slot.array) {
+        slot.values = value.cast<std::vector<double>>();
+      } else {
+        slot.value = value.cast<double>();
+      }
+      Slot& kept = slots_.emplace_back(std::move(slot));
+      if (kept.array) {
+        variables().Parameter(var, unit, &kept.values, "Python parameter");
+      } else {
+        variables().Parameter(var, unit, &kept.value, "Python parameter");
+      }
+      parameters_.push_back(&kept);
+    });
+  }
 
   void Give(const std::vector<Slot*>& slots) {
     for (const Slot* s : slots) {
@@ -181,11 +206,19 @@ class PythonUnit : public cosim::Unit {
     }
   }
   void Call(const char* method) {
-    if (!py::hasattr(object_, method)) return;
+    if (py::hasattr(object_, method)) object_.attr(method)();
+  }
+  // Runs `f` holding the GIL; what it raises becomes the unit's error,
+  // said while the GIL is still held.
+  template <typename F>
+  void WithPython(F&& f) {
+    py::gil_scoped_acquire gil;
     try {
-      object_.attr(method)();
+      f();
+    } catch (const cosim::UnitError&) {
+      throw;
     } catch (const std::exception& e) {
-      throw cosim::UnitError(std::string(method) + " raised: " + e.what());
+      throw cosim::UnitError(std::string("the Python unit raised: ") + e.what());
     }
   }
 

@@ -368,3 +368,27 @@ def test_inspect_a_scenario():
     assert system["step_order"].index("chassis") < system["step_order"].index("deviation")
     with pytest.raises(linesim.ScenarioError):
         linesim.inspect(scenario("cross_line.yaml"), set={"task.speed_mps": -1})
+
+
+class BadDeclaration(linesim.Unit):
+    inputs = {"position": "m"}  # not (unit, size)
+
+
+class RaisesInSetup(Raising):
+    def setup(self):
+        raise RuntimeError("no calibration file")
+
+
+# Guards a Python class that cannot be used: a declaration that is not
+# (unit, size) is refused before anything runs, naming the unit and the
+# declaration; an exception in setup fails the run naming the unit.
+def test_bad_python_classes_are_refused():
+    with pytest.raises(linesim.ScenarioError) as e:
+        linesim.run(scenario("cross_line.yaml"), units={"path_follower": BadDeclaration})
+    assert e.value.key == "units.path_follower"
+    assert "inputs['position'] must be (unit, size)" in str(e.value)
+    with pytest.raises(linesim.RunError) as e:
+        linesim.run(scenario("cross_line.yaml"), duration_s=0.1,
+                    units={"path_follower": RaisesInSetup})
+    assert e.value.unit == "path_follower"
+    assert "no calibration file" in e.value.cause
