@@ -240,13 +240,22 @@ def _table(raw):
     return {k: numpy.asarray(v) for k, v in raw.items()}
 
 
+def _jobs(jobs):
+    # As the command line's --jobs: 1 to 4096 runs at a time.
+    if not 1 <= int(jobs) <= 4096:
+        raise ValueError("jobs: expected 1 to 4096 runs at a time, got %r" % (jobs,))
+    return int(jobs)
+
+
 def runs(path, n, jobs=1, set=None, progress=True):  # noqa: A002
     """`n` runs of the scenario (`linesim run --runs N`: each its own seed
     derived from the scenario's), on `jobs` threads. A table, one row per
     run: id, seed, status, every metric, error, wall_s. Failed runs are rows
     with their error; a refused scenario raises ScenarioError."""
+    if not 2 <= int(n) <= 1_000_000:
+        raise ValueError("n: expected 2 to 1000000 runs (linesim.run for one), got %r" % (n,))
     sets = ["%s=%s" % (k, _text(v)) for k, v in (set or {}).items()]
-    return _table(_linesim.runs(os.fspath(path), sets, int(n), int(jobs), _progress(progress)))
+    return _table(_linesim.runs(os.fspath(path), sets, int(n), _jobs(jobs), _progress(progress)))
 
 
 def sweep(path_or_dict, jobs=1, progress=True):
@@ -261,10 +270,10 @@ def sweep(path_or_dict, jobs=1, progress=True):
                                          delete=False) as f:
             json.dump(spec, f)  # JSON is YAML
         try:
-            return _table(_linesim.sweep(f.name, int(jobs), _progress(progress)))
+            return _table(_linesim.sweep(f.name, _jobs(jobs), _progress(progress)))
         finally:
             os.unlink(f.name)
-    return _table(_linesim.sweep(os.fspath(path_or_dict), int(jobs), _progress(progress)))
+    return _table(_linesim.sweep(os.fspath(path_or_dict), _jobs(jobs), _progress(progress)))
 
 
 def inspect(type_or_path, set=None):  # noqa: A002

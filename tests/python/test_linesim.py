@@ -392,3 +392,16 @@ def test_bad_python_classes_are_refused():
                     units={"path_follower": RaisesInSetup})
     assert e.value.unit == "path_follower"
     assert "no calibration file" in e.value.cause
+
+
+# Guards the table functions' arguments: a run count or a job count out of
+# range is refused as the command line refuses --runs and --jobs (2 to 1e6,
+# 1 to 4096), before anything runs.
+@pytest.mark.parametrize("n,jobs", [(1, 1), (3, 0), (3, -2), (3, 5000)])
+def test_runs_refuses_counts_out_of_range(n, jobs):
+    with pytest.raises(ValueError):
+        linesim.runs(scenario("cross_line.yaml"), n, jobs=jobs, progress=False)
+    if n >= 2:
+        with pytest.raises(ValueError):
+            linesim.sweep(os.path.join(SOURCE, "scenarios", "sweeps",
+                                       "belt_speed_compensation.yaml"), jobs=jobs, progress=False)
