@@ -12,6 +12,7 @@
 
 #include "app/console.h"
 #include "config/unit_registry.h"
+#include "cosim/variable_rows.h"
 #include "loader/scenario.h"
 #include "session/run_folder.h"
 #include "session/session.h"
@@ -23,31 +24,22 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string TypeLabel(const cosim::VariableInfo& v) {
-  if (v.type == cosim::VarType::kRealArray) return "Real[" + std::to_string(v.size) + "]";
-  return std::string(cosim::ToString(v.type));
-}
-
-// The variable table as aligned columns; "start" is the value the unit
-// starts with: its declared start value, or what the scenario set; "rule"
-// the values a parameter accepts ("> 0", "(0, 1]", "one of: a, b",
-// "required"), "-" for none.
+// The variable table as aligned columns (cosim/variable_rows.h), "-" for
+// an empty unit or rule, the direct dependencies after the description.
 constexpr int kTableColumns = 7;
 using TableRow = std::array<std::string, kTableColumns>;
 
 std::vector<TableRow> TableRows(const cosim::Unit& unit) {
   std::vector<TableRow> rows{{"name", "causality", "type", "unit", "start", "rule", "description"}};
-  const auto& table = unit.variables();
-  for (const auto& v : table.infos()) {
+  for (const auto& v : cosim::VariableRows(unit)) {
     std::string description = v.description;
     if (!v.depends_on.empty()) {
       description += " [depends directly on:";
-      for (auto ref : v.depends_on) description += " " + table.info(ref).name;
+      for (const auto& name : v.depends_on) description += " " + name;
       description += "]";
     }
-    rows.push_back({v.name, std::string(cosim::ToString(v.causality)), TypeLabel(v),
-                    v.unit.empty() ? "-" : v.unit, cosim::FormatValue(table.GetValue(v.ref)),
-                    v.rule.empty() ? "-" : v.rule.Text(), description});
+    rows.push_back({v.name, v.causality, v.type, v.unit.empty() ? "-" : v.unit, v.start,
+                    v.rule.empty() ? "-" : v.rule, description});
   }
   return rows;
 }

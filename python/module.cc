@@ -15,6 +15,7 @@
 #include "config/scenario_error.h"
 #include "config/unit_registry.h"
 #include "cosim/run_error_json.h"
+#include "cosim/variable_rows.h"
 #include "loader/scenario.h"
 #include "platform/platform.h"
 #include "session/run_folder.h"
@@ -412,19 +413,19 @@ py::object Sweep(const std::string& file, int jobs, const py::object& progress) 
 
 // A unit's variable table: one dict per variable (its start value as
 // `linesim inspect` prints it: declared, or as the scenario set it).
-py::list VariableRows(const cosim::Unit& unit) {
+py::list VariableDicts(const cosim::Unit& unit) {
   py::list rows;
-  const cosim::VariableTable& table = unit.variables();
-  for (const auto& v : table.infos()) {
+  for (const auto& v : cosim::VariableRows(unit)) {
     py::dict d;
     d["name"] = v.name;
-    d["causality"] = std::string(cosim::ToString(v.causality));
-    d["type"] = std::string(cosim::ToString(v.type));
+    d["causality"] = v.causality;
+    d["type"] = v.type;
     d["size"] = v.size;
     d["unit"] = v.unit;
-    d["start"] = cosim::FormatValue(table.GetValue(v.ref));
-    d["rule"] = v.rule.empty() ? std::string() : v.rule.Text();
+    d["start"] = v.start;
+    d["rule"] = v.rule;
     d["description"] = v.description;
+    d["depends_on"] = v.depends_on;
     rows.append(d);
   }
   return rows;
@@ -438,7 +439,7 @@ py::list Inspect(const std::string& type) {
   } catch (const config::ScenarioError& e) {
     throw py::value_error(e.what());
   }
-  return VariableRows(*unit);
+  return VariableDicts(*unit);
 }
 
 // The system a scenario builds: each unit with its type, step and variable
@@ -453,7 +454,7 @@ py::object InspectScenario(const std::string& file, const std::vector<std::strin
       py::dict unit;
       unit["type"] = system.unit(u).type_name();
       unit["step_s"] = cosim::NsToSeconds(s.master->options().base_step * s.master->decimation(u));
-      unit["variables"] = VariableRows(system.unit(u));
+      unit["variables"] = VariableDicts(system.unit(u));
       units[py::str(system.unit(u).name())] = unit;
     }
     py::list connections;
