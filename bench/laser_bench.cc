@@ -8,6 +8,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -119,6 +120,44 @@ void BM_RaySceneCast541(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_RaySceneCast541);
+
+// A fleet's share of it (BM_Fleet): the same level scan cast as a 5 ms
+// step of the S300 casts it (8 calls of about 68 beams), against the other
+// robots' bodies as moving boxes, laid out as BM_Fleet lays out N robots
+// (two rows of five, 5 m apart along the line, 2 m across), the scanner on
+// the middle robot of the first row. Arg: the number of other robots.
+void BM_RaySceneCast541MovingBoxes(benchmark::State& state) {
+  const models::Scene scene = FactoryLine();
+  RayScene rs(scene);
+  const std::array<double, 3> origin{0.465, -5.232, 0.178};
+  std::vector<Ray> rays(541);
+  std::vector<RayHit> hits(541);
+  for (int i = 0; i < 541; ++i) {
+    const double a = (-135.0 + 0.5 * i - 45.0) * kDeg;
+    rays[static_cast<std::size_t>(i)] = {origin, {std::cos(a), std::sin(a), 0.0}, 29.5,
+                                         0.04 * i / 541.0};
+  }
+  // Robot k of BM_Fleet at (-10 + 5 (k % 5), k < 5 ? -5 : -3), heading +x at
+  // 0.3 m/s: a Rob@Work 3's body box (0.9 x 0.6 m, 0.05..0.4 m high).
+  std::vector<double> boxes;
+  const int others = static_cast<int>(state.range(0));
+  for (int k = 0, placed = 0; placed < others; ++k) {
+    if (k == 2) continue;  // the scanner's own robot
+    const double x = -10.0 + 5.0 * (k % 5), y = k < 5 ? -5.0 : -3.0;
+    boxes.insert(boxes.end(), {x, y, 0.0, 0.3, 0.0, 0.0, 0.9, 0.6, 0.05, 0.4});
+    ++placed;
+  }
+  const std::vector<double> travel{1.0}, speed{0.1};
+  for (auto _ : state) {
+    for (std::size_t first = 0; first < rays.size(); first += 68) {
+      const std::size_t n = std::min<std::size_t>(68, rays.size() - first);
+      rs.Cast(std::span<const Ray>(rays).subspan(first, n),
+              std::span<RayHit>(hits).subspan(first, n), travel, speed, {}, boxes);
+    }
+    benchmark::DoNotOptimize(hits.data());
+  }
+}
+BENCHMARK(BM_RaySceneCast541MovingBoxes)->Arg(0)->Arg(2)->Arg(9);
 
 }  // namespace
 }  // namespace linesim::sensors
