@@ -25,12 +25,22 @@ constexpr double kNoiseSpread = 0.2;       // relative spread of a noise-only me
 constexpr double kLostSnr = 0.18;          // snr at which half the blocks match noise
 constexpr double kMatchNoise = 0.42;       // block offset std * snr (px)
 constexpr double kMatchNoiseMax = 1.0;     // its limit at low snr (px)
-constexpr double kAliasScalePx = 2.3;
-// The whole-pixel match's snr under a brightness step scales with the SAD
-// gap's ratio to this power: fitted to the image-level reference's frame
-// flow under 120 Hz flicker of depth 0.05..0.3 (the competition between
-// offsets then turns on the block means, which a mean gap alone overstates).
-constexpr double kFlickerGapPower = 0.65;      // beyond the window: P(edge match) = exp(-(e/2.3)^2)
+constexpr double kAliasScalePx = 2.3;       // beyond the window: P(edge match) = exp(-(e/2.3)^2)
+// Under a brightness step delta between the frames the whole-pixel match's
+// margin is the SAD gap, about d^2 / (2 |delta|) per pixel (E|delta + t| -
+// |delta| for a texture difference t of std d, |delta| >> d), against a
+// spread of the wrong offsets' SADs set by the texture (std ~ d), not by
+// the sensor's noise: a block's snr is bounded by kFlickerSnr (d /
+// |delta|)^kFlickerPow (the margin argument gives the power 1; 1.25 is
+// fitted), combined with its noise snr as 1 / snr^2 = 1 / snr_noise^2 +
+// 1 / snr_step^2, with the block's own texture (d sqrt(X)): faint blocks
+// go first. Fitted to the image-level reference's mean frame flow at
+// 0.2 m/s under 120 Hz flicker of depth 0.1..0.3 over texture contrast
+// 0.03..0.2, where its lost share depends on depth / contrast alone, as
+// this law says (tests/units/sensors/px4flow_fast_vs_image_test.cc,
+// FlickerAgrees).
+constexpr double kFlickerSnr = 0.82;
+constexpr double kFlickerPow = 1.25;
 
 inline double Uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
@@ -474,30 +484,39 @@ void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, c
   const double n = std::sqrt(n2);
   double snr = d / std::max(e.noise_dn, 1e-9);
   double snr_sub = snr;  // the half-pixel refinement's
-  if (brightness_ != last_brightness_) {
-    // A brightness step between the frames: the mean SAD per pixel at the
-    // true offset is E|delta + n| (n the two frames' noise, std sqrt(n2)),
-    // at a wrong one E|delta + t| (t adds the texture difference: std d at
-    // a whole pixel, d / 2 at the half-pixel neighbours the refinement
-    // compares); the match's margin is their gap, which the step shrinks,
-    // the half-pixel one first.
-    const double delta = e.mean_dn * (brightness_ - last_brightness_);
-    const double s_wrong = std::sqrt(d * d + n2), s_half = std::sqrt(0.25 * d * d + n2);
-    // Without a step the gaps are sqrt(2 / pi) (s - n) (FoldedMean at 0).
-    constexpr double kSqrt2OverPi = 0.7978845608028654;
-    const double gap0 = kSqrt2OverPi * (s_wrong - n);
-    const double gap0_half = kSqrt2OverPi * (s_half - n);
-    const double true_sad = FoldedMean(delta, n);
-    if (gap0 > 0.0) {
-      const double ratio = (FoldedMean(delta, s_wrong) - true_sad) / gap0;
-      snr *= std::pow(std::max(ratio, 0.0), kFlickerGapPower);
-    }
+  // A brightness step between the frames (a flickering lamp): the whole-
+  // pixel match per block (kFlickerSnr, at the top); the half-pixel refinement
+  // by the SAD gap at its neighbours: the mean SAD per pixel at the true
+  // offset is E|delta + n| (n the two frames' noise, std sqrt(n2)), at a
+  // neighbour E|delta + t| (t adds the texture difference, std d / 2
+  // there); the step shrinks their gap.
+  const bool step = brightness_ != last_brightness_;
+  const double delta = e.mean_dn * (brightness_ - last_brightness_);
+  if (step) {
+    const double s_half = std::sqrt(0.25 * d * d + n2);
+    // Without a step the gap is sqrt(2 / pi) (s_half - n) (FoldedMean at 0).
+    const double gap0_half = 0.7978845608028654 * (s_half - n);
     if (gap0_half > 0.0) {
-      snr_sub *= (FoldedMean(delta, s_half) - true_sad) / gap0_half;
+      snr_sub *= (FoldedMean(delta, s_half) - FoldedMean(delta, n)) / gap0_half;
     }
   }
-  const double lost_ratio = kLostSnr / std::max(snr, 1e-9);
-  const double p_true = 1.0 / (1.0 + lost_ratio * lost_ratio * lost_ratio);
+  // The match's snr with the step's bound for a block of texture d sqrt(x)
+  // (x: its Gamma draw): 1 / bound^2 = 1 / (kFlickerSnr (d / delta)^1.25)^2
+  // / x^1.25, the frame's part once (a pow per frame, not per block).
+  const double inv_snr2 = 1.0 / (snr * snr);
+  const double inv_frame_bound2 =
+      step && delta != 0.0
+          ? 1.0 / (kFlickerSnr * kFlickerSnr * std::pow(d / std::abs(delta), 2.0 * kFlickerPow))
+          : 0.0;
+  const auto step_snr = [&](double x) {
+    static_assert(kFlickerPow == 1.25, "x^(2 kFlickerPow) below is x sqrt(sqrt(x))");
+    return 1.0 / std::sqrt(inv_snr2 + inv_frame_bound2 / (x * std::sqrt(std::sqrt(x))));
+  };
+  const auto p_match = [](double block_snr) {
+    const double lost_ratio = kLostSnr / std::max(block_snr, 1e-9);
+    return 1.0 / (1.0 + lost_ratio * lost_ratio * lost_ratio);
+  };
+  const double p_frame = p_match(snr);
   const double sigma_b = std::min(kMatchNoise / std::max(snr_sub, 1e-9), kMatchNoiseMax);
   const double S = static_cast<double>(search_range_);
   const double thr = static_cast<double>(feature_threshold_);
@@ -511,7 +530,7 @@ void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, c
   double p_alias = 0.0;
   bool alias_minus = false, alias_plus = false;
   if (periodic_share_ > 0.0) {
-    const double snr_ap = snr * std::sqrt(1.0 - periodic_share_);
+    const double snr_ap = (step ? step_snr(1.0) : snr) * std::sqrt(1.0 - periodic_share_);
     const double ratio = snr_ap / kLostSnr;
     p_alias = 0.5 / (1.0 + ratio * ratio * ratio);
     alias_minus = std::abs(fx - period_px_x_) <= edge && std::abs(fy - period_px_y_) <= edge;
@@ -527,6 +546,7 @@ void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, c
         kDiffPerSigma * (std::sqrt(d * d * x + n2) + kNoiseSpread * n * IrwinHall4(rng_()));
     if (m < thr) continue;
     double ox, oy;
+    const double p_true = step ? p_match(step_snr(x)) : p_frame;
     const std::uint64_t r = rng_();
     const double u = U16(r, 48);
     if (u < p_true * p_edge) {

@@ -89,8 +89,10 @@ namespace linesim::sensors {
 ///    flicker_hz and flicker_depth changes between exposures; the SAD is
 ///    not brightness invariant, so a brightness step Delta between frames
 ///    shrinks the SAD gap between the true and a wrong offset (fast model:
-///    the snr scaled by that gap, from folded-normal means; image model:
-///    the frame rendered brighter or darker).
+///    each block's snr bounded by 0.82 (d_block / Delta)^1.25, the gap
+///    against the texture's spread, so that a faint block is lost first; the
+///    half-pixel refinement's by the gap from folded-normal means; image
+///    model: the frame rendered brighter or darker).
 ///  - periodic texture (surface texture_period_m, texture_periodic_share):
 ///    a block may match one period off (x - p or x + p) when its aperiodic
 ///    part cannot tell them apart.

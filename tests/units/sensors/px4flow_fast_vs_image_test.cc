@@ -158,13 +158,15 @@ TEST(Px4FlowFastVsImage, QualityAndNoiseAgreeOverTheGrid) {
 
 
 // Flicker through the whole unit (its exposure timing, the lamp's phase and
-// the brightness step between frames), fast model against image mode: the
-// treadmill's belt (contrast 0.12, 300 lx of lamps at 120 Hz, the robot's
-// steady 500 lx) at 0.2 m/s. Mean and standard deviation of the frame
-// flow over the frames of quality > 0.
-Stats UnitFlicker(const std::string& mode, double depth, int frames, std::uint64_t seed) {
+// the brightness step between frames), fast model against image mode: a
+// belt of texture contrast `contrast` under 300 lx of lamps at 120 Hz and
+// the robot's steady 500 lx (the treadmill lab: contrast 0.12), at 0.2 m/s.
+// Mean and standard deviation of the frame flow over the frames of
+// quality > 0.
+Stats UnitFlicker(const std::string& mode, double contrast, double depth, int frames,
+                  std::uint64_t seed) {
   models::Scene s;
-  models::Surface surf{"belt", 0.8, 0.12, 300.0};
+  models::Surface surf{"belt", 0.8, contrast, 300.0};
   surf.flicker_hz = 120.0;
   surf.flicker_depth = depth;
   s.surfaces.push_back(surf);
@@ -188,39 +190,52 @@ Stats UnitFlicker(const std::string& mode, double depth, int frames, std::uint64
   return Summarize(q, f);
 }
 
-// The fast model's flicker (the SAD gap of folded normal means, the
-// whole-pixel part to the power 0.65 fitted here) against the image-level
-// reference, depth 0.1 (the treadmill lab's) and 0.3 (magnetic ballasts),
-// over 4 seed sets (each: image 400 frames, fast 4000); over the 12
-// cells fast - image mean -0.18 / 0.02 / 0.03 px (min / median / max),
-// fast / image std 0.91 / 1.15 / 1.46. Measured once over 5 depths
-// (depth: mean image / fast px, std image / fast px, seed set 0):
-// 0.05: 1.799 / 1.823, 0.071 / 0.051; 0.1: 1.799 / 1.816, 0.102 / 0.115;
-// 0.2: 1.601 / 1.752, 0.354 / 0.216; 0.3: 1.246 / 1.065, 0.594 / 0.866.
-// The calibration reaches: the mean within 0.25 px (14 % of the true
-// 1.81 px) and the standard deviation within a factor 2, and both models'
-// standard deviation grows with the depth (the direction physics says:
-// the SAD is not brightness invariant).
+// The fast model's flicker (each block's snr bounded by 0.82 (d_block /
+// delta)^1.25) against the image-level reference over texture contrast 0.03..0.2
+// and depth 0 (none), 0.1 (electronic ballasts; the treadmill lab's) and
+// 0.3 (magnetic ballasts): the lost share of the blocks, which pulls the
+// mean towards 0, depends on depth / contrast. Two seed sets (each: image
+// 400 frames, fast 4000). Measured over the 24 cells: fast - image mean
+// -0.09 / +0.01 / +0.15 px (min / median / max), fast / image std 0.62 /
+// 0.93 / 1.48; at the treadmill lab's cell (contrast 0.12, depth 0.1)
+// -0.02 px. Before the per-block law (the frame's snr scaled by the
+// gap ratio to the power 0.65, fitted at contrast 0.12 only) the same
+// grid gave fast - image mean up to +0.41 px (contrast 0.03, depth 0.1)
+// and +0.29 px (0.05, 0.1), +0.02 px at the lab's: the fast model read a
+// low-contrast belt under flicker up to 20 % faster than the firmware on
+// rendered frames.
+// Asserted: the mean within 0.2 px (11 % of the true 1.81 px), the
+// standard deviation within a factor 2, and both models' standard
+// deviation growing with the depth (the SAD is not brightness invariant)
+// where most blocks still match.
 TEST(Px4FlowFastVsImage, FlickerAgrees) {
   std::vector<double> mean_diff, std_ratio;
-  for (std::uint64_t set = 0; set < 4; ++set) {
-    double last_im = 0.0, last_fa = 0.0;
-    for (double depth : {0.0, 0.1, 0.3}) {
-      const Stats im = UnitFlicker("image", depth, 400, 300 + 2 * set);
-      const Stats fa = UnitFlicker("fast", depth, 4000, 301 + 2 * set);
-      std::printf("set %d depth %.2f | quality image %6.1f fast %6.1f | mean image %.3f fast %.3f "
-                  "| std image %.3f fast %.3f\n",
-                  static_cast<int>(set), depth, im.quality, fa.quality, im.mean, fa.mean, im.std,
-                  fa.std);
-      EXPECT_NEAR(im.mean, fa.mean, 0.25) << depth;
-      EXPECT_LT(fa.std, 2.0 * im.std) << depth;
-      EXPECT_GT(fa.std, 0.5 * im.std) << depth;
-      EXPECT_GE(im.std, last_im) << depth;
-      EXPECT_GE(fa.std, last_fa) << depth;
-      last_im = im.std;
-      last_fa = fa.std;
-      mean_diff.push_back(fa.mean - im.mean);
-      std_ratio.push_back(fa.std / im.std);
+  for (const double contrast : {0.03, 0.05, 0.12, 0.2}) {
+    for (std::uint64_t set = 0; set < 2; ++set) {
+      double last_im = 0.0, last_fa = 0.0;
+      for (const double depth : {0.0, 0.1, 0.3}) {
+        const Stats im = UnitFlicker("image", contrast, depth, 400, 300 + 2 * set);
+        const Stats fa = UnitFlicker("fast", contrast, depth, 4000, 301 + 2 * set);
+        std::printf(
+            "contrast %.2f set %d depth %.2f | quality image %6.1f fast %6.1f | mean image %.3f "
+            "fast %.3f | std image %.3f fast %.3f\n",
+            contrast, static_cast<int>(set), depth, im.quality, fa.quality, im.mean, fa.mean,
+            im.std, fa.std);
+        EXPECT_NEAR(im.mean, fa.mean, 0.2) << contrast << " " << depth;
+        EXPECT_LT(fa.std, 2.0 * im.std) << contrast << " " << depth;
+        EXPECT_GT(fa.std, 0.5 * im.std) << contrast << " " << depth;
+        // (At contrast 0.03 and depth 0.3 four fifths of the blocks match
+        // noise: the frame flow's spread is then that of a mean of noise
+        // matches, which need not grow further.)
+        if (contrast >= 0.05) {
+          EXPECT_GE(im.std, last_im) << contrast << " " << depth;
+          EXPECT_GE(fa.std, last_fa) << contrast << " " << depth;
+        }
+        last_im = im.std;
+        last_fa = fa.std;
+        mean_diff.push_back(fa.mean - im.mean);
+        std_ratio.push_back(fa.std / im.std);
+      }
     }
   }
   test_spread::Print("frame flow mean, fast - image (px)", mean_diff);
