@@ -503,7 +503,7 @@ void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, c
   // The match's snr with the step's bound for a block of texture d sqrt(x)
   // (x: its Gamma draw): 1 / bound^2 = 1 / (kFlickerSnr (d / delta)^1.25)^2
   // / x^1.25, the frame's part once (a pow per frame, not per block).
-  const double inv_snr2 = 1.0 / (snr * snr);
+  const double inv_snr2 = 1.0 / (std::max(snr, 1e-9) * std::max(snr, 1e-9));
   const double inv_frame_bound2 =
       step && delta != 0.0
           ? 1.0 / (kFlickerSnr * kFlickerSnr * std::pow(d / std::abs(delta), 2.0 * kFlickerPow))
