@@ -134,8 +134,8 @@ void BM_RaySceneCast541MovingBoxes(benchmark::State& state) {
   std::vector<RayHit> hits(541);
   for (int i = 0; i < 541; ++i) {
     const double a = (-135.0 + 0.5 * i - 45.0) * kDeg;
-    rays[static_cast<std::size_t>(i)] = {origin, {std::cos(a), std::sin(a), 0.0}, 29.5,
-                                         0.04 * i / 541.0};
+    rays[static_cast<std::size_t>(i)] = {
+        origin, {std::cos(a), std::sin(a), 0.0}, 29.5, 0.04 * i / 541.0};
   }
   // Robot k of BM_Fleet at (-10 + 5 (k % 5), k < 5 ? -5 : -3), heading +x at
   // 0.3 m/s: a Rob@Work 3's body box (0.9 x 0.6 m, 0.05..0.4 m high).

@@ -25,7 +25,7 @@ constexpr double kNoiseSpread = 0.2;       // relative spread of a noise-only me
 constexpr double kLostSnr = 0.18;          // snr at which half the blocks match noise
 constexpr double kMatchNoise = 0.42;       // block offset std * snr (px)
 constexpr double kMatchNoiseMax = 1.0;     // its limit at low snr (px)
-constexpr double kAliasScalePx = 2.3;       // beyond the window: P(edge match) = exp(-(e/2.3)^2)
+constexpr double kAliasScalePx = 2.3;      // beyond the window: P(edge match) = exp(-(e/2.3)^2)
 // Under a brightness step delta between the frames the whole-pixel match's
 // margin is the SAD gap, about d^2 / (2 |delta|) per pixel (E|delta + t| -
 // |delta| for a texture difference t of std d, |delta| >> d), against a
