@@ -20,7 +20,6 @@ constexpr std::uint64_t kImageSeedSalt = 0x9e3779b97f4a7c15ULL;
 constexpr double kDiffPerSigma = 19.1492;  // 24 * sqrt(2 / pi)
 constexpr double kNeighbourDiff = 0.45;    // std of a neighbour difference / (mean * contrast)
 constexpr double kBlurScalePx = 1.8;       // blur length halving the along-motion part
-constexpr double kBlockShape = 3.0;        // Gamma shape of the block-to-block texture variance
 constexpr double kNoiseSpread = 0.2;       // relative spread of a noise-only measure
 constexpr double kLostSnr = 0.18;          // snr at which half the blocks match noise
 constexpr double kMatchNoise = 0.42;       // block offset std * snr (px)
@@ -54,7 +53,8 @@ inline double IrwinHall4(std::uint64_t r) {
   return (sum * (1.0 / 65536.0) - 2.0) * 1.7320508075688772;
 }
 
-// ... and a Gamma(3, 1/3) variable (mean 1): the mean of three unit
+// ... and a Gamma(3, 1/3) variable (mean 1; the shape 3 is the fitted one
+// of the block-to-block texture variance): the mean of three unit
 // exponentials from three 21-bit uniforms in (0, 1].
 inline double Gamma3(std::uint64_t r) {
   constexpr double k = 1.0 / 2097152.0;
