@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <stdexcept>
 
 #include "cosim/run_error_json.h"
 #include "platform/provenance.h"
@@ -117,6 +118,9 @@ bool Session::Measure(const std::vector<std::string>& names) {
 }
 
 RunReport Session::Run(const std::atomic<bool>* stop) {
+  // The master would set up and initialize the used units again, with the
+  // last run's metrics observer (freed below) still registered.
+  if (metrics_) throw std::logic_error(s_.name + ": a session runs once; load the scenario again");
   RunReport report;
   metrics_ = std::make_unique<cosim::MetricsObserver>(measured_);
   cosim::MetricsObserver& metrics = *metrics_;

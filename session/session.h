@@ -64,7 +64,8 @@ class Session {
   bool Measure(const std::vector<std::string>& names);
 
   /// Runs to the stop time, or to the first communication point after
-  /// `stop` turned true. Once per session.
+  /// `stop` turned true. Once per session: a second call throws
+  /// std::logic_error (the units have run; load the scenario again).
   RunReport Run(const std::atomic<bool>* stop = nullptr);
 
  private:

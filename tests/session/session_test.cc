@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <stdexcept>
 #include <string>
 
 #include "config/scenario_error.h"
@@ -71,6 +72,14 @@ TEST(Session, StopTokenInterruptsAtTheNextStep) {
 
 // Guards Measure (the sweep's metrics): only those asked for, in that
 // order; a name the scenario lacks is refused and changes nothing.
+// A second run of the same session is refused (its units have run; the
+// first run's metrics observer must not be left registered and freed).
+TEST(Session, RunsOnce) {
+  Session run(Scenario("motor_step.yaml"), {"duration_s=0.1"});
+  EXPECT_STREQ(run.Run().status(), "ok");
+  EXPECT_THROW(run.Run(), std::logic_error);
+}
+
 TEST(Session, MeasuresTheMetricsAskedFor) {
   Session session(Scenario("cross_line.yaml"), {"duration_s=0.2"});
   EXPECT_FALSE(session.Measure({"max_path_deviation_m", "no_such_metric"}));
