@@ -348,6 +348,9 @@ SweepSpec RepeatSweepSpec(const std::string& scenario, const std::vector<std::st
   spec.scenario_sha256 = base.sha256;
   for (const std::string& a : set_args) {
     const auto eq = a.find('=');
+    // --set seed=N is the base the runs' seeds are derived from (base.seed
+    // below); kept as a fixed setting it would give every run that one seed.
+    if (a.substr(0, eq) == "seed") continue;
     spec.fixed.emplace_back(a.substr(0, eq), eq == std::string::npos ? "" : a.substr(eq + 1));
   }
   spec.repeats = runs;
@@ -388,6 +391,12 @@ SweepSpec LoadSweepSpec(const std::string& file) {
         if (!IsDottedPath(key)) {
           r.Error(kv.first, "set",
                   "expected dotted paths as keys, e.g. duration_s: 5, got " + Describe(kv.first));
+          continue;
+        }
+        if (key == "seed") {
+          r.Error(kv.first, "set.seed",
+                  "each run's seed comes from the sweep (repeats:, seeds: and seed:), which "
+                  "results.csv reports in its seed column: set the sweep's seed: instead");
           continue;
         }
         spec.fixed.emplace_back(key, YamlText(kv.second));

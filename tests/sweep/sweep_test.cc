@@ -289,6 +289,30 @@ TEST(SweepSpec, RepeatsWithoutParametersAndAReference) {
       "reference.metrics.max_path_deviation_m", "unknown key"));
 }
 
+// `run --runs N --set seed=S`: S is the base the N runs' seeds are derived
+// from, not a setting every run gets (which made the N runs one run N times).
+TEST(SweepSpec, RepeatsOfASetSeedAreDerivedFromIt) {
+  const SweepSpec two = RepeatSweepSpec(kCrossLine, {"seed=2", "duration_s=1"}, 3);
+  const SweepSpec three = RepeatSweepSpec(kCrossLine, {"seed=3", "duration_s=1"}, 3);
+  EXPECT_EQ(two.seed, 2u);
+  std::set<std::uint64_t> seeds;
+  for (std::int64_t id = 0; id < 3; ++id) {
+    const RunSpec run = PlanRun(two, id);
+    seeds.insert(run.seed);
+    EXPECT_NE(run.seed, PlanRun(three, id).seed);
+    const std::vector<std::string> overrides = RunOverrides(two, run);
+    EXPECT_EQ(std::count_if(overrides.begin(), overrides.end(),
+                            [](const std::string& a) { return a.rfind("seed=", 0) == 0; }),
+              1);
+    EXPECT_EQ(overrides.front(), "seed=" + std::to_string(run.seed));
+  }
+  EXPECT_EQ(seeds.size(), 3u);
+  // A sweep file says its base seed with seed:, never under set:.
+  EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("setseed.yaml", "scenario: " + kCrossLine +
+                                                                   "\nset: {seed: 5}\nrepeats: 2\n")),
+                          "set.seed", "the sweep's seed:"));
+}
+
 TEST(SweepSpec, MalformedPathsDuplicatesAndHugeSweepsAreRefused) {
   const std::string head = "scenario: " + kCrossLine + "\n";
   EXPECT_TRUE(AnyContains(
