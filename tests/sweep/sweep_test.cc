@@ -277,11 +277,11 @@ TEST(SweepSpec, RepeatsWithoutParametersAndAReference) {
       IssueTexts(WriteFile("reffile.yaml", head + "repeats: 2\nreference: {title: t, file: "
                                                   "'../x', metrics: {}}\n")),
       "reference.file", "[A-Za-z0-9_-]"));
-  EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("once.yaml", head)), "parameters",
-                          "repeats: N (N >= 2)"));
+  EXPECT_TRUE(
+      AnyContains(IssueTexts(WriteFile("once.yaml", head)), "parameters", "repeats: N (N >= 2)"));
   EXPECT_TRUE(AnyContains(
-      IssueTexts(WriteFile("refbad.yaml",
-                           head + "repeats: 2\nreference: {title: t, metrics: {nope: {std: 1}}}\n")),
+      IssueTexts(WriteFile(
+          "refbad.yaml", head + "repeats: 2\nreference: {title: t, metrics: {nope: {std: 1}}}\n")),
       "reference.metrics.nope", "not a metric this sweep collects"));
   EXPECT_TRUE(AnyContains(
       IssueTexts(WriteFile("refkey.yaml", head + "repeats: 2\nreference: {title: t, metrics: "
@@ -308,9 +308,10 @@ TEST(SweepSpec, RepeatsOfASetSeedAreDerivedFromIt) {
   }
   EXPECT_EQ(seeds.size(), 3u);
   // A sweep file says its base seed with seed:, never under set:.
-  EXPECT_TRUE(AnyContains(IssueTexts(WriteFile("setseed.yaml", "scenario: " + kCrossLine +
-                                                                   "\nset: {seed: 5}\nrepeats: 2\n")),
-                          "set.seed", "the sweep's seed:"));
+  EXPECT_TRUE(AnyContains(
+      IssueTexts(
+          WriteFile("setseed.yaml", "scenario: " + kCrossLine + "\nset: {seed: 5}\nrepeats: 2\n")),
+      "set.seed", "the sweep's seed:"));
 }
 
 TEST(SweepSpec, MalformedPathsDuplicatesAndHugeSweepsAreRefused) {
@@ -610,10 +611,10 @@ connections:
 metrics:
   - {name: peak_current, of: "motor.current[0]", reduce: max_abs}
 )");
-  const SweepSpec spec = LoadSweepSpec(WriteFile(
-      "blowup.yaml", "scenario: " + scenario +
-                         "\nparameters: [{path: units.supply.parameters.steps.0.value, "
-                         "values: [1.0, 1.0e308]}]\n"));
+  const SweepSpec spec = LoadSweepSpec(
+      WriteFile("blowup.yaml", "scenario: " + scenario +
+                                   "\nparameters: [{path: units.supply.parameters.steps.0.value, "
+                                   "values: [1.0, 1.0e308]}]\n"));
   const RunOutcome ok = ExecuteRun(spec, PlanRun(spec, 0));
   ASSERT_EQ(ok.status, RunStatus::kOk) << ok.error;
   const RunOutcome bad = ExecuteRun(spec, PlanRun(spec, 1));
@@ -688,12 +689,12 @@ TEST(ResultsFile, ResumeDropsRowsThatDoNotMatchThePlan) {
   // result) was kept; row_check proves the row.
   const std::string path = dir + "/results.csv";
   std::ofstream(path, std::ios::trunc)
-      << lines[0] << lines[1]                          // run 0 as it was
-      << field_replaced(lines[2], 1, "0.3")            // run 1: a value not planned
-      << field_replaced(lines[3], 3, "12345")          // run 2: another seed
-      << field_replaced(lines[4], 4, "lots")           // run 3: a metric that is no number
-      << field_replaced(lines[5], 12, "fine")          // run 4: an unknown status
-      << field_replaced(lines[6], 5, "999");           // run 5: an edited metric
+      << lines[0] << lines[1]                  // run 0 as it was
+      << field_replaced(lines[2], 1, "0.3")    // run 1: a value not planned
+      << field_replaced(lines[3], 3, "12345")  // run 2: another seed
+      << field_replaced(lines[4], 4, "lots")   // run 3: a metric that is no number
+      << field_replaced(lines[5], 12, "fine")  // run 4: an unknown status
+      << field_replaced(lines[6], 5, "999");   // run 5: an edited metric
   ResultsFile resumed = ResultsFile::Resume(path, spec);
   EXPECT_EQ(resumed.row_count(), 1u);
   EXPECT_TRUE(resumed.HasRow(0));

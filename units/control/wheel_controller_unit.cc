@@ -59,8 +59,9 @@ WheelControllerUnit::WheelControllerUnit(std::string name, int wheel_count)
   v.Parameter("compensation", &compensation_,
               "subtract the surface velocity under each wheel from its command (paper 1 "
               "Algorithm 1); false = the nominal controller");
-  v.Parameter("zero_speed_threshold", "m/s", &zero_speed_threshold_,
-              "below this contact speed a wheel keeps its heading and stops",
+  v.Parameter("steer_speed_threshold", "m/s", &steer_speed_threshold_,
+              "below this contact speed a wheel keeps its heading and rolls the command's "
+              "component along it",
               cosim::Rule::NonNegative());
   v.Parameter("steer_kp", "V/rad", &steer_kp_, "steering angle gain",
               cosim::Rule::NonNegative().NoDefault());
@@ -197,7 +198,7 @@ cosim::StepResult WheelControllerUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt)
       v = CompensateSurface(v, {surface_velocity_[2 * i], surface_velocity_[2 * i + 1]});
     }
     const WheelSetpoint setpoint =
-        ToWheelSetpoint(v, wheel_radius_, steer_angle_[i], flip_angle_[i], zero_speed_threshold_);
+        ToWheelSetpoint(v, wheel_radius_, steer_angle_[i], flip_angle_[i], steer_speed_threshold_);
     flip_angle_[i] = setpoint.steer_angle_rad;
     drive_setpoint_[i] = setpoint.drive_rate_rad_s;
     fastest_rad_s = std::max(fastest_rad_s, std::abs(setpoint.drive_rate_rad_s));

@@ -10,10 +10,14 @@ Eigen::Vector2d WheelVelocity(const Eigen::Vector3d& twist, const Eigen::Vector2
 }
 
 WheelSetpoint ToWheelSetpoint(const Eigen::Vector2d& velocity_mps, double radius_m,
-                              double angle_now_rad, double last_target_rad, double zero_speed_mps) {
+                              double angle_now_rad, double last_target_rad,
+                              double steer_speed_mps) {
   const double speed_mps = velocity_mps.norm();
-  if (!(speed_mps >= zero_speed_mps) || speed_mps == 0.0) {
-    return {WrapAngle(last_target_rad), 0.0};
+  if (!(speed_mps >= steer_speed_mps) || speed_mps == 0.0) {
+    const double heading = WrapAngle(last_target_rad);
+    const double along_mps =
+        velocity_mps[0] * std::cos(heading) + velocity_mps[1] * std::sin(heading);
+    return {heading, along_mps / radius_m};
   }
   const double forward = std::atan2(velocity_mps[1], velocity_mps[0]);
   const double backward = WrapAngle(forward + std::numbers::pi);

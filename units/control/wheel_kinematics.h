@@ -37,9 +37,13 @@ struct WheelSetpoint {
 ///   0.6 |wrap(a - angle_now)| + 0.4 |wrap(a - last_target)|
 /// wins (ties go to rolling forward), so a wheel at its last target never
 /// turns more than 90 deg: it reverses instead; the second term keeps a
-/// lagging wheel from flip-flopping near 90 deg. Below `zero_speed_mps` the
-/// heading is undefined: the wheel keeps `last_target` and stops.
+/// lagging wheel from flip-flopping near 90 deg. Below `steer_speed_mps` the
+/// command's direction is noise, not intent: the wheel keeps `last_target`
+/// and rolls the command's component along it (IPA keeps the heading for an
+/// exactly zero command only; then the component is zero too). Re-aiming on
+/// noise would swing a wheel by up to 90 deg at full steering rate, and a
+/// wheel left across the line when it starts pushes the robot sideways.
 WheelSetpoint ToWheelSetpoint(const Eigen::Vector2d& velocity_mps, double radius_m,
-                              double angle_now_rad, double last_target_rad, double zero_speed_mps);
+                              double angle_now_rad, double last_target_rad, double steer_speed_mps);
 
 }  // namespace linesim::control

@@ -119,7 +119,7 @@ TEST(WheelControllerUnit, VariableTable) {
       {"wheel_y", C::kParameter, "m", 4, {}},
       {"wheel_radius", C::kParameter, "m", 0, {}},
       {"compensation", C::kParameter, "", 0, {}},
-      {"zero_speed_threshold", C::kParameter, "m/s", 0, {}},
+      {"steer_speed_threshold", C::kParameter, "m/s", 0, {}},
       {"steer_kp", C::kParameter, "V/rad", 0, {}},
       {"steer_kd", C::kParameter, "V.s/rad", 0, {}},
       {"steer_feedforward", C::kParameter, "V.s/rad", 0, {}},

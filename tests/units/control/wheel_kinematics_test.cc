@@ -103,18 +103,31 @@ TEST(ToWheelSetpoint, NeverMoreThanNinetyDegreesAndReproducesTheVelocity) {
   }
 }
 
-// Guards against a wheel pointing somewhere random when the command is
-// (nearly) zero and atan2 is meaningless: it keeps its last target, stops.
-TEST(ToWheelSetpoint, ZeroCommandHoldsTheLastTargetAngle) {
+// Guards against a wheel re-aiming on noise: below the threshold the
+// command's direction means nothing (atan2 of noise), so the wheel keeps its
+// last target and rolls the command's component along it; zero stops it.
+TEST(ToWheelSetpoint, SlowCommandKeepsTheLastTargetAndRollsItsComponent) {
   const double last = Deg(30);
-  for (const Eigen::Vector2d& v : {Eigen::Vector2d(0, 0), Eigen::Vector2d(-5e-4, 5e-4)}) {
-    const WheelSetpoint s = ToWheelSetpoint(v, kRadiusM, Deg(28), last, 1e-3);
-    EXPECT_EQ(s.steer_angle_rad, last);
-    EXPECT_EQ(s.drive_rate_rad_s, 0.0);
-  }
-  // Just above the threshold the heading follows the command again.
-  const WheelSetpoint s = ToWheelSetpoint({0.0, 2e-3}, kRadiusM, 0.0, 0.0, 1e-3);
-  EXPECT_NEAR(s.steer_angle_rad, Deg(90), 1e-15);
+  const WheelSetpoint zero = ToWheelSetpoint({0.0, 0.0}, kRadiusM, Deg(28), last, 1e-2);
+  EXPECT_EQ(zero.steer_angle_rad, last);
+  EXPECT_EQ(zero.drive_rate_rad_s, 0.0);
+  // 5 mm/s at 120 deg, 90 deg off the heading: nothing to roll.
+  const Eigen::Vector2d across(5e-3 * std::cos(Deg(120)), 5e-3 * std::sin(Deg(120)));
+  const WheelSetpoint s = ToWheelSetpoint(across, kRadiusM, Deg(28), last, 1e-2);
+  EXPECT_EQ(s.steer_angle_rad, last);
+  EXPECT_NEAR(s.drive_rate_rad_s, 0.0, 1e-15);
+  // 8 mm/s at 90 deg: rolls 8 cos(60 deg) = 4 mm/s along 30 deg.
+  const WheelSetpoint half = ToWheelSetpoint({0.0, 8e-3}, kRadiusM, Deg(28), last, 1e-2);
+  EXPECT_EQ(half.steer_angle_rad, last);
+  EXPECT_NEAR(half.drive_rate_rad_s * kRadiusM, 4e-3, 1e-15);
+  // Behind the heading it rolls backward, still without turning.
+  const WheelSetpoint back = ToWheelSetpoint({-6e-3, 0.0}, kRadiusM, Deg(28), last, 1e-2);
+  EXPECT_EQ(back.steer_angle_rad, last);
+  EXPECT_NEAR(back.drive_rate_rad_s * kRadiusM, -6e-3 * std::cos(last), 1e-15);
+  // At the threshold the heading follows the command again.
+  const WheelSetpoint aimed = ToWheelSetpoint({0.0, 1e-2}, kRadiusM, 0.0, 0.0, 1e-2);
+  EXPECT_NEAR(aimed.steer_angle_rad, Deg(90), 1e-15);
+  EXPECT_NEAR(aimed.drive_rate_rad_s * kRadiusM, 1e-2, 1e-15);
 }
 
 // Guards against flip-flop near 90 deg. Cost 0.6 |a - now| + 0.4 |a - last|:
