@@ -11,7 +11,9 @@ constexpr double kNoLimit = std::numeric_limits<double>::infinity();
 }
 
 SafetyFieldUnit::SafetyFieldUnit(std::string name, int beam_count, std::vector<FieldSet> field_sets)
-    : cosim::Unit(kTypeName, std::move(name)), beam_count_(beam_count), sets_(std::move(field_sets)) {
+    : cosim::Unit(kTypeName, std::move(name)),
+      beam_count_(beam_count),
+      sets_(std::move(field_sets)) {
   if (beam_count_ < 1) throw cosim::UnitError(Where() + ": needs at least one beam");
   if (sets_.empty()) throw cosim::UnitError(Where() + ": needs at least one field set");
   for (std::size_t i = 0; i < sets_.size(); ++i) {
@@ -29,8 +31,8 @@ SafetyFieldUnit::SafetyFieldUnit(std::string name, int beam_count, std::vector<F
   auto& v = variables();
   v.Parameter("first_beam_angle", "rad", &first_beam_angle_,
               "angle of beam 0 in the scanner frame (S300: -135 deg, 8010948)", Rule::Finite());
-  v.Parameter("angular_step", "rad", &angular_step_,
-              "angle between beams (S300: 0.5 deg, 8010948)", Rule::Positive());
+  v.Parameter("angular_step", "rad", &angular_step_, "angle between beams (S300: 0.5 deg, 8010948)",
+              Rule::Positive());
   v.Parameter("no_return_value", "m", &no_return_value_,
               "what a beam without echo reads (never in a field)", Rule::Finite());
   v.Parameter("multiple_sampling", &multiple_sampling_,
@@ -51,8 +53,7 @@ SafetyFieldUnit::SafetyFieldUnit(std::string name, int beam_count, std::vector<F
               "application choice)",
               Rule::NonNegative());
   v.Parameter("resume_acceleration", "m/s2", &resume_acceleration_,
-              "how fast the speed cap rises on resuming (ASSUMPTION: 0.5 m/s^2)",
-              Rule::Positive());
+              "how fast the speed cap rises on resuming (ASSUMPTION: 0.5 m/s^2)", Rule::Positive());
   v.Input("ranges", "m", &ranges_, "the scanner's reported ranges");
   v.Input("scan_count", "1", &scan_count_, "the scanner's completed scans (a new scan: evaluate)");
   v.Input("velocity_command", "m/s", &velocity_command_, "the follower's [vx, vy] (base_link)");
@@ -67,7 +68,9 @@ SafetyFieldUnit::SafetyFieldUnit(std::string name, int beam_count, std::vector<F
   v.Output("warning_clear", "1", &warning_clear_, "1: warning field clear, 0: infringed", {});
   v.Output("field_set", "1", &field_set_, "index of the active field set", {});
   v.Output("speed_cap", "m/s", &speed_cap_out_, "the safety function's speed cap (-1: none)", {});
-  v.Output("protective_stops", "1", &protective_stops_, "protective field infringements so far",
+  v.Output("protective_stops", "1", &protective_stops_,
+           "safe stops the protective field caused so far (an infringement during a stop, before "
+           "its restart delay has run out, extends that stop)",
            {});
   v.Output("time_stopped", "s", &time_stopped_, "time the cap has held the robot at 0", {});
   v.Output("task_time", "s", &task_time_, "when task_done first rose (-1: not yet)", {});
@@ -116,7 +119,10 @@ void SafetyFieldUnit::EvaluateScan() {
   const bool was_clear = protective_clear_ == 1.0;
   protective_clear_ = protective_scans_ >= multiple_sampling_ ? 0.0 : 1.0;
   warning_clear_ = warning_scans_ >= multiple_sampling_ ? 0.0 : 1.0;
-  if (was_clear && protective_clear_ == 0.0) protective_stops_ += 1.0;
+  // A new stop, unless the last one still holds (target_ 0 until its
+  // restart delay has run out): legs walking out of a field break it again
+  // and again while the robot stands.
+  if (was_clear && protective_clear_ == 0.0 && target_ != 0.0) protective_stops_ += 1.0;
 }
 
 void SafetyFieldUnit::Initialize() {

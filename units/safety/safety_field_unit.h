@@ -31,7 +31,9 @@ namespace linesim::safety {
 ///
 /// Safety function, on the speed cap c (m/s; infinite: no limit):
 ///   protective infringed -> c falls to 0 at braking_deceleration (a safe
-///     stop from the speed last commanded; protective_stops counts them);
+///     stop from the speed last commanded; protective_stops counts them,
+///     an infringement before the last stop's restart delay has run out
+///     extends that stop);
 ///   warning infringed    -> c falls to warning_speed at braking_deceleration;
 ///   both clear for restart_delay -> c rises at resume_acceleration, and is
 ///     lifted once it reaches the command.
@@ -54,7 +56,10 @@ class SafetyFieldUnit : public cosim::Unit {
   SafetyFieldUnit(std::string name, int beam_count, std::vector<FieldSet> field_sets);
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
-  void Setup(cosim::TimeNs start, cosim::TimeNs stop) override { (void)stop; start_ = start; }
+  void Setup(cosim::TimeNs start, cosim::TimeNs stop) override {
+    (void)stop;
+    start_ = start;
+  }
   void Initialize() override;
   void UpdateOutputs() override;
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
@@ -93,10 +98,10 @@ class SafetyFieldUnit : public cosim::Unit {
   // State.
   double last_scan_count_ = 0.0;
   std::int64_t protective_scans_ = 0, warning_scans_ = 0;  // consecutive infringing
-  double cap_ = 0.0;           // +inf: no limit
-  double target_ = 0.0;        // the cap held since the last infringement (+inf: none)
+  double cap_ = 0.0;                                       // +inf: no limit
+  double target_ = 0.0;          // the cap held since the last infringement (+inf: none)
   cosim::TimeNs clear_for_ = 0;  // time both fields have been clear
-  double last_speed_ = 0.0;    // |velocity_out| last commanded
+  double last_speed_ = 0.0;      // |velocity_out| last commanded
 };
 
 }  // namespace linesim::safety

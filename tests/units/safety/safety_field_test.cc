@@ -1,14 +1,13 @@
 // The S300's field evaluation and the safety function against their
 // definitions (SICK 8010948) and the closed form of a constant-deceleration
 // stop.
-#include "units/safety/safety_field_unit.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 
 #include "../test_helpers.h"
+#include "units/safety/safety_field_unit.h"
 
 namespace linesim::safety {
 namespace {
@@ -111,6 +110,29 @@ TEST(SafetyField, ResumesAfterTheRestartDelay) {
   EXPECT_NEAR(Get(d.u, "time_stopped")[0], 0.02 * 103.5, 0.01 + 1e-9);
 }
 
+// Guards against counting a person's legs instead of stops: legs walking
+// out of the field break it again on alternate scans while the robot
+// stands; that extends the stop (its restart delay starts again), it is
+// not another one. After the delay has run out, a new infringement is.
+TEST(SafetyField, AnInfringementDuringAStopExtendsIt) {
+  Driven d(0.3);
+  const auto inside = Leg(0.5), clear = Leg(3.0);
+  for (int k = 0; k < 20; ++k) d.Step(k % 2 == 0 ? &inside : nullptr);
+  ASSERT_EQ(Get(d.u, "velocity_command_out")[0], 0.0);
+  for (int k = 0; k < 10; ++k) {  // clear, broken, clear, ...: 2 scans each
+    const auto& ranges = (k / 2) % 2 == 0 ? clear : inside;
+    d.Step(&ranges);
+    d.Step(nullptr);
+  }
+  EXPECT_EQ(Get(d.u, "protective_stops")[0], 1.0);
+  EXPECT_EQ(Get(d.u, "velocity_command_out")[0], 0.0);
+  for (int k = 0; k < 150; ++k) d.Step(k % 2 == 0 ? &clear : nullptr);  // 3 s > 2 s delay
+  ASSERT_GT(Get(d.u, "velocity_command_out")[0], 0.0);
+  d.Step(&inside);
+  d.Step(&inside);
+  EXPECT_EQ(Get(d.u, "protective_stops")[0], 2.0);
+}
+
 // Guards against the warning field stopping the robot or not acting: a leg
 // 1.0 m ahead (outside the protective field, inside the warning field)
 // brings 0.5 m/s down to warning_speed (0.3 m/s) at 1 m/s^2; a leg 1.5 m
@@ -139,8 +161,10 @@ TEST(SafetyField, WarningFieldSlowsOutsideNothing) {
 // monitoring cases by the vehicle's speed): below 0.2 m/s a 0.3 m deep
 // protective field, above it 0.6 m; a leg at 0.45 m trips only the fast one.
 TEST(SafetyField, FieldSetSwitchesWithSpeed) {
-  const SafetyFieldUnit::FieldSet slow{0.2, {{0.05, -0.4}, {0.3, -0.4}, {0.3, 0.4}, {0.05, 0.4}}, {}};
-  const SafetyFieldUnit::FieldSet fast{1e9, {{0.05, -0.4}, {0.6, -0.4}, {0.6, 0.4}, {0.05, 0.4}}, {}};
+  const SafetyFieldUnit::FieldSet slow{
+      0.2, {{0.05, -0.4}, {0.3, -0.4}, {0.3, 0.4}, {0.05, 0.4}}, {}};
+  const SafetyFieldUnit::FieldSet fast{
+      1e9, {{0.05, -0.4}, {0.6, -0.4}, {0.6, 0.4}, {0.05, 0.4}}, {}};
   const auto leg = Leg(0.45);
   for (const double speed : {0.1, 0.5}) {
     SafetyFieldUnit u("safety", 541, {slow, fast});
