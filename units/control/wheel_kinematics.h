@@ -43,6 +43,9 @@ struct WheelSetpoint {
 /// exactly zero command only; then the component is zero too). Re-aiming on
 /// noise would swing a wheel by up to 90 deg at full steering rate, and a
 /// wheel left across the line when it starts pushes the robot sideways.
+/// The price: a position loop of gain k (velocity k e) leaves an error
+/// across the wheels' heading until k e reaches the threshold (1 cm at the
+/// path follower's k_position 1/s and the controller's 1 cm/s).
 WheelSetpoint ToWheelSetpoint(const Eigen::Vector2d& velocity_mps, double radius_m,
                               double angle_now_rad, double last_target_rad, double steer_speed_mps);
 
