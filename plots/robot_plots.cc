@@ -155,6 +155,48 @@ void AppendBlock(std::string& script, const std::string& name, const std::string
   script += "$" + name + " << EOD\n" + data + "EOD\n";
 }
 
+/// The columns of signals.csv the time plots (and the track) draw, copied
+/// as text into the script's $signals block in the pass that reads the file
+/// anyway: gnuplot reads them there instead of parsing every row of
+/// signals.csv once per curve (in a fleet some 60 columns per robot).
+/// Block columns in order of first use; time is always the first.
+class DataColumns {
+ public:
+  DataColumns() { Use(1); }
+  /// Adds CSV column `csv` (1-based; 0: none, ignored).
+  void Use(int csv) {
+    if (csv <= 0 || Has(csv)) return;
+    if (static_cast<std::size_t>(csv) >= block_of_.size()) block_of_.resize(csv + 1, 0);
+    csv_.push_back(csv);
+    block_of_[static_cast<std::size_t>(csv)] = static_cast<int>(csv_.size());
+  }
+  /// The block column (1-based, as gnuplot counts) of CSV column `csv`.
+  int operator[](int csv) const {
+    if (!Has(csv))
+      throw std::logic_error("robot plots: column " + std::to_string(csv) + " not in $signals");
+    return block_of_[static_cast<std::size_t>(csv)];
+  }
+  std::size_t last_csv() const { return block_of_.size() - 1; }
+  /// One row of the block from the fields of a row of signals.csv (as
+  /// text: gnuplot reads the same characters it would have read there).
+  void AppendRow(const std::vector<std::string_view>& fields, std::string& block) const {
+    for (std::size_t k = 0; k < csv_.size(); ++k) {
+      if (k) block += ',';
+      const auto i = static_cast<std::size_t>(csv_[k] - 1);
+      if (i < fields.size()) block += fields[i];
+    }
+    block += '\n';
+  }
+
+ private:
+  bool Has(int csv) const {
+    return csv > 0 && static_cast<std::size_t>(csv) < block_of_.size() &&
+           block_of_[static_cast<std::size_t>(csv)] > 0;
+  }
+  std::vector<int> csv_;       // block column k + 1 holds CSV column csv_[k]
+  std::vector<int> block_of_;  // CSV column -> block column (0: not in it)
+};
+
 // Solids of the scene as gnuplot data: boxes as closed polygons, cylinders
 // as "x,y,radius" rows for `with circles`.
 struct SolidLayer {
@@ -372,8 +414,7 @@ std::string SideView(const RobotPlotSpec& spec, Signals& signals,
          "plot $side using 1:3 with filledcurves y1=0 lc rgb '#c8c8c8' title "
          "'ground under the track (floor, ramp, van floor)', \\\n"
          "     $side using 1:2 with lines lw 2 lc rgb '#d62728' title " +
-         GnuplotQuote("robot base_link height (" + spec.z_column + ")") +
-         "\n";
+         GnuplotQuote("robot base_link height (" + spec.z_column + ")") + "\n";
 }
 
 std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std::string>* outputs) {
@@ -431,6 +472,11 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
                         ? column(safety.distance_column, "person distance")
                         : 0;
   column.ThrowIfUnknown();
+  DataColumns data;
+  for (const int c : {ix, iy, ierr, iref, ivx, ivy, icap, iprot, iwarn, idist}) data.Use(c);
+  for (const auto* list : {&speeds, &ons, &flows, &flow_truths, &filtered}) {
+    for (const int c : *list) data.Use(c);
+  }
   if (!travels.empty() && travels.size() != spec.scene.belts.size()) {
     throw std::runtime_error("robot plots: " + std::to_string(travels.size()) +
                              " belt travel columns for " + std::to_string(spec.scene.belts.size()) +
@@ -439,7 +485,8 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
 
   std::string s =
       "# Written by linesim (plots/robot_plots.cc). Run `gnuplot plots.gp` in this folder\n"
-      "# to redraw; data come from signals.csv (columns by number, header skipped).\n" +
+      "# to redraw; the data are in its blocks, copied from signals.csv ($signals: the\n"
+      "# columns the time plots draw, time first).\n" +
       GnuplotTerminal(spec.format, kCanvasWidthPx, kCanvasHeightPx) +
       "set datafile separator comma\n"
       "set grid\n";
@@ -476,6 +523,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   // for each: in a fleet of N, N - 1 more passes over a row of some 60 N
   // columns, for each of the N robots' top views.
   std::vector<std::vector<Point>> other_tracks(others.size()), worker_tracks(workers.size());
+  std::string data_block;
   {
     std::vector<std::string_view> fields;
     std::string line;
@@ -483,13 +531,14 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     for (int col : travels) last_column = std::max(last_column, col);
     for (const auto& o : others) last_column = std::max({last_column, o.x, o.y});
     for (const auto& [wx, wy] : workers) last_column = std::max({last_column, wx, wy});
-    const auto needed = static_cast<std::size_t>(last_column);
+    const auto needed = std::max(static_cast<std::size_t>(last_column), data.last_csv());
     while (true) {
       const std::streamoff start = signals.in.tellg();
       if (!std::getline(signals.in, line)) break;
       if (line.empty() || line == "\r") continue;
       row_starts.push_back(start);
       SplitCsv(line, fields, needed);
+      data.AppendRow(fields, data_block);
       const auto x = Column(fields, ix), y = Column(fields, iy);
       if (x && y) view.Add(*x, *y);
       for (std::size_t k = 0; k < others.size(); ++k) {
@@ -656,14 +705,17 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   if (!worker_track_block.empty()) AppendBlock(s, "worker_tracks", worker_track_block);
   if (!contacts.empty()) AppendBlock(s, "contacts", contacts);
   if (!labels.empty()) AppendBlock(s, "labels", labels);
+  AppendBlock(s, "signals", data_block);
+  data_block = std::string();  // the script holds it now
 
   const std::string title_prefix = spec.title.empty() ? "" : spec.title + ": ";
-  const std::string signals_file = GnuplotQuote(kSignals);
+  // A curve's data: `using 1:` + expression, columns by their CSV number
+  // through data[].
+  const std::string signals_data = "$signals";
 
   // Top view of the robot's neighbourhood (path, track, outlines), not of
   // the whole line: belts are clipped to it.
-  s += "\n" + SetOutput(spec.file_prefix + "top_view", spec.format, outputs) +
-       "set title " +
+  s += "\n" + SetOutput(spec.file_prefix + "top_view", spec.format, outputs) + "set title " +
        GnuplotQuote(title_prefix + "top view (map frame)") +
        "\n"
        "set xlabel 'x (m)'\nset ylabel 'y (m)'\n"
@@ -730,12 +782,13 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   } else if (!path.empty()) {
     items.push_back("$path using 1:2 with lines dt 2 lw 1.5 lc rgb 'black' title 'desired path'");
   }
-  items.push_back(signals_file + " skip 1 using " + std::to_string(ix) + ":" + std::to_string(iy) +
+  items.push_back(signals_data + " using " + std::to_string(data[ix]) + ":" +
+                  std::to_string(data[iy]) +
                   " with lines lw 2 lc rgb '#d62728' title 'actual path'");
   if (!outlines.empty()) {
-    items.push_back("$outlines using 1:2 with lines lw 1 lc rgb '#1f77b4' title " +
-                    GnuplotQuote(spec.others.empty() ? "robot outline"
-                                                     : spec.robot_name + " outline"));
+    items.push_back(
+        "$outlines using 1:2 with lines lw 1 lc rgb '#1f77b4' title " +
+        GnuplotQuote(spec.others.empty() ? "robot outline" : spec.robot_name + " outline"));
   }
   if (!other_track_block.empty()) {
     items.push_back(
@@ -765,17 +818,18 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
   // time from the first row to the last.
   const std::string time_plot =
       "set xlabel 'time (s)'\nunset y2label\nunset y2tics\nset ytics mirror\n"
-      "set autoscale\nset offsets 0, 0, 0, 0\n" + std::string(kTimeKey);
+      "set autoscale\nset offsets 0, 0, 0, 0\n" +
+      std::string(kTimeKey);
   // Where any belt is scheduled on, as a column expression (1 on, 0 off).
   std::string any_on;
   for (std::size_t i = 0; i < ons.size(); ++i) {
-    any_on += (i ? " || " : "") + std::string("column(") + std::to_string(ons[i]) + ") > 0.5";
+    any_on += (i ? " || " : "") + std::string("column(") + std::to_string(data[ons[i]]) + ") > 0.5";
   }
   // The line's on state as grey bands behind the data (paper 1 Figs. 5-7
   // mark the line's state): filled from 0 to 1 on the second y axis.
   const auto on_shading = [&]() -> std::string {
     if (any_on.empty()) return {};
-    return signals_file + " skip 1 using 1:((" + any_on +
+    return signals_data + " using 1:((" + any_on +
            ") ? 1 : 0) axes x1y2 with filledcurves y=0 fillcolor rgb '#e4e4e4' "
            "fillstyle solid 1.0 noborder title 'line on'";
   };
@@ -789,7 +843,7 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
          "set ylabel " + GnuplotQuote(spec.error_label) + "\nset yrange [0:*]\n";
     items.clear();
     if (const std::string shading = on_shading(); !shading.empty()) items.push_back(shading);
-    items.push_back(signals_file + " skip 1 using 1:" + std::to_string(ierr) +
+    items.push_back(signals_data + " using 1:" + std::to_string(data[ierr]) +
                     " with lines lw 2 lc rgb '#1f77b4' title " +
                     GnuplotQuote(spec.error_name.empty() ? spec.error_label : spec.error_name));
     if (spec.error_bound_m > 0.0) {
@@ -815,12 +869,12 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
          "set y2range [-0.05:1.05]\nset y2tics 0, 1, 1\nset ytics nomirror\nplot ";
     items.clear();
     for (std::size_t i = 0; i < speeds.size(); ++i) {
-      items.push_back(signals_file + " skip 1 using 1:" + std::to_string(speeds[i]) +
+      items.push_back(signals_data + " using 1:" + std::to_string(data[speeds[i]]) +
                       " with lines lw 2 title " +
                       GnuplotQuote("speed of belt " + std::to_string(i)));
     }
     for (std::size_t i = 0; i < ons.size(); ++i) {
-      items.push_back(signals_file + " skip 1 using 1:" + std::to_string(ons[i]) +
+      items.push_back(signals_data + " using 1:" + std::to_string(data[ons[i]]) +
                       " axes x1y2 with steps dt 2 lw 1.5 title " +
                       GnuplotQuote("belt " + std::to_string(i) + " scheduled on"));
     }
@@ -843,7 +897,8 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
                             "the same from ground truth"
                           : "raw: what each PX4Flow reads (the surface relative to it), dashed: "
                             "the same from ground truth; filtered: the surface speed (Eq. 2)") +
-         "\n" + time_plot + shading_axes + "set ylabel 'speed along the belt (m/s)'\n"
+         "\n" + time_plot + shading_axes +
+         "set ylabel 'speed along the belt (m/s)'\n"
          "set offsets 0, 0, graph 0.05, graph 0.05\nset key maxcols 3\nplot ";
     items.clear();
     if (const std::string shading = on_shading(); !shading.empty()) items.push_back(shading);
@@ -852,14 +907,14 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     static const char* kColours[] = {"#9ecae1", "#fdbf6f", "#a1d99b", "#cbc9e2"};
     for (std::size_t i = 0; i < flows.size(); ++i) {
       const std::string label = i < spec.flow_labels.size() ? spec.flow_labels[i] : "sensor";
-      items.push_back(signals_file + " skip 1 using 1:" + std::to_string(flows[i]) +
+      items.push_back(signals_data + " using 1:" + std::to_string(data[flows[i]]) +
                       " with lines lw 1 lc rgb '" + kColours[i % 4] + "' title " +
                       GnuplotQuote("raw, " + label));
     }
     static const char* kMid[] = {"#3182bd", "#e6550d", "#31a354", "#756bb1"};
     for (std::size_t i = 0; i < flow_truths.size(); ++i) {
       const std::string label = i < spec.flow_labels.size() ? spec.flow_labels[i] : "sensor";
-      items.push_back(signals_file + " skip 1 using 1:" + std::to_string(flow_truths[i]) +
+      items.push_back(signals_data + " using 1:" + std::to_string(data[flow_truths[i]]) +
                       " with lines lw 1 dt 2 lc rgb '" + kMid[i % 4] + "' title " +
                       GnuplotQuote("true reading, " + label));
     }
@@ -867,11 +922,11 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     static const char* kDark[] = {"#08519c", "#d95f02", "#238b45", "#6a51a3"};
     for (std::size_t i = 0; i < filtered.size(); ++i) {
       const std::string label = i < spec.flow_labels.size() ? spec.flow_labels[i] : "sensor";
-      items.push_back(signals_file + " skip 1 using 1:" + std::to_string(filtered[i]) +
+      items.push_back(signals_data + " using 1:" + std::to_string(data[filtered[i]]) +
                       " with lines lw 2 lc rgb '" + kDark[i % 4] + "' title " +
                       GnuplotQuote("filtered, " + label));
     }
-    items.push_back(signals_file + " skip 1 using 1:" + std::to_string(iref) +
+    items.push_back(signals_data + " using 1:" + std::to_string(data[iref]) +
                     " with lines lw 2.5 lc rgb 'black' title 'ground truth (encoder wheel)'");
     for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];
     s += "\nset y2range [*:*]\nset grid back\nset bmargin -1\n";
@@ -884,27 +939,28 @@ std::string Script(const RobotPlotSpec& spec, Signals& signals, std::vector<std:
     // Speeds and the distance on the left axis; the fields' states as steps
     // on the right (1 clear, 0 infringed), offset so that both show.
     s += "\n" + SetOutput(spec.file_prefix + "safety", spec.format, outputs) + "set title " +
-         GnuplotQuote(title_prefix + "S300 safety fields: speed, speed cap, distance to the person") +
+         GnuplotQuote(title_prefix +
+                      "S300 safety fields: speed, speed cap, distance to the person") +
          "\n" + time_plot +
          "set ylabel 'speed (m/s), distance (m)'\nset yrange [0:*]\n"
          "set y2label 'field clear (1) / infringed (0)'\nset y2range [-0.1:1.3]\n"
          "set y2tics 0, 1, 1\nset ytics nomirror\nset offsets 0, 0, graph 0.05, 0\nplot ";
     items.clear();
-    items.push_back(signals_file + " skip 1 using 1:(sqrt(column(" + std::to_string(ivx) +
-                    ")**2 + column(" + std::to_string(ivy) +
+    items.push_back(signals_data + " using 1:(sqrt(column(" + std::to_string(data[ivx]) +
+                    ")**2 + column(" + std::to_string(data[ivy]) +
                     ")**2)) with lines lw 2 lc rgb '#1f77b4' title 'robot speed'");
-    items.push_back(signals_file + " skip 1 using 1:(column(" + std::to_string(icap) +
-                    ") < 0 ? NaN : column(" + std::to_string(icap) +
+    items.push_back(signals_data + " using 1:(column(" + std::to_string(data[icap]) +
+                    ") < 0 ? NaN : column(" + std::to_string(data[icap]) +
                     ")) with lines dt 2 lw 2 lc rgb '#ff7f0e' title 'speed cap'");
     if (idist > 0) {
-      items.push_back(signals_file + " skip 1 using 1:(column(" + std::to_string(idist) +
-                      ") > 1.5 ? NaN : column(" + std::to_string(idist) +
+      items.push_back(signals_data + " using 1:(column(" + std::to_string(data[idist]) +
+                      ") > 1.5 ? NaN : column(" + std::to_string(data[idist]) +
                       ")) with lines lw 1.5 lc rgb '#9467bd' "
                       "title 'distance to the person (below 1.5 m)'");
     }
-    items.push_back(signals_file + " skip 1 using 1:" + std::to_string(iprot) +
+    items.push_back(signals_data + " using 1:" + std::to_string(data[iprot]) +
                     " axes x1y2 with steps lw 2 lc rgb '#d62728' title 'protective field clear'");
-    items.push_back(signals_file + " skip 1 using 1:(column(" + std::to_string(iwarn) +
+    items.push_back(signals_data + " using 1:(column(" + std::to_string(data[iwarn]) +
                     ") * 1.1) axes x1y2 with steps lw 1.5 dt 3 lc rgb '#2ca02c' "
                     "title 'warning field clear (x 1.1)'");
     for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \\\n     " : "") + items[i];

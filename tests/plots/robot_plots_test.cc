@@ -97,7 +97,7 @@ class RobotPlotsTest : public ::testing::Test {
 
 // Guards against a run that silently produces no plots, broken files, or a
 // script the user cannot re-run: all three PNGs are real PNG files, and
-// plots.gp refers to signals.csv by a relative name.
+// plots.gp holds its data (no file name in it: it redraws anywhere).
 TEST_F(RobotPlotsTest, WritesTheThreePngsAndTheScript) {
   WriteSignals();
   const auto files = WriteRobotPlots(dir_.string(), Spec());
@@ -107,7 +107,17 @@ TEST_F(RobotPlotsTest, WritesTheThreePngsAndTheScript) {
   EXPECT_EQ(fs::path(files[2]).filename(), "belt.png");
   for (const auto& f : files) EXPECT_TRUE(IsPng(f)) << f;
   const std::string script = ReadAll(dir_ / "plots.gp");
-  EXPECT_NE(script.find("'signals.csv'"), std::string::npos);
+  EXPECT_EQ(script.find("'signals.csv'"), std::string::npos);
+  // The time plots' columns, copied from each of the 3001 rows as the text
+  // signals.csv holds: time, x, y, the deviation, the belt's speed and state.
+  const std::string block = "$signals << EOD\n";
+  const auto data = script.find(block);
+  ASSERT_NE(data, std::string::npos);
+  const auto data_end = script.find("EOD\n", data + block.size());
+  const std::string rows = script.substr(data + block.size(), data_end - data - block.size());
+  EXPECT_EQ(std::count(rows.begin(), rows.end(), '\n'), 3001);
+  EXPECT_EQ(rows.substr(0, rows.find('\n')), "0,0,-1.5,0,0,1");
+  EXPECT_NE(script.find("$signals using 2:3 with lines"), std::string::npos);
   EXPECT_NE(script.find("set size ratio -1"), std::string::npos);
   // 5 outlines of the robot by default, each a closed 5-point polygon plus a
   // 2-point heading tick; 4 wheel contacts at each of those instants.
@@ -172,16 +182,16 @@ TEST_F(RobotPlotsTest, SafetyPlotDrawsSpeedCapAndFields) {
       const double t = 0.1 * k;
       const bool stopped = t >= 2.0 && t < 4.0;
       out << t << ",0," << 0.3 * t << ",0," << (stopped ? 0.0 : 0.3) << ","
-          << (stopped ? 0.0 : -1.0) << "," << (stopped ? 0 : 1) << "," << (t >= 1.5 ? 0 : 1)
-          << "," << 1.0 - 0.1 * t << "," << -2.0 + 0.3 * t << ",1\n";
+          << (stopped ? 0.0 : -1.0) << "," << (stopped ? 0 : 1) << "," << (t >= 1.5 ? 0 : 1) << ","
+          << 1.0 - 0.1 * t << "," << -2.0 + 0.3 * t << ",1\n";
     }
   }
   RobotPlotSpec spec;
   spec.x_column = "chassis.position[0]";
   spec.y_column = "chassis.position[1]";
-  spec.safety = {"chassis.linear_velocity[0]", "chassis.linear_velocity[1]", "safety.speed_cap",
-                 "safety.protective_clear",    "safety.warning_clear",
-                 "person_clearance.distance"};
+  spec.safety = {"chassis.linear_velocity[0]", "chassis.linear_velocity[1]",
+                 "safety.speed_cap",           "safety.protective_clear",
+                 "safety.warning_clear",       "person_clearance.distance"};
   spec.worker_columns = {{"worker.pose[0]", "worker.pose[1]"}};
   const auto files = WriteRobotPlots(dir_.string(), spec);
   ASSERT_EQ(files.size(), 2u);
@@ -395,9 +405,9 @@ TEST_F(RobotPlotsTest, ErrorPlotDrawsTheBoundTheLineStateAndTheUsersNames) {
   EXPECT_EQ(error.find("title 'metrics.deviation'"), std::string::npos) << error;
   EXPECT_NE(error.find("0.04 with lines"), std::string::npos) << error;
   EXPECT_NE(error.find("title '4 cm (paper 1, Sec. VI-B)'"), std::string::npos) << error;
-  // belt.on[0] is column 15 (time, 3 pose, 8 contacts, deviation, speed,
-  // on).
-  EXPECT_NE(error.find("using 1:((column(15) > 0.5) ? 1 : 0) axes x1y2 with filledcurves"),
+  // belt.on[0] (column 15 of signals.csv) is column 6 of $signals (time, x,
+  // y, deviation, speed, on).
+  EXPECT_NE(error.find("$signals using 1:((column(6) > 0.5) ? 1 : 0) axes x1y2 with filledcurves"),
             std::string::npos)
       << error;
   EXPECT_NE(error.find("title 'line on'"), std::string::npos) << error;
