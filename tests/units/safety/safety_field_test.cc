@@ -1,13 +1,14 @@
 // The S300's field evaluation and the safety function against their
 // definitions (SICK 8010948) and the closed form of a constant-deceleration
 // stop.
+#include "units/safety/safety_field_unit.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 
 #include "../test_helpers.h"
-#include "units/safety/safety_field_unit.h"
 
 namespace linesim::safety {
 namespace {
