@@ -30,7 +30,7 @@ const std::vector<std::string> kOwnSensors = {"sensing.surface_velocity=fused_fl
 // corner PX4Flow see the belt before the wheels reach it, with the encoders
 // of the wheels still on the floor as the robot's motion (the flow
 // measurement's H = I): the estimate is ready when the wheels arrive.
-// max_path_deviation_m with the IMU fused, 20 runs (--runs 20): 4.7 / 5.8 /
+// max_path_deviation_m with the IMU fused, 20 runs (--runs 20): 5.2 / 5.8 /
 // 6.5 mm; seeds 1..8: 4.7 / 5.4 / 5.8 mm (without the IMU: 20 runs 5.6 /
 // 7.9 / 18.0 mm); final_progress_m above 3.9 at every seed.
 TEST(SurfaceFusionScenarios, CrossLineStaysWithin4cm) {
@@ -44,10 +44,10 @@ TEST(SurfaceFusionScenarios, CrossLineStaysWithin4cm) {
 // final deviation (the line steady again for 9 s at the end of the run).
 // With the IMU fused and the wheel controller's steering threshold (no
 // wheel re-aimed on noise-level commands, left across the belt when it
-// starts), 20 runs (--runs 20): peak 11.5 / 12.1 / 22.4 mm, final 0.3 /
-// 0.9 / 1.6 mm; 40 more (--set seed=2, 3): peak at most 21.2 mm, final at
-// most 2.2 mm; seeds 1..8: peak 11.1 / 13.0 / 20.6 mm, final 0.3 / 0.8 /
-// 1.5 mm. (Before the threshold one run of 20 peaked at 62 mm; without the
+// starts), 20 runs (--runs 20): peak 11.5 / 12.2 / 22.4 mm, final 0.0 /
+// 1.1 / 1.8 mm; 40 more (--set seed=2, 3): peak at most 21.2 mm, final at
+// most 2.0 mm; seeds 1..8: peak 11.1 / 13.0 / 20.6 mm, final 0.3 / 1.1 /
+// 1.7 mm. (Before the threshold one run of 20 peaked at 62 mm; without the
 // IMU, 8 of 20 over 4 cm.)
 TEST(SurfaceFusionScenarios, HoldOnBeltHoldsWithin4cmAndEndsWithin1cm) {
   const auto m = RunSeeds(Shipped("hold_on_belt"), kOwnSensors, kSeeds);
@@ -56,11 +56,11 @@ TEST(SurfaceFusionScenarios, HoldOnBeltHoldsWithin4cmAndEndsWithin1cm) {
 }
 
 // Straddling the line's edge (two wheels on the belt, two on the floor:
-// the robot turns as well): the same bounds. 20 runs: peak 12.6 / 24.6 /
-// 34.0 mm, final 0.7 / 2.1 / 5.3 mm; 40 more: peak at most 37.9 mm (the
+// the robot turns as well): the same bounds. 20 runs: peak 12.5 / 22.4 /
+// 34.0 mm, final 0.6 / 2.2 / 4.3 mm; 40 more: peak at most 36.5 mm (the
 // estimate's lag behind the belt's 1 s ramp, the wheels aligned in time),
-// final at most 6.1 mm; seeds 1..8: peak 11.3 / 19.3 / 35.6 mm, final 0.9
-// / 1.7 / 3.3 mm. (Before the threshold 2 of 20 peaked over 4 cm, at 44
+// final at most 6.7 mm; seeds 1..8: peak 10.2 / 18.2 / 35.6 mm, final 0.6
+// / 1.8 / 3.2 mm. (Before the threshold 2 of 20 peaked over 4 cm, at 44
 // and 48 mm.)
 TEST(SurfaceFusionScenarios, HoldStraddleHoldsWithin4cmAndEndsWithin1cm) {
   const auto m = RunSeeds(Shipped("hold_straddle"), kOwnSensors, kSeeds);

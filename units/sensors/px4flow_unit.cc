@@ -478,11 +478,19 @@ void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, c
                             int& q, double& flow_x, double& flow_y) {
   const double blur_px = std::sqrt(fx * fx + fy * fy) * e.exposure_s * frame_rate_;
   const double br = blur_px / kBlurScalePx;
-  const double d = kNeighbourDiff * e.mean_dn * surf.texture_contrast *
-                   std::sqrt(0.5 * (1.0 + 1.0 / (1.0 + br * br)));
+  // The blur keeps the texture across the motion and smooths it along: the
+  // texture measure (compute_diff, both axes' differences) keeps
+  // sqrt((1 + along) / 2) of it, along = 1 / (1 + (blur / 1.8)^2) the
+  // along-motion part's share; the match, which must also place the block
+  // along the motion, sees the geometric mean of that and sqrt(along)
+  // (fitted to the image-level reference's mean frame flow at long
+  // exposures: tests/units/sensors/px4flow_fast_vs_image_test.cc).
+  const double along = 1.0 / (1.0 + br * br);
+  const double texture_blur = std::sqrt(0.5 * (1.0 + along));
+  const double d = kNeighbourDiff * e.mean_dn * surf.texture_contrast * texture_blur;
   const double n2 = 2.0 * e.noise_dn * e.noise_dn + 1.0 / 6.0;
   const double n = std::sqrt(n2);
-  double snr = d / std::max(e.noise_dn, 1e-9);
+  double snr = d / std::max(e.noise_dn, 1e-9) * std::sqrt(std::sqrt(along) / texture_blur);
   double snr_sub = snr;  // the half-pixel refinement's
   // A brightness step between the frames (a flickering lamp): the whole-
   // pixel match per block (kFlickerSnr, at the top); the half-pixel refinement

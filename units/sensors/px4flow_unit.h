@@ -39,7 +39,10 @@ namespace linesim::sensors {
 /// (19.15 = 24 sqrt(2/pi): the mean of 24 absolute differences of Gaussian
 /// variables; blur_px = |flow| * exposure * frame_rate) and is used when
 /// M >= feature_threshold. A used block matches the true offset with
-/// probability p = 1 / (1 + (0.18 / snr)^3), snr = D / noise_dn, plus
+/// probability p = 1 / (1 + (0.18 / snr)^3), snr = D / noise_dn * (A^(1/2) /
+/// B)^(1/2) (B = sqrt((1 + A) / 2) the blur factor in D, A = 1 / (1 +
+/// (blur_px / 1.8)^2) the along-motion part's: placing the block along the
+/// motion needs the texture the blur smooths), plus
 /// min(0.42 / snr, 1) times such a z per axis, rounded to half pixels as the
 /// sub-pixel search does; otherwise it matches noise (uniform on the
 /// half-pixel grid within +-(S - 1/2)). Beyond the window (e = |flow| -

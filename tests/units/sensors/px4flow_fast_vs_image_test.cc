@@ -103,6 +103,12 @@ Stats Fast(double contrast, double lux, double v, int frames, std::uint64_t seed
 // measured once: quality within one step in 0.889 / 0.986 / 1 of the cells
 // (36 cells; 3/4 asked); noise within 3 standard errors + 0.03 px in
 // 0.966 / 1 / 1 of the cells (27 to 30 cells; 9/10 asked).
+// The mean frame flow (what a velocity reading inherits): a cell agrees
+// when the two differ by at most 3 standard errors of the reference's mean
+// (std / sqrt(n)) plus 0.2 px (the half-pixel quantization bias a few
+// textures leave: up to 0.25 px). 36 of 36 cells with the match's blur law
+// (px4flow_unit.cc, FastFrame); 31 of 36 before it, when the fast model
+// read up to 1.14 px too fast at long exposures and 0.5 m/s (9/10 asked).
 TEST(Px4FlowFastVsImage, QualityAndNoiseAgreeOverTheGrid) {
   const double contrasts[] = {0.02, 0.05, 0.1, 0.3};
   const double luxes[] = {20.0, 200.0, 1000.0};
@@ -111,9 +117,9 @@ TEST(Px4FlowFastVsImage, QualityAndNoiseAgreeOverTheGrid) {
   // Sets of seeds: set j renders textures 100 + 4 j .. 103 + 4 j and runs
   // the fast model with seed 200 + j.
   constexpr int kSets = 1;
-  std::vector<double> quality_share, noise_share;
+  std::vector<double> quality_share, noise_share, mean_share;
   for (int set = 0; set < kSets; ++set) {
-    int cells = 0, quality_ok = 0, noise_ok = 0, noise_cells = 0, strict_ok = 0;
+    int cells = 0, quality_ok = 0, noise_ok = 0, noise_cells = 0, strict_ok = 0, mean_ok = 0;
     for (double c : contrasts) {
       for (double lux : luxes) {
         for (double v : speeds) {
@@ -133,27 +139,33 @@ TEST(Px4FlowFastVsImage, QualityAndNoiseAgreeOverTheGrid) {
             noise_ok += n_ok;
             strict_ok += std::abs(fa.std - im.std) <= 0.2 * im.std;
           }
+          const bool m_ok = std::abs(fa.mean - im.mean) <=
+                            3.0 * im.std / std::sqrt(std::max(im.valid, 1)) + 0.2;
+          mean_ok += m_ok;
           std::printf(
               "c=%.2f lux=%6.0f v=%.2f | quality image %6.1f fast %6.1f %s | flow mean image "
-              "%6.3f fast %6.3f | std image %.3f fast %.3f %s\n",
-              c, lux, v, im.quality, fa.quality, q_ok ? "ok" : "--", im.mean, fa.mean, im.std,
-              fa.std, n_ok ? "ok" : "--");
+              "%6.3f fast %6.3f %s | std image %.3f fast %.3f %s\n",
+              c, lux, v, im.quality, fa.quality, q_ok ? "ok" : "--", im.mean, fa.mean,
+              m_ok ? "ok" : "--", im.std, fa.std, n_ok ? "ok" : "--");
         }
       }
     }
     std::printf(
         "quality within one step: %d of %d cells; noise within 3 standard errors + 0.03 px: %d of "
         "%d cells, "
-        "within 20 %%: %d\n",
-        quality_ok, cells, noise_ok, noise_cells, strict_ok);
+        "within 20 %%: %d; mean within 3 standard errors + 0.2 px: %d of %d cells\n",
+        quality_ok, cells, noise_ok, noise_cells, strict_ok, mean_ok, cells);
     EXPECT_GE(quality_ok, cells * 3 / 4);
     EXPECT_GE(noise_ok, noise_cells * 9 / 10);
+    EXPECT_GE(mean_ok, cells * 9 / 10);
     quality_share.push_back(static_cast<double>(quality_ok) / cells);
     noise_share.push_back(static_cast<double>(noise_ok) / noise_cells);
+    mean_share.push_back(static_cast<double>(mean_ok) / cells);
   }
   test_spread::Print("share of cells with the quality within one step", quality_share);
   test_spread::Print("share of cells with the noise within 3 standard errors + 0.03 px",
                      noise_share);
+  test_spread::Print("share of cells with the mean within 3 standard errors + 0.2 px", mean_share);
 }
 
 
@@ -196,8 +208,8 @@ Stats UnitFlicker(const std::string& mode, double contrast, double depth, int fr
 // 0.3 (magnetic ballasts): the lost share of the blocks, which pulls the
 // mean towards 0, depends on depth / contrast. Two seed sets (each: image
 // 400 frames, fast 4000). Measured over the 24 cells: fast - image mean
-// -0.09 / +0.01 / +0.15 px (min / median / max), fast / image std 0.62 /
-// 0.93 / 1.48; at the treadmill lab's cell (contrast 0.12, depth 0.1)
+// -0.09 / +0.01 / +0.15 px (min / median / max), fast / image std 0.61 /
+// 0.93 / 1.52; at the treadmill lab's cell (contrast 0.12, depth 0.1)
 // -0.02 px. Before the per-block law (the frame's snr scaled by the
 // gap ratio to the power 0.65, fitted at contrast 0.12 only) the same
 // grid gave fast - image mean up to +0.41 px (contrast 0.03, depth 0.1)
