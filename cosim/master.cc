@@ -150,9 +150,17 @@ Master::Master(System& system, MasterOptions options) : system_(system), options
   links_into_.assign(n, {});
   links_from_.assign(n, {});
   const auto& links = system_.links();
+  resolved_.clear();
   for (std::size_t l = 0; l < links.size(); ++l) {
-    links_into_[links[l].to_unit].push_back(l);
-    links_from_[links[l].from_unit].push_back(l);
+    const Link& link = links[l];
+    links_into_[link.to_unit].push_back(l);
+    links_from_[link.from_unit].push_back(l);
+    ResolvedLink r{link.from_unit, link.to_unit, link.type, {}, {}, link.from_index, link.to_index};
+    if (link.type == VarType::kReal || link.type == VarType::kRealArray) {
+      r.from = system_.unit(link.from_unit).variables().ResolveReal(link.from_ref);
+      r.to = system_.unit(link.to_unit).variables().ResolveWritableReal(link.to_ref);
+    }
+    resolved_.push_back(r);
   }
   has_feedthrough_.assign(n, false);
   for (std::size_t u = 0; u < n; ++u) {
@@ -248,6 +256,7 @@ bool Master::InitializeUnit(std::size_t u) {
 
 bool Master::CheckUnitOutputs(std::size_t u, TimeNs t, RunPhase phase) {
   const VariableTable& table = system_.unit(u).variables();
+  if (table.RealOutputsFinite()) return true;
   auto problem = FindNonFinite(table, table.real_outputs());
   if (!problem) return true;
   RecordError(u, t, phase, "", std::move(problem->text), std::move(problem->variable));
@@ -259,20 +268,50 @@ bool Master::CheckOutputs(std::size_t u) {
   return CheckUnitOutputs(u, plan_t_ + dt, RunPhase::kStep);
 }
 
+bool Master::Transfer(std::size_t l) {
+  const ResolvedLink& r = resolved_[l];
+  if (r.type == VarType::kReal) {
+    // A Real, or an element of a Real[] at either end; an index the array
+    // no longer holds takes the checked path (which throws).
+    const double* src = r.from.scalar;
+    if (src == nullptr) {
+      const auto i = static_cast<std::size_t>(r.from_index);
+      if (i >= r.from.array->size()) return Transfer(system_.links()[l]);
+      src = r.from.array->data() + i;
+    }
+    double* dst = r.to.scalar;
+    if (dst == nullptr) {
+      const auto i = static_cast<std::size_t>(r.to_index);
+      if (i >= r.to.array->size()) return Transfer(system_.links()[l]);
+      dst = r.to.array->data() + i;
+    }
+    const double v = *src;
+    const bool changed = !SameBits(v, *dst);
+    *dst = v;
+    return changed;
+  }
+  if (r.type == VarType::kRealArray && r.from.array->size() == r.to.array->size()) {
+    const std::vector<double>& src = *r.from.array;
+    std::vector<double>& dst = *r.to.array;
+    const bool changed = std::memcmp(src.data(), dst.data(), src.size() * sizeof(double)) != 0;
+    if (changed) std::copy(src.begin(), src.end(), dst.begin());
+    return changed;
+  }
+  return Transfer(system_.links()[l]);
+}
+
 void Master::TransferInto(std::size_t u) {
   // A link transfers when its destination steps now and its source is at a
   // communication point too, so a slow unit's future output never leaks
   // into a fast unit between the slow unit's points.
-  const auto& links = system_.links();
   for (std::size_t l : links_into_[u]) {
-    if (AtPoint(links[l].from_unit)) Transfer(links[l]);
+    if (AtPoint(resolved_[l].from_unit)) Transfer(l);
   }
 }
 
 void Master::TransferFrom(std::size_t u) {
-  const auto& links = system_.links();
   for (std::size_t l : links_from_[u]) {
-    if (AtPoint(links[l].to_unit)) Transfer(links[l]);
+    if (AtPoint(resolved_[l].to_unit)) Transfer(l);
   }
 }
 

@@ -159,6 +159,8 @@ class Master : private StepContext {
   void RecordPendingErrors();
   void PropagateInitialValues();
   bool Transfer(const Link& link);
+  /// Link l through its resolved storage (Reals; the rest through the Link).
+  bool Transfer(std::size_t l);
   bool CheckUnitOutputs(std::size_t u, TimeNs t, RunPhase phase);
   void RecordError(std::size_t u, TimeNs t, RunPhase phase, std::string_view phase_text,
                    std::string cause, std::string variable = {});
@@ -175,6 +177,17 @@ class Master : private StepContext {
   std::unique_ptr<StepAlgorithm> algorithm_;
   std::vector<Observer*> observers_;
   std::vector<std::int64_t> decimation_;
+  // Each link with its ends' storage, resolved at Start, so that a transfer
+  // reads the values and nothing of the variables' descriptions (a fleet's
+  // transfers ran out of cache on those).
+  struct ResolvedLink {
+    std::size_t from_unit = 0, to_unit = 0;
+    VarType type = VarType::kReal;
+    VariableTable::RealSlot from;
+    VariableTable::WritableRealSlot to;
+    std::ptrdiff_t from_index = -1, to_index = -1;
+  };
+  std::vector<ResolvedLink> resolved_;
   std::vector<std::vector<std::size_t>> links_into_;  // per destination unit
   std::vector<std::vector<std::size_t>> links_from_;  // per source unit
   std::vector<bool> has_feedthrough_;                 // some output depends on an input

@@ -67,6 +67,7 @@ void Unit::RestoreState(const UnitState& state) {
 std::vector<ParameterProblem> Unit::CheckParameters() const { return CheckRules(variables_); }
 
 bool Unit::InputsFinite(TimeNs t) {
+  if (variables_.RealInputsFinite()) return true;
   const auto problem = FindNonFinite(variables_, variables_.real_inputs());
   if (!problem) return true;
   Fail(Where() + ": " + problem->text + " at t = " + FormatSeconds(t) + " s", problem->variable);

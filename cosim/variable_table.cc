@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
 
 namespace linesim::cosim {
 
@@ -306,9 +307,21 @@ ValueRef VariableTable::Bind(std::string name, Causality causality, Variability 
   }
   info.ref = static_cast<ValueRef>(infos_.size());
   by_name_.emplace(info.name, info.ref);
-  if (info.type == VarType::kReal || info.type == VarType::kRealArray) {
-    if (causality == Causality::kInput) real_inputs_.push_back(info.ref);
-    if (causality == Causality::kOutput) real_outputs_.push_back(info.ref);
+  if constexpr (std::is_same_v<T, double> || std::is_same_v<T, std::vector<double>>) {
+    RealSlot slot;
+    if constexpr (std::is_same_v<T, double>) {
+      slot.scalar = storage;
+    } else {
+      slot.array = storage;
+    }
+    if (causality == Causality::kInput) {
+      real_inputs_.push_back(info.ref);
+      real_input_slots_.push_back(slot);
+    }
+    if (causality == Causality::kOutput) {
+      real_outputs_.push_back(info.ref);
+      real_output_slots_.push_back(slot);
+    }
   }
   infos_.push_back(std::move(info));
   storage_.push_back(storage);
@@ -516,6 +529,20 @@ void VariableTable::SetRealArray(ValueRef ref, std::span<const double> v) {
   std::copy(v.begin(), v.end(), dst->begin());
 }
 
+VariableTable::RealSlot VariableTable::ResolveReal(ValueRef ref) const {
+  if (ref < infos_.size() && infos_[ref].type == VarType::kReal) {
+    return {Slot<double>(ref, VarType::kReal), nullptr};
+  }
+  return {nullptr, Slot<std::vector<double>>(ref, VarType::kRealArray)};
+}
+
+VariableTable::WritableRealSlot VariableTable::ResolveWritableReal(ValueRef ref) {
+  if (ref < infos_.size() && infos_[ref].type == VarType::kReal) {
+    return {Writable<double>(ref, VarType::kReal), nullptr};
+  }
+  return {nullptr, Writable<std::vector<double>>(ref, VarType::kRealArray)};
+}
+
 double VariableTable::GetRealElement(ValueRef ref, std::size_t index) const {
   return Slot<std::vector<double>>(ref, VarType::kRealArray)->at(index);
 }
@@ -597,6 +624,23 @@ namespace {
 constexpr std::uint64_t kExponentBits = 0x7ff0000000000000ULL;
 constexpr std::uint64_t kExponentOne = std::uint64_t{1} << 52;
 }  // namespace
+
+bool VariableTable::AllFinite(std::span<const RealSlot> slots) {
+  // As FindNonFinite's first pass: a value is inf or NaN exactly when its
+  // exponent bits are all set, and then adding one to the exponent carries
+  // into the sign bit.
+  std::uint64_t carries = 0;
+  for (const RealSlot& slot : slots) {
+    if (slot.scalar != nullptr) {
+      carries |= (std::bit_cast<std::uint64_t>(*slot.scalar) & kExponentBits) + kExponentOne;
+      continue;
+    }
+    for (const double x : *slot.array) {
+      carries |= (std::bit_cast<std::uint64_t>(x) & kExponentBits) + kExponentOne;
+    }
+  }
+  return (carries >> 63) == 0;
+}
 
 std::optional<NonFinite> FindNonFinite(const VariableTable& table,
                                        std::span<const ValueRef> refs) {

@@ -229,6 +229,43 @@ TEST(VariableTable, FirstNonFiniteScansTheListedRealSignals) {
   EXPECT_EQ(FirstNonFinite(h.t, h.t.real_outputs()), "output 'force' is nan");
 }
 
+// Guards against: the one-pass checks (RealInputsFinite, RealOutputsFinite:
+// the master's every step) missing a value FindNonFinite finds, or scanning
+// what it does not; and the resolved slots pointing elsewhere than the
+// bound members.
+TEST(VariableTable, ResolvedSlotsAndOnePassChecksSeeTheBoundMembers) {
+  Holder h;
+  EXPECT_TRUE(h.t.RealInputsFinite());
+  EXPECT_TRUE(h.t.RealOutputsFinite());
+  h.gain = std::numeric_limits<double>::quiet_NaN();  // a parameter
+  h.state = std::numeric_limits<double>::infinity();  // a local
+  EXPECT_TRUE(h.t.RealInputsFinite());
+  EXPECT_TRUE(h.t.RealOutputsFinite());
+  h.scan[2] = -std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(h.t.RealInputsFinite());
+  EXPECT_TRUE(h.t.RealOutputsFinite());
+  h.scan[2] = 3.0;
+  h.speed = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(h.t.RealInputsFinite());
+  h.speed = 1.0;
+  h.force = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(h.t.RealOutputsFinite());
+  EXPECT_TRUE(h.t.RealInputsFinite());
+
+  const auto speed = h.t.ResolveWritableReal(h.speed_ref);
+  EXPECT_EQ(speed.scalar, &h.speed);
+  EXPECT_EQ(speed.array, nullptr);
+  const auto scan = h.t.ResolveReal(h.scan_ref);
+  EXPECT_EQ(scan.scalar, nullptr);
+  EXPECT_EQ(scan.array, &h.scan);
+  // Not a real: refused as the typed getters refuse it.
+  EXPECT_THROW(h.t.ResolveReal(h.count_ref), std::logic_error);
+  // Read-only: refused as the setters refuse it.
+  h.t.Lock();
+  EXPECT_THROW(h.t.ResolveWritableReal(h.gain_ref), std::logic_error);
+  EXPECT_NO_THROW(h.t.ResolveReal(h.gain_ref));
+}
+
 // Guards against: unreadable values in messages (a list without brackets,
 // a string without quotes, a real that does not read back).
 TEST(FormatValue, RendersEveryType) {
