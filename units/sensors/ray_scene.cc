@@ -440,32 +440,46 @@ int RayScene::CullCarried(const Bundle& bundle, std::span<const double> belt_tra
   return n;
 }
 
-int RayScene::CullMovingBoxes(const Bundle& bundle, std::span<const double> boxes, int own_box) {
+void RayScene::PrepareMovingBoxes(std::span<const double> boxes, int own_box) {
   using models::MovingBox;
   const std::size_t count = boxes.size() / MovingBox::kValues;
   if (box_candidates_.size() < count) {  // once per size
     box_candidates_.resize(count);
-    box_trig_.resize(count);
-    box_radius_.resize(count);
+    prepared_.resize(count);
   }
-  int n = 0;
   for (std::size_t i = 0; i < count; ++i) {
     const double* m = boxes.data() + i * MovingBox::kValues;
     const double length = m[MovingBox::kLength], width = m[MovingBox::kWidth];
     const double z0 = m[MovingBox::kZBottom], z1 = m[MovingBox::kZTop];
-    if (!(length > 0.0 && width > 0.0 && z1 > z0)) continue;  // absent
-    if (static_cast<int>(i) == own_box) continue;
-    const double sweep = std::hypot(m[MovingBox::kVx], m[MovingBox::kVy]) * bundle.s_half;
-    const double radius = 0.5 * std::sqrt(length * length + width * width + (z1 - z0) * (z1 - z0));
+    PreparedBox& p = prepared_[i];
+    // Absent (unsized), or the scanner's own robot.
+    p.present = length > 0.0 && width > 0.0 && z1 > z0 && static_cast<int>(i) != own_box;
+    if (!p.present) continue;
+    p.radius = 0.5 * std::sqrt(length * length + width * width + (z1 - z0) * (z1 - z0));
+    p.padded = p.radius * (1.0 + 1e-9) + 1e-9;
+    // Only a sweep's bound: the padding in MayMeet covers its rounding.
+    p.speed =
+        std::sqrt(m[MovingBox::kVx] * m[MovingBox::kVx] + m[MovingBox::kVy] * m[MovingBox::kVy]);
+    p.cos_yaw = std::cos(m[MovingBox::kYaw]);
+    p.sin_yaw = std::sin(m[MovingBox::kYaw]);
+  }
+}
+
+int RayScene::CullMovingBoxes(const Bundle& bundle, std::span<const double> boxes) {
+  using models::MovingBox;
+  const std::size_t count = boxes.size() / MovingBox::kValues;
+  int n = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    const PreparedBox& p = prepared_[i];
+    if (!p.present) continue;
+    const double* m = boxes.data() + i * MovingBox::kValues;
+    const double z0 = m[MovingBox::kZBottom], z1 = m[MovingBox::kZTop];
     if (!bundle.MayMeet(m[MovingBox::kX] + m[MovingBox::kVx] * bundle.s_mid,
                         m[MovingBox::kY] + m[MovingBox::kVy] * bundle.s_mid, 0.5 * (z0 + z1),
-                        radius + sweep, z0, z1)) {
+                        p.radius + p.speed * bundle.s_half, z0, z1)) {
       continue;
     }
     box_candidates_[static_cast<std::size_t>(n++)] = static_cast<int>(i);
-    box_trig_[i] = {std::cos(m[MovingBox::kYaw]), std::sin(m[MovingBox::kYaw])};
-    // Its bounding sphere, padded for rounding (the exact test decides).
-    box_radius_[i] = radius * (1.0 + 1e-9) + 1e-9;
   }
   return n;
 }
@@ -549,32 +563,46 @@ void RayScene::CastMovingBoxes(const Ray& ray, std::span<const double> boxes,
     const double cx = m[MovingBox::kX] + m[MovingBox::kVx] * ray.dt_s;
     const double cy = m[MovingBox::kY] + m[MovingBox::kVy] * ray.dt_s;
     const double cz = 0.5 * (z0 + z1);
+    const PreparedBox& p = prepared_[static_cast<std::size_t>(i)];
+    const double* o = ray.origin.data();
+    const double* d = ray.direction.data();
     // The box's bounding sphere first (a group's cone is wider than the
     // box: most of its rays pass by): off the ray's line, behind its origin
     // or beyond t_max, the box cannot be met.
+    const double vx = cx - o[0], vy = cy - o[1], vz = cz - o[2];
     {
-      const double r = box_radius_[static_cast<std::size_t>(i)];
-      const double vx = cx - ray.origin[0], vy = cy - ray.origin[1], vz = cz - ray.origin[2];
-      const double along = vx * ray.direction[0] + vy * ray.direction[1] + vz * ray.direction[2];
+      const double r = p.padded;
+      const double along = vx * d[0] + vy * d[1] + vz * d[2];
       const double off2 = vx * vx + vy * vy + vz * vz - along * along;
       if (off2 > r * r || along < -r || along - r > t_max) continue;
     }
-    // The yaw at the ray's time: the box's cos and sin (once per group of
-    // rays, box_trig_) turned by a = yaw_rate dt through its series (|a| <
-    // 0.1 rad within a scan: the terms left out are below 1e-8 rad).
+    // The yaw at the ray's time: the box's cos and sin (once per call,
+    // prepared_) turned by a = yaw_rate dt through its series (|a| < 0.1
+    // rad within a scan: the terms left out are below 1e-8 rad).
     const double a = m[MovingBox::kYawRate] * ray.dt_s, a2 = a * a;
     const double ca = 1.0 - a2 / 2.0 + a2 * a2 / 24.0, sa = a * (1.0 - a2 / 6.0 + a2 * a2 / 120.0);
-    const auto& cs = box_trig_[static_cast<std::size_t>(i)];
+    const double cos_yaw = p.cos_yaw * ca - p.sin_yaw * sa,
+                 sin_yaw = p.sin_yaw * ca + p.cos_yaw * sa;
+    const double hx = 0.5 * m[MovingBox::kLength], hy = 0.5 * m[MovingBox::kWidth];
+    // Then its footprint: the ray's horizontal line passes the rectangle by
+    // (the separating axis of the line's normal, as in CastCarried; padded:
+    // only a clear miss is dropped). Half the rays the sphere lets through
+    // miss the box in a fleet's rows.
+    {
+      const double cross = vx * d[1] - vy * d[0];
+      const double ldx = cos_yaw * d[0] + sin_yaw * d[1];
+      const double ldy = -sin_yaw * d[0] + cos_yaw * d[1];
+      const double reach = hx * std::abs(ldy) + hy * std::abs(ldx);
+      if (std::abs(cross) > reach * (1.0 + 1e-9) + 1e-9) continue;
+    }
     double n[3] = {0.0, 0.0, 0.0};
-    const double t = IntersectYawedBox(cx, cy, cz, 0.5 * m[MovingBox::kLength],
-                                       0.5 * m[MovingBox::kWidth], 0.5 * (z1 - z0),
-                                       cs[0] * ca - cs[1] * sa, cs[1] * ca + cs[0] * sa,
-                                       ray.origin.data(), ray.direction.data(), t_max, n);
+    const double t =
+        IntersectYawedBox(cx, cy, cz, hx, hy, 0.5 * (z1 - z0), cos_yaw, sin_yaw, o, d, t_max, n);
     if (t < t_max) {
       best.range = t;
       best.object = ObjectOfMoving(first_object + i);
-      best.cos_incidence = std::abs(n[0] * ray.direction[0] + n[1] * ray.direction[1] +
-                                    n[2] * ray.direction[2]);
+      best.cos_incidence =
+          std::abs(n[0] * ray.direction[0] + n[1] * ray.direction[1] + n[2] * ray.direction[2]);
     }
   }
 }
@@ -594,6 +622,7 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
   // (tests/units/sensors/ray_scene_test.cc catches it).
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
   int candidates = 0, box_count = 0;
+  if (!moving_boxes.empty()) PrepareMovingBoxes(moving_boxes, own_box);
   for (std::size_t first = 0; first < rays.size();) {
     const std::size_t count =
         rays.size() - first >= 16 ? 16 : std::min<std::size_t>(8, rays.size() - first);
@@ -615,7 +644,7 @@ void RayScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits,
       const Bundle bundle = Bundle::Of(
           rays.subspan(first, std::min<std::size_t>(kCullGroup, rays.size() - first)));
       candidates = carried_.empty() ? 0 : CullCarried(bundle, belt_travel, belt_speed);
-      box_count = moving_boxes.empty() ? 0 : CullMovingBoxes(bundle, moving_boxes, own_box);
+      box_count = moving_boxes.empty() ? 0 : CullMovingBoxes(bundle, moving_boxes);
     }
     for (std::size_t k = 0; k < count; ++k) {
       RayHit& h = hits[first + k];

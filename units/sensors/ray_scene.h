@@ -179,9 +179,12 @@ class RayScene {
     bool MayMeet(double cx, double cy, double cz, double radius, double z_bottom,
                  double z_top) const;
   };
+  /// What the culls and the exact tests need of each moving box, worked
+  /// out once per Cast call (into prepared_) instead of once per group.
+  void PrepareMovingBoxes(std::span<const double> boxes, int own_box);
   /// The moving boxes a bundle may meet (into box_candidates_, their spheres
   /// swept over the bundle's times); returns the count.
-  int CullMovingBoxes(const Bundle& bundle, std::span<const double> boxes, int own_box);
+  int CullMovingBoxes(const Bundle& bundle, std::span<const double> boxes);
   /// The carried objects a bundle of rays may meet (into candidates_):
   /// their bounding spheres, where their belts put them over the rays'
   /// times, against the bundle's cone. Returns the count.
@@ -194,10 +197,16 @@ class RayScene {
   std::vector<StaticSolid> solids_;
   std::array<Lane, 16> lanes_{};  // the packet being cast
   std::vector<Carried> carried_;
-  std::vector<int> candidates_;  // CullCarried's answer (carried_.size() long)
+  std::vector<int> candidates_;      // CullCarried's answer (carried_.size() long)
   std::vector<int> box_candidates_;  // CullMovingBoxes' answer
-  std::vector<std::array<double, 2>> box_trig_;  // cos, sin of each candidate's yaw
-  std::vector<double> box_radius_;               // its bounding sphere's radius
+  struct PreparedBox {
+    bool present;   // sized, and not the scanner's own robot
+    double radius;  // its bounding sphere's radius
+    double padded;  // the same, padded for rounding (the exact test decides)
+    double speed;   // of its centre
+    double cos_yaw, sin_yaw;
+  };
+  std::vector<PreparedBox> prepared_;
 };
 
 /// Exact first intersection (t > 1e-9, t < t_max) of a ray with a vertical
