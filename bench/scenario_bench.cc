@@ -61,12 +61,13 @@ void BM_Scenario(benchmark::State& state, const std::string& file,
 // the line, 5 m apart): the cost per simulated second grows with N (each
 // chassis, laser and clearance meets the N - 1 others). Issue 22: at most
 // N x 1.15 of one robot's.
-std::string FleetFile(int n) {
+// Robots first..end-1 of such a fleet (a file per robot for BM_FleetApart).
+std::string FleetFile(int n, int first = 0) {
   std::string text =
       "name: fleet_bench\nduration_s: 5\nseed: 1\n"
       "master: {algorithm: gauss_seidel, step_s: 0.005}\nscene: {model: factory_line}\n"
       "robots:\n";
-  for (int k = 0; k < n; ++k) {
+  for (int k = first; k < n; ++k) {
     const std::string x = std::to_string(-10 + 5 * (k % 5)), y = k < 5 ? "-5" : "-3";
     const std::string x1 = std::to_string(-10 + 5 * (k % 5) + 1.5);
     text += "  - {name: r" + std::to_string(k) + ", model: raw3, pose: {x_m: " + x + ", y_m: " + y +
@@ -75,8 +76,9 @@ std::string FleetFile(int n) {
             "]], speed_mps: 0.3}, sensing: {surface_velocity: ground_truth}, "
             "localization: {source: ground_truth}}\n";
   }
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("linesim_fleet_bench_" + std::to_string(n) + ".yaml");
+  const auto path =
+      std::filesystem::temp_directory_path() /
+      ("linesim_fleet_bench_" + std::to_string(first) + "_" + std::to_string(n) + ".yaml");
   std::ofstream(path) << text;
   return path.string();
 }
@@ -88,6 +90,46 @@ void BM_Fleet(benchmark::State& state) {
 BENCHMARK(BM_Fleet)
     ->Arg(1)
     ->Arg(3)
+    ->Arg(10)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+
+// The same N robots, each alone in its own session (a world of its own:
+// none sees or touches another), stepped in turn base step by base step
+// in one process as BM_Fleet's master steps them: what N robots cost
+// without sharing a world, so BM_Fleet / BM_FleetApart at the same N is
+// the price of the shared world itself, and BM_FleetApart's growth per
+// robot is the memory hierarchy's (no metrics observer here: compare
+// BM_FleetApart's N with its own N = 1).
+void BM_FleetApart(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  std::vector<std::string> files;
+  for (int k = 0; k < n; ++k) files.push_back(FleetFile(k + 1, k));
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::vector<std::unique_ptr<linesim::session::Session>> runs;
+    for (const auto& file : files) {
+      runs.push_back(std::make_unique<linesim::session::Session>(file, std::vector<std::string>{}));
+    }
+    state.ResumeTiming();
+    for (auto& run : runs) run->scenario().master->Start();
+    for (bool more = true; more;) {
+      for (auto& run : runs) more = run->scenario().master->Step() && more;
+    }
+    for (auto& run : runs) {
+      if (const auto result = run->scenario().master->Finish(); !result.ok) {
+        state.SkipWithError(result.ErrorText().c_str());
+      }
+    }
+    state.PauseTiming();
+    runs.clear();
+    state.ResumeTiming();
+  }
+  state.counters["robots"] = n;
+}
+BENCHMARK(BM_FleetApart)
+    ->Arg(1)
     ->Arg(10)
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
