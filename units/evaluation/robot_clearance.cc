@@ -35,12 +35,15 @@ struct Footprint {
     }
     return out;
   }
-  // Distance of point p from the footprint (0 inside).
-  double DistanceTo(const std::array<double, 2>& p) const {
+  // How far point p lies outside the footprint along its two axes (0 for
+  // an axis it lies within): its distance is the hypot of the two.
+  std::array<double, 2> OutsideBy(const std::array<double, 2>& p) const {
     const double dx = p[0] - x, dy = p[1] - y;
     const double ex = std::abs(c * dx + s * dy) - hx, ey = std::abs(-s * dx + c * dy) - hy;
-    return std::hypot(std::max(ex, 0.0), std::max(ey, 0.0));
+    return {std::max(ex, 0.0), std::max(ey, 0.0)};
   }
+  // Half its diagonal: the radius of the circle around it.
+  double Reach() const { return std::hypot(hx, hy); }
 };
 
 // Whether the footprints' projections on the axis (ux, uy) are disjoint.
@@ -54,23 +57,43 @@ bool Separates(const Corners& a, const Corners& b, double ux, double uy) {
   return a1 < b0 || b1 < a0;
 }
 
-}  // namespace
-
-double RobotClearanceUnit::FootprintDistance(const double* a, const double* b) {
-  const Footprint fa(a), fb(b);
+// The distance between footprints a (with its corners and reach, taken
+// once per step for the robot's own) and b.
+double Distance(const Footprint& fa, const Corners& ca, double reach_a, const Footprint& fb) {
   // Far apart (centres further than the half diagonals): the corners
   // decide without the separating axes.
-  const double reach = std::hypot(fa.hx, fa.hy) + std::hypot(fb.hx, fb.hy);
-  const Corners ca = fa.CornersOf(), cb = fb.CornersOf();
+  const double reach = reach_a + fb.Reach();
+  const Corners cb = fb.CornersOf();
   const bool separated = std::hypot(fb.x - fa.x, fb.y - fa.y) > reach ||
                          Separates(ca, cb, fa.c, fa.s) || Separates(ca, cb, -fa.s, fa.c) ||
                          Separates(ca, cb, fb.c, fb.s) || Separates(ca, cb, -fb.s, fb.c);
   if (!separated) return 0.0;
-  double best = std::numeric_limits<double>::max();
+  // The nearest corner: by squared distance, then the hypot (the reported
+  // distance, as before) of those that can tie with it at double rounding,
+  // not of all eight.
+  std::array<std::array<double, 2>, 8> out;
+  std::array<double, 8> squared;
+  double least = std::numeric_limits<double>::max();
   for (std::size_t k = 0; k < 4; ++k) {
-    best = std::min({best, fb.DistanceTo(ca[k]), fa.DistanceTo(cb[k])});
+    out[2 * k] = fb.OutsideBy(ca[k]);
+    out[2 * k + 1] = fa.OutsideBy(cb[k]);
+  }
+  for (std::size_t k = 0; k < 8; ++k) {
+    squared[k] = out[k][0] * out[k][0] + out[k][1] * out[k][1];
+    least = std::min(least, squared[k]);
+  }
+  double best = std::numeric_limits<double>::max();
+  for (std::size_t k = 0; k < 8; ++k) {
+    if (squared[k] <= least * (1.0 + 1e-9)) best = std::min(best, std::hypot(out[k][0], out[k][1]));
   }
   return best;
+}
+
+}  // namespace
+
+double RobotClearanceUnit::FootprintDistance(const double* a, const double* b) {
+  const Footprint fa(a), fb(b);
+  return Distance(fa, fa.CornersOf(), fa.Reach(), fb);
 }
 
 RobotClearanceUnit::RobotClearanceUnit(std::string name, int bodies)
@@ -107,6 +130,10 @@ RobotClearanceUnit::RobotClearanceUnit(std::string name, int bodies)
 void RobotClearanceUnit::Evaluate() {
   const auto self = static_cast<std::size_t>(own_);
   const double* own = boxes_.data() + self * MovingBox::kValues;
+  // The own footprint's trigonometry, corners and reach, once per step.
+  const Footprint own_print(own);
+  const Corners own_corners = own_print.CornersOf();
+  const double own_reach = own_print.Reach();
   distance_ = std::numeric_limits<double>::max();
   nearest_ = -1.0;
   for (std::size_t k = 0; k < static_cast<std::size_t>(bodies_); ++k) {
@@ -119,8 +146,9 @@ void RobotClearanceUnit::Evaluate() {
     const bool absent = !(other[MovingBox::kLength] > 0.0 && other[MovingBox::kWidth] > 0.0);
     const bool apart_in_height = other[MovingBox::kZTop] < own[MovingBox::kZBottom] ||
                                  other[MovingBox::kZBottom] > own[MovingBox::kZTop];
-    const double d = absent || apart_in_height ? std::numeric_limits<double>::max()
-                                               : FootprintDistance(own, other);
+    const double d = absent || apart_in_height
+                         ? std::numeric_limits<double>::max()
+                         : Distance(own_print, own_corners, own_reach, Footprint(other));
     robot_distance_[k] = d;
     if (d < distance_) {
       distance_ = d;
