@@ -381,8 +381,8 @@ void Master::PropagateInitialValues() {
   for (std::size_t pass = 0; pass <= n + 1; ++pass) {
     std::fill(changed.begin(), changed.end(), false);
     bool any = false;
-    for (const Link& link : system_.links()) {
-      if (Transfer(link)) changed[link.to_unit] = any = true;
+    for (std::size_t l = 0; l < resolved_.size(); ++l) {
+      if (Transfer(l)) changed[resolved_[l].to_unit] = any = true;
     }
     if (!any) return;
     for (std::size_t u = 0; u < n; ++u) {

@@ -621,39 +621,36 @@ void VariableTable::SetValue(ValueRef ref, const Value& v) {
 }
 
 namespace {
-constexpr std::uint64_t kExponentBits = 0x7ff0000000000000ULL;
-constexpr std::uint64_t kExponentOne = std::uint64_t{1} << 52;
+// A value is inf or NaN exactly when its exponent bits are all set, and then
+// adding one to the exponent carries into the sign bit: OR-ing the carries
+// of many values tests them all in one branch-free pass, which the compiler
+// vectorizes with SSE2 (every unit's real inputs and outputs are checked
+// every step, a laser's ranges among them).
+std::uint64_t NonFiniteCarry(double x) {
+  constexpr std::uint64_t kExponentBits = 0x7ff0000000000000ULL;
+  constexpr std::uint64_t kExponentOne = std::uint64_t{1} << 52;
+  return (std::bit_cast<std::uint64_t>(x) & kExponentBits) + kExponentOne;
+}
 }  // namespace
 
 bool VariableTable::AllFinite(std::span<const RealSlot> slots) {
-  // As FindNonFinite's first pass: a value is inf or NaN exactly when its
-  // exponent bits are all set, and then adding one to the exponent carries
-  // into the sign bit.
   std::uint64_t carries = 0;
   for (const RealSlot& slot : slots) {
     if (slot.scalar != nullptr) {
-      carries |= (std::bit_cast<std::uint64_t>(*slot.scalar) & kExponentBits) + kExponentOne;
+      carries |= NonFiniteCarry(*slot.scalar);
       continue;
     }
-    for (const double x : *slot.array) {
-      carries |= (std::bit_cast<std::uint64_t>(x) & kExponentBits) + kExponentOne;
-    }
+    for (const double x : *slot.array) carries |= NonFiniteCarry(x);
   }
   return (carries >> 63) == 0;
 }
 
 std::optional<NonFinite> FindNonFinite(const VariableTable& table,
                                        std::span<const ValueRef> refs) {
-  // The common case, all finite, in one branch-free pass that the compiler
-  // vectorizes with SSE2 (every unit's real inputs and outputs are checked
-  // every step, a laser's ranges among them): a value is inf or NaN exactly
-  // when its exponent bits are all set, and then adding one to the exponent
-  // carries into the sign bit.
+  // The common case, all finite, in one pass first.
   std::uint64_t carries = 0;
   for (ValueRef ref : refs) {
-    for (const double x : table.RealValues(ref)) {
-      carries |= (std::bit_cast<std::uint64_t>(x) & kExponentBits) + kExponentOne;
-    }
+    for (const double x : table.RealValues(ref)) carries |= NonFiniteCarry(x);
   }
   if ((carries >> 63) == 0) return std::nullopt;
   for (ValueRef ref : refs) {
