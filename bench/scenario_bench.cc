@@ -61,7 +61,7 @@ void BM_Scenario(benchmark::State& state, const std::string& file,
 // the line, 5 m apart): the cost per simulated second grows with N (each
 // chassis, laser and clearance meets the N - 1 others). Issue 22: at most
 // N x 1.15 of one robot's.
-// Robots first..end-1 of such a fleet (a file per robot for BM_FleetApart).
+// Robots first..n-1 of such a fleet (a file per robot for BM_FleetApart).
 std::string FleetFile(int n, int first = 0) {
   std::string text =
       "name: fleet_bench\nduration_s: 5\nseed: 1\n"
@@ -117,14 +117,18 @@ void BM_FleetApart(benchmark::State& state) {
     for (bool more = true; more;) {
       for (auto& run : runs) more = run->scenario().master->Step() && more;
     }
+    std::string error;
     for (auto& run : runs) {
-      if (const auto result = run->scenario().master->Finish(); !result.ok) {
-        state.SkipWithError(result.ErrorText().c_str());
-      }
+      const auto result = run->scenario().master->Finish();
+      if (!result.ok && error.empty()) error = result.ErrorText();
     }
     state.PauseTiming();
     runs.clear();
     state.ResumeTiming();
+    if (!error.empty()) {
+      state.SkipWithError(error.c_str());
+      break;
+    }
   }
   state.counters["robots"] = n;
 }

@@ -177,7 +177,7 @@ class Master : private StepContext {
   std::unique_ptr<StepAlgorithm> algorithm_;
   std::vector<Observer*> observers_;
   std::vector<std::int64_t> decimation_;
-  // Each link with its ends' storage, resolved at Start, so that a transfer
+  // Each link with its ends' storage, resolved at construction, so that a transfer
   // reads the values and nothing of the variables' descriptions (a fleet's
   // transfers ran out of cache on those).
   struct ResolvedLink {
