@@ -187,7 +187,7 @@ Master::Master(System& system, MasterOptions options) : system_(system), options
   time_ = options_.start;
 }
 
-bool Master::Transfer(const Link& link) {
+bool Master::TransferChecked(const Link& link) {
   const VariableTable& from = system_.unit(link.from_unit).variables();
   VariableTable& to = system_.unit(link.to_unit).variables();
   switch (link.type) {
@@ -276,13 +276,13 @@ bool Master::Transfer(std::size_t l) {
     const double* src = r.from.scalar;
     if (src == nullptr) {
       const auto i = static_cast<std::size_t>(r.from_index);
-      if (i >= r.from.array->size()) return Transfer(system_.links()[l]);
+      if (i >= r.from.array->size()) return TransferChecked(system_.links()[l]);
       src = r.from.array->data() + i;
     }
     double* dst = r.to.scalar;
     if (dst == nullptr) {
       const auto i = static_cast<std::size_t>(r.to_index);
-      if (i >= r.to.array->size()) return Transfer(system_.links()[l]);
+      if (i >= r.to.array->size()) return TransferChecked(system_.links()[l]);
       dst = r.to.array->data() + i;
     }
     const double v = *src;
@@ -297,7 +297,7 @@ bool Master::Transfer(std::size_t l) {
     if (changed) std::copy(src.begin(), src.end(), dst.begin());
     return changed;
   }
-  return Transfer(system_.links()[l]);
+  return TransferChecked(system_.links()[l]);
 }
 
 void Master::TransferInto(std::size_t u) {

@@ -158,9 +158,13 @@ class Master : private StepContext {
   TimeNs DivisorAtMost(TimeNs limit) const;
   void RecordPendingErrors();
   void PropagateInitialValues();
-  bool Transfer(const Link& link);
-  /// Link l through its resolved storage (Reals; the rest through the Link).
+  /// Link l through its resolved storage (Reals; the rest through
+  /// TransferChecked). True when the destination's value changed.
   bool Transfer(std::size_t l);
+  /// A link through the tables' typed, checked accessors: the integers,
+  /// booleans and strings, and a real link whose array end no longer has
+  /// the size it had at construction (the accessors throw what they say).
+  bool TransferChecked(const Link& link);
   bool CheckUnitOutputs(std::size_t u, TimeNs t, RunPhase phase);
   void RecordError(std::size_t u, TimeNs t, RunPhase phase, std::string_view phase_text,
                    std::string cause, std::string variable = {});

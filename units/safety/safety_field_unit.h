@@ -97,9 +97,11 @@ class SafetyFieldUnit : public cosim::Unit {
 
   // State.
   double last_scan_count_ = 0.0;
-  std::int64_t protective_scans_ = 0, warning_scans_ = 0;  // consecutive infringing
-  double cap_ = 0.0;                                       // +inf: no limit
-  double target_ = 0.0;          // the cap held since the last infringement (+inf: none)
+  // Consecutive infringing scans.
+  std::int64_t protective_scans_ = 0, warning_scans_ = 0;
+  // The speed cap, and the cap held since the last infringement (+inf: no
+  // limit, none).
+  double cap_ = 0.0, target_ = 0.0;
   cosim::TimeNs clear_for_ = 0;  // time both fields have been clear
   double last_speed_ = 0.0;      // |velocity_out| last commanded
 };
