@@ -11,7 +11,14 @@
 // features when the program loads (FMA, AVX2); they differ in the last bit
 // on some inputs, and a closed loop turns one bit into millimetres. ODE
 // (hinge angles: atan2; rotations: sincos), SUNDIALS (CVODE's step-size
-// control: pow), FCL and our own units all call them.
+// control: pow), FCL and our own units all call them. Functions that are
+// not dispatched themselves may call dispatched ones inside libm: erf and
+// erfc call its exp (1 call in 38,392 of the PX4Flow model's erf under
+// lamp flicker gave other bits on FMA and non-FMA CPUs). So every libm
+// function any linesim binary or library imports is defined here, except
+// those whose result IEEE 754 defines exactly (sqrt, rounding, fmod, ...);
+// tests/platform/deterministic_math_test.cc lists the imports of the
+// executables and of every library they load, and fails on any other.
 //
 // How: these definitions are linked as object code into every linesim
 // executable and exported (deterministic_math.list), so the dynamic linker
@@ -51,7 +58,12 @@ LINESIM_UNARY(tanh, Sleef_tanhd1_u35purec)
 LINESIM_UNARY(asinh, Sleef_asinhd1_u10purec)
 LINESIM_UNARY(acosh, Sleef_acoshd1_u10purec)
 LINESIM_UNARY(atanh, Sleef_atanhd1_u10purec)
+// The error functions (PX4Flow's exposure under flicker; FCL's erfc) and
+// hypot (distances in most units): 1, 1.5 and 0.5 ulp.
+LINESIM_UNARY(erf, Sleef_erfd1_u10purec)
+LINESIM_UNARY(erfc, Sleef_erfcd1_u15purec)
 double atan2(double y, double x) noexcept { return Sleef_atan2d1_u35purec(y, x); }
+double hypot(double x, double y) noexcept { return Sleef_hypotd1_u05purec(x, y); }
 // SLEEF's pow costs 76 ns against glibc's 10 (measured); CVODE's step-size
 // rule takes roots of order 1 to 3 at almost every step (x^1, x^(1/2),
 // x^(1/3) after each restart), so these go faster: x^1 and x^2 exactly,
