@@ -47,25 +47,44 @@ std::optional<sweep::ResultsFile> PrepareFolder(const sweep::SweepSpec& spec, co
                  "another --out\n";
     return std::nullopt;
   }
+  std::optional<sweep::SweepIdentity> held;
   if (exists && resume) {
-    const auto held = sweep::ReadSweepFingerprint(identity.string());
-    if (held != fingerprint) {
-      std::cerr << "linesim: cannot resume in " << dir.string() << ": "
-                << (!held ? identity.string() + " is missing or unreadable"
-                          : "it holds another sweep, or the sweep file, its base "
-                            "scenario or a model file changed since")
-                << "; --force starts afresh\n";
+    held = sweep::ReadSweepIdentity(identity.string());
+    if (!held) {
+      std::cerr << "linesim: cannot resume in " << dir.string() << ": " << identity.string()
+                << " is missing or unreadable (or from an older linesim); --force starts "
+                   "afresh\n";
+      return std::nullopt;
+    }
+    // Every file a row's run read must still be what it read: the rows and
+    // the runs still to do are then of one model.
+    if (const auto changed = sweep::ChangedInputs(held->inputs); !changed.empty()) {
+      std::cerr << "linesim: cannot resume in " << dir.string()
+                << ": the rows there were computed from files that changed since:\n";
+      for (const auto& c : changed) std::cerr << "  " << c << "\n";
+      std::cerr << "  --force starts afresh\n";
+      return std::nullopt;
+    }
+    if (held->fingerprint != fingerprint) {
+      std::cerr << "linesim: cannot resume in " << dir.string()
+                << ": it holds another sweep, or the sweep's settings or the files its base "
+                   "scenario reads changed since; --force starts afresh\n";
       return std::nullopt;
     }
   }
   if (!CreateOutputFolder(dir.string())) return std::nullopt;
   try {
-    if (exists && resume) return sweep::ResultsFile::Resume(results.string(), spec);
+    if (exists && resume) {
+      sweep::ResultsFile resumed = sweep::ResultsFile::Resume(results.string(), spec);
+      resumed.TrackInputs(identity.string(), spec, fingerprint, held->inputs);
+      return resumed;
+    }
     // The old identity goes first: a folder is never left saying it holds
     // this sweep while it holds another's rows.
     fs::remove(identity, ec);
     sweep::ResultsFile created = sweep::ResultsFile::Create(results.string(), spec);
-    sweep::WriteSweepIdentity(identity.string(), spec, fingerprint);
+    sweep::WriteSweepIdentity(identity.string(), spec, fingerprint, spec.inputs);
+    created.TrackInputs(identity.string(), spec, fingerprint, spec.inputs);
     return created;
   } catch (const std::exception& e) {
     std::cerr << "linesim: " << e.what() << "\n";
@@ -111,8 +130,8 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
   // Ranks on other machines must run the same sweep from the same files.
   if (const std::string held = mpi ? mpi->LeaderText(fingerprint) : fingerprint;
       held != fingerprint) {
-    problems << "linesim: the sweep file, its base scenario or a model file differs from rank "
-                "0's (fingerprint "
+    problems << "linesim: the sweep's settings or a file its base scenario reads differs from "
+                "rank 0's (fingerprint "
              << fingerprint << " against " << held << ")\n";
     status = kExitBadInput;
   }
@@ -164,8 +183,8 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
                          results->failed_count());
   std::mutex bar_mutex;
   const auto on_done = [&](const sweep::RunSpec& run, const sweep::RunOutcome& outcome) {
-    results->Append(run.id, sweep::FormatRow(run, outcome),
-                    outcome.status == sweep::RunStatus::kOk);
+    results->Append(run.id, sweep::FormatRow(run, outcome), outcome.status == sweep::RunStatus::kOk,
+                    outcome.inputs);
     const std::lock_guard lock(bar_mutex);
     bar.RunDone(outcome.status == sweep::RunStatus::kOk);
   };
@@ -237,8 +256,8 @@ int SweepCommand(const SweepArgs& args, sweep::MpiSession* mpi) {
     std::cout << "\nthe first run again, with its signals and plots, into "
               << (dir / "run_0").string() << ":\n"
               << std::flush;
-    one_run = RunCommand(args.file, (dir / "run_0").string(), sets, args.max_output_mb,
-                         args.format, nullptr, /*replay=*/true, args.mcap);
+    one_run = RunCommand(args.file, (dir / "run_0").string(), sets, args.max_output_mb, args.format,
+                         nullptr, /*replay=*/true, args.mcap);
   }
   if (one_run == kExitInterrupted) return kExitInterrupted;
   return results->failed_count() == 0 && one_run == kExitOk ? kExitOk : kExitRunFailed;

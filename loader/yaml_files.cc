@@ -5,12 +5,13 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <map>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <vector>
 
+#include "config/input_files.h"
 #include "cosim/closest_names.h"
 #include "models/models_dir.h"
 
@@ -98,17 +99,23 @@ std::optional<DuplicateKey> FindDuplicateKey(const YAML::Node& node,
 YamlFile LoadYamlFile(const std::string& file) {
   YamlFile out;
   std::error_code ec;
+  // Every file a scenario reads is recorded where it is read (the record a
+  // sweep keeps: config/input_files.h), a missing or unreadable one too: a
+  // result refused for its lack is as much the file's doing.
   if (!fs::exists(file, ec)) {
+    config::RecordInputFile(file);
     out.problem = YamlFile::Problem::kMissing;
     return out;
   }
   if (!fs::is_regular_file(file, ec)) {
+    config::RecordInputFile(file);
     out.problem = YamlFile::Problem::kFolder;
     return out;
   }
   // Checked before reading: yaml-cpp's tree takes some 50 bytes per byte
   // of text (a 40 MB scenario exhausted 2 GB).
   if (const auto size = fs::file_size(file, ec); !ec && size > kMaxYamlBytes) {
+    config::RecordInputFile(file);
     out.problem = YamlFile::Problem::kUnreadable;
     out.detail = "it is " + std::to_string(size) + " bytes, more than the " +
                  std::to_string(kMaxYamlBytes >> 20) +
@@ -120,11 +127,13 @@ YamlFile LoadYamlFile(const std::string& file) {
     std::ostringstream buffer;
     buffer << in.rdbuf();
     if (!in) {
+      config::RecordInputFile(file);
       out.problem = YamlFile::Problem::kUnreadable;
       out.detail = "not readable";
       return out;
     }
     const std::string text = buffer.str();
+    config::RecordInput(file, text);
     // A second document (after "---", or after a "..." end marker) would be
     // silently dropped by a single-document read. Asked of the parser one
     // document at a time, at most two: yaml-cpp's LoadAll never ends on text

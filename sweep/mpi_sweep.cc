@@ -56,6 +56,12 @@ std::vector<char> Pack(const RunOutcome& o) {
   for (const std::string* text : {&o.error, &e.unit, &e.unit_type, &e.variable, &e.cause}) {
     PackText(buf, *text);
   }
+  // The files the run read: their count, then path and digest of each.
+  PackText(buf, std::to_string(o.inputs.size()));
+  for (const auto& [path, digest] : o.inputs) {
+    PackText(buf, path);
+    PackText(buf, digest);
+  }
   return buf;
 }
 
@@ -81,6 +87,15 @@ RunOutcome Unpack(const std::vector<char>& buf) {
   if (head[5] != 0) e.time = head[6];
   for (std::string* text : {&o.error, &e.unit, &e.unit_type, &e.variable, &e.cause}) {
     *text = UnpackText(buf, pos);
+  }
+  const std::string count = UnpackText(buf, pos);
+  char* end = nullptr;
+  const unsigned long long files = std::strtoull(count.c_str(), &end, 10);
+  if (count.empty() || *end != '\0' || files > buf.size())
+    throw std::runtime_error("bad MPI result");
+  for (unsigned long long i = 0; i < files; ++i) {
+    std::string path = UnpackText(buf, pos);
+    o.inputs[std::move(path)] = UnpackText(buf, pos);
   }
   e.message = o.error;
   return o;

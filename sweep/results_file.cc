@@ -12,13 +12,12 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "config/input_files.h"
 #include "cosim/files.h"
 #include "cosim/variable_table.h"
-#include "models/models_dir.h"
+#include "platform/sha256.h"
 
 namespace linesim::sweep {
-
-namespace fs = std::filesystem;
 
 namespace {
 
@@ -44,13 +43,17 @@ std::uint64_t Fnv1a(std::uint64_t h, std::string_view text) {
   return h;
 }
 
-// The row's proof (results.csv's last column): FNV-1a 64 of the row's
-// text before it (run id, the plan's values and seed, metrics, status,
-// errors, wall time) as 16 hex digits. Resume recomputes it, so a row that
-// was edited in any field (a metric made 999) is done again rather than
-// parsed into the results.
-std::string RowCheck(std::string_view row_text) {
-  const std::uint64_t h = Fnv1a(1469598103934665603ull, row_text);
+// The row's check (results.csv's last column): FNV-1a 64, as 16 hex
+// digits, of the row's fields before wall_s (run id, the plan's values and
+// seed, metrics, status, errors) joined as results.csv writes them. Wall
+// time is left out: it is the one field that differs between two runs of a
+// sweep, and the check is the same bytes with it. Resume recomputes it, so
+// a row changed by accident (a hand edit, a spreadsheet's re-save, a line
+// cut or merged) is done again rather than parsed into the results. It
+// catches accidents, not forgery: whoever can edit the file can recompute
+// it (docs/outputs.md says why no key is kept).
+std::string RowCheck(std::string_view proven_text) {
+  const std::uint64_t h = Fnv1a(1469598103934665603ull, proven_text);
   char hex[17];
   static const char* kDigits = "0123456789abcdef";
   for (int i = 0; i < 16; ++i) hex[i] = kDigits[(h >> (60 - 4 * i)) & 0xf];
@@ -88,8 +91,7 @@ constexpr std::size_t kErrorFields = 5;  // unit, time_s, phase, variable, cause
 std::size_t StatusColumn(std::size_t np, std::size_t nm) { return 2 + np + nm; }
 std::size_t WallColumn(std::size_t np, std::size_t nm) { return 4 + np + nm + kErrorFields; }
 
-bool RowMatchesPlan(const SweepSpec& spec, const RunSpec& run,
-                    const std::vector<std::string>& f) {
+bool RowMatchesPlan(const SweepSpec& spec, const RunSpec& run, const std::vector<std::string>& f) {
   const std::size_t np = spec.parameters.size(), nm = spec.metrics.size();
   for (std::size_t i = 0; i < np; ++i) {
     if (f[1 + i] != run.values[i]) return false;
@@ -163,29 +165,22 @@ std::string FormatRow(const RunSpec& run, const RunOutcome& outcome) {
   f.push_back(failed ? std::string(cosim::ToString(e.phase)) : "");
   f.push_back(failed ? e.variable : "");
   f.push_back(failed ? e.cause : "");
+  const std::string proven = JoinCsvLine(f);
   f.push_back(cosim::FormatValue(outcome.wall_s));
-  const std::string text = JoinCsvLine(f);
-  f.push_back(RowCheck(std::string_view(text).substr(0, text.size() - 1)));
+  f.push_back(RowCheck(std::string_view(proven).substr(0, proven.size() - 1)));
   return JoinCsvLine(f);
 }
 
 std::string SweepFingerprint(const SweepSpec& spec) {
-  std::uint64_t h = 1469598103934665603ull;
-  const auto add = [&h](std::string_view text) { h = Fnv1a(Fnv1a(h, text), "\n"); };
-  // The files the runs are built from: the base scenario and every model
-  // file (a robot model names the others), sorted for a stable order.
-  add(ReadWhole(spec.scenario));
-  std::vector<fs::path> models;
-  std::error_code ec;
-  for (fs::recursive_directory_iterator it(models::ModelsDir(), ec), end; !ec && it != end;
-       it.increment(ec)) {
-    if (it->is_regular_file(ec)) models.push_back(it->path());
-  }
-  std::sort(models.begin(), models.end());
-  for (const auto& m : models) {
-    add(fs::relative(m, models::ModelsDir(), ec).string());
-    add(ReadWhole(m.string()));
-  }
+  std::string text;
+  const auto add = [&text](std::string_view line) {
+    text += line;
+    text += '\n';
+  };
+  // The files the runs are built from, by content: every file the base
+  // scenario's loads read (config/input_files.h), whatever its kind and
+  // wherever it lies.
+  for (const auto& [path, digest] : spec.inputs) add("file " + path + " " + digest);
   // What decides each run's overrides, seed and columns.
   for (const auto& a : FixedOverrides(spec)) add("set " + a);
   for (const auto& p : spec.parameters) {
@@ -198,30 +193,51 @@ std::string SweepFingerprint(const SweepSpec& spec) {
       std::to_string(spec.samples) + " repeats " + std::to_string(spec.repeats) + " seed " +
       std::to_string(spec.seed) + " seeds " + std::to_string(static_cast<int>(spec.seeds)));
   for (const auto& m : spec.metrics) add("metric " + m);
-  char text[17];
-  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
-  return text;
+  return platform::Sha256Hex(text);
 }
 
 void WriteSweepIdentity(const std::string& path, const SweepSpec& spec,
-                        const std::string& fingerprint) {
+                        const std::string& fingerprint,
+                        const std::map<std::string, std::string>& inputs) {
   nlohmann::ordered_json id;
   id["name"] = spec.name;
   id["sweep_file"] = spec.file;
   id["scenario"] = spec.scenario;
   id["runs"] = RunCount(spec);
   id["fingerprint"] = fingerprint;
+  id["inputs"] = nlohmann::ordered_json::object();
+  for (const auto& [file, digest] : inputs) id["inputs"][file] = digest;
   cosim::WriteFileAtomically(path, id.dump(2) + "\n");
 }
 
-std::optional<std::string> ReadSweepFingerprint(const std::string& path) {
+std::optional<SweepIdentity> ReadSweepIdentity(const std::string& path) {
   const auto text = cosim::ReadWholeFile(path);
   if (!text) return std::nullopt;
   const auto id = nlohmann::json::parse(*text, nullptr, /*allow_exceptions=*/false);
-  if (!id.is_object() || !id.contains("fingerprint") || !id["fingerprint"].is_string()) {
+  if (!id.is_object() || !id.contains("fingerprint") || !id["fingerprint"].is_string() ||
+      !id.contains("inputs") || !id["inputs"].is_object()) {
     return std::nullopt;
   }
-  return id["fingerprint"].get<std::string>();
+  SweepIdentity out;
+  out.fingerprint = id["fingerprint"].get<std::string>();
+  for (const auto& [file, digest] : id["inputs"].items()) {
+    if (!digest.is_string()) return std::nullopt;
+    out.inputs[file] = digest.get<std::string>();
+  }
+  return out;
+}
+
+std::vector<std::string> ChangedInputs(const std::map<std::string, std::string>& inputs) {
+  std::vector<std::string> changed;
+  for (const auto& [file, digest] : inputs) {
+    const std::string now = config::InputDigestNow(file);
+    if (now != digest) {
+      changed.push_back(file + (now == config::kUnreadable      ? " (now missing or unreadable)"
+                                : digest == config::kUnreadable ? " (unreadable then, present now)"
+                                                                : " (its content changed)"));
+    }
+  }
+  return changed;
 }
 
 ResultsFile::ResultsFile(std::string path, std::string header, std::FILE* file,
@@ -233,7 +249,13 @@ ResultsFile::ResultsFile(ResultsFile&& other) noexcept
       header_(std::move(other.header_)),
       file_(other.file_),
       rows_(std::move(other.rows_)),
-      failed_(other.failed_) {
+      failed_(other.failed_),
+      dropped_(other.dropped_),
+      tracking_(other.tracking_),
+      identity_path_(std::move(other.identity_path_)),
+      identity_spec_(std::move(other.identity_spec_)),
+      fingerprint_(std::move(other.fingerprint_)),
+      inputs_(std::move(other.inputs_)) {
   other.file_ = nullptr;
 }
 
@@ -286,8 +308,9 @@ ResultsFile ResultsFile::Resume(const std::string& path, const SweepSpec& spec) 
     const auto id = ParseId(fields->front());
     if (!id || *id < 0 || *id >= count) continue;
     if (rows.count(*id) != 0) continue;  // the first of duplicates stands
-    const std::string_view row_text = std::string_view(line).substr(0, line.rfind(','));
-    if (RowCheck(row_text) != fields->back() ||
+    const std::vector<std::string> proven_fields(fields->begin(), fields->end() - 2);
+    const std::string proven = JoinCsvLine(proven_fields);
+    if (RowCheck(std::string_view(proven).substr(0, proven.size() - 1)) != fields->back() ||
         !RowMatchesPlan(spec, PlanRun(spec, *id), *fields)) {
       ++dropped;
       continue;
@@ -313,7 +336,37 @@ void ResultsFile::Rewrite() {
   file_ = OpenOrThrow(path_, "ab");
 }
 
-void ResultsFile::Append(std::int64_t id, const std::string& line, bool ok) {
+void ResultsFile::TrackInputs(std::string identity_path, const SweepSpec& spec,
+                              std::string fingerprint, std::map<std::string, std::string> inputs) {
+  tracking_ = true;
+  identity_path_ = std::move(identity_path);
+  identity_spec_ = spec;
+  fingerprint_ = std::move(fingerprint);
+  inputs_ = std::move(inputs);
+}
+
+void ResultsFile::Append(std::int64_t id, const std::string& line, bool ok,
+                         const std::map<std::string, std::string>& inputs) {
+  if (tracking_) {
+    // The row stands for the files its run read: each must be what every
+    // other row's run read (a file edited during the sweep would mix two
+    // models in one table), and sweep.json must name it before the row is
+    // written, so that --resume checks it.
+    bool added = false;
+    for (const auto& [file, digest] : inputs) {
+      const auto [it, fresh] = inputs_.emplace(file, digest);
+      added = added || fresh;
+      if (!fresh && it->second != digest) {
+        throw std::runtime_error(
+            file + " changed during the sweep: run " + std::to_string(id) +
+            " read other bytes than the runs before it (SHA-256 " + digest.substr(0, 12) +
+            " against " + it->second.substr(0, 12) +
+            "); its row is not written. Rows of two versions of a file would mix two models: "
+            "--force starts the sweep afresh");
+      }
+    }
+    if (added) WriteSweepIdentity(identity_path_, identity_spec_, fingerprint_, inputs_);
+  }
   // One write and a flush per row: a kill loses at most the line being
   // written, which a resumed sweep drops and runs again.
   if (std::fputs(line.c_str(), file_) < 0 || std::fflush(file_) != 0) {

@@ -18,7 +18,8 @@ namespace linesim::sweep {
 /// Column names of results.csv: run_id, each parameter path, seed, each
 /// metric, status, error, error_unit, error_time_s, error_phase,
 /// error_variable, error_cause, wall_s, row_check (FNV-1a 64 of the row's
-/// text before it, 16 hex digits: Resume drops a row that was edited).
+/// fields before wall_s, 16 hex digits: Resume drops a row changed by
+/// accident; it is no proof against a deliberate edit, see RowCheck).
 /// `error` is the whole message; the
 /// error_* columns are the first failure's fields (cosim::RunError), empty
 /// for an ok run or a field that does not apply.
@@ -26,7 +27,8 @@ std::vector<std::string> ResultsHeader(const SweepSpec& spec);
 
 /// One line of results.csv (with its newline). Numbers are written as the
 /// shortest text that reads back to the same double, so rows are the same
-/// bytes on any machine, thread or rank; only wall_s differs between runs.
+/// bytes on any machine, thread or rank; only wall_s differs between runs
+/// (row_check leaves it out, so it does not).
 std::string FormatRow(const RunSpec& run, const RunOutcome& outcome);
 
 /// CSV fields, RFC 4180 quoting; nothing when a quote is left open (a line
@@ -34,18 +36,29 @@ std::string FormatRow(const RunSpec& run, const RunOutcome& outcome);
 std::optional<std::vector<std::string>> SplitCsvLine(std::string_view line);
 std::string JoinCsvLine(const std::vector<std::string>& fields);
 
-/// A fingerprint of everything that decides the rows: the base scenario's
-/// text, every model file, the sweep's settings and metrics. A resumed
-/// sweep, and every MPI rank, must match it.
+/// A fingerprint of everything that decides the rows: every file the base
+/// scenario's loads read, by content (spec.inputs: scenario, robot, scene,
+/// motor and sensor models, route graphs, FMUs, wherever they lie), and the
+/// sweep's settings and metrics; SHA-256, 64 hex digits. A resumed sweep,
+/// and every MPI rank, must match it.
 std::string SweepFingerprint(const SweepSpec& spec);
 
-/// sweep.json, which says what sweep a folder holds: name, files, run count
-/// and SweepFingerprint. Written atomically; throws std::runtime_error.
+/// sweep.json, which says what sweep a folder holds: name, files, run count,
+/// SweepFingerprint and `inputs`, every file the rows' runs read (absolute
+/// path -> SHA-256). Written atomically; throws std::runtime_error.
 void WriteSweepIdentity(const std::string& path, const SweepSpec& spec,
-                        const std::string& fingerprint);
-/// The fingerprint a sweep.json holds; nothing when it is missing or
-/// unreadable.
-std::optional<std::string> ReadSweepFingerprint(const std::string& path);
+                        const std::string& fingerprint,
+                        const std::map<std::string, std::string>& inputs);
+struct SweepIdentity {
+  std::string fingerprint;
+  std::map<std::string, std::string> inputs;
+};
+/// What a sweep.json holds; nothing when it is missing, unreadable or
+/// lacks a field.
+std::optional<SweepIdentity> ReadSweepIdentity(const std::string& path);
+/// The files of `inputs` whose bytes are no longer the recorded ones, each
+/// as "path (what changed)"; empty when every file is as it was.
+std::vector<std::string> ChangedInputs(const std::map<std::string, std::string>& inputs);
 
 /// The results.csv of a sweep folder, written as runs finish: one flushed
 /// line per run (completion order), then sorted by run id at the end.
@@ -61,7 +74,7 @@ class ResultsFile {
   /// whose status is neither ok nor failed, whose ok metrics or wall time
   /// do not read as finite numbers (a failed run's may be empty) is dropped
   /// (its run is done again) and counted in dropped_count(); so is a row
-  /// whose row_check is not its text's (an edited row). Throws
+  /// whose row_check is not its fields' (a row edited by accident). Throws
   /// std::runtime_error when the header is not this sweep's.
   static ResultsFile Resume(const std::string& path, const SweepSpec& spec);
 
@@ -71,9 +84,17 @@ class ResultsFile {
 
   bool HasRow(std::int64_t id) const { return rows_.count(id) != 0; }
   std::size_t row_count() const { return rows_.size(); }
-  /// Appends and flushes one row; throws std::runtime_error on a write
-  /// failure (disk full).
-  void Append(std::int64_t id, const std::string& line, bool ok);
+  /// From now on Append checks each run's files against `inputs` (those
+  /// of the rows so far, as sweep.json at `identity_path` holds them) and
+  /// rewrites sweep.json with the new ones before writing the row.
+  void TrackInputs(std::string identity_path, const SweepSpec& spec, std::string fingerprint,
+                   std::map<std::string, std::string> inputs);
+  /// Appends and flushes one row, whose run read `inputs`; throws
+  /// std::runtime_error on a write failure (disk full) and, with
+  /// TrackInputs, when the run read a file whose bytes differ from what
+  /// the rows before it were computed from (the row is not written).
+  void Append(std::int64_t id, const std::string& line, bool ok,
+              const std::map<std::string, std::string>& inputs = {});
   /// Rows whose run failed.
   std::int64_t failed_count() const { return failed_; }
   /// Rows Resume dropped because they did not match the plan.
@@ -94,6 +115,12 @@ class ResultsFile {
   std::map<std::int64_t, std::string> rows_;  // run id -> line with its newline
   std::int64_t failed_ = 0;
   std::int64_t dropped_ = 0;
+  // TrackInputs: sweep.json and the files every row so far was computed from.
+  bool tracking_ = false;
+  std::string identity_path_;
+  SweepSpec identity_spec_;
+  std::string fingerprint_;
+  std::map<std::string, std::string> inputs_;
 };
 
 }  // namespace linesim::sweep

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <limits>
 
+#include "config/input_files.h"
 #include "session/session.h"
 
 namespace linesim::sweep {
@@ -25,8 +26,10 @@ RunOutcome ExecuteRun(const SweepSpec& spec, const RunSpec& run, const std::atom
   out.seed = run.seed;
   out.metrics.assign(spec.metrics.size(), std::numeric_limits<double>::quiet_NaN());
   const auto wall0 = std::chrono::steady_clock::now();
+  const config::InputFileRecord inputs;
   const auto finish = [&](RunStatus status, std::string error,
                           cosim::RunError failure = cosim::RunError{}) {
+    out.inputs = inputs.files();
     out.status = status;
     out.error = OneLine(std::move(error));
     failure.cause = OneLine(std::move(failure.cause));

@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,10 @@ struct RunOutcome {
   /// message is `error`. Default (phase step, all empty) when ok.
   cosim::RunError failure;
   double wall_s = 0;
+  /// Every file the run read (config/input_files.h): absolute path ->
+  /// SHA-256 of the bytes it read. A refused scenario's too: its refusal
+  /// is as much the files' doing as a result is.
+  std::map<std::string, std::string> inputs;
 };
 
 /// Builds the base scenario with the run's overrides and runs it to the

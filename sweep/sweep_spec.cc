@@ -12,6 +12,7 @@
 #include <string_view>
 #include <unordered_set>
 
+#include "config/input_files.h"
 #include "config/yaml_reader.h"
 #include "cosim/system.h"
 #include "cosim/variable_table.h"
@@ -339,8 +340,10 @@ SweepSpec RepeatSweepSpec(const std::string& scenario, const std::vector<std::st
   if (runs < 2 || runs > 1000000) {
     throw std::invalid_argument("--runs " + std::to_string(runs) + ": expected 2 to 1000000");
   }
-  const loader::Scenario base = loader::LoadScenario(scenario, set_args);
   SweepSpec spec;
+  const config::InputFileRecord inputs;
+  const loader::Scenario base = loader::LoadScenario(scenario, set_args);
+  spec.inputs = inputs.files();
   spec.file = scenario;
   spec.scenario = scenario;
   spec.name = base.name;
@@ -463,7 +466,10 @@ SweepSpec LoadSweepSpec(const std::string& file) {
   spec.reference = loader::ReadReference(Child(root, "reference"), r);
   if (!r.ok()) throw ScenarioError(r.issues());
 
-  // The base scenario with the fixed settings must load by itself.
+  // The base scenario with the fixed settings must load by itself. Every
+  // file it reads (and the parameter checks' loads read) is one the runs
+  // depend on: spec.inputs.
+  const config::InputFileRecord inputs;
   loader::Scenario base;
   try {
     base = loader::LoadScenario(spec.scenario, FixedOverrides(spec));
@@ -525,6 +531,7 @@ SweepSpec LoadSweepSpec(const std::string& file) {
                        r);
   }
   if (!r.ok()) throw ScenarioError(r.issues());
+  spec.inputs = inputs.files();
   return spec;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,11 @@ struct SweepSpec {
   SeedPolicy seeds = SeedPolicy::kCommon;
   /// The base scenario's SHA-256 with `set:` applied (loader::Scenario::sha256).
   std::string scenario_sha256;
+  /// Every file the base scenario's loads read while the sweep was checked
+  /// (scenario, robot, scene, model files, route graphs, FMUs): absolute
+  /// path -> SHA-256 of its bytes (config/input_files.h). A run records
+  /// its own (RunOutcome::inputs); SweepFingerprint covers these.
+  std::map<std::string, std::string> inputs;
   /// Metrics of the base scenario to collect; all of them when the file
   /// names none.
   std::vector<std::string> metrics;

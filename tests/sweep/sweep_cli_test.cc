@@ -100,15 +100,16 @@ std::string Fresh(const std::string& name) {
   return p;
 }
 
-// results.csv without its last two columns (wall_s and row_check, which
-// covers wall_s): the rest must be the same bytes for any jobs, ranks or
+// results.csv without its wall_s column (the one before last; row_check
+// leaves it out): the rest must be the same bytes for any jobs, ranks or
 // interruptions.
 std::string Rows(const std::string& dir) {
   std::string out;
   std::istringstream in(ReadFile(fs::path(dir) / "results.csv"));
   for (std::string line; std::getline(in, line);) {
-    line = line.substr(0, line.rfind(','));
-    out += line.substr(0, line.rfind(',')) + "\n";
+    const std::size_t check = line.rfind(',');
+    const std::size_t wall = line.rfind(',', check - 1);
+    out += line.substr(0, wall) + line.substr(check) + "\n";
   }
   return out;
 }
@@ -199,7 +200,7 @@ TEST(SweepCli, OneMpiRankRunsAloneAndRanksWithOtherModelFilesAreRefused) {
                          "--out",
                          dir});
   EXPECT_NE(m.status, 0);
-  EXPECT_NE(m.err.find("rank 1: linesim: the sweep file, its base scenario or a model file "
+  EXPECT_NE(m.err.find("rank 1: linesim: the sweep's settings or a file its base scenario reads "
                        "differs from rank 0's"),
             std::string::npos)
       << m.err;
@@ -279,6 +280,47 @@ TEST(SweepCli, CtrlCStopsCleanlyAndResumeFinishes) {
   const std::string whole = Fresh("int_whole");
   ASSERT_EQ(Sweep(file, whole).status, 0);
   EXPECT_EQ(Rows(dir), Rows(whole));
+}
+
+// Guards --resume against rows of two models (issue 37: a robot file given
+// by path was in no fingerprint; edited, a resumed sweep mixed both robots'
+// rows with exit 0). The robot files are given by path and varied by the
+// sweep, so the second is read only by the runs, never by the base load:
+// the runs' own record of what they read must refuse the resume.
+TEST(SweepCli, ResumeRefusesWhenAFileARowsRunReadChanged) {
+  const fs::path dir = Temp("robots_by_path");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::string robot = ReadFile(LINESIM_SOURCE_DIR "/models/robots/raw3.yaml");
+  for (std::size_t at = robot.find("model: maxon_re40_148877"); at != std::string::npos;
+       at = robot.find("model: maxon_re40_148877", at + 1)) {
+    robot.replace(at, 24, "model: " LINESIM_SOURCE_DIR "/models/motors/maxon_re40_148877.yaml");
+  }
+  std::ofstream(dir / "a.yaml") << robot;
+  std::ofstream(dir / "b.yaml") << robot;
+  std::string scenario = ReadFile(kCrossLine);
+  scenario.replace(scenario.find("model: raw3"), 11, "model: ./a.yaml");
+  std::ofstream(dir / "scenario.yaml") << scenario;
+  const std::string file = (dir / "sweep.yaml").string();
+  std::ofstream(file) << "scenario: scenario.yaml\nset: {duration_s: 1}\n"
+                         "parameters: [{path: robot.model, values: [./a.yaml, ./b.yaml]}]\n";
+  const std::string out = Fresh("robots_by_path_out");
+  const Result first = Sweep(file, out);
+  ASSERT_EQ(first.status, 0) << first.out << first.err;
+  const auto identity = nlohmann::json::parse(ReadFile(fs::path(out) / "sweep.json"));
+  EXPECT_TRUE(identity["inputs"].contains((dir / "b.yaml").string())) << identity.dump(2);
+  const std::string rows = ReadFile(fs::path(out) / "results.csv");
+
+  std::ofstream(dir / "b.yaml", std::ios::app) << "\n# the robot changed\n";
+  const Result resumed = Sweep(file, out, {"--resume"});
+  EXPECT_EQ(resumed.status, 2) << resumed.out << resumed.err;
+  EXPECT_NE(resumed.err.find((dir / "b.yaml").string() + " (its content changed)"),
+            std::string::npos)
+      << resumed.err;
+  EXPECT_EQ(ReadFile(fs::path(out) / "results.csv"), rows);
+  // --force starts afresh from the files as they are.
+  EXPECT_EQ(Sweep(file, out, {"--force"}).status, 0);
+  EXPECT_EQ(Sweep(file, out, {"--resume"}).status, 0);
 }
 
 // Guards --resume against a results file that never ends: a link to a

@@ -14,6 +14,7 @@
 #include "sweep/executor.h"
 #include "sweep/progress.h"
 #include "sweep/results_file.h"
+#include "sweep/run_one.h"
 #include "sweep/run_plan.h"
 #include "sweep/sweep_spec.h"
 
@@ -394,6 +395,7 @@ TEST(SweepSpec, AWrongKeyInsideAValueFailsOnlyThatRun) {
 TEST(SweepFingerprint, ChangesWithTheSweepTheScenarioAndTheModelFiles) {
   const SweepSpec spec = LoadSweepSpec(WriteFile("fp.yaml", BeltSweep()));
   const std::string base = SweepFingerprint(spec);
+  EXPECT_EQ(base.size(), 64u);  // SHA-256
   EXPECT_EQ(SweepFingerprint(LoadSweepSpec(WriteFile("fp_same.yaml", BeltSweep()))), base);
   EXPECT_NE(SweepFingerprint(LoadSweepSpec(WriteFile("fp_rep.yaml", BeltSweep("repeats: 2\n")))),
             base);
@@ -405,12 +407,111 @@ TEST(SweepFingerprint, ChangesWithTheSweepTheScenarioAndTheModelFiles) {
   fs::remove_all(models);
   fs::copy(LINESIM_SOURCE_DIR "/models", models, fs::copy_options::recursive);
   setenv("LINESIM_MODELS_DIR", models.c_str(), 1);
-  const std::string copied = SweepFingerprint(spec);
+  const std::string copied =
+      SweepFingerprint(LoadSweepSpec(WriteFile("fp_copy.yaml", BeltSweep())));
   { std::ofstream(models / "robots" / "raw3.yaml", std::ios::app) << "\n# edited\n"; }
-  const std::string edited = SweepFingerprint(spec);
+  const std::string edited =
+      SweepFingerprint(LoadSweepSpec(WriteFile("fp_edit.yaml", BeltSweep())));
   unsetenv("LINESIM_MODELS_DIR");
-  EXPECT_EQ(copied, base);
-  EXPECT_NE(edited, base);
+  EXPECT_NE(copied, edited);
+}
+
+// cross_line in a folder of its own whose robot, motor and scene are files
+// given by path (robot: {model: ./robot.yaml}, the robot's motors
+// ./motor.yaml, scene: {model: ./scene.yaml}).
+fs::path WritePathModels(const std::string& name) {
+  const fs::path dir =
+      fs::path(::testing::TempDir()) / ("sweep_paths_" + std::to_string(getpid()) + "_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto replace_all = [](std::string text, const std::string& from, const std::string& to) {
+    for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at)) {
+      text.replace(at, from.size(), to);
+      at += to.size();
+    }
+    return text;
+  };
+  const std::string robot = ReadFile(LINESIM_SOURCE_DIR "/models/robots/raw3.yaml");
+  std::ofstream(dir / "robot.yaml")
+      << replace_all(robot, "model: maxon_re40_148877", "model: ./motor.yaml");
+  fs::copy_file(LINESIM_SOURCE_DIR "/models/motors/maxon_re40_148877.yaml", dir / "motor.yaml");
+  fs::copy_file(LINESIM_SOURCE_DIR "/models/scenes/factory_line.yaml", dir / "scene.yaml");
+  std::string scenario = ReadFile(kCrossLine);
+  scenario = replace_all(scenario, "model: raw3", "model: ./robot.yaml");
+  scenario = replace_all(scenario, "{model: factory_line}", "{model: ./scene.yaml}");
+  std::ofstream(dir / "scenario.yaml") << scenario;
+  std::ofstream(dir / "sweep.yaml") << "scenario: scenario.yaml\nset: {duration_s: 1}\n"
+                                       "parameters: [{path: control.compensation, values: [true, "
+                                       "false]}]\n";
+  return dir;
+}
+
+// Guards --resume against rows of two models (issue 37): every file a run
+// reads is in the fingerprint by content, whatever its kind and wherever
+// it lies, found where the loader reads it rather than listed by kind.
+TEST(SweepFingerprint, CoversEveryFileTheRunsReadGivenByPathOrByName) {
+  const fs::path dir = WritePathModels("fp");
+  const SweepSpec spec = LoadSweepSpec((dir / "sweep.yaml").string());
+  for (const char* file : {"scenario.yaml", "robot.yaml", "motor.yaml", "scene.yaml"}) {
+    const std::string key = (dir / file).lexically_normal().string();
+    ASSERT_TRUE(spec.inputs.count(key)) << key;
+    EXPECT_EQ(spec.inputs.at(key).size(), 64u) << key;
+  }
+  // The sensors' model files, named by the robot file, from models/.
+  EXPECT_TRUE(spec.inputs.count((fs::path(LINESIM_SOURCE_DIR) / "models/sensors/sick_s300.yaml")
+                                    .lexically_normal()
+                                    .string()));
+  const std::string before = SweepFingerprint(spec);
+  for (const char* file : {"robot.yaml", "motor.yaml", "scene.yaml", "scenario.yaml"}) {
+    const std::string text = ReadFile((dir / file).string());
+    std::ofstream(dir / file, std::ios::app) << "\n# edited\n";
+    EXPECT_NE(SweepFingerprint(LoadSweepSpec((dir / "sweep.yaml").string())), before) << file;
+    std::ofstream(dir / file, std::ios::binary) << text;
+  }
+  EXPECT_EQ(SweepFingerprint(LoadSweepSpec((dir / "sweep.yaml").string())), before);
+  // What a run read, recorded by the run itself (a parameter may name
+  // other files than the base scenario reads).
+  const RunOutcome outcome = ExecuteRun(spec, PlanRun(spec, 0));
+  ASSERT_EQ(outcome.status, RunStatus::kOk) << outcome.error;
+  EXPECT_EQ(outcome.inputs.at((dir / "robot.yaml").lexically_normal().string()),
+            spec.inputs.at((dir / "robot.yaml").lexically_normal().string()));
+  EXPECT_TRUE(ChangedInputs(outcome.inputs).empty());
+  std::ofstream(dir / "motor.yaml", std::ios::app) << "\n# edited\n";
+  const auto changed = ChangedInputs(outcome.inputs);
+  ASSERT_EQ(changed.size(), 1u);
+  EXPECT_NE(changed[0].find("motor.yaml (its content changed)"), std::string::npos) << changed[0];
+}
+
+// Guards a sweep whose file is edited while it runs: a run that read other
+// bytes than the rows before it is refused (its row is not written), and a
+// run that read a new file adds it to sweep.json before its row.
+TEST(ResultsFile, ARunThatReadAnEditedFileIsRefusedAndNewFilesAreNamedFirst) {
+  const SweepSpec spec = LoadSweepSpec(WriteFile("inputs.yaml", BeltSweep()));
+  const std::string path = WriteFile("inputs_results.csv", "");
+  const std::string identity = WriteFile("inputs_sweep.json", "");
+  ResultsFile results = ResultsFile::Create(path, spec);
+  WriteSweepIdentity(identity, spec, SweepFingerprint(spec), {{"/a.yaml", "1111"}});
+  results.TrackInputs(identity, spec, SweepFingerprint(spec), {{"/a.yaml", "1111"}});
+  RunOutcome outcome;
+  outcome.status = RunStatus::kOk;
+  outcome.seed = PlanRun(spec, 0).seed;
+  outcome.metrics.assign(spec.metrics.size(), 1.0);
+  results.Append(0, FormatRow(PlanRun(spec, 0), outcome), true,
+                 {{"/a.yaml", "1111"}, {"/b.yaml", "2222"}});
+  ASSERT_TRUE(ReadSweepIdentity(identity));
+  EXPECT_EQ(ReadSweepIdentity(identity)->inputs,
+            (std::map<std::string, std::string>{{"/a.yaml", "1111"}, {"/b.yaml", "2222"}}));
+  const std::string before = ReadFile(path);
+  try {
+    results.Append(1, FormatRow(PlanRun(spec, 1), outcome), true, {{"/b.yaml", "3333"}});
+    ADD_FAILURE() << "a run of another /b.yaml was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/b.yaml changed during the sweep: run 1"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(ReadFile(path), before);
+  EXPECT_FALSE(results.HasRow(1));
 }
 
 // Every shipped sweep passes the checks made before anything runs: its
@@ -498,15 +599,16 @@ std::string FreshDir(const std::string& name) {
   return p.string();
 }
 
-// The rows without the wall_s column, the one thing that differs between
-// two runs of the same sweep.
+// The rows without the wall_s column (the one before last), the one thing
+// that differs between two runs of the same sweep: row_check leaves it out
+// (issue 37: it covered wall_s, so it differed too).
 std::string WithoutWallTime(const std::string& csv) {
   std::string out;
   std::istringstream in(csv);
-  // wall_s and row_check (which covers wall_s): the two last columns.
   for (std::string line; std::getline(in, line);) {
-    line = line.substr(0, line.rfind(','));
-    out += line.substr(0, line.rfind(',')) + "\n";
+    const std::size_t check = line.rfind(',');
+    const std::size_t wall = line.rfind(',', check - 1);
+    out += line.substr(0, wall) + line.substr(check) + "\n";
   }
   return out;
 }
@@ -686,7 +788,8 @@ TEST(ResultsFile, ResumeDropsRowsThatDoNotMatchThePlan) {
   // Columns: run_id, speed, compensation, seed, 8 metrics..., status, error,
   // the 5 error fields, wall_s, row_check. Guards issue 24: a metric edited
   // into a finished row (999, a number the plan checks cannot tell from a
-  // result) was kept; row_check proves the row.
+  // result) was kept; row_check catches such an edit (not one whose check
+  // was recomputed: docs/outputs.md).
   const std::string path = dir + "/results.csv";
   std::ofstream(path, std::ios::trunc)
       << lines[0] << lines[1]                  // run 0 as it was
@@ -700,6 +803,49 @@ TEST(ResultsFile, ResumeDropsRowsThatDoNotMatchThePlan) {
   EXPECT_TRUE(resumed.HasRow(0));
   EXPECT_EQ(resumed.dropped_count(), 5);
   EXPECT_EQ(ReadFile(path), lines[0] + lines[1]);
+}
+
+// Guards the row check's scope (issue 37): it leaves wall_s out, so two
+// runs of a row are the same bytes but for wall_s, and it catches what
+// happens to a file by accident: a spreadsheet's re-save (CRLF line ends,
+// a number rewritten as 1.5E-3), a quote lost. It is no proof against a
+// deliberate edit (docs/outputs.md): a row whose check was recomputed
+// after an edit is kept, as the docs say.
+TEST(ResultsFile, RowCheckLeavesWallTimeOutAndCatchesAccidents) {
+  const SweepSpec spec = LoadSweepSpec(WriteFile("rowcheck.yaml", BeltSweep()));
+  const RunSpec run = PlanRun(spec, 0);
+  RunOutcome outcome;
+  outcome.status = RunStatus::kOk;
+  outcome.seed = run.seed;
+  outcome.metrics.assign(spec.metrics.size(), 0.0015);
+  outcome.wall_s = 0.25;
+  const std::string a = FormatRow(run, outcome);
+  outcome.wall_s = 0.75;
+  const std::string b = FormatRow(run, outcome);
+  const auto fa = *SplitCsvLine(std::string_view(a).substr(0, a.size() - 1));
+  const auto fb = *SplitCsvLine(std::string_view(b).substr(0, b.size() - 1));
+  EXPECT_EQ(fa.back(), fb.back());                  // row_check
+  EXPECT_NE(fa[fa.size() - 2], fb[fb.size() - 2]);  // wall_s
+  EXPECT_EQ(WithoutWallTime(a), WithoutWallTime(b));
+
+  const std::string dir = FreshDir("rowcheck");
+  const std::string path = dir + "/results.csv";
+  const std::string header = JoinCsvLine(ResultsHeader(spec));
+  std::string metric_rewritten = a;
+  metric_rewritten.replace(metric_rewritten.find("0.0015"), 6, "1.5E-3");
+  std::string crlf = a;
+  crlf.insert(crlf.size() - 1, "\r");
+  for (const std::string& accident : {crlf, metric_rewritten}) {
+    std::ofstream(path, std::ios::trunc | std::ios::binary) << header << accident;
+    const ResultsFile resumed = ResultsFile::Resume(path, spec);
+    EXPECT_FALSE(resumed.HasRow(0)) << accident;
+    EXPECT_EQ(resumed.dropped_count(), 1) << accident;
+  }
+  // A row as written, or with only its wall time changed, is kept.
+  for (const std::string& kept : {a, b}) {
+    std::ofstream(path, std::ios::trunc | std::ios::binary) << header << kept;
+    EXPECT_TRUE(ResultsFile::Resume(path, spec).HasRow(0)) << kept;
+  }
 }
 
 TEST(ResultsFile, TableParsesRowsBack) {

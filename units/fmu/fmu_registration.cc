@@ -1,6 +1,7 @@
 // Registers the fmu family's unit type (see config/unit_registry.h).
 #include <filesystem>
 
+#include "config/input_files.h"
 #include "config/unit_registry.h"
 #include "units/fmu/fmu_unit.h"
 
@@ -24,6 +25,8 @@ std::unique_ptr<cosim::Unit> MakeFmu(const UnitBuildContext& c) {
   if (file.is_relative()) {
     file = std::filesystem::path(c.reader.file()).parent_path() / file;
   }
+  // The FMU is a file the run's results depend on (config/input_files.h).
+  config::RecordInputFile(file.string());
   try {
     return std::make_unique<FmuUnit>(c.name, file.lexically_normal().string());
   } catch (const FmuError& e) {

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "config/input_files.h"
 #include "config/scenario_error.h"
 #include "loader/scenario.h"
 #include "tests/units/fmu/fmu_test_support.h"
@@ -27,10 +28,14 @@ std::string Scenario(const std::string& fmu_path, const std::string& rate_unit) 
          "units:\n"
          "  rate:\n"
          "    type: step_signal\n"
-         "    parameters: {unit: " + rate_unit + ", steps: [{time_s: 0, value: 0.3}]}\n"
+         "    parameters: {unit: " +
+         rate_unit +
+         ", steps: [{time_s: 0, value: 0.3}]}\n"
          "  plant:\n"
          "    type: fmu\n"
-         "    parameters: {path: " + fmu_path + ", k: 2.0, x0: 0.5}\n"
+         "    parameters: {path: " +
+         fmu_path +
+         ", k: 2.0, x0: 0.5}\n"
          "connections:\n"
          "  - {from: \"rate.value[0]\", to: plant.u}\n";
 }
@@ -49,6 +54,23 @@ TEST(FmuScenario, LoadsAndRunsWithThePathRelativeToTheFile) {
   const auto& plant = sc.system->unit(*sc.system->FindUnit("plant"));
   const double exact = 0.3 / 2.0 + (0.5 - 0.3 / 2.0) * std::exp(-2.0);
   EXPECT_NEAR(plant.variables().GetReal(*plant.variables().Find("x")), exact, 1e-14);
+}
+
+// Guards a sweep's fingerprint (issue 37): the FMU a scenario names is a
+// file its results depend on, recorded by content where it is read, beside
+// the scenario file.
+TEST(FmuScenario, TheFmuIsRecordedAsAnInputByContent) {
+  Scratch s("scenario_inputs");
+  fs::create_directories(s.path() / "fmus");
+  fs::copy_file(test::Fmu("dahlquist"), s / "fmus/dahlquist.fmu");
+  std::ofstream(s / "plant.yaml") << Scenario("fmus/dahlquist.fmu", "m/s");
+  const config::InputFileRecord record;
+  (void)loader::LoadScenario(s / "plant.yaml");
+  const std::string fmu = (s.path() / "fmus/dahlquist.fmu").lexically_normal().string();
+  ASSERT_EQ(record.files().count(fmu), 1u);
+  EXPECT_EQ(record.files().at(fmu), config::InputDigestNow(fmu));
+  EXPECT_EQ(record.files().at(fmu).size(), 64u);
+  EXPECT_EQ(record.files().count((s.path() / "plant.yaml").lexically_normal().string()), 1u);
 }
 
 TEST(FmuScenario, RefusesAMismatchedUnitAndAMissingFile) {
@@ -116,14 +138,17 @@ TEST(FmuScenario, AnFmuThatAsksToTerminateEndsTheRunOk) {
                          "units:\n"
                          "  end:\n"
                          "    type: fmu\n"
-                         "    parameters: {path: " + test::Fmu("terminate2") + "}\n"
-                         "recording: {interval_s: 0.01, variables: [end.x]}\n";
+                         "    parameters: {path: " +
+                             test::Fmu("terminate2") +
+                             "}\n"
+                             "recording: {interval_s: 0.01, variables: [end.x]}\n";
   const std::string out_dir = dir / "out";
   const std::string out = RunCommand(std::string(LINESIM_CLI) + " run " + file + " --out " +
                                      out_dir + " 2>&1; echo exit=$?");
   EXPECT_NE(out.find("exit=0"), std::string::npos) << out;
   std::ifstream summary_file(out_dir + "/summary.json");
-  const std::string summary((std::istreambuf_iterator<char>(summary_file)), std::istreambuf_iterator<char>());
+  const std::string summary((std::istreambuf_iterator<char>(summary_file)),
+                            std::istreambuf_iterator<char>());
   EXPECT_NE(summary.find("\"status\": \"ok\""), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"ended_by\": \"unit 'end' (fmu): fmi2DoStep returned fmi2Discard with "
                          "fmi2Terminated = true"),
