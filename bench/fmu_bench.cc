@@ -9,8 +9,6 @@
 //   BM_FmuUnitDoStep     FmuUnit::DoStep: the same calls plus the unit's
 //                        checks (finite inputs, step size, tunables) and
 //                        the copies between the table and the FMI buffers
-//   BM_FmuUnitStepAndUpdate  UpdateOutputs + DoStep, as the master calls a
-//                        unit with direct feedthrough at each point
 // The wrapper's overhead = BM_FmuUnitDoStep - BM_FmuBareExchange (the FMU's
 // own work), or - BM_FmuBareDoStep for everything beyond doStep.
 
@@ -135,7 +133,7 @@ void BM_FmuBareExchange(benchmark::State& state) {
 }
 BENCHMARK(BM_FmuBareExchange);
 
-void UnitBench(benchmark::State& state, bool update) {
+void UnitBench(benchmark::State& state) {
   const std::string file = kDir + "/feedthrough2.fmu";
   if (kDir.empty() || !std::filesystem::exists(file)) {
     state.SkipWithError("feedthrough2 test FMU not built (configure with tests on)");
@@ -149,7 +147,6 @@ void UnitBench(benchmark::State& state, bool update) {
   std::int64_t n = 0;
   for (auto _ : state) {
     unit.variables().SetReal(in_a, static_cast<double>(n & 7));
-    if (update) unit.UpdateOutputs();
     if (unit.DoStep(n * kStep, kStep) != linesim::cosim::StepResult::kOk) {
       state.SkipWithError(unit.last_error().c_str());
       break;
@@ -157,10 +154,8 @@ void UnitBench(benchmark::State& state, bool update) {
     ++n;
   }
 }
-void BM_FmuUnitDoStep(benchmark::State& state) { UnitBench(state, false); }
-void BM_FmuUnitStepAndUpdate(benchmark::State& state) { UnitBench(state, true); }
+void BM_FmuUnitDoStep(benchmark::State& state) { UnitBench(state); }
 BENCHMARK(BM_FmuUnitDoStep);
-BENCHMARK(BM_FmuUnitStepAndUpdate);
 
 }  // namespace
 

@@ -126,15 +126,32 @@ class FmuBinary {
     };
     const auto p = [](auto f) { return reinterpret_cast<const void*>(f); };
     switch (type) {
-      case FmiType::kFloat32: need(p(f3.GetFloat32), p(f3.SetFloat32), "Float32"); break;
-      case FmiType::kInt8: need(p(f3.GetInt8), p(f3.SetInt8), "Int8"); break;
-      case FmiType::kUInt8: need(p(f3.GetUInt8), p(f3.SetUInt8), "UInt8"); break;
-      case FmiType::kInt16: need(p(f3.GetInt16), p(f3.SetInt16), "Int16"); break;
-      case FmiType::kUInt16: need(p(f3.GetUInt16), p(f3.SetUInt16), "UInt16"); break;
-      case FmiType::kUInt32: need(p(f3.GetUInt32), p(f3.SetUInt32), "UInt32"); break;
-      case FmiType::kInt64: need(p(f3.GetInt64), p(f3.SetInt64), "Int64"); break;
-      case FmiType::kUInt64: need(p(f3.GetUInt64), p(f3.SetUInt64), "UInt64"); break;
-      default: break;
+      case FmiType::kFloat32:
+        need(p(f3.GetFloat32), p(f3.SetFloat32), "Float32");
+        break;
+      case FmiType::kInt8:
+        need(p(f3.GetInt8), p(f3.SetInt8), "Int8");
+        break;
+      case FmiType::kUInt8:
+        need(p(f3.GetUInt8), p(f3.SetUInt8), "UInt8");
+        break;
+      case FmiType::kInt16:
+        need(p(f3.GetInt16), p(f3.SetInt16), "Int16");
+        break;
+      case FmiType::kUInt16:
+        need(p(f3.GetUInt16), p(f3.SetUInt16), "UInt16");
+        break;
+      case FmiType::kUInt32:
+        need(p(f3.GetUInt32), p(f3.SetUInt32), "UInt32");
+        break;
+      case FmiType::kInt64:
+        need(p(f3.GetInt64), p(f3.SetInt64), "Int64");
+        break;
+      case FmiType::kUInt64:
+        need(p(f3.GetUInt64), p(f3.SetUInt64), "UInt64");
+        break;
+      default:
+        break;
     }
   }
   FmuBinary(const FmuBinary&) = delete;
@@ -231,8 +248,8 @@ class FmuBinary {
 namespace {
 
 const char* StatusName(int major, int status) {
-  static const char* k2[] = {"fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal",
-                             "fmi2Pending"};
+  static const char* k2[] = {"fmi2OK",    "fmi2Warning", "fmi2Discard",
+                             "fmi2Error", "fmi2Fatal",   "fmi2Pending"};
   static const char* k3[] = {"fmi3OK", "fmi3Warning", "fmi3Discard", "fmi3Error", "fmi3Fatal"};
   if (major == 2 && status >= 0 && status <= 5) return k2[status];
   if (major == 3 && status >= 0 && status <= 4) return k3[status];
@@ -280,8 +297,9 @@ fs::path InsideFolder(const fs::path& root, const std::string& relative,
                       const std::string& fmu_file, const std::string& attribute) {
   const auto refuse = [&](const std::string& why) -> FmuError {
     return FmuError(fmu_file + ": " + attribute + " makes the path '" + relative + "', which " +
-                    why + ": refused (every path built from the model description must stay in "
-                          "the FMU)");
+                    why +
+                    ": refused (every path built from the model description must stay in "
+                    "the FMU)");
   };
   std::error_code ec;
   const fs::path base = fs::canonical(root, ec);
@@ -333,7 +351,8 @@ FmuUnit::FmuUnit(std::string name, const std::string& fmu_file)
     // Name the file inside the FMU, not the temporary folder.
     std::string what = e.what();
     const std::string prefix = md_file.string();
-    if (what.rfind(prefix, 0) == 0) what = fmu_file + "/modelDescription.xml" + what.substr(prefix.size());
+    if (what.rfind(prefix, 0) == 0)
+      what = fmu_file + "/modelDescription.xml" + what.substr(prefix.size());
     throw FmuError(what);
   }
   if (fs::exists(root / "terminalsAndIcons" / "terminalsAndIcons.xml", ec)) {
@@ -351,8 +370,8 @@ FmuUnit::FmuUnit(std::string name, const std::string& fmu_file)
       found += (found.empty() ? "" : ", ") + e.path().filename().string();
     }
     throw FmuError(fmu_file + ": no binary for this platform: binaries/" + platform + "/" +
-                   description_.model_identifier + ".so is missing (binaries for: " +
-                   (found.empty() ? "none" : found) + ")");
+                   description_.model_identifier +
+                   ".so is missing (binaries for: " + (found.empty() ? "none" : found) + ")");
   }
   binary_ = std::make_unique<FmuBinary>(so.string(), description_, fmu_file);
   DeclareVariables();
@@ -394,7 +413,8 @@ void FmuUnit::DeclareVariables() {
     }
   }
   for (const std::string& name : description_.left_out) mapping_.push_back({name, "", 0, false});
-  conversion_ = std::make_unique<unsigned char[]>(8 * std::max<std::size_t>({count[0], count[1], 1}));
+  conversion_ =
+      std::make_unique<unsigned char[]>(8 * std::max<std::size_t>({count[0], count[1], 1}));
   integer_variable_.assign(count[1], 0);
   reals_ = std::make_unique<double[]>(count[0]);
   integers_ = std::make_unique<std::int64_t[]>(count[1]);
@@ -406,7 +426,6 @@ void FmuUnit::DeclareVariables() {
 
   std::set<std::string> used;
   std::map<std::size_t, std::string> input_names;  // variable index -> table name
-  std::vector<std::string> all_inputs;
   // Per identifier, the suffix to try next: names that all become one
   // identifier ("a.b", "a_b", ...) would otherwise search from _2 each time,
   // quadratic in their number. The names are the same as with that search
@@ -457,7 +476,8 @@ void FmuUnit::DeclareVariables() {
         }
         if (!v.items.empty()) {
           text += ", enumeration '" + v.declared_type + "':";
-          for (const auto& [value, item] : v.items) text += " " + std::to_string(value) + " " + item;
+          for (const auto& [value, item] : v.items)
+            text += " " + std::to_string(value) + " " + item;
         }
         if (v.min) text += ", min " + cosim::FormatValue(*v.min);
         if (v.max) text += ", max " + cosim::FormatValue(*v.max);
@@ -472,21 +492,31 @@ void FmuUnit::DeclareVariables() {
           text += " row-major";
         }
         text += ")";
-        std::vector<std::string> deps;
-        if (d == kOutputs) {
-          if (!v.dependencies) {
-            deps = all_inputs;
-          } else {
+        // ModelStructure's direct dependencies hold in initialization mode
+        // only: in step mode a co-simulation FMU's outputs are those doStep
+        // computed, and no fmi*Get may follow an fmi*Set before the next
+        // doStep (FMI 2.0.4 section 4.2.4, FMI 3.0.2 Step Mode). So the
+        // outputs depend on no input at a communication point: the master
+        // neither orders nor loops on them, and never asks for outputs
+        // after setting inputs. Initialize() reads them after setting the
+        // inputs, as initialization mode allows.
+        const std::vector<std::string> deps;
+        if (d == kOutputs && (!v.dependencies || !v.dependencies->empty())) {
+          std::string on;
+          if (v.dependencies) {
             for (auto index : *v.dependencies) {
-              if (auto it = input_names.find(index); it != input_names.end()) deps.push_back(it->second);
+              if (auto it = input_names.find(index); it != input_names.end()) {
+                on += (on.empty() ? "" : " ") + it->second;
+              }
             }
           }
-          if (!deps.empty()) has_feedthrough_ = true;
+          text.insert(text.size() - 1, std::string(", depends on ") +
+                                           (v.dependencies ? on : "every input") +
+                                           " in initialization mode");
         }
-        const cosim::Variability variability =
-            d == kDirections ? cosim::Variability::kConstant
-            : d == kTunables ? cosim::Variability::kTunable
-                             : cosim::Variability::kFixed;
+        const cosim::Variability variability = d == kDirections ? cosim::Variability::kConstant
+                                               : d == kTunables ? cosim::Variability::kTunable
+                                                                : cosim::Variability::kFixed;
         const bool parameter = d == kParameters || d == kTunables || d == kDirections;
         if (arrays) {
           arrays_.emplace_back(v.size, 0.0);
@@ -546,7 +576,6 @@ void FmuUnit::DeclareVariables() {
         }
         if (d == kInputs) {
           input_names[i] = name;
-          all_inputs.push_back(name);
         }
       }
       if (g && t >= 4 && g->vrs.empty()) groups_[d].extras.pop_back();
@@ -554,16 +583,15 @@ void FmuUnit::DeclareVariables() {
   }
   // Tunable parameters: what was last given to the FMU.
   const Groups& tun = groups_[kTunables];
-  has_tunables_ = !tun.real.vrs.empty() || !tun.integer.vrs.empty() ||
-                  !tun.boolean.vrs.empty() || !tun.string.vrs.empty() || !tun.arrays.empty() ||
-                  !tun.extras.empty();
+  has_tunables_ = !tun.real.vrs.empty() || !tun.integer.vrs.empty() || !tun.boolean.vrs.empty() ||
+                  !tun.string.vrs.empty() || !tun.arrays.empty() || !tun.extras.empty();
 }
 
 std::vector<cosim::ParameterProblem> FmuUnit::CheckParameters() const {
   auto problems = cosim::Unit::CheckParameters();
   if (!binary_) {
-    problems.push_back({"path", std::nullopt,
-                        "must be set: the FMU file (.fmu), relative to the scenario file"});
+    problems.push_back(
+        {"path", std::nullopt, "must be set: the FMU file (.fmu), relative to the scenario file"});
   }
   return problems;
 }
@@ -662,8 +690,9 @@ void FmuUnit::CheckInteger(std::size_t slot, std::int64_t x, const char* phase) 
                     v.name);
   }
   if (v.items.empty()) return;
-  const auto it = std::lower_bound(v.items.begin(), v.items.end(), x,
-                                   [](const auto& item, std::int64_t value) { return item.first < value; });
+  const auto it =
+      std::lower_bound(v.items.begin(), v.items.end(), x,
+                       [](const auto& item, std::int64_t value) { return item.first < value; });
   if (it == v.items.end() || it->first != x) {
     std::string items;
     for (const auto& [value, name] : v.items) {
@@ -701,15 +730,32 @@ void FmuUnit::SetExtra(const TypedGroup& x, const char* phase) {
     Check(function(instance_, g.vrs.data(), n, buffer, n), call, phase);
   };
   switch (x.type) {
-    case FmiType::kFloat32: set(f.SetFloat32, fmi3::Float32{}, "fmi3SetFloat32"); break;
-    case FmiType::kInt8: set(f.SetInt8, fmi3::Int8{}, "fmi3SetInt8"); break;
-    case FmiType::kUInt8: set(f.SetUInt8, fmi3::UInt8{}, "fmi3SetUInt8"); break;
-    case FmiType::kInt16: set(f.SetInt16, fmi3::Int16{}, "fmi3SetInt16"); break;
-    case FmiType::kUInt16: set(f.SetUInt16, fmi3::UInt16{}, "fmi3SetUInt16"); break;
-    case FmiType::kUInt32: set(f.SetUInt32, fmi3::UInt32{}, "fmi3SetUInt32"); break;
-    case FmiType::kInt64: set(f.SetInt64, fmi3::Int64{}, "fmi3SetInt64"); break;
-    case FmiType::kUInt64: set(f.SetUInt64, fmi3::UInt64{}, "fmi3SetUInt64"); break;
-    default: break;
+    case FmiType::kFloat32:
+      set(f.SetFloat32, fmi3::Float32{}, "fmi3SetFloat32");
+      break;
+    case FmiType::kInt8:
+      set(f.SetInt8, fmi3::Int8{}, "fmi3SetInt8");
+      break;
+    case FmiType::kUInt8:
+      set(f.SetUInt8, fmi3::UInt8{}, "fmi3SetUInt8");
+      break;
+    case FmiType::kInt16:
+      set(f.SetInt16, fmi3::Int16{}, "fmi3SetInt16");
+      break;
+    case FmiType::kUInt16:
+      set(f.SetUInt16, fmi3::UInt16{}, "fmi3SetUInt16");
+      break;
+    case FmiType::kUInt32:
+      set(f.SetUInt32, fmi3::UInt32{}, "fmi3SetUInt32");
+      break;
+    case FmiType::kInt64:
+      set(f.SetInt64, fmi3::Int64{}, "fmi3SetInt64");
+      break;
+    case FmiType::kUInt64:
+      set(f.SetUInt64, fmi3::UInt64{}, "fmi3SetUInt64");
+      break;
+    default:
+      break;
   }
 }
 
@@ -737,15 +783,32 @@ void FmuUnit::GetExtra(const TypedGroup& x, const char* phase) {
     }
   };
   switch (x.type) {
-    case FmiType::kFloat32: get(f.GetFloat32, fmi3::Float32{}, "fmi3GetFloat32"); break;
-    case FmiType::kInt8: get(f.GetInt8, fmi3::Int8{}, "fmi3GetInt8"); break;
-    case FmiType::kUInt8: get(f.GetUInt8, fmi3::UInt8{}, "fmi3GetUInt8"); break;
-    case FmiType::kInt16: get(f.GetInt16, fmi3::Int16{}, "fmi3GetInt16"); break;
-    case FmiType::kUInt16: get(f.GetUInt16, fmi3::UInt16{}, "fmi3GetUInt16"); break;
-    case FmiType::kUInt32: get(f.GetUInt32, fmi3::UInt32{}, "fmi3GetUInt32"); break;
-    case FmiType::kInt64: get(f.GetInt64, fmi3::Int64{}, "fmi3GetInt64"); break;
-    case FmiType::kUInt64: get(f.GetUInt64, fmi3::UInt64{}, "fmi3GetUInt64"); break;
-    default: break;
+    case FmiType::kFloat32:
+      get(f.GetFloat32, fmi3::Float32{}, "fmi3GetFloat32");
+      break;
+    case FmiType::kInt8:
+      get(f.GetInt8, fmi3::Int8{}, "fmi3GetInt8");
+      break;
+    case FmiType::kUInt8:
+      get(f.GetUInt8, fmi3::UInt8{}, "fmi3GetUInt8");
+      break;
+    case FmiType::kInt16:
+      get(f.GetInt16, fmi3::Int16{}, "fmi3GetInt16");
+      break;
+    case FmiType::kUInt16:
+      get(f.GetUInt16, fmi3::UInt16{}, "fmi3GetUInt16");
+      break;
+    case FmiType::kUInt32:
+      get(f.GetUInt32, fmi3::UInt32{}, "fmi3GetUInt32");
+      break;
+    case FmiType::kInt64:
+      get(f.GetInt64, fmi3::Int64{}, "fmi3GetInt64");
+      break;
+    case FmiType::kUInt64:
+      get(f.GetUInt64, fmi3::UInt64{}, "fmi3GetUInt64");
+      break;
+    default:
+      break;
   }
 }
 
@@ -863,8 +926,9 @@ void FmuUnit::RememberTunables() {
       }
     }
   }
-  sent_strings_.assign(strings_.begin() + static_cast<std::ptrdiff_t>(g.string.first),
-                       strings_.begin() + static_cast<std::ptrdiff_t>(g.string.first + g.string.vrs.size()));
+  sent_strings_.assign(
+      strings_.begin() + static_cast<std::ptrdiff_t>(g.string.first),
+      strings_.begin() + static_cast<std::ptrdiff_t>(g.string.first + g.string.vrs.size()));
 }
 
 // ---------------------------------------------------------------------------
@@ -960,7 +1024,9 @@ void FmuUnit::Initialize() {
 }
 
 void FmuUnit::UpdateOutputs() {
-  if (!has_feedthrough_ || !instance_) return;
+  // Only in initialization mode may outputs be read after inputs were set
+  // (see DeclareVariables); in step mode they are doStep's, as they are.
+  if (!instance_ || mode_ != Mode::kInitialization) return;
   call_messages_ = message_count_;
   SetGroups(groups_[kInputs], "updating outputs");
   GetGroups(groups_[kOutputs], "updating outputs");
@@ -969,8 +1035,9 @@ void FmuUnit::UpdateOutputs() {
 StepResult FmuUnit::DoStep(TimeNs t, TimeNs dt) {
   ClearError();
   if (mode_ == Mode::kError) {
-    return Fail(Where() + ": the FMU returned an error before t = " + cosim::FormatSeconds(t) +
-                " s: it cannot be stepped again (FMI: only freeing or restoring a state is allowed)");
+    return Fail(
+        Where() + ": the FMU returned an error before t = " + cosim::FormatSeconds(t) +
+        " s: it cannot be stepped again (FMI: only freeing or restoring a state is allowed)");
   }
   if (mode_ != Mode::kInitialization && mode_ != Mode::kStep) {
     return Fail(Where() + ": the FMU is not initialized (or was terminated) at t = " +
@@ -1048,8 +1115,7 @@ StepResult FmuUnit::DoStep(TimeNs t, TimeNs dt) {
         if (!(last_time > tc)) {
           return Fail(Where() + ": fmi3DoStep returned early at lastSuccessfulTime " +
                       cosim::FormatValue(last_time) + " s, not after the step's start " +
-                      cosim::FormatValue(tc) + " s (no progress)" +
-                      RecentMessages(call_messages_));
+                      cosim::FormatValue(tc) + " s (no progress)" + RecentMessages(call_messages_));
         }
         if (returns >= kMaxEarlyReturns) {
           return Fail(Where() + ": fmi3DoStep returned early " + std::to_string(returns + 1) +
@@ -1080,8 +1146,8 @@ StepResult FmuUnit::DoStep(TimeNs t, TimeNs dt) {
       // unit and time). No unit name in front: the master's message names
       // it, around this.
       Fail(Describe(call, status) + " for the step from t = " + cosim::FormatSeconds(t) + " s to " +
-           cosim::FormatSeconds(t + dt) + " s (last successful time " + cosim::FormatValue(last_time) +
-           " s)" + RecentMessages(call_messages_));
+           cosim::FormatSeconds(t + dt) + " s (last successful time " +
+           cosim::FormatValue(last_time) + " s)" + RecentMessages(call_messages_));
       return StepResult::kDiscard;
     }
     if (status == 5) {
@@ -1107,8 +1173,9 @@ void FmuUnit::Terminate() {
   if (!instance_ || mode_ == Mode::kBroken || mode_ == Mode::kTerminated) return;
   if (mode_ != Mode::kInitialization && mode_ != Mode::kStep) return;
   call_messages_ = message_count_;
-  const int status = description_.fmi_major == 2 ? static_cast<int>(binary_->f2.Terminate(instance_))
-                                                 : static_cast<int>(binary_->f3.Terminate(instance_));
+  const int status = description_.fmi_major == 2
+                         ? static_cast<int>(binary_->f2.Terminate(instance_))
+                         : static_cast<int>(binary_->f3.Terminate(instance_));
   mode_ = Mode::kTerminated;
   Check(status, description_.fmi_major == 2 ? "fmi2Terminate" : "fmi3Terminate", "terminate");
 }
@@ -1126,7 +1193,8 @@ void FmuUnit::SaveInternal(cosim::UnitState& state) const {
                     (mode_ == Mode::kBroken ? "a fatal error" : "an error"));
   }
   if (!description_.can_get_and_set_state) {
-    throw UnitError(Where() + ": cannot save the state: the FMU does not offer it "
+    throw UnitError(Where() +
+                    ": cannot save the state: the FMU does not offer it "
                     "(canGetAndSetFMUstate is not true in its modelDescription.xml)");
   }
   const bool v2 = description_.fmi_major == 2;
@@ -1143,9 +1211,10 @@ void FmuUnit::SaveInternal(cosim::UnitState& state) const {
                : binary_->f3.SerializedFMUStateSize(instance_, fmu_state, &size);
     std::string bytes(size, '\0');
     if (s <= 1) {
-      s = v2 ? static_cast<int>(binary_->f2.SerializeFMUstate(instance_, fmu_state, bytes.data(), size))
-             : static_cast<int>(binary_->f3.SerializeFMUState(instance_, fmu_state,
-                                             reinterpret_cast<fmi3::Byte*>(bytes.data()), size));
+      s = v2 ? static_cast<int>(
+                   binary_->f2.SerializeFMUstate(instance_, fmu_state, bytes.data(), size))
+             : static_cast<int>(binary_->f3.SerializeFMUState(
+                   instance_, fmu_state, reinterpret_cast<fmi3::Byte*>(bytes.data()), size));
     }
     if (v2) {
       binary_->f2.FreeFMUstate(instance_, &fmu_state);
@@ -1178,7 +1247,8 @@ void FmuUnit::RestoreInternal(const cosim::UnitState& state) {
     return;
   }
   if (!instance_ || mode_ == Mode::kBroken || mode_ == Mode::kNone) {
-    throw UnitError(Where() + ": cannot restore an FMU state: the FMU is not instantiated (call "
+    throw UnitError(Where() +
+                    ": cannot restore an FMU state: the FMU is not instantiated (call "
                     "Setup first) or failed fatally");
   }
   const bool v2 = description_.fmi_major == 2;
@@ -1187,7 +1257,8 @@ void FmuUnit::RestoreInternal(const cosim::UnitState& state) {
     if (state.strings.size() != 1) throw std::invalid_argument(Where() + ": damaged FMU state");
     const std::string& bytes = state.strings[0];
     void* fmu_state = nullptr;
-    status = v2 ? static_cast<int>(binary_->f2.DeSerializeFMUstate(instance_, bytes.data(), bytes.size(), &fmu_state))
+    status = v2 ? static_cast<int>(binary_->f2.DeSerializeFMUstate(instance_, bytes.data(),
+                                                                   bytes.size(), &fmu_state))
                 : static_cast<int>(binary_->f3.DeserializeFMUState(
                       instance_, reinterpret_cast<const fmi3::Byte*>(bytes.data()), bytes.size(),
                       &fmu_state));
@@ -1205,11 +1276,14 @@ void FmuUnit::RestoreInternal(const cosim::UnitState& state) {
   } else {
     if (state.integers[2] != id_ || kind < 0 ||
         static_cast<std::size_t>(kind) >= kept_states_.size()) {
-      throw UnitError(Where() + ": the FMU cannot serialize its state (canSerializeFMUstate is "
+      throw UnitError(Where() +
+                      ": the FMU cannot serialize its state (canSerializeFMUstate is "
                       "not true): a saved state restores only into the unit that saved it");
     }
-    status = v2 ? static_cast<int>(binary_->f2.SetFMUstate(instance_, kept_states_[static_cast<std::size_t>(kind)]))
-                : static_cast<int>(binary_->f3.SetFMUState(instance_, kept_states_[static_cast<std::size_t>(kind)]));
+    status = v2 ? static_cast<int>(binary_->f2.SetFMUstate(
+                      instance_, kept_states_[static_cast<std::size_t>(kind)]))
+                : static_cast<int>(binary_->f3.SetFMUState(
+                      instance_, kept_states_[static_cast<std::size_t>(kind)]));
   }
   if (status > 1) {
     throw UnitError(Where() + ": cannot restore the state: " +

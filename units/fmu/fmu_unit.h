@@ -17,10 +17,10 @@ class TempFolder;
 
 /// What became of each FMI variable in the unit's table.
 struct MappedVariable {
-  std::string fmi_name;       // as in modelDescription.xml ("motor.R")
-  std::string name;           // in the VariableTable ("motor_R")
+  std::string fmi_name;  // as in modelDescription.xml ("motor.R")
+  std::string name;      // in the VariableTable ("motor_R")
   std::uint32_t value_reference = 0;
-  bool mapped = true;         // false: left out (a non-Real local, the independent time)
+  bool mapped = true;  // false: left out (a non-Real local, the independent time)
 };
 
 /// An FMI 2.0 or FMI 3.0 co-simulation FMU as a linesim unit (type `fmu`).
@@ -30,23 +30,26 @@ struct MappedVariable {
 /// dlopens binaries/linux64/ (FMI 2.0) or binaries/x86_64-linux/ (FMI 3.0)
 /// <modelIdentifier>.so and resolves every function the unit calls, and
 /// declares the FMU's variables: parameters (fixed, tunable, structural as
-/// constant), inputs, outputs (with ModelStructure's direct dependencies),
-/// Float64 locals and calculated parameters as locals. Names that are no
+/// constant), inputs, outputs, Float64 locals and calculated parameters as
+/// locals. Outputs declare no direct dependency: in step mode the standard
+/// allows no fmi*Get after an fmi*Set before the next doStep (FMI 2.0.4
+/// section 4.2.4, FMI 3.0.2 Step Mode), so a co-simulation FMU's outputs
+/// are doStep's; ModelStructure's dependencies, which hold in
+/// initialization mode, are named in the description. Names that are no
 /// linesim identifier are written with '_' ("motor.R" -> "motor_R"); the
 /// description keeps the FMI name and value reference.
 ///
 /// Setup instantiates (the log goes to messages()); the first Initialize
 /// sets parameters and inputs and enters initialization mode, and every
-/// Initialize sets inputs and reads outputs in it; the first DoStep exits
-/// it. DoStep(t, dt) calls doStep at t and dt as the master gives them
-/// (integer nanoseconds, so every communication point is start + k h
-/// exactly). fmi2Discard / fmi3Discard give StepResult::kDiscard; an FMI
-/// 3.0 early return is continued from lastSuccessfulTime to t + dt; a
-/// terminate request (fmi2Discard with fmi2Terminated, fmi3DoStep's
-/// terminateSimulation) reads the outputs and asks the master to end the
-/// run there (Unit::stop_request). SaveState / RestoreState use get/setFMUstate
-/// (serialized into the UnitState when canSerializeFMUstate), and throw
-/// naming the capability when the FMU has neither.
+/// Initialize (and UpdateOutputs) sets inputs and reads outputs in it; the
+/// first DoStep exits it, and from then on UpdateOutputs calls nothing. DoStep(t, dt) calls doStep
+/// at t and dt as the master gives them (integer nanoseconds, so every communication point is start
+/// + k h exactly). fmi2Discard / fmi3Discard give StepResult::kDiscard; an FMI 3.0 early return is
+/// continued from lastSuccessfulTime to t + dt; a terminate request (fmi2Discard with
+/// fmi2Terminated, fmi3DoStep's terminateSimulation) reads the outputs and asks the master to end
+/// the run there (Unit::stop_request). SaveState / RestoreState use get/setFMUstate (serialized
+/// into the UnitState when canSerializeFMUstate), and throw naming the capability when the FMU has
+/// neither.
 class FmuUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "fmu";
@@ -97,7 +100,13 @@ class FmuUnit : public cosim::Unit {
   // kError: a call returned Error (only FreeInstance or a state restore
   // may follow); kBroken: Fatal (nothing may follow but forgetting it).
   enum class Mode : std::int64_t {
-    kNone = 0, kInstantiated, kInitialization, kStep, kTerminated, kBroken, kError
+    kNone = 0,
+    kInstantiated,
+    kInitialization,
+    kStep,
+    kTerminated,
+    kBroken,
+    kError
   };
   // One direction of one type: the FMI value references and the first slot
   // of its contiguous storage.
@@ -157,7 +166,6 @@ class FmuUnit : public cosim::Unit {
   std::vector<std::string> strings_;
   std::vector<std::vector<double>> arrays_;
   Groups groups_[kDirections];
-  bool has_feedthrough_ = false;
   // Conversion buffers (FMI 2.0 Integer and Boolean are int; strings are
   // passed as pointers), sized once.
   std::vector<int> int_buffer_;
@@ -179,7 +187,8 @@ class FmuUnit : public cosim::Unit {
   Mode mode_ = Mode::kNone;
   cosim::TimeNs start_ = 0;
   cosim::TimeNs stop_ = 0;
-  cosim::TimeNs first_dt_ = 0;  // the first communication step (variable steps refused when the FMU cannot)
+  cosim::TimeNs first_dt_ =
+      0;  // the first communication step (variable steps refused when the FMU cannot)
   // States kept by the FMU when it cannot serialize them: a saved
   // UnitState names one by index (and this unit by id_).
   mutable std::vector<void*> kept_states_;

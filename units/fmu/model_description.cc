@@ -1,17 +1,16 @@
 #include "units/fmu/model_description.h"
 
-#include <pugixml.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cctype>
-#include <charconv>
 #include <cfloat>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <pugixml.hpp>
 #include <set>
 #include <sstream>
 #include <unordered_map>
@@ -67,7 +66,8 @@ std::optional<Exponents> ProductExponents(std::string_view text) {
       const auto [end, ec] = std::from_chars(first, last, power);
       if (ec != std::errc() || end != last) return std::nullopt;
     }
-    for (int i = 0; i < 8; ++i) total[static_cast<std::size_t>(i)] += power * (*symbol)[static_cast<std::size_t>(i)];
+    for (int i = 0; i < 8; ++i)
+      total[static_cast<std::size_t>(i)] += power * (*symbol)[static_cast<std::size_t>(i)];
     if (dot == text.size()) break;
     pos = dot + 1;
   }
@@ -93,10 +93,10 @@ std::optional<Exponents> ExpressionExponents(std::string_view text) {
 // preference for base units that several share.
 const std::vector<std::string>& LinesimSpellings() {
   static const std::vector<std::string> kSpellings = {
-      "1",     "m",      "m/s",    "m/s2",   "rad",       "rad/s",   "rad/s2", "s",
-      "1/s",   "Hz",     "V",      "A",      "Ohm",       "H",       "N",      "N.m",
-      "kg",    "kg.m2",  "N/m",    "N.s/m",  "N.m.s/rad", "V.s/rad", "V/rad",  "V.s2/rad",
-      "N.m/A", "W",      "J",      "Pa",     "K"};
+      "1",     "m",     "m/s", "m/s2",  "rad",       "rad/s",   "rad/s2", "s",
+      "1/s",   "Hz",    "V",   "A",     "Ohm",       "H",       "N",      "N.m",
+      "kg",    "kg.m2", "N/m", "N.s/m", "N.m.s/rad", "V.s/rad", "V/rad",  "V.s2/rad",
+      "N.m/A", "W",     "J",   "Pa",    "K"};
   return kSpellings;
 }
 
@@ -113,8 +113,8 @@ class LineIndex {
   }
   int LineOf(std::ptrdiff_t offset) const {
     if (offset < 0) return 0;
-    const auto after = std::upper_bound(starts_.begin(), starts_.end(),
-                                        static_cast<std::size_t>(offset));
+    const auto after =
+        std::upper_bound(starts_.begin(), starts_.end(), static_cast<std::size_t>(offset));
     return static_cast<int>(after - starts_.begin());
   }
 
@@ -161,7 +161,7 @@ class Parser {
     md.has_model_exchange = bool(root.child("ModelExchange"));
     md.has_scheduled_execution = bool(root.child("ScheduledExecution"));
     if (!cs) {
-      std::string what = md.has_model_exchange ? "model exchange only"
+      std::string what = md.has_model_exchange        ? "model exchange only"
                          : md.has_scheduled_execution ? "scheduled execution only"
                                                       : "no interface";
       Fail(root, "the FMU is " + what +
@@ -208,8 +208,8 @@ class Parser {
 
  private:
   [[noreturn]] void Fail(const pugi::xml_node& at, const std::string& message) const {
-    throw FmuError(file_ + ":" + std::to_string(lines_.LineOf(at ? at.offset_debug() : 0)) +
-                   ": " + message);
+    throw FmuError(file_ + ":" + std::to_string(lines_.LineOf(at ? at.offset_debug() : 0)) + ": " +
+                   message);
   }
   double Real(const pugi::xml_node& at, const pugi::xml_attribute& a) const {
     const std::string s = a.as_string();
@@ -299,8 +299,7 @@ class Parser {
           }
           if (!values.insert(value).second) {
             Fail(item, "enumeration '" + std::string(t.attribute("name").as_string()) +
-                           "': two items have the value " + text +
-                           " (item values must be unique)");
+                           "': two items have the value " + text + " (item values must be unique)");
           }
           d.items.emplace_back(value, item.attribute("name").as_string());
         }
@@ -323,15 +322,15 @@ class Parser {
     if (!d) return nullptr;
     const auto it = types_.find(d.as_string());
     if (it == types_.end()) {
-      Fail(element, std::string("declaredType '") + d.as_string() +
-                        "' is not in <TypeDefinitions>");
+      Fail(element,
+           std::string("declaredType '") + d.as_string() + "' is not in <TypeDefinitions>");
     }
     for (const char* k : kinds) {
       if (it->second.element == k) return &it->second;
     }
     Fail(element, "variable '" + v.name + "': declaredType '" + d.as_string() + "' is a " +
-                      it->second.element + ", not a type for this variable (" +
-                      *kinds.begin() + ")");
+                      it->second.element + ", not a type for this variable (" + *kinds.begin() +
+                      ")");
   }
 
   // Unit, bounds, nominal and items from the variable's element, else its
@@ -376,8 +375,8 @@ class Parser {
             if (ec != std::errc() || end != w.data() + w.size()) bad(w);
           }
           if (v.type == FmiType::kFloat32 && std::isfinite(x) && std::fabs(x) > FLT_MAX) {
-            Fail(at, "variable '" + v.name + "': start value '" + w +
-                         "' is outside the Float32 range");
+            Fail(at,
+                 "variable '" + v.name + "': start value '" + w + "' is outside the Float32 range");
           }
           v.start_reals.push_back(x);
         }
@@ -433,8 +432,8 @@ class Parser {
     v.description = e.attribute("description").as_string();
     v.line = lines_.LineOf(e.offset_debug());
     static const std::set<std::string> kCausalities = {
-        "parameter", "calculatedParameter", "structuralParameter", "input",
-        "output",    "local",               "independent"};
+        "parameter", "calculatedParameter", "structuralParameter", "input", "output",
+        "local",     "independent"};
     if (!kCausalities.count(v.causality)) {
       Fail(e, "variable '" + v.name + "' has an unknown causality '" + v.causality + "'");
     }
@@ -503,12 +502,12 @@ class Parser {
         Fail(e, "variable '" + v.name + "' is a clock: FMI 3.0 clocks are not supported");
       }
       static const std::map<std::string, FmiType> kTypes = {
-          {"Float64", FmiType::kFloat64}, {"Float32", FmiType::kFloat32},
-          {"Int8", FmiType::kInt8},       {"UInt8", FmiType::kUInt8},
-          {"Int16", FmiType::kInt16},     {"UInt16", FmiType::kUInt16},
-          {"Int32", FmiType::kInt32},     {"UInt32", FmiType::kUInt32},
-          {"Int64", FmiType::kInt64},     {"UInt64", FmiType::kUInt64},
-          {"Boolean", FmiType::kBoolean}, {"String", FmiType::kString},
+          {"Float64", FmiType::kFloat64},  {"Float32", FmiType::kFloat32},
+          {"Int8", FmiType::kInt8},        {"UInt8", FmiType::kUInt8},
+          {"Int16", FmiType::kInt16},      {"UInt16", FmiType::kUInt16},
+          {"Int32", FmiType::kInt32},      {"UInt32", FmiType::kUInt32},
+          {"Int64", FmiType::kInt64},      {"UInt64", FmiType::kUInt64},
+          {"Boolean", FmiType::kBoolean},  {"String", FmiType::kString},
           {"Enumeration", FmiType::kInt64}};
       if (tag == "Binary") {
         // Left out: the FMU keeps its start value; nothing to connect.
@@ -518,8 +517,7 @@ class Parser {
       }
       const auto known = kTypes.find(tag);
       if (known == kTypes.end()) {
-        Fail(e, "variable '" + v.name + "' has type " + tag +
-                    ": not an FMI 3.0 variable type");
+        Fail(e, "variable '" + v.name + "' has type " + tag + ": not an FMI 3.0 variable type");
       }
       v.type = known->second;
       const std::string type_element = tag + "Type";
@@ -537,8 +535,8 @@ class Parser {
         if (const auto a = dim.attribute("valueReference")) {
           // Sized by a structural parameter: its start value, resolved
           // once every variable is read.
-          pending_dimensions_.push_back({md.variables.size(), v.dimensions.size(),
-                                         Unsigned(dim, "valueReference"), dim});
+          pending_dimensions_.push_back(
+              {md.variables.size(), v.dimensions.size(), Unsigned(dim, "valueReference"), dim});
           v.size_from_structural = true;
           v.dimensions.push_back(0);
           continue;
@@ -571,7 +569,8 @@ class Parser {
   void ResolveDimensions(ModelDescription& md) {
     if (pending_dimensions_.empty()) return;
     std::unordered_map<std::uint32_t, std::size_t> by_vr;
-    for (std::size_t i = 0; i < md.variables.size(); ++i) by_vr.emplace(md.variables[i].value_reference, i);
+    for (std::size_t i = 0; i < md.variables.size(); ++i)
+      by_vr.emplace(md.variables[i].value_reference, i);
     for (const PendingDimension& p : pending_dimensions_) {
       FmiVariable& v = md.variables[p.variable];
       const auto it = by_vr.find(p.vr);
@@ -600,7 +599,8 @@ class Parser {
         size *= d;
       }
       v.size = size;
-      if (v.has_start && v.start_reals.size() == 1 && size > 1) v.start_reals.assign(size, v.start_reals[0]);
+      if (v.has_start && v.start_reals.size() == 1 && size > 1)
+        v.start_reals.assign(size, v.start_reals[0]);
       if (v.has_start && v.start_reals.size() != size) {
         Fail(p.at, "variable '" + v.name + "' has " + std::to_string(v.start_reals.size()) +
                        " start values for " + std::to_string(size) + " elements");
@@ -647,7 +647,8 @@ class Parser {
           if (!fresh) {
             throw FmuError(at(v) + "valueReference " + std::to_string(v.value_reference) +
                            " is also " + md.variables[it->second].causality + " '" +
-                           md.variables[it->second].name + "': two " + "variables set from outside " +
+                           md.variables[it->second].name + "': two " +
+                           "variables set from outside " +
                            "share a value (FMI 2.0 aliases: at most one parameter or input per "
                            "alias set)");
           }
@@ -744,13 +745,18 @@ class Parser {
     }
     for (const auto& u : root.child("ModelStructure").child("Outputs").children("Unknown")) {
       const std::uint32_t index = Unsigned(u, "index");
-      if (index == 0 || index > index2_.size() || index2_[index - 1] < 0) {
-        Fail(u, "output index " + std::to_string(index) + " names no mapped variable");
+      if (index == 0 || index > index2_.size()) {
+        Fail(u, "output index " + std::to_string(index) + " names no variable (there are " +
+                    std::to_string(index2_.size()) + ")");
       }
+      // An output linesim leaves out is the FMU's own: it refuses nothing
+      // unless a scenario connects or records it (then it is no variable).
+      if (index2_[index - 1] < 0) continue;
       FmiVariable& out = md.variables[static_cast<std::size_t>(index2_[index - 1])];
       if (out.causality != "output") {
         Fail(u, "ModelStructure/Outputs: index " + std::to_string(index) + " is '" + out.name +
-                    "', a " + out.causality + " (FMI 2.0.4 section 2.2.8: every output, and "
+                    "', a " + out.causality +
+                    " (FMI 2.0.4 section 2.2.8: every output, and "
                     "only outputs, are listed)");
       }
       if (!u.attribute("dependencies")) continue;  // unknown: every input
@@ -786,8 +792,12 @@ class Parser {
     for (const auto& o : root.child("ModelStructure").children("Output")) {
       const std::uint32_t vr = Unsigned(o, "valueReference");
       const auto it = by_vr.find(vr);
+      // A Binary output (the Reference-FMUs' Feedthrough has one) is left
+      // out: the FMU is refused only where a scenario connects or records
+      // it, as no variable of the unit.
+      if (it == by_vr.end() && binary_vrs_.count(vr)) continue;
       if (it == by_vr.end()) {
-        Fail(o, "output valueReference " + std::to_string(vr) + " names no mapped variable");
+        Fail(o, "output valueReference " + std::to_string(vr) + " names no variable");
       }
       if (md.variables[it->second].causality != "output") {
         Fail(o, "ModelStructure: <Output valueReference=\"" + std::to_string(vr) + "\"> is '" +
@@ -824,18 +834,30 @@ class Parser {
 
 const char* ToString(FmiType type) {
   switch (type) {
-    case FmiType::kFloat64: return "Float64";
-    case FmiType::kInt32: return "Int32";
-    case FmiType::kBoolean: return "Boolean";
-    case FmiType::kString: return "String";
-    case FmiType::kFloat32: return "Float32";
-    case FmiType::kInt8: return "Int8";
-    case FmiType::kUInt8: return "UInt8";
-    case FmiType::kInt16: return "Int16";
-    case FmiType::kUInt16: return "UInt16";
-    case FmiType::kUInt32: return "UInt32";
-    case FmiType::kInt64: return "Int64";
-    case FmiType::kUInt64: return "UInt64";
+    case FmiType::kFloat64:
+      return "Float64";
+    case FmiType::kInt32:
+      return "Int32";
+    case FmiType::kBoolean:
+      return "Boolean";
+    case FmiType::kString:
+      return "String";
+    case FmiType::kFloat32:
+      return "Float32";
+    case FmiType::kInt8:
+      return "Int8";
+    case FmiType::kUInt8:
+      return "UInt8";
+    case FmiType::kInt16:
+      return "Int16";
+    case FmiType::kUInt16:
+      return "UInt16";
+    case FmiType::kUInt32:
+      return "UInt32";
+    case FmiType::kInt64:
+      return "Int64";
+    case FmiType::kUInt64:
+      return "UInt64";
   }
   return "?";
 }
@@ -843,23 +865,35 @@ const char* ToString(FmiType type) {
 int StorageOf(FmiType type) {
   switch (type) {
     case FmiType::kFloat64:
-    case FmiType::kFloat32: return 0;
-    case FmiType::kBoolean: return 2;
-    case FmiType::kString: return 3;
-    default: return 1;
+    case FmiType::kFloat32:
+      return 0;
+    case FmiType::kBoolean:
+      return 2;
+    case FmiType::kString:
+      return 3;
+    default:
+      return 1;
   }
 }
 
 std::pair<std::int64_t, std::int64_t> IntegerRange(FmiType type) {
   switch (type) {
-    case FmiType::kInt8: return {INT8_MIN, INT8_MAX};
-    case FmiType::kUInt8: return {0, UINT8_MAX};
-    case FmiType::kInt16: return {INT16_MIN, INT16_MAX};
-    case FmiType::kUInt16: return {0, UINT16_MAX};
-    case FmiType::kInt32: return {INT32_MIN, INT32_MAX};
-    case FmiType::kUInt32: return {0, UINT32_MAX};
-    case FmiType::kUInt64: return {0, INT64_MAX};
-    default: return {INT64_MIN, INT64_MAX};
+    case FmiType::kInt8:
+      return {INT8_MIN, INT8_MAX};
+    case FmiType::kUInt8:
+      return {0, UINT8_MAX};
+    case FmiType::kInt16:
+      return {INT16_MIN, INT16_MAX};
+    case FmiType::kUInt16:
+      return {0, UINT16_MAX};
+    case FmiType::kInt32:
+      return {INT32_MIN, INT32_MAX};
+    case FmiType::kUInt32:
+      return {0, UINT32_MAX};
+    case FmiType::kUInt64:
+      return {0, INT64_MAX};
+    default:
+      return {INT64_MIN, INT64_MAX};
   }
 }
 
@@ -897,7 +931,8 @@ ModelDescription ParseModelDescriptionText(const std::string& text, const std::s
 
 ModelDescription ParseModelDescription(const std::string& file) {
   std::error_code ec;
-  if (const auto size = std::filesystem::file_size(file, ec); !ec && size > kMaxModelDescriptionBytes) {
+  if (const auto size = std::filesystem::file_size(file, ec);
+      !ec && size > kMaxModelDescriptionBytes) {
     throw FmuError(file + ": the model description is " + std::to_string(size) +
                    " bytes, more than the " + std::to_string(kMaxModelDescriptionBytes >> 20) +
                    " MiB linesim reads (kMaxModelDescriptionBytes)");

@@ -42,8 +42,9 @@ std::string Dahlquist2Xml() {
 
 std::string Fmi3Xml(const std::string& variables, const std::string& cs_extra = "") {
   return "<?xml version=\"1.0\"?>\n<fmiModelDescription fmiVersion=\"3.0\" modelName=\"m\" "
-         "instantiationToken=\"t\">\n  <CoSimulation modelIdentifier=\"m\"" + cs_extra +
-         "/>\n  <ModelVariables>\n" + variables + "  </ModelVariables>\n</fmiModelDescription>\n";
+         "instantiationToken=\"t\">\n  <CoSimulation modelIdentifier=\"m\"" +
+         cs_extra + "/>\n  <ModelVariables>\n" + variables +
+         "  </ModelVariables>\n</fmiModelDescription>\n";
 }
 
 TEST(FmuMalformed, MissingFile) {
@@ -63,19 +64,19 @@ TEST(FmuMalformed, NotAZipArchive) {
 TEST(FmuMalformed, ZipSlipEntriesAreRefused) {
   Scratch s("slip");
   const std::string escaped = "linesim-zip-slip-" + std::to_string(::getpid()) + ".txt";
-  for (const std::string& name : {"../" + escaped, "binaries/../../" + escaped, "a/../../" + escaped}) {
+  for (const std::string& name :
+       {"../" + escaped, "binaries/../../" + escaped, "a/../../" + escaped}) {
     MakeZip(s / "slip.fmu", {{"modelDescription.xml", Dahlquist2Xml()}, {name, "pwned"}});
     const auto e = LoadError(s / "slip.fmu");
-    EXPECT_NE(e.find("refused: entry '" + name + "' has a '..' component"), std::string::npos)
-        << e;
+    EXPECT_NE(e.find("refused: entry '" + name + "' has a '..' component"), std::string::npos) << e;
     EXPECT_FALSE(fs::exists(fs::temp_directory_path() / escaped));
   }
 }
 
 TEST(FmuMalformed, AbsolutePathsAreRefused) {
   Scratch s("abs");
-  const std::string target = (fs::temp_directory_path() /
-                              ("linesim-abs-" + std::to_string(::getpid()) + ".txt")).string();
+  const std::string target =
+      (fs::temp_directory_path() / ("linesim-abs-" + std::to_string(::getpid()) + ".txt")).string();
   MakeZip(s / "abs.fmu", {{"modelDescription.xml", Dahlquist2Xml()}, {target, "pwned"}});
   auto e = LoadError(s / "abs.fmu");
   EXPECT_NE(e.find("has an absolute path"), std::string::npos) << e;
@@ -90,8 +91,8 @@ TEST(FmuMalformed, AbsolutePathsAreRefused) {
 
 TEST(FmuMalformed, SymbolicLinksAreRefused) {
   Scratch s("link");
-  MakeZip(s / "link.fmu", {{"modelDescription.xml", Dahlquist2Xml()},
-                           {"resources/passwd", "/etc/passwd", true}});
+  MakeZip(s / "link.fmu",
+          {{"modelDescription.xml", Dahlquist2Xml()}, {"resources/passwd", "/etc/passwd", true}});
   const auto e = LoadError(s / "link.fmu");
   EXPECT_NE(e.find("entry 'resources/passwd' is a symbolic link"), std::string::npos) << e;
 }
@@ -118,8 +119,8 @@ TEST(FmuMalformed, InvalidXmlNamesFileAndLine) {
 
 TEST(FmuMalformed, WrongPlatform) {
   Scratch s("platform");
-  MakeZip(s / "p.fmu", {{"modelDescription.xml", Dahlquist2Xml()},
-                        {"binaries/win64/dahlquist.dll", "MZ"}});
+  MakeZip(s / "p.fmu",
+          {{"modelDescription.xml", Dahlquist2Xml()}, {"binaries/win64/dahlquist.dll", "MZ"}});
   const auto e = LoadError(s / "p.fmu");
   EXPECT_NE(e.find("no binary for this platform: binaries/linux64/dahlquist.so is missing "
                    "(binaries for: win64)"),
@@ -132,8 +133,9 @@ TEST(FmuMalformed, MissingSymbols) {
   std::string xml = Dahlquist2Xml();
   const std::string from = "modelIdentifier=\"dahlquist\"";
   xml.replace(xml.find(from), from.size(), "modelIdentifier=\"missing_symbols\"");
-  MakeZip(s / "sym.fmu", {{"modelDescription.xml", xml},
-                          {"binaries/linux64/missing_symbols.so", ReadFile(LINESIM_MISSING_SYMBOLS_SO)}});
+  MakeZip(s / "sym.fmu",
+          {{"modelDescription.xml", xml},
+           {"binaries/linux64/missing_symbols.so", ReadFile(LINESIM_MISSING_SYMBOLS_SO)}});
   const auto e = LoadError(s / "sym.fmu");
   EXPECT_NE(e.find("does not export fmi2FreeInstance (missing symbol)"), std::string::npos) << e;
 }
@@ -151,8 +153,9 @@ TEST(FmuMalformed, ModelExchangeOnly) {
 
 TEST(FmuMalformed, ClocksAreRefused) {
   Scratch s("clock");
-  MakeZip(s / "c.fmu", {{"modelDescription.xml",
-                         Fmi3Xml("    <Clock name=\"tick\" valueReference=\"1\" causality=\"input\"/>\n")}});
+  MakeZip(s / "c.fmu",
+          {{"modelDescription.xml",
+            Fmi3Xml("    <Clock name=\"tick\" valueReference=\"1\" causality=\"input\"/>\n")}});
   const auto e = LoadError(s / "c.fmu");
   EXPECT_NE(e.find("modelDescription.xml:5: variable 'tick' is a clock: FMI 3.0 clocks are not "
                    "supported"),
@@ -217,15 +220,17 @@ TEST(FmuMalformed, InstantiationRefusedIsNamedWithTheLog) {
 // bits are still refused.
 TEST(FmuMalformed, EntriesWithoutFileTypeBitsAreFiles) {
   Scratch s("writestr");
-  MakeZip(s / "w.fmu", {{"modelDescription.xml", Dahlquist2Xml(), false, 0600},
-                        {"binaries/linux64/dahlquist.so", ReadFile(LINESIM_DAHLQUIST_SO), false, 0600}});
+  MakeZip(s / "w.fmu",
+          {{"modelDescription.xml", Dahlquist2Xml(), false, 0600},
+           {"binaries/linux64/dahlquist.so", ReadFile(LINESIM_DAHLQUIST_SO), false, 0600}});
   FmuUnit u("w", s / "w.fmu");
   u.Setup(0, 1'000'000'000);
   u.Initialize();
   EXPECT_EQ(u.DoStep(0, 10'000'000), cosim::StepResult::kOk) << u.last_error();
   MakeZip(s / "f.fmu", {{"modelDescription.xml", Dahlquist2Xml(), false, S_IFIFO | 0600}});
   const std::string e = LoadError(s / "f.fmu");
-  EXPECT_NE(e.find("entry 'modelDescription.xml' is not a file or a folder"), std::string::npos) << e;
+  EXPECT_NE(e.find("entry 'modelDescription.xml' is not a file or a folder"), std::string::npos)
+      << e;
 }
 
 // The folder an FMU unpacks into is private and goes with the unit.
@@ -258,7 +263,8 @@ std::string FolderOfAChildThatDies(int sig) {
       FmuUnit u("u", Fmu("dahlquist"));
       // The unit's folder is the only linesim-fmu-<pid>- folder of this pid.
       const std::string prefix = "linesim-fmu-" + std::to_string(getpid()) + "-";
-      for (const auto& e : std::filesystem::directory_iterator(std::filesystem::temp_directory_path())) {
+      for (const auto& e :
+           std::filesystem::directory_iterator(std::filesystem::temp_directory_path())) {
         const std::string name = e.path().filename().string();
         if (name.rfind(prefix, 0) == 0) {
           const std::string line = e.path().string() + "\n";
@@ -275,7 +281,8 @@ std::string FolderOfAChildThatDies(int sig) {
   close(fds[1]);
   std::string text;
   char buffer[512];
-  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, static_cast<std::size_t>(n));
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;)
+    text.append(buffer, static_cast<std::size_t>(n));
   close(fds[0]);
   int status = 0;
   waitpid(child, &status, 0);
@@ -305,6 +312,66 @@ TEST(FmuArchive, NoFolderOutlivesACrashOrATermination) {
     ASSERT_NE(folder.find("linesim-fmu-"), std::string::npos) << sig << ": " << folder;
     EXPECT_FALSE(std::filesystem::exists(folder)) << sig << ": " << folder << " was left behind";
   }
+}
+
+// Guards issue 24's SIGTERM during loading, which issue 37 found the kill
+// test no longer reached (loading got fast: it ended before its kill). This
+// FMU takes seconds to load: dahlquist with 300,000 more Float64 locals (the
+// model description's reading and the table's declaring are linear, some
+// 15 us per variable). The child loads it; once its folder holds the
+// unpacked archive, SIGTERM; the child must still be loading then (it
+// writes "loaded" after), and the folder must be gone once it died.
+TEST(FmuArchive, NoFolderOutlivesATerminationDuringLoading) {
+  test::Scratch s("slow_load");
+  std::string xml = Dahlquist2Xml();
+  std::string locals;
+  locals.reserve(300000 * 110);
+  for (int i = 0; i < 300000; ++i) {
+    locals += "<ScalarVariable name=\"l" + std::to_string(i) + "\" valueReference=\"" +
+              std::to_string(100 + i) + "\" causality=\"local\"><Real/></ScalarVariable>\n";
+  }
+  xml.insert(xml.find("  </ModelVariables>"), locals);
+  MakeZip(s / "slow.fmu", {{"modelDescription.xml", xml},
+                           {"binaries/linux64/dahlquist.so", ReadFile(LINESIM_DAHLQUIST_SO)}});
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  const pid_t child = fork();
+  if (child == 0) {
+    close(fds[0]);
+    try {
+      FmuUnit u("u", s / "slow.fmu");
+      if (write(fds[1], "loaded\n", 7) < 0) _exit(3);
+    } catch (...) {
+      _exit(2);
+    }
+    _exit(0);
+  }
+  close(fds[1]);
+  // The child's folder, once the archive is in it (unpacking comes first).
+  const std::string prefix = "linesim-fmu-" + std::to_string(child) + "-";
+  std::string folder;
+  for (int polls = 0; polls < 600'000 && folder.empty(); ++polls) {
+    for (const auto& e : fs::directory_iterator(fs::temp_directory_path())) {
+      if (e.path().filename().string().rfind(prefix, 0) == 0 &&
+          fs::exists(e.path() / "binaries/linux64/dahlquist.so")) {
+        folder = e.path().string();
+      }
+    }
+    if (folder.empty()) usleep(100);
+  }
+  ASSERT_FALSE(folder.empty()) << "the child's folder never appeared";
+  kill(child, SIGTERM);
+  std::string said;
+  char buffer[64];
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;)
+    said.append(buffer, static_cast<std::size_t>(n));
+  close(fds[0]);
+  int status = 0;
+  waitpid(child, &status, 0);
+  EXPECT_EQ(said, "") << "the FMU loaded before the kill: the test no longer kills during "
+                         "loading (make the FMU slower to load)";
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << "status " << status;
+  EXPECT_FALSE(fs::exists(folder)) << folder << " was left behind";
 }
 
 // Folders of processes that are gone are swept; those of a live process

@@ -3,7 +3,6 @@
 #include "units/fmu/model_description.h"
 
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <filesystem>
@@ -46,7 +45,8 @@ TEST(ModelDescription, FmiVersionMustBeExactlyASupportedOne) {
 }
 
 // An FMI 3.0 description with `n` Float64 variables, every fourth an input
-// (with its start value, which inputs need) and every fourth an output depending on the input before it, one per line.
+// (with its start value, which inputs need) and every fourth an output depending on the input
+// before it, one per line.
 std::string Fmi3WithVariables(std::size_t n) {
   std::string vars, outputs;
   vars.reserve(n * 80);
@@ -62,7 +62,8 @@ std::string Fmi3WithVariables(std::size_t n) {
   }
   return "<?xml version=\"1.0\"?>\n<fmiModelDescription fmiVersion=\"3.0\" modelName=\"m\" "
          "instantiationToken=\"t\">\n  <CoSimulation modelIdentifier=\"m\"/>\n"
-         "  <ModelVariables>\n" + vars + "  </ModelVariables>\n  <ModelStructure>\n" + outputs +
+         "  <ModelVariables>\n" +
+         vars + "  </ModelVariables>\n  <ModelStructure>\n" + outputs +
          "  </ModelStructure>\n</fmiModelDescription>\n";
 }
 
@@ -103,14 +104,16 @@ TEST(ModelDescription, MoreVariablesThanTheLimitAreRefused) {
 
 // FMI 2.0 and 3.0 descriptions with the given variables (and FMI 2.0
 // outputs / FMI 3.0 structure).
-std::string Fmi2(const std::string& types, const std::string& vars, const std::string& outputs = "") {
+std::string Fmi2(const std::string& types, const std::string& vars,
+                 const std::string& outputs = "") {
   return "<?xml version=\"1.0\"?>\n<fmiModelDescription fmiVersion=\"2.0\" modelName=\"m\" "
-         "guid=\"g\">\n  <CoSimulation modelIdentifier=\"m\"/>\n  <TypeDefinitions>" + types +
-         "</TypeDefinitions>\n  <ModelVariables>\n" + vars +
+         "guid=\"g\">\n  <CoSimulation modelIdentifier=\"m\"/>\n  <TypeDefinitions>" +
+         types + "</TypeDefinitions>\n  <ModelVariables>\n" + vars +
          "  </ModelVariables>\n  <ModelStructure><Outputs>" + outputs +
          "</Outputs></ModelStructure>\n</fmiModelDescription>\n";
 }
-std::string Fmi3(const std::string& types, const std::string& vars, const std::string& structure = "") {
+std::string Fmi3(const std::string& types, const std::string& vars,
+                 const std::string& structure = "") {
   return "<?xml version=\"1.0\"?>\n<fmiModelDescription fmiVersion=\"3.0\" modelName=\"m\" "
          "instantiationToken=\"t\">\n  <CoSimulation modelIdentifier=\"m\"/>\n  <TypeDefinitions>" +
          types + "</TypeDefinitions>\n  <ModelVariables>\n" + vars +
@@ -144,7 +147,8 @@ TEST(ModelDescription, RulesTheSchemaCannotExpressAreEnforced) {
       << ParseError(Fmi2("", in + out, "<Unknown index=\"2\"/>"));
   // Another base type on the same reference is no alias; an output alias of
   // a local is lawful.
-  EXPECT_EQ(ParseError(Fmi2("", p1 + Sv("n", 1, "parameter", "<Integer start=\"1\"/>", "fixed"))), "");
+  EXPECT_EQ(ParseError(Fmi2("", p1 + Sv("n", 1, "parameter", "<Integer start=\"1\"/>", "fixed"))),
+            "");
   EXPECT_EQ(ParseError(Fmi2("", in + out3 + Sv("l", 3, "local"), "<Unknown index=\"2\"/>")), "");
   // FMI 3.0: a valueReference is a variable's own.
   const std::string f1 = "    <Float64 name=\"a\" valueReference=\"1\" causality=\"local\"/>\n";
@@ -153,7 +157,8 @@ TEST(ModelDescription, RulesTheSchemaCannotExpressAreEnforced) {
             std::string::npos)
       << ParseError(Fmi3("", f1 + f2));
   // ModelStructure: indices in range, naming outputs.
-  EXPECT_NE(ParseError(Fmi2("", in + out3, "<Unknown index=\"7\"/>")).find("output index 7 names no mapped variable"),
+  EXPECT_NE(ParseError(Fmi2("", in + out3, "<Unknown index=\"7\"/>"))
+                .find("output index 7 names no variable"),
             std::string::npos);
   EXPECT_NE(ParseError(Fmi2("", in + out3, "<Unknown index=\"1\"/>")).find("is 'u', a input"),
             std::string::npos)
@@ -165,32 +170,45 @@ TEST(ModelDescription, RulesTheSchemaCannotExpressAreEnforced) {
   EXPECT_NE(ParseError(Fmi3("", f1 + o3, "<Output valueReference=\"2\" dependencies=\"8\"/>"))
                 .find("depends on valueReference 8, which names no variable"),
             std::string::npos);
-  EXPECT_NE(ParseError(Fmi3("", f1 + o3, "<Output valueReference=\"1\"/>")).find("only outputs are listed"),
+  EXPECT_NE(ParseError(Fmi3("", f1 + o3, "<Output valueReference=\"1\"/>"))
+                .find("only outputs are listed"),
             std::string::npos);
-  EXPECT_NE(ParseError(Fmi3("", f1 + o3, "<InitialUnknown valueReference=\"5\"/>")).find("names no variable"),
+  EXPECT_NE(ParseError(Fmi3("", f1 + o3, "<InitialUnknown valueReference=\"5\"/>"))
+                .find("names no variable"),
             std::string::npos);
   EXPECT_EQ(ParseError(Fmi3("", f1 + o3, "<Output valueReference=\"2\" dependencies=\"1\"/>")), "");
   // Declared types exist and fit; start values within [min, max]; a NaN
   // start of a value linesim gives the FMU; an enumeration start an item.
-  EXPECT_NE(ParseError(Fmi2("", Sv("a", 1, "local", "<Real declaredType=\"T\"/>"))).find("declaredType 'T' is not in <TypeDefinitions>"),
+  EXPECT_NE(ParseError(Fmi2("", Sv("a", 1, "local", "<Real declaredType=\"T\"/>")))
+                .find("declaredType 'T' is not in <TypeDefinitions>"),
             std::string::npos);
-  const std::string enum2 = "<SimpleType name=\"E\"><Enumeration><Item name=\"a\" value=\"1\"/>"
-                            "<Item name=\"b\" value=\"4\"/></Enumeration></SimpleType>";
-  EXPECT_NE(ParseError(Fmi2(enum2, Sv("a", 1, "local", "<Real declaredType=\"E\"/>"))).find("is a Enumeration, not a type for this variable"),
+  const std::string enum2 =
+      "<SimpleType name=\"E\"><Enumeration><Item name=\"a\" value=\"1\"/>"
+      "<Item name=\"b\" value=\"4\"/></Enumeration></SimpleType>";
+  EXPECT_NE(ParseError(Fmi2(enum2, Sv("a", 1, "local", "<Real declaredType=\"E\"/>")))
+                .find("is a Enumeration, not a type for this variable"),
             std::string::npos)
       << ParseError(Fmi2(enum2, Sv("a", 1, "local", "<Real declaredType=\"E\"/>")));
-  EXPECT_NE(ParseError(Fmi2("", Sv("a", 1, "parameter", "<Real start=\"5\" min=\"0\" max=\"2\"/>", "fixed")))
+  EXPECT_NE(ParseError(Fmi2("", Sv("a", 1, "parameter", "<Real start=\"5\" min=\"0\" max=\"2\"/>",
+                                   "fixed")))
                 .find("start value 5 is outside [0, 2] (FMI: min <= start <= max)"),
             std::string::npos);
-  EXPECT_NE(ParseError(Fmi2("", Sv("a", 1, "parameter", "<Real start=\"NaN\"/>", "fixed"))).find("start value NaN"),
+  EXPECT_NE(ParseError(Fmi2("", Sv("a", 1, "parameter", "<Real start=\"NaN\"/>", "fixed")))
+                .find("start value NaN"),
             std::string::npos);
-  EXPECT_NE(ParseError(Fmi2(enum2, Sv("a", 1, "input", "<Enumeration declaredType=\"E\" start=\"3\"/>")))
-                .find("start value 3 is no item of enumeration 'E'"),
-            std::string::npos);
-  EXPECT_EQ(ParseError(Fmi2(enum2, Sv("a", 1, "input", "<Enumeration declaredType=\"E\" start=\"4\"/>"))), "");
-  EXPECT_NE(ParseError(Fmi3("", "    <Int8 name=\"a\" valueReference=\"1\" causality=\"input\" start=\"300\"/>\n"))
-                .find("start value '300' is not a Int8"),
-            std::string::npos);
+  EXPECT_NE(
+      ParseError(Fmi2(enum2, Sv("a", 1, "input", "<Enumeration declaredType=\"E\" start=\"3\"/>")))
+          .find("start value 3 is no item of enumeration 'E'"),
+      std::string::npos);
+  EXPECT_EQ(
+      ParseError(Fmi2(enum2, Sv("a", 1, "input", "<Enumeration declaredType=\"E\" start=\"4\"/>"))),
+      "");
+  EXPECT_NE(
+      ParseError(
+          Fmi3("",
+               "    <Int8 name=\"a\" valueReference=\"1\" causality=\"input\" start=\"300\"/>\n"))
+          .find("start value '300' is not a Int8"),
+      std::string::npos);
 }
 // `text` with `units` as its <UnitDefinitions>, before <TypeDefinitions>
 // (where the schemas put it).
@@ -209,8 +227,8 @@ std::string WithUnits(std::string text, const std::string& units) {
 TEST(ModelDescription, ParameterOrInputWithoutStartIsRefused) {
   for (const char* causality : {"parameter", "input"}) {
     SCOPED_TRACE(causality);
-    const std::string e = ParseError(Fmi2("", Sv("a", 1, causality, "<Real/>",
-                                                 causality[0] == 'p' ? "fixed" : "")));
+    const std::string e =
+        ParseError(Fmi2("", Sv("a", 1, causality, "<Real/>", causality[0] == 'p' ? "fixed" : "")));
     EXPECT_NE(e.find(std::string("variable 'a': ") + causality +
                      " without a start value (FMI: a parameter or input must have one)"),
               std::string::npos)
@@ -219,16 +237,19 @@ TEST(ModelDescription, ParameterOrInputWithoutStartIsRefused) {
   EXPECT_NE(ParseError(Fmi2("", Sv("n", 1, "parameter", "<Integer/>", "tunable")))
                 .find("parameter without a start value"),
             std::string::npos);
-  EXPECT_NE(ParseError(Fmi3("", "    <Float64 name=\"a\" valueReference=\"1\" "
-                                "causality=\"parameter\" variability=\"fixed\"/>\n"))
+  EXPECT_NE(ParseError(Fmi3("",
+                            "    <Float64 name=\"a\" valueReference=\"1\" "
+                            "causality=\"parameter\" variability=\"fixed\"/>\n"))
                 .find("parameter without a start value"),
             std::string::npos);
-  EXPECT_NE(ParseError(Fmi3("", "    <Int32 name=\"s\" valueReference=\"1\" "
-                                "causality=\"structuralParameter\" variability=\"fixed\"/>\n"))
+  EXPECT_NE(ParseError(Fmi3("",
+                            "    <Int32 name=\"s\" valueReference=\"1\" "
+                            "causality=\"structuralParameter\" variability=\"fixed\"/>\n"))
                 .find("structuralParameter without a start value"),
             std::string::npos);
-  EXPECT_EQ(ParseError(Fmi2("", Sv("y", 1, "output") + Sv("l", 2, "local") +
-                                    Sv("c", 3, "calculatedParameter", "<Real/>", "fixed"),
+  EXPECT_EQ(ParseError(Fmi2("",
+                            Sv("y", 1, "output") + Sv("l", 2, "local") +
+                                Sv("c", 3, "calculatedParameter", "<Real/>", "fixed"),
                             "<Unknown index=\"1\"/>")),
             "");
 }
@@ -252,8 +273,9 @@ TEST(ModelDescription, AUnitMustBeInUnitDefinitionsWhenTheFmuHasThem) {
   EXPECT_NE(ParseError(WithUnits(Fmi2(type, in_m + typed), units))
                 .find("variable 'w': unit 'm/s' is not in <UnitDefinitions>"),
             std::string::npos);
-  const std::string f3 = "    <Float64 name=\"y\" valueReference=\"1\" causality=\"output\" "
-                         "unit=\"rad\"/>\n";
+  const std::string f3 =
+      "    <Float64 name=\"y\" valueReference=\"1\" causality=\"output\" "
+      "unit=\"rad\"/>\n";
   const std::string out3 = "<Output valueReference=\"1\"/>";
   EXPECT_NE(ParseError(WithUnits(Fmi3("", f3, out3), units))
                 .find("variable 'y': unit 'rad' is not in <UnitDefinitions>"),
@@ -275,7 +297,7 @@ TEST(ModelDescription, AFileAboveTheSizeLimitIsRefusedBeforeReading) {
     ADD_FAILURE() << "read a model description above the limit";
   } catch (const FmuError& e) {
     EXPECT_NE(std::string(e.what()).find(file + ": the model description is 134217729 bytes, more "
-                                         "than the 128 MiB linesim reads"),
+                                                "than the 128 MiB linesim reads"),
               std::string::npos)
         << e.what();
   }

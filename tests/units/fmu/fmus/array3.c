@@ -21,6 +21,7 @@ static void ModelDefaults(Model* m) {
 }
 
 static void ModelOutputs(Model* m) {
+  m->f[TIME] = m->time; /* the independent variable */
   for (int i = 0; i < 2; ++i)
     for (int j = 0; j < 3; ++j) m->f[Y + 3 * i + j] = m->f[SCALE] * m->f[P + j] * (i + 1) * m->f[TIME];
 }

@@ -16,6 +16,7 @@ static void ModelDefaults(Model* m) {
 }
 
 static void ModelOutputs(Model* m) {
+  m->f[2] = m->time; /* the independent variable */
   m->f[1] = m->f[0];
   m->i[1] = m->i[0];
   m->b[1] = m->b[0];

@@ -61,6 +61,11 @@ typedef struct {
   Model m;
   fmi2CallbackFunctions cb;
   char name[STR_LEN];
+  /* FMI 2.0.4 section 4.2.4: after fmi2ExitInitializationMode no fmi2Get*
+   * may follow an fmi2Set* without an fmi2DoStep in between; this FMU
+   * refuses one (fmi2Error), as a conforming FMU may. */
+  int step_mode;
+  int set_since_step;
 } Instance;
 
 static void ModelDefaults(Model* m);
@@ -110,7 +115,10 @@ EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tol_defined, 
   return fmi2OK;
 }
 EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { (void)c; return fmi2OK; }
-EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { (void)c; return fmi2OK; }
+EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
+  ((Instance*)c)->step_mode = 1;
+  return fmi2OK;
+}
 EXPORT fmi2Status fmi2Terminate(fmi2Component c) {
   /* Logged, so that tests see which call sequences an importer made. */
   Say((Instance*)c, fmi2OK, "logAll", "fmi2Terminate called");
@@ -118,15 +126,26 @@ EXPORT fmi2Status fmi2Terminate(fmi2Component c) {
 }
 EXPORT fmi2Status fmi2Reset(fmi2Component c) {
   ModelDefaults(&((Instance*)c)->m);
+  ((Instance*)c)->step_mode = 0;
+  ((Instance*)c)->set_since_step = 0;
   return fmi2OK;
 }
 
 #define CHECK_VR(count)                                        \
   for (size_t k = 0; k < n; ++k)                               \
     if ((long)vr[k] >= (long)(count)) return fmi2Error;
+/* A get after a set in step mode, refused (see Instance). */
+#define CHECK_GET(function)                                                              \
+  if (((Instance*)c)->step_mode && ((Instance*)c)->set_since_step) {                     \
+    Say((Instance*)c, fmi2Error, "logStatusError",                                       \
+        function " after fmi2Set* without fmi2DoStep in between (FMI 2.0.4, 4.2.4)");     \
+    return fmi2Error;                                                                    \
+  }
+#define NOTE_SET() ((Instance*)c)->set_since_step = ((Instance*)c)->step_mode;
 
 EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real v[]) {
   Model* m = &((Instance*)c)->m;
+  CHECK_GET("fmi2GetReal")
   CHECK_VR(NR)
   ModelOutputs(m);
   for (size_t k = 0; k < n; ++k) v[k] = m->r[vr[k]];
@@ -134,6 +153,7 @@ EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], si
 }
 EXPORT fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer v[]) {
   Model* m = &((Instance*)c)->m;
+  CHECK_GET("fmi2GetInteger")
   CHECK_VR(NI)
   ModelOutputs(m);
   for (size_t k = 0; k < n; ++k) v[k] = m->i[vr[k]];
@@ -141,6 +161,7 @@ EXPORT fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[],
 }
 EXPORT fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean v[]) {
   Model* m = &((Instance*)c)->m;
+  CHECK_GET("fmi2GetBoolean")
   CHECK_VR(NB)
   ModelOutputs(m);
   for (size_t k = 0; k < n; ++k) v[k] = m->b[vr[k]];
@@ -148,6 +169,7 @@ EXPORT fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[],
 }
 EXPORT fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String v[]) {
   Model* m = &((Instance*)c)->m;
+  CHECK_GET("fmi2GetString")
   CHECK_VR(NS)
   ModelOutputs(m);
   for (size_t k = 0; k < n; ++k) v[k] = m->s[vr[k]];
@@ -156,24 +178,28 @@ EXPORT fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], 
 EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real v[]) {
   Model* m = &((Instance*)c)->m;
   CHECK_VR(NR)
+  NOTE_SET()
   for (size_t k = 0; k < n; ++k) m->r[vr[k]] = v[k];
   return fmi2OK;
 }
 EXPORT fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer v[]) {
   Model* m = &((Instance*)c)->m;
   CHECK_VR(NI)
+  NOTE_SET()
   for (size_t k = 0; k < n; ++k) m->i[vr[k]] = v[k];
   return fmi2OK;
 }
 EXPORT fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean v[]) {
   Model* m = &((Instance*)c)->m;
   CHECK_VR(NB)
+  NOTE_SET()
   for (size_t k = 0; k < n; ++k) m->b[vr[k]] = v[k] != 0;
   return fmi2OK;
 }
 EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String v[]) {
   Model* m = &((Instance*)c)->m;
   CHECK_VR(NS)
+  NOTE_SET()
   for (size_t k = 0; k < n; ++k) {
     strncpy(m->s[vr[k]], v[k] ? v[k] : "", STR_LEN - 1);
     m->s[vr[k]][STR_LEN - 1] = 0;
@@ -184,6 +210,7 @@ EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], 
 EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean no_set_prior) {
   (void)no_set_prior;
   Instance* ci = (Instance*)c;
+  ci->set_since_step = 0;
   ModelOutputs(&ci->m);
   ci->m.started = 1;
   return ModelStep(ci, t, h);
@@ -201,7 +228,75 @@ EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, fmi2StatusKind s, fmi2Bo
   return fmi2OK;
 }
 
-#if MODEL_CAN_GET_SET_STATE
+/* The rest of the functions FMI 2.0.4 requires of every co-simulation
+ * binary (sections 2.1 and 4.2), for capabilities these FMUs do not have:
+ * present, refusing. Status kinds they cannot report give fmi2Discard
+ * (section 4.2.3). */
+EXPORT fmi2Status fmi2GetStatus(fmi2Component c, fmi2StatusKind s, fmi2Status* v) {
+  (void)c; (void)s; (void)v;
+  return fmi2Discard;
+}
+EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component c, fmi2StatusKind s, fmi2Integer* v) {
+  (void)c; (void)s; (void)v;
+  return fmi2Discard;
+}
+EXPORT fmi2Status fmi2GetStringStatus(fmi2Component c, fmi2StatusKind s, fmi2String* v) {
+  (void)c; (void)s; (void)v;
+  return fmi2Discard;
+}
+EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[],
+                                               size_t nu, const fmi2ValueReference z[], size_t nz,
+                                               const fmi2Real dv[], fmi2Real dz[]) {
+  (void)u; (void)nu; (void)z; (void)nz; (void)dv; (void)dz;
+  Say((Instance*)c, fmi2Error, "logStatusError", "no directional derivatives");
+  return fmi2Error;
+}
+EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
+                                              size_t n, const fmi2Integer order[],
+                                              const fmi2Real v[]) {
+  (void)vr; (void)n; (void)order; (void)v;
+  Say((Instance*)c, fmi2Error, "logStatusError", "no input derivatives (canInterpolateInputs)");
+  return fmi2Error;
+}
+EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
+                                               size_t n, const fmi2Integer order[], fmi2Real v[]) {
+  (void)vr; (void)n; (void)order; (void)v;
+  Say((Instance*)c, fmi2Error, "logStatusError", "no output derivatives (maxOutputDerivativeOrder 0)");
+  return fmi2Error;
+}
+
+#if !MODEL_CAN_GET_SET_STATE
+/* Present, refusing: canGetAndSetFMUstate is false. */
+static fmi2Status NoState(fmi2Component c, const char* function) {
+  Say((Instance*)c, fmi2Error, "logStatusError", "%s: no FMU state", function);
+  return fmi2Error;
+}
+EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* s) {
+  (void)s;
+  return NoState(c, "fmi2GetFMUstate");
+}
+EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate s) {
+  (void)s;
+  return NoState(c, "fmi2SetFMUstate");
+}
+EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* s) {
+  (void)s;
+  return NoState(c, "fmi2FreeFMUstate");
+}
+EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate s, size_t* size) {
+  (void)s; (void)size;
+  return NoState(c, "fmi2SerializedFMUstateSize");
+}
+EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate s, fmi2Byte b[], size_t size) {
+  (void)s; (void)b; (void)size;
+  return NoState(c, "fmi2SerializeFMUstate");
+}
+EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte b[], size_t size,
+                                          fmi2FMUstate* s) {
+  (void)s; (void)b; (void)size;
+  return NoState(c, "fmi2DeSerializeFMUstate");
+}
+#else
 EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* s) {
   Model* copy = (Model*)malloc(sizeof(Model));
   *copy = ((Instance*)c)->m;

@@ -6,7 +6,13 @@
  *   static const size_t kSize[NF];
  *   static void ModelDefaults(Model* m); static void ModelOutputs(Model* m);
  *   static fmi3Status ModelStep(Instance* c, double t, double h, bool* early, double* last,
- *                               bool* terminate); */
+ *                               bool* terminate);
+ * and may define MODEL_HAS_EXTRA_TYPES (it defines fmi3Get/Set of Float32
+ * and the integer types beyond Int32 itself) and MODEL_HAS_BINARY (the same
+ * for Binary); otherwise this file defines them for a model with no
+ * variable of those types. Every function FMI 3.0.2 requires of a
+ * co-simulation binary is present (section 2.5: all common functions and
+ * the interface type's, even for capabilities the FMU lacks). */
 #include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
@@ -51,7 +57,23 @@ typedef struct {
   fmi3InstanceEnvironment env;
   fmi3LogMessageCallback log;
   bool early_allowed; /* earlyReturnAllowed at instantiation */
+  /* FMI 3.0.2 Step Mode: no fmi3Get* may follow an fmi3Set* without an
+   * fmi3DoStep in between; this FMU refuses one (fmi3Error), as a
+   * conforming FMU may. */
+  bool step_mode;
+  bool set_since_step;
 } Instance;
+
+/* For the accessors: a get after a set in step mode is refused. */
+#define FMI3_CHECK_GET(function)                                                       \
+  if (((Instance*)c)->step_mode && ((Instance*)c)->set_since_step) {                   \
+    Instance* ci_ = (Instance*)c;                                                      \
+    if (ci_->log)                                                                      \
+      ci_->log(ci_->env, fmi3Error, "logStatusError",                                  \
+               function " after fmi3Set* without fmi3DoStep in between (FMI 3.0.2, Step Mode)"); \
+    return fmi3Error;                                                                  \
+  }
+#define FMI3_NOTE_SET() ((Instance*)c)->set_since_step = ((Instance*)c)->step_mode;
 
 static void ModelDefaults(Model* m);
 static void ModelOutputs(Model* m);
@@ -89,7 +111,10 @@ EXPORT fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean tol_de
   ((Instance*)c)->m.time = start;
   return fmi3OK;
 }
-EXPORT fmi3Status fmi3ExitInitializationMode(fmi3Instance c) { (void)c; return fmi3OK; }
+EXPORT fmi3Status fmi3ExitInitializationMode(fmi3Instance c) {
+  ((Instance*)c)->step_mode = true;
+  return fmi3OK;
+}
 EXPORT fmi3Status fmi3Terminate(fmi3Instance c) {
   /* Logged, so that tests see which call sequences an importer made. */
   Instance* ci = (Instance*)c;
@@ -100,6 +125,7 @@ EXPORT fmi3Status fmi3Terminate(fmi3Instance c) {
 EXPORT fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
                                  fmi3Float64 v[], size_t nv) {
   Model* m = &((Instance*)c)->m;
+  FMI3_CHECK_GET("fmi3GetFloat64")
   ModelOutputs(m);
   size_t at = 0;
   for (size_t k = 0; k < n; ++k) {
@@ -112,6 +138,7 @@ EXPORT fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], 
 EXPORT fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
                                  const fmi3Float64 v[], size_t nv) {
   Model* m = &((Instance*)c)->m;
+  FMI3_NOTE_SET()
   size_t at = 0;
   for (size_t k = 0; k < n; ++k) {
     if (vr[k] >= NF || at + kSize[vr[k]] > nv) return fmi3Error;
@@ -127,6 +154,7 @@ EXPORT fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference vr[], 
 
 EXPORT fmi3Status fmi3GetInt32(fmi3Instance c, const fmi3ValueReference vr[], size_t n, fmi3Int32 v[], size_t nv) {
   Model* m = &((Instance*)c)->m;
+  FMI3_CHECK_GET("fmi3GetInt32")
   CHECK3(100, NI)
   ModelOutputs(m);
   for (size_t k = 0; k < n; ++k) v[k] = m->i[vr[k] - 100];
@@ -134,12 +162,14 @@ EXPORT fmi3Status fmi3GetInt32(fmi3Instance c, const fmi3ValueReference vr[], si
 }
 EXPORT fmi3Status fmi3SetInt32(fmi3Instance c, const fmi3ValueReference vr[], size_t n, const fmi3Int32 v[], size_t nv) {
   Model* m = &((Instance*)c)->m;
+  FMI3_NOTE_SET()
   CHECK3(100, NI)
   for (size_t k = 0; k < n; ++k) m->i[vr[k] - 100] = v[k];
   return fmi3OK;
 }
 EXPORT fmi3Status fmi3GetBoolean(fmi3Instance c, const fmi3ValueReference vr[], size_t n, fmi3Boolean v[], size_t nv) {
   Model* m = &((Instance*)c)->m;
+  FMI3_CHECK_GET("fmi3GetBoolean")
   CHECK3(200, NB)
   ModelOutputs(m);
   for (size_t k = 0; k < n; ++k) v[k] = m->b[vr[k] - 200];
@@ -147,12 +177,14 @@ EXPORT fmi3Status fmi3GetBoolean(fmi3Instance c, const fmi3ValueReference vr[], 
 }
 EXPORT fmi3Status fmi3SetBoolean(fmi3Instance c, const fmi3ValueReference vr[], size_t n, const fmi3Boolean v[], size_t nv) {
   Model* m = &((Instance*)c)->m;
+  FMI3_NOTE_SET()
   CHECK3(200, NB)
   for (size_t k = 0; k < n; ++k) m->b[vr[k] - 200] = v[k];
   return fmi3OK;
 }
 EXPORT fmi3Status fmi3GetString(fmi3Instance c, const fmi3ValueReference vr[], size_t n, fmi3String v[], size_t nv) {
   Model* m = &((Instance*)c)->m;
+  FMI3_CHECK_GET("fmi3GetString")
   CHECK3(300, NS)
   ModelOutputs(m);
   for (size_t k = 0; k < n; ++k) v[k] = m->s[vr[k] - 300];
@@ -160,6 +192,7 @@ EXPORT fmi3Status fmi3GetString(fmi3Instance c, const fmi3ValueReference vr[], s
 }
 EXPORT fmi3Status fmi3SetString(fmi3Instance c, const fmi3ValueReference vr[], size_t n, const fmi3String v[], size_t nv) {
   Model* m = &((Instance*)c)->m;
+  FMI3_NOTE_SET()
   CHECK3(300, NS)
   for (size_t k = 0; k < n; ++k) {
     strncpy(m->s[vr[k] - 300], v[k] ? v[k] : "", STR_LEN - 1);
@@ -173,6 +206,7 @@ EXPORT fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 t, fmi3Float64 h, fmi3B
                              fmi3Float64* last) {
   (void)no_set_prior;
   Instance* ci = (Instance*)c;
+  ci->set_since_step = false;
   *event_needed = false;
   *terminate = false;
   *early = false;
@@ -216,4 +250,159 @@ EXPORT fmi3Status fmi3DeserializeFMUState(fmi3Instance c, const fmi3Byte b[], si
   memcpy(copy, b, sizeof(Model));
   *s = copy;
   return fmi3OK;
+}
+
+/* The functions of capabilities these FMUs lack, present as FMI 3.0.2
+ * section 2.5 requires, refusing (fmi3Error, logged). */
+static fmi3Status Refuse(fmi3Instance c, const char* function) {
+  Instance* ci = (Instance*)c;
+  if (ci && ci->log) ci->log(ci->env, fmi3Error, "logStatusError", function);
+  return fmi3Error;
+}
+/* Accessors of a type the model has no variable of: nothing to get or set. */
+#define NO_VARIABLES(Name, T)                                                                 \
+  EXPORT fmi3Status fmi3Get##Name(fmi3Instance c, const fmi3ValueReference vr[], size_t n,   \
+                                  T v[], size_t nv) {                                         \
+    (void)vr; (void)v; (void)nv;                                                              \
+    return n == 0 ? fmi3OK : Refuse(c, "fmi3Get" #Name ": the FMU has no such variable");    \
+  }                                                                                           \
+  EXPORT fmi3Status fmi3Set##Name(fmi3Instance c, const fmi3ValueReference vr[], size_t n,   \
+                                  const T v[], size_t nv) {                                   \
+    (void)vr; (void)v; (void)nv;                                                              \
+    return n == 0 ? fmi3OK : Refuse(c, "fmi3Set" #Name ": the FMU has no such variable");    \
+  }
+#ifndef MODEL_HAS_EXTRA_TYPES
+NO_VARIABLES(Float32, float)
+NO_VARIABLES(Int8, int8_t)
+NO_VARIABLES(UInt8, uint8_t)
+NO_VARIABLES(Int16, int16_t)
+NO_VARIABLES(UInt16, uint16_t)
+NO_VARIABLES(UInt32, uint32_t)
+NO_VARIABLES(Int64, int64_t)
+NO_VARIABLES(UInt64, uint64_t)
+#endif
+#undef NO_VARIABLES
+EXPORT fmi3Status fmi3GetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t n, bool v[]) {
+  (void)vr; (void)v;
+  return n == 0 ? fmi3OK : Refuse(c, "fmi3GetClock: the FMU has no clocks");
+}
+EXPORT fmi3Status fmi3SetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                               const bool v[]) {
+  (void)vr; (void)v;
+  return n == 0 ? fmi3OK : Refuse(c, "fmi3SetClock: the FMU has no clocks");
+}
+#ifndef MODEL_HAS_BINARY
+EXPORT fmi3Status fmi3GetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                                size_t sizes[], const fmi3Byte* v[], size_t nv) {
+  (void)vr; (void)sizes; (void)v; (void)nv;
+  return n == 0 ? fmi3OK : Refuse(c, "fmi3GetBinary: the FMU has no Binary variable");
+}
+EXPORT fmi3Status fmi3SetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                                const size_t sizes[], const fmi3Byte* const v[], size_t nv) {
+  (void)vr; (void)sizes; (void)v; (void)nv;
+  return n == 0 ? fmi3OK : Refuse(c, "fmi3SetBinary: the FMU has no Binary variable");
+}
+#endif
+EXPORT fmi3Status fmi3SetDebugLogging(fmi3Instance c, bool on, size_t n, const fmi3String cat[]) {
+  (void)c; (void)on; (void)n; (void)cat;
+  return fmi3OK;
+}
+EXPORT fmi3Status fmi3EnterEventMode(fmi3Instance c) {
+  return Refuse(c, "fmi3EnterEventMode: no event mode");
+}
+EXPORT fmi3Status fmi3Reset(fmi3Instance c) {
+  Instance* ci = (Instance*)c;
+  ModelDefaults(&ci->m);
+  ci->step_mode = false;
+  ci->set_since_step = false;
+  return fmi3OK;
+}
+EXPORT fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance c, fmi3ValueReference vr,
+                                                      size_t* n) {
+  (void)vr; (void)n;
+  return Refuse(c, "fmi3GetNumberOfVariableDependencies: see ModelStructure");
+}
+EXPORT fmi3Status fmi3GetVariableDependencies(fmi3Instance c, fmi3ValueReference vr,
+                                              size_t element[], fmi3ValueReference independent[],
+                                              size_t element_independent[], int kind[],
+                                              size_t n) {
+  (void)vr; (void)element; (void)independent; (void)element_independent; (void)kind; (void)n;
+  return Refuse(c, "fmi3GetVariableDependencies: see ModelStructure");
+}
+EXPORT fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference u[],
+                                               size_t nu, const fmi3ValueReference k[], size_t nk,
+                                               const double seed[], size_t ns, double sens[],
+                                               size_t nsens) {
+  (void)u; (void)nu; (void)k; (void)nk; (void)seed; (void)ns; (void)sens; (void)nsens;
+  return Refuse(c, "fmi3GetDirectionalDerivative: not provided");
+}
+EXPORT fmi3Status fmi3GetAdjointDerivative(fmi3Instance c, const fmi3ValueReference u[],
+                                           size_t nu, const fmi3ValueReference k[], size_t nk,
+                                           const double seed[], size_t ns, double sens[],
+                                           size_t nsens) {
+  (void)u; (void)nu; (void)k; (void)nk; (void)seed; (void)ns; (void)sens; (void)nsens;
+  return Refuse(c, "fmi3GetAdjointDerivative: not provided");
+}
+EXPORT fmi3Status fmi3EnterConfigurationMode(fmi3Instance c) {
+  return Refuse(c, "fmi3EnterConfigurationMode: no tunable structural parameter");
+}
+EXPORT fmi3Status fmi3ExitConfigurationMode(fmi3Instance c) {
+  return Refuse(c, "fmi3ExitConfigurationMode: no configuration mode");
+}
+EXPORT fmi3Status fmi3GetIntervalDecimal(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                                         double interval[], int qualifier[]) {
+  (void)vr; (void)n; (void)interval; (void)qualifier;
+  return Refuse(c, "fmi3GetIntervalDecimal: no clocks");
+}
+EXPORT fmi3Status fmi3GetIntervalFraction(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                                          uint64_t counter[], uint64_t resolution[],
+                                          int qualifier[]) {
+  (void)vr; (void)n; (void)counter; (void)resolution; (void)qualifier;
+  return Refuse(c, "fmi3GetIntervalFraction: no clocks");
+}
+EXPORT fmi3Status fmi3GetShiftDecimal(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                                      double shift[]) {
+  (void)vr; (void)n; (void)shift;
+  return Refuse(c, "fmi3GetShiftDecimal: no clocks");
+}
+EXPORT fmi3Status fmi3GetShiftFraction(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                                       uint64_t counter[], uint64_t resolution[]) {
+  (void)vr; (void)n; (void)counter; (void)resolution;
+  return Refuse(c, "fmi3GetShiftFraction: no clocks");
+}
+EXPORT fmi3Status fmi3SetIntervalDecimal(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                                         const double interval[]) {
+  (void)vr; (void)n; (void)interval;
+  return Refuse(c, "fmi3SetIntervalDecimal: no clocks");
+}
+EXPORT fmi3Status fmi3SetIntervalFraction(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                                          const uint64_t counter[], const uint64_t resolution[]) {
+  (void)vr; (void)n; (void)counter; (void)resolution;
+  return Refuse(c, "fmi3SetIntervalFraction: no clocks");
+}
+EXPORT fmi3Status fmi3SetShiftDecimal(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                                      const double shift[]) {
+  (void)vr; (void)n; (void)shift;
+  return Refuse(c, "fmi3SetShiftDecimal: no clocks");
+}
+EXPORT fmi3Status fmi3SetShiftFraction(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                                       const uint64_t counter[], const uint64_t resolution[]) {
+  (void)vr; (void)n; (void)counter; (void)resolution;
+  return Refuse(c, "fmi3SetShiftFraction: no clocks");
+}
+EXPORT fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance c) {
+  return Refuse(c, "fmi3EvaluateDiscreteStates: no event mode");
+}
+EXPORT fmi3Status fmi3UpdateDiscreteStates(fmi3Instance c, bool* a, bool* b, bool* d, bool* e,
+                                           bool* f, double* g) {
+  (void)a; (void)b; (void)d; (void)e; (void)f; (void)g;
+  return Refuse(c, "fmi3UpdateDiscreteStates: no event mode");
+}
+EXPORT fmi3Status fmi3EnterStepMode(fmi3Instance c) {
+  return Refuse(c, "fmi3EnterStepMode: no event mode (step mode follows initialization)");
+}
+EXPORT fmi3Status fmi3GetOutputDerivatives(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                                           const int32_t order[], double v[], size_t nv) {
+  (void)vr; (void)n; (void)order; (void)v; (void)nv;
+  return Refuse(c, "fmi3GetOutputDerivatives: maxOutputDerivativeOrder is 0");
 }

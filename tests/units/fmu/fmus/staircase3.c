@@ -7,16 +7,16 @@
  * with fmi3Error. At t_stop it asks to end the simulation
  * (terminateSimulation). */
 #define MODEL_TOKEN "{linesim-test-staircase-3}"
-#define NF 5
-#define NFV 5
+#define NF 6
+#define NFV 6
 #define NI 0
 #define NB 0
 #define NS 0
 #include <stddef.h>
-static const size_t kSize[NF] = {1, 1, 1, 1, 1};
+static const size_t kSize[NF] = {1, 1, 1, 1, 1, 1};
 #include "fmi3_skeleton.h"
 
-enum { Y = 0, AREA = 1, PERIOD = 2, T_STOP = 3, EVENTS = 4 };
+enum { Y = 0, AREA = 1, PERIOD = 2, T_STOP = 3, EVENTS = 4, TIME = 5 };
 /* Times closer than this are one time (the test's times are multiples of
  * 0.05 s, computed in doubles). */
 #define SAME_TIME 1e-9
@@ -27,7 +27,8 @@ static void ModelDefaults(Model* m) {
   m->f[T_STOP] = 1e9;
 }
 
-static void ModelOutputs(Model* m) { (void)m; }
+/* The independent variable `time` is the FMU's time. */
+static void ModelOutputs(Model* m) { m->f[TIME] = m->time; }
 
 static fmi3Status ModelStep(Instance* c, double t, double h, bool* early, double* last,
                             bool* terminate) {

@@ -1,7 +1,9 @@
 /* Every FMI 3.0 scalar type (fmus/types3.xml): each <type>_out is its
  * <type>_in, f32_out is f32_in; y[k] = (k + 1) * f32_in, an array of n
  * elements where n is a UInt64 structural parameter (start 3). A Binary
- * input (vr 490) is declared and never read. */
+ * output (vr 491) is its Binary input (vr 490): linesim leaves both out,
+ * as the Reference-FMUs' Feedthrough's, whose model structure lists the
+ * Binary output. */
 #define MODEL_TOKEN "{linesim-test-types-3}"
 #define NF 1
 #define NFV 3
@@ -11,7 +13,12 @@
 #include <stddef.h>
 #include <stdint.h>
 static const size_t kSize[NF] = {3};
+#define MODEL_HAS_EXTRA_TYPES
+#define MODEL_HAS_BINARY
+#define BLOB_MAX 64
 #define MODEL_EXTRA_FIELDS \
+  uint8_t blob[2][BLOB_MAX]; \
+  size_t blob_size[2];     \
   float f32[2];            \
   int8_t i8[2];            \
   uint8_t u8[2];           \
@@ -26,6 +33,8 @@ static const size_t kSize[NF] = {3};
 static void ModelDefaults(Model* m) {
   memset(m, 0, sizeof *m);
   m->e[0] = m->e[1] = 1;
+  memcpy(m->blob[0], "foo", 3); /* start 666f6f */
+  m->blob_size[0] = 3;
 }
 
 static void ModelOutputs(Model* m) {
@@ -38,6 +47,8 @@ static void ModelOutputs(Model* m) {
   m->i64[1] = m->i64[0];
   m->u64[1] = m->u64[0];
   m->e[1] = m->e[0];
+  memcpy(m->blob[1], m->blob[0], m->blob_size[0]);
+  m->blob_size[1] = m->blob_size[0];
   for (int k = 0; k < 3; ++k) m->f[k] = (k + 1) * (double)m->f32[0];
 }
 
@@ -55,6 +66,7 @@ static fmi3Status ModelStep(Instance* c, double t, double h, bool* early, double
                                   T v[], size_t nv) {                                       \
     Model* m = &((Instance*)c)->m;                                                          \
     if (n != nv) return fmi3Error;                                                          \
+    FMI3_CHECK_GET("fmi3Get" #Name)                                                          \
     ModelOutputs(m);                                                                        \
     for (size_t k = 0; k < n; ++k) {                                                        \
       if (vr[k] < (base) || vr[k] > (base) + 1) return fmi3Error;                           \
@@ -66,6 +78,7 @@ static fmi3Status ModelStep(Instance* c, double t, double h, bool* early, double
                                   const T v[], size_t nv) {                                 \
     Model* m = &((Instance*)c)->m;                                                          \
     if (n != nv) return fmi3Error;                                                          \
+    FMI3_NOTE_SET()                                                                         \
     for (size_t k = 0; k < n; ++k) {                                                        \
       if (vr[k] != (base)) return fmi3Error; /* inputs only */                              \
       m->field[0] = v[k];                                                                   \
@@ -90,6 +103,7 @@ EXPORT fmi3Status fmi3GetInt64(fmi3Instance c, const fmi3ValueReference vr[], si
                                int64_t v[], size_t nv) {
   Model* m = &((Instance*)c)->m;
   if (n != nv) return fmi3Error;
+  FMI3_CHECK_GET("fmi3GetInt64")
   ModelOutputs(m);
   for (size_t k = 0; k < n; ++k) {
     int64_t* slot = Int64Slot(m, vr[k]);
@@ -102,6 +116,7 @@ EXPORT fmi3Status fmi3SetInt64(fmi3Instance c, const fmi3ValueReference vr[], si
                                const int64_t v[], size_t nv) {
   Model* m = &((Instance*)c)->m;
   if (n != nv) return fmi3Error;
+  FMI3_NOTE_SET()
   for (size_t k = 0; k < n; ++k) {
     if (vr[k] != 460 && vr[k] != 480) return fmi3Error; /* inputs only */
     *Int64Slot(m, vr[k]) = v[k];
@@ -114,6 +129,7 @@ EXPORT fmi3Status fmi3GetUInt64(fmi3Instance c, const fmi3ValueReference vr[], s
                                 uint64_t v[], size_t nv) {
   Model* m = &((Instance*)c)->m;
   if (n != nv) return fmi3Error;
+  FMI3_CHECK_GET("fmi3GetUInt64")
   ModelOutputs(m);
   for (size_t k = 0; k < n; ++k) {
     if (vr[k] == 500) {
@@ -130,6 +146,7 @@ EXPORT fmi3Status fmi3SetUInt64(fmi3Instance c, const fmi3ValueReference vr[], s
                                 const uint64_t v[], size_t nv) {
   Model* m = &((Instance*)c)->m;
   if (n != nv) return fmi3Error;
+  FMI3_NOTE_SET()
   for (size_t k = 0; k < n; ++k) {
     if (vr[k] == 500) {
       if (v[k] != 3) return fmi3Error;
@@ -138,6 +155,33 @@ EXPORT fmi3Status fmi3SetUInt64(fmi3Instance c, const fmi3ValueReference vr[], s
     } else {
       return fmi3Error;
     }
+  }
+  return fmi3OK;
+}
+
+/* Binary: the input at 490, the output at 491 (its copy). */
+EXPORT fmi3Status fmi3GetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                                size_t sizes[], const fmi3Byte* v[], size_t nv) {
+  Model* m = &((Instance*)c)->m;
+  if (n != nv) return fmi3Error;
+  FMI3_CHECK_GET("fmi3GetBinary")
+  ModelOutputs(m);
+  for (size_t k = 0; k < n; ++k) {
+    if (vr[k] != 490 && vr[k] != 491) return fmi3Error;
+    sizes[k] = m->blob_size[vr[k] - 490];
+    v[k] = m->blob[vr[k] - 490];
+  }
+  return fmi3OK;
+}
+EXPORT fmi3Status fmi3SetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t n,
+                                const size_t sizes[], const fmi3Byte* const v[], size_t nv) {
+  Model* m = &((Instance*)c)->m;
+  if (n != nv) return fmi3Error;
+  FMI3_NOTE_SET()
+  for (size_t k = 0; k < n; ++k) {
+    if (vr[k] != 490 || sizes[k] > BLOB_MAX) return fmi3Error; /* the input only */
+    memcpy(m->blob[0], v[k], sizes[k]);
+    m->blob_size[0] = sizes[k];
   }
   return fmi3OK;
 }
