@@ -1,5 +1,6 @@
 #include "fmu_export/export_layout.h"
 
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
@@ -86,6 +87,13 @@ constexpr char kMagic[] = "LSUS1";
 
 }  // namespace
 
+bool IsInt64In3(const cosim::VariableInfo& info) {
+  if (info.type != cosim::VarType::kInteger) return false;
+  const auto lo = info.rule.lower(), hi = info.rule.upper();
+  return (lo && *lo < static_cast<double>(INT32_MIN)) ||
+         (hi && *hi > static_cast<double>(INT32_MAX));
+}
+
 std::string GuidOf(const std::string& text) {
   const std::uint64_t a = Fnv1a(text, 0xcbf29ce484222325ULL);
   const std::uint64_t b = Fnv1a(text, 0x84222325cbf29ce4ULL);
@@ -141,10 +149,18 @@ cosim::UnitState DeserializeState(const char* data, std::size_t size) {
   const auto n = r.Pod<std::uint64_t>();
   for (std::uint64_t k = 0; k < n; ++k) {
     switch (r.Pod<std::uint8_t>()) {
-      case 0: state.variables.emplace_back(r.Pod<double>()); break;
-      case 1: state.variables.emplace_back(r.Pod<std::int64_t>()); break;
-      case 2: state.variables.emplace_back(r.Pod<std::uint8_t>() != 0); break;
-      case 3: state.variables.emplace_back(r.Text()); break;
+      case 0:
+        state.variables.emplace_back(r.Pod<double>());
+        break;
+      case 1:
+        state.variables.emplace_back(r.Pod<std::int64_t>());
+        break;
+      case 2:
+        state.variables.emplace_back(r.Pod<std::uint8_t>() != 0);
+        break;
+      case 3:
+        state.variables.emplace_back(r.Text());
+        break;
       case 4: {
         const auto m = r.Pod<std::uint64_t>();
         std::vector<double> a;
@@ -152,7 +168,8 @@ cosim::UnitState DeserializeState(const char* data, std::size_t size) {
         state.variables.emplace_back(std::move(a));
         break;
       }
-      default: throw std::runtime_error("serialized FMU state: unknown value kind");
+      default:
+        throw std::runtime_error("serialized FMU state: unknown value kind");
     }
   }
   const auto nr = r.Pod<std::uint64_t>();

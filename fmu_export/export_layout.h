@@ -17,10 +17,10 @@ namespace linesim::fmu_export {
 /// One FMI 2.0 ScalarVariable: a scalar of the table, or one element of a
 /// Real array. Its value reference is its index in Layout::variables.
 struct ExportedVariable {
-  std::string name;                  // "resistance", "ranges[1]" (1-based, FMI structured naming)
-  cosim::ValueRef ref = 0;           // in the unit's table
-  std::size_t element = 0;           // element of a Real array
-  bool is_element = false;           // true: GetRealElement(ref, element)
+  std::string name;         // "resistance", "ranges[1]" (1-based, FMI structured naming)
+  cosim::ValueRef ref = 0;  // in the unit's table
+  std::size_t element = 0;  // element of a Real array
+  bool is_element = false;  // true: GetRealElement(ref, element)
   cosim::VarType type = cosim::VarType::kReal;  // scalar type (kReal for an element)
 };
 
@@ -33,6 +33,12 @@ struct Layout {
 /// Table variables in declaration order; a Real array of n elements becomes
 /// n Real scalars, named "x" when n == 1 and "x[1]" .. "x[n]" otherwise.
 Layout MakeLayout(const cosim::VariableTable& table);
+
+/// The FMI 3.0 type of a linesim Integer: Int64 when its declared range
+/// reaches beyond 32 bits (a device seed up to 2^32 - 1), else Int32 (as
+/// the FMI 2.0 Integer). The writer and the runtime's fmi3Get/SetInt32 and
+/// Int64 decide by it.
+bool IsInt64In3(const cosim::VariableInfo& info);
 
 /// FNV-1a 64 of `text`, as an FMI 2.0 guid "{xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx}"
 /// (two differently seeded hashes fill its 128 bits).

@@ -12,12 +12,12 @@
 // with a linesim that loads the FMU.
 
 #include <cstdarg>
-#include <initializer_list>
-#include <span>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <memory>
+#include <span>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -66,10 +66,11 @@ struct Instance {
 void Log(const Instance* c, fmi2::Status status, const char* category, const std::string& text) {
   if (c && c->version == 3) {
     // FMI 3.0's status values are FMI 2.0's (without pending).
-    if (c->log3) c->log3(c->environment3, static_cast<fmi3::Status>(status), category, text.c_str());
+    if (c->log3)
+      c->log3(c->environment3, static_cast<fmi3::Status>(status), category, text.c_str());
   } else if (c && c->callbacks.logger) {
-    c->callbacks.logger(c->callbacks.componentEnvironment, c->name.c_str(), status, category,
-                        "%s", text.c_str());
+    c->callbacks.logger(c->callbacks.componentEnvironment, c->name.c_str(), status, category, "%s",
+                        text.c_str());
   }
 }
 
@@ -143,8 +144,7 @@ void Open(Instance& c, const std::string& resources, const char* token) {
   const std::string expected = linesim::fmu_export::GuidOfResources(text, scene);
   if (!token || expected != token) {
     throw std::runtime_error(std::string(c.version == 2 ? "guid " : "instantiationToken ") +
-                             (token ? token : "(null)") + " does not match this FMU's " +
-                             expected);
+                             (token ? token : "(null)") + " does not match this FMU's " + expected);
   }
   Build(c);
 }
@@ -254,9 +254,11 @@ LINESIM_FMI_EXPORT fmi2::Status fmi2SetupExperiment(fmi2::Component component, f
                                                     fmi2::Real stop_time) {
   Instance* c = Of(component);
   return Guard(c, "fmi2SetupExperiment", [&] {
-    if (c->phase != Phase::kInstantiated) return Fail(c, "fmi2SetupExperiment: not after instantiation");
+    if (c->phase != Phase::kInstantiated)
+      return Fail(c, "fmi2SetupExperiment: not after instantiation");
     c->start = cosim::SecondsToNs(start_time);
-    c->stop = stop_time_defined ? cosim::SecondsToNs(stop_time) : cosim::kNsPerSecond * 1'000'000'000LL;
+    c->stop =
+        stop_time_defined ? cosim::SecondsToNs(stop_time) : cosim::kNsPerSecond * 1'000'000'000LL;
     c->last_successful = c->start;
     return fmi2::kOK;
   });
@@ -509,8 +511,8 @@ LINESIM_FMI_EXPORT fmi2::Status fmi2SerializeFMUstate(fmi2::Component component,
 }
 
 LINESIM_FMI_EXPORT fmi2::Status fmi2DeSerializeFMUstate(fmi2::Component component,
-                                                        const fmi2::Byte bytes[],
-                                                        std::size_t size, fmi2::FMUstate* state) {
+                                                        const fmi2::Byte bytes[], std::size_t size,
+                                                        fmi2::FMUstate* state) {
   Instance* c = Of(component);
   return Guard(c, "fmi2DeSerializeFMUstate", [&] {
     if (!bytes || !state) return Fail(c, "fmi2DeSerializeFMUstate: no bytes or state pointer");
@@ -531,13 +533,11 @@ LINESIM_FMI_EXPORT fmi2::Status fmi2DeSerializeFMUstate(fmi2::Component componen
 
 // --- not provided (the model description says so) -----------------------
 
-LINESIM_FMI_EXPORT fmi2::Status fmi2GetDirectionalDerivative(fmi2::Component c,
-                                                             const fmi2::ValueReference[],
-                                                             std::size_t,
-                                                             const fmi2::ValueReference[],
-                                                             std::size_t, const fmi2::Real[],
-                                                             fmi2::Real[]) {
-  return Fail(Of(c), "fmi2GetDirectionalDerivative: not provided (providesDirectionalDerivative=false)");
+LINESIM_FMI_EXPORT fmi2::Status fmi2GetDirectionalDerivative(
+    fmi2::Component c, const fmi2::ValueReference[], std::size_t, const fmi2::ValueReference[],
+    std::size_t, const fmi2::Real[], fmi2::Real[]) {
+  return Fail(Of(c),
+              "fmi2GetDirectionalDerivative: not provided (providesDirectionalDerivative=false)");
 }
 
 LINESIM_FMI_EXPORT fmi2::Status fmi2SetRealInputDerivatives(fmi2::Component c,
@@ -583,12 +583,12 @@ LINESIM_FMI_EXPORT fmi2::Status fmi2DoStep(fmi2::Component component, fmi2::Real
         break;
     }
     c->phase = Phase::kBroken;
-    return Fail(c, "fmi2DoStep at t = " + cosim::FormatSeconds(t_ns) + " s: " + c->unit->last_error());
+    return Fail(c,
+                "fmi2DoStep at t = " + cosim::FormatSeconds(t_ns) + " s: " + c->unit->last_error());
   });
 }
 
-LINESIM_FMI_EXPORT fmi2::Status fmi2GetStatus(fmi2::Component c, fmi2::StatusKind,
-                                              fmi2::Status*) {
+LINESIM_FMI_EXPORT fmi2::Status fmi2GetStatus(fmi2::Component c, fmi2::StatusKind, fmi2::Status*) {
   return Fail(Of(c), "fmi2GetStatus: doStep never returns fmi2Pending");
 }
 
@@ -609,8 +609,7 @@ LINESIM_FMI_EXPORT fmi2::Status fmi2GetIntegerStatus(fmi2::Component c, fmi2::St
 }
 
 LINESIM_FMI_EXPORT fmi2::Status fmi2GetBooleanStatus(fmi2::Component component,
-                                                     fmi2::StatusKind kind,
-                                                     fmi2::Boolean* value) {
+                                                     fmi2::StatusKind kind, fmi2::Boolean* value) {
   Instance* c = Of(component);
   if (!c || !value) return fmi2::kError;
   if (kind != fmi2::kTerminated) {
@@ -653,9 +652,7 @@ namespace {
 fmi3::Status S3(fmi2::Status s) { return static_cast<fmi3::Status>(s); }
 Instance* Of3(fmi3::Instance c) { return static_cast<Instance*>(c); }
 
-fmi3::Status Refuse3(fmi3::Instance c, const std::string& what) {
-  return S3(Fail(Of3(c), what));
-}
+fmi3::Status Refuse3(fmi3::Instance c, const std::string& what) { return S3(Fail(Of3(c), what)); }
 
 // A get or set of a type this FMU has no variable of: fine for none.
 fmi3::Status NoVariables3(fmi3::Instance c, const char* function, std::size_t n) {
@@ -689,8 +686,8 @@ fmi2::Status CountMismatch(Instance* c, const char* function, std::size_t used, 
 
 LINESIM_FMI_EXPORT const char* fmi3GetVersion() { return "3.0"; }
 
-LINESIM_FMI_EXPORT fmi3::Status fmi3SetDebugLogging(fmi3::Instance c, fmi3::Boolean on,
-                                                    std::size_t, const fmi3::String[]) {
+LINESIM_FMI_EXPORT fmi3::Status fmi3SetDebugLogging(fmi3::Instance c, fmi3::Boolean on, std::size_t,
+                                                    const fmi3::String[]) {
   if (!c) return fmi3::kError;
   Of3(c)->logging = on;
   return fmi3::kOK;
@@ -716,7 +713,8 @@ LINESIM_FMI_EXPORT fmi3::Instance fmi3InstantiateCoSimulation(
   c->environment3 = environment;
   c->logging = logging_on;
   try {
-    if (event_mode_used) throw std::runtime_error("event mode is not provided (hasEventMode=false)");
+    if (event_mode_used)
+      throw std::runtime_error("event mode is not provided (hasEventMode=false)");
     if (n_required_intermediate > 0) {
       throw std::runtime_error("intermediate variables are not provided");
     }
@@ -743,14 +741,13 @@ LINESIM_FMI_EXPORT fmi3::Instance fmi3InstantiateScheduledExecution(
 
 LINESIM_FMI_EXPORT void fmi3FreeInstance(fmi3::Instance c) { delete Of3(c); }
 
-LINESIM_FMI_EXPORT fmi3::Status fmi3EnterInitializationMode(fmi3::Instance instance,
-                                                            fmi3::Boolean, fmi3::Float64,
-                                                            fmi3::Float64 start_time,
+LINESIM_FMI_EXPORT fmi3::Status fmi3EnterInitializationMode(fmi3::Instance instance, fmi3::Boolean,
+                                                            fmi3::Float64, fmi3::Float64 start_time,
                                                             fmi3::Boolean stop_time_defined,
                                                             fmi3::Float64 stop_time) {
-  const fmi2::Status s = fmi2SetupExperiment(instance, fmi2::kFalse, 0.0, start_time,
-                                             stop_time_defined ? fmi2::kTrue : fmi2::kFalse,
-                                             stop_time);
+  const fmi2::Status s =
+      fmi2SetupExperiment(instance, fmi2::kFalse, 0.0, start_time,
+                          stop_time_defined ? fmi2::kTrue : fmi2::kFalse, stop_time);
   if (s != fmi2::kOK) return S3(s);
   return S3(fmi2EnterInitializationMode(instance));
 }
@@ -810,41 +807,82 @@ LINESIM_FMI_EXPORT fmi3::Status fmi3SetFloat64(fmi3::Instance instance,
   }));
 }
 
-LINESIM_FMI_EXPORT fmi3::Status fmi3GetInt32(fmi3::Instance instance,
-                                             const fmi3::ValueReference vr[], std::size_t nvr,
-                                             fmi3::Int32 values[], std::size_t n) {
-  Instance* c = Of3(instance);
-  return S3(Guard(c, "fmi3GetInt32", [&] {
-    if (n != nvr) return CountMismatch(c, "fmi3GetInt32", nvr, n);
-    Refresh(c);
-    for (std::size_t i = 0; i < nvr; ++i) {
-      const auto* info = Variable3(c, vr[i], {cosim::VarType::kInteger}, "fmi3GetInt32");
-      if (!info) return fmi2::kError;
-      const std::int64_t x = c->unit->variables().GetInteger(info->ref);
-      if (x < INT32_MIN || x > INT32_MAX) {
-        return Fail(c, "fmi3GetInt32: " + info->name + " = " + std::to_string(x) +
-                           " does not fit 32 bits");
-      }
-      values[i] = static_cast<fmi3::Int32>(x);
-    }
-    return fmi2::kOK;
-  }));
+namespace {
+
+// A linesim Integer of the FMI 3.0 type `int64` selects (IsInt64In3: Int64
+// when its declared range is wider than 32 bits, else Int32), or nothing
+// after reporting: each variable is served by the functions of its
+// declared type only.
+const cosim::VariableInfo* Integer3(Instance* c, fmi3::ValueReference vr, bool int64,
+                                    const char* function) {
+  const auto* info = Variable3(c, vr, {cosim::VarType::kInteger}, function);
+  if (info && linesim::fmu_export::IsInt64In3(*info) != int64) {
+    Fail(c, std::string(function) + ": value reference " + std::to_string(vr) + " is '" +
+                info->name + "', an " + (int64 ? "Int32" : "Int64") + " variable");
+    return nullptr;
+  }
+  return info;
 }
 
-LINESIM_FMI_EXPORT fmi3::Status fmi3SetInt32(fmi3::Instance instance,
-                                             const fmi3::ValueReference vr[], std::size_t nvr,
-                                             const fmi3::Int32 values[], std::size_t n) {
+template <typename T>
+fmi2::Status GetInteger3(fmi3::Instance instance, const fmi3::ValueReference vr[], std::size_t nvr,
+                         T values[], std::size_t n, const char* function) {
   Instance* c = Of3(instance);
-  return S3(Guard(c, "fmi3SetInt32", [&] {
-    if (n != nvr) return CountMismatch(c, "fmi3SetInt32", nvr, n);
+  constexpr bool kInt64 = sizeof(T) == 8;
+  return Guard(c, function, [&] {
+    if (n != nvr) return CountMismatch(c, function, nvr, n);
+    Refresh(c);
     for (std::size_t i = 0; i < nvr; ++i) {
-      const auto* info = Variable3(c, vr[i], {cosim::VarType::kInteger}, "fmi3SetInt32");
+      const auto* info = Integer3(c, vr[i], kInt64, function);
+      if (!info) return fmi2::kError;
+      const std::int64_t x = c->unit->variables().GetInteger(info->ref);
+      if (!kInt64 && (x < INT32_MIN || x > INT32_MAX)) {
+        return Fail(c, std::string(function) + ": " + info->name + " = " + std::to_string(x) +
+                           " does not fit 32 bits");
+      }
+      values[i] = static_cast<T>(x);
+    }
+    return fmi2::kOK;
+  });
+}
+
+template <typename T>
+fmi2::Status SetInteger3(fmi3::Instance instance, const fmi3::ValueReference vr[], std::size_t nvr,
+                         const T values[], std::size_t n, const char* function) {
+  Instance* c = Of3(instance);
+  return Guard(c, function, [&] {
+    if (n != nvr) return CountMismatch(c, function, nvr, n);
+    for (std::size_t i = 0; i < nvr; ++i) {
+      const auto* info = Integer3(c, vr[i], sizeof(T) == 8, function);
       if (!info) return fmi2::kError;
       c->unit->variables().SetInteger(info->ref, values[i]);
       MarkSetRef(c, info->ref);
     }
     return fmi2::kOK;
-  }));
+  });
+}
+
+}  // namespace
+
+LINESIM_FMI_EXPORT fmi3::Status fmi3GetInt32(fmi3::Instance instance,
+                                             const fmi3::ValueReference vr[], std::size_t nvr,
+                                             fmi3::Int32 values[], std::size_t n) {
+  return S3(GetInteger3(instance, vr, nvr, values, n, "fmi3GetInt32"));
+}
+LINESIM_FMI_EXPORT fmi3::Status fmi3SetInt32(fmi3::Instance instance,
+                                             const fmi3::ValueReference vr[], std::size_t nvr,
+                                             const fmi3::Int32 values[], std::size_t n) {
+  return S3(SetInteger3(instance, vr, nvr, values, n, "fmi3SetInt32"));
+}
+LINESIM_FMI_EXPORT fmi3::Status fmi3GetInt64(fmi3::Instance instance,
+                                             const fmi3::ValueReference vr[], std::size_t nvr,
+                                             std::int64_t values[], std::size_t n) {
+  return S3(GetInteger3(instance, vr, nvr, values, n, "fmi3GetInt64"));
+}
+LINESIM_FMI_EXPORT fmi3::Status fmi3SetInt64(fmi3::Instance instance,
+                                             const fmi3::ValueReference vr[], std::size_t nvr,
+                                             const std::int64_t values[], std::size_t n) {
+  return S3(SetInteger3(instance, vr, nvr, values, n, "fmi3SetInt64"));
 }
 
 LINESIM_FMI_EXPORT fmi3::Status fmi3GetBoolean(fmi3::Instance instance,
@@ -912,14 +950,14 @@ LINESIM_FMI_EXPORT fmi3::Status fmi3SetString(fmi3::Instance instance,
 }
 
 // Types no linesim variable has.
-#define LINESIM_FMI3_NO_TYPE(Name, T)                                                         \
+#define LINESIM_FMI3_NO_TYPE(Name, T)                                                           \
   LINESIM_FMI_EXPORT fmi3::Status fmi3Get##Name(fmi3::Instance c, const fmi3::ValueReference[], \
-                                                std::size_t nvr, T[], std::size_t) {           \
-    return NoVariables3(c, "fmi3Get" #Name, nvr);                                             \
-  }                                                                                           \
+                                                std::size_t nvr, T[], std::size_t) {            \
+    return NoVariables3(c, "fmi3Get" #Name, nvr);                                               \
+  }                                                                                             \
   LINESIM_FMI_EXPORT fmi3::Status fmi3Set##Name(fmi3::Instance c, const fmi3::ValueReference[], \
-                                                std::size_t nvr, const T[], std::size_t) {     \
-    return NoVariables3(c, "fmi3Set" #Name, nvr);                                             \
+                                                std::size_t nvr, const T[], std::size_t) {      \
+    return NoVariables3(c, "fmi3Set" #Name, nvr);                                               \
   }
 LINESIM_FMI3_NO_TYPE(Float32, float)
 LINESIM_FMI3_NO_TYPE(Int8, std::int8_t)
@@ -927,7 +965,6 @@ LINESIM_FMI3_NO_TYPE(UInt8, std::uint8_t)
 LINESIM_FMI3_NO_TYPE(Int16, std::int16_t)
 LINESIM_FMI3_NO_TYPE(UInt16, std::uint16_t)
 LINESIM_FMI3_NO_TYPE(UInt32, std::uint32_t)
-LINESIM_FMI3_NO_TYPE(Int64, std::int64_t)
 LINESIM_FMI3_NO_TYPE(UInt64, std::uint64_t)
 #undef LINESIM_FMI3_NO_TYPE
 
@@ -939,8 +976,8 @@ LINESIM_FMI_EXPORT fmi3::Status fmi3GetBinary(fmi3::Instance c, const fmi3::Valu
   return NoVariables3(c, "fmi3GetBinary", nvr);
 }
 LINESIM_FMI_EXPORT fmi3::Status fmi3SetBinary(fmi3::Instance c, const fmi3::ValueReference[],
-                                              std::size_t nvr, const std::size_t[],
-                                              const Binary3[], std::size_t) {
+                                              std::size_t nvr, const std::size_t[], const Binary3[],
+                                              std::size_t) {
   return NoVariables3(c, "fmi3SetBinary", nvr);
 }
 LINESIM_FMI_EXPORT fmi3::Status fmi3GetClock(fmi3::Instance c, const fmi3::ValueReference[],
@@ -959,7 +996,14 @@ LINESIM_FMI_EXPORT fmi3::Status fmi3GetNumberOfVariableDependencies(fmi3::Instan
                                                                     std::size_t*) {
   return Refuse3(c, "fmi3GetNumberOfVariableDependencies: not provided (see ModelStructure)");
 }
-enum DependencyKind3 : int { kIndependent3, kConstant3, kFixed3, kTunable3, kDiscrete3, kDependent3 };
+enum DependencyKind3 : int {
+  kIndependent3,
+  kConstant3,
+  kFixed3,
+  kTunable3,
+  kDiscrete3,
+  kDependent3
+};
 LINESIM_FMI_EXPORT fmi3::Status fmi3GetVariableDependencies(fmi3::Instance c, fmi3::ValueReference,
                                                             std::size_t[], fmi3::ValueReference[],
                                                             std::size_t[], DependencyKind3[],
@@ -998,9 +1042,11 @@ LINESIM_FMI_EXPORT fmi3::Status fmi3GetDirectionalDerivative(
     std::size_t, const fmi3::Float64[], std::size_t, fmi3::Float64[], std::size_t) {
   return Refuse3(c, "fmi3GetDirectionalDerivative: not provided");
 }
-LINESIM_FMI_EXPORT fmi3::Status fmi3GetAdjointDerivative(
-    fmi3::Instance c, const fmi3::ValueReference[], std::size_t, const fmi3::ValueReference[],
-    std::size_t, const fmi3::Float64[], std::size_t, fmi3::Float64[], std::size_t) {
+LINESIM_FMI_EXPORT fmi3::Status fmi3GetAdjointDerivative(fmi3::Instance c,
+                                                         const fmi3::ValueReference[], std::size_t,
+                                                         const fmi3::ValueReference[], std::size_t,
+                                                         const fmi3::Float64[], std::size_t,
+                                                         fmi3::Float64[], std::size_t) {
   return Refuse3(c, "fmi3GetAdjointDerivative: not provided");
 }
 LINESIM_FMI_EXPORT fmi3::Status fmi3EnterConfigurationMode(fmi3::Instance c) {
@@ -1025,9 +1071,9 @@ LINESIM_FMI_EXPORT fmi3::Status fmi3GetShiftDecimal(fmi3::Instance c, const fmi3
                                                     std::size_t, fmi3::Float64[]) {
   return Refuse3(c, "fmi3GetShiftDecimal: the FMU has no clocks");
 }
-LINESIM_FMI_EXPORT fmi3::Status fmi3GetShiftFraction(fmi3::Instance c,
-                                                     const fmi3::ValueReference[], std::size_t,
-                                                     std::uint64_t[], std::uint64_t[]) {
+LINESIM_FMI_EXPORT fmi3::Status fmi3GetShiftFraction(fmi3::Instance c, const fmi3::ValueReference[],
+                                                     std::size_t, std::uint64_t[],
+                                                     std::uint64_t[]) {
   return Refuse3(c, "fmi3GetShiftFraction: the FMU has no clocks");
 }
 LINESIM_FMI_EXPORT fmi3::Status fmi3SetIntervalDecimal(fmi3::Instance c,
@@ -1045,9 +1091,9 @@ LINESIM_FMI_EXPORT fmi3::Status fmi3SetShiftDecimal(fmi3::Instance c, const fmi3
                                                     std::size_t, const fmi3::Float64[]) {
   return Refuse3(c, "fmi3SetShiftDecimal: the FMU has no clocks");
 }
-LINESIM_FMI_EXPORT fmi3::Status fmi3SetShiftFraction(fmi3::Instance c,
-                                                     const fmi3::ValueReference[], std::size_t,
-                                                     const std::uint64_t[], const std::uint64_t[]) {
+LINESIM_FMI_EXPORT fmi3::Status fmi3SetShiftFraction(fmi3::Instance c, const fmi3::ValueReference[],
+                                                     std::size_t, const std::uint64_t[],
+                                                     const std::uint64_t[]) {
   return Refuse3(c, "fmi3SetShiftFraction: the FMU has no clocks");
 }
 LINESIM_FMI_EXPORT fmi3::Status fmi3EvaluateDiscreteStates(fmi3::Instance c) {
@@ -1074,8 +1120,8 @@ LINESIM_FMI_EXPORT fmi3::Status fmi3SetContinuousStates(fmi3::Instance c, const 
                                                         std::size_t) {
   return Refuse3(c, "fmi3SetContinuousStates: co-simulation only");
 }
-LINESIM_FMI_EXPORT fmi3::Status fmi3GetContinuousStateDerivatives(fmi3::Instance c,
-                                                                  fmi3::Float64[], std::size_t) {
+LINESIM_FMI_EXPORT fmi3::Status fmi3GetContinuousStateDerivatives(fmi3::Instance c, fmi3::Float64[],
+                                                                  std::size_t) {
   return Refuse3(c, "fmi3GetContinuousStateDerivatives: co-simulation only");
 }
 LINESIM_FMI_EXPORT fmi3::Status fmi3GetEventIndicators(fmi3::Instance c, fmi3::Float64[],
@@ -1086,8 +1132,8 @@ LINESIM_FMI_EXPORT fmi3::Status fmi3GetContinuousStates(fmi3::Instance c, fmi3::
                                                         std::size_t) {
   return Refuse3(c, "fmi3GetContinuousStates: co-simulation only");
 }
-LINESIM_FMI_EXPORT fmi3::Status fmi3GetNominalsOfContinuousStates(fmi3::Instance c,
-                                                                  fmi3::Float64[], std::size_t) {
+LINESIM_FMI_EXPORT fmi3::Status fmi3GetNominalsOfContinuousStates(fmi3::Instance c, fmi3::Float64[],
+                                                                  std::size_t) {
   return Refuse3(c, "fmi3GetNominalsOfContinuousStates: co-simulation only");
 }
 LINESIM_FMI_EXPORT fmi3::Status fmi3GetNumberOfEventIndicators(fmi3::Instance c, std::size_t*) {
@@ -1118,7 +1164,8 @@ LINESIM_FMI_EXPORT fmi3::Status fmi3DoStep(fmi3::Instance c, fmi3::Float64 t, fm
   if (event_handling_needed) *event_handling_needed = false;
   if (terminate_simulation) *terminate_simulation = false;
   if (early_return) *early_return = false;
-  if (last_successful_time && c) *last_successful_time = cosim::NsToSeconds(Of3(c)->last_successful);
+  if (last_successful_time && c)
+    *last_successful_time = cosim::NsToSeconds(Of3(c)->last_successful);
   return S3(s);
 }
 
@@ -1127,8 +1174,10 @@ LINESIM_FMI_EXPORT fmi3::Status fmi3ActivateModelPartition(fmi3::Instance c, fmi
   return Refuse3(c, "fmi3ActivateModelPartition: co-simulation only");
 }
 
-static_assert(std::is_same_v<decltype(&fmi3InstantiateCoSimulation), fmi3::InstantiateCoSimulationTYPE>);
-static_assert(std::is_same_v<decltype(&fmi3EnterInitializationMode), fmi3::EnterInitializationModeTYPE>);
+static_assert(
+    std::is_same_v<decltype(&fmi3InstantiateCoSimulation), fmi3::InstantiateCoSimulationTYPE>);
+static_assert(
+    std::is_same_v<decltype(&fmi3EnterInitializationMode), fmi3::EnterInitializationModeTYPE>);
 static_assert(std::is_same_v<decltype(&fmi3GetFloat64), fmi3::GetFloat64TYPE>);
 static_assert(std::is_same_v<decltype(&fmi3SetFloat64), fmi3::SetFloat64TYPE>);
 static_assert(std::is_same_v<decltype(&fmi3GetInt32), fmi3::GetInt32TYPE>);

@@ -1,5 +1,7 @@
 #include "fmu_export/model_description_writer.h"
 
+#include <algorithm>
+#include <cstdint>
 #include <map>
 #include <set>
 #include <sstream>
@@ -15,12 +17,23 @@ std::string Escape(const std::string& s) {
   out.reserve(s.size());
   for (const char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\n': out += "&#10;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\n':
+        out += "&#10;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -31,19 +44,26 @@ const char* Causality(const cosim::VariableInfo& info) {
     case cosim::Causality::kParameter:
       // FMI 2.0 has no constant parameter: a constant is a local.
       return info.variability == cosim::Variability::kConstant ? "local" : "parameter";
-    case cosim::Causality::kInput: return "input";
-    case cosim::Causality::kOutput: return "output";
-    case cosim::Causality::kLocal: return "local";
+    case cosim::Causality::kInput:
+      return "input";
+    case cosim::Causality::kOutput:
+      return "output";
+    case cosim::Causality::kLocal:
+      return "local";
   }
   return "local";
 }
 
 const char* Variability(const cosim::VariableInfo& info, cosim::VarType scalar_type) {
   switch (info.variability) {
-    case cosim::Variability::kConstant: return "constant";
-    case cosim::Variability::kFixed: return "fixed";
-    case cosim::Variability::kTunable: return "tunable";
-    case cosim::Variability::kDiscrete: return "discrete";
+    case cosim::Variability::kConstant:
+      return "constant";
+    case cosim::Variability::kFixed:
+      return "fixed";
+    case cosim::Variability::kTunable:
+      return "tunable";
+    case cosim::Variability::kDiscrete:
+      return "discrete";
     case cosim::Variability::kContinuous:
       // FMI 2.0: only a Real may be continuous.
       return scalar_type == cosim::VarType::kReal ? "continuous" : "discrete";
@@ -65,10 +85,14 @@ std::string StartText(const cosim::VariableTable& table, const ExportedVariable&
 
 const char* TypeElement(cosim::VarType t) {
   switch (t) {
-    case cosim::VarType::kInteger: return "Integer";
-    case cosim::VarType::kBoolean: return "Boolean";
-    case cosim::VarType::kString: return "String";
-    default: return "Real";
+    case cosim::VarType::kInteger:
+      return "Integer";
+    case cosim::VarType::kBoolean:
+      return "Boolean";
+    case cosim::VarType::kString:
+      return "String";
+    default:
+      return "Real";
   }
 }
 
@@ -134,8 +158,7 @@ std::string WriteModelDescription(const cosim::Unit& unit, const Layout& layout,
     if (info.causality == cosim::Causality::kOutput) outputs.push_back(vr);
     x << "    <!-- index " << vr + 1 << " -->\n";
     x << "    <ScalarVariable name=\"" << Escape(v.name) << "\" valueReference=\"" << vr
-      << "\" causality=\"" << causality << "\" variability=\"" << Variability(info, v.type)
-      << "\"";
+      << "\" causality=\"" << causality << "\" variability=\"" << Variability(info, v.type) << "\"";
     if (has_start && info.causality == cosim::Causality::kParameter) x << " initial=\"exact\"";
     if (!info.description.empty()) x << " description=\"" << Escape(info.description) << "\"";
     x << ">\n      <" << TypeElement(v.type);
@@ -144,8 +167,16 @@ std::string WriteModelDescription(const cosim::Unit& unit, const Layout& layout,
       if (const auto lo = info.rule.lower()) x << " min=\"" << cosim::FormatValue(*lo) << "\"";
       if (const auto hi = info.rule.upper()) x << " max=\"" << cosim::FormatValue(*hi) << "\"";
     } else if (v.type == cosim::VarType::kInteger) {
-      if (const auto lo = info.rule.lower()) x << " min=\"" << static_cast<long long>(*lo) << "\"";
-      if (const auto hi = info.rule.upper()) x << " max=\"" << static_cast<long long>(*hi) << "\"";
+      // FMI 2.0's Integer has 32 bits (fmi2Integer, xs:int): a wider
+      // declared range is clipped to it, since no value beyond can pass
+      // fmi2SetInteger (a device seed up to 2^32 - 1 reaches 2^31 - 1 here,
+      // all of it in FMI 3.0's Int64).
+      if (const auto lo = info.rule.lower(); lo && *lo > INT32_MIN) {
+        x << " min=\"" << static_cast<long long>(*lo) << "\"";
+      }
+      if (const auto hi = info.rule.upper()) {
+        x << " max=\"" << static_cast<long long>(std::min<double>(*hi, INT32_MAX)) << "\"";
+      }
     }
     if (has_start) x << " start=\"" << Escape(StartText(table, v)) << "\"";
     x << "/>\n    </ScalarVariable>\n";
@@ -211,7 +242,8 @@ std::string WriteModelDescription3(const cosim::Unit& unit, const DescriptionInf
   std::vector<cosim::ValueRef> outputs;
   for (const auto& info : table.infos()) {
     const bool real = info.type == cosim::VarType::kReal || info.type == cosim::VarType::kRealArray;
-    const char* tag = real                                      ? "Float64"
+    const char* tag = real                                    ? "Float64"
+                      : IsInt64In3(info)                      ? "Int64"
                       : info.type == cosim::VarType::kInteger ? "Int32"
                       : info.type == cosim::VarType::kBoolean ? "Boolean"
                                                               : "String";
@@ -275,7 +307,8 @@ std::string WriteModelDescription3(const cosim::Unit& unit, const DescriptionInf
     }
     x << "\"/>\n";
   }
-  for (cosim::ValueRef out : outputs) x << "    <InitialUnknown valueReference=\"" << out << "\"/>\n";
+  for (cosim::ValueRef out : outputs)
+    x << "    <InitialUnknown valueReference=\"" << out << "\"/>\n";
   x << "  </ModelStructure>\n";
   x << "</fmiModelDescription>\n";
   return x.str();
