@@ -8,9 +8,11 @@
 namespace linesim::json_text {
 
 /// Appends `s` as a quoted JSON string: '"' and '\' escaped, control
-/// characters as \u00XX. With `inside_html_script` also '<', '>' and '&'
-/// as \u00XX, so that no text inside a page's <script> element can close
-/// it.
+/// characters as \u00XX, bytes that are not well-formed UTF-8 as U+FFFD
+/// (one per ill-formed part, as a browser decodes them): the text is
+/// always valid UTF-8 JSON. With `inside_html_script` also '<', '>' and
+/// '&' as \u00XX, so that no text inside a page's <script> element can
+/// close it.
 void AppendString(std::string& out, std::string_view s, bool inside_html_script = false);
 
 }  // namespace linesim::json_text
