@@ -456,7 +456,62 @@ TEST(ReplayHostileTexts, AreShownAsTextAndNothingOfThemRuns) {
   EXPECT_GE(probe["refused"].get<int>(), 1);
 }
 
-// ---- How the run ended ----------------------------------------------------
+// ---- A run cut short says so ---------------------------------------------
+
+// Guards a replay of a cut-short run passing for a whole one (issue 37:
+// after SIGTERM replay.html carried no sign of it): its data say
+// interrupted, at the time reached of the time meant, and the page says so
+// above everything, in words.
+TEST(ReplayInterrupted, ThePageSaysTheRunWasCutShort) {
+  ASSERT_TRUE(fs::exists(kChromium)) << kChromium << " is missing: run tools/setup.sh";
+  const std::string out = Fresh("replay_interrupted");
+  const std::string base = ::testing::TempDir() + "replay_bg_" + std::to_string(getpid());
+  // 600 s: far longer than the test waits.
+  const std::string command = "exec " + std::string(LINESIM_CLI) + " run " + kCrossLine +
+                              " --set duration_s=600 --out " + out + " >" + base + ".out 2>" +
+                              base + ".err";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  ASSERT_GT(pid, 0);
+  // Under way once signals.csv holds some rows (up to five minutes).
+  bool running = false;
+  for (int i = 0; i < 3000 && !running; ++i) {
+    std::error_code ec;
+    running = fs::file_size(fs::path(out) / "signals.csv", ec) >= 64 * 1024 && !ec;
+    if (!running) usleep(100'000);
+  }
+  kill(pid, SIGTERM);
+  int raw = 0;
+  waitpid(pid, &raw, 0);
+  ASSERT_TRUE(running) << "the run wrote no signals";
+  ASSERT_TRUE(WIFEXITED(raw));
+  EXPECT_EQ(WEXITSTATUS(raw), 130);
+
+  const fs::path page = fs::path(out) / "replay.html";
+  const Json d = PageData(ReadFile(page));
+  ASSERT_TRUE(d.is_object());
+  EXPECT_EQ(d["outcome"]["status"], "interrupted");
+  EXPECT_EQ(d["outcome"]["stop_s"], 600);
+  const double end = d["outcome"]["end_s"].get<double>();
+  EXPECT_GT(end, 0.0);
+  EXPECT_LT(end, 600.0);
+  EXPECT_NEAR(end, d["t"].back().get<double>(), 0.02 + 1e-9);  // the last frame, 20 ms apart
+  EXPECT_NE(d["outcome"]["message"].get<std::string>().find("SIGTERM"), std::string::npos);
+
+  linesim::replay_test::DevToolsPipe browser(kChromium, Fresh("replay_interrupted_profile"));
+  const std::string s = OpenPage(browser, page);
+  const Json banner = browser.Evaluate(
+      s,
+      "({ text: document.getElementById('outcome').textContent,"
+      " shown: getComputedStyle(document.getElementById('outcome')).display !== 'none' })");
+  EXPECT_TRUE(banner["shown"].get<bool>());
+  EXPECT_EQ(banner["text"].get<std::string>().rfind("INTERRUPTED at ", 0), 0u) << banner.dump();
+  EXPECT_NE(banner["text"].get<std::string>().find("of 600 s"), std::string::npos) << banner.dump();
+  EXPECT_TRUE(Complaints(browser).empty()) << Complaints(browser).front();
+}
 
 // Guards the other side: a run that reached its end says ok, at its stop
 // time, with nothing to explain (the page shows no banner for it).
