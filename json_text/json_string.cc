@@ -76,4 +76,21 @@ void AppendString(std::string& out, std::string_view s, bool inside_html_script)
   out += '"';
 }
 
+std::string ValidUtf8(std::string_view s, std::size_t max_bytes) {
+  std::string out;
+  for (std::size_t i = 0; i < s.size();) {
+    std::size_t n = 1;
+    std::string_view piece = s.substr(i, 1);
+    if (static_cast<unsigned char>(s[i]) >= 0x80) {
+      const auto [length, well_formed] = Sequence(s, i);
+      n = length;
+      piece = well_formed ? s.substr(i, n) : std::string_view("\xEF\xBF\xBD");
+    }
+    if (out.size() + piece.size() > max_bytes) break;
+    out.append(piece);
+    i += n;
+  }
+  return out;
+}
+
 }  // namespace linesim::json_text

@@ -15,4 +15,9 @@ namespace linesim::json_text {
 /// close it.
 void AppendString(std::string& out, std::string_view s, bool inside_html_script = false);
 
+/// `s` as valid UTF-8, its ill-formed parts as U+FFFD as AppendString
+/// writes them, and cut to at most `max_bytes` at a character's boundary
+/// (for a binary format's strings, which must be UTF-8: MCAP's).
+std::string ValidUtf8(std::string_view s, std::size_t max_bytes = std::string_view::npos);
+
 }  // namespace linesim::json_text

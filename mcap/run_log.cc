@@ -6,6 +6,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <string_view>
 #include <utility>
 
 #include "mcap/foxglove_schemas.h"
@@ -736,8 +737,8 @@ void RunLog::Close(const RunOutcome& outcome) {
     headline = "run ended: ok at " + reached;
   }
   // The message as the summary has it, cut to a length the size bound
-  // allows for (summary.json keeps it whole).
-  const std::string why = outcome.message.substr(0, kMaxOutcomeBytes);
+  // allows for (summary.json keeps it whole), as UTF-8 (MCAP's strings are).
+  const std::string why = json_text::ValidUtf8(outcome.message, kMaxOutcomeBytes);
   if (!why.empty()) headline += " (" + why + ")";
   const TimeNs t = std::max<TimeNs>(outcome.end, 0);
   text_ = "{\"timestamp\":";

@@ -55,5 +55,14 @@ TEST(JsonString, BytesThatAreNotUtf8BecomeReplacementCharacters) {
   }
 }
 
+// Guards the strings of a binary format (MCAP's metadata must be UTF-8): the
+// same replacement, and a cut never inside a character.
+TEST(JsonString, ValidUtf8ReplacesAndCutsAtACharactersBoundary) {
+  EXPECT_EQ(ValidUtf8(std::string("a\xff") + "b"), std::string("a\xEF\xBF\xBD") + "b");
+  EXPECT_EQ(ValidUtf8("ab\xe2\x82\xac", 4), "ab");  // the euro sign takes 3 bytes
+  EXPECT_EQ(ValidUtf8("ab\xe2\x82\xac", 5), "ab\xe2\x82\xac");
+  EXPECT_EQ(ValidUtf8("plain", 3), "pla");
+}
+
 }  // namespace
 }  // namespace linesim::json_text
