@@ -329,6 +329,11 @@ RunLog::RunLog(std::ostream& out, const loader::Scenario& scenario, RunLogOption
   log_channel_ = writer_.AddChannel(writer_.AddSchema("foxglove.Log", "jsonschema", LogSchema()),
                                     "/log", "json");
 
+  AddLasers(system);
+  AddSignals(system);
+}
+
+void RunLog::AddLasers(const cosim::System& system) {
   // Lasers: every laser_scanner unit, its beams' bearings from its
   // parameters.
   std::uint16_t laser_schema = 0;
@@ -363,7 +368,9 @@ RunLog::RunLog(std::ostream& out, const loader::Scenario& scenario, RunLogOption
     l.head += ",\"intensities\":[],\"ranges\":[";
     lasers_.push_back(std::move(l));
   }
+}
 
+void RunLog::AddSignals(const cosim::System& system) {
   // Signals: one channel per unit with recorded variables, in the order
   // signals.csv has them.
   std::map<std::size_t, std::size_t> unit_slot;

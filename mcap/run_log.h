@@ -125,6 +125,10 @@ class RunLog : public cosim::Observer {
     std::string frame;  // "belt/NAME": moved by the travel along the belt
   };
 
+  /// The constructor's parts: a channel per laser scanner, and per unit
+  /// with recorded variables.
+  void AddLasers(const cosim::System& system);
+  void AddSignals(const cosim::System& system);
   std::uint64_t Bound() const;
   /// The texts of /scene/static and /tf/mounts at time t ("" for none).
   std::string StaticText(cosim::TimeNs t) const;
