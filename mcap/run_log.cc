@@ -203,17 +203,21 @@ constexpr std::uint64_t kNumberBytes = 25;
 constexpr double kHuge = 1e300;
 
 // The longest text json::TenthMillimetres writes for a laser's range, its
-// comma included: a measured range lies within range_max plus the device's
-// bias and noise (centimetres), so under twice range_max; no echo is
+// comma included: a measured range is at most range_max, plus the device's
+// bias (at most bias_max, or some bias_sigma) and noise (some noise_sigma):
+// twice range_max and ten sigmas are beyond any run; no echo is
 // no_return_value.
-std::uint64_t RangeBytes(double range_max, double no_return) {
+std::uint64_t RangeBytes(const cosim::Unit& laser) {
+  const auto real = [&](const char* name) { return Parameter(laser, name).value_or(0.0); };
+  const double farthest = 2.0 * Parameter(laser, "range_max").value_or(kHuge) + real("bias_max") +
+                          10.0 * (real("bias_sigma") + real("noise_sigma"));
   const auto text = [](double v) -> std::uint64_t {
     if (!(std::abs(v) < 9e14)) return kNumberBytes;
     std::uint64_t digits = 1;
     for (double d = std::ceil(std::abs(v)); d >= 10.0; d /= 10.0) ++digits;
     return 1 + digits + 5 + 1;  // sign, integer digits, ".dddd", comma
   };
-  return std::max(text(2.0 * range_max), text(no_return));
+  return std::max(text(farthest), text(Parameter(laser, "no_return_value").value_or(kHuge)));
 }
 
 // A text's longest JSON form: every byte as \u00XX, the quotes.
@@ -350,8 +354,7 @@ void RunLog::AddLasers(const cosim::System& system) {
     const std::size_t beams = v.info(*ranges).size;
     Laser l;
     l.beams = beams;
-    l.range_bytes = RangeBytes(Parameter(unit, "range_max").value_or(kHuge),
-                               Parameter(unit, "no_return_value").value_or(kHuge));
+    l.range_bytes = RangeBytes(unit);
     l.unit = u;
     l.ranges = *ranges;
     l.scan_count = *count;

@@ -76,7 +76,8 @@ class RunLog : public cosim::Observer {
 
   /// The most bytes run.mcap of `scenario` can take (built, not yet run):
   /// every message at its longest (numbers at 24 characters, ranges up to
-  /// twice the laser's range_max) at the most the rates allow over the
+  /// twice the laser's range_max plus its bias and ten sigmas of its
+  /// noise) at the most the rates allow over the
   /// scenario's duration, /scene at most once per belt switch and twice
   /// per carried object (a belt's travel runs one way: its speed varies by
   /// at most 50 %), the records' and indexes' overhead, the compressor's

@@ -91,9 +91,16 @@ ReplaySpec ReplaySpecFor(const loader::Scenario& s, double bound_m,
       if (!laser->name().starts_with(scope)) continue;
       const cosim::VariableTable& v = laser->variables();
       const auto ranges = v.Find("ranges");
-      const auto range_max = v.Find("range_max");
-      spec.lasers.push_back({laser->name(), laser, ranges ? v.info(*ranges).size : 0,
-                             range_max ? v.GetReal(*range_max) : 0.0});
+      const auto real = [&](const char* name) {
+        const auto ref = v.Find(name);
+        return ref ? v.GetReal(*ref) : 0.0;
+      };
+      // A measured range: at most range_max, plus the device's bias (at
+      // most bias_max, or some bias_sigma) and noise (some noise_sigma):
+      // ten sigmas and twice range_max are beyond any run.
+      const double farthest = 2.0 * real("range_max") + real("bias_max") +
+                              10.0 * (real("bias_sigma") + real("noise_sigma"));
+      spec.lasers.push_back({laser->name(), laser, ranges ? v.info(*ranges).size : 0, farthest});
     }
   }
   for (const loader::RobotInfo& other : r.fleet) {
@@ -122,12 +129,10 @@ ReplaySpec ReplaySpecFor(const loader::Scenario& s, double bound_m,
 
 namespace {
 
-// The longest text of a range of a laser whose farthest range is
-// `range_max_m`, in whole millimetres, with its comma: a measured range is
-// at most range_max plus the device's bias and noise (centimetres); twice
-// range_max covers them. "-1" for no echo.
-std::uint64_t RangeBytes(double range_max_m) {
-  const double mm = std::ceil(2000.0 * std::max(range_max_m, 0.0));
+// The longest text of a range no farther than `farthest_m`, in whole
+// millimetres, with its comma; "-1" for no echo.
+std::uint64_t RangeBytes(double farthest_m) {
+  const double mm = std::ceil(1000.0 * std::max(farthest_m, 0.0));
   if (!(mm < 1e15)) return kMaxNumberBytes;
   std::uint64_t digits = 1;
   for (double d = mm; d >= 10.0; d /= 10.0) ++digits;
@@ -175,7 +180,7 @@ std::uint64_t ReplayBytesBound(const ReplaySpec& spec, cosim::TimeNs start, cosi
   for (const auto& l : spec.lasers) {
     bytes += kItem + TextBytes(l.name) + 5 * n;
     bytes += count(spec.rates.scan_interval) *
-             (64 + 4 * n + static_cast<std::uint64_t>(l.beams) * RangeBytes(l.range_max_m));
+             (64 + 4 * n + static_cast<std::uint64_t>(l.beams) * RangeBytes(l.farthest_m));
   }
   return bytes;
 }

@@ -63,9 +63,10 @@ struct ReplaySpec {
   struct Laser {
     std::string name;
     const sensors::LaserScannerUnit* unit = nullptr;
-    /// Its beams and its farthest range (for the page's size bound).
+    /// Its beams and the farthest range it can report (for the page's size
+    /// bound: twice range_max, plus its bias and ten sigmas of its noise).
     std::size_t beams = 0;
-    double range_max_m = 0.0;
+    double farthest_m = 0.0;
   };
   std::vector<Laser> lasers;
   /// What else moves on the floor: a fleet's other robots (a box, with
@@ -91,8 +92,8 @@ ReplaySpec ReplaySpecFor(const loader::Scenario& s, double bound_m, const std::s
 /// The most bytes replay.html of `spec` can take for a run from `start` to
 /// `stop`: the template, every text escaped at its longest (6 bytes a
 /// byte), one frame every frame interval and one scan per laser every scan
-/// interval with every number at kMaxNumberBytes, a range up to twice the
-/// laser's range_max. Known before the run (RunIntoFolder checks it
+/// interval with every number at kMaxNumberBytes, a range at the laser's
+/// farthest (Laser::farthest_m). Known before the run (RunIntoFolder checks it
 /// against --max-output-mb).
 std::uint64_t ReplayBytesBound(const ReplaySpec& spec, cosim::TimeNs start, cosim::TimeNs stop);
 
