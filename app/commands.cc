@@ -118,12 +118,15 @@ int RunCommand(const std::string& file, const std::string& out_dir,
     std::cerr << "linesim: " << e.what() << "\n";
     return kExitBadInput;
   }
+  const session::RunReport& report = written.report;
+  // Every file that could not be written is named, also when the summary
+  // that lists them is one of them (a full disk).
   for (const auto& w : written.warnings) std::cerr << "linesim: " << w << "\n";
   if (!written.summary_error.empty()) {
+    for (const auto& e : report.errors) std::cerr << "linesim: " << e.message << "\n";
     std::cerr << "linesim: " << written.summary_error << "\n";
     return kExitRunFailed;
   }
-  const session::RunReport& report = written.report;
   const cosim::RunResult& result = report.result;
   const fs::path dir(out_dir);
   const cosim::MasterOptions& master = s.master->options();

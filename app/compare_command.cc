@@ -35,8 +35,12 @@ struct Comparison {
   std::vector<CompareRun> runs;
 };
 
+// A run's folder name: at most NAME_MAX (255 bytes on Linux's file
+// systems) of [A-Za-z0-9._-], not "." or "..".
+constexpr std::size_t kMaxFolderName = 255;
+
 bool SafeName(const std::string& name) {
-  if (name.empty() || name == "." || name == "..") return false;
+  if (name.empty() || name == "." || name == ".." || name.size() > kMaxFolderName) return false;
   for (char c : name) {
     const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
                     c == '_' || c == '-' || c == '.';
@@ -117,7 +121,8 @@ Comparison ReadComparison(const std::string& file) {
       run.name = text(r, path, "name", true);
       if (!run.name.empty() && !SafeName(run.name)) {
         issue(r["name"], path + ".name",
-              "expected a folder name of [A-Za-z0-9._-], got '" + run.name + "'");
+              "expected a folder name of at most " + std::to_string(kMaxFolderName) +
+                  " characters of [A-Za-z0-9._-], got '" + run.name + "'");
       } else if (!run.name.empty() && !names.insert(run.name).second) {
         issue(r["name"], path + ".name", "'" + run.name + "' names two runs");
       }

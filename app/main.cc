@@ -58,7 +58,7 @@ int main(int argc, char** argv) {
                 "animated in a browser)");
   double max_output_mb = linesim::app::kDefaultMaxOutputMb;
   run->add_option("--max-output-mb", max_output_mb,
-                  "refuse a run whose signals.csv could exceed this many MB (default 1024)")
+                  "refuse a run whose files could exceed this many MB together (default 1024)")
       ->check(kFinite)
       ->check(CLI::Range(0.001, 1e9));
   CLI::Option* runs_option = run->add_option("--runs", runs,

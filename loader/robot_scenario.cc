@@ -86,6 +86,9 @@ void CheckStartPose(assembly::SystemBuilder& b, const models::Scene& scene,
 
 // The sections of a robot scenario that describe one robot: the shorthand's
 // top-level keys, each robot's keys in `robots:`.
+// The longest robot name of a fleet (see where it is checked).
+constexpr std::size_t kMaxRobotName = 64;
+
 const std::vector<std::string> kRobotSections = {"task",         "control", "sensing",
                                                  "localization", "sensors", "safety"};
 
@@ -341,6 +344,18 @@ SystemSpec ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
       r.Error(Child(entry, "name"), JoinPath(path, "name"),
               "robot name '" + name + "' is not valid: expected letters, digits and _ (it "
               "scopes the robot's units: " + name + ".chassis)");
+      continue;
+    }
+    // The name names files (NAME_top_view.png, NAME_plots.gp) and metrics
+    // (NAME.robot_OTHER_collisions, which a sweep's pictures are named
+    // after): two names and the longest suffix stay within a file name's
+    // 255 bytes.
+    if (name.size() > kMaxRobotName) {
+      r.Error(Child(entry, "name"), JoinPath(path, "name"),
+              "robot name '" + name.substr(0, 40) + "...' has " + std::to_string(name.size()) +
+                  " characters: at most " + std::to_string(kMaxRobotName) +
+                  " (it names the robot's files, " + name.substr(0, 8) +
+                  "..._top_view.png, and metrics, which a file name limits to 255 bytes)");
       continue;
     }
     if (std::any_of(robots.begin(), robots.end(),

@@ -166,4 +166,21 @@ std::string SceneUpdateSchema() {
       .dump();
 }
 
+std::string LogSchema() {
+  return Object("foxglove.Log", "a log message",
+                {{"timestamp", Time("time of the message")},
+                 {"level", Enum("foxglove.LogLevel", "how severe",
+                                {{"UNKNOWN", 0},
+                                 {"DEBUG", 1},
+                                 {"INFO", 2},
+                                 {"WARNING", 3},
+                                 {"ERROR", 4},
+                                 {"FATAL", 5}})},
+                 {"message", Text("the message")},
+                 {"name", Text("what wrote it")},
+                 {"file", Text("source file (empty: none)")},
+                 {"line", {{"type", "integer"}, {"minimum", 0}, {"description", "line in file"}}}})
+      .dump();
+}
+
 }  // namespace linesim::mcap

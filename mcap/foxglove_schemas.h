@@ -7,11 +7,12 @@
 /// Foxglove's schema reference (docs.foxglove.dev, "Message schemas": the
 /// fields, their types and meanings). Foxglove recognises a channel's type
 /// by the schema's name (foxglove.FrameTransforms, foxglove.LaserScan,
-/// foxglove.SceneUpdate); the schema text tells a reader the fields.
+/// foxglove.SceneUpdate, foxglove.Log); the schema text tells a reader the fields.
 namespace linesim::mcap {
 
 std::string FrameTransformsSchema();
 std::string LaserScanSchema();
 std::string SceneUpdateSchema();
+std::string LogSchema();
 
 }  // namespace linesim::mcap

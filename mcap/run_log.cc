@@ -6,6 +6,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <string_view>
 #include <utility>
 
 #include "mcap/foxglove_schemas.h"
@@ -196,6 +197,42 @@ std::optional<cosim::ValueRef> ArrayOutput(const cosim::Unit& unit, const char* 
 
 std::uint64_t LogTime(TimeNs t) { return static_cast<std::uint64_t>(std::max<TimeNs>(t, 0)); }
 
+// The longest text of a JSON number (json::Number: a double's shortest
+// round-trip form, "-2.2250738585072014e-308", or null), its comma included.
+constexpr std::uint64_t kNumberBytes = 25;
+constexpr double kHuge = 1e300;
+
+// The longest text json::TenthMillimetres writes for a laser's range, its
+// comma included: a measured range is at most range_max, plus the device's
+// bias (at most bias_max, or some bias_sigma) and noise (some noise_sigma):
+// twice range_max and ten sigmas are beyond any run; no echo is
+// no_return_value.
+std::uint64_t RangeBytes(const cosim::Unit& laser) {
+  const auto real = [&](const char* name) { return Parameter(laser, name).value_or(0.0); };
+  const double farthest = 2.0 * Parameter(laser, "range_max").value_or(kHuge) + real("bias_max") +
+                          10.0 * (real("bias_sigma") + real("noise_sigma"));
+  const auto text = [](double v) -> std::uint64_t {
+    if (!(std::abs(v) < 9e14)) return kNumberBytes;
+    std::uint64_t digits = 1;
+    for (double d = std::ceil(std::abs(v)); d >= 10.0; d /= 10.0) ++digits;
+    return 1 + digits + 5 + 1;  // sign, integer digits, ".dddd", comma
+  };
+  return std::max(text(farthest), text(Parameter(laser, "no_return_value").value_or(kHuge)));
+}
+
+// A text's longest JSON form: every byte as \u00XX, the quotes.
+std::uint64_t QuotedBytes(std::string_view s) { return 6 * s.size() + 2; }
+
+// The longest {"sec":S,"nsec":N}.
+constexpr std::uint64_t kTimeBytes = 48;
+
+// The most of a run's error message the log's end holds.
+constexpr std::size_t kMaxOutcomeBytes = 4096;
+
+// A message's record (opcode, length, channel, sequence, two times) and its
+// entry in its chunk's message index.
+constexpr std::uint64_t kMessageOverhead = 1 + 8 + 2 + 4 + 8 + 8 + 16;
+
 }  // namespace
 
 RunLog::RunLog(std::ostream& out, const loader::Scenario& scenario, RunLogOptions options)
@@ -293,7 +330,14 @@ RunLog::RunLog(std::ostream& out, const loader::Scenario& scenario, RunLogOption
       scene_channel_ = writer_.AddChannel(schema, "/scene", "json");
     }
   }
+  log_channel_ = writer_.AddChannel(writer_.AddSchema("foxglove.Log", "jsonschema", LogSchema()),
+                                    "/log", "json");
 
+  AddLasers(system);
+  AddSignals(system);
+}
+
+void RunLog::AddLasers(const cosim::System& system) {
   // Lasers: every laser_scanner unit, its beams' bearings from its
   // parameters.
   std::uint16_t laser_schema = 0;
@@ -309,6 +353,8 @@ RunLog::RunLog(std::ostream& out, const loader::Scenario& scenario, RunLogOption
     }
     const std::size_t beams = v.info(*ranges).size;
     Laser l;
+    l.beams = beams;
+    l.range_bytes = RangeBytes(unit);
     l.unit = u;
     l.ranges = *ranges;
     l.scan_count = *count;
@@ -325,7 +371,9 @@ RunLog::RunLog(std::ostream& out, const loader::Scenario& scenario, RunLogOption
     l.head += ",\"intensities\":[],\"ranges\":[";
     lasers_.push_back(std::move(l));
   }
+}
 
+void RunLog::AddSignals(const cosim::System& system) {
   // Signals: one channel per unit with recorded variables, in the order
   // signals.csv has them.
   std::map<std::size_t, std::size_t> unit_slot;
@@ -409,7 +457,7 @@ void RunLog::OnStart(const cosim::Master& master) {
   for (Laser& l : lasers_) l.next = start_;
 }
 
-void RunLog::WriteStatic(TimeNs now) {
+std::string RunLog::StaticText(TimeNs now) const {
   const models::Scene& scene = scenario_.scene;
   const cosim::System& system = *scenario_.system;
   std::string o;
@@ -479,17 +527,26 @@ void RunLog::WriteStatic(TimeNs now) {
     Box(p.cubes, 0, 0, com, Quat{}, other.length, other.width, height, kBody);
     Entity(o, now, other.frame, "robot/" + other.name, true, other.name, p);
   }
-  text_ = "{\"deletions\":[],\"entities\":[" + o + "]}";
+  return "{\"deletions\":[],\"entities\":[" + o + "]}";
+}
+
+std::string RunLog::MountsText(TimeNs now) const {
+  if (frames_.empty()) return "";
+  std::string text = "{\"transforms\":[";
+  for (std::size_t k = 0; k < frames_.size(); ++k) {
+    if (k) text += ',';
+    text += "{\"timestamp\":";
+    json::Time(text, now);
+    text += frames_[k].text;
+  }
+  return text + "]}";
+}
+
+void RunLog::WriteStatic(TimeNs now) {
+  text_ = StaticText(now);
   writer_.WriteMessage(static_channel_, LogTime(now), LogTime(now), text_);
   if (!frames_.empty()) {
-    text_ = "{\"transforms\":[";
-    for (std::size_t k = 0; k < frames_.size(); ++k) {
-      if (k) text_ += ',';
-      text_ += "{\"timestamp\":";
-      json::Time(text_, now);
-      text_ += frames_[k].text;
-    }
-    text_ += "]}";
+    text_ = MountsText(now);
     writer_.WriteMessage(mounts_channel_, LogTime(now), LogTime(now), text_);
   }
 }
@@ -513,7 +570,12 @@ void RunLog::WriteScene(TimeNs t, const cosim::System& system) {
   }
   if (state == scene_state_) return;
   scene_state_ = state;
+  text_ = SceneText(t, state);
+  writer_.WriteMessage(scene_channel_, LogTime(t), LogTime(t), text_);
+}
 
+std::string RunLog::SceneText(TimeNs t, const std::string& state) const {
+  const models::Scene& scene = scenario_.scene;
   std::string entities, deletions;
   std::size_t s = 0;
   for (std::size_t k = 0; k < scene.belts.size(); ++k) {
@@ -544,8 +606,7 @@ void RunLog::WriteScene(TimeNs t, const cosim::System& system) {
     AddSolid(p, c.solid, 0.0, 0.0, kCarried);
     Entity(entities, t, belts_[k].frame, id, true, "carried", p);
   }
-  text_ = "{\"deletions\":[" + deletions + "],\"entities\":[" + entities + "]}";
-  writer_.WriteMessage(scene_channel_, LogTime(t), LogTime(t), text_);
+  return "{\"deletions\":[" + deletions + "],\"entities\":[" + entities + "]}";
 }
 
 void RunLog::WriteTransforms(TimeNs t, const cosim::System& system) {
@@ -667,10 +728,122 @@ void RunLog::OnSample(TimeNs t, const cosim::System& system) {
   WriteScans(t, system);
 }
 
-void RunLog::OnEnd(cosim::TimeNs, bool) {
-  if (ended_) return;
-  ended_ = true;
+void RunLog::OnEnd(cosim::TimeNs, bool) { ended_ = true; }
+
+void RunLog::Close(const RunOutcome& outcome) {
+  if (closed_) return;
+  closed_ = ended_ = true;
+  const std::string reached =
+      cosim::FormatSeconds(outcome.end) + " s of " + cosim::FormatSeconds(outcome.stop) + " s";
+  std::string headline;
+  int level = 2;  // foxglove.LogLevel INFO
+  if (outcome.status == "interrupted") {
+    headline = "run INTERRUPTED at " + reached + ": the log ends there";
+    level = 3;  // WARNING
+  } else if (outcome.status != "ok") {
+    headline = "run FAILED at " + reached;
+    level = 4;  // ERROR
+  } else {
+    headline = "run ended: ok at " + reached;
+  }
+  // The message as the summary has it, cut to a length the size bound
+  // allows for (summary.json keeps it whole), as UTF-8 (MCAP's strings are).
+  const std::string why = json_text::ValidUtf8(outcome.message, kMaxOutcomeBytes);
+  if (!why.empty()) headline += " (" + why + ")";
+  const TimeNs t = std::max<TimeNs>(outcome.end, 0);
+  text_ = "{\"timestamp\":";
+  json::Time(text_, t);
+  text_ += ",\"level\":" + std::to_string(level) + ",\"message\":";
+  json::String(text_, headline);
+  text_ += ",\"name\":\"linesim\",\"file\":\"\",\"line\":0}";
+  writer_.WriteMessage(log_channel_, LogTime(t), LogTime(t), text_);
+  writer_.AddMetadata("linesim.run", {{"status", outcome.status},
+                                      {"end_time_s", cosim::FormatSeconds(outcome.end)},
+                                      {"stop_time_s", cosim::FormatSeconds(outcome.stop)},
+                                      {"message", why}});
   writer_.Close();
+}
+
+std::uint64_t RunLog::BytesBound(const loader::Scenario& scenario, const RunLogOptions& options) {
+  std::ostream sink(nullptr);  // built only to measure: it writes nothing
+  const RunLog log(sink, scenario, options);
+  return log.Bound();
+}
+
+std::uint64_t RunLog::Bound() const {
+  const cosim::MasterOptions& master = scenario_.master->options();
+  const TimeNs span = std::max<TimeNs>(master.stop - master.start, 0);
+  const auto count = [&](TimeNs period) {
+    return static_cast<std::uint64_t>(span / std::max<TimeNs>(period, 1)) + 2;
+  };
+  const TimeNs row_period = std::max(options_.signal_period, record_interval_);
+  std::uint64_t records = 0, largest = 0;
+  const auto add = [&](std::uint64_t n, std::uint64_t bytes) {
+    records += n * (bytes + kMessageOverhead);
+    largest = std::max(largest, bytes + kMessageOverhead);
+  };
+  // /signals: per row one message per unit: its time, each field's key and
+  // numbers.
+  for (const Signals& sig : signals_) {
+    std::uint64_t bytes = 16 + kTimeBytes;
+    for (const auto& f : sig.fields) bytes += f.name.size() + 6 + f.probes.size() * kNumberBytes;
+    add(count(row_period), bytes);
+  }
+  // /tf: the robot, the other robots, the belts with their travel.
+  if (has_robot_) {
+    std::uint64_t bytes = 32;
+    const std::uint64_t transform = kTimeBytes + 100 + 7 * (kNumberBytes + 5);
+    bytes += transform;
+    for (const OtherRobot& other : others_) bytes += transform + QuotedBytes(other.frame);
+    for (const Dynamic& belt : belts_) {
+      if (belt.travel) bytes += transform + QuotedBytes(belt.frame);
+    }
+    add(count(row_period), bytes);
+  }
+  for (const Laser& l : lasers_) {
+    add(count(options_.scan_period), 16 + kTimeBytes + l.head.size() + l.beams * l.range_bytes);
+  }
+  // Once: the static scene and the mounts; /scene at its start, at each
+  // belt switch, and as each carried object joins or leaves its belt, at
+  // most once per scene period; /log at the end.
+  const TimeNs end = master.stop;
+  add(1, StaticText(end).size());
+  if (!frames_.empty()) add(1, MountsText(end).size());
+  const models::Scene& scene = scenario_.scene;
+  if (!scene.belts.empty()) {
+    std::uint64_t changes = 1 + 2 * scene.carried.size();
+    for (const models::Belt& b : scene.belts) changes += b.schedule.size();
+    const std::string on(scene.belts.size() + scene.carried.size(), '1');
+    std::string off = on;
+    std::fill(off.begin(), off.begin() + static_cast<std::ptrdiff_t>(scene.belts.size()), '0');
+    add(std::min(changes, count(options_.scene_period)),
+        std::max(SceneText(end, on).size(), SceneText(end, off).size()));
+  }
+  add(1, 512 + QuotedBytes(std::string(kMaxOutcomeBytes, ' ')));  // /log
+  // Schemas and channels: in the chunks before their first message, and
+  // again in the summary.
+  std::uint64_t definitions = 0;
+  for (std::uint16_t id = 1; id <= writer_.schema_count(); ++id) {
+    definitions += 9 + writer_.SchemaBytes(id);
+  }
+  for (std::uint16_t id = 0; id < writer_.channel_count(); ++id) {
+    definitions += 9 + writer_.ChannelBytes(id);
+  }
+  records += definitions;
+  // Chunks close once their records reach the chunk size: each holds at
+  // least that much but the last, and at most that plus one message.
+  const std::uint64_t chunks = records / options_.writer.chunk_size + 1;
+  const std::uint64_t chunk_bytes = options_.writer.chunk_size + largest;
+  const std::uint64_t per_chunk = 61 + CompressedBound(options_.writer.compression, chunk_bytes) -
+                                  chunk_bytes + writer_.channel_count() * 15;
+  std::uint64_t bytes = records + chunks * per_chunk;
+  // The summary: definitions again, statistics, chunk indexes, metadata
+  // and its index, summary offsets, footer, magic and header.
+  bytes += definitions + 64 + 10 * static_cast<std::uint64_t>(writer_.channel_count()) +
+           chunks * (80 + 10 * static_cast<std::uint64_t>(writer_.channel_count())) +
+           2 * (256 + kMaxOutcomeBytes) + 8 * 32 + 64 + 2 * 8 + 64 +
+           options_.writer.profile.size() + options_.writer.library.size();
+  return bytes;
 }
 
 }  // namespace linesim::mcap

@@ -34,6 +34,10 @@
 ///                  objects on them, in their belt's frame (riding with it)
 /// What is written once is on a topic of its own: a viewer that seeks shows
 /// the last message of each topic before the new time.
+///   /log           foxglove.Log once, at the end: how the run ended (ok,
+///                  failed or interrupted, at what time of its stop time,
+///                  and why); the same as metadata "linesim.run" (status,
+///                  end_time_s, stop_time_s, message) in the summary
 ///   /signals/UNIT  one message per recorded row of signals.csv (at most
 ///                  every signal_period): the unit's
 ///                  recorded variables as fields (an array for elements
@@ -55,6 +59,14 @@ struct RunLogOptions {
   WriterOptions writer;
 };
 
+/// How a run ended, as the log's last message and its metadata say it.
+struct RunOutcome {
+  std::string status = "ok";  // ok, failed or interrupted
+  cosim::TimeNs end = 0;      // the time reached
+  cosim::TimeNs stop = 0;     // the time the run was to reach
+  std::string message;        // why, when not ok (or ended early)
+};
+
 class RunLog : public cosim::Observer {
  public:
   /// Reads what it needs of `scenario` (scene, robot, recorded probes,
@@ -62,10 +74,26 @@ class RunLog : public cosim::Observer {
   RunLog(std::ostream& out, const loader::Scenario& scenario, RunLogOptions options = {});
   ~RunLog() override;
 
+  /// The most bytes run.mcap of `scenario` can take (built, not yet run):
+  /// every message at its longest (numbers at 24 characters, ranges up to
+  /// twice the laser's range_max plus its bias and ten sigmas of its
+  /// noise) at the most the rates allow over the
+  /// scenario's duration, /scene at most once per belt switch and twice
+  /// per carried object (a belt's travel runs one way: its speed varies by
+  /// at most 50 %), the records' and indexes' overhead, the compressor's
+  /// worst case (incompressible chunks) and the summary. Known before the
+  /// run (RunIntoFolder checks it against --max-output-mb).
+  static std::uint64_t BytesBound(const loader::Scenario& scenario,
+                                  const RunLogOptions& options = {});
+
   void OnStart(const cosim::Master& master) override;
   void OnSample(cosim::TimeNs t, const cosim::System& system) override;
-  /// Closes the file (summary, footer).
+  /// Stops logging (nothing after the run's end).
   void OnEnd(cosim::TimeNs t, bool ok) override;
+  /// Writes how the run ended (/log and the metadata) and closes the file
+  /// (summary, footer). Without it the destructor closes the file, saying
+  /// nothing of the end.
+  void Close(const RunOutcome& outcome);
 
   std::uint64_t bytes() const { return writer_.bytes_written(); }
   std::uint64_t messages() const { return writer_.message_count(); }
@@ -85,6 +113,8 @@ class RunLog : public cosim::Observer {
     std::size_t unit = 0;
     cosim::ValueRef ranges{}, scan_count{}, scan_time{};
     std::string head;  // the message's text from "frame_id" to "ranges":[
+    std::size_t beams = 0;
+    std::uint64_t range_bytes = 0;  // the longest text of a range, its comma included
     double last_count = 0;
     cosim::TimeNs next = 0;
   };
@@ -96,6 +126,17 @@ class RunLog : public cosim::Observer {
     std::string frame;  // "belt/NAME": moved by the travel along the belt
   };
 
+  /// The constructor's parts: a channel per laser scanner, and per unit
+  /// with recorded variables.
+  void AddLasers(const cosim::System& system);
+  void AddSignals(const cosim::System& system);
+  std::uint64_t Bound() const;
+  /// The texts of /scene/static and /tf/mounts at time t ("" for none).
+  std::string StaticText(cosim::TimeNs t) const;
+  std::string MountsText(cosim::TimeNs t) const;
+  /// The /scene message for `state` (each belt on, then each carried object
+  /// on its belt: '1' or '0').
+  std::string SceneText(cosim::TimeNs t, const std::string& state) const;
   void WriteStatic(cosim::TimeNs t);
   void WriteScene(cosim::TimeNs t, const cosim::System& system);
   void WriteTransforms(cosim::TimeNs t, const cosim::System& system);
@@ -125,12 +166,13 @@ class RunLog : public cosim::Observer {
     double length = 0.0, width = 0.0;
   };
   std::vector<OtherRobot> others_;
-  std::uint16_t tf_channel_ = 0, mounts_channel_ = 0, static_channel_ = 0, scene_channel_ = 0;
+  std::uint16_t tf_channel_ = 0, mounts_channel_ = 0, static_channel_ = 0, scene_channel_ = 0,
+                log_channel_ = 0;
   bool started_ = false;
   std::string scene_state_;  // belts on and objects on their belts, at the last /scene
   cosim::TimeNs next_scene_ = 0, next_signals_ = 0;
   std::string text_;  // a message being written
-  bool ended_ = false;
+  bool ended_ = false, closed_ = false;
 };
 
 }  // namespace linesim::mcap

@@ -67,6 +67,20 @@ const char* CompressionName(Compression c) {
 
 }  // namespace
 
+std::uint64_t CompressedBound(Compression compression, std::uint64_t bytes) {
+  switch (compression) {
+    case Compression::kZstd:
+      return ZSTD_compressBound(bytes);
+    case Compression::kLz4: {
+      LZ4F_preferences_t prefs{};
+      prefs.frameInfo.contentSize = bytes;
+      return LZ4F_compressFrameBound(bytes, &prefs);
+    }
+    default:
+      return bytes;
+  }
+}
+
 Writer::Writer(std::ostream& out, WriterOptions options)
     : out_(out), options_(std::move(options)) {
   Emit(kMagic);
@@ -110,6 +124,12 @@ std::uint16_t Writer::AddChannel(std::uint16_t schema_id, std::string topic,
   c.metadata = std::move(metadata);
   channels_.push_back(std::move(c));
   return static_cast<std::uint16_t>(channels_.size() - 1);
+}
+
+void Writer::AddMetadata(std::string name,
+                         std::vector<std::pair<std::string, std::string>> metadata) {
+  if (closed_) throw std::logic_error("mcap: metadata after Close()");
+  metadata_.push_back({std::move(name), std::move(metadata)});
 }
 
 std::string Writer::SchemaContent(std::uint16_t id) const {
@@ -255,6 +275,15 @@ void Writer::Close() {
   if (closed_) return;
   closed_ = true;
   FlushChunk();
+  for (Metadata& m : metadata_) {
+    std::string content, record;
+    PutString(content, m.name);
+    PutStringMap(content, m.entries);
+    PutRecord(record, Opcode::kMetadata, content);
+    m.offset = offset_;
+    m.length = record.size();
+    Emit(record);
+  }
 
   // Data end: the CRC of every byte before it, from the opening magic on.
   {
@@ -296,7 +325,7 @@ void Writer::Close() {
     PutU16(s, static_cast<std::uint16_t>(schemas_.size()));
     PutU32(s, static_cast<std::uint32_t>(channels_.size()));
     PutU32(s, 0);  // attachments
-    PutU32(s, 0);  // metadata
+    PutU32(s, static_cast<std::uint32_t>(metadata_.size()));
     PutU32(s, static_cast<std::uint32_t>(chunk_indexes_.size()));
     PutU64(s, first_time_);
     PutU64(s, last_time_);
@@ -323,6 +352,17 @@ void Writer::Close() {
       indexes.push_back(std::move(s));
     }
     group(Opcode::kChunkIndex, indexes);
+  }
+  {
+    std::vector<std::string> indexes;
+    for (const Metadata& m : metadata_) {
+      std::string s;
+      PutU64(s, m.offset);
+      PutU64(s, m.length);
+      PutString(s, m.name);
+      indexes.push_back(std::move(s));
+    }
+    group(Opcode::kMetadataIndex, indexes);
   }
   const std::uint64_t summary_offset_start = offset_;
   for (const Group& g : groups) {

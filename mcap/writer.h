@@ -30,6 +30,8 @@ enum class Opcode : std::uint8_t {
   kMessageIndex = 0x07,
   kChunkIndex = 0x08,
   kStatistics = 0x0B,
+  kMetadata = 0x0C,
+  kMetadataIndex = 0x0D,
   kSummaryOffset = 0x0E,
   kDataEnd = 0x0F,
 };
@@ -54,6 +56,10 @@ struct WriterOptions {
   /// linesim's JSON, against 3.3 at its default 3, in half the time).
   int zstd_level = 1;
 };
+
+/// The most bytes `bytes` of records take in a chunk compressed with
+/// `compression` (the compressor's own worst case: incompressible input).
+std::uint64_t CompressedBound(Compression compression, std::uint64_t bytes);
 
 /// Little-endian encoders of the specification's field types.
 void PutU8(std::string& out, std::uint8_t v);
@@ -85,13 +91,23 @@ class Writer {
   /// itself are written into the data section before its first message.
   void WriteMessage(std::uint16_t channel_id, std::uint64_t log_time, std::uint64_t publish_time,
                     std::string_view data);
-  /// Closes the last chunk and writes data end, summary, summary offsets,
-  /// footer and magic. Called by the destructor if not before.
+  /// A metadata record: `name` and its key-value pairs (strings). Written in
+  /// the data section after the last chunk, indexed in the summary (a
+  /// Metadata Index record) and counted in the statistics.
+  void AddMetadata(std::string name, std::vector<std::pair<std::string, std::string>> metadata);
+  /// Closes the last chunk and writes the metadata, data end, summary,
+  /// summary offsets, footer and magic. Called by the destructor if not
+  /// before.
   void Close();
 
   std::uint64_t bytes_written() const { return offset_; }
   std::uint64_t message_count() const { return message_count_; }
   std::uint32_t chunk_count() const { return static_cast<std::uint32_t>(chunk_indexes_.size()); }
+  std::uint16_t schema_count() const { return static_cast<std::uint16_t>(schemas_.size()); }
+  std::uint16_t channel_count() const { return static_cast<std::uint16_t>(channels_.size()); }
+  /// The content's size of schema `id` (from 1) and of channel `id`.
+  std::uint64_t SchemaBytes(std::uint16_t id) const { return SchemaContent(id).size(); }
+  std::uint64_t ChannelBytes(std::uint16_t id) const { return ChannelContent(id).size(); }
 
  private:
   struct Schema {
@@ -131,6 +147,12 @@ class Writer {
   bool chunk_has_messages_ = false;
   std::uint64_t chunk_start_ = 0, chunk_end_ = 0;
   std::vector<ChunkIndex> chunk_indexes_;
+  struct Metadata {
+    std::string name;
+    std::vector<std::pair<std::string, std::string>> entries;
+    std::uint64_t offset = 0, length = 0;  // of its record, once written
+  };
+  std::vector<Metadata> metadata_;
   std::uint64_t message_count_ = 0;
   std::uint64_t first_time_ = 0, last_time_ = 0;
   bool closed_ = false;

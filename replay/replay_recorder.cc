@@ -1,116 +1,14 @@
 #include "replay/replay_recorder.h"
 
-#include <charconv>
+#include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <stdexcept>
+#include <cstdlib>
 
 #include "cosim/files.h"
-#include "json_text/json_string.h"
 #include "loader/scenario.h"
 #include "units/sensors/laser_scanner_unit.h"
 
 namespace linesim::replay {
-
-namespace {
-
-void AppendInt(std::string& out, std::int64_t v) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  out.append(buf, static_cast<std::size_t>(r.ptr - buf));
-}
-
-// Numbers in fixed notation with a set number of decimals, trailing zeros
-// dropped: the value scaled by 10^decimals and rounded to an integer
-// (llround: exact, the same on every CPU), written as digits; the same
-// double gives the same text everywhere, whatever the locale. Not finite:
-// null. Beyond 9e15 after scaling (nothing a replay draws): std::to_chars.
-void AppendFixed(std::string& out, double v, int decimals) {
-  static constexpr double kScale[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9};
-  static constexpr std::int64_t kPower[] = {1,       10,       100,       1000,       10000,
-                                            100000,  1000000,  10000000,  100000000,  1000000000};
-  if (!std::isfinite(v)) {
-    out += "null";
-    return;
-  }
-  const double scaled = v * kScale[decimals];
-  if (!(std::abs(scaled) < 9e15)) {
-    char buf[400];
-    const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, 0);
-    out.append(buf, r.ptr);
-    return;
-  }
-  std::int64_t n = std::llround(scaled);
-  if (n < 0) {
-    out += '-';
-    n = -n;
-  }
-  AppendInt(out, n / kPower[decimals]);
-  std::int64_t fraction = n % kPower[decimals];
-  if (fraction == 0) return;
-  int digits = decimals;
-  while (fraction % 10 == 0) {
-    fraction /= 10;
-    --digits;
-  }
-  out += '.';
-  char buf[16];
-  for (int i = digits - 1; i >= 0; --i) {
-    buf[i] = static_cast<char>('0' + fraction % 10);
-    fraction /= 10;
-  }
-  out.append(buf, static_cast<std::size_t>(digits));
-}
-
-// A JSON string inside the page's <script> element.
-void AppendString(std::string& out, const std::string& s) {
-  json_text::AppendString(out, s, /*inside_html_script=*/true);
-}
-
-void AppendArray(std::string& out, const std::vector<double>& values, int decimals) {
-  out += '[';
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    if (i > 0) out += ',';
-    AppendFixed(out, values[i], decimals);
-  }
-  out += ']';
-}
-
-// Decimals per quantity: 0.1 mm for positions and travels, 1e-5 rad
-// (10 um at a metre) for angles, 1e-5 of the plotted signals' units (m,
-// m/s, A), whole seconds to the nanosecond's 1e-6 for times (every sample
-// time is a whole number of base steps, at least a microsecond).
-constexpr int kMetres = 4;
-constexpr int kRadians = 5;
-constexpr int kSignal = 5;
-constexpr int kSeconds = 6;
-
-// A key and its value: `"key":` then the caller appends the value.
-void Key(std::string& out, const char* key) {
-  out += '"';
-  out += key;
-  out += "\":";
-}
-
-void Member(std::string& out, const char* key, double v, int decimals) {
-  Key(out, key);
-  AppendFixed(out, v, decimals);
-  out += ',';
-}
-
-void AppendSolid(std::string& out, const models::Solid& s) {
-  Key(out, "shape");
-  out += s.kind == models::Solid::Kind::kBox ? "\"box\"," : "\"cylinder\",";
-  Member(out, "x", s.x_m, kMetres);
-  Member(out, "y", s.y_m, kMetres);
-  Member(out, "yaw", s.yaw_rad, kRadians);
-  Member(out, "length", s.length_m, kMetres);
-  Member(out, "width", s.width_m, kMetres);
-  Key(out, "radius");
-  AppendFixed(out, s.radius_m, kMetres);
-}
-
-}  // namespace
 
 ReplaySpec ReplaySpecFor(const loader::Scenario& s, double bound_m,
                          const std::string& bound_label) {
@@ -121,6 +19,7 @@ ReplaySpec ReplaySpecFor(const loader::Scenario& s, double bound_m,
   };
   ReplaySpec spec;
   spec.title = s.name;
+  spec.description = s.description;
   spec.task = r.task;
   spec.scene = s.scene;
   spec.path = r.path;
@@ -189,7 +88,19 @@ ReplaySpec ReplaySpecFor(const loader::Scenario& s, double bound_m,
   const std::string scope = r.name.empty() ? "" : r.name + ".";
   for (std::size_t u = 0; u < system.unit_count(); ++u) {
     if (const auto* laser = dynamic_cast<const sensors::LaserScannerUnit*>(&system.unit(u))) {
-      if (laser->name().starts_with(scope)) spec.lasers.push_back({laser->name(), laser});
+      if (!laser->name().starts_with(scope)) continue;
+      const cosim::VariableTable& v = laser->variables();
+      const auto ranges = v.Find("ranges");
+      const auto real = [&](const char* name) {
+        const auto ref = v.Find(name);
+        return ref ? v.GetReal(*ref) : 0.0;
+      };
+      // A measured range: at most range_max, plus the device's bias (at
+      // most bias_max, or some bias_sigma) and noise (some noise_sigma):
+      // ten sigmas and twice range_max are beyond any run.
+      const double farthest = 2.0 * real("range_max") + real("bias_max") +
+                              10.0 * (real("bias_sigma") + real("noise_sigma"));
+      spec.lasers.push_back({laser->name(), laser, ranges ? v.info(*ranges).size : 0, farthest});
     }
   }
   for (const loader::RobotInfo& other : r.fleet) {
@@ -216,24 +127,105 @@ ReplaySpec ReplaySpecFor(const loader::Scenario& s, double bound_m,
   return spec;
 }
 
+namespace {
+
+// The longest text of a range no farther than `farthest_m`, in whole
+// millimetres, with its comma; "-1" for no echo.
+std::uint64_t RangeBytes(double farthest_m) {
+  const double mm = std::ceil(1000.0 * std::max(farthest_m, 0.0));
+  if (!(mm < 1e15)) return kMaxNumberBytes;
+  std::uint64_t digits = 1;
+  for (double d = mm; d >= 10.0; d /= 10.0) ++digits;
+  return std::max<std::uint64_t>(digits, 2) + 1;
+}
+
+// A text's longest escaped form: every byte as \u00XX, the quotes, a comma.
+std::uint64_t TextBytes(const std::string& s) { return 6 * s.size() + 3; }
+
+}  // namespace
+
+std::uint64_t ReplayBytesBound(const ReplaySpec& spec, cosim::TimeNs start, cosim::TimeNs stop) {
+  const auto count = [&](cosim::TimeNs interval) {
+    return static_cast<std::uint64_t>(std::max<cosim::TimeNs>(stop - start, 0) /
+                                      std::max<cosim::TimeNs>(interval, 1)) +
+           2;
+  };
+  constexpr std::uint64_t kItem = 256;  // an item's keys and punctuation
+  const std::uint64_t n = kMaxNumberBytes;
+  std::uint64_t bytes = PageBytesWithoutData() + 4096;  // the fixed keys and rates
+  bytes += TextBytes(spec.title) + TextBytes(spec.description) + TextBytes(spec.task);
+  const models::Scene& scene = spec.scene;
+  for (const auto& s : scene.surfaces) bytes += TextBytes(s.name);
+  for (const auto& b : scene.belts) bytes += kItem + TextBytes(b.name) + 8 * n;
+  for (const auto& o : scene.obstacles) {
+    bytes += kItem + TextBytes(o.name) + TextBytes(o.kind) + 6 * n;
+  }
+  for (const auto& c : scene.carried) bytes += kItem + TextBytes(c.name) + 9 * n;
+  for (const auto& t : scene.terrain) bytes += kItem + TextBytes(t.name) + 6 * n;
+  bytes += spec.path.size() * (2 * n + 3);
+  // Per frame: time and pose, each wheel's contact point and surface, each
+  // belt's travel and on state, every curve, every mover's pose.
+  std::uint64_t per_frame =
+      4 + 3 * spec.wheels.size() + spec.belt_travel.size() + spec.belt_on.size();
+  for (const auto& p : spec.plots) {
+    bytes += kItem + TextBytes(p.title) + TextBytes(p.unit) + TextBytes(p.bound_label) + n;
+    for (const auto& c : p.curves) bytes += kItem + TextBytes(c.label);
+    per_frame += p.curves.size();
+  }
+  for (const auto& m : spec.movers) {
+    bytes += kItem + TextBytes(m.name) + 3 * n;
+    per_frame += m.robot ? 3 : 2;
+  }
+  bytes += count(spec.rates.frame_interval) * per_frame * n;
+  for (const auto& l : spec.lasers) {
+    bytes += kItem + TextBytes(l.name) + 5 * n;
+    bytes += count(spec.rates.scan_interval) *
+             (64 + 4 * n + static_cast<std::uint64_t>(l.beams) * RangeBytes(l.farthest_m));
+  }
+  return bytes;
+}
+
 ReplayRecorder::ReplayRecorder(ReplaySpec spec) : spec_(std::move(spec)) {
-  wheel_xy_.resize(2 * spec_.wheels.size());
-  wheel_surface_.resize(spec_.wheel_surface.size());
-  belt_travel_.resize(spec_.belt_travel.size());
-  belt_on_.resize(spec_.belt_on.size());
-  curves_.resize(spec_.plots.size());
-  for (std::size_t p = 0; p < spec_.plots.size(); ++p) {
-    curves_[p].resize(spec_.plots[p].curves.size());
+  ReplayData& d = data_;
+  d.title = spec_.title;
+  d.description = spec_.description;
+  d.task = spec_.task;
+  d.frame_hz = cosim::kNsPerSecond / static_cast<double>(spec_.rates.frame_interval);
+  d.scan_hz = cosim::kNsPerSecond / static_cast<double>(spec_.rates.scan_interval);
+  d.scene = spec_.scene;
+  d.path = spec_.path;
+  d.body_length_m = spec_.body_length_m;
+  d.body_width_m = spec_.body_width_m;
+  d.wheels.resize(spec_.wheels.size());
+  d.belt_travel.resize(spec_.belt_travel.size());
+  d.belt_on.resize(spec_.belt_on.size());
+  for (const ReplaySpec::Plot& p : spec_.plots) {
+    ReplayData::Plot plot{p.title, p.unit, p.bound, p.bound_label, {}};
+    for (const auto& c : p.curves) plot.curves.push_back({c.label, {}});
+    d.plots.push_back(std::move(plot));
+  }
+  for (const ReplaySpec::Mover& m : spec_.movers) {
+    d.movers.push_back({m.name, m.robot, m.length_m, m.width_m, m.radius_m, {}, {}, {}});
+  }
+  for (const ReplaySpec::Laser& l : spec_.lasers) {
+    const auto g = l.unit->beam_geometry();
+    d.lasers.push_back({l.name,
+                        g.mount_x_m,
+                        g.mount_y_m,
+                        g.mount_yaw_rad,
+                        g.first_beam_rad,
+                        g.beam_step_rad,
+                        g.no_return_m,
+                        {}});
   }
   last_count_.assign(spec_.lasers.size(), 0.0);
   next_scan_.assign(spec_.lasers.size(), 0);
-  scans_.resize(spec_.lasers.size());
-  movers_.resize(spec_.movers.size());
 }
 
 void ReplayRecorder::OnStart(const cosim::Master& master) {
   next_frame_ = master.options().start;
   for (auto& n : next_scan_) n = master.options().start;
+  data_.outcome.stop_s = cosim::NsToSeconds(master.options().stop);
 }
 
 void ReplayRecorder::OnSample(cosim::TimeNs t, const cosim::System& system) {
@@ -242,37 +234,39 @@ void ReplayRecorder::OnSample(cosim::TimeNs t, const cosim::System& system) {
   const double yaw = cosim::ReadProbe(system, spec_.yaw);
   history_[history_count_ % history_.size()] = {t, x, y, yaw};
   ++history_count_;
+  ReplayData& d = data_;
+  d.outcome.end_s = cosim::NsToSeconds(t);
 
   if (t >= next_frame_) {
     while (next_frame_ <= t) next_frame_ += spec_.rates.frame_interval;
-    time_.push_back(cosim::NsToSeconds(t));
-    x_.push_back(x);
-    y_.push_back(y);
-    yaw_.push_back(yaw);
+    d.t.push_back(cosim::NsToSeconds(t));
+    d.x.push_back(x);
+    d.y.push_back(y);
+    d.yaw.push_back(yaw);
     for (std::size_t w = 0; w < spec_.wheels.size(); ++w) {
-      wheel_xy_[2 * w].push_back(cosim::ReadProbe(system, spec_.wheels[w][0]));
-      wheel_xy_[2 * w + 1].push_back(cosim::ReadProbe(system, spec_.wheels[w][1]));
-    }
-    for (std::size_t w = 0; w < spec_.wheel_surface.size(); ++w) {
-      wheel_surface_[w].push_back(cosim::ReadProbe(system, spec_.wheel_surface[w]));
+      d.wheels[w].x.push_back(cosim::ReadProbe(system, spec_.wheels[w][0]));
+      d.wheels[w].y.push_back(cosim::ReadProbe(system, spec_.wheels[w][1]));
+      if (w < spec_.wheel_surface.size()) {
+        d.wheels[w].surface.push_back(cosim::ReadProbe(system, spec_.wheel_surface[w]));
+      }
     }
     for (std::size_t b = 0; b < spec_.belt_travel.size(); ++b) {
-      belt_travel_[b].push_back(cosim::ReadProbe(system, spec_.belt_travel[b]));
+      d.belt_travel[b].push_back(cosim::ReadProbe(system, spec_.belt_travel[b]));
     }
     for (std::size_t b = 0; b < spec_.belt_on.size(); ++b) {
-      belt_on_[b].push_back(cosim::ReadProbe(system, spec_.belt_on[b]));
+      d.belt_on[b].push_back(cosim::ReadProbe(system, spec_.belt_on[b]));
     }
     for (std::size_t p = 0; p < spec_.plots.size(); ++p) {
       const auto& curves = spec_.plots[p].curves;
       for (std::size_t c = 0; c < curves.size(); ++c) {
-        curves_[p][c].push_back(cosim::ReadProbe(system, curves[c].probe));
+        d.plots[p].curves[c].values.push_back(cosim::ReadProbe(system, curves[c].probe));
       }
     }
     for (std::size_t m = 0; m < spec_.movers.size(); ++m) {
       const ReplaySpec::Mover& mover = spec_.movers[m];
-      movers_[m][0].push_back(cosim::ReadProbe(system, mover.x));
-      movers_[m][1].push_back(cosim::ReadProbe(system, mover.y));
-      if (mover.robot) movers_[m][2].push_back(cosim::ReadProbe(system, mover.yaw));
+      d.movers[m].x.push_back(cosim::ReadProbe(system, mover.x));
+      d.movers[m].y.push_back(cosim::ReadProbe(system, mover.y));
+      if (mover.robot) d.movers[m].yaw.push_back(cosim::ReadProbe(system, mover.yaw));
     }
   }
 
@@ -293,292 +287,8 @@ void ReplayRecorder::OnSample(cosim::TimeNs t, const cosim::System& system) {
       const Pose& p = history_[i];
       if (!best || std::llabs(p.t - scan_t) < std::llabs(best->t - scan_t)) best = &p;
     }
-    scans_[k].push_back({scan_s, best->x, best->y, best->yaw, laser.ranges()});
+    d.lasers[k].scans.push_back({scan_s, best->x, best->y, best->yaw, laser.ranges()});
   }
-}
-
-std::string ReplayRecorder::DataJson() const {
-  std::string out;
-  out.reserve(std::size_t{2} << 20);  // a 20 s cross_line: 1.5 MB
-  out += '{';
-  Key(out, "format");
-  out += "1,";
-  Key(out, "title");
-  AppendString(out, spec_.title);
-  out += ',';
-  Key(out, "task");
-  AppendString(out, spec_.task);
-  out += ',';
-  Key(out, "rates");
-  out += '{';
-  Member(out, "frame_hz", cosim::kNsPerSecond / static_cast<double>(spec_.rates.frame_interval),
-         kSignal);
-  Key(out, "scan_hz");
-  AppendFixed(out, cosim::kNsPerSecond / static_cast<double>(spec_.rates.scan_interval), kSignal);
-  out += "},";
-
-  // The scene.
-  const models::Scene& scene = spec_.scene;
-  Key(out, "surfaces");
-  out += '[';
-  for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-    if (i > 0) out += ',';
-    AppendString(out, scene.surfaces[i].name);
-  }
-  out += "],";
-  Key(out, "floor");
-  out += '{';
-  Member(out, "min_x", scene.floor.min_x_m, kMetres);
-  Member(out, "max_x", scene.floor.max_x_m, kMetres);
-  Member(out, "min_y", scene.floor.min_y_m, kMetres);
-  Member(out, "max_y", scene.floor.max_y_m, kMetres);
-  Key(out, "surface");
-  AppendInt(out, scene.floor.surface);
-  out += "},";
-  Key(out, "belts");
-  out += '[';
-  for (std::size_t b = 0; b < scene.belts.size(); ++b) {
-    const models::Belt& belt = scene.belts[b];
-    if (b > 0) out += ',';
-    out += '{';
-    Key(out, "name");
-    AppendString(out, belt.name);
-    out += ',';
-    Member(out, "x", belt.area.center_x_m, kMetres);
-    Member(out, "y", belt.area.center_y_m, kMetres);
-    Member(out, "length", belt.area.length_m, kMetres);
-    Member(out, "width", belt.area.width_m, kMetres);
-    Member(out, "dir", belt.area.direction_rad, kRadians);
-    Key(out, "surface");
-    AppendInt(out, belt.surface);
-    out += ',';
-    Key(out, "travel");
-    AppendArray(out, b < belt_travel_.size() ? belt_travel_[b] : std::vector<double>{}, kMetres);
-    out += ',';
-    Key(out, "on");
-    AppendArray(out, b < belt_on_.size() ? belt_on_[b] : std::vector<double>{}, 0);
-    out += '}';
-  }
-  out += "],";
-  Key(out, "obstacles");
-  out += '[';
-  for (std::size_t i = 0; i < scene.obstacles.size(); ++i) {
-    if (i > 0) out += ',';
-    out += '{';
-    Key(out, "name");
-    AppendString(out, scene.obstacles[i].name);
-    out += ',';
-    Key(out, "kind");
-    AppendString(out, scene.obstacles[i].kind);
-    out += ',';
-    AppendSolid(out, scene.obstacles[i].solid);
-    out += '}';
-  }
-  out += "],";
-  Key(out, "carried");
-  out += '[';
-  for (std::size_t i = 0; i < scene.carried.size(); ++i) {
-    const models::CarriedObject& c = scene.carried[i];
-    if (i > 0) out += ',';
-    out += '{';
-    Key(out, "name");
-    AppendString(out, c.name);
-    out += ',';
-    Key(out, "belt");
-    AppendInt(out, c.belt);
-    out += ',';
-    // The travel over which it lies on its belt (outside: lifted off).
-    const bool has_belt = c.belt >= 0 && static_cast<std::size_t>(c.belt) < scene.belts.size();
-    const auto range = has_belt ? models::CarriedTravelRange(
-                                      scene.belts[static_cast<std::size_t>(c.belt)].area, c.solid)
-                                : std::array<double, 2>{0.0, 0.0};
-    Member(out, "travel_min", range[0], kMetres);
-    Member(out, "travel_max", range[1], kMetres);
-    AppendSolid(out, c.solid);
-    out += '}';
-  }
-  out += "],";
-  Key(out, "terrain");
-  out += '[';
-  for (std::size_t i = 0; i < scene.terrain.size(); ++i) {
-    const models::TerrainPiece& p = scene.terrain[i];
-    if (i > 0) out += ',';
-    out += '{';
-    Key(out, "name");
-    AppendString(out, p.name);
-    out += ',';
-    Member(out, "x", p.center_x_m, kMetres);
-    Member(out, "y", p.center_y_m, kMetres);
-    Member(out, "yaw", p.yaw_rad, kRadians);
-    // The footprint of its top face seen from above.
-    Member(out, "length", p.length_m * std::cos(p.pitch_rad), kMetres);
-    Member(out, "width", p.width_m * std::cos(p.roll_rad), kMetres);
-    Key(out, "surface");
-    AppendInt(out, p.surface);
-    out += '}';
-  }
-  out += "],";
-  Key(out, "path");
-  out += '[';
-  for (std::size_t i = 0; i < spec_.path.size(); ++i) {
-    if (i > 0) out += ',';
-    out += '[';
-    AppendFixed(out, spec_.path[i][0], kMetres);
-    out += ',';
-    AppendFixed(out, spec_.path[i][1], kMetres);
-    out += ']';
-  }
-  out += "],";
-
-  // The robot over time.
-  Key(out, "body");
-  out += '{';
-  Member(out, "length", spec_.body_length_m, kMetres);
-  Key(out, "width");
-  AppendFixed(out, spec_.body_width_m, kMetres);
-  out += "},";
-  Key(out, "t");
-  AppendArray(out, time_, kSeconds);
-  out += ',';
-  Key(out, "x");
-  AppendArray(out, x_, kMetres);
-  out += ',';
-  Key(out, "y");
-  AppendArray(out, y_, kMetres);
-  out += ',';
-  Key(out, "yaw");
-  AppendArray(out, yaw_, kRadians);
-  out += ',';
-  Key(out, "wheels");
-  out += '[';
-  for (std::size_t w = 0; w < spec_.wheels.size(); ++w) {
-    if (w > 0) out += ',';
-    out += '{';
-    Key(out, "x");
-    AppendArray(out, wheel_xy_[2 * w], kMetres);
-    out += ',';
-    Key(out, "y");
-    AppendArray(out, wheel_xy_[2 * w + 1], kMetres);
-    out += ',';
-    Key(out, "surface");
-    AppendArray(out, w < wheel_surface_.size() ? wheel_surface_[w] : std::vector<double>{}, 0);
-    out += '}';
-  }
-  out += "],";
-  Key(out, "plots");
-  out += '[';
-  for (std::size_t p = 0; p < spec_.plots.size(); ++p) {
-    const ReplaySpec::Plot& plot = spec_.plots[p];
-    if (p > 0) out += ',';
-    out += '{';
-    Key(out, "title");
-    AppendString(out, plot.title);
-    out += ',';
-    Key(out, "unit");
-    AppendString(out, plot.unit);
-    out += ',';
-    Member(out, "bound", plot.bound, kSignal);
-    Key(out, "bound_label");
-    AppendString(out, plot.bound_label);
-    out += ',';
-    Key(out, "curves");
-    out += '[';
-    for (std::size_t c = 0; c < plot.curves.size(); ++c) {
-      if (c > 0) out += ',';
-      out += '{';
-      Key(out, "label");
-      AppendString(out, plot.curves[c].label);
-      out += ',';
-      Key(out, "values");
-      AppendArray(out, curves_[p][c], kSignal);
-      out += '}';
-    }
-    out += "]}";
-  }
-  out += "],";
-  Key(out, "movers");
-  out += '[';
-  for (std::size_t m = 0; m < spec_.movers.size(); ++m) {
-    const ReplaySpec::Mover& mover = spec_.movers[m];
-    if (m > 0) out += ',';
-    out += '{';
-    Key(out, "name");
-    AppendString(out, mover.name);
-    out += ',';
-    Key(out, "robot");
-    out += mover.robot ? "true," : "false,";
-    Member(out, "length", mover.length_m, kMetres);
-    Member(out, "width", mover.width_m, kMetres);
-    Member(out, "radius", mover.radius_m, kMetres);
-    Key(out, "x");
-    AppendArray(out, movers_[m][0], kMetres);
-    out += ',';
-    Key(out, "y");
-    AppendArray(out, movers_[m][1], kMetres);
-    out += ',';
-    Key(out, "yaw");
-    AppendArray(out, movers_[m][2], kRadians);
-    out += '}';
-  }
-  out += "],";
-  // Ranges in whole millimetres (the S300 and LMS151 report in mm), -1 for
-  // no echo.
-  Key(out, "lasers");
-  out += '[';
-  for (std::size_t k = 0; k < spec_.lasers.size(); ++k) {
-    const auto g = spec_.lasers[k].unit->beam_geometry();
-    if (k > 0) out += ',';
-    out += '{';
-    Key(out, "name");
-    AppendString(out, spec_.lasers[k].name);
-    out += ',';
-    Member(out, "mount_x", g.mount_x_m, kMetres);
-    Member(out, "mount_y", g.mount_y_m, kMetres);
-    Member(out, "mount_yaw", g.mount_yaw_rad, kRadians);
-    Member(out, "first_beam", g.first_beam_rad, 7);
-    Member(out, "beam_step", g.beam_step_rad, 9);
-    Key(out, "scans");
-    out += '[';
-    for (std::size_t i = 0; i < scans_[k].size(); ++i) {
-      const Scan& scan = scans_[k][i];
-      if (i > 0) out += ',';
-      out += '{';
-      Member(out, "t", scan.time_s, kSeconds);
-      Key(out, "pose");
-      out += '[';
-      AppendFixed(out, scan.x, kMetres);
-      out += ',';
-      AppendFixed(out, scan.y, kMetres);
-      out += ',';
-      AppendFixed(out, scan.yaw, kRadians);
-      out += "],";
-      Key(out, "ranges_mm");
-      out += '[';
-      for (std::size_t b = 0; b < scan.ranges.size(); ++b) {
-        if (b > 0) out += ',';
-        const double range = scan.ranges[b];
-        if (range == g.no_return_m || !std::isfinite(range)) {
-          out += "-1";
-        } else {
-          AppendInt(out, std::llround(range * 1000.0));
-        }
-      }
-      out += "]}";
-    }
-    out += "]}";
-  }
-  out += "]}";
-  return out;
-}
-
-std::string ReplayRecorder::Html() const {
-  const std::string page = PageTemplate();
-  const std::size_t at = page.find(kDataMarker);
-  if (at == std::string::npos) throw std::logic_error("replay page template without its data marker");
-  std::string html = page.substr(0, at);
-  html += DataJson();
-  html += page.substr(at + std::strlen(kDataMarker));
-  return html;
 }
 
 void ReplayRecorder::Write(const std::string& path) const {

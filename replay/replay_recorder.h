@@ -8,6 +8,7 @@
 #include "cosim/master.h"
 #include "cosim/observers.h"
 #include "models/scene.h"
+#include "replay/replay_data.h"
 
 namespace linesim::loader {
 struct Scenario;
@@ -34,7 +35,7 @@ struct ReplayRates {
 /// What the replay shows, as probes into the running system and the
 /// scene; ReplaySpecFor builds it from a loaded robot scenario.
 struct ReplaySpec {
-  std::string title;
+  std::string title, description;
   std::string task;  // path, hold or route
   models::Scene scene;
   std::vector<std::array<double, 2>> path;
@@ -62,6 +63,10 @@ struct ReplaySpec {
   struct Laser {
     std::string name;
     const sensors::LaserScannerUnit* unit = nullptr;
+    /// Its beams and the farthest range it can report (for the page's size
+    /// bound: twice range_max, plus its bias and ten sigmas of its noise).
+    std::size_t beams = 0;
+    double farthest_m = 0.0;
   };
   std::vector<Laser> lasers;
   /// What else moves on the floor: a fleet's other robots (a box, with
@@ -84,57 +89,52 @@ struct ReplaySpec {
 /// not resolve.
 ReplaySpec ReplaySpecFor(const loader::Scenario& s, double bound_m, const std::string& bound_label);
 
-/// Samples the run for the replay (an observer of the master) and writes
-/// the page. Sampling reads a few variables per base step and copies a
-/// scan's ranges at the scan rate; everything else happens in Write.
+/// The most bytes replay.html of `spec` can take for a run from `start` to
+/// `stop`: the template, every text escaped at its longest (6 bytes a
+/// byte), one frame every frame interval and one scan per laser every scan
+/// interval with every number at kMaxNumberBytes, a range at the laser's
+/// farthest (Laser::farthest_m). Known before the run (RunIntoFolder checks it
+/// against --max-output-mb).
+std::uint64_t ReplayBytesBound(const ReplaySpec& spec, cosim::TimeNs start, cosim::TimeNs stop);
+
+/// Samples the run for the replay (an observer of the master) into a
+/// ReplayData and writes the page. Sampling reads a few variables per base
+/// step and copies a scan's ranges at the scan rate; everything else
+/// happens in Write.
 class ReplayRecorder : public cosim::Observer {
  public:
   explicit ReplayRecorder(ReplaySpec spec);
   void OnStart(const cosim::Master& master) override;
   void OnSample(cosim::TimeNs t, const cosim::System& system) override;
 
-  /// The page's data as JSON text (numbers in fixed notation, the same
-  /// bytes for the same run).
-  std::string DataJson() const;
-  /// The whole page: the template with the data inside.
-  std::string Html() const;
+  /// How the run ended (the page shows a banner unless ok).
+  void SetOutcome(ReplayData::Outcome outcome) { data_.outcome = std::move(outcome); }
+  const ReplayData& data() const { return data_; }
+  /// The page's data as JSON text (DataJson).
+  std::string DataJson() const { return replay::DataJson(data_); }
+  /// The whole page (PageHtml).
+  std::string Html() const { return PageHtml(data_); }
   /// Writes Html() to `path` (atomically); throws std::runtime_error when it
   /// cannot be written.
   void Write(const std::string& path) const;
-  std::int64_t frames() const { return static_cast<std::int64_t>(time_.size()); }
+  std::int64_t frames() const { return static_cast<std::int64_t>(data_.t.size()); }
 
  private:
-  struct Scan {
-    double time_s;
-    double x, y, yaw;  // the robot's pose at the scan's start
-    std::vector<double> ranges;
-  };
   struct Pose {
     cosim::TimeNs t;
     double x, y, yaw;
   };
   ReplaySpec spec_;
+  ReplayData data_;
   cosim::TimeNs next_frame_ = 0;
-  std::vector<double> time_;
-  // One column per value, each as long as time_.
-  std::vector<double> x_, y_, yaw_;
-  std::vector<std::vector<double>> wheel_xy_, wheel_surface_, belt_travel_, belt_on_;
-  std::vector<std::vector<std::vector<double>>> curves_;  // [plot][curve][frame]
-  std::vector<std::array<std::vector<double>, 3>> movers_;  // [mover]{x, y, yaw}[frame]
-  // Lasers: their last seen scan count, the time after which a scan is
-  // kept, and the kept scans.
+  // Lasers: their last seen scan count and the time after which a scan is
+  // kept.
   std::vector<double> last_count_;
   std::vector<cosim::TimeNs> next_scan_;
-  std::vector<std::vector<Scan>> scans_;
   // The robot's pose over the last base steps (a ring): a scan is drawn
   // from the pose at its start, up to a scan period back.
   std::array<Pose, 64> history_{};
   std::size_t history_count_ = 0;
 };
-
-/// The page's template (replay/page.html), with kDataMarker where the data
-/// goes.
-const char* PageTemplate();
-inline constexpr const char* kDataMarker = "\"__LINESIM_REPLAY_DATA__\"";
 
 }  // namespace linesim::replay

@@ -9,6 +9,8 @@
 #   fuzz_model_description  tests/units/fmu/fmus/*.xml
 #   fuzz_fmu_loader         the test FMUs (build-asan/tests/units/fmu/*.fmu,
 #                           when the sanitizer build made them)
+#   fuzz_replay_data        replay.html's data of 0.2 s runs of cross_line,
+#                           fleet_line and worker_crossing
 #     bash tools/fuzz.sh [SECONDS] [HARNESS ...]
 # The corpora grow in build-asan/fuzz/corpus/HARNESS; an input that crashes,
 # leaks, runs over 30 s, allocates over 2 GB at once or trips a sanitizer is saved as
@@ -21,12 +23,13 @@ shift || true
 harnesses=("$@")
 [ ${#harnesses[@]} -gt 0 ] || harnesses=(fuzz_scenario fuzz_description fuzz_sweep_file
                                          fuzz_results_file fuzz_model_description
-                                         fuzz_fmu_loader)
+                                         fuzz_fmu_loader fuzz_replay_data)
 bash tools/setup.sh
 source tools/sanitizer_build.sh "${harnesses[@]}"
 
 out=build-asan/fuzz
 mkdir -p "$out/findings"
+wanted() { [[ " ${harnesses[*]} " == *" $1 "* ]]; }
 seed() {  # seed HARNESS FILE...: copies the shipped files into its corpus
   local h=$1; shift
   mkdir -p "$out/corpus/$h"
@@ -43,12 +46,19 @@ seed fuzz_scenario scenarios/*.yaml
 seed fuzz_description models/robots/*.yaml models/scenes/*.yaml
 seed fuzz_sweep_file scenarios/sweeps/*.yaml
 mkdir -p "$out/corpus/fuzz_results_file"
-LINESIM_FUZZ_SEED_DIR="$out/corpus/fuzz_results_file" build-asan/fuzz/fuzz_results_file
+if wanted fuzz_results_file; then  # a harness is built only when asked for
+  LINESIM_FUZZ_SEED_DIR="$out/corpus/fuzz_results_file" build-asan/fuzz/fuzz_results_file
+fi
 seed fuzz_model_description tests/units/fmu/fmus/*.xml
 mkdir -p "$out/corpus/fuzz_fmu_loader"
 for f in build-asan/tests/units/fmu/*.fmu; do
   [ -e "$f" ] && seed fuzz_fmu_loader "$f"
 done
+
+mkdir -p "$out/corpus/fuzz_replay_data"
+if wanted fuzz_replay_data; then  # real runs' page data (a few seconds)
+  LINESIM_FUZZ_SEED_DIR="$out/corpus/fuzz_replay_data" build-asan/fuzz/fuzz_replay_data
+fi
 
 status=0
 for h in "${harnesses[@]}"; do

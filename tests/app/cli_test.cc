@@ -249,8 +249,8 @@ TEST(Cli, RecordingBeyondTheOutputLimitIsRefusedBeforeTheRun) {
   const std::string out = Fresh("output_limit");
   const Result r = Linesim("run " + kMotorStep + " --out " + out + " --max-output-mb 0.1");
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("the recording would take up to 1 MB (1502 rows of 11 columns), more "
-                       "than the 0.1 MB allowed"),
+  EXPECT_NE(r.err.find("the run's files would take up to 0.4 MB, more than the 0.1 MB allowed "
+                       "(--max-output-mb): signals.csv up to 0.4 MB (1502 rows of 11 columns)"),
             std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(out));
@@ -265,6 +265,48 @@ TEST(Cli, RecordingBeyondTheOutputLimitIsRefusedBeforeTheRun) {
     EXPECT_NE(n.err.find("--max-output-mb"), std::string::npos) << bad << ": " << n.err;
     EXPECT_FALSE(fs::exists(out2)) << bad;
   }
+}
+
+// Guards the limit covering every output (issue 37: under --max-output-mb 1
+// a 1,000 s cross_line wrote a 72.7 MB replay.html and a 15.9 MB run.mcap,
+// the limit bounding signals.csv alone): the run is refused before it
+// starts, exit 2, nothing written, the message naming each file with its
+// bound and how to make it smaller.
+TEST(Cli, EveryOutputCountsAgainstTheLimit) {
+  const std::string out = Fresh("output_limit_all");
+  const Result r = Linesim("run " + kCrossLine + " --set duration_s=1000 --mcap --out " + out +
+                           " --max-output-mb 1");
+  EXPECT_EQ(r.status, 2) << r.err;
+  for (const char* named : {"signals.csv up to", "plots.gp up to", "replay.html up to",
+                            "50001 frames, the scans of 2 lasers", "run.mcap up to", "--no-replay",
+                            "leave out run.mcap"}) {
+    EXPECT_NE(r.err.find(named), std::string::npos) << named << " in: " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(out));
+  // Without the replay and the log, the replay and the log are not counted.
+  const Result lean = Linesim("run " + kCrossLine + " --set duration_s=1000 --no-replay --out " +
+                              out + " --max-output-mb 1");
+  EXPECT_EQ(lean.status, 2);
+  EXPECT_EQ(lean.err.find("replay.html"), std::string::npos) << lean.err;
+  EXPECT_EQ(lean.err.find("run.mcap"), std::string::npos) << lean.err;
+}
+
+// Guards a name that becomes a file name (issue 37: a 300-character robot
+// name said "cannot remove the previous run's ... File name too long" and
+// left an empty folder): it is refused at its key when the scenario is
+// read, exit 2, nothing written; 64 characters are fine.
+TEST(Cli, ARobotNameTooLongForItsFilesIsRefusedAtItsKey) {
+  const std::string fleet = LINESIM_SOURCE_DIR "/scenarios/fleet_line.yaml";
+  const std::string out = Fresh("long_robot_name");
+  const Result r =
+      Linesim("run " + fleet + " --set robots.1.name=" + std::string(300, 'a') + " --out " + out);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find(fleet + ": robots.1.name (set on the command line): robot name '"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("has 300 characters: at most 64"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(Linesim("inspect " + fleet + " --set robots.1.name=" + std::string(64, 'a')).status, 0);
 }
 
 // Guards a robot scenario's own recording list: the columns the plots read
@@ -478,6 +520,54 @@ TEST(Cli, ARunClearsThePreviousRunsOutputs) {
   }
   const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
   EXPECT_EQ(summary["file"], kMotorStep);
+}
+
+// `linesim ARGS` with every file it writes limited to `kib` KiB (as a full
+// disk stops it: the writes past it fail, SIGXFSZ ignored, inherited). Its
+// messages go through a pipe (no limit) to the file the result reads;
+// stdout is dropped.
+Result LinesimOnAFullDisk(const std::string& args, int kib) {
+  const std::string err = ::testing::TempDir() + "cli_full_" + std::to_string(getpid()) + ".err";
+  const std::string cmd = "bash -c 'set -o pipefail; (trap \"\" XFSZ; ulimit -f " +
+                          std::to_string(kib) + "; exec " + std::string(LINESIM_CLI) + " " + args +
+                          " 2>&1 >/dev/null </dev/null) | cat >" + err + "'";
+  const int raw = std::system(cmd.c_str());
+  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, "", ReadFile(err)};
+}
+
+// Guards every file that could not be written being named (issue 37: on a
+// full disk the message named plots.gp and summary.json but never the cut
+// run.mcap): each of signals.csv, run.mcap, replay.html and summary.json
+// that a full disk cut is named, also when the summary that would list
+// them is one of them; the run fails (exit 1) and the summary written at
+// its start still says failed.
+TEST(Cli, AFullDiskNamesEveryFileItCut) {
+  for (const int kib : {8, 4}) {  // the final summary fits, and it does not
+    SCOPED_TRACE(kib);
+    const std::string out = Fresh("full_disk_" + std::to_string(kib));
+    const Result r =
+        LinesimOnAFullDisk("run " + kCrossLine + " --set duration_s=1 --mcap --out " + out, kib);
+    EXPECT_EQ(r.status, 1) << r.err;
+    for (const char* file : {"/signals.csv", "/run.mcap", "/replay.html"}) {
+      EXPECT_NE(r.err.find("cannot write " + out + file), std::string::npos) << file << r.err;
+    }
+    EXPECT_EQ(r.err.find("cannot write " + out + "/summary.json") != std::string::npos, kib == 4)
+        << r.err;
+    const auto summary = nlohmann::json::parse(ReadFile(fs::path(out) / "summary.json"));
+    EXPECT_EQ(summary["status"], "failed");
+  }
+}
+
+// Guards "nothing written" when a run cannot start (issue 37: a refused run
+// left an empty --out folder): here not even the summary written at the
+// start fits, so the run is refused (exit 2, naming the file) and the
+// folders it made for it are gone again.
+TEST(Cli, ARunThatCannotStartLeavesNoFolder) {
+  const std::string out = Fresh("cannot_start");
+  const Result r = LinesimOnAFullDisk("run " + kMotorStep + " --out " + out + "/a/b", 0);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find(out + "/a/b/summary.json"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 // Guards against a lost signals.csv passing for a good run: when its writes

@@ -8,7 +8,8 @@
 // expect.json (written by tests/mcap/mcap_test.cc from the loaded scenario):
 //   {compression, beams: {UNIT: n}, angular_step: {UNIT: rad}, x, y, yaw: CSV
 //    columns, carried: {ID: [x0, y0, belt travel column, direction rad, belt frame]},
-//    entities: [static entity ids], scan_period_ns, signal_period_ns}
+//    entities: [static entity ids], scan_period_ns, signal_period_ns,
+//    status: how the run ended (ok, failed, interrupted), stop_time_s}
 // Exit 0 with "mcap check: ok ..." or 1 with the first failure.
 import fs from "node:fs";
 import { McapIndexedReader, McapStreamReader } from "@mcap/core";
@@ -120,7 +121,7 @@ for (const line of lines.slice(1)) {
 const nsOf = (t) => BigInt(t.sec) * 1000000000n + BigInt(t.nsec);
 const same = (json, csv) => (json === null ? !Number.isFinite(csv) : json === csv);
 
-let tf = 0, scans = 0, signals = 0, scenes = 0, statics = 0, mounts = 0;
+let tf = 0, scans = 0, signals = 0, scenes = 0, statics = 0, mounts = 0, logs = 0;
 const lastScan = {};
 const carriedSeen = new Set();
 for (const m of indexed) {
@@ -198,6 +199,18 @@ for (const m of indexed) {
       check(ids.includes(id), `/scene/static has no entity '${id}'`);
     }
     statics++;
+  } else if (topic === "/log") {
+    // How the run ended, as the last message: its level and the words a
+    // viewer's log panel shows.
+    check(schemaOf(m).name === "foxglove.Log", "/log schema");
+    const level = { ok: 2, interrupted: 3, failed: 4 }[expect.status];
+    const word = { ok: "run ended: ok at ", interrupted: "run INTERRUPTED at ",
+                   failed: "run FAILED at " }[expect.status];
+    check(msg.level === level && msg.message.startsWith(word) && msg.name === "linesim",
+          `/log: level ${msg.level}, '${msg.message}' for a run that is ${expect.status}`);
+    check(m === indexed[indexed.length - 1] || m.logTime === indexed[indexed.length - 1].logTime,
+          "/log is not the last message");
+    logs++;
   } else if (topic === "/scene") {
     check(schemaOf(m).name === "foxglove.SceneUpdate", "/scene schema");
     const ids = msg.entities.map((e) => e.id);
@@ -229,6 +242,22 @@ for (const unit of Object.keys(expect.beams)) {
   check(lastScan[unit] !== undefined, `no scan of ${unit}`);
 }
 check(carriedSeen.size === Object.keys(expect.carried).length, "a carried object never drawn");
+// The same as metadata, found through the summary's metadata index.
+check(logs === 1, `${logs} /log messages: one at the end`);
+check(reader.metadataIndexes.length === 1 && stats.metadataCount === 1,
+      `${reader.metadataIndexes.length} metadata indexes, statistics ${stats.metadataCount}: one`);
+check(reader.summaryOffsetsByOpcode.has(0x0d), "no summary offset for the metadata index");
+const metadata = [];
+for await (const r of reader.readMetadata({ name: "linesim.run" })) metadata.push(r);
+check(metadata.length === 1, `${metadata.length} metadata records 'linesim.run'`);
+const run = metadata[0].metadata;
+check(run.get("status") === expect.status,
+      `metadata status '${run.get("status")}', expected ${expect.status}`);
+check(Number(run.get("stop_time_s")) === expect.stop_time_s,
+      `metadata stop_time_s ${run.get("stop_time_s")}, expected ${expect.stop_time_s}`);
+const endTime = Number(run.get("end_time_s"));
+check(expect.status === "ok" ? endTime === expect.stop_time_s : endTime < expect.stop_time_s,
+      `metadata end_time_s ${endTime} of ${expect.stop_time_s} for a run that is ${expect.status}`);
 console.log(`mcap check: ok, ${indexed.length} messages in ${chunks} chunks: ${tf} /tf, ` +
-            `${scans} scans, ${scenes} /scene, ${signals} signals, ${statics} /scene/static, ${mounts} /tf/mounts; CRCs of data, summary and ` +
-            `every chunk valid`);
+            `${scans} scans, ${scenes} /scene, ${signals} signals, ${statics} /scene/static, ${mounts} /tf/mounts, ` +
+            `${logs} /log (${run.get("status")} at ${endTime} s); CRCs of data, summary and every chunk valid`);

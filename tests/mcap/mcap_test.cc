@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -220,6 +221,50 @@ TEST(Writer, ChunkClosesAtItsSize) {
   EXPECT_EQ(w.message_count(), 5u);
 }
 
+// Guards the metadata record (the run's end, issue 37): written in the
+// data section after the chunks, indexed in the summary (a Metadata Index
+// pointing at it, in a group of its own) and counted in the statistics.
+TEST(Writer, MetadataIsWrittenIndexedAndCounted) {
+  std::ostringstream out;
+  WriterOptions options;
+  options.compression = Compression::kNone;
+  Writer w(out, options);
+  const auto channel = w.AddChannel(0, "/t", "json");
+  w.WriteMessage(channel, 5, 5, "{}");
+  w.AddMetadata("linesim.run", {{"status", "interrupted"}, {"end_time_s", "1.5"}});
+  w.Close();
+  const std::string b = out.str();
+  const std::size_t footer_at = b.size() - 8 - 29;
+  const std::size_t summary_at = U(b, footer_at + 9, 8);
+  // The metadata record: name, then the map (uint32 byte length, pairs).
+  std::size_t at = 8;
+  while (U(b, at, 1) != 0x0Cu) {
+    ASSERT_LT(at, summary_at) << "no metadata record in the data section";
+    at += 9 + U(b, at + 1, 8);
+  }
+  const std::size_t metadata_at = at, metadata_length = 9 + U(b, at + 1, 8);
+  EXPECT_EQ(Str(b, at + 9), "linesim.run");
+  EXPECT_EQ(U(b, at + 24, 4), (4u + 6u + 4u + 11u) + (4u + 10u + 4u + 3u));
+  EXPECT_EQ(Str(b, at + 28), "status");
+  EXPECT_EQ(Str(b, at + 38), "interrupted");
+  EXPECT_EQ(U(b, metadata_at + metadata_length, 1), 0x0Fu);  // then data end
+  // Its index in the summary, and the statistics' count.
+  at = summary_at;
+  while (U(b, at, 1) != 0x0Du) at += 9 + U(b, at + 1, 8);
+  EXPECT_EQ(U(b, at + 9, 8), metadata_at);
+  EXPECT_EQ(U(b, at + 17, 8), metadata_length);
+  EXPECT_EQ(Str(b, at + 25), "linesim.run");
+  at = summary_at;
+  while (U(b, at, 1) != 0x0Bu) at += 9 + U(b, at + 1, 8);
+  EXPECT_EQ(U(b, at + 27, 4), 1u);  // metadata count
+  // A summary offset for the metadata index group.
+  bool grouped = false;
+  for (at = U(b, footer_at + 17, 8); at < footer_at; at += 9 + U(b, at + 1, 8)) {
+    grouped |= U(b, at + 9, 1) == 0x0Du;
+  }
+  EXPECT_TRUE(grouped);
+}
+
 // ---- run.mcap ---------------------------------------------------------------
 
 struct Result {
@@ -263,6 +308,10 @@ nlohmann::json Expectations(const std::string& scenario, const std::vector<std::
   e["y"] = s.robot->y_column;
   e["yaw"] = s.robot->yaw_column;
   e["compression"] = "lz4";
+  // How the run ends (the /log message and the metadata): overwritten by a
+  // test that stops it early.
+  e["status"] = "ok";
+  e["stop_time_s"] = s.duration_s;
   // The rates mcap::RunLogOptions states: scans at 5 Hz, rows at 25 Hz.
   e["scan_period_ns"] = 200'000'000;
   e["signal_period_ns"] = 40'000'000;
@@ -317,6 +366,58 @@ TEST(RunMcap, IndependentReaderValidatesAndMatchesTheSignals) {
                              dir + "/run.mcap " + dir + "/signals.csv " + dir + "/expect.json");
   EXPECT_EQ(check.status, 0) << check.out << check.err;
   EXPECT_NE(check.out.find("mcap check: ok"), std::string::npos) << check.out << check.err;
+}
+
+// `linesim ARGS` started in the background (its output to files); its pid.
+pid_t Start(const std::string& args) {
+  const std::string base = ::testing::TempDir() + "mcap_bg_" + std::to_string(getpid());
+  const std::string command =
+      "exec " + std::string(LINESIM_CLI) + " " + args + " >" + base + ".out 2>" + base + ".err";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+// Waits until `file` holds at least `bytes` (the run is under way), up to
+// five minutes; false if it never does.
+bool WaitForBytes(const std::string& file, std::uintmax_t bytes) {
+  for (int i = 0; i < 3000; ++i) {
+    std::error_code ec;
+    if (fs::exists(file, ec) && fs::file_size(file, ec) >= bytes) return true;
+    usleep(100'000);
+  }
+  return false;
+}
+
+// Guards a cut-short run's log passing for a whole one (issue 37: after
+// SIGTERM a valid run.mcap carried no sign of it): it is still valid and
+// complete (the independent reader's every check), and says how it ended
+// in a last /log message and its "linesim.run" metadata: interrupted, at a
+// time before the stop time.
+TEST(RunMcap, InterruptedRunIsValidAndSaysSo) {
+  const std::string check_dir = LINESIM_MCAP_CHECK_DIR;
+  const std::string dir = Fresh("mcap_interrupted");
+  // 600 s: far longer than the test waits.
+  const pid_t pid = Start("run " + kCrossLine + " --set duration_s=600 --mcap --out " + dir);
+  ASSERT_GT(pid, 0);
+  const bool running = WaitForBytes(dir + "/signals.csv", 64 * 1024);
+  kill(pid, SIGTERM);
+  int raw = 0;
+  waitpid(pid, &raw, 0);
+  ASSERT_TRUE(running) << "the run wrote no signals";
+  ASSERT_TRUE(WIFEXITED(raw));
+  EXPECT_EQ(WEXITSTATUS(raw), 130);
+  nlohmann::json expect = Expectations(kCrossLine, {"duration_s=600"});
+  expect["status"] = "interrupted";
+  std::ofstream(dir + "/expect.json") << expect.dump();
+  const Result check = Shell(std::string(LINESIM_NODE) + " " + check_dir + "/check_mcap.mjs " +
+                             dir + "/run.mcap " + dir + "/signals.csv " + dir + "/expect.json");
+  EXPECT_EQ(check.status, 0) << check.out << check.err;
+  EXPECT_NE(check.out.find("mcap check: ok"), std::string::npos) << check.out << check.err;
+  EXPECT_NE(check.out.find("(interrupted at "), std::string::npos) << check.out;
 }
 
 TEST(RunMcap, SameScenarioAndSeedSameBytes) {

@@ -4,6 +4,7 @@
 // run's recorded pose puts the robot, with a play control that advances
 // time. Real binary, real files, real browser.
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -267,6 +268,259 @@ TEST_F(Replay, ChromiumDrawsTheRobotAtItsRecordedPoseAndPlays) {
       EXPECT_NE(e["params"]["entry"].value("level", ""), "error") << e.dump();
     }
   }
+}
+
+// ---- Texts from the scenario are text, never code ------------------------
+
+// A piece of markup that, if it ever ran, would leave a trace: the global
+// linesimPwned set to `tag`, and an error on the console.
+std::string Hostile(int kind, const std::string& tag) {
+  const std::string trace = "window.linesimPwned='" + tag + "';console.error('pwned " + tag + "')";
+  switch (kind % 6) {
+    case 0:
+      return "<img src=x onerror=\"" + trace + "\"> " + tag;
+    case 1:
+      return "</script><script>" + trace + "</script> " + tag;
+    case 2:
+      return "<svg onload=\"" + trace + "\"></svg> " + tag;
+    case 3:
+      return "\"'><iframe srcdoc=\"&lt;script&gt;parent." + trace + "&lt;/script&gt;\"></iframe> " +
+             tag;
+    case 4:
+      return "<!--<script>" + trace + "</script>--> &amp; &lt;b&gt; " + tag;
+    default:
+      return "<style>body{display:none}</style><b onmouseover=\"" + trace + "\">" + tag +
+             "</b>\u2028 \xc3\xa4";
+  }
+}
+
+// A robot scenario whose every free text is hostile: its name and
+// description, the scene's surfaces, belt, obstacle, carried body and
+// terrain piece (robot, worker, unit, variable and metric names are
+// identifiers: letters, digits, _).
+struct HostileTexts {
+  std::string name = Hostile(0, "name"), description = Hostile(1, "description");
+  std::string floor = Hostile(2, "floor"), belt_surface = Hostile(3, "belt surface");
+  std::string belt = Hostile(4, "belt"), obstacle = Hostile(5, "obstacle");
+  std::string carried = Hostile(0, "carried"), terrain = Hostile(1, "terrain");
+};
+
+std::string HostileScenario(const HostileTexts& h) {
+  // JSON strings are YAML double-quoted scalars.
+  const auto q = [](const std::string& s) { return Json(s).dump(); };
+  const std::string file = ::testing::TempDir() + "hostile_" + std::to_string(getpid()) + ".yaml";
+  std::ofstream(file) << "name: " << q(h.name) << "\ndescription: " << q(h.description) << R"(
+duration_s: 0.5
+seed: 1
+master: {algorithm: gauss_seidel, step_s: 0.005}
+robot:
+  model: raw3
+  pose: {x_m: 0.0, y_m: -2.0, yaw_deg: 90}
+scene:
+  surfaces:
+    - {name: )" << q(h.floor)
+                      << R"(, friction: 0.8, texture_contrast: 0.2, illumination_lux: 500}
+    - {name: )" << q(h.belt_surface)
+                      << R"(, friction: 0.8, texture_contrast: 0.05, illumination_lux: 500}
+  floor: {min_x_m: -15.0, max_x_m: 15.0, min_y_m: -10.0, max_y_m: 10.0, surface: )"
+                      << q(h.floor) << R"(}
+  belts:
+    - {name: )" << q(h.belt)
+                      << ", surface: " << q(h.belt_surface) << R"(, center_x_m: 0.0,
+       center_y_m: 0.0, length_m: 20.0, width_m: 2.0, direction_deg: 0, speed_mps: 0.1,
+       schedule: [{time_s: 0, on: true}]}
+  obstacles:
+    - {name: )" << q(h.obstacle)
+                      << R"(, kind: cart,
+       box: {x_m: 5.0, y_m: -4.0, yaw_deg: 0, length_m: 1.2, width_m: 0.8, height_m: 1.0}}
+  carried:
+    - {name: )" << q(h.carried)
+                      << ", belt: " << q(h.belt) << R"(,
+       box: {x_m: 6.0, y_m: 0.0, yaw_deg: 0, length_m: 4.6, width_m: 1.8, height_m: 1.2, bottom_m: 0.3},
+       skids: {width_m: 0.1, gauge_m: 1.2}}
+  terrain:
+    - {name: )" << q(h.terrain)
+                      << R"(, center_m: [8.0, -6.0, 0.05], size_m: [2.0, 1.0, 0.1],
+       surface: )" << q(h.floor)
+                      << R"(}
+control: {compensation: true, period_s: 0.02}
+task: {type: path, waypoints: [[0.0, -2.0], [0.0, 2.0]], speed_mps: 0.3}
+sensors: {default: true}
+sensing: {surface_velocity: ground_truth}
+localization: {source: ground_truth}
+)";
+  return file;
+}
+
+// A page in Debian's headless chromium, at 1400 x 900, from the disk.
+std::string OpenPage(linesim::replay_test::DevToolsPipe& browser, const fs::path& page) {
+  const std::string s = browser.OpenPage();
+  browser.Call("Runtime.enable", {}, s);
+  browser.Call("Log.enable", {}, s);
+  browser.Call("Page.enable", {}, s);
+  browser.Call("Emulation.setDeviceMetricsOverride",
+               {{"width", 1400}, {"height", 900}, {"deviceScaleFactor", 1}, {"mobile", false}}, s);
+  browser.Call("Page.navigate", {{"url", "file://" + fs::absolute(page).string()}}, s);
+  browser.WaitFor("Page.loadEventFired", s);
+  return s;
+}
+
+// Every console message, exception and log entry so far (the policy's
+// refusals are log entries of level error).
+std::vector<std::string> Complaints(const linesim::replay_test::DevToolsPipe& browser) {
+  std::vector<std::string> out;
+  for (const auto& e : browser.events()) {
+    const std::string method = e.value("method", "");
+    if (method == "Runtime.exceptionThrown" || method == "Runtime.consoleAPICalled" ||
+        (method == "Log.entryAdded" && e["params"]["entry"].value("level", "") == "error")) {
+      out.push_back(e.dump());
+    }
+  }
+  return out;
+}
+
+// Guards against a page that runs a scenario's text as code (issue 37: the
+// legend was built with innerHTML, and a surface named <img src=x
+// onerror=...> ran its handler in Chromium): every text the page shows is
+// a text node, the canvas's text or an attribute set as text; no handler
+// of any of them runs, nothing of them becomes an element, and each is
+// shown as written.
+TEST(ReplayHostileTexts, AreShownAsTextAndNothingOfThemRuns) {
+  ASSERT_TRUE(fs::exists(kChromium)) << kChromium << " is missing: run tools/setup.sh";
+  const HostileTexts h;
+  const std::string out = Fresh("replay_hostile");
+  const auto [status, err] = Linesim("run " + HostileScenario(h) + " --out " + out);
+  ASSERT_EQ(status, 0) << err;
+  const fs::path page = fs::path(out) / "replay.html";
+  const std::string html = ReadFile(page);
+  // In the file: the texts only as JSON strings, their '<' escaped.
+  for (const std::string* text : {&h.name, &h.description, &h.floor, &h.belt, &h.obstacle}) {
+    EXPECT_EQ(html.find(*text), std::string::npos) << *text;
+  }
+
+  linesim::replay_test::DevToolsPipe browser(kChromium, Fresh("replay_hostile_profile"));
+  const std::string s = OpenPage(browser, page);
+  ASSERT_TRUE(browser.Evaluate(s, "typeof window.linesimReplay === 'object'").get<bool>())
+      << "the page's own script did not run (its policy's hash?)";
+  // The canvas's texts, recorded while the page draws again at 0.3 s.
+  browser.Evaluate(s,
+                   "window.drawn = []; const fill = CanvasRenderingContext2D.prototype.fillText;"
+                   " CanvasRenderingContext2D.prototype.fillText = function (t, ...rest) {"
+                   " window.drawn.push(String(t)); return fill.call(this, t, ...rest); };"
+                   " linesimReplay.setTime(0.3); 0");
+  const Json shown =
+      browser.Evaluate(s,
+                       "({ pwned: typeof window.linesimPwned, title: document.title,"
+                       " heading: document.getElementById('title').textContent,"
+                       " tooltip: document.getElementById('title').title,"
+                       " legend: document.getElementById('legend').textContent,"
+                       " elements: document.querySelectorAll('img, svg, iframe, b').length,"
+                       " styles: document.querySelectorAll('style').length,"
+                       " scripts: document.querySelectorAll('script').length,"
+                       " drawn: window.drawn, data: linesimReplay.data })");
+  EXPECT_EQ(shown["pwned"], "undefined");
+  EXPECT_EQ(shown["title"], "linesim replay: " + h.name);
+  EXPECT_EQ(shown["heading"], "linesim replay: " + h.name);
+  EXPECT_EQ(shown["tooltip"], h.description);
+  const std::string legend = shown["legend"].get<std::string>();
+  EXPECT_NE(legend.find(h.floor), std::string::npos) << legend;
+  EXPECT_NE(legend.find(h.belt_surface), std::string::npos) << legend;
+  EXPECT_EQ(shown["elements"], 0);
+  EXPECT_EQ(shown["styles"], 1);   // the page's own
+  EXPECT_EQ(shown["scripts"], 2);  // its data and its code
+  bool belt_drawn = false;
+  for (const auto& t : shown["drawn"]) belt_drawn |= t.get<std::string>().starts_with(h.belt);
+  EXPECT_TRUE(belt_drawn) << shown["drawn"].dump();
+  // The texts the page keeps without showing them, as written.
+  const Json& d = shown["data"];
+  EXPECT_EQ(d["obstacles"][0]["name"], h.obstacle);
+  EXPECT_EQ(d["carried"][0]["name"], h.carried);
+  EXPECT_EQ(d["terrain"][0]["name"], h.terrain);
+  EXPECT_EQ(d["belts"][0]["name"], h.belt);
+  // Nothing on the console: no handler's error, no refusal of the policy
+  // (nothing tried to run), no exception.
+  EXPECT_TRUE(Complaints(browser).empty()) << Complaints(browser).front();
+
+  // The policy stands behind it: markup put in by a script later (as the
+  // old legend did) gets no handler run; the browser reports the refusal.
+  const Json probe = browser.Evaluate(
+      s,
+      "new Promise((done) => { let refused = 0;"
+      " document.addEventListener('securitypolicyviolation', () => { refused++; });"
+      " document.body.insertAdjacentHTML('beforeend',"
+      " '<img src=\"x\" onerror=\"window.policyProbe = 1\"><div onclick=\"window.policyProbe = 2\"'"
+      " + ' id=\"probe\"></div>');"
+      " document.getElementById('probe').click();"
+      " setTimeout(() => done({ ran: typeof window.policyProbe, refused }), 500); })");
+  EXPECT_EQ(probe["ran"], "undefined");
+  EXPECT_GE(probe["refused"].get<int>(), 1);
+}
+
+// ---- A run cut short says so ---------------------------------------------
+
+// Guards a replay of a cut-short run passing for a whole one (issue 37:
+// after SIGTERM replay.html carried no sign of it): its data say
+// interrupted, at the time reached of the time meant, and the page says so
+// above everything, in words.
+TEST(ReplayInterrupted, ThePageSaysTheRunWasCutShort) {
+  ASSERT_TRUE(fs::exists(kChromium)) << kChromium << " is missing: run tools/setup.sh";
+  const std::string out = Fresh("replay_interrupted");
+  const std::string base = ::testing::TempDir() + "replay_bg_" + std::to_string(getpid());
+  // 600 s: far longer than the test waits.
+  const std::string command = "exec " + std::string(LINESIM_CLI) + " run " + kCrossLine +
+                              " --set duration_s=600 --out " + out + " >" + base + ".out 2>" +
+                              base + ".err";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  ASSERT_GT(pid, 0);
+  // Under way once signals.csv holds some rows (up to five minutes).
+  bool running = false;
+  for (int i = 0; i < 3000 && !running; ++i) {
+    std::error_code ec;
+    running = fs::file_size(fs::path(out) / "signals.csv", ec) >= 64 * 1024 && !ec;
+    if (!running) usleep(100'000);
+  }
+  kill(pid, SIGTERM);
+  int raw = 0;
+  waitpid(pid, &raw, 0);
+  ASSERT_TRUE(running) << "the run wrote no signals";
+  ASSERT_TRUE(WIFEXITED(raw));
+  EXPECT_EQ(WEXITSTATUS(raw), 130);
+
+  const fs::path page = fs::path(out) / "replay.html";
+  const Json d = PageData(ReadFile(page));
+  ASSERT_TRUE(d.is_object());
+  EXPECT_EQ(d["outcome"]["status"], "interrupted");
+  EXPECT_EQ(d["outcome"]["stop_s"], 600);
+  const double end = d["outcome"]["end_s"].get<double>();
+  EXPECT_GT(end, 0.0);
+  EXPECT_LT(end, 600.0);
+  EXPECT_NEAR(end, d["t"].back().get<double>(), 0.02 + 1e-9);  // the last frame, 20 ms apart
+  EXPECT_NE(d["outcome"]["message"].get<std::string>().find("SIGTERM"), std::string::npos);
+
+  linesim::replay_test::DevToolsPipe browser(kChromium, Fresh("replay_interrupted_profile"));
+  const std::string s = OpenPage(browser, page);
+  const Json banner = browser.Evaluate(
+      s,
+      "({ text: document.getElementById('outcome').textContent,"
+      " shown: getComputedStyle(document.getElementById('outcome')).display !== 'none' })");
+  EXPECT_TRUE(banner["shown"].get<bool>());
+  EXPECT_EQ(banner["text"].get<std::string>().rfind("INTERRUPTED at ", 0), 0u) << banner.dump();
+  EXPECT_NE(banner["text"].get<std::string>().find("of 600 s"), std::string::npos) << banner.dump();
+  EXPECT_TRUE(Complaints(browser).empty()) << Complaints(browser).front();
+}
+
+// Guards the other side: a run that reached its end says ok, at its stop
+// time, with nothing to explain (the page shows no banner for it).
+TEST_F(Replay, AWholeRunSaysItEndedOk) {
+  const Json d = PageData(ReadFile(Out() / "replay.html"));
+  EXPECT_EQ(d["outcome"]["status"], "ok");
+  EXPECT_EQ(d["outcome"]["end_s"], 20);
+  EXPECT_EQ(d["outcome"]["stop_s"], 20);
+  EXPECT_EQ(d["outcome"]["message"], "");
 }
 
 }  // namespace
