@@ -585,12 +585,39 @@ def test_ctrl_c_stops_runs(tmp_path, what):
          str(tmp_path / "out")],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
         env=dict(os.environ, PYTHONPATH=os.path.dirname(os.path.dirname(linesim.__file__))))
-    assert process.stdout.readline().strip() == "started"
-    time.sleep(2)  # into the run: the scenario loads in well under a second
-    process.send_signal(signal.SIGINT)
-    out, err = process.communicate(timeout=300)
+    try:
+        assert process.stdout.readline().strip() == "started"
+        time.sleep(2)  # into the run: the scenario loads in well under a second
+        process.send_signal(signal.SIGINT)
+        out, err = process.communicate(timeout=300)
+    finally:
+        process.kill()  # a run that ignored the signal is not left behind
     assert process.returncode == 0, err
     assert out.strip() == "KeyboardInterrupt", out + err
     if what == "run":
         with open(tmp_path / "out" / "summary.json") as f:
             assert json.load(f)["status"] == "interrupted"
+
+
+# Guards `pip install .` in a fresh clone on a machine without the build's
+# Debian packages: before compiling anything the backend names the missing
+# packages and the apt-get line (a dpkg-query that says libode-dev is not
+# installed stands in for such a machine), and configures nothing.
+def test_backend_names_missing_packages_before_compiling(tmp_path, monkeypatch):
+    fake = tmp_path / "bin"
+    fake.mkdir()
+    (fake / "dpkg-query").write_text(
+        "#!/bin/sh\nfor a; do last=$a; done\n"
+        "[ \"$last\" = libode-dev ] && exit 1\necho 'install ok installed'\n")
+    (fake / "dpkg-query").chmod(0o755)
+    monkeypatch.setenv("PATH", str(fake) + os.pathsep + os.environ["PATH"])
+    monkeypatch.setenv("LINESIM_BUILD_DIR", str(tmp_path / "fresh"))
+    sys.path.insert(0, os.path.join(SOURCE, "python"))
+    try:
+        import build_backend
+    finally:
+        sys.path.pop(0)
+    with pytest.raises(RuntimeError) as e:
+        build_backend.build_wheel(str(tmp_path))
+    assert "libode-dev" in str(e.value) and "apt-get install libode-dev" in str(e.value)
+    assert not (tmp_path / "fresh").exists()
