@@ -292,6 +292,10 @@ def _text(value: object) -> str:
     # A --set value: YAML text. JSON is YAML, so lists and maps go as JSON.
     if isinstance(value, bool):
         return "true" if value else "false"
+    if isinstance(value, float) and value != value:
+        return ".nan"
+    if isinstance(value, float) and value in (float("inf"), float("-inf")):
+        return ".inf" if value > 0 else "-.inf"  # as YAML writes them (and the dicts go)
     if isinstance(value, (int, float)):
         return repr(value)
     if isinstance(value, str):

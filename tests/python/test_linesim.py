@@ -460,6 +460,11 @@ def test_dict_scenarios_are_refused_at_their_keys():
                       progress=False)
     assert e.value.key == "repeats"
     assert temp_leftovers() == before
+    # An infinite number goes as YAML writes it, in `set` as in a dict: the
+    # loader reads a number and says what is wrong with it.
+    with pytest.raises(linesim.ScenarioError) as e:
+        linesim.run(scenario("cross_line.yaml"), set={"task.speed_mps": float("inf")})
+    assert "out of range" in str(e.value) and "expected a number, got" not in str(e.value)
 
 
 # Guards typed results: counts are ints (collisions: the final value of an
