@@ -12,7 +12,11 @@ table. Each block below is a notebook cell."""
 import os
 import subprocess
 import sys
+from typing import Dict, List, Tuple
 
+# From the repository (the package beside this folder, its native part in
+# build/), or installed (share/linesim/examples: the package is on Python's
+# path, the scenarios beside this folder).
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 import linesim  # noqa: E402
 
@@ -23,15 +27,21 @@ here = os.path.dirname(os.path.abspath(__file__))
 table = linesim.sweep(os.path.join(here, "..", "scenarios", "sweeps",
                                    "belt_speed_compensation.yaml"), jobs=2)
 
-# %% The mean over the repeats, per belt speed and compensation.
+# %% The mean over the repeats, per belt speed (a float column) and
+# compensation (a bool column).
 speed, compensation = table["line.belts.0.speed_mps"], table["control.compensation"]
 deviation = table["max_path_deviation_m"]
-points = {}
+points: Dict[Tuple[float, bool], List[float]] = {}
 for s, c, d in zip(speed, compensation, deviation):
-    points.setdefault((float(s), str(c)), []).append(float(d))
+    points.setdefault((float(s), bool(c)), []).append(float(d))
+
+
+def mean(values: List[float]) -> float:
+    return sum(values) / len(values)
+
+
 speeds = sorted({s for s, _ in points})
-rows = [(s, sum(points[(s, "true")]) / len(points[(s, "true")]),
-         sum(points[(s, "false")]) / len(points[(s, "false")])) for s in speeds]
+rows = [(s, mean(points[(s, True)]), mean(points[(s, False)])) for s in speeds]
 csv_path = os.path.join(out, "sweep_belt_speed.csv")
 with open(csv_path, "w") as f:
     f.write("belt_speed_mps,max_deviation_compensated_m,max_deviation_nominal_m\n")

@@ -21,6 +21,7 @@
 #include "loader/overrides.h"
 #include "loader/scenario.h"
 #include "loader/yaml_files.h"
+#include "models/models_dir.h"
 
 namespace linesim::fmu_export {
 
@@ -111,7 +112,11 @@ void AddBuffer(zip_t* zip, const std::string& name, const std::string& text) {
 
 }  // namespace
 
-std::string RuntimeLibraryPath() { return LINESIM_FMU_RUNTIME; }
+std::string RuntimeLibraryPath() {
+  // An installed linesim's (lib/linesim/ beside bin/), else the build tree's.
+  const std::string installed = models::InstalledPath(LINESIM_FMU_RUNTIME_FROM_BINDIR);
+  return installed.empty() ? std::string(LINESIM_FMU_RUNTIME) : installed;
+}
 
 ExportResult ExportFmu(const ExportOptions& o) {
   const config::UnitType* type = config::FindUnitType(o.type);

@@ -50,8 +50,9 @@ struct ExportResult {
 /// 2.0 cannot carry, a missing runtime library, a file that cannot be written.
 ExportResult ExportFmu(const ExportOptions& options);
 
-/// The runtime library this build made (next to the linesim binary in the
-/// build tree).
+/// The runtime library to ship: an installed linesim's (lib/linesim/ of
+/// its prefix), else the one this build made (next to the linesim binary in
+/// the build tree).
 std::string RuntimeLibraryPath();
 
 /// The resource files inside an FMU, relative to its resources folder.

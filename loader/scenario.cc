@@ -501,23 +501,13 @@ static void ReplaceUnitTypes(SystemSpec& spec, const std::map<std::string, std::
   }
 }
 
-Scenario LoadScenario(const std::string& file, const std::vector<std::string>& set_args,
-                      const std::map<std::string, std::string>& unit_types) {
-  // Refused before anything is read or written (no --out folder).
-  if (!IsUtf8(file)) {
-    Issue issue;
-    issue.file = Escaped(file);
-    issue.message =
-        "the scenario file's path is not valid UTF-8 (summary.json and the results name it): "
-        "expected a UTF-8 path; rename the file";
-    throw ScenarioError({issue});
-  }
-  Scenario s;
-  s.file = file;
+static std::vector<Issue> ParseOverrides(const std::vector<std::string>& set_args,
+                                         const std::string& file,
+                                         std::vector<Override>& overrides) {
   std::vector<Issue> issues;
   for (const auto& arg : set_args) {
     try {
-      s.overrides.push_back(ParseOverride(arg));
+      overrides.push_back(ParseOverride(arg));
     } catch (const ScenarioError& e) {
       for (auto i : e.issues()) {
         i.file = file;
@@ -525,7 +515,17 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
       }
     }
   }
-  YAML::Node tree = LoadYamlOrThrow(file);
+  return issues;
+}
+
+// The scenario `tree` (of `file`, as messages name it) with the overrides,
+// checked and built.
+static Scenario BuildScenario(YAML::Node tree, const std::string& file,
+                              std::vector<Override> overrides, std::vector<Issue> issues,
+                              const std::map<std::string, std::string>& unit_types) {
+  Scenario s;
+  s.file = file;
+  s.overrides = std::move(overrides);
   RefuseOverridesThroughAliases(tree, s.overrides, file, issues);
   ExposeSceneModelToOverrides(tree, s.overrides, file);
   ApplyOverrides(tree, s.overrides, file, issues);
@@ -585,6 +585,32 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
   return s;
 }
 
+Scenario LoadScenario(const std::string& file, const std::vector<std::string>& set_args,
+                      const std::map<std::string, std::string>& unit_types) {
+  // Refused before anything is read or written (no --out folder).
+  if (!IsUtf8(file)) {
+    Issue issue;
+    issue.file = Escaped(file);
+    issue.message =
+        "the scenario file's path is not valid UTF-8 (summary.json and the results name it): "
+        "expected a UTF-8 path; rename the file";
+    throw ScenarioError({issue});
+  }
+  // The overrides' own problems are found before the file is read.
+  std::vector<Override> overrides;
+  std::vector<Issue> issues = ParseOverrides(set_args, file, overrides);
+  YAML::Node tree = LoadYamlOrThrow(file);
+  return BuildScenario(tree, file, std::move(overrides), std::move(issues), unit_types);
+}
+
+Scenario LoadScenarioTree(YAML::Node tree, const std::string& label,
+                          const std::vector<std::string>& set_args,
+                          const std::map<std::string, std::string>& unit_types) {
+  std::vector<Override> overrides;
+  std::vector<Issue> issues = ParseOverrides(set_args, label, overrides);
+  return BuildScenario(tree, label, std::move(overrides), std::move(issues), unit_types);
+}
+
 cosim::TimeNs ReadMasterStep(YamlReader& r, const YAML::Node& master) {
   return r.Time(master, "master", "step_s", 0.001, {0.0, 10.0, true});
 }
@@ -597,19 +623,18 @@ cosim::RetryOptions ReadMasterRetry(YamlReader& r, const YAML::Node& master,
   r.CheckKeys(node, "master.retry", {"enabled", "min_step_s", "shrink", "grow"});
   const std::string path = "master.retry";
   retry.enabled = r.Boolean(node, path, "enabled", false);
-  retry.min_step = r.Time(node, path, "min_step_s", cosim::NsToSeconds(retry.min_step),
-                          {0.0, 10.0, true});
+  retry.min_step =
+      r.Time(node, path, "min_step_s", cosim::NsToSeconds(retry.min_step), {0.0, 10.0, true});
   retry.shrink = r.Real(node, path, "shrink", retry.shrink, {0.0, 1.0, true});
   retry.grow = r.Real(node, path, "grow", retry.grow, {1.0, 1e6});
   if (retry.shrink >= 1.0) {
     r.Error(Child(node, "shrink"), path + ".shrink",
-            "must be below 1 (a retried step is smaller), got " +
-                cosim::FormatValue(retry.shrink));
+            "must be below 1 (a retried step is smaller), got " + cosim::FormatValue(retry.shrink));
   }
   if (base_step > 0 && retry.min_step > base_step) {
     r.Error(Child(node, "min_step_s"), path + ".min_step_s",
-            "min_step_s " + cosim::FormatSeconds(retry.min_step) +
-                " s is above the master step " + cosim::FormatSeconds(base_step) + " s");
+            "min_step_s " + cosim::FormatSeconds(retry.min_step) + " s is above the master step " +
+                cosim::FormatSeconds(base_step) + " s");
   }
   return retry;
 }

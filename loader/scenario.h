@@ -66,6 +66,14 @@ Scenario LoadScenario(const std::string& file, const std::vector<std::string>& s
 Scenario LoadScenario(const std::string& file, const std::vector<std::string>& set_args,
                       const std::map<std::string, std::string>& unit_types);
 
+/// A scenario given as data rather than as a file (the Python package's
+/// dicts): `tree` is what the file would hold, `label` names it where a
+/// file's path would be ("<dict>": issues then carry the key path and no
+/// line), and a relative path in it is relative to the current folder.
+Scenario LoadScenarioTree(YAML::Node tree, const std::string& label,
+                          const std::vector<std::string>& set_args = {},
+                          const std::map<std::string, std::string>& unit_types = {});
+
 /// `master.step_s` of the map `master` as every loader reads it: within
 /// (0, 10] s, 1 ms when absent. A bad value is reported through `r` and
 /// reads as 1 ms.

@@ -1,15 +1,17 @@
 // linesim's Python face (the `linesim` package's native part, _linesim): a
 // run session in the Python process. The package's Python code
 // (linesim/__init__.py) shapes what this returns into Result objects and
-// exceptions.
+// exceptions; linesim/_linesim.pyi declares these functions' types.
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <atomic>
-#include <deque>
+#include <chrono>
+#include <exception>
 #include <map>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "config/scenario_error.h"
@@ -17,7 +19,10 @@
 #include "cosim/run_error_json.h"
 #include "cosim/variable_rows.h"
 #include "loader/scenario.h"
+#include "platform/build_info.h"
 #include "platform/platform.h"
+#include "python/python_unit.h"
+#include "python/python_values.h"
 #include "session/run_folder.h"
 #include "session/session.h"
 #include "sweep/executor.h"
@@ -39,6 +44,14 @@ py::dict IssueDict(const config::Issue& i) {
   return d;
 }
 
+py::dict Refused(const std::vector<config::Issue>& issues) {
+  py::list list;
+  for (const auto& i : issues) list.append(IssueDict(i));
+  py::dict out;
+  out["issues"] = list;
+  return out;
+}
+
 py::dict RunErrorDict(const cosim::RunError& e) {
   py::dict d;
   d["unit"] = e.unit;
@@ -51,258 +64,47 @@ py::dict RunErrorDict(const cosim::RunError& e) {
   return d;
 }
 
-// A unit written in Python: a class with `inputs`, `outputs` and
-// `parameters` (dicts of name -> (unit of measure, size or default)), and
-// `setup(self)`, `do_step(self, t, dt)` (seconds); the variables are the
-// object's attributes (a float, or a list for size > 1). Each call takes
-// the GIL for its duration only: native units step without it.
-class PythonUnit : public cosim::Unit {
- public:
-  PythonUnit(const std::string& type, const std::string& name, PyObject* cls)
-      : cosim::Unit(type, name) {
-    py::gil_scoped_acquire gil;
-    try {
-      Declare(cls);
-    } catch (const std::exception& e) {
-      // Said and let go while the GIL is held: a Python error's objects
-      // and the instance must not outlive it.
-      const std::string what = e.what();
-      object_ = py::object();
-      throw std::runtime_error("the Python class " + type + " cannot be used: " + what);
+// A scenario as the caller gave it: a file's path, or a dict of the files'
+// schema (its YAML tree, built here while the GIL is held).
+struct ScenarioSource {
+  std::string file;  // the path, or kDictLabel
+  std::optional<YAML::Node> tree;
+  std::vector<config::Issue> issues;  // a dict that is not a scenario's data
+
+  explicit ScenarioSource(py::handle given) {
+    if (py::isinstance<py::dict>(given)) {
+      file = kDictLabel;
+      tree = TreeFromPython(given, issues);
+    } else {
+      file = given.cast<std::string>();
     }
   }
-
-  ~PythonUnit() override {
-    py::gil_scoped_acquire gil;
-    object_ = py::object();
+  // Called without the GIL.
+  loader::Scenario Load(const std::vector<std::string>& set,
+                        const std::map<std::string, std::string>& unit_types = {}) const {
+    if (!issues.empty()) throw config::ScenarioError(issues);
+    return tree ? loader::LoadScenarioTree(*tree, file, set, unit_types)
+                : loader::LoadScenario(file, set, unit_types);
   }
-
-  void Setup(cosim::TimeNs, cosim::TimeNs) override {
-    WithPython([&] {
-      // Every declared variable is an attribute from the start (outputs at
-      // their start value, 0).
-      Give(parameters_);
-      Give(inputs_);
-      Give(outputs_);
-      Call("setup");
-    });
-  }
-
-  void Initialize() override {
-    WithPython([&] {
-      Give(inputs_);
-      Call("initialize");
-      Take();
-    });
-  }
-
-  cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override {
-    ClearError();
-    py::gil_scoped_acquire gil;
-    try {
-      Give(inputs_);
-      if (py::hasattr(object_, "do_step")) {
-        object_.attr("do_step")(cosim::NsToSeconds(t), cosim::NsToSeconds(dt));
-      }
-      Take();
-    } catch (const std::exception& e) {
-      return Fail(std::string("the Python unit raised: ") + e.what());
-    }
-    return cosim::StepResult::kOk;
-  }
-
- private:
-  struct Slot {
-    std::string name;
-    bool array;
-    double value;
-    std::vector<double> values;
-  };
-
-  // The instance and its declared variables, bound into the table.
-  void Declare(PyObject* cls) {
-    object_ = py::reinterpret_borrow<py::object>(cls)();
-    const auto declared = [&](const char* what) {
-      return py::hasattr(object_, what) ? py::dict(object_.attr(what)) : py::dict();
-    };
-    const auto declare = [&](const char* what, auto&& bind) {
-      for (const auto& [key, spec] : declared(what)) {
-        const std::string var = py::str(key);
-        if (!py::isinstance<py::tuple>(spec) || py::len(spec) != 2 ||
-            !py::isinstance<py::str>(py::reinterpret_borrow<py::tuple>(spec)[0])) {
-          throw std::invalid_argument(std::string(what) + "['" + var + "'] must be (unit, " +
-                                      (std::string(what) == "parameters" ? "default" : "size") +
-                                      "), got " + std::string(py::repr(spec)));
-        }
-        const py::tuple t = py::reinterpret_borrow<py::tuple>(spec);
-        bind(var, py::str(t[0]).cast<std::string>(), t[1]);
-      }
-    };
-    // Inputs and outputs: (unit, size); parameters: (unit, default).
-    const auto size_of = [](const std::string& var, py::handle size) {
-      const auto n = size.cast<std::int64_t>();
-      if (n < 1) throw std::invalid_argument("'" + var + "' must have a size of at least 1");
-      return static_cast<std::size_t>(n);
-    };
-    declare("inputs", [&](const std::string& var, const std::string& unit, py::handle size) {
-      const std::size_t n = size_of(var, size);
-      Slot& slot = slots_.emplace_back(Slot{var, n > 1, 0.0, std::vector<double>(n, 0.0)});
-      if (slot.array) {
-        variables().Input(var, unit, &slot.values, "Python input");
-      } else {
-        variables().Input(var, unit, &slot.value, "Python input");
-      }
-      inputs_.push_back(&slot);
-    });
-    declare("outputs", [&](const std::string& var, const std::string& unit, py::handle size) {
-      const std::size_t n = size_of(var, size);
-      Slot& slot = slots_.emplace_back(Slot{var, n > 1, 0.0, std::vector<double>(n, 0.0)});
-      if (slot.array) {
-        variables().Output(var, unit, &slot.values, "Python output", {});
-      } else {
-        variables().Output(var, unit, &slot.value, "Python output", {});
-      }
-      outputs_.push_back(&slot);
-    });
-    declare("parameters", [&](const std::string& var, const std::string& unit, py::handle value) {
-      Slot slot{var, py::isinstance<py::sequence>(value), 0.0, {}};
-      if (slot.array) {
-        slot.values = value.cast<std::vector<double>>();
-      } else {
-        slot.value = value.cast<double>();
-      }
-      Slot& kept = slots_.emplace_back(std::move(slot));
-      if (kept.array) {
-        variables().Parameter(var, unit, &kept.values, "Python parameter");
-      } else {
-        variables().Parameter(var, unit, &kept.value, "Python parameter");
-      }
-      parameters_.push_back(&kept);
-    });
-  }
-
-  void Give(const std::vector<Slot*>& slots) {
-    for (const Slot* s : slots) {
-      if (s->array) {
-        object_.attr(s->name.c_str()) = py::cast(s->values);
-      } else {
-        object_.attr(s->name.c_str()) = s->value;
-      }
-    }
-  }
-  void Take() {
-    for (Slot* s : outputs_) {
-      const py::object v = object_.attr(s->name.c_str());
-      if (s->array) {
-        const auto values = v.cast<std::vector<double>>();
-        if (values.size() != s->values.size()) {
-          throw cosim::UnitError("output '" + s->name + "' has " + std::to_string(values.size()) +
-                                     " values, declared " + std::to_string(s->values.size()),
-                                 s->name);
-        }
-        s->values = values;
-      } else {
-        s->value = v.cast<double>();
-      }
-    }
-  }
-  void Call(const char* method) {
-    if (py::hasattr(object_, method)) object_.attr(method)();
-  }
-  // Runs `f` holding the GIL; what it raises becomes the unit's error,
-  // said while the GIL is still held.
-  template <typename F>
-  void WithPython(F&& f) {
-    py::gil_scoped_acquire gil;
-    try {
-      f();
-    } catch (const cosim::UnitError&) {
-      throw;
-    } catch (const std::exception& e) {
-      throw cosim::UnitError(std::string("the Python unit raised: ") + e.what());
-    }
-  }
-
-  py::object object_;
-  std::deque<Slot> slots_;  // stable addresses: the variable table points into them
-  std::vector<Slot*> inputs_, outputs_, parameters_;
 };
 
-// Registers the class `cls` as unit type `type` (once per type name).
-void RegisterPythonUnit(const std::string& type, py::object cls) {
-  if (config::FindUnitType(type) != nullptr) {
-    throw py::value_error("a unit type '" + type + "' is registered already");
+// The run's metrics, each in its type (MetricKind).
+py::dict TypedMetrics(const std::vector<cosim::MetricSpec>& specs,
+                      const std::vector<std::pair<std::string, double>>& values) {
+  std::map<std::string, std::string> kinds;
+  for (const auto& m : specs) kinds[m.name] = MetricKind(m);
+  py::dict metrics;
+  for (const auto& [name, value] : values) {
+    const auto kind = kinds.find(name);
+    metrics[py::str(name)] = TypedMetric(kind == kinds.end() ? "float" : kind->second, value);
   }
-  // The registry lives until the process ends, after the interpreter: the
-  // class is kept for good (never released).
-  PyObject* kept = cls.release().ptr();
-  config::UnitType t;
-  t.name = type;
-  t.description = "a unit written in Python (" + std::string(py::str(py::handle(kept))) + ")";
-  t.create = [type, kept](const config::UnitBuildContext& c) -> std::unique_ptr<cosim::Unit> {
-    return std::make_unique<PythonUnit>(type, c.name, kept);
-  };
-  config::RegisterUnitType(std::move(t));
+  return metrics;
 }
 
-// One run: {"issues": [...]} when the scenario is refused; else status,
-// metrics, signals (time_s and one array per recorded column), units of
-// measure, errors and summary.json's text.
-py::dict Run(const std::string& file, const std::vector<std::string>& set,
-             const std::map<std::string, std::string>& unit_types, const std::string& out_dir) {
-  std::optional<session::Session> run;
-  std::optional<config::ScenarioError> refused;
-  {
-    // No Python object is touched while the scenario loads and runs: other
-    // Python threads go on.
-    py::gil_scoped_release release;
-    try {
-      run.emplace(file, set, unit_types);
-    } catch (const config::ScenarioError& e) {
-      refused = e;
-    }
-  }
-  py::dict out;
-  if (refused) {
-    py::list issues;
-    for (const auto& i : refused->issues()) issues.append(IssueDict(i));
-    out["issues"] = issues;
-    return out;
-  }
-  const loader::Scenario& s = run->scenario();
-  session::SignalRecorder recorder(s.recorded, s.record_interval);
-  run->AddObserver(&recorder);
-  session::RunReport report;
-  if (out_dir.empty()) {
-    py::gil_scoped_release release;
-    report = run->Run();
-  } else {
-    // The command line's files too (linesim run --out), with its defaults.
-    session::FolderRun written;
-    std::string refused_output;
-    {
-      py::gil_scoped_release release;
-      try {
-        written = session::RunIntoFolder(*run, file, out_dir, session::FolderOptions{});
-      } catch (const session::OutputError& e) {
-        refused_output = e.what();
-      }
-    }
-    if (!refused_output.empty()) throw py::value_error(refused_output);
-    if (!written.summary_error.empty()) written.report.AddFailure(written.summary_error);
-    report = std::move(written.report);
-    out["warnings"] = written.warnings;
-  }
-  out["status"] = report.status();
-  py::list metrics;
-  for (const auto& [name, value] : report.metrics) metrics.append(py::make_tuple(name, value));
-  out["metrics"] = metrics;
-  py::list errors;
-  for (const auto& e : report.errors) errors.append(RunErrorDict(e));
-  out["errors"] = errors;
-
-  // Each column as the bytes of its doubles: the package makes numpy arrays
-  // of them where numpy is installed, array.array('d') otherwise.
+// The recorded signals: each column as the bytes of its doubles (the
+// package makes numpy arrays of them where numpy is installed,
+// array.array('d') otherwise), with its name and unit of measure.
+void AddSignals(const loader::Scenario& s, const session::SignalRecorder& recorder, py::dict& out) {
   const auto array = [](const std::vector<double>& v) {
     return py::bytes(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(double));
   };
@@ -320,45 +122,129 @@ py::dict Run(const std::string& file, const std::vector<std::string>& set,
   out["signal_names"] = names;
   out["signal_columns"] = columns;
   out["signal_units"] = units;
-  out["summary"] = session::Summary(s, file, report).dump();
+}
+
+// One run: {"issues": [...]} when the scenario is refused; else status,
+// metrics, signals (time_s and one array per recorded column), units of
+// measure, errors and summary.json's text. Ctrl-C (and a KeyboardInterrupt
+// or SystemExit from a unit written in Python) stops the run within a step
+// and is raised here.
+py::dict Run(const py::object& scenario, const std::vector<std::string>& set,
+             const std::map<std::string, std::string>& unit_types, const std::string& out_dir) {
+  const ScenarioSource source(scenario);
+  PythonRun python;
+  std::optional<session::Session> run;
+  std::optional<config::ScenarioError> refused;
+  {
+    // No Python object is touched while the scenario loads and runs: other
+    // Python threads go on.
+    py::gil_scoped_release release;
+    const BuildingRun building(&python);
+    try {
+      run.emplace(source.Load(set, unit_types));
+    } catch (const config::ScenarioError& e) {
+      refused = e;
+    }
+  }
+  if (python.pending) throw *python.pending;  // raised while a class was instantiated
+  if (refused) return Refused(refused->issues());
+  const loader::Scenario& s = run->scenario();
+  session::SignalRecorder recorder(s.recorded, s.record_interval);
+  run->AddObserver(&recorder);
+  SignalCheck signals(python);
+  run->AddObserver(&signals);
+  session::RunReport report;
+  py::dict out;
+  if (out_dir.empty()) {
+    py::gil_scoped_release release;
+    report = run->Run(&python.stop);
+  } else {
+    // The command line's files too (linesim run --out), with its defaults.
+    session::FolderRun written;
+    std::string refused_output;
+    {
+      py::gil_scoped_release release;
+      try {
+        written = session::RunIntoFolder(*run, source.file, out_dir, session::FolderOptions{},
+                                         &python.stop);
+      } catch (const session::OutputError& e) {
+        refused_output = e.what();
+      }
+    }
+    if (!refused_output.empty()) throw py::value_error(refused_output);
+    if (!written.summary_error.empty()) written.report.AddFailure(written.summary_error);
+    report = std::move(written.report);
+    out["warnings"] = written.warnings;
+  }
+  if (python.pending) throw *python.pending;
+  out["status"] = report.status();
+  out["metrics"] = TypedMetrics(s.metrics, report.metrics);
+  py::list errors;
+  for (const auto& e : report.errors) errors.append(RunErrorDict(e));
+  out["errors"] = errors;
+  AddSignals(s, recorder, out);
+  out["summary"] = session::Summary(s, source.file, report).dump();
   return out;
 }
 
-// Runs every run of `spec` on `jobs` threads: a table as columns (id,
-// point, sample, repeat, seed, status, each parameter, each metric, error,
-// wall_s), in run order. `progress(done, total)` is called after each run
-// (with the GIL; None: not called). Ctrl-C stops the runs not yet started
-// and raises KeyboardInterrupt.
+// Runs `ids` of `spec` on `jobs` threads while this thread checks for
+// Ctrl-C (SignalCheck): the runs stop at their next master step and the
+// KeyboardInterrupt is raised here. `progress(done, total)` is called
+// after each run (with the GIL; None: not called).
+void RunInterruptibly(const sweep::SweepSpec& spec, const std::vector<std::int64_t>& ids, int jobs,
+                      const py::object& progress, std::vector<sweep::RunSpec>& runs,
+                      std::vector<sweep::RunOutcome>& outcomes) {
+  const auto total = static_cast<std::int64_t>(ids.size());
+  PythonRun python;
+  SignalCheck signals(python);
+  std::int64_t done = 0;
+  std::exception_ptr failure;
+  std::atomic<bool> finished{false};
+  {
+    py::gil_scoped_release release;
+    std::thread worker([&] {
+      try {
+        sweep::RunOnThreads(spec, ids, jobs, python.stop,
+                            [&](const sweep::RunSpec& run, const sweep::RunOutcome& outcome) {
+                              runs[static_cast<std::size_t>(run.id)] = run;
+                              outcomes[static_cast<std::size_t>(run.id)] = outcome;
+                              ++done;
+                              if (progress.is_none()) return;
+                              py::gil_scoped_acquire gil;
+                              progress(done, total);
+                            });
+      } catch (...) {
+        failure = std::current_exception();
+      }
+      finished = true;
+    });
+    while (!finished) {
+      std::this_thread::sleep_for(SignalCheck::kSignalCheckInterval);
+      if (!python.stop) signals.CheckNow();
+    }
+    worker.join();
+  }
+  if (python.pending) throw *python.pending;
+  if (failure) std::rethrow_exception(failure);
+}
+
+// Runs every run of `spec` on `jobs` threads: a table as typed columns
+// (id, point, sample, repeat, seed, status, each parameter, each metric,
+// error, wall_s), in run order.
 py::dict RunSweep(const sweep::SweepSpec& spec, int jobs, const py::object& progress) {
   const std::int64_t total = sweep::RunCount(spec);
   std::vector<std::int64_t> ids(static_cast<std::size_t>(total));
   for (std::int64_t i = 0; i < total; ++i) ids[static_cast<std::size_t>(i)] = i;
-  std::vector<sweep::RunSpec> runs(ids.size());
-  std::vector<sweep::RunOutcome> outcomes(ids.size());
-  std::atomic<bool> stop{false};
-  bool interrupted = false;
-  std::int64_t done = 0;
+  // The metrics' types: from the base scenario with the sweep's settings.
+  std::vector<cosim::MetricSpec> metric_specs;
   {
     py::gil_scoped_release release;
-    sweep::RunOnThreads(spec, ids, jobs, stop,
-                        [&](const sweep::RunSpec& run, const sweep::RunOutcome& outcome) {
-                          runs[static_cast<std::size_t>(run.id)] = run;
-                          outcomes[static_cast<std::size_t>(run.id)] = outcome;
-                          ++done;
-                          py::gil_scoped_acquire gil;
-                          if (PyErr_CheckSignals() != 0) {
-                            PyErr_Clear();
-                            interrupted = true;
-                            stop = true;
-                            return;
-                          }
-                          if (!progress.is_none()) progress(done, total);
-                        });
+    metric_specs = loader::LoadScenario(spec.scenario, sweep::FixedOverrides(spec)).metrics;
   }
-  if (interrupted) {
-    PyErr_SetNone(PyExc_KeyboardInterrupt);
-    throw py::error_already_set();
-  }
+  std::vector<sweep::RunSpec> runs(ids.size());
+  std::vector<sweep::RunOutcome> outcomes(ids.size());
+  RunInterruptibly(spec, ids, jobs, progress, runs, outcomes);
+
   py::dict table;
   const auto column = [&](auto&& of) {
     py::list values;
@@ -375,11 +261,17 @@ py::dict RunSweep(const sweep::SweepSpec& spec, int jobs, const py::object& prog
   table["status"] = column(
       [](R, O o) { return std::string(o.status == sweep::RunStatus::kOk ? "ok" : "failed"); });
   for (std::size_t p = 0; p < spec.parameters.size(); ++p) {
-    table[py::str(spec.parameters[p].path)] =
-        column([p](R r, O) { return p < r.values.size() ? r.values[p] : std::string(); });
+    std::vector<std::string> texts;
+    for (const auto& r : runs) texts.push_back(p < r.values.size() ? r.values[p] : std::string());
+    table[py::str(spec.parameters[p].path)] = TypedParameterColumn(texts);
   }
   for (std::size_t m = 0; m < spec.metrics.size(); ++m) {
-    table[py::str(spec.metrics[m])] = column([m](R, O o) { return o.metrics[m]; });
+    std::string kind = "float";
+    for (const auto& ms : metric_specs) {
+      if (ms.name == spec.metrics[m]) kind = MetricKind(ms);
+    }
+    table[py::str(spec.metrics[m])] =
+        column([m, &kind](R, O o) { return TypedMetric(kind, o.metrics[m]); });
   }
   table["error"] = column([](R, O o) { return o.error; });
   table["wall_s"] = column([](R, O o) { return o.wall_s; });
@@ -391,11 +283,7 @@ py::object Refusing(F&& load) {
   try {
     return load();
   } catch (const config::ScenarioError& e) {
-    py::list issues;
-    for (const auto& i : e.issues()) issues.append(IssueDict(i));
-    py::dict out;
-    out["issues"] = issues;
-    return out;
+    return Refused(e.issues());
   }
 }
 
@@ -406,23 +294,32 @@ py::object Runs(const std::string& file, const std::vector<std::string>& set, st
   });
 }
 
-py::object Sweep(const std::string& file, int jobs, const py::object& progress) {
-  return Refusing(
-      [&]() -> py::object { return RunSweep(sweep::LoadSweepSpec(file), jobs, progress); });
+// A sweep file's path, or a dict with its keys.
+py::object Sweep(const py::object& given, int jobs, const py::object& progress) {
+  const ScenarioSource source(given);
+  return Refusing([&]() -> py::object {
+    if (!source.issues.empty()) throw config::ScenarioError(source.issues);
+    return RunSweep(source.tree ? sweep::LoadSweepSpecTree(*source.tree, source.file)
+                                : sweep::LoadSweepSpec(source.file),
+                    jobs, progress);
+  });
 }
 
-// A unit's variable table: one dict per variable (its start value as
-// `linesim inspect` prints it: declared, or as the scenario set it).
+// A unit's variable table: one dict per variable, its start value in its
+// type (declared, or as the scenario set it).
 py::list VariableDicts(const cosim::Unit& unit) {
   py::list rows;
-  for (const auto& v : cosim::VariableRows(unit)) {
+  const cosim::VariableTable& table = unit.variables();
+  const std::vector<cosim::VariableRow> described = cosim::VariableRows(unit);
+  for (std::size_t i = 0; i < described.size(); ++i) {
+    const cosim::VariableRow& v = described[i];
     py::dict d;
     d["name"] = v.name;
     d["causality"] = v.causality;
     d["type"] = v.type;
     d["size"] = v.size;
     d["unit"] = v.unit;
-    d["start"] = v.start;
+    d["start"] = ToPython(table.GetValue(table.infos()[i].ref));
     d["rule"] = v.rule;
     d["description"] = v.description;
     d["depends_on"] = v.depends_on;
@@ -442,12 +339,13 @@ py::list Inspect(const std::string& type) {
   return VariableDicts(*unit);
 }
 
-// The system a scenario builds: each unit with its type, step and variable
-// table, the connections, and the step order; {"issues": [...]} when the
-// scenario is refused.
-py::object InspectScenario(const std::string& file, const std::vector<std::string>& set) {
+// The system a scenario (a path or a dict) builds: each unit with its
+// type, step and variable table, the connections, and the step order;
+// {"issues": [...]} when the scenario is refused.
+py::object InspectScenario(const py::object& scenario, const std::vector<std::string>& set) {
+  const ScenarioSource source(scenario);
   return Refusing([&]() -> py::object {
-    const loader::Scenario s = loader::LoadScenario(file, set);
+    const loader::Scenario s = source.Load(set);
     const cosim::System& system = *s.system;
     py::dict units;
     for (std::size_t u = 0; u < system.unit_count(); ++u) {
@@ -477,14 +375,15 @@ py::object InspectScenario(const std::string& file, const std::vector<std::strin
 
 PYBIND11_MODULE(_linesim, m) {
   m.doc() = "linesim's native part: run sessions and the unit registry";
-  m.def("run", &linesim::python::Run, py::arg("file"), py::arg("set"), py::arg("unit_types"),
+  m.attr("__version__") = linesim::platform::build_info::kVersion;
+  m.def("run", &linesim::python::Run, py::arg("scenario"), py::arg("set"), py::arg("unit_types"),
         py::arg("out"));
   m.def("register_unit", &linesim::python::RegisterPythonUnit, py::arg("type"), py::arg("cls"));
   m.def("inspect", &linesim::python::Inspect, py::arg("type"));
-  m.def("inspect_scenario", &linesim::python::InspectScenario, py::arg("file"), py::arg("set"));
+  m.def("inspect_scenario", &linesim::python::InspectScenario, py::arg("scenario"), py::arg("set"));
   m.def("runs", &linesim::python::Runs, py::arg("file"), py::arg("set"), py::arg("n"),
         py::arg("jobs"), py::arg("progress"));
-  m.def("sweep", &linesim::python::Sweep, py::arg("file"), py::arg("jobs"), py::arg("progress"));
+  m.def("sweep", &linesim::python::Sweep, py::arg("sweep"), py::arg("jobs"), py::arg("progress"));
   m.def("unit_types", &linesim::config::UnitTypeNames);
   m.def("math_library", &linesim::platform::MathLibrary);
 }

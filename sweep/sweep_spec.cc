@@ -370,9 +370,12 @@ SweepSpec RepeatSweepSpec(const std::string& scenario, const std::vector<std::st
 }
 
 SweepSpec LoadSweepSpec(const std::string& file) {
+  return LoadSweepSpecTree(loader::LoadYamlOrThrow(file, "sweep"), file);
+}
+
+SweepSpec LoadSweepSpecTree(const YAML::Node& root, const std::string& file) {
   SweepSpec spec;
   spec.file = file;
-  const YAML::Node root = loader::LoadYamlOrThrow(file, "sweep");
   YamlReader r(file);
   if (!r.ExpectMap(root, "")) throw ScenarioError(r.issues());
   r.CheckKeys(root, "",

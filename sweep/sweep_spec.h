@@ -1,5 +1,7 @@
 #pragma once
 
+#include <yaml-cpp/yaml.h>
+
 #include <cstdint>
 #include <map>
 #include <string>
@@ -86,6 +88,10 @@ std::vector<std::string> FixedOverrides(const SweepSpec& spec);
 /// one it defines. Throws config::ScenarioError listing every problem (file,
 /// line, key path, what was expected).
 SweepSpec LoadSweepSpec(const std::string& file);
+/// The same for a sweep given as data (the Python package's dicts): `root`
+/// is what the file would hold, `label` names it in messages ("<dict>"),
+/// and a relative `scenario` is relative to the current folder.
+SweepSpec LoadSweepSpecTree(const YAML::Node& root, const std::string& label);
 
 /// The sweep `linesim run FILE --runs N` makes: the scenario as it is with
 /// `set_args` ("dotted.path=value", as --set takes them), run N times, each

@@ -5,5 +5,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+# The tests and benchmarks explicitly: a build/ that `pip install .` configured
+# has them off.
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  -DLINESIM_BUILD_TESTS=ON -DLINESIM_BUILD_BENCH=ON
 cmake --build build --parallel "$(nproc)"

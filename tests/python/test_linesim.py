@@ -4,12 +4,16 @@ exceptions carrying the same fields."""
 
 import array
 import csv
-import math
+import glob
 import json
+import math
 import os
+import re
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 import zipfile
 
 import numpy as np
@@ -256,7 +260,7 @@ def test_sweep_from_a_dict_is_its_runs():
         "parameters": [{"path": "line.belts.0.speed_mps", "values": [0.05, 0.2]}],
         "metrics": ["max_path_deviation_m"],
     }, jobs=2, progress=False))
-    assert table["line.belts.0.speed_mps"] == ["0.05", "0.2"]
+    assert table["line.belts.0.speed_mps"] == [0.05, 0.2]
     assert table["status"] == ["ok", "ok"]
     for value, seed, metric in zip(table["line.belts.0.speed_mps"], table["seed"],
                                    table["max_path_deviation_m"]):
@@ -315,11 +319,15 @@ def test_wheel_installs_and_runs(tmp_path):
         sys.path.pop(0)
     assert build_backend.get_requires_for_build_wheel() == []
     name = build_backend.build_wheel(str(tmp_path))
-    assert name.startswith("linesim-0.1.0-cp3")
+    assert name.startswith("linesim-%s-cp3" % linesim.__version__)
     site = tmp_path / "site"
     with zipfile.ZipFile(tmp_path / name) as z:
         z.extractall(site)
-        assert any(n.startswith("linesim/_linesim") for n in z.namelist())
+        names = z.namelist()
+    assert any(n.startswith("linesim/_linesim") and n.endswith(".so") for n in names)
+    # The types (PEP 561) and the models the native part reads beside itself.
+    assert "linesim/py.typed" in names and "linesim/_linesim.pyi" in names
+    assert "linesim/models/robots/raw3.yaml" in names
     check = ("import linesim, sys; r = linesim.run(sys.argv[1], duration_s=0.5); "
              "print(linesim.__file__, linesim.math_library(), r.status)")
     done = subprocess.run([sys.executable, "-c", check, scenario("cross_line.yaml")],
@@ -362,7 +370,7 @@ def test_inspect_a_scenario():
     assert system["units"]["chassis"]["type"] == "chassis"
     assert system["units"]["path_follower"]["step_s"] == 0.02
     start = {v["name"]: v["start"] for v in system["units"]["chassis"]["variables"]}
-    assert start["initial_y"] == "-2"  # cross_line.yaml: robot.pose.y_m
+    assert start["initial_y"] == -2.0  # cross_line.yaml: robot.pose.y_m
     assert ("path_follower.velocity_command", "wheel_controller.velocity_command") in \
         [tuple(c) for c in system["connections"]]
     assert system["step_order"].index("chassis") < system["step_order"].index("deviation")
@@ -405,3 +413,216 @@ def test_runs_refuses_counts_out_of_range(n, jobs):
         with pytest.raises(ValueError):
             linesim.sweep(os.path.join(SOURCE, "scenarios", "sweeps",
                                        "belt_speed_compensation.yaml"), jobs=jobs, progress=False)
+
+
+MOTOR_SYSTEM = {
+    "duration_s": 0.2,
+    "units": {
+        "supply": {"type": "step_signal",
+                   "parameters": {"unit": "V", "steps": [{"time_s": 0.0, "value": 12.0}]}},
+        "motor": {"type": "dc_motor"},
+    },
+    "connections": [{"from": "supply.value", "to": "motor.voltage"}],
+}
+
+
+def temp_leftovers():
+    return set(glob.glob(os.path.join(tempfile.gettempdir(), "linesim_*")))
+
+
+# Guards dicts passed as data (no temporary file): a refused dict is
+# reported at its key path (file "<dict>", no line), never at a deleted
+# temporary file's line 1; a value that is not data (an object, a dict that
+# contains itself: what json.dump refused after the file was made) is
+# refused at its key; and nothing is left in $TMPDIR.
+def test_dict_scenarios_are_refused_at_their_keys():
+    before = temp_leftovers()
+    bad_value = json.loads(json.dumps(MOTOR_SYSTEM))
+    bad_value["units"]["motor"]["parameters"] = {"resistance": -1.0}
+    with pytest.raises(linesim.ScenarioError) as e:
+        linesim.run(bad_value)
+    assert (e.value.file, e.value.line) == ("<dict>", 0)
+    assert e.value.key == "units.motor.parameters.resistance.0"  # Real[1]: its element
+    assert str(e.value).startswith("<dict>: units.motor.parameters.resistance.0: ")
+    not_data = json.loads(json.dumps(MOTOR_SYSTEM))
+    not_data["units"]["supply"]["parameters"]["steps"][0]["value"] = object()
+    with pytest.raises(linesim.ScenarioError) as e:
+        linesim.run(not_data)
+    assert e.value.key == "units.supply.parameters.steps.0.value"
+    assert "is not a scenario value" in str(e.value)
+    looped = json.loads(json.dumps(MOTOR_SYSTEM))
+    looped["units"]["motor"]["parameters"] = looped["units"]
+    with pytest.raises(linesim.ScenarioError) as e:
+        linesim.inspect(looped)
+    assert "contains itself" in str(e.value)
+    with pytest.raises(linesim.ScenarioError) as e:
+        linesim.sweep({"scenario": scenario("cross_line.yaml"), "repeats": object()},
+                      progress=False)
+    assert e.value.key == "repeats"
+    assert temp_leftovers() == before
+    # An infinite number goes as YAML writes it, in `set` as in a dict: the
+    # loader reads a number and says what is wrong with it.
+    with pytest.raises(linesim.ScenarioError) as e:
+        linesim.run(scenario("cross_line.yaml"), set={"task.speed_mps": float("inf")})
+    assert "out of range" in str(e.value) and "expected a number, got" not in str(e.value)
+
+
+# Guards typed results: counts are ints (collisions: the final value of an
+# Integer variable), measures floats, in a run and in a table; a sweep's
+# parameter columns are in their types (floats, bools); inspect's start
+# values are in their variables' types; the version is the project's.
+def test_values_come_in_their_types():
+    r = linesim.run(scenario("cross_line.yaml"), duration_s=0.5)
+    assert type(r.metrics["collisions"]) is int
+    assert type(r.metrics["max_path_deviation_m"]) is float
+    table = linesim.sweep({
+        "scenario": scenario("cross_line.yaml"), "set": {"duration_s": 0.5},
+        "parameters": [{"path": "line.belts.0.speed_mps", "values": [0.05, 1]},
+                       {"path": "control.compensation", "values": [True, False]},
+                       {"path": "master.algorithm", "values": ["jacobi"]}],
+        "metrics": ["collisions", "max_path_deviation_m"]}, progress=False)
+    cols = {k: list(table[k]) for k in table.keys()}
+    assert cols["line.belts.0.speed_mps"] == [0.05, 0.05, 1.0, 1.0]
+    assert cols["control.compensation"] == [True, False, True, False]
+    assert cols["master.algorithm"] == ["jacobi"] * 4
+    assert all(isinstance(v, (int, np.integer)) for v in cols["collisions"])
+    assert all(isinstance(v, (int, np.integer)) for v in cols["seed"] + cols["id"])
+    assert all(isinstance(v, (float, np.floating)) for v in cols["max_path_deviation_m"])
+    start = {v["name"]: v["start"] for v in linesim.inspect("dc_motor")}
+    types = {v["name"]: v["type"] for v in linesim.inspect("dc_motor")}
+    expected = {"Real": float, "Integer": int, "Boolean": bool, "String": str}
+    for name, value in start.items():
+        wanted = list if types[name].startswith("Real[") else expected[types[name]]
+        assert type(value) is wanted, (name, types[name], value)
+    with open(os.path.join(SOURCE, "CMakeLists.txt")) as f:
+        version = re.search(r"project\(linesim VERSION ([0-9.]+)", f.read()).group(1)
+    assert linesim.__version__ == version
+
+
+class BadName(linesim.Unit):
+    inputs = {"position": ("m", 2), "yaw": ("rad", 1)}
+    outputs = {"velocity_command": ("m/s", 2), "yaw_rate_command": ("rad/s", 1),
+               "a,b": ("1", 1)}
+
+
+# Guards a Python unit's variable names (a name "a,b" split signals.csv's
+# header into one field more than its rows): the rules of every unit's
+# variables, refused before anything runs.
+def test_python_unit_names_follow_the_variable_rules():
+    with pytest.raises(linesim.ScenarioError) as e:
+        linesim.run(scenario("cross_line.yaml"), units={"path_follower": BadName})
+    assert e.value.key == "units.path_follower"
+    assert "'a,b' is not a valid variable name" in str(e.value)
+
+
+class TextOutput(Raising):
+    def do_step(self, t, dt):
+        self.velocity_command = [0.0, 0.0]
+        self.yaw_rate_command = "fast"
+
+
+class NoneInList(Raising):
+    def do_step(self, t, dt):
+        self.velocity_command = [0.1, None]
+
+
+# Guards a Python unit's output of the wrong type: the run fails naming the
+# unit, the variable, what it got and what it takes (not pybind11's "Unable
+# to cast Python instance to C++ type").
+def test_python_unit_outputs_of_the_wrong_type_are_named():
+    with pytest.raises(linesim.RunError) as e:
+        linesim.run(scenario("cross_line.yaml"), duration_s=1, units={"path_follower": TextOutput})
+    assert (e.value.unit, e.value.variable) == ("path_follower", "yaw_rate_command")
+    assert "takes a number (rad/s), got a str: 'fast'" in e.value.cause
+    with pytest.raises(linesim.RunError) as e:
+        linesim.run(scenario("cross_line.yaml"), duration_s=1, units={"path_follower": NoneInList})
+    assert e.value.variable == "velocity_command[1]"
+    assert "takes a list of 2 numbers (m/s); velocity_command[1] is a NoneType: None" in \
+        e.value.cause
+
+
+class Interrupting(Raising):
+    def do_step(self, t, dt):
+        if t >= 0.1:
+            raise KeyboardInterrupt
+
+
+class Exiting(Raising):
+    def do_step(self, t, dt):
+        if t >= 0.1:
+            sys.exit(3)
+
+
+# Guards KeyboardInterrupt and SystemExit raised in a Python unit: they stop
+# the run and reach the caller as themselves (they became a RunError).
+def test_interrupt_and_exit_in_a_python_unit_reach_the_caller():
+    with pytest.raises(KeyboardInterrupt):
+        linesim.run(scenario("cross_line.yaml"), duration_s=5, units={"path_follower": Interrupting})
+    with pytest.raises(SystemExit) as e:
+        linesim.run(scenario("cross_line.yaml"), duration_s=5, units={"path_follower": Exiting})
+    assert e.value.code == 3
+
+
+CTRL_C = """
+import sys, linesim
+print("started", flush=True)
+try:
+    if sys.argv[1] == "run":
+        # 3000 s: what the folder's 1024 MB of signals.csv allows.
+        linesim.run(sys.argv[2], duration_s=3000, out=sys.argv[3])
+    else:
+        linesim.runs(sys.argv[2], 2, jobs=2, set={"duration_s": 100000}, progress=False)
+    print("finished")
+except KeyboardInterrupt:
+    print("KeyboardInterrupt")
+"""
+
+
+# Guards Ctrl-C during a run and during repeated runs (a run ignored it
+# until its end): a real SIGINT to the process stops the runs within a step
+# and raises KeyboardInterrupt; a run writing a folder marks its
+# summary.json interrupted. The timeout only guards against a hang (the
+# runs would take many minutes).
+@pytest.mark.parametrize("what", ["run", "runs"])
+def test_ctrl_c_stops_runs(tmp_path, what):
+    process = subprocess.Popen(
+        [sys.executable, "-c", CTRL_C, what, scenario("optic_flow_profile.yaml"),
+         str(tmp_path / "out")],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env=dict(os.environ, PYTHONPATH=os.path.dirname(os.path.dirname(linesim.__file__))))
+    try:
+        assert process.stdout.readline().strip() == "started"
+        time.sleep(2)  # into the run: the scenario loads in well under a second
+        process.send_signal(signal.SIGINT)
+        out, err = process.communicate(timeout=300)
+    finally:
+        process.kill()  # a run that ignored the signal is not left behind
+    assert process.returncode == 0, err
+    assert out.strip() == "KeyboardInterrupt", out + err
+    if what == "run":
+        with open(tmp_path / "out" / "summary.json") as f:
+            assert json.load(f)["status"] == "interrupted"
+
+
+# Guards `pip install .` in a fresh clone on a machine without the build's
+# Debian packages: before compiling anything the backend names the missing
+# packages and the apt-get line (a dpkg-query that says libode-dev is not
+# installed stands in for such a machine), and configures nothing.
+def test_backend_names_missing_packages_before_compiling(tmp_path, monkeypatch):
+    fake = tmp_path / "bin"
+    fake.mkdir()
+    (fake / "dpkg-query").write_text(
+        "#!/bin/sh\nfor a; do last=$a; done\n"
+        "[ \"$last\" = libode-dev ] && exit 1\necho 'install ok installed'\n")
+    (fake / "dpkg-query").chmod(0o755)
+    monkeypatch.setenv("PATH", str(fake) + os.pathsep + os.environ["PATH"])
+    monkeypatch.setenv("LINESIM_BUILD_DIR", str(tmp_path / "fresh"))
+    sys.path.insert(0, os.path.join(SOURCE, "python"))
+    try:
+        import build_backend
+    finally:
+        sys.path.pop(0)
+    with pytest.raises(RuntimeError) as e:
+        build_backend.build_wheel(str(tmp_path))
+    assert "libode-dev" in str(e.value) and "apt-get install libode-dev" in str(e.value)
+    assert not (tmp_path / "fresh").exists()
