@@ -22,9 +22,15 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     add("max_path_deviation_m", deviation, cosim::Reduction::kMax);
     add("final_path_deviation_m", deviation, cosim::Reduction::kFinal);
     add("final_progress_m", Signal(kDeviation, "progress"), cosim::Reduction::kFinal);
+    // Paper 1's criterion for its crossing (path_deviation.h): within 4 cm
+    // all the way, and across (not for a route: paper 2 has its own).
+    if (info.task == "path") {
+      add("crossing_success", Signal(kDeviation, "success"), cosim::Reduction::kFinal);
+    }
   } else {
     add("max_position_drift_m", deviation, cosim::Reduction::kMax);
     add("final_position_drift_m", deviation, cosim::Reduction::kFinal);
+    add("hold_success", Signal(kDeviation, "success"), cosim::Reduction::kFinal);
   }
   add("final_yaw_rad", s.true_yaw, cosim::Reduction::kFinal);
 
@@ -132,6 +138,8 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     add("surface_velocity_rmse_raw_mps", Signal(kFlowError, "rmse"), cosim::Reduction::kFinal);
     add("surface_velocity_plateau_rmse_raw_mps", Signal(kFlowError, "rmse_plateau"),
         cosim::Reduction::kFinal);
+    add("surface_velocity_on_rmse_raw_mps", Signal(kFlowError, "rmse_plateau_on"),
+        cosim::Reduction::kFinal);
     if (!s.surface_estimate.empty()) {
       // The surface estimator's filtered value per sensor, the same order.
       b.Connect(s.surface_estimate, Signal(kFlowError, "estimated"));
@@ -140,6 +148,8 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
           cosim::Reduction::kFinal);
       add("surface_velocity_plateau_rmse_filtered_mps",
           Signal(kFlowError, "rmse_plateau_estimated"), cosim::Reduction::kFinal);
+      add("surface_velocity_on_rmse_filtered_mps", Signal(kFlowError, "rmse_plateau_on_estimated"),
+          cosim::Reduction::kFinal);
       add("surface_velocity_settling_time_s", Signal(kFlowError, "settling_time"),
           cosim::Reduction::kFinal);
     }
