@@ -125,6 +125,11 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
   frame_flow_.assign(2, 0.0);
   sonar_velocity_.assign(2, 0.0);
 
+  DeclareParameters();
+  DeclareInputsAndOutputs(n_belts > 0);
+}
+
+void Px4FlowUnit::DeclareParameters() {
   using cosim::Rule;
   auto& v = variables();
   v.Parameter("mount_x", "m", &mount_x_, "sensor position along base_link x",
@@ -260,14 +265,17 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
               "the ambient light flickers (scene surface flicker_hz, flicker_depth)");
   v.Parameter("periodic_texture", &periodic_texture_,
               "the surface's periodic texture can alias (scene surface texture_period_m)");
+}
 
+void Px4FlowUnit::DeclareInputsAndOutputs(bool belts) {
+  auto& v = variables();
   v.Input("position", "m", &position_, "base_link x, y in map");
   v.Input("yaw", "rad", &yaw_, "base_link yaw in map");
   v.Input("linear_velocity", "m/s", &linear_velocity_, "base_link vx, vy in map");
   v.Input("yaw_rate", "rad/s", &yaw_rate_, "base_link yaw rate");
   v.Input("angular_velocity", "rad/s", &angular_velocity_,
           "base_link angular velocity in base_link (the board gyro)");
-  if (n_belts > 0) {
+  if (belts) {
     v.Input("belt_velocity", "m/s", &belt_velocity_,
             "surface velocity of each scene belt in map: vx, vy per belt");
   }

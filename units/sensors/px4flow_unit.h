@@ -170,6 +170,10 @@ class Px4FlowUnit : public cosim::Unit {
   void RestoreInternal(const cosim::UnitState& state) override;
 
  private:
+  /// The constructor's declarations: parameters, then inputs (the belts'
+  /// velocity with `belts`) and outputs.
+  void DeclareParameters();
+  void DeclareInputsAndOutputs(bool belts);
   void CacheCamera();
   /// TrueFlow, and the direction of the surface's length (its belt's
   /// direction, map x for the floor) in the sensor frame.
