@@ -3,6 +3,77 @@
 
 namespace linesim::loader::assembly {
 
+namespace {
+
+// Raw optic flow against the belt's ground truth (paper 1 Fig. 4), when
+// both are there.
+void AddFlowError(SystemBuilder& b, Signals& s, RobotInfo& info) {
+  std::vector<const models::SensorMount*> flows;
+  for (const auto& sensor : s.sensors) {
+    if (sensor.kind == "px4flow") flows.push_back(&sensor);
+  }
+  if (!flows.empty() && !s.belt_ground_truth.empty()) {
+    b.Unit(kFlowError, "surface_velocity_error");
+    Parameters& p = b.Params(kFlowError);
+    p["sensors"] = static_cast<int>(flows.size());
+    p["belt"] = s.belt_ground_truth_belt;
+    if (!s.surface_estimate.empty()) p["estimated"] = true;
+    std::vector<double> x, y, yaw;
+    for (std::size_t k = 0; k < flows.size(); ++k) {
+      x.push_back(flows[k]->x_m);
+      y.push_back(flows[k]->y_m);
+      yaw.push_back(flows[k]->yaw_rad);
+      for (std::size_t i = 0; i < 2; ++i) {
+        b.Connect(Element(flows[k]->name, "velocity", i),
+                  Element(kFlowError, "measured", 2 * k + i));
+      }
+    }
+    p["mount_x"] = x;
+    p["mount_y"] = y;
+    p["mount_yaw"] = yaw;
+    b.Connect(s.true_position, Signal(kFlowError, "position"));
+    b.Connect(s.true_yaw, Signal(kFlowError, "yaw"));
+    b.Connect(Signal(kChassis, "linear_velocity"), Signal(kFlowError, "linear_velocity"));
+    b.Connect(Signal(kChassis, "yaw_rate"), Signal(kFlowError, "yaw_rate"));
+    b.Connect(s.belt_ground_truth, Signal(kFlowError, "reference"));
+    s.recorded.push_back(Signal(kFlowError, "reading"));
+    s.recorded.push_back(Signal(kFlowError, "true_reading"));
+    b.Metric("surface_velocity_rmse_raw_mps", Signal(kFlowError, "rmse"), cosim::Reduction::kFinal);
+    b.Metric("surface_velocity_plateau_rmse_raw_mps", Signal(kFlowError, "rmse_plateau"),
+             cosim::Reduction::kFinal);
+    b.Metric("surface_velocity_on_rmse_raw_mps", Signal(kFlowError, "rmse_plateau_on"),
+             cosim::Reduction::kFinal);
+    if (!s.surface_estimate.empty()) {
+      // The surface estimator's filtered value per sensor, the same order.
+      b.Connect(s.surface_estimate, Signal(kFlowError, "estimated"));
+      s.recorded.push_back(Signal(kFlowError, "estimated_speed"));
+      b.Metric("surface_velocity_rmse_filtered_mps", Signal(kFlowError, "rmse_estimated"),
+               cosim::Reduction::kFinal);
+      b.Metric("surface_velocity_plateau_rmse_filtered_mps",
+               Signal(kFlowError, "rmse_plateau_estimated"), cosim::Reduction::kFinal);
+      b.Metric("surface_velocity_on_rmse_filtered_mps",
+               Signal(kFlowError, "rmse_plateau_on_estimated"), cosim::Reduction::kFinal);
+      b.Metric("surface_velocity_settling_time_s", Signal(kFlowError, "settling_time"),
+               cosim::Reduction::kFinal);
+    }
+    // The first sensor's quality (0..255, OPTICAL_FLOW_RAD's mean over its
+    // publishing interval), over the run.
+    b.Metric("optic_flow_quality_mean", Signal(flows.front()->name, "quality"),
+             cosim::Reduction::kMean);
+    for (std::size_t k = 0; k < flows.size(); ++k) {
+      info.flow_columns.push_back(Element(kFlowError, "reading", k).Name());
+      info.flow_truth_columns.push_back(Element(kFlowError, "true_reading", k).Name());
+      info.flow_sensor_names.push_back(flows[k]->name);
+      if (!s.surface_estimate.empty()) {
+        info.flow_filtered_columns.push_back(Element(kFlowError, "estimated_speed", k).Name());
+      }
+    }
+    info.flow_reference_column = s.belt_ground_truth.Name();
+  }
+}
+
+}  // namespace
+
 void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Signals& s,
                    RobotInfo& info) {
   // The deviation is measured on the ground truth, whatever the robot
@@ -22,9 +93,15 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     add("max_path_deviation_m", deviation, cosim::Reduction::kMax);
     add("final_path_deviation_m", deviation, cosim::Reduction::kFinal);
     add("final_progress_m", Signal(kDeviation, "progress"), cosim::Reduction::kFinal);
+    // Paper 1's criterion for its crossing (path_deviation.h): within 4 cm
+    // all the way, and across (not for a route: paper 2 has its own).
+    if (info.task == "path") {
+      add("crossing_success", Signal(kDeviation, "success"), cosim::Reduction::kFinal);
+    }
   } else {
     add("max_position_drift_m", deviation, cosim::Reduction::kMax);
     add("final_position_drift_m", deviation, cosim::Reduction::kFinal);
+    add("hold_success", Signal(kDeviation, "success"), cosim::Reduction::kFinal);
   }
   add("final_yaw_rad", s.true_yaw, cosim::Reduction::kFinal);
 
@@ -97,65 +174,7 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     }
   }
 
-  // Raw optic flow against the belt's ground truth (paper 1 Fig. 4), when
-  // both are there.
-  std::vector<const models::SensorMount*> flows;
-  for (const auto& sensor : s.sensors) {
-    if (sensor.kind == "px4flow") flows.push_back(&sensor);
-  }
-  if (!flows.empty() && !s.belt_ground_truth.empty()) {
-    b.Unit(kFlowError, "surface_velocity_error");
-    Parameters& p = b.Params(kFlowError);
-    p["sensors"] = static_cast<int>(flows.size());
-    p["belt"] = s.belt_ground_truth_belt;
-    if (!s.surface_estimate.empty()) p["estimated"] = true;
-    std::vector<double> x, y, yaw;
-    for (std::size_t k = 0; k < flows.size(); ++k) {
-      x.push_back(flows[k]->x_m);
-      y.push_back(flows[k]->y_m);
-      yaw.push_back(flows[k]->yaw_rad);
-      for (std::size_t i = 0; i < 2; ++i) {
-        b.Connect(Element(flows[k]->name, "velocity", i),
-                  Element(kFlowError, "measured", 2 * k + i));
-      }
-    }
-    p["mount_x"] = x;
-    p["mount_y"] = y;
-    p["mount_yaw"] = yaw;
-    b.Connect(s.true_position, Signal(kFlowError, "position"));
-    b.Connect(s.true_yaw, Signal(kFlowError, "yaw"));
-    b.Connect(Signal(kChassis, "linear_velocity"), Signal(kFlowError, "linear_velocity"));
-    b.Connect(Signal(kChassis, "yaw_rate"), Signal(kFlowError, "yaw_rate"));
-    b.Connect(s.belt_ground_truth, Signal(kFlowError, "reference"));
-    s.recorded.push_back(Signal(kFlowError, "reading"));
-    s.recorded.push_back(Signal(kFlowError, "true_reading"));
-    add("surface_velocity_rmse_raw_mps", Signal(kFlowError, "rmse"), cosim::Reduction::kFinal);
-    add("surface_velocity_plateau_rmse_raw_mps", Signal(kFlowError, "rmse_plateau"),
-        cosim::Reduction::kFinal);
-    if (!s.surface_estimate.empty()) {
-      // The surface estimator's filtered value per sensor, the same order.
-      b.Connect(s.surface_estimate, Signal(kFlowError, "estimated"));
-      s.recorded.push_back(Signal(kFlowError, "estimated_speed"));
-      add("surface_velocity_rmse_filtered_mps", Signal(kFlowError, "rmse_estimated"),
-          cosim::Reduction::kFinal);
-      add("surface_velocity_plateau_rmse_filtered_mps",
-          Signal(kFlowError, "rmse_plateau_estimated"), cosim::Reduction::kFinal);
-      add("surface_velocity_settling_time_s", Signal(kFlowError, "settling_time"),
-          cosim::Reduction::kFinal);
-    }
-    // The first sensor's quality (0..255, OPTICAL_FLOW_RAD's mean over its
-    // publishing interval), over the run.
-    add("optic_flow_quality_mean", Signal(flows.front()->name, "quality"), cosim::Reduction::kMean);
-    for (std::size_t k = 0; k < flows.size(); ++k) {
-      info.flow_columns.push_back(Element(kFlowError, "reading", k).Name());
-      info.flow_truth_columns.push_back(Element(kFlowError, "true_reading", k).Name());
-      info.flow_sensor_names.push_back(flows[k]->name);
-      if (!s.surface_estimate.empty()) {
-        info.flow_filtered_columns.push_back(Element(kFlowError, "estimated_speed", k).Name());
-      }
-    }
-    info.flow_reference_column = s.belt_ground_truth.Name();
-  }
+  AddFlowError(b, s, info);
   info.error_column = deviation.Name();
 }
 

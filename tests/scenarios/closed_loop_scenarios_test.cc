@@ -57,10 +57,11 @@ std::string WithSensors(const std::string& name, const std::string& add, const s
 // fusion of odometry and matching against a 0.025 m grid) stays within one
 // cell of the truth all the way. The fusion is on odometry alone only before
 // the first match: one 40 ms scan and the 5 ms step, 45 ms of 20 s (0.00225).
-// Seeds 1..8: max_path_deviation_m 0.0042 / 0.0073 / 0.0088 (20 runs of
-// `linesim run --runs 20`: 0.0036 / 0.0070 / 0.0117); localization_error_max_m
-// 0.0094 / 0.0098 / 0.0104 (20 runs: 0.0089 / 0.0102 / 0.0113);
-// final_progress_m 3.9806 / 3.9810 / 3.9817; pose_fusion_fallback_fraction
+// Seeds 1..8 (the PX4Flow at its measured noise and px4flow_node's 40 Hz,
+// issue 36): max_path_deviation_m 0.0045 / 0.0082 / 0.0114 (20 runs of
+// `linesim run --runs 20`: 0.0055 / 0.0077 / 0.0144); localization_error_max_m
+// 0.0087 / 0.0106 / 0.0112 (20 runs: 0.0090 / 0.0104 / 0.0122);
+// final_progress_m 3.9802 / 3.9808 / 3.9814; pose_fusion_fallback_fraction
 // 0.00225 at every seed.
 TEST(ClosedLoopScenarios, CrossLineWithItsOwnSensorsStaysWithin4cm) {
   const auto m = RunSeeds(Shipped("cross_line"), kClosedLoop, kSeeds);
@@ -76,19 +77,27 @@ TEST(ClosedLoopScenarios, CrossLineWithItsOwnSensorsStaysWithin4cm) {
 // timeout (source 1) and returns to matching when the scans come back: the
 // share of the run on the fallback is about (4 - 0.5) s / 20 s = 0.175.
 // Meanwhile the pose is dead reckoning on a moving floor: its drift over the
-// 3.5 s is the error of the fusion's belt-velocity state, bounded by losing
-// the belt altogether: 0.11 m/s (0.10 m/s + 10 %) x 3.5 s = 0.385 m; over 8
-// seeds it drifted 12.1 to 58.8 mm (localization) and the path deviated 7.3 to
-// 51.8 mm, beyond paper 1's 4 cm, which it sets for a robot that sees. Once
-// the lasers are back the matches pull the pose in, and the robot ends
-// within the paper's 4 cm of its path.
+// 3.5 s is the error of the odometry's surface velocity (Eq. 3), bounded by
+// losing the belt altogether: 0.11 m/s (0.10 m/s + 10 %) x 3.5 s = 0.385 m.
+// Once the lasers are back the matches pull the pose in, and the robot ends
+// within the paper's 4 cm of its path. The surface velocity is the fused
+// estimator's (fused_flow: encoders, IMU and flow, which the blackout leaves
+// bounded): paper 1's filter fed by this fusion's velocity (Eq. 2) is not,
+// at the PX4Flow's 40 Hz: with the wheels on the belt its input is its own
+// estimate plus the fusion's odometry offset, which the blackout freezes,
+// and it integrates that offset at K = 0.105 a message, 4.2 /s (issue 36;
+// docs/results.md: over these seeds the localization drifted up to 0.52 m
+// and one run did not find its map again). Seeds 1..8: localization_error_
+// max_m 8.9 / 20.7 / 29.8 mm; final_path_deviation_m at most 0.6 mm;
+// pose_fusion_fallback_fraction 0.1812 at every seed.
 TEST(ClosedLoopScenarios, LasersBlackedOutTheFusionFallsBackToOdometryAndReturns) {
   const std::string file =
       WithSensors("cross_line",
                   "  laser_front: {parameters: {blackout_from: 5, blackout_until: 9}}\n"
                   "  laser_rear: {parameters: {blackout_from: 5, blackout_until: 9}}\n",
                   "blackout");
-  const auto m = RunSeeds(file, kClosedLoop, kSeeds);
+  const auto m =
+      RunSeeds(file, {"sensing.surface_velocity=fused_flow", "localization.source=fused"}, kSeeds);
   EXPECT_GT(m["pose_fusion_fallback_fraction"].min(), 0.17);
   // At most: the 3.5 s, one scan period (40 ms) and one control period
   // (20 ms) at each edge of the blackout (the scans straddling it and the
@@ -108,10 +117,10 @@ TEST(ClosedLoopScenarios, LasersBlackedOutTheFusionFallsBackToOdometryAndReturns
 // crosses as the nominal system does, with the standing error v / k of a
 // loop of gain k = 1/s against a belt at v = 0.10 m/s (+10 % variation):
 // bounded by 0.11 m, never carried away. Seeds 1..8: max_path_deviation_m
-// 0.0915 / 0.0973 / 0.1009 (within 9 % of the analytic 0.11: the belt's
+// 0.0913 / 0.0972 / 0.1009 (within 9 % of the analytic 0.11: the belt's
 // speed nears its +10 % at some seeds and the loop nears v / k);
-// refused_front_left 96 / 97 / 98; wheel_source_max 3 at every seed;
-// final_progress_m 3.9805 / 3.9812 / 3.9818.
+// refused_front_left 395 / 398 / 402 (messages at 40 Hz); wheel_source_max
+// 3 at every seed; final_progress_m 3.9804 / 3.9811 / 3.9814.
 TEST(ClosedLoopScenarios, DarkFlowSensorsAreRefusedAndTheRobotStaysBounded) {
   std::string file =
       WithSensors("cross_line",

@@ -73,6 +73,35 @@ TEST(Paper1Scenarios, CrossLineCompensatedStaysWithin4cmNominalDoesNot) {
   }
   EXPECT_GT(on["final_progress_m"].min(), 3.9);
   EXPECT_GT(off["final_progress_m"].min(), 3.9);
+  // Paper 1's judgement (Fig. 5 and 6): within 4 cm all the way and across.
+  EXPECT_EQ(on["crossing_success"].min(), 1.0);
+  EXPECT_EQ(off["crossing_success"].max(), 0.0);
+}
+
+// Paper 1's Fig. 6 as it judges it (issue 36 item 5): only the modified
+// system crosses successfully, with the robots localizing themselves
+// (localization.source fused, as scenarios/nominal_vs_modified.yaml).
+// Expected: the nominal system leaves the 4 cm band in every run (its
+// standing error v / k = 0.10 m, and its odometry, which takes the belt for
+// a still floor, adds to it) although it reaches the far side; the modified
+// one stays within it (as above, plus the localization's error, about 1
+// cm). 20 runs (docs/results.md): nominal 107.8 / 114.2 / 121.0 mm,
+// modified 4.9 / 5.8 / 6.2 mm; success 0 and 20 of 20. Seeds 1..4 here:
+// nominal 106.1 / 108.4 / 115.6 mm, modified 5.0 / 5.4 / 5.6 mm.
+TEST(Paper1Scenarios, Fig6OnlyTheModifiedSystemCrossesWithItsOwnLocalization) {
+  const auto nominal = test_scenarios::RunSeeds(
+      test_scenarios::Shipped("cross_line"),
+      {"control.compensation=false", "sensing.surface_velocity=none", "localization.source=fused"},
+      4);
+  const auto modified = test_scenarios::RunSeeds(
+      test_scenarios::Shipped("cross_line"),
+      {"control.compensation=true", "sensing.surface_velocity=ground_truth",
+       "localization.source=fused"},
+      4);
+  EXPECT_EQ(nominal["crossing_success"].max(), 0.0);
+  EXPECT_GT(nominal["max_path_deviation_m"].min(), 0.5 * 0.10 / kGain);
+  EXPECT_GT(nominal["final_progress_m"].min(), 3.9);
+  EXPECT_EQ(modified["crossing_success"].min(), 1.0);
 }
 
 // The result is the system's, not an artefact of the coupling: it holds

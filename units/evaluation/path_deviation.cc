@@ -29,10 +29,20 @@ PathDeviationUnit::PathDeviationUnit(std::string name, std::vector<std::array<do
       path_(std::move(path)),
       cumulative_m_(models::CumulativeLengths(path_)) {
   auto& v = variables();
+  v.Parameter("band", "m", &band_,
+              "the band around the path the task must stay in (paper 1 Fig. 5: 4 cm for the "
+              "entire path)",
+              cosim::Rule::Positive());
   v.Input("position", "m", &position_, "true position x, y of base_link in the map frame");
   v.Output("deviation", "m", &deviation_,
            "distance of the robot centre from the desired path or held point", {"position"});
   v.Output("progress", "m", &progress_, "arc length of the nearest point along the path",
+           {"position"});
+  v.Output("band_exceeded", "1", &band_exceeded_,
+           "1 once the deviation has exceeded band at some step (latched)", {"position"});
+  v.Output("success", "1", &success_,
+           "1 while the deviation has stayed within band and the robot is within band of the "
+           "path's end along it (a hold: within band), else 0",
            {"position"});
 }
 
@@ -55,10 +65,27 @@ void PathDeviationUnit::Evaluate() {
   const PathDistance d = DistanceToPath(path_, cumulative_m_, position_[0], position_[1]);
   deviation_ = d.distance_m;
   progress_ = d.progress_m;
+  const bool out = exceeded_ || !(deviation_ <= band_);
+  band_exceeded_ = out ? 1.0 : 0.0;
+  const bool arrived = path_.size() < 2 || progress_ >= cumulative_m_.back() - band_;
+  success_ = !out && arrived ? 1.0 : 0.0;
 }
 
 cosim::StepResult PathDeviationUnit::DoStep(cosim::TimeNs, cosim::TimeNs) {
+  // The outputs of this communication point were evaluated: latch them.
+  exceeded_ = band_exceeded_ != 0.0;
   return cosim::StepResult::kOk;
+}
+
+void PathDeviationUnit::SaveInternal(cosim::UnitState& state) const {
+  state.integers = {exceeded_ ? 1 : 0};
+}
+
+void PathDeviationUnit::RestoreInternal(const cosim::UnitState& state) {
+  if (state.integers.size() != 1) {
+    throw cosim::UnitError(Where() + ": saved state has the wrong shape");
+  }
+  exceeded_ = state.integers[0] != 0;
 }
 
 }  // namespace linesim::evaluation

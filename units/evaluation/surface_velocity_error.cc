@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "cosim/time.h"
-#include <utility>
 
 namespace linesim::evaluation {
 
@@ -72,19 +72,25 @@ SurfaceVelocityErrorUnit::SurfaceVelocityErrorUnit(std::string name, int sensors
   v.Output("samples", "1", &samples_out_, "how many (sensor, step) pairs rmse holds", {});
   // Issue 21 item 2: plateaus from 1 s after a switch; within 2 cm/s.
   v.Parameter("plateau_delay", "s", &plateau_delay_,
-              "a plateau starts this long after the reference last changed", cosim::Rule::NonNegative());
+              "a plateau starts this long after the reference last changed",
+              cosim::Rule::NonNegative());
   v.Parameter("switch_step", "m/s", &switch_step_,
               "the reference changes (a switch) where it moves this far from where it settled "
               "(default 0.01: 5 % of a 0.2 m/s line; the ground-truth encoder's quantization, "
               "2.6 mm/s at 0.2 m/s, and a line's slow speed variation stay below it)",
               cosim::Rule::Positive());
   v.Parameter("settle_tolerance", "m/s", &settle_tolerance_,
-              "a switch has settled when every estimate over the belt stays this close",
+              "a switch has settled when the belt's estimate (the mean of the estimates over "
+              "the belt) stays this close",
               cosim::Rule::Positive());
   v.Output("rmse_plateau", "m/s", &rmse_plateau_,
            "root mean square of error over the plateau samples (line steadily on or off)", {});
   v.Output("plateau_samples", "1", &plateau_samples_out_,
            "how many (sensor, step) pairs rmse_plateau holds", {});
+  v.Output("rmse_plateau_on", "m/s", &rmse_on_,
+           "root mean square of error over the plateau samples with the line on (the reference "
+           "beyond switch_step)",
+           {});
   v.Output("switches", "1", &switches_out_, "switches of the reference seen so far", {});
   if (estimated) {
     estimated_.assign(2 * n, 0.0);
@@ -97,9 +103,12 @@ SurfaceVelocityErrorUnit::SurfaceVelocityErrorUnit(std::string name, int sensors
              "root mean square of estimated_speed - reference over the samples rmse holds", {});
     v.Output("rmse_plateau_estimated", "m/s", &rmse_plateau_estimated_,
              "root mean square of estimated_speed - reference over the plateau samples", {});
+    v.Output("rmse_plateau_on_estimated", "m/s", &rmse_on_estimated_,
+             "the same over the plateau samples with the line on", {});
     v.Output("settling_time", "s", &settling_out_,
-             "largest time from a switch's start until every estimate over the belt stayed "
-             "within settle_tolerance of the reference (until the next switch)",
+             "largest time from a switch's start until the belt's estimate (the mean of the "
+             "estimates over the belt) stayed within settle_tolerance of the reference (until "
+             "the next switch)",
              {});
   }
 }
@@ -145,6 +154,8 @@ void SurfaceVelocityErrorUnit::Initialize() {
   plateau_samples_ = switches_ = 0;
   rmse_plateau_ = rmse_plateau_estimated_ = settling_out_ = switches_out_ = 0.0;
   plateau_samples_out_ = 0.0;
+  on_sum_ = on_sum_estimated_ = rmse_on_ = rmse_on_estimated_ = 0.0;
+  on_samples_ = 0;
   Evaluate();
 }
 
@@ -174,23 +185,36 @@ cosim::StepResult SurfaceVelocityErrorUnit::DoStep(cosim::TimeNs t, cosim::TimeN
     level_taken_ = true;
   }
   const bool plateau = now - last_change_ >= plateau_delay_;
+  const bool line_on = plateau && std::abs(reference_) > switch_step_;
   // A violation counts towards the switch's settling only where the
   // reference is at its level (within half a switch step of where it
   // settled): the first samples of the next switch, before it has moved a
   // whole step, belong to that one.
   const bool at_level = std::abs(reference_ - anchor_) <= 0.5 * switch_step_;
+  double estimate_sum = 0.0;
+  int over = 0;
   for (std::size_t k = 0; k < sensors_; ++k) {
     if (over_belt_[k] == 0.0) continue;
     sum_squared_ += error_[k] * error_[k];
     if (plateau) plateau_sum_ += error_[k] * error_[k];
+    if (line_on) on_sum_ += error_[k] * error_[k];
     if (!estimated_.empty()) {
       const double e = estimated_speed_[k] - reference_;
       sum_squared_estimated_ += e * e;
       if (plateau) plateau_sum_estimated_ += e * e;
-      if (in_switch_ && at_level && std::abs(e) > settle_tolerance_) last_bad_ = now;
+      if (line_on) on_sum_estimated_ += e * e;
+      estimate_sum += estimated_speed_[k];
+      ++over;
     }
     ++samples_;
     if (plateau) ++plateau_samples_;
+    if (line_on) ++on_samples_;
+  }
+  // Settled: the belt's estimate, the mean of the sensors over it (what the
+  // surface estimator gives the wheels on it), within the tolerance.
+  if (in_switch_ && at_level && over > 0 &&
+      std::abs(estimate_sum / over - reference_) > settle_tolerance_) {
+    last_bad_ = now;
   }
   // The switch stays open (its settling time can still grow) until the next.
   if (in_switch_) settling_out_ = std::max(settling_max_, std::max(last_bad_ - switch_start_, 0.0));
@@ -202,6 +226,11 @@ cosim::StepResult SurfaceVelocityErrorUnit::DoStep(cosim::TimeNs t, cosim::TimeN
     const double np = static_cast<double>(plateau_samples_);
     rmse_plateau_ = std::sqrt(plateau_sum_ / np);
     rmse_plateau_estimated_ = std::sqrt(plateau_sum_estimated_ / np);
+  }
+  if (on_samples_ > 0) {
+    const double no = static_cast<double>(on_samples_);
+    rmse_on_ = std::sqrt(on_sum_ / no);
+    rmse_on_estimated_ = std::sqrt(on_sum_estimated_ / no);
   }
   samples_out_ = static_cast<double>(samples_);
   const double n = static_cast<double>(samples_);
@@ -216,18 +245,18 @@ void SurfaceVelocityErrorUnit::FinishSwitch() {
 }
 
 void SurfaceVelocityErrorUnit::SaveInternal(cosim::UnitState& state) const {
-  state.reals = {sum_squared_,  sum_squared_estimated_, anchor_, last_t_,
-                 last_change_,  switch_start_,          last_bad_,       settling_max_,
-                 plateau_sum_,  plateau_sum_estimated_};
-  state.integers = {samples_,           plateau_samples_,    switches_, have_last_ ? 1 : 0,
-                    in_switch_ ? 1 : 0, level_taken_ ? 1 : 0};
+  state.reals = {sum_squared_, sum_squared_estimated_, anchor_,   last_t_,
+                 last_change_, switch_start_,          last_bad_, settling_max_,
+                 plateau_sum_, plateau_sum_estimated_, on_sum_,   on_sum_estimated_};
+  state.integers = {samples_,           plateau_samples_,     switches_,  have_last_ ? 1 : 0,
+                    in_switch_ ? 1 : 0, level_taken_ ? 1 : 0, on_samples_};
 }
 
 void SurfaceVelocityErrorUnit::RestoreInternal(const cosim::UnitState& state) {
-  if (state.reals.size() != 10 || state.integers.size() != 6) {
+  if (state.reals.size() != 12 || state.integers.size() != 7) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
-                           " integers, expected 10 and 6");
+                           " integers, expected 12 and 7");
   }
   const auto& r = state.reals;
   sum_squared_ = r[0];
@@ -240,6 +269,9 @@ void SurfaceVelocityErrorUnit::RestoreInternal(const cosim::UnitState& state) {
   settling_max_ = r[7];
   plateau_sum_ = r[8];
   plateau_sum_estimated_ = r[9];
+  on_sum_ = r[10];
+  on_sum_estimated_ = r[11];
+  on_samples_ = state.integers[6];
   samples_ = state.integers[0];
   plateau_samples_ = state.integers[1];
   switches_ = state.integers[2];

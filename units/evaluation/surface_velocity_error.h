@@ -36,13 +36,17 @@ namespace linesim::evaluation {
 /// line is steadily on or off where the reference has not moved more than
 /// switch_step away from where it last settled for plateau_delay; `rmse_plateau` and
 /// `rmse_plateau_estimated` are the two root mean square errors over those
-/// samples only. A switch starts where the reference starts changing after
-/// a plateau (has moved switch_step); its settling time is the time from then to the last
-/// sample, before the next switch, at which some sensor's estimate over the
-/// belt was more than settle_tolerance off the reference while the
-/// reference was at a level (within switch_step / 2 of where it last
-/// settled: the next switch's first samples are not this one's);
-/// `settling_time` is the largest so far, `switches` their count.
+/// samples only; `rmse_plateau_on` and `rmse_plateau_on_estimated` over
+/// those with the line on (the reference beyond switch_step: the device's
+/// noise at speed, where its scale error shows). A switch starts where the reference starts
+/// changing after a plateau (has moved switch_step); its settling time is the time from then to the
+/// last sample, before the next switch, at which the belt's estimate (the mean of the sensors'
+/// estimates over the belt: what the surface estimator gives the wheels on it) was more than
+/// settle_tolerance off the reference while the reference was at a level (within switch_step / 2 of
+/// where it last settled: the next switch's first samples are not this one's); `settling_time` is
+/// the largest so far, `switches` their count. (Not each sensor's: with the device's measured
+/// noise, 3 cm/s a message, a single filtered estimate leaves 2 cm/s now and then on a plateau, and
+/// the time of its last excursion says nothing about the switch.)
 class SurfaceVelocityErrorUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "surface_velocity_error";
@@ -93,6 +97,9 @@ class SurfaceVelocityErrorUnit : public cosim::Unit {
   double switch_start_ = 0.0, last_bad_ = -1.0, settling_max_ = 0.0;
   double plateau_sum_ = 0.0, plateau_sum_estimated_ = 0.0;
   std::int64_t plateau_samples_ = 0, switches_ = 0;
+  // The plateaus with the line on (the reference beyond switch_step).
+  double on_sum_ = 0.0, on_sum_estimated_ = 0.0, rmse_on_ = 0.0, rmse_on_estimated_ = 0.0;
+  std::int64_t on_samples_ = 0;
   double rmse_plateau_ = 0.0, rmse_plateau_estimated_ = 0.0, settling_out_ = 0.0,
          switches_out_ = 0.0, plateau_samples_out_ = 0.0;
 };

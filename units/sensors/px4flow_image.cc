@@ -11,11 +11,12 @@ Exposure AutoExposure(const Px4FlowCamera& cam, double lux) {
   Exposure e{};
   const double per_s = cam.responsivity_dn * std::max(lux, 0.0);  // DN/s at gain 1
   // Exposure first (no shorter than one 10 us row), then gain.
-  e.exposure_s = per_s > 0.0 ? std::clamp(cam.target_brightness_dn / per_s, 1e-5, cam.max_exposure_s)
-                             : cam.max_exposure_s;
+  e.exposure_s = per_s > 0.0
+                     ? std::clamp(cam.target_brightness_dn / per_s, 1e-5, cam.max_exposure_s)
+                     : cam.max_exposure_s;
   const double level = per_s * e.exposure_s;
-  e.gain = level > 0.0 ? std::clamp(cam.target_brightness_dn / level, 1.0, cam.max_gain)
-                       : cam.max_gain;
+  e.gain =
+      level > 0.0 ? std::clamp(cam.target_brightness_dn / level, 1.0, cam.max_gain) : cam.max_gain;
   e.mean_dn = std::min(level * e.gain, 255.0);
   e.noise_dn = std::sqrt(e.mean_dn * e.gain * cam.full_well_dn +
                          cam.read_noise_dn * cam.read_noise_dn * e.gain * e.gain);
@@ -139,6 +140,10 @@ FlowResult ComputeFlow(const Image& im1, const Image& im2, int search_range,
 
 namespace {
 
+constexpr double kPi = std::numbers::pi;
+// The golden angle, pi (3 - sqrt 5): successive points of a Vogel spiral.
+constexpr double kGoldenAngle = 2.399963229728653;
+
 inline std::uint64_t Mix(std::uint64_t z) {
   z += 0x9e3779b97f4a7c15ULL;
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
@@ -161,7 +166,7 @@ double Px4FlowImageModel::Field(double x, double y) const {
   const auto ix = static_cast<std::int64_t>(fx), iy = static_cast<std::int64_t>(fy);
   auto node = [&](std::int64_t a, std::int64_t b) {
     const std::uint64_t h = Mix(texture_seed_ ^ Mix(static_cast<std::uint64_t>(a) * 0x1f1f1f1fULL +
-                                                     static_cast<std::uint64_t>(b)));
+                                                    static_cast<std::uint64_t>(b)));
     // Uniform in [-sqrt 3, sqrt 3]: unit variance.
     return (static_cast<double>(h >> 11) * 0x1.0p-53 * 2.0 - 1.0) * 1.7320508075688772;
   };
@@ -185,7 +190,7 @@ void Px4FlowImageModel::SetPeriodicTexture(double period_m, double cos_dir, doub
 
 void Px4FlowImageModel::Render(double dx_m, double dy_m, double vx_mps, double vy_mps,
                                double height_m, double contrast, double lux, Image& out,
-                               double brightness) {
+                               double brightness, double defocus_px) {
   Exposure e = AutoExposure(cam_, lux);
   // The auto exposure follows the mean light; a flickering lamp makes this
   // exposure brighter or darker than that.
@@ -195,6 +200,24 @@ void Px4FlowImageModel::Render(double dx_m, double dy_m, double vx_mps, double v
   // with the blur length so that samples are at most 1/2 pixel apart.
   const double blur_px = std::hypot(vx_mps, vy_mps) * e.exposure_s / pix_m;
   const int k_samples = std::clamp(static_cast<int>(std::ceil(2.0 * blur_px)) + 1, 1, 32);
+  // Defocus: the lens' blur circle (diameter defocus_px) sampled by a
+  // Vogel spiral of points at most about 1/2 pixel apart (pi c^2 points
+  // over the disk of area pi c^2 / 4), each also on one corner of the 2x2
+  // footprint pattern below.
+  const int disk_points =
+      defocus_px > 0.0 ? std::max(4, static_cast<int>(std::ceil(kPi * defocus_px * defocus_px)))
+                       : 4;
+  if (defocus_px > 0.0) {
+    disk_.resize(static_cast<std::size_t>(2 * disk_points));
+    for (int p = 0; p < disk_points; ++p) {
+      const double r = 0.5 * defocus_px * std::sqrt((p + 0.5) / disk_points);
+      const double a = kGoldenAngle * p;
+      const double u = ((p & 1) ? 0.25 : -0.25) + r * std::cos(a);
+      const double v = ((p & 2) ? 0.25 : -0.25) + r * std::sin(a);
+      disk_[static_cast<std::size_t>(2 * p)] = u * pix_m;
+      disk_[static_cast<std::size_t>(2 * p + 1)] = v * pix_m;
+    }
+  }
   std::normal_distribution<double> gauss(0.0, 1.0);
   const double half = 0.5 * (kImageSize - 1);
   for (int j = 0; j < kImageSize; ++j) {
@@ -203,14 +226,23 @@ void Px4FlowImageModel::Render(double dx_m, double dy_m, double vx_mps, double v
       for (int k = 0; k < k_samples; ++k) {
         const double back = k_samples == 1 ? 0.0 : e.exposure_s * k / (k_samples - 1);
         const double sx = dx_m - vx_mps * back, sy = dy_m - vy_mps * back;
-        // 2x2 samples over the binned pixel's footprint.
+        if (defocus_px > 0.0) {
+          // Over the binned pixel's footprint (2x2) and the blur circle.
+          const double cx = (i - half) * pix_m - sx, cy = (j - half) * pix_m - sy;
+          for (int p = 0; p < disk_points; ++p) {
+            sum += Field(cx + disk_[static_cast<std::size_t>(2 * p)],
+                         cy + disk_[static_cast<std::size_t>(2 * p + 1)]);
+          }
+          continue;
+        }
+        // In focus: 2x2 samples over the binned pixel's footprint.
         for (int q = 0; q < 4; ++q) {
           const double u = (i - half + ((q & 1) ? 0.25 : -0.25)) * pix_m - sx;
           const double v = (j - half + ((q & 2) ? 0.25 : -0.25)) * pix_m - sy;
           sum += Field(u, v);
         }
       }
-      const double level = e.mean_dn * (1.0 + contrast * sum / (4.0 * k_samples));
+      const double level = e.mean_dn * (1.0 + contrast * sum / (disk_points * k_samples));
       const double sigma = std::sqrt(std::max(level, 0.0) * e.gain * cam_.full_well_dn +
                                      cam_.read_noise_dn * cam_.read_noise_dn * e.gain * e.gain);
       const double value = std::round(level + sigma * gauss(rng_));
@@ -221,16 +253,16 @@ void Px4FlowImageModel::Render(double dx_m, double dy_m, double vx_mps, double v
 }
 
 FlowResult Px4FlowImageModel::Step(double vx_mps, double vy_mps, double height_m, double contrast,
-                                   double lux, double brightness) {
+                                   double lux, double brightness, double defocus_px) {
   const double dt = 1.0 / cam_.frame_rate_hz;
   if (!have_previous_) {
-    Render(dx_m_, dy_m_, vx_mps, vy_mps, height_m, contrast, lux, current_, brightness);
+    Render(dx_m_, dy_m_, vx_mps, vy_mps, height_m, contrast, lux, current_, brightness, defocus_px);
     have_previous_ = true;
   }
   previous_ = current_;
   dx_m_ += vx_mps * dt;
   dy_m_ += vy_mps * dt;
-  Render(dx_m_, dy_m_, vx_mps, vy_mps, height_m, contrast, lux, current_, brightness);
+  Render(dx_m_, dy_m_, vx_mps, vy_mps, height_m, contrast, lux, current_, brightness, defocus_px);
   return ComputeFlow(previous_, current_, cam_.search_range_px, cam_.feature_threshold);
 }
 

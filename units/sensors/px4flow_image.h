@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <random>
+#include <vector>
 
 namespace linesim::sensors {
 
@@ -16,17 +17,17 @@ namespace linesim::sensors {
 /// fast model. Defaults are the device's (see models/sensors/px4flow.yaml for
 /// the sources).
 struct Px4FlowCamera {
-  double focal_length_px = 666.7;   // 16 mm lens / (6 um * 4 binning)
-  double frame_rate_hz = 400.0;     // PX4Flow README
-  int search_range_px = 4;          // BOTTOM_FLOW_SEARCH_WINDOW_SIZE (2013-2016 firmware)
-  int feature_threshold = 30;       // BFLOW_F_THLD
-  double max_exposure_s = 0.0025;   // EXPOSURE_MAX rows, capped by the frame interval
-  double max_gain = 4.0;            // MT9V034 analog gain 1x..4x
-  double target_brightness_dn = 80; // AEC/AGC desired bin BRIGHT = 20 of 64 -> 80 of 255
-  double responsivity_dn = 42.0;    // 8-bit DN per (lux at the floor * s) at gain 1
-  double full_well_dn = 0.0128;     // DN per electron at gain 1 (8-bit), for shot noise
-  double read_noise_dn = 0.5;       // read noise at gain 1, 8-bit DN
-  double texture_scale_m = 0.001;   // lattice of the procedural texture
+  double focal_length_px = 666.7;    // 16 mm lens / (6 um * 4 binning)
+  double frame_rate_hz = 400.0;      // PX4Flow README
+  int search_range_px = 4;           // BOTTOM_FLOW_SEARCH_WINDOW_SIZE (2013-2016 firmware)
+  int feature_threshold = 30;        // BFLOW_F_THLD
+  double max_exposure_s = 0.0025;    // EXPOSURE_MAX rows, capped by the frame interval
+  double max_gain = 4.0;             // MT9V034 analog gain 1x..4x
+  double target_brightness_dn = 80;  // AEC/AGC desired bin BRIGHT = 20 of 64 -> 80 of 255
+  double responsivity_dn = 42.0;     // 8-bit DN per (lux at the floor * s) at gain 1
+  double full_well_dn = 0.0128;      // DN per electron at gain 1 (8-bit), for shot noise
+  double read_noise_dn = 0.5;        // read noise at gain 1, 8-bit DN
+  double texture_scale_m = 0.001;    // lattice of the procedural texture
 };
 
 /// Result of the sensor's auto exposure / gain for an illuminance.
@@ -79,14 +80,17 @@ class Px4FlowImageModel {
   /// height h (m), contrast c and illuminance `lux` (which sets the auto
   /// exposure); `brightness` scales the light of this exposure against the
   /// one the auto exposure adapted to (a flickering lamp: 1 + its deviation
-  /// averaged over the exposure).
+  /// averaged over the exposure); `defocus_px`: the diameter of the lens'
+  /// blur circle on the sensor, in binned pixels (a uniform disk: a thin
+  /// lens focused at another distance; 0: in focus).
   void Render(double dx_m, double dy_m, double vx_mps, double vy_mps, double height_m,
-              double contrast, double lux, Image& out, double brightness = 1.0);
+              double contrast, double lux, Image& out, double brightness = 1.0,
+              double defocus_px = 0.0);
 
   /// Renders the next frame after a frame interval at the given relative
   /// velocity and returns the firmware's flow between the two frames.
   FlowResult Step(double vx_mps, double vy_mps, double height_m, double contrast, double lux,
-                  double brightness = 1.0);
+                  double brightness = 1.0, double defocus_px = 0.0);
 
   /// A periodic part of the texture (slats, a weave): period (m) along the
   /// direction (cos, sin) in the sensor frame, carrying `share` of the
@@ -103,6 +107,7 @@ class Px4FlowImageModel {
   double dx_m_ = 0.0, dy_m_ = 0.0;
   bool have_previous_ = false;
   Image previous_{}, current_{};
+  std::vector<double> disk_;  // the blur circle's sample offsets (m), x y per point
 };
 
 }  // namespace linesim::sensors

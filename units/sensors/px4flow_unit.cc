@@ -40,6 +40,9 @@ constexpr double kAliasScalePx = 2.3;      // beyond the window: P(edge match) =
 // FlickerAgrees).
 constexpr double kFlickerSnr = 0.82;
 constexpr double kFlickerPow = 1.25;
+// A uniform disk of diameter c has the per-axis variance c^2 / 16, a box of
+// length b b^2 / 12: the box of the same variance is c sqrt(12 / 16) long.
+constexpr double kDiskToBox = 0.8660254037844386;
 
 inline double Uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
@@ -94,11 +97,18 @@ inline double FoldedMean(double mu, double s) {
 
 // Salts keeping the per-device and per-run draws apart from the frame stream.
 constexpr std::uint64_t kDeviceSalt = 0xd1b54a32d192ed03ULL;
+constexpr std::uint64_t kSonarSalt = 0x8bb84b93962eacc9ULL;
+constexpr std::uint64_t kResidualSalt = 0x4f1bbcdcbfa53e0bULL;
 
 }  // namespace
 
 Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint64_t seed)
-    : cosim::Unit(kTypeName, std::move(name)), surfaces_(scene.surfaces), seed_(seed), rng_(seed) {
+    : cosim::Unit(kTypeName, std::move(name)),
+      surfaces_(scene.surfaces),
+      seed_(seed),
+      rng_(seed),
+      sonar_rng_(seed ^ kSonarSalt),
+      residual_rng_(seed ^ kResidualSalt) {
   if (surfaces_.empty()) throw cosim::UnitError(Where() + ": the scene has no surfaces");
   floor_surface_ = scene.floor.surface;
   for (const models::Belt& b : scene.belts) {
@@ -113,7 +123,13 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
   integrated_gyro_.assign(3, 0.0);
   velocity_.assign(2, 0.0);
   frame_flow_.assign(2, 0.0);
+  sonar_velocity_.assign(2, 0.0);
 
+  DeclareParameters();
+  DeclareInputsAndOutputs(n_belts > 0);
+}
+
+void Px4FlowUnit::DeclareParameters() {
   using cosim::Rule;
   auto& v = variables();
   v.Parameter("mount_x", "m", &mount_x_, "sensor position along base_link x",
@@ -164,10 +180,46 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
               Rule::NonNegative());
   v.Parameter("dark_until", "s", &dark_until_,
               "... until this time (dark_until <= dark_from: never)", Rule::NonNegative());
-  v.Parameter("sonar_noise", "m", &sonar_noise_, "standard deviation of the sonar distance",
+  v.Parameter("sonar_noise", "m", &sonar_noise_,
+              "standard deviation of a sonar reading (before its rounding)", Rule::NonNegative());
+  v.Parameter("sonar_min", "m", &sonar_min_,
+              "the firmware keeps readings above this and flags a filtered distance below it "
+              "invalid (sonar.c SONAR_MIN)",
+              Rule::Positive());
+  v.Parameter("sonar_max", "m", &sonar_max_, "... and below this (SONAR_MAX)", Rule::Positive());
+  v.Parameter("sonar_min_range", "m", &sonar_min_range_,
+              "the sonar reports anything closer as this distance (HRLV-MaxSonar-EZ: 300 mm)",
               Rule::NonNegative());
-  v.Parameter("sonar_min", "m", &sonar_min_, "shortest valid sonar distance", Rule::Positive());
-  v.Parameter("sonar_max", "m", &sonar_max_, "longest valid sonar distance", Rule::Positive());
+  v.Parameter("sonar_resolution", "m", &sonar_resolution_,
+              "the sonar's reading is a whole number of these (0: exact)", Rule::NonNegative());
+  v.Parameter("sonar_period", "s", &sonar_period_, "time between sonar readings",
+              Rule::Range(1e-3, 10.0));
+  v.Parameter("sonar_gain_position", "1", &sonar_gain_position_,
+              "the firmware's sonar filter: position gain (SONAR_KAL_L1)", Rule::Range(0.0, 1.0));
+  v.Parameter("sonar_gain_velocity", "1/s", &sonar_gain_velocity_,
+              "... velocity gain (SONAR_KAL_L2)", Rule::NonNegative());
+  v.Parameter("sonar_filtered", &sonar_filtered_,
+              "OPTICAL_FLOW's ground_distance is the filtered sonar distance (SONAR_FILTERED; "
+              "default: the raw reading)");
+  v.Parameter("velocity_scaling", &velocity_scaling_,
+              "the distance `velocity` scales the flow with: fixed_height (mount_height, paper 1) "
+              "or sonar (the firmware's flow_comp_m, the filtered sonar distance)",
+              Rule::OneOf({"fixed_height", "sonar"}));
+  v.Parameter("f_number", "1", &f_number_, "the lens' f-number (its aperture is f / N)",
+              Rule::Range(0.5, 64.0));
+  v.Parameter("focus_distance", "m", &focus_distance_,
+              "the distance the lens is focused at (0: at mount_height; a large value: far away)",
+              Rule::NonNegative());
+  v.Parameter("pixel_pitch", "m", &pixel_pitch_,
+              "the binned pixel's size on the sensor (6 um x 4 binning)", Rule::Positive());
+  v.Parameter("residual", &residual_,
+              "add the unexplained residual (residual_flow_noise) to each message (off: the "
+              "modelled mechanisms alone)");
+  v.Parameter("residual_flow_noise", "rad/s", &residual_flow_noise_,
+              "UNEXPLAINED RESIDUAL: standard deviation per message and axis of white noise on "
+              "the message's flow rate, calibrated to the device's measured noise (see "
+              "models/sensors/px4flow.yaml); no mechanism of its own",
+              Rule::NonNegative());
   v.Parameter("gyro_noise", "rad/s", &gyro_noise_,
               "standard deviation of each gyro axis per frame sample", Rule::NonNegative());
   v.Parameter("gyro_range", "rad/s", &gyro_range_, "gyro full scale (saturates beyond)",
@@ -195,8 +247,8 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
   v.Parameter("tyre_mode_frequency", "Hz", &tyre_mode_frequency_,
               "natural frequency of the body's pitch and roll on its tyres",
               Rule::Range(0.1, 200.0));
-  v.Parameter("tyre_mode_damping", "1", &tyre_mode_damping_,
-              "damping ratio of that mode", Rule::Range(0.0, 10.0));
+  v.Parameter("tyre_mode_damping", "1", &tyre_mode_damping_, "damping ratio of that mode",
+              Rule::Range(0.0, 10.0));
   v.Parameter("wheelbase", "m", &wheelbase_,
               "distance between front and rear wheel contacts (pitch from the surface profile)",
               Rule::Positive());
@@ -213,14 +265,17 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
               "the ambient light flickers (scene surface flicker_hz, flicker_depth)");
   v.Parameter("periodic_texture", &periodic_texture_,
               "the surface's periodic texture can alias (scene surface texture_period_m)");
+}
 
+void Px4FlowUnit::DeclareInputsAndOutputs(bool belts) {
+  auto& v = variables();
   v.Input("position", "m", &position_, "base_link x, y in map");
   v.Input("yaw", "rad", &yaw_, "base_link yaw in map");
   v.Input("linear_velocity", "m/s", &linear_velocity_, "base_link vx, vy in map");
   v.Input("yaw_rate", "rad/s", &yaw_rate_, "base_link yaw rate");
   v.Input("angular_velocity", "rad/s", &angular_velocity_,
           "base_link angular velocity in base_link (the board gyro)");
-  if (n_belts > 0) {
+  if (belts) {
     v.Input("belt_velocity", "m/s", &belt_velocity_,
             "surface velocity of each scene belt in map: vx, vy per belt");
   }
@@ -241,11 +296,21 @@ Px4FlowUnit::Px4FlowUnit(std::string name, const models::Scene& scene, std::uint
   v.Output("integrated_gyro", "rad", &integrated_gyro_,
            "OPTICAL_FLOW_RAD integrated_xgyro, ygyro, zgyro (sensor frame)", {});
   v.Output("distance", "m", &distance_,
-           "OPTICAL_FLOW_RAD distance: sonar distance, -1 outside sonar_min..sonar_max", {});
+           "OPTICAL_FLOW ground_distance: the sonar's raw reading (filtered with "
+           "sonar_filtered), 0 while the filtered distance is outside sonar_min..sonar_max",
+           {});
+  v.Output("sonar_velocity", "m/s", &sonar_velocity_,
+           "OPTICAL_FLOW flow_comp_m (turned to the surface relative to the sensor, as "
+           "`velocity`): the message's frames' flow scaled by the filtered sonar distance; 0 "
+           "without a frame of quality > 0 and a valid distance",
+           {});
+  v.Output("defocus", "1", &defocus_,
+           "diameter of the lens' blur circle on the sensor at the last frame, binned pixels", {});
   v.Output("frame_count", "1", &frame_count_, "frames of quality > 0 in the last message", {});
   v.Output("velocity", "m/s", &velocity_,
            "surface velocity relative to the sensor in the sensor frame, from the integrated "
-           "flow and the known mount_height (paper 1); held when valid is 0",
+           "flow and the distance velocity_scaling says (paper 1: the known mount_height); held "
+           "when valid is 0",
            {});
   v.Output("valid", "1", &valid_, "1 if velocity is from the last message, 0 if held", {});
   v.Output("message_count", "1", &message_count_,
@@ -260,6 +325,18 @@ std::vector<cosim::ParameterProblem> Px4FlowUnit::CheckParameters() const {
   if (sonar_min_ >= sonar_max_) {
     problems.push_back({"sonar_max", std::nullopt,
                         "must be greater than sonar_min (" + cosim::FormatValue(sonar_min_) + ")"});
+  }
+  // The thin lens: the lens' focal length is focal_length_px pixels.
+  const double focal_m = focal_length_px_ * pixel_pitch_;
+  if (mount_height_ <= 2.0 * focal_m) {
+    problems.push_back({"mount_height", std::nullopt,
+                        "must be more than twice the focal length (" + cosim::FormatValue(focal_m) +
+                            " m: focal_length_px x pixel_pitch)"});
+  }
+  if (focus_distance_ > 0.0 && focus_distance_ <= 2.0 * focal_m) {
+    problems.push_back({"focus_distance", std::nullopt,
+                        "must be 0 (at mount_height) or more than twice the focal length (" +
+                            cosim::FormatValue(focal_m) + " m)"});
   }
   if (publish_rate_ > frame_rate_) {
     problems.push_back({"publish_rate", std::nullopt,
@@ -293,6 +370,63 @@ void Px4FlowUnit::CacheCamera() {
   cam_.read_noise_dn = read_noise_;
   // The gyro's first-order lag per frame interval.
   gyro_lag_factor_ = gyro_lag_ > 0.0 ? 1.0 - std::exp(-1.0 / (frame_rate_ * gyro_lag_)) : 1.0;
+  scale_by_sonar_ = velocity_scaling_ == "sonar";
+}
+
+double Px4FlowUnit::DefocusPx(double height) const {
+  // Thin lens of this device's focal length f: a floor at s is imaged at
+  // v_s = f s / (s - f); focused at s_f the sensor sits at v_f, and a point
+  // of the floor at `height` spreads over a disk of diameter A |v_h - v_f|
+  // / v_h there (A = f / N, the aperture).
+  const double f = focal_length_px_ * focal_factor_ * pixel_pitch_;
+  const double s_f = focus_distance_ > 0.0 ? focus_distance_ : mount_height_;
+  const double h = std::max(height, 2.0 * f);
+  const double v_h = f * h / (h - f), v_f = f * s_f / (s_f - f);
+  return f / f_number_ * std::abs(v_h - v_f) / v_h / pixel_pitch_;
+}
+
+void Px4FlowUnit::SonarUpTo(cosim::TimeNs t, double height) {
+  const double period_ns = 1e9 * sonar_period_;
+  while (next_sonar_ <= t) {
+    SonarReading(cosim::NsToSeconds(next_sonar_), height, false);
+    ++sonar_index_;
+    next_sonar_ = start_ + static_cast<cosim::TimeNs>(
+                               std::llround(period_ns * static_cast<double>(sonar_index_)));
+  }
+}
+
+void Px4FlowUnit::SonarReading(double t_s, double height, bool settle) {
+  // The HRLV-MaxSonar-EZ: closer than its minimum it reports the minimum;
+  // its serial output is whole millimetres.
+  double r = std::max(height, sonar_min_range_);
+  if (sonar_noise_ > 0.0) r += sonar_noise_ * Normal(sonar_rng_);
+  if (sonar_resolution_ > 0.0) r = sonar_resolution_ * std::nearbyint(r / sonar_resolution_);
+  // sonar.c: a reading inside (SONAR_MIN, SONAR_MAX) enters the filter
+  // (sonar_filter: note that the position is predicted with the velocity
+  // of the update before last, v_pred, as the firmware does); outside,
+  // the distance is invalid until the next one.
+  if (r > sonar_min_ && r < sonar_max_) {
+    if (settle) {
+      // The device has run before the start: its filter sits on the reading.
+      sonar_x_ = r;
+      sonar_v_ = sonar_v_pred_ = 0.0;
+    } else {
+      const double dt = t_s - sonar_last_t_;
+      if (dt > 0.25) sonar_v_pred_ = 0.0;  // "more than 2 values lost"
+      const double x_pred = sonar_x_ + dt * sonar_v_pred_;
+      sonar_v_pred_ = sonar_v_;
+      const double innovation = r - x_pred;
+      sonar_x_ = x_pred + sonar_gain_position_ * innovation;
+      sonar_v_ = sonar_v_pred_ + sonar_gain_velocity_ * innovation;
+    }
+    sonar_last_t_ = t_s;
+    sonar_raw_ = r;
+    sonar_valid_ = true;
+  } else {
+    sonar_valid_ = false;
+  }
+  // sonar_read: a filtered distance out of the band is not valid either.
+  if (sonar_x_ < sonar_min_ || sonar_x_ > sonar_max_) sonar_valid_ = false;
 }
 
 void Px4FlowUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }
@@ -309,9 +443,9 @@ void Px4FlowUnit::Initialize() {
   publish_index_ = 1;
   next_frame_ = start_ + static_cast<cosim::TimeNs>(std::llround(1e9 / frame_rate_));
   next_publish_ = start_ + static_cast<cosim::TimeNs>(std::llround(1e9 / publish_rate_));
-  acc_x_ = acc_y_ = comp_x_ = comp_y_ = 0.0;
+  acc_x_ = acc_y_ = comp_x_ = comp_y_ = sonar_comp_x_ = sonar_comp_y_ = 0.0;
   acc_gyro_[0] = acc_gyro_[1] = acc_gyro_[2] = 0.0;
-  acc_count_ = acc_quality_ = 0;
+  acc_count_ = acc_quality_ = sonar_frames_ = 0;
   // The device's own errors, from its seed (not the frame stream, so that a
   // parameter set to 0 leaves the other draws as they were): its lens'
   // focal length and its gyro's bias; and the mains phase of this run.
@@ -332,8 +466,18 @@ void Px4FlowUnit::Initialize() {
   std::fill(integrated_gyro_.begin(), integrated_gyro_.end(), 0.0);
   std::fill(velocity_.begin(), velocity_.end(), 0.0);
   std::fill(frame_flow_.begin(), frame_flow_.end(), 0.0);
+  std::fill(sonar_velocity_.begin(), sonar_velocity_.end(), 0.0);
   valid_ = frame_quality_ = message_count_ = 0.0;
-  distance_ = (mount_height_ >= sonar_min_ && mount_height_ <= sonar_max_) ? mount_height_ : -1.0;
+  defocus_ = DefocusPx(mount_height_);
+  // The sonar: its first reading at the start (the filter settled on it),
+  // then one every sonar_period.
+  sonar_valid_ = false;
+  sonar_x_ = sonar_v_ = sonar_v_pred_ = sonar_raw_ = 0.0;
+  sonar_last_t_ = cosim::NsToSeconds(start_);
+  SonarReading(sonar_last_t_, mount_height_, true);
+  sonar_index_ = 1;
+  next_sonar_ = start_ + static_cast<cosim::TimeNs>(std::llround(1e9 * sonar_period_));
+  distance_ = sonar_valid_ ? (sonar_filtered_ ? sonar_x_ : sonar_raw_) : 0.0;
 }
 
 void Px4FlowUnit::TrueFlow(double& fx, double& fy, int& surface) const {
@@ -395,8 +539,10 @@ void Px4FlowUnit::BodyMotion(double rel_speed, const models::Surface& surf) {
     if (b > 0.0) {
       for (double& c : contact_) c = a * c + b * IrwinHall4(rng_());
     }
-    const double front = 0.5 * (contact_[0] + contact_[1]), rear = 0.5 * (contact_[2] + contact_[3]);
-    const double left = 0.5 * (contact_[0] + contact_[2]), right = 0.5 * (contact_[1] + contact_[3]);
+    const double front = 0.5 * (contact_[0] + contact_[1]),
+                 rear = 0.5 * (contact_[2] + contact_[3]);
+    const double left = 0.5 * (contact_[0] + contact_[2]),
+                 right = 0.5 * (contact_[1] + contact_[3]);
     pitch = -(front - rear) / wheelbase_;  // + nose down (about base_link y)
     roll = (left - right) / track_;        // + left side up (about base_link x)
     heave = 0.25 * (contact_[0] + contact_[1] + contact_[2] + contact_[3]);
@@ -431,13 +577,17 @@ void Px4FlowUnit::BodyMotion(double rel_speed, const models::Surface& surf) {
   height_ = mount_height_ + heave - pitch * mount_x_ + roll * mount_y_;
 }
 
-void Px4FlowUnit::Frame(double t_s) {
+void Px4FlowUnit::Frame(cosim::TimeNs t) {
+  const double t_s = cosim::NsToSeconds(t);
   double fx = 0.0, fy = 0.0, dir_c = 1.0, dir_s = 0.0;
   int surface = 0;
   TrueFlowAndDirection(fx, fy, surface, dir_c, dir_s);
   const models::Surface& surf = surfaces_[static_cast<std::size_t>(surface)];
   const double to_mps = frame_rate_ * mount_height_ / focal_length_px_;
   BodyMotion(std::hypot(fx, fy) * to_mps, surf);
+  defocus_ = DefocusPx(height_);
+  // main.c reads the sonar once per frame (sonar_read).
+  SonarUpTo(t, height_);
   // The image moves by the translation at the real height, seen through
   // this device's lens, plus the rotation (rad) times its focal length.
   const double f_true = focal_length_px_ * focal_factor_;
@@ -447,8 +597,8 @@ void Px4FlowUnit::Frame(double t_s) {
   fx += rot_y_ * f_true;
   fy -= rot_x_ * f_true;
   // A periodic texture's period in the image (px, sensor frame).
-  periodic_share_ = periodic_texture_ && surf.texture_period_m > 0.0 ? surf.texture_periodic_share
-                                                                     : 0.0;
+  periodic_share_ =
+      periodic_texture_ && surf.texture_period_m > 0.0 ? surf.texture_periodic_share : 0.0;
   const double period_px = surf.texture_period_m * f_true / std::max(height_, 1e-3);
   period_px_x_ = period_px * dir_c;
   period_px_y_ = period_px * dir_s;
@@ -460,11 +610,12 @@ void Px4FlowUnit::Frame(double t_s) {
   double flow_x = 0.0, flow_y = 0.0;
   if (image_) {
     // The image model renders the displacement (fx, fy) px at mount_height.
-    image_->SetPeriodicTexture(surf.texture_period_m * mount_height_ / std::max(height_, 1e-3) *
-                                   focal_factor_,
-                               dir_c, dir_s, periodic_share_);
-    const FlowResult r = image_->Step(fx * to_mps, fy * to_mps, mount_height_,
-                                      surf.texture_contrast, Illuminance(surf), brightness_);
+    image_->SetPeriodicTexture(
+        surf.texture_period_m * mount_height_ / std::max(height_, 1e-3) * focal_factor_, dir_c,
+        dir_s, periodic_share_);
+    const FlowResult r =
+        image_->Step(fx * to_mps, fy * to_mps, mount_height_, surf.texture_contrast,
+                     Illuminance(surf), brightness_, defocus_);
     q = r.quality;
     flow_x = r.flow_x_px;
     flow_y = r.flow_y_px;
@@ -478,6 +629,16 @@ void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, c
                             int& q, double& flow_x, double& flow_y) {
   const double blur_px = std::sqrt(fx * fx + fy * fy) * e.exposure_s * frame_rate_;
   const double br = blur_px / kBlurScalePx;
+  // Defocus: its disk as the box of the same variance on both axes, along
+  // the motion added in quadrature to the motion blur.
+  double along, across = 1.0;
+  if (defocus_ > 0.0) {
+    const double bd = kDiskToBox * defocus_ / kBlurScalePx;
+    along = 1.0 / (1.0 + br * br + bd * bd);
+    across = 1.0 / (1.0 + bd * bd);
+  } else {
+    along = 1.0 / (1.0 + br * br);
+  }
   // The blur keeps the texture across the motion and smooths it along: the
   // texture measure (compute_diff, both axes' differences) keeps
   // sqrt((1 + along) / 2) of it, along = 1 / (1 + (blur / 1.8)^2) the
@@ -485,8 +646,7 @@ void Px4FlowUnit::FastFrame(double fx, double fy, const models::Surface& surf, c
   // along the motion, sees the geometric mean of that and sqrt(along)
   // (fitted to the image-level reference's mean frame flow at long
   // exposures: tests/units/sensors/px4flow_fast_vs_image_test.cc).
-  const double along = 1.0 / (1.0 + br * br);
-  const double texture_blur = std::sqrt(0.5 * (1.0 + along));
+  const double texture_blur = std::sqrt(0.5 * (across + along));
   const double d = kNeighbourDiff * e.mean_dn * surf.texture_contrast * texture_blur;
   const double n2 = 2.0 * e.noise_dn * e.noise_dn + 1.0 / 6.0;
   const double n = std::sqrt(n2);
@@ -617,12 +777,19 @@ void Px4FlowUnit::CommitFrame(int q, double flow_x, double flow_y) {
     acc_y_ -= flow_x / focal_length_px_;
     // The firmware's compensation: minus the gyro's rotation in pixels
     // (nominal focal length), the inverse of the rotation flow.
+    double cx = flow_x, cy = flow_y;
     if (gyro_compensation_) {
-      comp_x_ += flow_x - g[1] * dt * focal_length_px_;
-      comp_y_ += flow_y + g[0] * dt * focal_length_px_;
-    } else {
-      comp_x_ += flow_x;
-      comp_y_ += flow_y;
+      cx = flow_x - g[1] * dt * focal_length_px_;
+      cy = flow_y + g[0] * dt * focal_length_px_;
+    }
+    comp_x_ += cx;
+    comp_y_ += cy;
+    // flow_comp_m: each frame's flow times the filtered sonar distance,
+    // over the frames with a valid distance.
+    if (sonar_valid_) {
+      sonar_comp_x_ += cx * sonar_x_;
+      sonar_comp_y_ += cy * sonar_x_;
+      ++sonar_frames_;
     }
     for (int i = 0; i < 3; ++i) acc_gyro_[i] += g[i] * dt;
     ++acc_count_;
@@ -642,21 +809,43 @@ void Px4FlowUnit::Publish() {
   frame_count_ = static_cast<double>(acc_count_);
   quality_ = acc_count_ > 0 ? static_cast<double>(acc_quality_ / acc_count_) : 0.0;
   for (int i = 0; i < 3; ++i) integrated_gyro_[static_cast<std::size_t>(i)] = acc_gyro_[i];
-  double sonar = mount_height_;
-  if (sonar_noise_ > 0.0) sonar += sonar_noise_ * Normal(rng_);
-  distance_ = (sonar >= sonar_min_ && sonar <= sonar_max_) ? sonar : -1.0;
+  distance_ = sonar_valid_ ? (sonar_filtered_ ? sonar_x_ : sonar_raw_) : 0.0;
+  // The unexplained residual: a flow rate (rad/s) per axis over the
+  // message, as if the frames' flow had carried it.
+  double nx = 0.0, ny = 0.0;
+  if (residual_ && residual_flow_noise_ > 0.0) {
+    nx = residual_flow_noise_ * Normal(residual_rng_);
+    ny = residual_flow_noise_ * Normal(residual_rng_);
+    integrated_x_ += ny * integration_time_;
+    integrated_y_ -= nx * integration_time_;
+  }
+  // flow_comp_m: surface relative to the sensor, +flow / f / dt * distance
+  // averaged over the frames (0 without one).
+  if (sonar_frames_ > 0) {
+    const double per_frame = frame_rate_ / (focal_length_px_ * static_cast<double>(sonar_frames_));
+    sonar_velocity_[0] = sonar_comp_x_ * per_frame + nx * sonar_x_;
+    sonar_velocity_[1] = sonar_comp_y_ * per_frame + ny * sonar_x_;
+  } else {
+    sonar_velocity_[0] = sonar_velocity_[1] = 0.0;
+  }
   if (acc_count_ > 0) {
-    // Surface relative to the sensor: +flow / f / T * h (the gyro-compensated
-    // flow when the firmware compensates).
-    velocity_[0] = comp_x_ / focal_length_px_ / integration_time_ * mount_height_;
-    velocity_[1] = comp_y_ / focal_length_px_ / integration_time_ * mount_height_;
+    if (scale_by_sonar_) {
+      velocity_ = sonar_velocity_;
+    } else {
+      // Surface relative to the sensor: +flow / f / T * h (the gyro-
+      // compensated flow when the firmware compensates).
+      velocity_[0] =
+          comp_x_ / focal_length_px_ / integration_time_ * mount_height_ + nx * mount_height_;
+      velocity_[1] =
+          comp_y_ / focal_length_px_ / integration_time_ * mount_height_ + ny * mount_height_;
+    }
     valid_ = 1.0;
   } else {
     valid_ = 0.0;
   }
-  acc_x_ = acc_y_ = comp_x_ = comp_y_ = 0.0;
+  acc_x_ = acc_y_ = comp_x_ = comp_y_ = sonar_comp_x_ = sonar_comp_y_ = 0.0;
   acc_gyro_[0] = acc_gyro_[1] = acc_gyro_[2] = 0.0;
-  acc_count_ = acc_quality_ = 0;
+  acc_count_ = acc_quality_ = sonar_frames_ = 0;
   message_count_ += 1.0;
 }
 
@@ -685,7 +874,7 @@ cosim::StepResult Px4FlowUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     if (next_frame_ <= next_publish_) {
       const double frame_s = cosim::NsToSeconds(next_frame_);
       dark_ = frame_s >= dark_from_ && frame_s < dark_until_;
-      Frame(frame_s);
+      Frame(next_frame_);
       ++frame_index_;
       next_frame_ = start_ + static_cast<cosim::TimeNs>(
                                  std::llround(frame_ns * static_cast<double>(frame_index_)));
@@ -705,30 +894,66 @@ void Px4FlowUnit::SaveInternal(cosim::UnitState& state) const {
                            ": mode image cannot save its state (the rendered texture "
                            "and the last image are not kept); use mode fast");
   }
-  std::ostringstream rng;
+  std::ostringstream rng, sonar_rng, residual_rng;
   rng << rng_;
-  state.strings = {rng.str()};
-  state.reals = {acc_x_,       acc_y_,          acc_gyro_[0],     acc_gyro_[1],
-                 acc_gyro_[2], comp_x_,         comp_y_,          focal_factor_,
-                 bias_[0],     bias_[1],        bias_[2],         contact_[0],
-                 contact_[1],  contact_[2],     contact_[3],      tyre_pitch_,
-                 tyre_pitch_rate_, tyre_roll_,  tyre_roll_rate_,  last_pitch_,
-                 last_roll_,   gyro_lagged_[0], gyro_lagged_[1],  gyro_lagged_[2],
-                 accel_x_,     accel_y_,        last_vx_,         last_vy_,
-                 have_last_velocity_ ? 1.0 : 0.0, brightness_,    flicker_phase_};
-  state.integers = {start_,         next_frame_, next_publish_, frame_index_,
-                    publish_index_, acc_count_,  acc_quality_};
+  sonar_rng << sonar_rng_;
+  residual_rng << residual_rng_;
+  state.strings = {rng.str(), sonar_rng.str(), residual_rng.str()};
+  state.reals = {acc_x_,
+                 acc_y_,
+                 acc_gyro_[0],
+                 acc_gyro_[1],
+                 acc_gyro_[2],
+                 comp_x_,
+                 comp_y_,
+                 focal_factor_,
+                 bias_[0],
+                 bias_[1],
+                 bias_[2],
+                 contact_[0],
+                 contact_[1],
+                 contact_[2],
+                 contact_[3],
+                 tyre_pitch_,
+                 tyre_pitch_rate_,
+                 tyre_roll_,
+                 tyre_roll_rate_,
+                 last_pitch_,
+                 last_roll_,
+                 gyro_lagged_[0],
+                 gyro_lagged_[1],
+                 gyro_lagged_[2],
+                 accel_x_,
+                 accel_y_,
+                 last_vx_,
+                 last_vy_,
+                 have_last_velocity_ ? 1.0 : 0.0,
+                 brightness_,
+                 flicker_phase_,
+                 sonar_comp_x_,
+                 sonar_comp_y_,
+                 sonar_raw_,
+                 sonar_x_,
+                 sonar_v_,
+                 sonar_v_pred_,
+                 sonar_last_t_,
+                 sonar_valid_ ? 1.0 : 0.0};
+  state.integers = {start_,     next_frame_,  next_publish_, frame_index_, publish_index_,
+                    acc_count_, acc_quality_, sonar_frames_, next_sonar_,  sonar_index_};
 }
 
 void Px4FlowUnit::RestoreInternal(const cosim::UnitState& state) {
-  if (state.strings.size() != 1 || state.reals.size() != 31 || state.integers.size() != 7) {
+  if (state.strings.size() != 3 || state.reals.size() != 39 || state.integers.size() != 10) {
     throw cosim::UnitError(Where() + ": saved state has the wrong shape");
   }
-  std::istringstream rng_text(state.strings[0]);
-  std::mt19937_64 rng;
-  rng_text >> rng;
-  if (!rng_text) throw cosim::UnitError(Where() + ": saved generator state is not readable");
-  rng_ = rng;
+  std::mt19937_64* const generators[] = {&rng_, &sonar_rng_, &residual_rng_};
+  for (std::size_t i = 0; i < 3; ++i) {
+    std::istringstream rng_text(state.strings[i]);
+    std::mt19937_64 rng;
+    rng_text >> rng;
+    if (!rng_text) throw cosim::UnitError(Where() + ": saved generator state is not readable");
+    *generators[i] = rng;
+  }
   const auto& r = state.reals;
   acc_x_ = r[0];
   acc_y_ = r[1];
@@ -752,6 +977,14 @@ void Px4FlowUnit::RestoreInternal(const cosim::UnitState& state) {
   have_last_velocity_ = r[28] != 0.0;
   brightness_ = r[29];
   flicker_phase_ = r[30];
+  sonar_comp_x_ = r[31];
+  sonar_comp_y_ = r[32];
+  sonar_raw_ = r[33];
+  sonar_x_ = r[34];
+  sonar_v_ = r[35];
+  sonar_v_pred_ = r[36];
+  sonar_last_t_ = r[37];
+  sonar_valid_ = r[38] != 0.0;
   start_ = state.integers[0];
   next_frame_ = state.integers[1];
   next_publish_ = state.integers[2];
@@ -759,6 +992,9 @@ void Px4FlowUnit::RestoreInternal(const cosim::UnitState& state) {
   publish_index_ = state.integers[4];
   acc_count_ = state.integers[5];
   acc_quality_ = state.integers[6];
+  sonar_frames_ = state.integers[7];
+  next_sonar_ = state.integers[8];
+  sonar_index_ = state.integers[9];
   CacheCamera();
 }
 

@@ -103,6 +103,43 @@ namespace linesim::sensors {
 ///    sigma scale_error from the unit's seed (the firmware uses the nominal
 ///    focal_length_px).
 ///  - the compute rate: frame_rate.
+///  - defocus (f_number, focus_distance): a thin lens focused at
+///    focus_distance images the floor at the sensor's real height as a
+///    uniform blur circle of diameter (f / N) |v_h - v_f| / v_h on the
+///    sensor (v_s = f s / (s - f)), in binned pixels of pixel_pitch. Image
+///    model: rendered through that disk; fast model: the disk as a box
+///    blur of the same variance per axis (length c sqrt(12 / 16)) on both
+///    axes, added in quadrature to the motion blur along the motion, in
+///    the blur law above (texture measure and match).
+///
+/// After the frames (both modes alike), what the messages carry:
+///  - the sonar (MaxBotix HRLV-MaxSonar-EZ4 on the board; PX4/Flow
+///    sonar.c): a reading every sonar_period of the real height, but never
+///    below sonar_min_range (the HRLV reports targets closer than 300 mm
+///    as 300 mm), with sonar_noise, rounded to sonar_resolution (its
+///    serial output in mm); the firmware keeps readings inside
+///    (sonar_min, sonar_max) and filters them (a position-velocity Kalman
+///    filter with the fixed gains sonar_gain_position and
+///    sonar_gain_velocity, SONAR_KAL_L1 and L2); the distance is valid
+///    while the filtered value is inside the band. OPTICAL_FLOW carries
+///    `distance` (ground_distance: the raw reading, or the filtered one
+///    with sonar_filtered; 0 when invalid) and `sonar_velocity`
+///    (flow_comp_m: the mean over the message's frames of quality > 0
+///    and a valid distance of flow / f / frame interval times the
+///    filtered distance). `velocity` is either that (velocity_scaling
+///    sonar) or the flow scaled by the fixed mount_height (fixed_height:
+///    paper 1 Sec. IV-A, "the fixed height of the sensor is used in
+///    calculating velocity, rather than the noisy sonar measurements").
+///  - the message cadence: a message every 1 / publish_rate (the firmware
+///    sends OPTICAL_FLOW every BFLOW_THROTT computed frames: publish_rate
+///    = frame_rate / BFLOW_THROTT; px4flow_node publishes each one).
+///  - an UNEXPLAINED RESIDUAL (residual, residual_flow_noise): white noise
+///    per message and axis, in rad/s of flow (velocity: times the height
+///    used for the scaling), for what the device's measured noise has
+///    beyond the mechanisms above. It has no mechanism and no source of
+///    its own: its size is calibrated to the published noise figures
+///    (models/sensors/px4flow.yaml says how). Its draws have a generator
+///    of their own, so switching it off leaves every other draw as it was.
 ///
 /// With `mode: image` each frame is rendered and matched instead
 /// (Px4FlowImageModel: the 64 x 64 binned image of the surface's procedural
@@ -133,12 +170,16 @@ class Px4FlowUnit : public cosim::Unit {
   void RestoreInternal(const cosim::UnitState& state) override;
 
  private:
+  /// The constructor's declarations: parameters, then inputs (the belts'
+  /// velocity with `belts`) and outputs.
+  void DeclareParameters();
+  void DeclareInputsAndOutputs(bool belts);
   void CacheCamera();
   /// TrueFlow, and the direction of the surface's length (its belt's
   /// direction, map x for the floor) in the sensor frame.
   void TrueFlowAndDirection(double& fx, double& fy, int& surface, double& dir_c,
                             double& dir_s) const;
-  void Frame(double t_s);
+  void Frame(cosim::TimeNs t);
   /// The fast model's frame: quality and flow (px) of the true flow (fx, fy)
   /// over surface `surf` under the frame's exposure `e`; q stays 0 with 10
   /// or fewer blocks.
@@ -150,6 +191,13 @@ class Px4FlowUnit : public cosim::Unit {
   /// rot_x_, rot_y_ (the sensor's rotation over the frame, rad, sensor
   /// frame) and height_ (m).
   void BodyMotion(double rel_speed, const models::Surface& surf);
+  /// The lens' blur circle diameter on the sensor (binned px) for a floor
+  /// at `height` (m): 0 when focused there.
+  double DefocusPx(double height) const;
+  /// The sonar readings due up to time t (ns) and the firmware's filter
+  /// (sonar.c sonar_read); one reading of the height `height` (m).
+  void SonarUpTo(cosim::TimeNs t, double height);
+  void SonarReading(double t_s, double height, bool settle);
   /// The ambient light's brightness over the exposure ending at time t (s),
   /// relative to its mean (1 without flicker).
   double Brightness(const models::Surface& surf, double t, double exposure_s) const;
@@ -182,6 +230,17 @@ class Px4FlowUnit : public cosim::Unit {
   double dark_from_ = 0.0, dark_until_ = 0.0;
   bool dark_ = false;  // the frame being computed falls in it
   double sonar_noise_ = 0.005, sonar_min_ = 0.12, sonar_max_ = 3.5;
+  double sonar_min_range_ = 0.3, sonar_resolution_ = 0.001, sonar_period_ = 0.1;
+  double sonar_gain_position_ = 0.8461, sonar_gain_velocity_ = 6.2034;
+  bool sonar_filtered_ = false;
+  // `velocity_scaling`: "fixed_height" (paper 1) or "sonar" (flow_comp_m).
+  std::string velocity_scaling_ = "fixed_height";
+  // Defocus: the lens' f-number, the distance it is focused at (0: at
+  // mount_height) and the binned pixel's pitch on the sensor.
+  double f_number_ = 1.4, focus_distance_ = 0.0, pixel_pitch_ = 24e-6;
+  // The unexplained residual (rad/s of flow per message and axis).
+  double residual_flow_noise_ = 0.0;
+  bool residual_ = true;
   double gyro_noise_ = 0.0, gyro_range_ = 4.363323129985824;  // 250 deg/s
   bool gyro_compensation_ = false;
   double gyro_bias_ = 0.0, gyro_lag_ = 0.0, scale_error_ = 0.0;
@@ -197,8 +256,9 @@ class Px4FlowUnit : public cosim::Unit {
 
   // Outputs.
   double integrated_x_ = 0.0, integrated_y_ = 0.0, integration_time_ = 0.0, quality_ = 0.0;
-  std::vector<double> integrated_gyro_, velocity_, frame_flow_;
-  double distance_ = -1.0, valid_ = 0.0, frame_quality_ = 0.0, frame_count_ = 0.0;
+  std::vector<double> integrated_gyro_, velocity_, frame_flow_, sonar_velocity_;
+  double distance_ = 0.0, valid_ = 0.0, frame_quality_ = 0.0, frame_count_ = 0.0;
+  double defocus_ = 0.0;  // the last frame's blur circle (px)
   double message_count_ = 0.0;
 
   // `mode`: "fast" (the per-frame model above) or "image" (every frame
@@ -211,13 +271,27 @@ class Px4FlowUnit : public cosim::Unit {
   std::uint64_t seed_;
   std::unique_ptr<Px4FlowImageModel> image_;  // image mode only
   double cos_mount_ = 1.0, sin_mount_ = 0.0;  // of mount_yaw (CacheCamera)
+  bool scale_by_sonar_ = false;               // velocity_scaling is sonar (CacheCamera)
   std::mt19937_64 rng_;
   cosim::TimeNs start_ = 0, next_frame_ = 0, next_publish_ = 0;
   std::int64_t frame_index_ = 0, publish_index_ = 0;
   double acc_x_ = 0.0, acc_y_ = 0.0, acc_gyro_[3] = {0, 0, 0};
   std::int64_t acc_count_ = 0, acc_quality_ = 0;
-  // The firmware's gyro-compensated flow sums (px), for `velocity`.
-  double comp_x_ = 0.0, comp_y_ = 0.0;
+  // The firmware's gyro-compensated flow sums (px), for `velocity`, and
+  // the same scaled per frame by the filtered sonar distance (px m) over
+  // the frames with a valid distance (flow_comp_m).
+  double comp_x_ = 0.0, comp_y_ = 0.0, sonar_comp_x_ = 0.0, sonar_comp_y_ = 0.0;
+  std::int64_t sonar_frames_ = 0;
+  // The sonar and its filter in the firmware: the last reading (m), the
+  // filter's position (m) and velocity (m/s) and the time of its last
+  // update (s), whether the distance is valid; the next reading's time.
+  double sonar_raw_ = 0.0, sonar_x_ = 0.0, sonar_v_ = 0.0, sonar_v_pred_ = 0.0, sonar_last_t_ = 0.0;
+  bool sonar_valid_ = false;
+  cosim::TimeNs next_sonar_ = 0;
+  std::int64_t sonar_index_ = 0;
+  // Generators of their own (seeded from the unit's seed), so that the
+  // sonar and the residual leave the frame stream's draws as they are.
+  std::mt19937_64 sonar_rng_, residual_rng_;
   // Per device (drawn from the seed at Initialize): focal length factor and gyro bias.
   double focal_factor_ = 1.0, bias_[3] = {0, 0, 0};
   // Body motion state: contact heights (m) front-left, front-right,

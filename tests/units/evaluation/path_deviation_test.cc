@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 namespace linesim::evaluation {
 namespace {
@@ -48,6 +50,46 @@ TEST(PathDeviationUnit, OutputsFollowThePose) {
   EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("progress")), 3.0);
   EXPECT_EQ(u.DoStep(0, 1'000'000), cosim::StepResult::kOk);
   EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("deviation")), 0.04);
+}
+
+// Guards paper 1's criterion for a crossing (Fig. 5: "<4 cm for the entire
+// path", Fig. 6: only the modified system gets across): success only
+// while the deviation never left the 4 cm band and once the robot is
+// within 4 cm of the path's end along it. A single step 4.1 cm off latches
+// the failure even when the robot comes back and arrives; 3.9 cm off does
+// not; a hold succeeds while it stays within the band.
+TEST(PathDeviationUnit, SuccessIsWithinTheBandAllTheWayAndAcross) {
+  PathDeviationUnit u("monitor", {{0, -2}, {0, 2}});
+  auto& v = u.variables();
+  const auto at = [&](double x, double y) {
+    v.SetRealArray(*v.Find("position"), std::vector<double>{x, y});
+    u.UpdateOutputs();
+    return std::pair<double, double>{v.GetReal(*v.Find("success")),
+                                     v.GetReal(*v.Find("band_exceeded"))};
+  };
+  v.SetRealArray(*v.Find("position"), std::vector<double>{0.0, -2.0});
+  u.Initialize();
+  EXPECT_EQ(at(0.0, -2.0), (std::pair<double, double>{0.0, 0.0}));  // not across yet
+  ASSERT_EQ(u.DoStep(0, 1'000'000), cosim::StepResult::kOk);
+  EXPECT_EQ(at(0.039, 0.0), (std::pair<double, double>{0.0, 0.0}));  // inside the band
+  ASSERT_EQ(u.DoStep(1'000'000, 1'000'000), cosim::StepResult::kOk);
+  EXPECT_EQ(at(0.0, 1.97), (std::pair<double, double>{1.0, 0.0}));  // across, 3 cm short
+  ASSERT_EQ(u.DoStep(2'000'000, 1'000'000), cosim::StepResult::kOk);
+  EXPECT_EQ(at(0.041, 1.0), (std::pair<double, double>{0.0, 1.0}));  // out of the band
+  ASSERT_EQ(u.DoStep(3'000'000, 1'000'000), cosim::StepResult::kOk);
+  EXPECT_EQ(at(0.0, 2.0), (std::pair<double, double>{0.0, 1.0}));  // latched
+  // A restart clears it; the saved state carries it.
+  const cosim::UnitState saved = u.SaveState();
+  u.Initialize();
+  EXPECT_EQ(at(0.0, 2.0), (std::pair<double, double>{1.0, 0.0}));
+  u.RestoreState(saved);
+  EXPECT_EQ(at(0.0, 2.0), (std::pair<double, double>{0.0, 1.0}));
+
+  PathDeviationUnit hold("hold", {{1, 1}});
+  auto& h = hold.variables();
+  h.SetRealArray(*h.Find("position"), std::vector<double>{1.03, 1.0});
+  hold.Initialize();
+  EXPECT_EQ(h.GetReal(*h.Find("success")), 1.0);
 }
 
 // Guards against an empty path being accepted (every distance would be NaN),

@@ -305,7 +305,8 @@ TEST(Px4FlowUnit, IntegrationCountsOnlyFramesWithQuality) {
     EXPECT_NEAR(Get(u, "integrated_y")[0], -20 * 2.0 / 666.7, 1e-12);
     EXPECT_NEAR(Get(u, "integrated_x")[0], 0.0, 1e-12);
     EXPECT_NEAR(Get(u, "velocity")[0], v, 1e-9);
-    EXPECT_DOUBLE_EQ(Get(u, "distance")[0], kHeight);
+    // The sonar: 0.1841 m is closer than the HRLV's 300 mm minimum.
+    EXPECT_DOUBLE_EQ(Get(u, "distance")[0], 0.3);
     // One message at 0.1 s (publish_rate 10 Hz), the next at 0.2 s.
     EXPECT_EQ(Get(u, "message_count")[0], 1.0);
     StepFor(u, 100 * kMs, 200 * kMs);
@@ -351,15 +352,192 @@ TEST(Px4FlowUnit, DarkSpellLosesTheBeltUntilTheLightReturns) {
   test_spread::Print("velocity dark (m/s)", dark);
 }
 
-// The sonar's valid window (sonar.c 0.12..3.5 m): a sensor mounted at
-// 0.1 m reports distance -1 (unknown).
-TEST(Px4FlowUnit, SonarOutsideItsRangeIsFlaggedInvalid) {
-  Px4FlowUnit u("flow", Scene(0.3, 3000.0), 8);
+// The firmware's valid window (sonar.c 0.12..3.5 m): a sonar that did
+// range down to its face (sonar_min_range 0) at 0.1 m would be dropped,
+// and main.c sends ground_distance 0 and no sonar-scaled velocity; the
+// fixed-height velocity does not need the sonar. The HRLV itself never
+// reads below 300 mm, so at 0.1 m it reports 0.3 (valid): the firmware
+// then scales with the wrong distance.
+TEST(Px4FlowUnit, SonarOutsideTheFirmwaresWindowIsInvalid) {
+  for (const double min_range : {0.0, 0.3}) {
+    SCOPED_TRACE(min_range);
+    Px4FlowUnit u("flow", Scene(0.3, 3000.0), 8);
+    Mount(u);
+    SetAll(u, "mount_height", 0.1);
+    SetAll(u, "sonar_min_range", min_range);
+    SetAll(u, "sonar_noise", 0.0);
+    Start(u);
+    SetArray(u, "belt_velocity", {0.2, 0.0});
+    StepFor(u, 0, 300 * kMs);
+    EXPECT_EQ(Get(u, "valid")[0], 1.0);
+    EXPECT_NEAR(Get(u, "velocity")[0], 0.2, 0.03);
+    if (min_range == 0.0) {
+      EXPECT_EQ(Get(u, "distance")[0], 0.0);
+      EXPECT_EQ(Get(u, "sonar_velocity")[0], 0.0);
+    } else {
+      EXPECT_DOUBLE_EQ(Get(u, "distance")[0], 0.3);
+      EXPECT_NEAR(Get(u, "sonar_velocity")[0] / Get(u, "velocity")[0], 3.0, 1e-9);
+    }
+  }
+}
+
+// Guards the sonar at paper 1's mount (MaxBotix HRLV-MaxSonar-EZ data
+// sheet: targets closer than 300 mm range as 300 mm; main.c: flow_comp_m =
+// the mean over the frames of flow / f / dt times the filtered sonar
+// distance). Expected, noise off, a belt moving exactly 2 px/frame: every
+// frame's flow is 2 px, so `velocity` (fixed height) is the belt's speed
+// exactly and `sonar_velocity` that times 0.300 / 0.1841 = 1.630; with
+// velocity_scaling sonar, `velocity` is the latter.
+TEST(Px4FlowUnit, TheSonarAtPaper1sMountReadsItsMinimumAndScalesTheFlowWithIt) {
+  for (const std::string scaling : {"fixed_height", "sonar"}) {
+    SCOPED_TRACE(scaling);
+    Px4FlowUnit u("flow", Scene(0.3, 3000.0), 4);
+    Mount(u);
+    SetAll(u, "sonar_noise", 0.0);
+    u.variables().SetValue(*u.variables().Find("velocity_scaling"), cosim::Value{scaling});
+    Start(u);
+    const double v = 2.0 * kHeight / (0.0025 * 666.7);
+    SetArray(u, "belt_velocity", {v, 0.0});
+    StepFor(u, 0, 300 * kMs);
+    EXPECT_DOUBLE_EQ(Get(u, "distance")[0], 0.3);
+    EXPECT_NEAR(Get(u, "sonar_velocity")[0], v * 0.3 / kHeight, 1e-9);
+    EXPECT_NEAR(Get(u, "velocity")[0], scaling == "sonar" ? v * 0.3 / kHeight : v, 1e-9);
+  }
+}
+
+// Guards the sonar's noise and the firmware's filter (HRLV: whole
+// millimetres; sonar.c: a position-velocity filter with gains 0.8461 and
+// 6.2034 over the 100 ms readings). Expected: every ground_distance is a
+// whole number of millimetres, their mean is 300 mm within 3 standard
+// errors (5 mm / sqrt(n)) and their standard deviation 5 mm within 3 of
+// its standard errors (plus the rounding's 0.3 mm); the sonar-scaled
+// velocity follows the filtered distance, which passes the readings'
+// noise nearly whole (its steady-state gain to the filter's position is
+// near 1 with L1 = 0.85), and so its relative spread lies between a
+// quarter and 1.5 times the readings'. Seed 5, 300 messages of 0.1 s.
+TEST(Px4FlowUnit, SonarReadingsAreWholeMillimetresAndTheFilterFollowsThem) {
+  Px4FlowUnit u("flow", Scene(0.3, 3000.0), 5);
   Mount(u);
-  SetAll(u, "mount_height", 0.1);
   Start(u);
-  StepFor(u, 0, 100 * kMs);
-  EXPECT_EQ(Get(u, "distance")[0], -1.0);
+  const double v = 2.0 * kHeight / (0.0025 * 666.7);
+  SetArray(u, "belt_velocity", {v, 0.0});
+  std::vector<double> d, ratio;
+  for (int m = 0; m < 300; ++m) {
+    StepFor(u, m * 100 * kMs, (m + 1) * 100 * kMs);
+    d.push_back(Get(u, "distance")[0]);
+    ratio.push_back(Get(u, "sonar_velocity")[0] / Get(u, "velocity")[0] * kHeight / 0.3);
+  }
+  const auto mean_std = [](const std::vector<double>& x) {
+    double s = 0.0, q = 0.0;
+    for (double e : x) s += e;
+    const double mean = s / x.size();
+    for (double e : x) q += (e - mean) * (e - mean);
+    return std::pair<double, double>{mean, std::sqrt(q / (x.size() - 1))};
+  };
+  for (double e : d) EXPECT_NEAR(e * 1000.0, std::nearbyint(e * 1000.0), 1e-9) << e;
+  const auto [mean, sd] = mean_std(d);
+  EXPECT_NEAR(mean, 0.3, 3.0 * 0.005 / std::sqrt(300.0));
+  EXPECT_NEAR(sd, 0.005, 3.0 * 0.005 / std::sqrt(2.0 * 299.0) + 0.0003);
+  const auto [r_mean, r_sd] = mean_std(ratio);
+  EXPECT_NEAR(r_mean, 1.0, 0.003);
+  EXPECT_GT(r_sd, 0.25 * 0.005 / 0.3);
+  EXPECT_LT(r_sd, 1.5 * 0.005 / 0.3);
+  std::printf("ground_distance mean %.5f std %.5f m; sonar / fixed velocity std %.5f\n", mean, sd,
+              r_sd);
+}
+
+// Guards the lens' defocus (thin lens, f = 666.7 px x 24 um = 16 mm,
+// f/1.4): focused at the mount height the floor is sharp (0 px); focused at
+// 3 m the floor at 0.1841 m is imaged at v_h = f h / (h - f) = 17.524 mm
+// against the sensor at v_f = f 3 / (3 - f) = 16.086 mm: a blur circle of
+// (f / 1.4) (v_h - v_f) / v_h = 0.938 mm, 39.1 binned pixels; focused at
+// 0.1941 m (10 mm off) 2.3 px, which the firmware hardly notices. With
+// the 39 px blur (10 mm on the floor) little of the 1 mm texture is left:
+// many blocks match noise, the quality falls but stays above 0
+// (PX4-Autopilot PR 5574: a lens focused far away is out of focus on the
+// ground and still reports a quality), and the velocity reads well short
+// of the belt: below 0.15 m/s on average over 20 messages (the fast model
+// 0.117 m/s here, 1.06 of 1.81 px a frame; the image-level reference 0.76
+// px: px4flow_fast_vs_image_test.cc, DefocusAgrees) with a quality below
+// 200 (the reference 125, the fast model 154).
+TEST(Px4FlowUnit, DefocusIsTheThinLensBlurCircle) {
+  const double f = 666.7 * 24e-6;
+  const auto expected = [&](double focus) {
+    const double v_h = f * kHeight / (kHeight - f), v_f = f * focus / (focus - f);
+    return f / 1.4 * std::abs(v_h - v_f) / v_h / 24e-6;
+  };
+  EXPECT_NEAR(expected(3.0), 39.1, 0.05);
+  for (const double focus : {0.0, 0.1941, 3.0}) {
+    SCOPED_TRACE(focus);
+    Px4FlowUnit u("flow", Scene(0.12, 800.0), 3);
+    Mount(u);
+    SetAll(u, "focus_distance", focus);
+    SetAll(u, "scale_error", 0.0);
+    Start(u);
+    SetArray(u, "belt_velocity", {0.2, 0.0});
+    // The mean of 20 messages (0.1 s each).
+    double sum = 0.0;
+    for (int m = 0; m < 20; ++m) {
+      StepFor(u, m * 100 * kMs, (m + 1) * 100 * kMs);
+      sum += Get(u, "velocity")[0];
+      EXPECT_GT(Get(u, "quality")[0], 0.0);
+    }
+    EXPECT_NEAR(Get(u, "defocus")[0], focus == 0.0 ? 0.0 : expected(focus), 1e-9);
+    if (focus == 3.0) {
+      EXPECT_LT(std::abs(sum / 20), 0.15);
+      EXPECT_LT(Get(u, "quality")[0], 200.0);
+    } else {
+      EXPECT_NEAR(sum / 20, 0.2, 0.03);
+    }
+    std::printf("focus %.4f m: defocus %.2f px, mean velocity %.4f m/s\n", focus,
+                Get(u, "defocus")[0], sum / 20);
+  }
+}
+
+// Guards the unexplained residual: white noise of residual_flow_noise
+// rad/s per message and axis, on `velocity` times the height it is scaled
+// with and on the integrated flow times the integration time; off, the
+// messages are what the mechanisms give. Expected, on a strong texture
+// whose frames read exactly 2 px: velocity - v of standard deviation
+// 0.143 x 0.1841 = 26.3 mm/s per axis within 3 standard errors over 400
+// messages (sigma / sqrt(2 x 399): 3.6 %), mean 0 within 3 sigma / sqrt(n);
+// integrated_y = -(flow sum / f) - n_x T exactly consistent with the
+// velocity's deviation; switched off, velocity = v exactly.
+TEST(Px4FlowUnit, ResidualIsWhiteNoiseOfItsSizeAndSwitchesOff) {
+  const double sigma = 0.143, v = 2.0 * kHeight / (0.0025 * 666.7);
+  for (const bool on : {true, false}) {
+    SCOPED_TRACE(on);
+    Px4FlowUnit u("flow", Scene(0.3, 3000.0), 6);
+    Mount(u);
+    SetAll(u, "residual_flow_noise", sigma);
+    u.variables().SetValue(*u.variables().Find("residual"), cosim::Value{on});
+    Start(u);
+    SetArray(u, "belt_velocity", {v, 0.0});
+    double sum = 0.0, sq = 0.0, sum_y = 0.0, sq_y = 0.0;
+    constexpr int kMessages = 400;
+    for (int m = 0; m < kMessages; ++m) {
+      StepFor(u, m * 100 * kMs, (m + 1) * 100 * kMs);
+      const double e = Get(u, "velocity")[0] - v, ey = Get(u, "velocity")[1];
+      sum += e;
+      sq += e * e;
+      sum_y += ey;
+      sq_y += ey * ey;
+      // The integrated flow carries the same rate: -(40 x 2 px) / f - n_x T.
+      const double n_x = e / kHeight;
+      EXPECT_NEAR(Get(u, "integrated_y")[0], -40 * 2.0 / 666.7 - n_x * 0.1, 1e-12);
+    }
+    const double sd = std::sqrt(sq / kMessages), sd_y = std::sqrt(sq_y / kMessages);
+    if (on) {
+      const double expected = sigma * kHeight;
+      EXPECT_NEAR(sum / kMessages, 0.0, 3.0 * expected / std::sqrt(kMessages));
+      EXPECT_NEAR(sd, expected, 3.0 * expected / std::sqrt(2.0 * (kMessages - 1)));
+      EXPECT_NEAR(sd_y, expected, 3.0 * expected / std::sqrt(2.0 * (kMessages - 1)));
+      EXPECT_NEAR(sum_y / kMessages, 0.0, 3.0 * expected / std::sqrt(kMessages));
+    } else {
+      EXPECT_LT(sd, 1e-12);
+      EXPECT_LT(sd_y, 1e-12);
+    }
+  }
 }
 
 // Integrated gyro: omega_z * integration time over the valid frames.
@@ -415,7 +593,6 @@ TEST(Px4FlowUnit, RestoredUnitContinuesIdentically) {
         << cosim::FormatSeconds(t);
   }
 }
-
 
 // ---- Issue 21: the disturbances, each a mechanism ----
 
@@ -729,11 +906,12 @@ TEST(Px4FlowUnit, ReportsParameterProblems) {
   SetInt(u, "search_range", 9);
   SetAll(u, "sonar_min", 4.0);
   SetAll(u, "publish_rate", 500.0);
+  SetAll(u, "focus_distance", 0.02);  // inside twice the 16 mm focal length
   const auto problems = u.CheckParameters();
   std::string all;
   for (const auto& p : problems) all += p.variable + ": " + p.message + "\n";
-  for (const char* name :
-       {"mount_x", "mount_y", "mount_height", "search_range", "sonar_max", "publish_rate"}) {
+  for (const char* name : {"mount_x", "mount_y", "mount_height", "search_range", "sonar_max",
+                           "publish_rate", "focus_distance"}) {
     EXPECT_NE(all.find(std::string(name) + ":"), std::string::npos) << name << "\n" << all;
   }
   EXPECT_THROW(u.Initialize(), cosim::UnitError);
@@ -749,7 +927,7 @@ TEST(Px4FlowUnit, DeclaresBeltVelocityOnlyWithBelts) {
   EXPECT_TRUE(w.variables().Find("belt_velocity"));
   for (const char* name : {"integrated_x", "integrated_y", "integration_time", "quality",
                            "integrated_gyro", "distance", "velocity", "valid", "frame_quality",
-                           "frame_flow", "frame_count"}) {
+                           "frame_flow", "frame_count", "sonar_velocity", "defocus"}) {
     EXPECT_TRUE(w.variables().Find(name)) << name;
   }
 }
@@ -820,7 +998,8 @@ TEST(Px4FlowImage, ComputeFlowFindsAnIntegerShift) {
   m.Render(0.0, 0.0, 0.0, 0.0, kHeight, 0.3, 3000.0, a);
   for (int y = 0; y < kImageSize; ++y) {
     for (int x = 0; x < kImageSize; ++x) {
-      const int sx = std::clamp(x - 3, 0, kImageSize - 1), sy = std::clamp(y + 2, 0, kImageSize - 1);
+      const int sx = std::clamp(x - 3, 0, kImageSize - 1),
+                sy = std::clamp(y + 2, 0, kImageSize - 1);
       b[y * kImageSize + x] = a[sy * kImageSize + sx];
     }
   }
