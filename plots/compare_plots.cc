@@ -61,7 +61,7 @@ PlotItem LineOnBand(const std::string& dir, const ComparisonPlotSpec& spec) {
   }
   return {GnuplotQuote(first.signals_csv) + " skip 1 using 1:((" + any_on + ") ? " +
               style::kLineOnBandFrom + " : 1):(1)",
-          style::kLineOnStyle, style::kLineOnTitle};
+          std::string("axes x1y2 with filledcurves ") + style::kLineOnFill, style::kLineOnTitle};
 }
 
 }  // namespace
@@ -72,7 +72,7 @@ std::string ComparisonScript(const std::string& dir, const ComparisonPlotSpec& s
   std::string axes;
   if (!spec.belt_on_columns.empty()) {
     items.push_back(LineOnBand(dir, spec));
-    axes = style::kLineOnAxes;
+    axes = "set y2range [0:1]\nunset y2tics\nset offsets 0, 0, graph 0.1, 0\n";
   }
   for (std::size_t i = 0; i < spec.runs.size(); ++i) {
     const ComparisonPlotSpec::Run& run = spec.runs[i];

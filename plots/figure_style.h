@@ -67,15 +67,12 @@ inline constexpr const char* kCarriedEndStyle = "dt 2 lw 1.5 lc rgb '#C07020'";
 inline constexpr const char* kBoundStyle = "dt 2 lw 2 lc rgb '#000000'";
 
 /// The line's on state in a time plot (paper 1 Figs. 5-7 mark it): a grey
-/// band along the top of the plot where any belt is scheduled on, drawn on
-/// the second y axis (0 to 1; the band from kLineOnBandFrom up), the data
-/// kept below it by an offset.
+/// band along the top of the plot (from kLineOnBandFrom of the graph's
+/// height up) where any belt is scheduled on, the data kept below it by
+/// an offset.
 inline constexpr const char* kLineOnBandFrom = "0.97";
-inline constexpr const char* kLineOnStyle =
-    "axes x1y2 with filledcurves fillcolor rgb '#BDBDBD' fillstyle solid 1.0 noborder";
+inline constexpr const char* kLineOnFill = "fillcolor rgb '#BDBDBD' fillstyle solid 1.0 noborder";
 inline constexpr const char* kLineOnTitle = "line on (band along the top)";
-inline constexpr const char* kLineOnAxes =
-    "set y2range [0:1]\nunset y2tics\nset offsets 0, 0, graph 0.1, 0\n";
 
 /// The pictures' sizes (px).
 struct Canvas {

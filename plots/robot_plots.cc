@@ -88,21 +88,70 @@ Columns FindColumns(const RobotPlotSpec& spec, const table::Signals& signals) {
   return c;
 }
 
+// Spans of time where a state holds, from one row after another.
+class SpanTracker {
+ public:
+  void Row(double t, bool holds, std::vector<std::array<double, 2>>& spans) {
+    if (holds && !open_) spans.push_back({t, t});
+    // A span reaches to the next row: the state held until then.
+    if (holds || open_) spans.back()[1] = t;
+    open_ = holds;
+  }
+
+ private:
+  bool open_ = false;
+};
+
+// What the figures draw of states (the line on, the fields infringed, the
+// field set, the task done) from one row: spans and change points, so that
+// gnuplot draws a few rectangles and steps instead of a curve of every row.
+struct StateTrackers {
+  SpanTracker line_on, protective, warning;
+  void Row(RobotRun& run, const std::vector<std::string_view>& fields, double t) {
+    const Columns& c = run.col;
+    using table::Column;
+    if (!c.belt_ons.empty()) {
+      bool on = false;
+      for (const int col : c.belt_ons) on = on || Column(fields, col).value_or(0.0) > 0.5;
+      line_on.Row(t, on, run.line_on);
+    }
+    if (c.protective > 0) {
+      protective.Row(t, Column(fields, c.protective).value_or(1.0) < 0.5, run.protective_infringed);
+      warning.Row(t, Column(fields, c.warning).value_or(1.0) < 0.5, run.warning_infringed);
+    }
+    if (const auto set = Column(fields, c.field_set)) {
+      const int index = static_cast<int>(std::lround(*set));
+      if (run.field_sets.empty() || run.field_sets.back().second != index) {
+        run.field_sets.emplace_back(t, index);
+      }
+    }
+    if (std::isnan(run.bound_from_t) && Column(fields, c.bound_from).value_or(0.0) > 0.5) {
+      run.bound_from_t = t;
+    }
+    if (const auto d = Column(fields, c.distance); d && !(*d >= run.closest_m)) {
+      run.closest_m = *d;
+      run.closest_t = t;
+    }
+  }
+};
+
 // The one pass over the rows: where each starts, the $signals block of the
 // columns the time plots draw, the tracks' extent, the other robots' and
-// workers' tracks, each belt's last travel and a person's nearest approach.
+// workers' tracks, each belt's last travel, the states' spans and a
+// person's nearest approach.
 std::string ReadRows(RobotRun& run) {
   const Columns& c = run.col;
-  for (const int col : {c.x, c.y, c.error, c.bound_from, c.flow_reference, c.vx, c.vy, c.cap,
-                        c.protective, c.warning, c.distance, c.field_set}) {
-    run.data.Use(col);
-  }
+  run.data.Use(c.x);
+  run.data.Use(c.y);
+  run.data.UseScaled(c.error, 1000.0);  // drawn in mm
+  for (const int col : {c.flow_reference, c.vx, c.vy, c.cap, c.distance}) run.data.Use(col);
   for (const auto* list :
        {&c.belt_speeds, &c.belt_ons, &c.flows, &c.flow_truths, &c.flow_filtered}) {
     for (const int col : *list) run.data.Use(col);
   }
-  int last_column = std::max(c.x, c.y);
+  int last_column = std::max({c.x, c.y, c.bound_from, c.protective, c.warning, c.field_set});
   for (int col : c.belt_travels) last_column = std::max(last_column, col);
+  for (int col : c.belt_ons) last_column = std::max(last_column, col);
   for (const auto& o : c.others) last_column = std::max({last_column, o.x, o.y});
   for (const auto& w : c.workers) last_column = std::max({last_column, w.x, w.y});
   const auto needed = std::max(static_cast<std::size_t>(last_column), run.data.last_csv());
@@ -114,6 +163,7 @@ std::string ReadRows(RobotRun& run) {
   std::vector<std::string_view> fields;
   std::string line;
   table::Signals& signals = run.signals;
+  StateTrackers states;
   bool first = true;
   while (true) {
     const std::streamoff start = signals.in.tellg();
@@ -127,11 +177,7 @@ std::string ReadRows(RobotRun& run) {
       if (first) run.t_first = *t;
       first = false;
       run.t_last = *t;
-      const auto d = Column(fields, c.distance);
-      if (d && !(*d >= run.closest_m)) {
-        run.closest_m = *d;
-        run.closest_t = *t;
-      }
+      states.Row(run, fields, *t);
     }
     const auto x = Column(fields, c.x), y = Column(fields, c.y);
     if (x && y) run.tracks.Add(*x, *y);
@@ -165,29 +211,31 @@ std::string TimeAxes(const RobotRun& run, const std::vector<std::string>& titles
          "\nset xlabel 'time (s)'\nset xrange [" + Num(run.t_first) + ":" + Num(run.t_last) + "]\n";
 }
 
-// Where any belt is scheduled on, as a column expression (1 on, 0 off);
-// empty without on columns.
-std::string AnyBeltOn(const RobotRun& run) {
-  std::string any_on;
-  for (std::size_t i = 0; i < run.col.belt_ons.size(); ++i) {
-    any_on += (i ? " || " : "") + run.data.Expr(run.col.belt_ons[i]) + " > 0.5";
+// Rectangles over time spans, from y0 to y1 in `y_system` (graph or
+// first), behind the data.
+std::string SpanRectangles(const std::vector<std::array<double, 2>>& spans,
+                           const std::string& y_system, const std::string& y0,
+                           const std::string& y1, const std::string& fill) {
+  std::string s;
+  for (const auto& [from, to] : spans) {
+    s += "set object rectangle from first " + Num(from) + ", " + y_system + " " + y0 +
+         " to first " + Num(to) + ", " + y_system + " " + y1 + " " + fill + " behind\n";
   }
-  return any_on;
+  return s;
 }
 
 // The line's on state (paper 1 Figs. 5-7 mark it) as a band along the top
-// of the plot, on the second y axis, and the data kept clear of it; none
-// without on columns.
+// of the plot where any belt is scheduled on, the data kept clear of it;
+// none without on columns.
 struct LineOnBand {
   std::string axes;  // set before the plot
   std::vector<PlotItem> items;
 };
 LineOnBand LineOn(const RobotRun& run) {
-  const std::string any_on = AnyBeltOn(run);
-  if (any_on.empty()) return {};
-  return {style::kLineOnAxes,
-          {{"$signals using 1:((" + any_on + ") ? " + style::kLineOnBandFrom + " : 1):(1)",
-            style::kLineOnStyle, style::kLineOnTitle}}};
+  if (run.col.belt_ons.empty()) return {};
+  return {SpanRectangles(run.line_on, "graph", style::kLineOnBandFrom, "1", style::kLineOnFill) +
+              "set offsets 0, 0, graph 0.1, 0\n",
+          {{"keyentry", std::string("with boxes ") + style::kLineOnFill, style::kLineOnTitle}}};
 }
 
 // error.png: the deviation (or drift) in mm against time, with the bound
@@ -197,25 +245,28 @@ std::string ErrorFigure(RobotRun& run) {
   if (run.col.error == 0) return {};
   const LineOnBand band = LineOn(run);
   std::vector<PlotItem> items = band.items;
-  items.push_back({"$signals using 1:(1000 * " + run.data.Expr(run.col.error) + ")",
+  items.push_back({"$signals using 1:" + std::to_string(run.data[run.col.error]),
                    std::string("with lines ") + style::kMeasuredStyle,
                    spec.error_name.empty() ? spec.error_label : spec.error_name});
   const RobotPlotSpec::Bound& bound = spec.error_bound;
+  std::string bound_block;
   if (bound.value_m > 0.0) {
     const std::string mm = Num(1000.0 * bound.value_m);
     const std::string label =
         bound.label.empty() ? "bound " + style::Short(1000.0 * bound.value_m) + " mm" : bound.label;
     if (run.col.bound_from > 0) {
-      items.push_back(
-          {"$signals using 1:(" + run.data.Expr(run.col.bound_from) + " > 0.5 ? " + mm + " : NaN)",
-           std::string("with lines ") + style::kBoundStyle, label});
+      // From the time the task was done to the end (nothing if never).
+      const double from = std::isnan(run.bound_from_t) ? run.t_last : run.bound_from_t;
+      bound_block =
+          "$bound << EOD\n" + Num(from) + "," + mm + "\n" + Num(run.t_last) + "," + mm + "\nEOD\n";
+      items.push_back({"$bound using 1:2", std::string("with lines ") + style::kBoundStyle, label});
     } else {
       items.push_back({mm, std::string("with lines ") + style::kBoundStyle, label});
     }
   }
   std::string what = spec.error_label;
   if (!what.empty()) what[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(what[0])));
-  return style::BeginFigure(spec.file_prefix + "error", spec.format, run.outputs) +
+  return bound_block + style::BeginFigure(spec.file_prefix + "error", spec.format, run.outputs) +
          style::Caption(what + " against time", spec.run_caption) +
          TimeAxes(run, style::Titles(items)) + "set offsets 0, 0, graph 0.08, 0\n" + band.axes +
          "set ylabel " + GnuplotQuote(spec.error_label + " (mm)") + "\nset yrange [0:*]\n" +
@@ -351,18 +402,24 @@ std::string OpticFlowFigure(RobotRun& run) {
   return s + "unset multiplot\n";
 }
 
-// The field depth of the active set (a column expression from the field
-// set's index; `which` 0 protective, 1 warning).
-std::string ActiveDepth(const RobotRun& run, int which) {
+// How far the active field set's protective and warning fields reach
+// beyond the body's front, as a block of steps from each change of the
+// set on ("t,protective,warning"; NaN: no such field); empty without.
+std::string ActiveReach(const RobotRun& run) {
   const auto& depths = run.spec.safety.field_depths_m;
-  if (run.col.field_set == 0 || depths.empty()) return {};
-  std::string e = "NaN";
-  for (std::size_t k = depths.size(); k-- > 0;) {
-    const double d = depths[k][static_cast<std::size_t>(which)];
-    e = "(" + run.data.Expr(run.col.field_set) + " < " + std::to_string(k) + ".5 ? " +
-        (std::isfinite(d) ? Num(d) : "NaN") + " : " + e + ")";
-  }
-  return e;
+  if (run.field_sets.empty() || depths.empty()) return {};
+  std::string rows;
+  const auto row = [&](double t, int set) {
+    const bool known = set >= 0 && static_cast<std::size_t>(set) < depths.size();
+    const auto depth = [&](std::size_t which) {
+      const double d = known ? depths[static_cast<std::size_t>(set)][which] : NAN;
+      return std::isfinite(d) ? Num(d) : std::string("NaN");
+    };
+    rows += Num(t) + "," + depth(0) + "," + depth(1) + "\n";
+  };
+  for (const auto& [t, set] : run.field_sets) row(t, set);
+  row(run.t_last, run.field_sets.back().second);
+  return "$reach << EOD\n" + rows + "EOD\n";
 }
 
 // safety.png: the S300's safety function against a person, in panels on
@@ -385,14 +442,14 @@ std::string SafetyFigure(RobotRun& run) {
     std::vector<PlotItem> items = {{"$signals using 1:" + std::to_string(run.data[c.distance]),
                                     "with lines lw 2 lc rgb '#009E73'",
                                     "distance to the nearest person"}};
-    const std::string protective = ActiveDepth(run, 0), warning = ActiveDepth(run, 1);
-    if (!protective.empty()) {
-      items.push_back({"$signals using 1:" + protective, "with steps lw 1.5 lc rgb '#CC0000'",
+    const std::string reach = ActiveReach(run);
+    if (!reach.empty()) {
+      items.push_back({"$reach using 1:2", "with steps lw 1.5 lc rgb '#CC0000'",
                        "protective field's reach (active set)"});
-      items.push_back({"$signals using 1:" + warning, "with steps dt 4 lw 1.5 lc rgb '#E69F00'",
+      items.push_back({"$reach using 1:3", "with steps dt 4 lw 1.5 lc rgb '#E69F00'",
                        "warning field's reach (active set)"});
     }
-    std::string setup = "set ylabel 'distance (m)'\nset yrange [0:*]\n";
+    std::string setup = reach + "set ylabel 'distance (m)'\nset yrange [0:*]\n";
     if (std::isfinite(run.closest_m)) {
       setup =
           "$closest << EOD\n" + Num(run.closest_t) + "," + Num(run.closest_m) + "\nEOD\n" + setup;
@@ -403,18 +460,16 @@ std::string SafetyFigure(RobotRun& run) {
     panels.push_back(items);
     setups.push_back(setup);
   }
-  // Each field a lane: a bar where it is infringed.
-  const auto lane = [&](int csv, double at) {
-    return "$signals using 1:(" + Num(at - 0.3) + "):(" + expr(csv) + " < 0.5 ? " + Num(at + 0.3) +
-           " : " + Num(at - 0.3) + ")";
-  };
-  panels.push_back({{lane(c.protective, 1.0),
-                     "with filledcurves fillcolor rgb '#CC0000' fillstyle solid 1.0 noborder",
-                     "protective field infringed (a safe stop)"},
-                    {lane(c.warning, 0.0),
-                     "with filledcurves fillcolor rgb '#E69F00' fillstyle solid 1.0 noborder",
-                     "warning field infringed (slow down)"}});
+  // Each field a lane: a bar where it is infringed (rectangles over the
+  // spans; the panel plots only the legend's entries).
+  const std::string protective_fill = "fillcolor rgb '#CC0000' fillstyle solid 1.0 noborder";
+  const std::string warning_fill = "fillcolor rgb '#E69F00' fillstyle solid 1.0 noborder";
+  panels.push_back(
+      {{"keyentry", "with boxes " + protective_fill, "protective field infringed (a safe stop)"},
+       {"keyentry", "with boxes " + warning_fill, "warning field infringed (slow down)"}});
   setups.push_back(
+      SpanRectangles(run.protective_infringed, "first", "0.7", "1.3", protective_fill) +
+      SpanRectangles(run.warning_infringed, "first", "-0.3", "0.3", warning_fill) +
       "set ylabel 'field'\nset yrange [-0.6:1.6]\nset ytics ('warning' 0, 'protective' 1)\n"
       "set offsets 0, 0, 0, 0\n");
 
@@ -436,9 +491,9 @@ std::string SafetyFigure(RobotRun& run) {
     // own items are drawn untitled, and all entries given as keyentries.
     const bool last = i + 1 == panels.size();
     std::vector<PlotItem> items = panels[i];
-    if (last) {
-      for (auto& item : items) item.title.clear();
-    }
+    // The fields' lanes are rectangles: the panel plots nothing of its own
+    // (NaN: gnuplot fails on a plot of keyentries alone).
+    if (last) items = {{"NaN", "with lines", ""}};
     s += grid[i].Margins() + setups[i] +
          (last ? "set xlabel 'time (s)'\n" + key.commands
                : std::string("unset xlabel\nunset key\n")) +
@@ -484,8 +539,7 @@ std::vector<std::string> WriteRobotPlots(const std::string& dir, const RobotPlot
   const fs::path folder(dir);
   table::Signals signals = table::OpenSignals(folder / kSignals);
   std::vector<std::string> names;
-  RobotRun run{spec, signals, FindColumns(spec, signals), {}, 0.0, 0.0, {}, {}, {}, {}, NAN,
-               NAN,  &names};
+  RobotRun run(spec, signals, FindColumns(spec, signals), &names);
   const std::string script = Script(run);
   return DrawWithGnuplot(dir, spec.file_prefix + kScript, script, names);
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "plots/robot_plots.h"
@@ -52,6 +53,10 @@ struct Columns {
 
 /// The run as the figures need it after one pass over signals.csv.
 struct RobotRun {
+  RobotRun(const RobotPlotSpec& s, table::Signals& rows, Columns columns,
+           std::vector<std::string>* files)
+      : spec(s), signals(rows), col(std::move(columns)), outputs(files) {}
+
   const RobotPlotSpec& spec;
   table::Signals& signals;
   Columns col;
@@ -65,6 +70,13 @@ struct RobotRun {
   Bounds tracks;
   /// The nearest approach of a person: its time and distance (NaN: none).
   double closest_t = NAN, closest_m = NAN;
+  /// Spans [from, to] of time (s) where any belt is scheduled on, and
+  /// where the protective and the warning field are infringed.
+  std::vector<std::array<double, 2>> line_on, protective_infringed, warning_infringed;
+  /// The safety unit's field set from each time it changed on (s, index).
+  std::vector<std::pair<double, int>> field_sets;
+  /// When the bound's from column first rose (s; NaN: never).
+  double bound_from_t = NAN;
   /// The figures' file names, in the spec's format, as they are begun.
   std::vector<std::string>* outputs;
 };

@@ -86,10 +86,13 @@ void ColumnFinder::ThrowIfUnknown() const {
   throw std::runtime_error(text);
 }
 
-void DataColumns::Use(int csv) {
+void DataColumns::Use(int csv) { UseScaled(csv, 1.0); }
+
+void DataColumns::UseScaled(int csv, double factor) {
   if (csv <= 0 || Has(csv)) return;
   if (static_cast<std::size_t>(csv) >= block_of_.size()) block_of_.resize(csv + 1, 0);
   csv_.push_back(csv);
+  scale_.push_back(factor);
   block_of_[static_cast<std::size_t>(csv)] = static_cast<int>(csv_.size());
 }
 
@@ -104,7 +107,12 @@ void DataColumns::AppendRow(const std::vector<std::string_view>& fields, std::st
   for (std::size_t k = 0; k < csv_.size(); ++k) {
     if (k) block += ',';
     const auto i = static_cast<std::size_t>(csv_[k] - 1);
-    if (i < fields.size()) block += fields[i];
+    if (i >= fields.size()) continue;
+    if (scale_[k] == 1.0) {
+      block += fields[i];
+    } else if (const auto v = cosim::ParseFiniteValue(fields[i])) {
+      block += cosim::FormatValue(*v * scale_[k]);
+    }
   }
   block += '\n';
 }

@@ -71,6 +71,10 @@ class DataColumns {
   DataColumns() { Use(1); }
   /// Adds CSV column `csv` (1-based; 0: none, ignored).
   void Use(int csv);
+  /// Adds CSV column `csv` as its values times `factor` (a deviation in m
+  /// as mm: gnuplot then reads the column instead of evaluating a product
+  /// per row).
+  void UseScaled(int csv, double factor);
   /// The block column (1-based, as gnuplot counts) of CSV column `csv`.
   int operator[](int csv) const;
   /// "column(N)" of CSV column `csv` in the block, for expressions.
@@ -83,6 +87,7 @@ class DataColumns {
  private:
   bool Has(int csv) const;
   std::vector<int> csv_;       // block column k + 1 holds CSV column csv_[k]
+  std::vector<double> scale_;  // ... times scale_[k] (1: copied as text)
   std::vector<int> block_of_;  // CSV column -> block column (0: not in it)
 };
 

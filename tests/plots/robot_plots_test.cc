@@ -207,16 +207,21 @@ TEST_F(RobotPlotsTest, SafetyPlotDrawsSpeedCapAndFields) {
   EXPECT_EQ(fs::path(files[1]).filename(), "safety.png");
   EXPECT_TRUE(IsPng(files[1]));
   const std::string script = ReadAll(dir_ / "plots.gp");
-  // Columns by number: velocity 4 and 5, cap 6 (-1: NaN), fields 7 and 8
-  // (each a lane, barred where infringed), distance 9 in a panel of its
-  // own (not on the speed's axis, not cut off); the closest approach (0.4 m
-  // at 6 s) marked; the worker's track (columns 10 and 11) in the top view,
-  // named, from a data block the script carries.
+  // $signals columns: velocity 4 and 5, cap 6 (-1: NaN), the distance 7
+  // in a panel of its own (not on the speed's axis, not cut off); each
+  // field a lane, barred over the spans it is infringed (protective 2-4 s,
+  // warning from 1.5 s to the end); the closest approach (0.4 m at 6 s)
+  // marked; the worker's track in the top view, named, from a data block
+  // the script carries.
   EXPECT_NE(script.find("sqrt(column(4)**2 + column(5)**2)"), std::string::npos);
   EXPECT_NE(script.find("column(6) < 0 ? NaN : column(6)"), std::string::npos);
-  EXPECT_NE(script.find("(column(7) < 0.5 ? 1.3 : 0.7)"), std::string::npos) << script;
-  EXPECT_NE(script.find("(column(8) < 0.5 ? 0.3 : -0.3)"), std::string::npos) << script;
-  EXPECT_NE(script.find("$signals using 1:9 with lines"), std::string::npos) << script;
+  EXPECT_NE(script.find("set object rectangle from first 2, first 0.7 to first 4, first 1.3"),
+            std::string::npos)
+      << script;
+  EXPECT_NE(script.find("set object rectangle from first 1.5, first -0.3 to first 6, first 0.3"),
+            std::string::npos)
+      << script;
+  EXPECT_NE(script.find("$signals using 1:7 with lines"), std::string::npos) << script;
   EXPECT_EQ(script.find("1.5 ? NaN"), std::string::npos) << script;
   EXPECT_NE(script.find("$closest << EOD\n6,0.4\n"), std::string::npos) << script;
   EXPECT_NE(script.find("closest approach: 0.4 m at t = 6 s"), std::string::npos) << script;
@@ -420,15 +425,12 @@ TEST_F(RobotPlotsTest, ErrorPlotDrawsTheBoundTheLineStateAndTheUsersNames) {
             std::string::npos)
       << error;
   EXPECT_EQ(error.find("title 'metrics.deviation'"), std::string::npos) << error;
-  EXPECT_NE(error.find("$signals using 1:(1000 * column(4)) with lines"), std::string::npos)
-      << error;
+  EXPECT_NE(error.find("$signals using 1:4 with lines"), std::string::npos) << error;
   EXPECT_NE(error.find("set ylabel 'deviation from path (mm)'"), std::string::npos) << error;
   EXPECT_NE(error.find("40 with lines dt 2 lw 2 lc rgb '#000000'"), std::string::npos) << error;
   EXPECT_NE(error.find("title '4 cm (paper 1, Sec. VI-B)'"), std::string::npos) << error;
-  // belt.on[0] (column 15 of signals.csv) is column 6 of $signals (time, x,
-  // y, deviation, speed, on).
-  EXPECT_NE(error.find("$signals using 1:((column(6) > 0.5) ? 0.97 : 1):(1) axes x1y2 with "
-                       "filledcurves"),
+  // belt.on[0] is on from 0 to 10 s: a band at the top over that span.
+  EXPECT_NE(error.find("set object rectangle from first 0, graph 0.97 to first 10, graph 1"),
             std::string::npos)
       << error;
   EXPECT_NE(error.find("title 'line on (band along the top)'"), std::string::npos) << error;
@@ -437,16 +439,25 @@ TEST_F(RobotPlotsTest, ErrorPlotDrawsTheBoundTheLineStateAndTheUsersNames) {
 }
 
 // Guards a bound on the final pose (paper 2's Table 1 on van_entry): drawn
-// only where the task's done column is 1, not across the climb.
+// from the time the task's done column rose (12 s here) to the end, in mm,
+// not across the whole run.
 TEST_F(RobotPlotsTest, FinalPoseBoundIsDrawnFromTheTasksEnd) {
   WriteSignals();
+  {
+    std::ifstream in(dir_ / "signals.csv");
+    std::string line, out;
+    std::getline(in, line);
+    out = line + ",path_follower.done\n";
+    for (int k = 0; std::getline(in, line); ++k) out += line + (k >= 1200 ? ",1\n" : ",0\n");
+    in.close();
+    std::ofstream(dir_ / "signals.csv") << out;
+  }
   RobotPlotSpec spec = Spec();
-  spec.error_bound = {0.014, "paper 2, Table 1", "belt.on[0]"};
+  spec.error_bound = {0.014, "paper 2, Table 1", "path_follower.done"};
   WriteRobotPlots(dir_.string(), spec);
   const std::string script = ReadAll(dir_ / "plots.gp");
-  EXPECT_NE(script.find("$signals using 1:(column(5) > 0.5 ? 14 : NaN) with lines dt 2"),
-            std::string::npos)
-      << script;
+  EXPECT_NE(script.find("$bound << EOD\n12,14\n30,14\nEOD\n"), std::string::npos) << script;
+  EXPECT_NE(script.find("$bound using 1:2 with lines dt 2"), std::string::npos) << script;
 }
 
 // Guards paper 1 Fig. 4 as optic_flow.png draws it: a panel per sensor
