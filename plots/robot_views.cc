@@ -83,17 +83,28 @@ struct SceneLayers {
   std::vector<std::array<Point, 4>> footprints;  // for framing
 };
 SceneLayers SceneAt(const models::Scene& scene, const std::vector<std::optional<double>>& travel,
-                    bool obstacles_too) {
+                    bool obstacles_too, const Bounds* within = nullptr) {
   SceneLayers l;
   for (const models::Belt& b : scene.belts) {
     AppendPolygon(l.belts, BeltCorners(b));
     l.footprints.push_back(BeltCorners(b));
   }
-  if (obstacles_too) {
-    for (const models::Obstacle& o : scene.obstacles) {
-      AppendSolid(l.obstacles, o.solid, 0.0, 0.0);
-      l.footprints.push_back(Footprint(o.solid, 0.0, 0.0));
+  // A solid outside `within` is left out (neither drawn nor in the legend).
+  const auto add = [&](SolidLayer& layer, const models::Solid& solid, double dx, double dy) {
+    const auto corners = Footprint(solid, dx, dy);
+    if (within != nullptr) {
+      Bounds box;
+      for (const Point& c : corners) box.Add(c.x, c.y);
+      if (box.x_max < within->x_min || box.x_min > within->x_max || box.y_max < within->y_min ||
+          box.y_min > within->y_max) {
+        return;
+      }
     }
+    AppendSolid(layer, solid, dx, dy);
+    l.footprints.push_back(corners);
+  };
+  if (obstacles_too) {
+    for (const models::Obstacle& o : scene.obstacles) add(l.obstacles, o.solid, 0.0, 0.0);
   }
   for (const models::CarriedObject& c : scene.carried) {
     const auto b = static_cast<std::size_t>(c.belt);
@@ -103,8 +114,7 @@ SceneLayers SceneAt(const models::Scene& scene, const std::vector<std::optional<
     const auto range = models::CarriedTravelRange(scene.belts[b].area, c.solid);
     if (d < range[0] || d > range[1]) continue;
     const double heading = scene.belts[b].area.direction_rad;
-    AppendSolid(l.carried, c.solid, d * std::cos(heading), d * std::sin(heading));
-    l.footprints.push_back(Footprint(c.solid, d * std::cos(heading), d * std::sin(heading)));
+    add(l.carried, c.solid, d * std::cos(heading), d * std::sin(heading));
   }
   return l;
 }
@@ -210,22 +220,26 @@ struct LabelBox {
 // (within a quarter body length of an earlier labelled one) join that
 // label ("t = 0 / 6 / 12 s"); each label goes above its outline, else
 // below, right or left of it, where it overlaps no other label and stays
-// in the frame. Returns the $labels rows ("x,y,text").
-std::string PlaceTimeLabels(const std::vector<std::pair<Point, double>>& instants, double reach_m,
-                            double join_m, const Frame& frame, double metres_per_px) {
+// in the frame, and where it covers no outline (`outlines`: their boxes)
+// if it can. Returns the $labels rows ("x,y,text").
+std::string PlaceTimeLabels(const std::vector<std::pair<Point, double>>& instants,
+                            const std::vector<LabelBox>& own, double join_m, const Frame& frame,
+                            double metres_per_px, const std::vector<LabelBox>& outlines) {
   struct Group {
     Point at;
+    LabelBox outline;
     std::string times;
   };
   std::vector<Group> groups;
-  for (const auto& [at, t] : instants) {
+  for (std::size_t i = 0; i < instants.size(); ++i) {
+    const auto& [at, t] = instants[i];
     auto it = std::find_if(groups.begin(), groups.end(), [&](const Group& g) {
       return std::hypot(at.x - g.at.x, at.y - g.at.y) < join_m;
     });
     if (it != groups.end()) {
       it->times += " / " + style::Short(t, 4);
     } else {
-      groups.push_back({at, style::Short(t, 4)});
+      groups.push_back({at, own[i], style::Short(t, 4)});
     }
   }
   std::vector<LabelBox> placed;
@@ -236,23 +250,25 @@ std::string PlaceTimeLabels(const std::vector<std::pair<Point, double>>& instant
     const double half_w =
         0.5 * (style::TextWidthEm(text) * style::kSmallFontPx + 2 * pad_px) * metres_per_px;
     const double half_h = 0.5 * (1.0 * style::kSmallFontPx + 2 * pad_px) * metres_per_px;
-    const LabelBox candidates[] = {{g.at.x, g.at.y + reach_m + half_h, half_w, half_h},
-                                   {g.at.x, g.at.y - reach_m - half_h, half_w, half_h},
-                                   {g.at.x + reach_m + half_w, g.at.y, half_w, half_h},
-                                   {g.at.x - reach_m - half_w, g.at.y, half_w, half_h}};
-    const auto fits = [&](const LabelBox& b) {
-      if (b.x - b.half_w < frame.x0 || b.x + b.half_w > frame.x1 || b.y - b.half_h < frame.y0 ||
-          b.y + b.half_h > frame.y1) {
-        return false;
-      }
-      return std::none_of(placed.begin(), placed.end(),
+    // Beside the outline's box, a pad away.
+    const LabelBox& b = g.outline;
+    const double gap = pad_px * metres_per_px;
+    const LabelBox candidates[] = {{b.x, b.y + b.half_h + gap + half_h, half_w, half_h},
+                                   {b.x, b.y - b.half_h - gap - half_h, half_w, half_h},
+                                   {b.x + b.half_w + gap + half_w, b.y, half_w, half_h},
+                                   {b.x - b.half_w - gap - half_w, b.y, half_w, half_h}};
+    const auto clear_of = [&](const LabelBox& b, const std::vector<LabelBox>& boxes) {
+      return std::none_of(boxes.begin(), boxes.end(),
                           [&](const LabelBox& p) { return p.Overlaps(b); });
     };
+    const auto fits = [&](const LabelBox& b) {
+      return b.x - b.half_w >= frame.x0 && b.x + b.half_w <= frame.x1 &&
+             b.y - b.half_h >= frame.y0 && b.y + b.half_h <= frame.y1 && clear_of(b, placed);
+    };
     const LabelBox* chosen = nullptr;
-    for (const LabelBox& b : candidates) {
-      if (fits(b)) {
-        chosen = &b;
-        break;
+    for (const bool strict : {true, false}) {
+      for (const LabelBox& c : candidates) {
+        if (!chosen && fits(c) && (!strict || clear_of(c, outlines))) chosen = &c;
       }
     }
     // Nowhere free: stacked above the highest label it would overlap.
@@ -268,8 +284,18 @@ std::string PlaceTimeLabels(const std::vector<std::pair<Point, double>>& instant
 struct Outlines {
   std::string own, contacts;
   std::vector<std::string> others;                 // per other robot
+  std::vector<LabelBox> boxes;                     // every outline's bounding box
+  std::vector<LabelBox> own_boxes;                 // the robot's, one per instant
   std::vector<std::pair<Point, double>> instants;  // the robot's centre, time
 };
+// The bounding box of an outline's corners.
+LabelBox BoxOf(const std::array<Point, 4>& corners) {
+  Bounds b;
+  for (const Point& p : corners) b.Add(p.x, p.y);
+  return {0.5 * (b.x_min + b.x_max), 0.5 * (b.y_min + b.y_max), 0.5 * (b.x_max - b.x_min),
+          0.5 * (b.y_max - b.y_min)};
+}
+
 Outlines ReadOutlines(RobotRun& run, Bounds& view) {
   Outlines o;
   const RobotPlotSpec& spec = run.spec;
@@ -283,18 +309,21 @@ Outlines ReadOutlines(RobotRun& run, Bounds& view) {
     const auto get = [&](int col) { return Column(fields, col); };
     const auto t = get(1), x = get(c.x), y = get(c.y), yaw = get(c.yaw);
     if (!x || !y || !yaw) continue;
-    for (const Point& p : Rectangle(*x, *y, *yaw, spec.body_length_m, spec.body_width_m)) {
-      view.Add(p.x, p.y);
-    }
+    const auto corners = Rectangle(*x, *y, *yaw, spec.body_length_m, spec.body_width_m);
+    for (const Point& p : corners) view.Add(p.x, p.y);
+    o.boxes.push_back(BoxOf(corners));
     AppendOutline(o.own, *x, *y, *yaw, spec.body_length_m, spec.body_width_m);
-    if (t) o.instants.push_back({{*x, *y}, *t});
+    if (t) {
+      o.instants.push_back({{*x, *y}, *t});
+      o.own_boxes.push_back(BoxOf(corners));
+    }
     for (std::size_t k = 0; k < c.others.size(); ++k) {
       const auto ox = get(c.others[k].x), oy = get(c.others[k].y), oyaw = get(c.others[k].yaw);
       if (!ox || !oy || !oyaw) continue;
       const auto& other = spec.others[k];
-      for (const Point& p : Rectangle(*ox, *oy, *oyaw, other.body_length_m, other.body_width_m)) {
-        view.Add(p.x, p.y);
-      }
+      const auto corners = Rectangle(*ox, *oy, *oyaw, other.body_length_m, other.body_width_m);
+      for (const Point& p : corners) view.Add(p.x, p.y);
+      o.boxes.push_back(BoxOf(corners));
       AppendOutline(o.others[k], *ox, *oy, *oyaw, other.body_length_m, other.body_width_m);
     }
     for (const auto& [wx, wy] : c.wheels) {
@@ -434,10 +463,16 @@ std::string TopView(RobotRun& run) {
   const RobotPlotSpec& spec = run.spec;
   Bounds view = run.tracks;
   const Outlines o = ReadOutlines(run, view);
-  const SceneLayers start = SceneAt(spec.scene, {}, true);
+  {
+    const SceneLayers all = SceneAt(spec.scene, {}, true);
+    const SceneLayers all_end =
+        run.travel_end.empty() ? SceneLayers{} : SceneAt(spec.scene, run.travel_end, false);
+    FrameScene(spec, all, all_end.footprints, view);
+  }
+  // What is in the frame: solids outside it are not listed in the legend.
+  const SceneLayers start = SceneAt(spec.scene, {}, true, &view);
   const SceneLayers end =
-      run.travel_end.empty() ? SceneLayers{} : SceneAt(spec.scene, run.travel_end, false);
-  FrameScene(spec, start, end.footprints, view);
+      run.travel_end.empty() ? SceneLayers{} : SceneAt(spec.scene, run.travel_end, false, &view);
 
   std::string s;
   if (!start.belts.empty()) AppendBlock(s, "belts", start.belts);
@@ -491,10 +526,9 @@ std::string TopView(RobotRun& run) {
   const double margin_m = 0.3 + 0.05 * std::max(view.x_max - view.x_min, view.y_max - view.y_min);
   const ViewLayout layout = LayoutView(style::Titles(items), view, view.empty() ? 1.0 : margin_m);
   if (!o.instants.empty()) {
-    const double reach_m = 0.5 * std::hypot(spec.body_length_m, spec.body_width_m);
     const std::string labels =
-        PlaceTimeLabels(o.instants, reach_m, 0.25 * spec.body_length_m, layout.frame,
-                        layout.frame.MetresPerPx(layout.area_w_px));
+        PlaceTimeLabels(o.instants, o.own_boxes, 0.25 * spec.body_length_m, layout.frame,
+                        layout.frame.MetresPerPx(layout.area_w_px), o.boxes);
     AppendBlock(s, "labels", labels);
     items.push_back(
         {"$labels using 1:2:3",

@@ -308,8 +308,9 @@ TEST_F(RobotPlotsTest, StandingRobotGetsOneJoinedTimeLabel) {
 
 // Guards the scene in the top view: obstacles near the path are drawn and
 // framed (boxes as filled outlines, cylinders as circles), one far away does
-// not stretch the view, and a carried object appears at time zero and at
-// the end, moved along its belt by the travel column's last value.
+// not stretch the view (nor is it listed), and a carried object appears
+// where it is in view: at the end, moved along its belt by the travel
+// column's last value.
 TEST_F(RobotPlotsTest, DrawsObstaclesAndCarriedObjects) {
   WriteSignals();
   {
@@ -355,8 +356,11 @@ TEST_F(RobotPlotsTest, DrawsObstaclesAndCarriedObjects) {
   EXPECT_NE(script.find("$obstacles << EOD\n1.6,0.4\n"), std::string::npos) << script;
   EXPECT_NE(script.find("$obstacles_circles << EOD\n-1,0,0.25\n"), std::string::npos) << script;
   EXPECT_NE(script.find("with circles"), std::string::npos);
-  // Time zero: front-left corner at (-2, 0.4); end: moved 3 m along +x.
-  EXPECT_NE(script.find("$carried << EOD\n-2,0.4\n"), std::string::npos) << script;
+  // Time zero: the body spans x -4 to -2, beyond 1.5 m (near_m) of the
+  // path: out of the view, neither drawn nor in the legend; the end: moved
+  // 3 m along +x onto the path, front-left corner at (1, 0.4).
+  EXPECT_EQ(script.find("$carried << EOD"), std::string::npos) << script;
+  EXPECT_EQ(script.find("carried object (t = 0)"), std::string::npos) << script;
   EXPECT_NE(script.find("$carried_end << EOD\n1,0.4\n"), std::string::npos) << script;
   // The wall at x = 50 is not near the path: the view stays within 10 m.
   const auto at = script.find("set xrange [");
