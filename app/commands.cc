@@ -156,6 +156,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
     plot_columns->error_column = s.robot->error_column;
     plot_columns->belt_on_columns = s.robot->belt_on_columns;
     plot_columns->task = s.robot->task;
+    plot_columns->bound = s.robot->figure_bound;
   }
   if (report.interrupted) return kExitInterrupted;
   return report.ok() ? kExitOk : kExitRunFailed;

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "loader/robot_scenario.h"
 #include "plots/gnuplot.h"
 
 namespace linesim::sweep {
@@ -27,6 +28,7 @@ struct RunColumns {
   std::string error_column;                 // deviation or drift ("" for none)
   std::vector<std::string> belt_on_columns;  // each belt's scheduled on state
   std::string task;                          // path, hold, route
+  loader::RobotInfo::FigureBound bound;      // the scenario's figures.bound
 };
 
 /// `linesim run FILE --out DIR [--set path=value ...] [--max-output-mb N]

@@ -178,9 +178,7 @@ int CompareCommand(const std::string& file, const std::string& out_dir,
   if (!CreateOutputFolder(out_dir)) return kExitBadInput;
   const fs::path dir(out_dir);
   plots::ComparisonPlotSpec spec;
-  spec.title = c.name + (c.description.empty() ? "" : ": " + c.description);
-  spec.bound_m = session::kPaperBoundM;
-  spec.bound_label = session::kPaperBoundLabel;
+  spec.run_caption = c.description.empty() ? c.name : c.description + " (" + c.name + ")";
   spec.format = format;
   Json summary;
   summary["comparison"] = c.name;
@@ -213,8 +211,11 @@ int CompareCommand(const std::string& file, const std::string& out_dir,
     if (columns.error_column.empty()) continue;
     if (spec.runs.empty()) {
       spec.belt_on_columns = columns.belt_on_columns;
-      spec.error_label = columns.task == "hold" ? "drift from the held position (m)"
-                                                : "deviation from the path (m)";
+      spec.error_label =
+          columns.task == "hold" ? "drift from the held position" : "deviation from the path";
+      // The compared scenario's published bound (its figures.bound).
+      spec.bound_m = columns.bound.value_m;
+      spec.bound_label = columns.bound.label;
     }
     spec.runs.push_back({run.name + "/signals.csv", columns.error_column, run.label});
   }

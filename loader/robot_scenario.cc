@@ -120,7 +120,7 @@ void AssembleRobot(assembly::SystemBuilder& b, const std::vector<std::string>& r
     assembly::AddSensors(b, *file, s);
     assembly::AddSensing(b, *file, start, scene, s);
     assembly::AddControl(b, *file, s);
-    assembly::AddSafetyFields(b, *file, s);
+    assembly::AddSafetyFields(b, *file, s, info);
     assembly::AddTask(b, *file, start, s, info);
     assembly::ConnectMapSwitch(b, s);
     assembly::AddBeaconGroundTruth(b, *file, start, scene, s);
@@ -136,6 +136,29 @@ void ReadBody(assembly::SystemBuilder& b, const std::string& chassis, RobotInfo&
   info.body_width_m = PositiveChassisValue(b, chassis, "body_width");
 }
 
+// figures: {bound: {value_m, label, over: run | final_pose}}: the published
+// bound the run's figures judge it by (docs/scenarios.md). A bound on the
+// final pose needs a task that finishes: a route.
+RobotInfo::FigureBound ReadFigureBound(const YAML::Node& root, YamlReader& r,
+                                       const RobotInfo& info) {
+  RobotInfo::FigureBound bound;
+  const YAML::Node figures = Child(root, "figures");
+  if (!figures.IsDefined() || figures.IsNull() || !r.ExpectMap(figures, "figures")) return bound;
+  r.CheckKeys(figures, "figures", {"bound"});
+  const YAML::Node node = Child(figures, "bound");
+  if (!node.IsDefined() || node.IsNull() || !r.ExpectMap(node, "figures.bound")) return bound;
+  r.CheckKeys(node, "figures.bound", {"value_m", "label", "over"});
+  bound.value_m = r.Real(node, "figures.bound", "value_m", std::nullopt, {0.0, 100.0, true});
+  bound.label = r.String(node, "figures.bound", "label", std::nullopt);
+  bound.final_pose =
+      r.String(node, "figures.bound", "over", "run", {"run", "final_pose"}) == "final_pose";
+  if (bound.final_pose && info.task_done_column.empty()) {
+    r.Error(Child(node, "over"), "figures.bound.over",
+            "a bound on the final pose needs a task that finishes (task.type: route)");
+  }
+  return bound;
+}
+
 // Every "unit.variable" column of `info` through `scope`.
 void ScopeColumns(RobotInfo& info, const std::function<std::string(const std::string&)>& scope) {
   const auto one = [&](std::string& c) {
@@ -144,11 +167,12 @@ void ScopeColumns(RobotInfo& info, const std::function<std::string(const std::st
   const auto all = [&](std::vector<std::string>& v) {
     for (auto& c : v) one(c);
   };
-  for (std::string* c : {&info.x_column, &info.y_column, &info.yaw_column, &info.z_column,
-                         &info.wheel_surface_column, &info.motor_current_column,
-                         &info.error_column, &info.flow_reference_column, &info.velocity_x_column,
-                         &info.velocity_y_column, &info.speed_cap_column, &info.protective_column,
-                         &info.warning_column, &info.person_distance_column}) {
+  for (std::string* c :
+       {&info.x_column, &info.y_column, &info.yaw_column, &info.z_column,
+        &info.wheel_surface_column, &info.motor_current_column, &info.error_column,
+        &info.task_done_column, &info.field_set_column, &info.flow_reference_column,
+        &info.velocity_x_column, &info.velocity_y_column, &info.speed_cap_column,
+        &info.protective_column, &info.warning_column, &info.person_distance_column}) {
     one(*c);
   }
   for (auto& [x, y] : info.wheel_columns) one(x), one(y);
@@ -321,7 +345,7 @@ void MergeRobot(assembly::SystemBuilder& top, assembly::SystemBuilder& b, YamlRe
 SystemSpec ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
   r.CheckKeys(root, "",
               {"name", "description", "duration_s", "seed", "master", "robots", "scene", "line",
-               "units", "connections", "recording", "metrics", "reference", "workers"});
+               "units", "connections", "recording", "metrics", "reference", "workers", "figures"});
   assembly::SystemBuilder top(root, r);
   ReadSystemHead(root, r, top.spec());
   const models::Scene scene = assembly::AddScene(top);
@@ -412,6 +436,7 @@ SystemSpec ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
   if (!robots.empty()) {
     info = robots.front();
     info.fleet.assign(robots.begin() + 1, robots.end());
+    info.figure_bound = ReadFigureBound(root, r, info);
   }
   return std::move(top.spec());
 }
@@ -431,15 +456,17 @@ SystemSpec ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
     return ExpandFleet(root, r, info);
   }
   r.CheckKeys(root, "",
-              {"name", "description", "duration_s", "seed", "master", "robot", "scene", "line",
-               "control", "task", "sensors", "sensing", "localization", "units", "connections",
-               "recording", "metrics", "reference", "workers", "safety"});
+              {"name",         "description", "duration_s",  "seed",      "master",  "robot",
+               "scene",        "line",        "control",     "task",      "sensors", "sensing",
+               "localization", "units",       "connections", "recording", "metrics", "reference",
+               "workers",      "safety",      "figures"});
   assembly::SystemBuilder b(root, r);
   ReadSystemHead(root, r, b.spec());
   const models::Scene scene = assembly::AddScene(b);
   AssembleRobot(b, {"model", "pose", "payload"}, scene, info);
   Passthrough(b);
   ReadBody(b, assembly::kChassis, info);
+  info.figure_bound = ReadFigureBound(root, r, info);
   return std::move(b.spec());
 }
 

@@ -41,6 +41,8 @@ struct RobotInfo {
   /// armature currents, whole arrays (the replay reads them).
   std::string wheel_surface_column, motor_current_column;
   std::string error_column;
+  /// The route follower's done output (0/1; "" for other tasks).
+  std::string task_done_column;
   std::vector<std::string> belt_speed_columns, belt_on_columns, belt_travel_columns;
   /// Optic flow against the belt's ground truth (paper 1 Fig. 4): what
   /// each PX4Flow reads along the belt (the surface relative to it), its
@@ -71,6 +73,25 @@ struct RobotInfo {
   std::vector<std::pair<std::string, std::string>> worker_columns;
   std::string velocity_x_column, velocity_y_column, speed_cap_column, protective_column,
       warning_column, person_distance_column;
+  /// Each worker's name and legs' columns ([x_left, y_left, x_right,
+  /// y_right]), in the order of worker_columns.
+  std::vector<std::string> worker_names;
+  std::vector<std::array<std::string, 4>> worker_leg_columns;
+  /// The safety unit's active field set (its index) and, per field set,
+  /// how far forward its protective and warning fields reach in base_link
+  /// (m, the polygons' largest x; NaN: no warning field).
+  std::string field_set_column;
+  std::vector<std::array<double, 2>> field_reach_m;
+  /// `figures.bound`: the published bound the figures judge the run by
+  /// (error.png, the replay, a comparison): value (m), legend entry, and
+  /// whether it bounds the final pose (drawn from the task's done on)
+  /// rather than the whole run. value_m 0: none.
+  struct FigureBound {
+    double value_m = 0.0;
+    std::string label;
+    bool final_pose = false;
+  };
+  FigureBound figure_bound;
   /// A fleet's other robots (the first robot is this one), their columns
   /// scoped by their names.
   std::vector<RobotInfo> fleet;

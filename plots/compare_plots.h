@@ -10,8 +10,12 @@ namespace linesim::plots {
 /// Several runs' deviation (or drift) against time in one figure, as paper
 /// 1 Fig. 6 sets the nominal system beside the modified one.
 struct ComparisonPlotSpec {
-  std::string title;
-  std::string error_label = "deviation from the path (m)";  // the y axis
+  /// What the comparison is, the caption's second line (its description
+  /// and name).
+  std::string run_caption;
+  /// What is compared, without its unit (drawn in mm): the y axis and the
+  /// caption.
+  std::string error_label = "deviation from the path";
   struct Run {
     std::string signals_csv;   // relative to the output folder
     std::string error_column;  // its header name in that file
@@ -19,7 +23,8 @@ struct ComparisonPlotSpec {
   };
   std::vector<Run> runs;
   /// The line's on state (one column per belt, in the first run's file):
-  /// the spans where any belt is on are shaded "line on"; none when empty.
+  /// the spans where any belt is on are marked in a band along the top;
+  /// none when empty.
   std::vector<std::string> belt_on_columns;
   /// A bound drawn across the figure (m) with its legend entry; none when 0.
   double bound_m = 0.0;

@@ -70,13 +70,14 @@ std::string PlotFile(const std::string& name, PlotFormat format) {
 std::string GnuplotTerminal(PlotFormat format, int width_px, int height_px) {
   switch (format) {
     case PlotFormat::kSvg:
-      return "set terminal svg size " + std::to_string(width_px) + "," +
-             std::to_string(height_px) + " noenhanced font ',10' background rgb 'white'\n";
+      return "set terminal svg size " + std::to_string(width_px) + "," + std::to_string(height_px) +
+             " noenhanced font ',13.33' background rgb 'white'\n";
     case PlotFormat::kPdf: {
       // pdfcairo takes inches: 100 pixels to the inch keeps the PNG's layout.
-      const auto inches = [](int px) { return std::to_string(px / 100) + "." +
-                                              std::to_string((px % 100) / 10) +
-                                              std::to_string(px % 10); };
+      const auto inches = [](int px) {
+        return std::to_string(px / 100) + "." + std::to_string((px % 100) / 10) +
+               std::to_string(px % 10);
+      };
       return "set terminal pdfcairo size " + inches(width_px) + "in," + inches(height_px) +
              "in noenhanced font ',10'\n";
     }

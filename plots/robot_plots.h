@@ -14,7 +14,9 @@ namespace linesim::plots {
 /// signals.csv as the recorder writes them ("chassis.position[0]"); an
 /// empty name leaves out what it would draw.
 struct RobotPlotSpec {
-  std::string title;
+  /// The run the figures are of, the second line of every caption (the
+  /// scenario's description, its name and seed); none when empty.
+  std::string run_caption;
   /// What the top view draws around the robot: belts (rectangles with
   /// arrows along their motion), obstacles (filled outlines; cylinders as
   /// circles), carried objects at their time-zero pose.
@@ -42,17 +44,24 @@ struct RobotPlotSpec {
   /// footprints with the outlines.
   std::vector<std::pair<std::string, std::string>> wheel_columns;
   /// Deviation from the path or drift from the hold target against time
-  /// (error.png); none when empty. The label names it on the y axis.
+  /// (error.png, drawn in mm); none when empty. The label names it on the
+  /// y axis and in the caption, without its unit.
   std::string error_column;
-  std::string error_label = "error (m)";
-  /// The curve's name in the legend ("deviation from the path"); the
-  /// label when empty.
+  std::string error_label = "error";
+  /// The curve's name in the legend ("deviation of the robot's centre from
+  /// the desired path"); the label when empty.
   std::string error_name;
-  /// A bound drawn across error.png (m), with its legend entry; none when 0.
-  /// The time plots shade the spans where any belt is scheduled on (from
-  /// belt_on_columns) as "line on".
-  double error_bound_m = 0.0;
-  std::string error_bound_label;
+  /// The published bound the run is judged by (m), drawn across error.png
+  /// with its legend entry; none when 0. With `from_column` (a 0/1 column:
+  /// the task done), it is drawn only from the time that column first
+  /// rises: a bound on the final pose. The time plots mark the spans where
+  /// any belt is scheduled on (from belt_on_columns) in a band at the top.
+  struct Bound {
+    double value_m = 0.0;
+    std::string label;
+    std::string from_column;
+  };
+  Bound error_bound;
   /// Belt speed (m/s) and on state (0/1) columns for belt.png; none when
   /// both are empty.
   std::vector<std::string> belt_speed_columns, belt_on_columns;
@@ -83,20 +92,36 @@ struct RobotPlotSpec {
   /// The S300's safety function against a person (safety.png): the robot's
   /// speed (from its map velocity's x and y columns), the safety unit's
   /// speed cap (-1: none), the protective and warning fields' states (1
-  /// clear, 0 infringed) and the distance from the body to the nearest
-  /// person. None when cap_column is empty.
+  /// clear, 0 infringed), the distance from the body to the nearest person
+  /// and, from the active field set's index, how far each field reaches
+  /// beyond the body's front. None when cap_column is empty.
   struct Safety {
-    std::string velocity_x_column, velocity_y_column, cap_column, protective_column,
-        warning_column, distance_column;
+    std::string velocity_x_column, velocity_y_column, cap_column, protective_column, warning_column,
+        distance_column, field_set_column;
+    /// Per field set: the protective and the warning field's reach beyond
+    /// the body's front (m; NaN: no warning field).
+    std::vector<std::array<double, 2>> field_depths_m;
   };
   Safety safety;
-  /// Each worker's track in the top view: x and y columns of its pose.
-  std::vector<std::pair<std::string, std::string>> worker_columns;
-  /// A fleet's other robots in the top view: their tracks, and their
-  /// outlines at the same instants as the robot's.
+  /// The workers: each one's track in the top view (its pose's x and y
+  /// columns), with its name; in scan.png its legs (the
+  /// [x_left, y_left, x_right, y_right] columns, "" for none) and its
+  /// torso as the scanner meets them.
+  struct Worker {
+    std::string name, x_column, y_column;
+    std::array<std::string, 4> leg_columns;
+    double leg_radius_m = 0.0, torso_radius_m = 0.0;
+  };
+  std::vector<Worker> workers;
+  /// A fleet's other robots in the top view (their tracks, and their
+  /// outlines at the same instants as the robot's) and in scan.png (their
+  /// outlines at the scan).
   struct OtherRobot {
     std::string name, x_column, y_column, yaw_column;
     double body_length_m = 0.0, body_width_m = 0.0;
+    /// Its place in the fleet (0: the first robot): its colour, the same
+    /// in every robot's figures.
+    std::size_t fleet_index = 0;
   };
   std::vector<OtherRobot> others;
   /// The robot's name in a fleet ("" for one robot).

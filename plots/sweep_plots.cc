@@ -1,36 +1,31 @@
 #include "plots/sweep_plots.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
-#include <iomanip>
-#include <locale>
 #include <numbers>
 #include <optional>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 
 #include "cosim/variable_table.h"
+#include "plots/figure_style.h"
 #include "plots/gnuplot.h"
+#include "plots/metric_labels.h"
 
 namespace linesim::plots {
 
 namespace {
 
 constexpr const char* kScript = "sweep_plots.gp";
-constexpr int kWidthPx = 800, kHeightPx = 500;
+constexpr style::Canvas kCanvas{800, 500};
 
 // Shortest text that reads back to the same double, independent of the
 // locale.
 std::string Num(double x) { return cosim::FormatValue(x); }
 
-// A number for a legend: 4 significant digits, independent of the locale.
-std::string Short(double x) {
-  std::ostringstream out;
-  out.imbue(std::locale::classic());
-  out << std::setprecision(4) << x;
-  return out.str();
-}
+// A number for a legend: 3 significant digits, independent of the locale.
+std::string Short(double x) { return style::Short(x, 3); }
 
 bool IsSafeFileName(const std::string& name) {
   return !name.empty() && name != "." && name != ".." && SafeFileName(name) == name;
@@ -109,22 +104,63 @@ std::vector<Point> Points(const SweepChart& chart, const SweepSeries& s,
   return points;
 }
 
-// The script lines of a histogram chart: counts per bin as boxes and the
-// normal density N(mean, std) times n x bin width over them; empty without
-// finite samples.
-std::string HistogramScript(const SweepChart& chart, std::size_t index) {
-  std::vector<double> v;
-  for (double x : chart.series[0].mean) {
-    if (std::isfinite(x)) v.push_back(x);
+// How a chart's values are shown: its metric's caption and unit, the
+// values scaled (SI to mm, degrees); or the labels as given.
+struct Shown {
+  std::string caption, value_label, unit;
+  double scale = 1.0;
+};
+Shown ShownAs(const SweepChart& chart) {
+  if (chart.metric.empty()) {
+    return {chart.title, chart.histogram ? chart.x_label : chart.y_label, "", 1.0};
   }
-  if (v.empty()) return {};
-  const double n = static_cast<double>(v.size());
-  double mean = 0.0;
-  for (double x : v) mean += x / n;
+  double largest = 0.0;
+  const auto take = [&](double v) {
+    if (std::isfinite(v)) largest = std::max(largest, std::abs(v));
+  };
+  for (const SweepSeries& series : chart.series) {
+    for (double v : series.mean) take(v);
+    for (double v : series.min) take(v);
+    for (double v : series.max) take(v);
+  }
+  if (!chart.reference.label.empty()) take(chart.reference.max_abs);
+  const MetricAxis axis = DescribeMetric(chart.metric, largest);
+  std::string caption = axis.caption;
+  if (!caption.empty()) {
+    caption[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(caption[0])));
+  }
+  return {caption, axis.Label(), axis.unit, axis.scale};
+}
+
+// The start of a chart's figure: gnuplot's settings reset, its caption and
+// the legend in a band under the axes.
+std::string BeginChart(const SweepChart& chart, const std::string& caption,
+                       const std::vector<std::string>& titles, const std::string& key_title = "") {
+  const style::KeyBand key = style::KeyBelow(titles, kCanvas, key_title);
+  return style::BeginFigure(chart.file.substr(0, chart.file.size() - 4), PlotFormat::kPng,
+                            nullptr) +
+         style::Caption(caption, chart.run_caption) + key.commands + "set bmargin at screen " +
+         style::Short(style::AxisBottomAbove(key.top_screen, kCanvas), 4) + "\n";
+}
+
+// A histogram's samples (finite, scaled for showing) and their bins.
+struct Histogram {
+  std::vector<double> v;
+  double mean = 0.0, sd = 0.0, lo = 0.0, width = 0.0;
+  std::vector<int> counts;
+};
+Histogram Bin(const SweepChart& chart, double scale) {
+  Histogram h;
+  for (double x : chart.series[0].mean) {
+    if (std::isfinite(x)) h.v.push_back(x * scale);
+  }
+  if (h.v.empty()) return h;
+  const double n = static_cast<double>(h.v.size());
+  for (double x : h.v) h.mean += x / n;
   double var = 0.0;
-  for (double x : v) var += (x - mean) * (x - mean);
-  const double sd = v.size() > 1 ? std::sqrt(var / (n - 1.0)) : 0.0;
-  const auto [lo_it, hi_it] = std::minmax_element(v.begin(), v.end());
+  for (double x : h.v) var += (x - h.mean) * (x - h.mean);
+  h.sd = h.v.size() > 1 ? std::sqrt(var / (n - 1.0)) : 0.0;
+  const auto [lo_it, hi_it] = std::minmax_element(h.v.begin(), h.v.end());
   double lo = *lo_it, hi = *hi_it;
   // Square-root choice of the bin count (at least 5, at most 30); a single
   // value gets one bin of a width that shows it.
@@ -134,82 +170,108 @@ std::string HistogramScript(const SweepChart& chart, std::size_t index) {
     lo -= half;
     hi += half;
   }
-  const double width = (hi - lo) / bins;
-  std::vector<int> counts(static_cast<std::size_t>(bins), 0);
-  for (double x : v) {
-    const int b = std::min(bins - 1, static_cast<int>((x - lo) / width));
-    ++counts[static_cast<std::size_t>(b)];
+  h.lo = lo;
+  h.width = (hi - lo) / bins;
+  h.counts.assign(static_cast<std::size_t>(bins), 0);
+  for (double x : h.v) {
+    const int b = std::min(bins - 1, static_cast<int>((x - lo) / h.width));
+    ++h.counts[static_cast<std::size_t>(b)];
   }
+  return h;
+}
+
+// The script lines of a histogram chart: counts per bin as boxes, the
+// normal density N(mean, std) times n x bin width over them and the mean
+// as a line; a source's figures in the bound style. Empty without finite
+// samples.
+std::string HistogramScript(const SweepChart& chart, std::size_t index) {
+  const Shown shown = ShownAs(chart);
+  const Histogram h = Bin(chart, shown.scale);
+  if (h.v.empty()) return {};
+  const double n = static_cast<double>(h.v.size());
   const std::string block = "$hist" + std::to_string(index);
-  std::string s = "\n" + block + " << EOD\n";
-  for (int b = 0; b < bins; ++b) {
-    s += Num(lo + (b + 0.5) * width) + " " + std::to_string(counts[static_cast<std::size_t>(b)]) +
-         "\n";
+  std::string data = block + " << EOD\n";
+  for (std::size_t b = 0; b < h.counts.size(); ++b) {
+    data += Num(h.lo + (static_cast<double>(b) + 0.5) * h.width) + "," +
+            std::to_string(h.counts[b]) + "\n";
   }
+  data += "EOD\n";
   // The x range: the bins, the fitted normal's +-3 std and the source's
-  // marks.
+  // figures.
   const SweepChart::Reference& ref = chart.reference;
   const bool marked = !ref.label.empty();
-  double x0 = lo, x1 = hi;
-  if (sd > 0.0) {
-    x0 = std::min(x0, mean - 3.0 * sd);
-    x1 = std::max(x1, mean + 3.0 * sd);
+  const double ref_max = ref.max_abs * shown.scale, ref_std = ref.std * shown.scale;
+  double x0 = h.lo, x1 = h.lo + h.width * static_cast<double>(h.counts.size());
+  if (h.sd > 0.0) {
+    x0 = std::min(x0, h.mean - 3.0 * h.sd);
+    x1 = std::max(x1, h.mean + 3.0 * h.sd);
   }
-  if (marked && std::isfinite(ref.max_abs)) {
-    x0 = std::min(x0, -ref.max_abs);
-    x1 = std::max(x1, ref.max_abs);
+  if (marked && std::isfinite(ref_max)) {
+    x0 = std::min(x0, -ref_max);
+    x1 = std::max(x1, ref_max);
   }
-  if (marked && std::isfinite(ref.std) && ref.std > 0.0) {
-    x0 = std::min(x0, -3.0 * ref.std);
-    x1 = std::max(x1, 3.0 * ref.std);
+  if (marked && std::isfinite(ref_std) && ref_std > 0.0) {
+    x0 = std::min(x0, -3.0 * ref_std);
+    x1 = std::max(x1, 3.0 * ref_std);
   }
   const double pad = 0.05 * (x1 - x0);
-  s += "EOD\nset output " + GnuplotQuote(chart.file) + "\nset title " +
-       GnuplotQuote(chart.title) + "\nset xlabel " + GnuplotQuote(chart.x_label) +
-       "\nset ylabel 'runs'\nset xrange [" + Num(x0 - pad) + ":" + Num(x1 + pad) +
-       "]\nset xtics autofreq\nset key title ''\n"
-       "set yrange [0:*]\nset ytics 1\nunset arrow\n"
-       "set boxwidth " + Num(width) + " absolute\nset style fill solid 0.5 border -1\n";
-  std::string extra;
-  if (marked && std::isfinite(ref.max_abs)) {
-    for (const double x : {-ref.max_abs, ref.max_abs}) {
-      s += "set arrow from " + Num(x) + ", graph 0 to " + Num(x) +
-           ", graph 1 nohead lw 2 lc rgb '#cc0000' dt 2\n";
+  const int most = *std::max_element(h.counts.begin(), h.counts.end());
+  // Values in the legend with their unit; a mean within rounding of 0 as 0.
+  const std::string unit = shown.unit.empty() ? "" : " " + shown.unit;
+  const auto value = [&](double x) {
+    return Short(std::abs(x) < 1e-9 * (std::abs(h.lo) + h.width * 30.0) ? 0.0 : x) + unit;
+  };
+  std::vector<style::PlotItem> items = {
+      {block + " using 1:2",
+       "with boxes fillcolor rgb '#56B4E9' fillstyle solid 0.6 border lc rgb '#0072B2'",
+       std::to_string(h.v.size()) + " runs, bins of " + value(h.width)}};
+  const auto normal = [&](double mean, double sd) {
+    const std::string k = Num(n * h.width / (sd * std::sqrt(2.0 * std::numbers::pi)));
+    return "[" + Num(mean - 4.0 * sd) + ":" + Num(mean + 4.0 * sd) + "] " + k +
+           " * exp(-0.5 * ((x - " + Num(mean) + ") / " + Num(sd) + ") ** 2)";
+  };
+  if (h.sd > 0.0) {
+    items.push_back({normal(h.mean, h.sd), "with lines lw 2 lc rgb '#D55E00'",
+                     "normal fit: std " + value(h.sd)});
+  }
+  std::string arrows = "set arrow from " + Num(h.mean) + ", graph 0 to " + Num(h.mean) +
+                       ", graph 1 nohead lw 2 dt 4 lc rgb '#D55E00'\n";
+  items.push_back(
+      {"keyentry", "with lines lw 2 dt 4 lc rgb '#D55E00'", "mean of the runs: " + value(h.mean)});
+  if (marked && std::isfinite(ref_max)) {
+    for (const double x : {-ref_max, ref_max}) {
+      arrows += "set arrow from " + Num(x) + ", graph 0 to " + Num(x) + ", graph 1 nohead " +
+                style::kBoundStyle + "\n";
     }
-    std::string what = ref.label + ": max |error| " + Short(ref.max_abs);
-    if (std::isfinite(ref.mean_abs)) what += ", mean |error| " + Short(ref.mean_abs);
-    extra += ", \\\n     NaN with lines lw 2 lc rgb '#cc0000' dt 2 title " + GnuplotQuote(what);
+    items.push_back({"keyentry", std::string("with lines ") + style::kBoundStyle,
+                     "source: largest |error| " + value(ref_max)});
   }
-  if (marked && std::isfinite(ref.std) && ref.std > 0.0) {
-    const std::string k = Num(n * width / (ref.std * std::sqrt(2.0 * std::numbers::pi)));
-    extra += ", \\\n     [" + Num(-4.0 * ref.std) + ":" + Num(4.0 * ref.std) + "] " + k +
-             " * exp(-0.5 * (x / " + Num(ref.std) +
-             ") ** 2) with lines lw 2 lc rgb '#cc0000' dt 3 title " +
-             GnuplotQuote(ref.label + ": std " + Short(ref.std) + " (as N(0, std))");
+  if (marked && std::isfinite(ref_std) && ref_std > 0.0) {
+    items.push_back({normal(0.0, ref_std), "with lines dt 3 lw 2 lc rgb '#000000'",
+                     "source: std " + value(ref_std) + ", as N(0, std)"});
   }
-  s += "plot " + block + " using 1:2 with boxes lt 1 title " +
-       GnuplotQuote(std::to_string(v.size()) + " runs, bins of " + Short(width));
-  if (sd > 0.0) {
-    const std::string k = Num(n * width / (sd * std::sqrt(2.0 * std::numbers::pi)));
-    s += ", \\\n     [" + Num(mean - 4.0 * sd) + ":" + Num(mean + 4.0 * sd) + "] " + k +
-         " * exp(-0.5 * ((x - " + Num(mean) + ") / " + Num(sd) +
-         ") ** 2) with lines lw 2 lt 2 title " +
-         GnuplotQuote("normal: mean " + Short(mean) + ", std " + Short(sd));
-  }
-  s += extra;
-  // The next chart scales its own axes.
-  return s + "\nunset arrow\nset autoscale x\nset autoscale y\nset ytics autofreq\n";
+  return "\n" + data +
+         BeginChart(chart,
+                    shown.caption + ": distribution over " + std::to_string(h.v.size()) + " runs",
+                    style::Titles(items), marked ? "source: " + ref.label : "") +
+         "set xlabel " + GnuplotQuote(shown.value_label) + "\nset ylabel 'runs'\nset xrange [" +
+         Num(x0 - pad) + ":" + Num(x1 + pad) +
+         "]\nset yrange [0:*]\nset offsets 0, 0, graph 0.08, 0\n" +
+         (most <= 10 ? "set ytics 1\n" : "") + "set boxwidth " + Num(h.width) + " absolute\n" +
+         arrows + style::PlotCommand(items);
 }
 
 // The script lines of one chart; empty when it has nothing to draw.
 std::string ChartScript(const SweepChart& chart, std::size_t index) {
   if (chart.histogram) return HistogramScript(chart, index);
+  const Shown shown = ShownAs(chart);
   const std::vector<std::string> categories =
       chart.categorical_x ? Categories(chart) : std::vector<std::string>{};
   const std::size_t count = chart.series.size();
   // Sideways spread of the series at one category: at most 0.6 of the gap.
   const double step = std::min(0.1, 0.6 / static_cast<double>(count));
-  std::string blocks, items;
+  std::string blocks;
+  std::vector<style::PlotItem> items;
   // What a point is: the series' title, or the legend's when series have labels.
   const std::string what = chart.scatter ? "one point per run" : "mean, bars: min to max";
   bool any_label = false;
@@ -224,44 +286,42 @@ std::string ChartScript(const SweepChart& chart, std::size_t index) {
     const std::string block = "$chart" + std::to_string(index) + "_" + std::to_string(k);
     blocks += block + " << EOD\n";
     for (const Point& p : points) {
-      blocks += Num(p.x) + " " + Num(p.mean);
-      if (!chart.scatter) blocks += " " + Num(p.min) + " " + Num(p.max);
+      blocks += Num(p.x) + "," + Num(p.mean * shown.scale);
+      if (!chart.scatter) blocks += "," + Num(p.min * shown.scale) + "," + Num(p.max * shown.scale);
       blocks += "\n";
     }
     blocks += "EOD\n";
     any_label = any_label || !s.label.empty();
     std::string style;
     if (chart.scatter) {
-      style = "using 1:2 with points pt 7 ps 0.8";
+      style = "with points pt 7 ps 0.8";
     } else if (chart.categorical_x) {
-      style = "using 1:2:3:4 with yerrorbars pt 7 ps 1.2 lw 2";
+      style = "with yerrorbars pt 7 ps 1.2 lw 2";
     } else {
-      style = "using 1:2:3:4 with yerrorlines pt 7 ps 1.2 lw 2";
+      style = "with yerrorlines pt 7 ps 1.2 lw 2";
     }
-    items += std::string(items.empty() ? "plot " : ", \\\n     ") + block + " " + style + " lt " +
-             std::to_string(k + 1) + " title " +
-             GnuplotQuote(s.label.empty() ? what : s.label);
+    items.push_back({block + (chart.scatter ? " using 1:2" : " using 1:2:3:4"),
+                     style + " lc rgb '" + style::SeriesColour(k) + "'",
+                     s.label.empty() ? what : s.label + (count > 1 ? "" : " (" + what + ")")});
   }
   if (items.empty()) return {};
-
-  std::string s = "\n" + blocks + "set output " + GnuplotQuote(chart.file) + "\nset title " +
-                  GnuplotQuote(chart.title) + "\nset xlabel " + GnuplotQuote(chart.x_label) +
-                  "\nset ylabel " + GnuplotQuote(chart.y_label) + "\n";
+  const std::string x_label = chart.x_label;
+  const bool key_title = any_label && count > 1;
+  std::string s =
+      "\n" + blocks +
+      BeginChart(chart,
+                 chart.metric.empty() ? shown.caption : shown.caption + " against " + x_label,
+                 style::Titles(items), key_title ? what : "") +
+      "set xlabel " + GnuplotQuote(x_label) + "\nset ylabel " + GnuplotQuote(shown.value_label) +
+      "\nset offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n";
   if (chart.categorical_x) {
     s += "set xrange [-0.5:" + Num(static_cast<double>(categories.size()) - 0.5) + "]\nset xtics (";
     for (std::size_t i = 0; i < categories.size(); ++i) {
       s += (i ? ", " : "") + GnuplotQuote(categories[i]) + " " + std::to_string(i);
     }
     s += ")\n";
-  } else {
-    s += "set autoscale x\nset xtics autofreq\n";
   }
-  if (any_label) {
-    s += "set key title " + GnuplotQuote(what) + "\n";
-  } else {
-    s += "set key title ''\n";
-  }
-  return s + items + "\n";
+  return s + style::PlotCommand(items);
 }
 
 }  // namespace
@@ -286,10 +346,7 @@ std::vector<std::string> WriteSweepPlots(const std::string& dir,
   std::string script =
       "# Written by linesim (plots/sweep_plots.cc). Run `gnuplot sweep_plots.gp` in this\n"
       "# folder to redraw; the data are inline.\n" +
-      GnuplotPngTerminal(kWidthPx, kHeightPx) +
-      "set grid\n"
-      "set key below\n"
-      "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n";
+      GnuplotPngTerminal(kCanvas.width_px, kCanvas.height_px);
   std::vector<std::string> outputs;
   for (std::size_t i = 0; i < charts.size(); ++i) {
     const std::string chart = ChartScript(charts[i], i);

@@ -21,6 +21,14 @@ struct SweepChart {
   /// PNG file name in the output folder, made of [A-Za-z0-9._-] only (see
   /// SafeFileName), ending in ".png".
   std::string file;
+  /// The metric drawn (a histogram's samples, the y of the others), by its
+  /// name: the caption, axis label and unit come from it (DescribeMetric:
+  /// lengths in mm, angles in degrees), the values stay in SI. Without it,
+  /// `title`, `x_label` and `y_label` are used as given.
+  std::string metric;
+  /// What the runs are of (the sweep's or scenario's name), the caption's
+  /// second line.
+  std::string run_caption;
   std::string title, x_label, y_label;
   /// Categories are drawn at 0..n-1 with their text as tic labels, in the
   /// order of `categories` (those missing from it after, in first-seen
@@ -30,14 +38,15 @@ struct SweepChart {
   bool scatter = false;
   /// A histogram of the samples in series[0].mean (x, min and max unused),
   /// with the normal density of their mean and sample standard deviation
-  /// scaled to counts over it (as paper 2's Figs. 6-11 show a histogram and
-  /// its normal distribution). `x_label` names the sample's quantity.
+  /// scaled to counts over it and the mean as a vertical line (as paper 2's
+  /// Figs. 6-11 show a histogram and its normal distribution).
   bool histogram = false;
   /// A source's figures marked on a histogram (when `label` is not empty):
-  /// +-max_abs as vertical lines and the zero-mean normal of `std` scaled
-  /// to counts, dashed (NaN figures are left out; paper 2's Table 1 gives
-  /// these three of its signed errors, not their mean); mean_abs is named
-  /// in the legend. The x range widens to show them.
+  /// +-max_abs as vertical lines (the bound style) and the zero-mean
+  /// normal of `std` scaled to counts, dotted (NaN figures are left out;
+  /// paper 2's Table 1 gives these three of its signed errors, not their
+  /// mean; its mean_abs is in the written table, not drawn). The x range
+  /// widens to show them.
   struct Reference {
     std::string label;
     double max_abs = 0.0, std = 0.0, mean_abs = 0.0;

@@ -314,7 +314,7 @@ FolderRun RunIntoFolder(Session& session, const std::string& file, const std::st
   std::unique_ptr<replay::ReplayRecorder> replayer;
   if (s.robot && options.replay) {
     replayer = std::make_unique<replay::ReplayRecorder>(
-        replay::ReplaySpecFor(s, kPaperBoundM, kPaperBoundLabel));
+        replay::ReplaySpecFor(s, s.robot->figure_bound.value_m, s.robot->figure_bound.label));
     session.AddObserver(replayer.get());
   }
   // The run for Foxglove and PlotJuggler, gathered as it runs.

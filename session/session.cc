@@ -17,13 +17,32 @@ using Json = nlohmann::ordered_json;
 
 Json Number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
+// The worker's parameter `name` as the built unit has it (its default when
+// the scenario gives none); 0 when the unit or parameter is not there.
+double WorkerParameter(const cosim::System& system, const std::string& worker,
+                       const std::string& name) {
+  const auto unit = system.FindUnit(worker);
+  if (!unit) return 0.0;
+  const cosim::VariableTable& v = system.unit(*unit).variables();
+  const auto ref = v.Find(name);
+  return ref ? v.GetReal(*ref) : 0.0;
+}
+
+// The caption line naming the run: the scenario's description, its name
+// (with the robot's in a fleet) and seed.
+std::string RunCaption(const loader::Scenario& s, const loader::RobotInfo& robot) {
+  std::string run = s.name + (robot.name.empty() ? "" : ", robot " + robot.name) + ", seed " +
+                    std::to_string(s.seed);
+  return s.description.empty() ? run : s.description + " (" + run + ")";
+}
+
 // What the plots of a robot run draw, by the columns the robot expansion
 // names. `robot` is the scenario's robot, or in a fleet any of its robots
 // (the others drawn in its top view; `first` is the scenario's).
 plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat format,
                               const loader::RobotInfo& robot, const loader::RobotInfo& first) {
   plots::RobotPlotSpec spec;
-  spec.title = s.name;
+  spec.run_caption = RunCaption(s, robot);
   spec.scene = s.scene;
   spec.path_m = robot.path;
   spec.x_column = robot.x_column;
@@ -32,12 +51,16 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat forma
   spec.z_column = robot.z_column;
   spec.wheel_columns = robot.wheel_columns;
   spec.error_column = robot.error_column;
-  spec.error_label =
-      robot.task != "hold" ? "deviation from the path (m)" : "drift from the held position (m)";
-  spec.error_name = robot.task != "hold" ? "deviation of the robot's centre from the desired path"
-                                         : "drift of the robot's centre from the held position";
-  spec.error_bound_m = kPaperBoundM;
-  spec.error_bound_label = kPaperBoundLabel;
+  const bool hold = robot.task == "hold";
+  spec.error_label = hold ? "drift from the held position" : "deviation from the path";
+  spec.error_name = hold ? "drift of the robot's centre from the held position"
+                         : "deviation of the robot's centre from the desired path";
+  // The scenario's published bound (figures.bound), the same for each
+  // robot of a fleet.
+  const loader::RobotInfo::FigureBound& bound = first.figure_bound;
+  spec.error_bound.value_m = bound.value_m;
+  spec.error_bound.label = bound.label;
+  if (bound.final_pose) spec.error_bound.from_column = robot.task_done_column;
   spec.format = format;
   spec.belt_speed_columns = robot.belt_speed_columns;
   spec.belt_on_columns = robot.belt_on_columns;
@@ -47,21 +70,34 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat forma
   spec.flow_truth_columns = robot.flow_truth_columns;
   spec.flow_filtered_columns = robot.flow_filtered_columns;
   spec.flow_reference_column = robot.flow_reference_column;
-  spec.worker_columns = robot.worker_columns;
+  for (std::size_t w = 0; w < robot.worker_columns.size(); ++w) {
+    plots::RobotPlotSpec::Worker worker;
+    worker.x_column = robot.worker_columns[w].first;
+    worker.y_column = robot.worker_columns[w].second;
+    if (w < robot.worker_names.size()) {
+      worker.name = robot.worker_names[w];
+      worker.leg_radius_m = WorkerParameter(*s.system, worker.name, "leg_radius");
+      worker.torso_radius_m = WorkerParameter(*s.system, worker.name, "torso_radius");
+    }
+    if (w < robot.worker_leg_columns.size()) worker.leg_columns = robot.worker_leg_columns[w];
+    spec.workers.push_back(worker);
+  }
   // A fleet: each robot's plots, with the others in the top view; the
   // first robot's files have no prefix, the others' their name.
   spec.robot_name = robot.name;
-  const auto add_other = [&](const loader::RobotInfo& other) {
+  const auto add_other = [&](const loader::RobotInfo& other, std::size_t index) {
     if (other.name == robot.name) return;
     spec.others.push_back({other.name, other.x_column, other.y_column, other.yaw_column,
-                           other.body_length_m.value_or(0.0), other.body_width_m.value_or(0.0)});
+                           other.body_length_m.value_or(0.0), other.body_width_m.value_or(0.0),
+                           index});
   };
-  add_other(first);
-  for (const loader::RobotInfo& other : first.fleet) add_other(other);
+  add_other(first, 0);
+  for (std::size_t i = 0; i < first.fleet.size(); ++i) add_other(first.fleet[i], i + 1);
   if (robot.name != first.name) spec.file_prefix = robot.name + "_";
-  if (!robot.name.empty()) spec.title = s.name + " (" + robot.name + ")";
-  spec.safety = {robot.velocity_x_column, robot.velocity_y_column, robot.speed_cap_column,
-                 robot.protective_column, robot.warning_column,    robot.person_distance_column};
+  spec.safety = {robot.velocity_x_column, robot.velocity_y_column,
+                 robot.speed_cap_column,  robot.protective_column,
+                 robot.warning_column,    robot.person_distance_column,
+                 robot.field_set_column,  {}};
   if (!robot.scan_unit.empty() && robot.scan_geometry) {
     // The beams' geometry as the system description gives it.
     const loader::RobotInfo::ScanGeometry& g = *robot.scan_geometry;
@@ -81,6 +117,12 @@ plots::RobotPlotSpec PlotSpec(const loader::Scenario& s, plots::PlotFormat forma
   }
   if (robot.body_length_m) spec.body_length_m = *robot.body_length_m;
   if (robot.body_width_m) spec.body_width_m = *robot.body_width_m;
+  // The fields' reach beyond the body's front (base_link's origin is the
+  // body's centre).
+  for (const auto& reach : robot.field_reach_m) {
+    spec.safety.field_depths_m.push_back(
+        {reach[0] - 0.5 * spec.body_length_m, reach[1] - 0.5 * spec.body_length_m});
+  }
   return spec;
 }
 

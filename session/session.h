@@ -20,13 +20,6 @@
 /// the summary and the plots. The command line is a thin layer over it.
 namespace linesim::session {
 
-/// Paper 1, Sec. VI-B: with the modified system the maximum deviation
-/// crossing the line at 0.10 m/s is under 4 cm; a robot run's plots and
-/// replay draw it as the bound the deviation and the holds' drift are
-/// judged by.
-inline constexpr double kPaperBoundM = 0.04;
-inline constexpr const char* kPaperBoundLabel = "4 cm (paper 1, Sec. VI-B)";
-
 /// What one run gave.
 struct RunReport {
   /// The master's result (its errors are also in `errors`).

@@ -586,6 +586,8 @@ std::vector<plots::SweepChart> SweepCharts(const SweepTable& t) {
     for (std::size_t m = 0; m + 1 < t.metrics.size(); ++m) {
       plots::SweepChart chart;
       chart.histogram = true;
+      chart.metric = t.metrics[m];  // its caption and unit come from its name
+      chart.run_caption = t.name;
       chart.title = (t.name.empty() ? "" : t.name + ": ") + t.metrics[m] + " over " +
                     std::to_string(t.rows.size()) + " runs";
       chart.x_label = t.metrics[m];
@@ -611,6 +613,8 @@ std::vector<plots::SweepChart> SweepCharts(const SweepTable& t) {
       const std::string& path = t.parameters[p];
       plots::SweepChart chart;
       chart.title = (t.name.empty() ? "" : t.name + ": ") + t.metrics[m] + " against " + path;
+      chart.metric = t.metrics[m];
+      chart.run_caption = t.name;
       chart.x_label = path;
       chart.y_label = t.metrics[m];
       std::vector<plots::SweepSeries> series;

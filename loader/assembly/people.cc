@@ -1,5 +1,7 @@
 #include "loader/assembly/people.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 
@@ -40,6 +42,19 @@ YAML::Node ReadPolygonInScanner(YamlReader& r, const YAML::Node& item, const std
   return PointList(corners);
 }
 
+// How far forward a polygon of the scanner's frame (as ReadPolygonInScanner
+// wrote it) reaches in base_link: its corners' largest x; NaN for none.
+double ReachInBaseLink(const YAML::Node& polygon, const models::SensorMount& laser) {
+  if (!polygon.IsDefined() || !polygon.IsSequence() || polygon.size() == 0) return NAN;
+  const double c = std::cos(laser.yaw_rad), s = std::sin(laser.yaw_rad);
+  double reach = -INFINITY;
+  for (const auto& p : polygon) {
+    const double x = p[0].as<double>(), y = p[1].as<double>();
+    reach = std::max(reach, laser.x_m + c * x - s * y);
+  }
+  return reach;
+}
+
 const models::SensorMount* FindLaser(const Signals& s, const std::string& name) {
   for (const auto& m : s.sensors) {
     if (m.kind == "laser_scanner" && (name.empty() || m.name == name)) return &m;
@@ -49,7 +64,7 @@ const models::SensorMount* FindLaser(const Signals& s, const std::string& name) 
 
 }  // namespace
 
-void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s) {
+void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo& info) {
   YamlReader& r = b.reader();
   const YAML::Node safety = Child(b.root(), "safety");
   if (!safety.IsDefined() || safety.IsNull()) return;
@@ -129,6 +144,8 @@ void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s) {
                                                         laser->x_m, laser->y_m, laser->yaw_rad);
         if (warning.IsDefined()) set["warning"] = warning;
         out_sets.push_back(set);
+        info.field_reach_m.push_back(
+            {ReachInBaseLink(set["protective"], *laser), ReachInBaseLink(warning, *laser)});
       }
     }
   }
@@ -183,6 +200,7 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
     info.speed_cap_column = Signal(kSafety, "speed_cap").Name();
     info.protective_column = Signal(kSafety, "protective_clear").Name();
     info.warning_column = Signal(kSafety, "warning_clear").Name();
+    info.field_set_column = Signal(kSafety, "field_set").Name();
   }
 
   const YAML::Node list = Child(b.root(), "workers");
@@ -295,6 +313,10 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
     info.worker_columns.emplace_back(Element(names[w], "pose", 0).Name(),
                                      Element(names[w], "pose", 1).Name());
     s.recorded.push_back(Signal(names[w], "legs"));
+    info.worker_names.push_back(names[w]);
+    std::array<std::string, 4> legs;
+    for (std::size_t k = 0; k < 4; ++k) legs[k] = Element(names[w], "legs", k).Name();
+    info.worker_leg_columns.push_back(legs);
     add(names[w] + "_time_waited_s", Signal(names[w], "time_waited"), cosim::Reduction::kFinal);
     add("robot_" + names[w] + "_collisions", Element(kPersonClearance, "worker_collisions", w),
         cosim::Reduction::kFinal);

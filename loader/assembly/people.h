@@ -13,7 +13,7 @@ inline constexpr const char* kPersonClearance = "person_clearance";
 /// between the task and the wheel controller: after AddControl, before
 /// AddTask (it takes over the wheel controller's command inputs in `s`).
 /// Nothing when the scenario has no `safety:` section.
-void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s);
+void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo& info);
 
 /// workers: a worker unit per entry, its legs and torso connected to every
 /// laser on the robot (moving cylinders) and to a person_clearance unit

@@ -1,8 +1,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <numbers>
+#include <optional>
 
 #include "loader/assembly/concerns.h"
 #include "loader/route_graph_file.h"
@@ -140,6 +140,7 @@ void AddRoute(SystemBuilder& b, const RobotFile& file, const YAML::Node& task, S
   b.Connect(Signal(kPathFollower, "yaw_rate_command"), s.yaw_rate_command_input);
   s.map_index_output = Signal(kPathFollower, "map_index");
   s.route_done = Signal(kPathFollower, "done");
+  info.task_done_column = s.route_done.Name();
   for (const char* v : {"velocity_command", "yaw_rate_command", "distance_error",
                         "orientation_error", "segment", "map_index", "done"}) {
     s.recorded.push_back(Signal(kPathFollower, v));

@@ -2,9 +2,11 @@
 // expand into, and bad input named at its file and key path.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include "tests/loader/scenario_test.h"
 
@@ -26,6 +28,32 @@ TEST(PeopleAssembly, WorkersReachTheLasersAndTheSafetyUnit) {
     const auto ref = v.Find("moving_cylinders");
     ASSERT_TRUE(ref.has_value()) << laser;
     EXPECT_EQ(v.info(*ref).size, 21u) << laser;
+  }
+}
+
+// Guards what the figures read of the workers and the safety fields: each
+// worker's name and recorded legs, the field set column, and how far each
+// field set's fields reach forward in base_link (models/robots/raw3.yaml:
+// the front at 0.515 m, protective 0.15/0.25/1.0 m and warning
+// 0.65/0.75/1.5 m beyond it).
+TEST(PeopleAssembly, FiguresGetTheWorkersAndTheFieldsReach) {
+  const Scenario s = LoadScenario(Shipped(), {"duration_s=0.1"});
+  const RobotInfo& info = *s.robot;
+  ASSERT_EQ(info.worker_names.size(), 1u);
+  EXPECT_EQ(info.worker_names[0], "worker");
+  ASSERT_EQ(info.worker_leg_columns.size(), 1u);
+  EXPECT_EQ(info.worker_leg_columns[0][3], "worker.legs[3]");
+  std::vector<std::string> recorded;
+  for (const auto& p : s.recorded) recorded.push_back(p.label);
+  for (const auto& column : {info.worker_leg_columns[0][0], info.field_set_column}) {
+    EXPECT_NE(std::find(recorded.begin(), recorded.end(), column), recorded.end()) << column;
+  }
+  EXPECT_EQ(info.field_set_column, "safety.field_set");
+  const double reach[3][2] = {{0.665, 1.165}, {0.765, 1.265}, {1.515, 2.015}};
+  ASSERT_EQ(info.field_reach_m.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_NEAR(info.field_reach_m[k][0], reach[k][0], 1e-12) << k;
+    EXPECT_NEAR(info.field_reach_m[k][1], reach[k][1], 1e-12) << k;
   }
 }
 

@@ -180,6 +180,39 @@ TEST(RobotScenario, PlotColumnsAndBodyComeFromTheExpansion) {
   EXPECT_EQ(longer.robot->body_width_m, 0.57);
 }
 
+// Guards `figures.bound`, the published bound a run's figures judge it by:
+// paper 1's 4 cm on cross_line (its Sec. VI-B), paper 2's Table 1 (14 mm)
+// over van_entry's final pose, from its route's done column, none on a
+// scenario that reproduces no paper (the fleet); a bound on the final pose
+// of a task that never finishes, an unknown key and a bound of 0 refused at
+// their keys.
+TEST(RobotScenario, FiguresBoundIsTheScenariosOwn) {
+  const Scenario cross = LoadScenario(kCross);
+  EXPECT_EQ(cross.robot->figure_bound.value_m, 0.04);
+  EXPECT_FALSE(cross.robot->figure_bound.final_pose);
+  EXPECT_NE(cross.robot->figure_bound.label.find("paper 1"), std::string::npos);
+  const Scenario van = LoadScenario(LINESIM_SOURCE_DIR "/scenarios/van_entry.yaml");
+  EXPECT_EQ(van.robot->figure_bound.value_m, 0.014);
+  EXPECT_TRUE(van.robot->figure_bound.final_pose);
+  EXPECT_EQ(van.robot->task_done_column, "path_follower.done");
+  EXPECT_EQ(LoadScenario(kHusky).robot->figure_bound.value_m, 0.0);
+  const Scenario fleet = LoadScenario(LINESIM_SOURCE_DIR "/scenarios/fleet_line.yaml");
+  EXPECT_EQ(fleet.robot->figure_bound.value_m, 0.0);
+  std::ifstream in(kCross);
+  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  text = text.substr(0, text.find("\nfigures:")) + "\nfigures:\n";
+  const std::string final_pose = WriteScenario(
+      "cross_final_pose.yaml", text + "  bound: {value_m: 0.04, label: x, over: final_pose}\n");
+  const std::string e = Issues(final_pose);
+  EXPECT_TRUE(Has(e, "figures.bound.over")) << e;
+  EXPECT_TRUE(Has(e, "needs a task that finishes")) << e;
+  const std::string unknown = WriteScenario(
+      "cross_colour.yaml", text + "  bound: {value_m: 0.04, label: x, colour: red}\n");
+  EXPECT_TRUE(Has(Issues(unknown), "figures.bound.colour")) << Issues(unknown);
+  const std::string v = Issues(kCross, {"figures.bound.value_m=0"});
+  EXPECT_TRUE(Has(v, "figures.bound.value_m")) << v;
+}
+
 // Guards the default recording interval: the first whole number of master
 // steps from 10 ms on, exact in decimal (no 0.010199999999999999 for a
 // 0.3 ms step), and 10 ms for a missing or bad step (reported elsewhere).

@@ -39,7 +39,7 @@ class ComparePlotsTest : public ::testing::Test {
 
   ComparisonPlotSpec Spec() const {
     ComparisonPlotSpec spec;
-    spec.title = "nominal 'against' modified";
+    spec.run_caption = "nominal 'against' modified";
     spec.runs = {{"nominal/signals.csv", "deviation.deviation", "nominal"},
                  {"modified/signals.csv", "deviation.deviation", "modified"}};
     spec.belt_on_columns = {"belt.on[0]"};
@@ -61,15 +61,25 @@ class ComparePlotsTest : public ::testing::Test {
 // (its column 2), the bound, the runs' labels in a legend below the data.
 TEST_F(ComparePlotsTest, OverlaysEveryRunWithTheLineStateAndTheBound) {
   const std::string s = ComparisonScript(dir_.string(), Spec());
-  EXPECT_NE(s.find("'nominal/signals.csv' skip 1 using 1:((column(2) > 0.5) ? 1 : 0) axes x1y2"),
+  EXPECT_NE(
+      s.find("'nominal/signals.csv' skip 1 using 1:((column(2) > 0.5) ? 0.97 : 1):(1) axes x1y2"),
+      std::string::npos)
+      << s;
+  // Each run in mm, the bound at 40 mm in the bounds' style (black dashed,
+  // as error.png draws it).
+  EXPECT_NE(s.find("'nominal/signals.csv' skip 1 using 1:(1000 * column(3)) with lines"),
             std::string::npos)
       << s;
-  EXPECT_NE(s.find("'nominal/signals.csv' skip 1 using 1:3 with lines"), std::string::npos) << s;
-  EXPECT_NE(s.find("'modified/signals.csv' skip 1 using 1:3 with lines"), std::string::npos) << s;
+  EXPECT_NE(s.find("'modified/signals.csv' skip 1 using 1:(1000 * column(3)) with lines"),
+            std::string::npos)
+      << s;
   EXPECT_NE(s.find("title 'nominal'"), std::string::npos);
   EXPECT_NE(s.find("title 'modified'"), std::string::npos);
-  EXPECT_NE(s.find("0.04 with lines"), std::string::npos);
-  EXPECT_NE(s.find("title 'line on'"), std::string::npos);
+  EXPECT_NE(s.find("40 with lines dt 2 lw 2 lc rgb '#000000' title '4 cm (paper 1, Sec. VI-B)'"),
+            std::string::npos)
+      << s;
+  EXPECT_NE(s.find("set ylabel 'deviation from the path (mm)'"), std::string::npos) << s;
+  EXPECT_NE(s.find("title 'line on (band along the top)'"), std::string::npos);
   EXPECT_NE(s.find("set key at screen 0.5, 0.01 center bottom"), std::string::npos);
   const std::string png = WriteComparisonPlot(dir_.string(), Spec());
   EXPECT_EQ(fs::path(png).filename(), "comparison.png");
@@ -89,8 +99,7 @@ TEST_F(ComparePlotsTest, SvgAndAMissingColumnIsNamed) {
     FAIL() << "an unknown column was accepted";
   } catch (const std::runtime_error& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("modified/signals.csv: no column 'deviation.deviatoin'"),
-              std::string::npos)
+    EXPECT_NE(what.find("modified/signals.csv: no column 'deviation.deviatoin'"), std::string::npos)
         << what;
     EXPECT_NE(what.find("deviation.deviation"), std::string::npos) << what;
   }

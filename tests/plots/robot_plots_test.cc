@@ -60,7 +60,7 @@ class RobotPlotsTest : public ::testing::Test {
 
   static RobotPlotSpec Spec() {
     RobotPlotSpec spec;
-    spec.title = "crossing 'test'";
+    spec.run_caption = "crossing 'test'";
     models::Belt belt;
     belt.name = "line";
     belt.area = {0.0, 0.0, 10.0, 1.0, 0.0};
@@ -74,7 +74,7 @@ class RobotPlotsTest : public ::testing::Test {
                                       "chassis.contact_y[" + std::to_string(w) + "]");
     }
     spec.error_column = "metrics.deviation";
-    spec.error_label = "deviation from path (m)";
+    spec.error_label = "deviation from path";
     spec.belt_speed_columns = {"belt.speed[0]"};
     spec.belt_on_columns = {"belt.on[0]"};
     return spec;
@@ -189,23 +189,45 @@ TEST_F(RobotPlotsTest, SafetyPlotDrawsSpeedCapAndFields) {
   RobotPlotSpec spec;
   spec.x_column = "chassis.position[0]";
   spec.y_column = "chassis.position[1]";
-  spec.safety = {"chassis.linear_velocity[0]", "chassis.linear_velocity[1]",
-                 "safety.speed_cap",           "safety.protective_clear",
-                 "safety.warning_clear",       "person_clearance.distance"};
-  spec.worker_columns = {{"worker.pose[0]", "worker.pose[1]"}};
+  spec.safety = {"chassis.linear_velocity[0]",
+                 "chassis.linear_velocity[1]",
+                 "safety.speed_cap",
+                 "safety.protective_clear",
+                 "safety.warning_clear",
+                 "person_clearance.distance",
+                 "",
+                 {}};
+  RobotPlotSpec::Worker worker;
+  worker.name = "worker";
+  worker.x_column = "worker.pose[0]";
+  worker.y_column = "worker.pose[1]";
+  spec.workers = {worker};
   const auto files = WriteRobotPlots(dir_.string(), spec);
   ASSERT_EQ(files.size(), 2u);
   EXPECT_EQ(fs::path(files[1]).filename(), "safety.png");
   EXPECT_TRUE(IsPng(files[1]));
   const std::string script = ReadAll(dir_ / "plots.gp");
-  // Columns by number: velocity 4 and 5, cap 6 (-1: NaN), fields 7 and 8,
-  // distance 9; the worker's track (columns 10 and 11) in the top view, from
-  // a data block the script carries.
+  // $signals columns: velocity 4 and 5, cap 6 (-1: NaN), the distance 7
+  // in a panel of its own (not on the speed's axis, not cut off); each
+  // field a lane, barred over the spans it is infringed (protective 2-4 s,
+  // warning from 1.5 s to the end); the closest approach (0.4 m at 6 s)
+  // marked; the worker's track in the top view, named, from a data block
+  // the script carries.
   EXPECT_NE(script.find("sqrt(column(4)**2 + column(5)**2)"), std::string::npos);
   EXPECT_NE(script.find("column(6) < 0 ? NaN : column(6)"), std::string::npos);
-  EXPECT_NE(script.find("using 1:7 axes x1y2 with steps"), std::string::npos);
-  EXPECT_NE(script.find("$worker_tracks using 1:2 with lines"), std::string::npos);
-  EXPECT_NE(script.find("$worker_tracks << EOD"), std::string::npos);
+  EXPECT_NE(script.find("set object rectangle from first 2, first 0.7 to first 4, first 1.3"),
+            std::string::npos)
+      << script;
+  EXPECT_NE(script.find("set object rectangle from first 1.5, first -0.3 to first 6, first 0.3"),
+            std::string::npos)
+      << script;
+  EXPECT_NE(script.find("$signals using 1:7 with lines"), std::string::npos) << script;
+  EXPECT_EQ(script.find("1.5 ? NaN"), std::string::npos) << script;
+  EXPECT_NE(script.find("$closest << EOD\n6,0.4\n"), std::string::npos) << script;
+  EXPECT_NE(script.find("closest approach: 0.4 m at t = 6 s"), std::string::npos) << script;
+  EXPECT_NE(script.find("$worker_track_0 using 1:2 with lines"), std::string::npos);
+  EXPECT_NE(script.find("title 'worker: walk'"), std::string::npos);
+  EXPECT_NE(script.find("$worker_track_0 << EOD"), std::string::npos);
 }
 
 // Guards against output that changes from run to run (timestamps, map
@@ -286,8 +308,9 @@ TEST_F(RobotPlotsTest, StandingRobotGetsOneJoinedTimeLabel) {
 
 // Guards the scene in the top view: obstacles near the path are drawn and
 // framed (boxes as filled outlines, cylinders as circles), one far away does
-// not stretch the view, and a carried object appears at time zero and at
-// the end, moved along its belt by the travel column's last value.
+// not stretch the view (nor is it listed), and a carried object appears
+// where it is in view: at the end, moved along its belt by the travel
+// column's last value.
 TEST_F(RobotPlotsTest, DrawsObstaclesAndCarriedObjects) {
   WriteSignals();
   {
@@ -333,8 +356,11 @@ TEST_F(RobotPlotsTest, DrawsObstaclesAndCarriedObjects) {
   EXPECT_NE(script.find("$obstacles << EOD\n1.6,0.4\n"), std::string::npos) << script;
   EXPECT_NE(script.find("$obstacles_circles << EOD\n-1,0,0.25\n"), std::string::npos) << script;
   EXPECT_NE(script.find("with circles"), std::string::npos);
-  // Time zero: front-left corner at (-2, 0.4); end: moved 3 m along +x.
-  EXPECT_NE(script.find("$carried << EOD\n-2,0.4\n"), std::string::npos) << script;
+  // Time zero: the body spans x -4 to -2, beyond 1.5 m (near_m) of the
+  // path: out of the view, neither drawn nor in the legend; the end: moved
+  // 3 m along +x onto the path, front-left corner at (1, 0.4).
+  EXPECT_EQ(script.find("$carried << EOD"), std::string::npos) << script;
+  EXPECT_EQ(script.find("carried object (t = 0)"), std::string::npos) << script;
   EXPECT_NE(script.find("$carried_end << EOD\n1,0.4\n"), std::string::npos) << script;
   // The wall at x = 50 is not near the path: the view stays within 10 m.
   const auto at = script.find("set xrange [");
@@ -384,16 +410,16 @@ TEST_F(RobotPlotsTest, GnuplotFailureCarriesItsErrorText) {
 }
 
 // Guards paper 1 Figs. 5 and 7 as error.png draws them: the curve under
-// the user's name (not the column's), the 4 cm bound of paper 1 Sec. VI-B
-// as a line with its legend entry, the spans the belt is scheduled on
-// (0-10 s in the synthetic run) shaded "line on" from its on column, and the
-// legend below the data.
+// the user's name (not the column's), in mm, the 4 cm bound of paper 1
+// Sec. VI-B as a line at 40 mm with its legend entry, the spans the belt
+// is scheduled on (0-10 s in the synthetic run) marked in a band along the
+// top from its on column, time from the first row to the last (not to the
+// next tic), and the legend below the data.
 TEST_F(RobotPlotsTest, ErrorPlotDrawsTheBoundTheLineStateAndTheUsersNames) {
   WriteSignals();
   RobotPlotSpec spec = Spec();
   spec.error_name = "deviation of the robot's centre from the desired path";
-  spec.error_bound_m = 0.04;
-  spec.error_bound_label = "4 cm (paper 1, Sec. VI-B)";
+  spec.error_bound = {0.04, "4 cm (paper 1, Sec. VI-B)", ""};
   WriteRobotPlots(dir_.string(), spec);
   const std::string script = ReadAll(dir_ / "plots.gp");
   const auto at = script.find("set output 'error.png'");
@@ -403,22 +429,46 @@ TEST_F(RobotPlotsTest, ErrorPlotDrawsTheBoundTheLineStateAndTheUsersNames) {
             std::string::npos)
       << error;
   EXPECT_EQ(error.find("title 'metrics.deviation'"), std::string::npos) << error;
-  EXPECT_NE(error.find("0.04 with lines"), std::string::npos) << error;
+  EXPECT_NE(error.find("$signals using 1:4 with lines"), std::string::npos) << error;
+  EXPECT_NE(error.find("set ylabel 'deviation from path (mm)'"), std::string::npos) << error;
+  EXPECT_NE(error.find("40 with lines dt 2 lw 2 lc rgb '#000000'"), std::string::npos) << error;
   EXPECT_NE(error.find("title '4 cm (paper 1, Sec. VI-B)'"), std::string::npos) << error;
-  // belt.on[0] (column 15 of signals.csv) is column 6 of $signals (time, x,
-  // y, deviation, speed, on).
-  EXPECT_NE(error.find("$signals using 1:((column(6) > 0.5) ? 1 : 0) axes x1y2 with filledcurves"),
+  // belt.on[0] is on from 0 to 10 s: a band at the top over that span.
+  EXPECT_NE(error.find("set object rectangle from first 0, graph 0.97 to first 10, graph 1"),
             std::string::npos)
       << error;
-  EXPECT_NE(error.find("title 'line on'"), std::string::npos) << error;
+  EXPECT_NE(error.find("title 'line on (band along the top)'"), std::string::npos) << error;
+  EXPECT_NE(error.find("set xrange [0:30]"), std::string::npos) << error;
   EXPECT_NE(error.find("set key at screen 0.5, 0.01 center bottom"), std::string::npos) << error;
 }
 
-// Guards paper 1 Fig. 4's legend: four sensors raw, their true readings,
-// filtered and the ground truth (thirteen entries) go below the data, never
-// over the plateau; the raw curves are drawn as the readings they are (the
-// surface relative to the sensor), each beside its true reading.
-TEST_F(RobotPlotsTest, OpticFlowLegendIsOutsideTheData) {
+// Guards a bound on the final pose (paper 2's Table 1 on van_entry): drawn
+// from the time the task's done column rose (12 s here) to the end, in mm,
+// not across the whole run.
+TEST_F(RobotPlotsTest, FinalPoseBoundIsDrawnFromTheTasksEnd) {
+  WriteSignals();
+  {
+    std::ifstream in(dir_ / "signals.csv");
+    std::string line, out;
+    std::getline(in, line);
+    out = line + ",path_follower.done\n";
+    for (int k = 0; std::getline(in, line); ++k) out += line + (k >= 1200 ? ",1\n" : ",0\n");
+    in.close();
+    std::ofstream(dir_ / "signals.csv") << out;
+  }
+  RobotPlotSpec spec = Spec();
+  spec.error_bound = {0.014, "paper 2, Table 1", "path_follower.done"};
+  WriteRobotPlots(dir_.string(), spec);
+  const std::string script = ReadAll(dir_ / "plots.gp");
+  EXPECT_NE(script.find("$bound << EOD\n12,14\n30,14\nEOD\n"), std::string::npos) << script;
+  EXPECT_NE(script.find("$bound using 1:2 with lines dt 2"), std::string::npos) << script;
+}
+
+// Guards paper 1 Fig. 4 as optic_flow.png draws it: a panel per sensor
+// (named), each with its raw reading (the surface relative to the sensor),
+// its true reading, its filtered value and the ground truth; one legend
+// of five kinds (not thirteen entries) below the panels.
+TEST_F(RobotPlotsTest, OpticFlowHasAPanelPerSensorAndOneShortLegend) {
   {
     std::ofstream out(dir_ / "signals.csv");
     out << "time,x,y";
@@ -445,13 +495,24 @@ TEST_F(RobotPlotsTest, OpticFlowLegendIsOutsideTheData) {
   ASSERT_EQ(files.size(), 3u);  // top view, belt (its on state), optic flow
   const std::string script = ReadAll(dir_ / "plots.gp");
   const std::string flow = script.substr(script.find("set output 'optic_flow.png'"));
+  EXPECT_NE(flow.find("set multiplot"), std::string::npos) << flow;
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_NE(flow.find("set title 'optic_flow_" + std::to_string(k) + "'"), std::string::npos)
+        << flow;
+  }
   EXPECT_NE(flow.find("set key at screen 0.5, 0.01 center bottom"), std::string::npos) << flow;
-  EXPECT_NE(flow.find("title 'raw, optic_flow_3'"), std::string::npos) << flow;
-  EXPECT_NE(flow.find("title 'filtered, optic_flow_3'"), std::string::npos) << flow;
-  EXPECT_NE(flow.find("title 'true reading, optic_flow_3'"), std::string::npos) << flow;
-  EXPECT_NE(flow.find("what each PX4Flow reads (the surface relative to it)"), std::string::npos)
-      << flow;
-  EXPECT_NE(flow.find("title 'line on'"), std::string::npos) << flow;
+  // Legend entries: plot items with a title (not the panels' or the
+  // caption's `set ... title`).
+  const auto count = [&](const std::string& what) {
+    std::size_t n = 0;
+    for (auto at = flow.find(what); at != std::string::npos; at = flow.find(what, at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count(" title '") - count("set title '") - count("multiplot title '"), 5u)
+      << flow;  // the line's band and four kinds, once
+  EXPECT_NE(flow.find("PX4Flow reading (the surface relative to the sensor)"), std::string::npos);
+  EXPECT_NE(flow.find("the same from ground truth"), std::string::npos);
+  EXPECT_NE(flow.find("filtered: the surface speed (Eq. 2)"), std::string::npos);
 }
 
 // Guards --format svg and pdf: the pictures are written in the format asked
@@ -462,8 +523,7 @@ TEST_F(RobotPlotsTest, OpticFlowLegendIsOutsideTheData) {
 TEST_F(RobotPlotsTest, VectorFormatsWriteSvgAndPdf) {
   WriteSignals();
   RobotPlotSpec spec = Spec();
-  spec.error_bound_m = 0.04;
-  spec.error_bound_label = "4 cm (paper 1, Sec. VI-B)";
+  spec.error_bound = {0.04, "4 cm (paper 1, Sec. VI-B)", ""};
   spec.format = PlotFormat::kSvg;
   auto files = WriteRobotPlots(dir_.string(), spec);
   ASSERT_EQ(files.size(), 3u);

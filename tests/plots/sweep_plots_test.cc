@@ -127,7 +127,7 @@ TEST_F(SweepPlotsTest, ScriptDrawsEachKindAsDocumented) {
   WriteSweepPlots(dir_.string(), {NumericChart(), CategoricalChart(), ScatterChart()});
   const std::string script = ReadAll(dir_ / "sweep_plots.gp");
   // x mean min max per line; the first series sorted from 0.05 to 0.25.
-  EXPECT_NE(script.find("$chart0_0 << EOD\n0.05 1 0.5 1.5\n0.15 2 1.5 2.5\n0.25 3 2.5 3.5\nEOD\n"),
+  EXPECT_NE(script.find("$chart0_0 << EOD\n0.05,1,0.5,1.5\n0.15,2,1.5,2.5\n0.25,3,2.5,3.5\nEOD\n"),
             std::string::npos)
       << script;
   EXPECT_NE(script.find("with yerrorlines"), std::string::npos);
@@ -135,10 +135,10 @@ TEST_F(SweepPlotsTest, ScriptDrawsEachKindAsDocumented) {
   // jacobi first as the chart's categories say, though the series lists
   // gauss_seidel first.
   EXPECT_NE(script.find("set xtics ('jacobi' 0, 'gauss_seidel' 1)"), std::string::npos) << script;
-  EXPECT_NE(script.find("$chart1_0 << EOD\n1 1 0.9 1.1\n0 2 1.8 2.2\nEOD\n"), std::string::npos)
+  EXPECT_NE(script.find("$chart1_0 << EOD\n1,1,0.9,1.1\n0,2,1.8,2.2\nEOD\n"), std::string::npos)
       << script;
   EXPECT_NE(script.find("with yerrorbars"), std::string::npos);
-  EXPECT_NE(script.find("$chart2_0 << EOD\n0.01 0.1\n0.02 0.2\n0.05 0.5\n0.1 1\nEOD\n"),
+  EXPECT_NE(script.find("$chart2_0 << EOD\n0.01,0.1\n0.02,0.2\n0.05,0.5\n0.1,1\nEOD\n"),
             std::string::npos)
       << script;
   EXPECT_NE(script.find("with points"), std::string::npos);
@@ -234,6 +234,40 @@ TEST_F(SweepPlotsTest, GnuplotMissingOrFailingIsAClearError) {
               std::string::npos)
         << what;
   }
+}
+
+// Guards the histogram of `run --runs` as paper 2's Figs. 6-11 with Table
+// 1 beside it: captioned with what the metric measures (not its name), in
+// mm (the errors are millimetres), the runs' mean drawn (not only cited),
+// the source's largest error and std in the bounds' black.
+TEST_F(SweepPlotsTest, HistogramIsCaptionedInMillimetresWithItsMeanDrawn) {
+  SweepChart chart;
+  chart.file = "beacon_error_x_m_histogram.png";
+  chart.histogram = true;
+  chart.metric = "beacon_error_x_m";
+  chart.run_caption = "van_entry";
+  chart.reference = {"paper 2, Table 1", 0.019, 0.005, 0.004};
+  chart.series = {{"", {}, {-0.002, -0.001, 0.0, 0.001, 0.002, 0.003, 0.004}, {}, {}}};
+  WriteSweepPlots(dir_.string(), {chart});
+  const std::string script = ReadAll(dir_ / "sweep_plots.gp");
+  EXPECT_NE(
+      script.find("set title 'Final pose error in X by the beacons: distribution over 7 runs' . "
+                  "\"\\n\" . 'van_entry'"),
+      std::string::npos)
+      << script;
+  EXPECT_NE(script.find("set xlabel 'final pose error in X by the beacons (mm)'"),
+            std::string::npos)
+      << script;
+  EXPECT_EQ(script.find("beacon_error_x_m'"), std::string::npos) << script;
+  // Samples and figures in mm; the mean (0) drawn as a line.
+  EXPECT_NE(script.find("set arrow from -19, graph 0 to -19, graph 1 nohead dt 2 lw 2 lc rgb "
+                        "'#000000'"),
+            std::string::npos)
+      << script;
+  EXPECT_NE(script.find("graph 1 nohead lw 2 dt 4 lc rgb '#D55E00'"), std::string::npos) << script;
+  EXPECT_NE(script.find("title 'mean of the runs: 1 mm'"), std::string::npos) << script;
+  EXPECT_NE(script.find("title 'source: std 5 mm, as N(0, std)'"), std::string::npos) << script;
+  EXPECT_NE(script.find("title 'source: paper 2, Table 1'"), std::string::npos) << script;
 }
 
 // Guards against a script or gnuplot run for nothing: no charts, no files.
