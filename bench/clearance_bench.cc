@@ -83,8 +83,9 @@ void SetUp(ClearanceUnit& u, const std::string& query) {
   auto& v = u.variables();
   v.SetReal(*v.Find("body_length"), 1.03);
   v.SetReal(*v.Find("body_width"), 0.57);
-  v.SetReal(*v.Find("body_height"), 0.40);
-  v.SetReal(*v.Find("body_bottom"), 0.13 - 0.20);
+  // models/robots/raw3.yaml's body box: 0.07 to 0.40 m.
+  v.SetReal(*v.Find("body_height"), 0.33);
+  v.SetReal(*v.Find("body_bottom"), 0.07);
   v.SetString(*v.Find("query"), query);
 }
 

@@ -93,12 +93,27 @@ class Reader {
       return;
     }
     if (!r_.ExpectMap(root, "body")) return;
-    r_.CheckKeys(root, "body", {"length_m", "width_m", "height_m", "mass_kg", "com_height_m"});
+    r_.CheckKeys(root, "body",
+                 {"length_m", "width_m", "height_m", "bottom_m", "mass_kg", "com_height_m"});
+    const std::size_t before = r_.issues().size();
     b.length_m = r_.Real(root, "body", "length_m", std::nullopt, kSizeM);
     b.width_m = r_.Real(root, "body", "width_m", std::nullopt, kSizeM);
     b.height_m = r_.Real(root, "body", "height_m", std::nullopt, kSizeM);
+    // The underside: on or above the floor (a body reaching below it would
+    // meet every terrain piece it drives onto).
+    b.bottom_m = r_.Real(root, "body", "bottom_m", std::nullopt, {0.0, 10.0});
     b.mass_kg = r_.Real(root, "body", "mass_kg", std::nullopt, kMassKg);
     b.com_height_m = r_.Real(root, "body", "com_height_m", std::nullopt, kSizeM);
+    // Where the mass is and where the box is are separate facts, but the
+    // body's centre of mass lies within its body.
+    if (r_.issues().size() == before &&
+        (b.com_height_m < b.bottom_m || b.com_height_m > b.top_m())) {
+      r_.Error(Child(root, "com_height_m"), "body.com_height_m",
+               "the body's centre of mass must lie within its box, from bottom_m " +
+                   cosim::FormatValue(b.bottom_m) + " m to bottom_m + height_m " +
+                   cosim::FormatValue(b.top_m()) + " m above the floor; got " +
+                   cosim::FormatValue(b.com_height_m) + " m");
+    }
   }
 
   void MotorGroups(const YAML::Node& list, models::RobotDescription& robot) {

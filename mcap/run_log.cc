@@ -507,9 +507,9 @@ std::string RunLog::StaticText(TimeNs now) const {
     const double length = scenario_.robot->body_length_m.value_or(0.0);
     const double width = scenario_.robot->body_width_m.value_or(0.0);
     const double height = Parameter(chassis, "body_height").value_or(0.0);
-    const double com = Parameter(chassis, "com_height").value_or(0.5 * height);
+    const double middle = Parameter(chassis, "body_bottom").value_or(0.0) + 0.5 * height;
     if (length > 0 && width > 0 && height > 0) {
-      Box(p.cubes, 0, 0, com, Quat{}, length, width, height, kBody);
+      Box(p.cubes, 0, 0, middle, Quat{}, length, width, height, kBody);
     }
     const auto wx = ArrayParameter(chassis, "wheel_x"), wy = ArrayParameter(chassis, "wheel_y"),
                wr = ArrayParameter(chassis, "wheel_radius");
@@ -521,10 +521,10 @@ std::string RunLog::StaticText(TimeNs now) const {
   for (const OtherRobot& other : others_) {
     const cosim::Unit& chassis = system.unit(other.chassis);
     const double height = Parameter(chassis, "body_height").value_or(0.0);
-    const double com = Parameter(chassis, "com_height").value_or(0.5 * height);
+    const double middle = Parameter(chassis, "body_bottom").value_or(0.0) + 0.5 * height;
     if (other.length <= 0 || other.width <= 0 || height <= 0) continue;
     Primitives p;
-    Box(p.cubes, 0, 0, com, Quat{}, other.length, other.width, height, kBody);
+    Box(p.cubes, 0, 0, middle, Quat{}, other.length, other.width, height, kBody);
     Entity(o, now, other.frame, "robot/" + other.name, true, other.name, p);
   }
   return "{\"deletions\":[],\"entities\":[" + o + "]}";

@@ -18,14 +18,26 @@
 /// left, z up, origin at the planform centre on the floor.
 namespace linesim::models {
 
+/// The body: where its solid parts are (a box on the planform centre, from
+/// its underside bottom_m above the floor to bottom_m + height_m: what the
+/// scene, the other robots' lasers and chassis and the clearances meet) and
+/// where its mass is (mass_kg, com_height_m), two separate facts: a robot
+/// whose batteries sit low has its centre of mass well below the middle of
+/// its box.
 struct BodyDescription {
   double length_m = 0.0;  // along base_link x
   double width_m = 0.0;
   double height_m = 0.0;
+  /// The box's underside above the floor (base_link z): the ground
+  /// clearance under the body.
+  double bottom_m = 0.0;
   /// The whole robot, wheels included.
   double mass_kg = 0.0;
-  /// Height of the body's centre of mass (wheels excluded) above the floor.
+  /// Height of the body's centre of mass (wheels excluded) above the floor;
+  /// within the box.
   double com_height_m = 0.0;
+
+  double top_m() const { return bottom_m + height_m; }
 };
 
 /// A load fixed rigidly on the body (paper 2's Husky carries a UR10 arm on a

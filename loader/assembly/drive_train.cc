@@ -91,6 +91,7 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
   c["body_length"] = robot.body.length_m;
   c["body_width"] = robot.body.width_m;
   c["body_height"] = robot.body.height_m;
+  c["body_bottom"] = robot.body.bottom_m;
   c["mass"] = robot.body.mass_kg;
   c["com_height"] = robot.body.com_height_m;
   // One mass for every wheel module (the robot file checked that the wheels
@@ -117,8 +118,9 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
   const std::string cp = "units.chassis.parameters";
   for (const auto& [param, key] :
        {std::pair{"body_length", "body.length_m"}, std::pair{"body_width", "body.width_m"},
-        std::pair{"body_height", "body.height_m"}, std::pair{"mass", "body.mass_kg"},
-        std::pair{"com_height", "body.com_height_m"}, std::pair{"module_mass", "wheels.0.mass_kg"}}) {
+        std::pair{"body_height", "body.height_m"}, std::pair{"body_bottom", "body.bottom_m"},
+        std::pair{"mass", "body.mass_kg"}, std::pair{"com_height", "body.com_height_m"},
+        std::pair{"module_mass", "wheels.0.mass_kg"}}) {
     b.Origin(JoinPath(cp, param), file.At(key));
   }
   for (const char* param : {"wheel_x", "wheel_y", "wheel_radius"}) {

@@ -112,8 +112,8 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
   c["body_length"] = body.length_m;
   c["body_width"] = body.width_m;
   c["body_height"] = body.height_m;
-  // The chassis centres the body box on com_height.
-  c["body_bottom"] = body.com_height_m - 0.5 * body.height_m;
+  // The body box where the robot file puts it (the chassis's).
+  c["body_bottom"] = body.bottom_m;
   b.Connect(Signal(kChassis, "position_3d"), Signal(kClearance, "position_3d"));
   b.Connect(Signal(kChassis, "orientation"), Signal(kClearance, "orientation"));
   if (s.belt_count > 0) b.Connect(Signal(kBelt, "travel"), Signal(kClearance, "belt_travel"));

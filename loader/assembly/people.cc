@@ -299,9 +299,9 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
   c["workers"] = static_cast<int>(names.size());
   c["body_length"] = body.length_m;
   c["body_width"] = body.width_m;
-  // The chassis centres the body box on com_height (flat floor).
-  c["body_z_min"] = body.com_height_m - 0.5 * body.height_m;
-  c["body_z_max"] = body.com_height_m + 0.5 * body.height_m;
+  // The body box where the robot file puts it (the chassis's; flat floor).
+  c["body_z_min"] = body.bottom_m;
+  c["body_z_max"] = body.top_m();
   b.Connect(Signal(kChassis, "position_3d"), Signal(kPersonClearance, "position_3d"));
   b.Connect(Signal(kChassis, "orientation"), Signal(kPersonClearance, "orientation"));
   for (std::size_t w = 0; w < names.size(); ++w) {

@@ -29,6 +29,11 @@ TEST(PeopleAssembly, WorkersReachTheLasersAndTheSafetyUnit) {
     ASSERT_TRUE(ref.has_value()) << laser;
     EXPECT_EQ(v.info(*ref).size, 21u) << laser;
   }
+  // The person clearance's body heights are raw3.yaml's box (0.07 to
+  // 0.40 m), not a box about the centre of mass.
+  const auto& pc = s.system->unit(*s.system->FindUnit("person_clearance")).variables();
+  EXPECT_EQ(pc.GetReal(*pc.Find("body_z_min")), 0.07);
+  EXPECT_NEAR(pc.GetReal(*pc.Find("body_z_max")), 0.40, 1e-15);
 }
 
 // Guards what the figures read of the workers and the safety fields: each

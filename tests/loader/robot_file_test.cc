@@ -28,8 +28,11 @@ Read ReadModel(const std::string& model, const std::string& relative_to = "scena
 
 // A complete differential robot with one line left out or changed by the
 // test, to check what is refused and where.
-std::string Robot(const std::string& wheel0) {
-  return "body: {length_m: 1, width_m: 0.6, height_m: 0.3, mass_kg: 40, com_height_m: 0.2}\n"
+const char* kBody =
+    "{length_m: 1, width_m: 0.6, bottom_m: 0.1, height_m: 0.3, mass_kg: 40, com_height_m: 0.2}";
+
+std::string Robot(const std::string& wheel0, const std::string& body = kBody) {
+  return "body: " + body + "\n" +
          "wheels:\n"
          "  - " + wheel0 + "\n"
          "  - {name: r, x_m: 0, y_m: -0.3, radius_m: 0.1, width_m: 0.05, mass_kg: 2, "
@@ -56,6 +59,11 @@ TEST(RobotFile, ShippedRobotsRead) {
   EXPECT_EQ(r.wheels[1].x_m, -0.368);
   EXPECT_EQ(r.wheels[1].y_m, 0.134);
   EXPECT_EQ(r.body.mass_kg, 120.0);
+  // The box from the URDF's underside (0.07 m) to Table I's 0.40 m top; the
+  // centre of mass where the file assumes it, low in the box.
+  EXPECT_EQ(r.body.bottom_m, 0.07);
+  EXPECT_NEAR(r.body.top_m(), 0.40, 1e-15);
+  EXPECT_EQ(r.body.com_height_m, 0.13);
   ASSERT_EQ(r.Motors().size(), 8u);
   EXPECT_EQ(r.motor_groups[1].gear_ratio, 21.0);
   EXPECT_EQ(r.motor_groups[1].motor.at("gear_ratio"), 21.0);
@@ -73,6 +81,9 @@ TEST(RobotFile, ShippedRobotsRead) {
   EXPECT_FALSE(h.wheels[0].steer_motor);
   EXPECT_EQ(h.wheels[0].drive_motor, h.wheels[1].drive_motor);  // belt-coupled side
   EXPECT_EQ(h.wheels[0].radius_m, 0.1651);
+  // The URDF's base box over its bottom plate: 0.1323 to 0.3798 m.
+  EXPECT_EQ(h.body.bottom_m, 0.1323);
+  EXPECT_NEAR(h.body.top_m(), 0.3798, 1e-15);
   EXPECT_EQ(h.Motors().size(), 2u);
   ASSERT_EQ(h.sensor_mounts.size(), 3u);
   EXPECT_EQ(h.sensor_mounts[0].model, "sick_lms151");
@@ -89,6 +100,63 @@ TEST(RobotFile, MissingRequiredValueNamesFileLineAndKey) {
   EXPECT_TRUE(Has(read.issues, file + ":3")) << read.issues;
   EXPECT_TRUE(Has(read.issues, "wheels.0.radius_m")) << read.issues;
   EXPECT_TRUE(Has(read.issues, "missing required key")) << read.issues;
+}
+
+// Guards the body's keys (issue 35: the box's heights are a fact of their
+// own, not derived from the centre of mass): a missing bottom_m, an
+// underside below the floor, a centre of mass outside the box and an
+// unknown key are each refused in the file, on the body's line (1), at
+// the key path, saying what was expected.
+TEST(RobotFile, BodyKeysAreCheckedWhereWritten) {
+  const auto issues = [](const std::string& name, const std::string& body) {
+    const std::string file = WriteScenario(name, Robot(kLeft, body));
+    const Read read = ReadModel(file);
+    EXPECT_FALSE(read.file) << body;
+    return std::pair{file, read.issues};
+  };
+  {
+    const auto [file, text] =
+        issues("robot_no_bottom.yaml",
+               "{length_m: 1, width_m: 0.6, height_m: 0.3, mass_kg: 40, com_height_m: 0.2}");
+    EXPECT_TRUE(Has(text, file + ":1: body.bottom_m: missing required key")) << text;
+  }
+  {
+    const auto [file, text] =
+        issues("robot_sunk_body.yaml",
+               "{length_m: 1, width_m: 0.6, bottom_m: -0.05, height_m: 0.3, mass_kg: 40, "
+               "com_height_m: 0.2}");
+    EXPECT_TRUE(Has(text, file + ":1: body.bottom_m: value -0.05 is out of range: expected a "
+                                 "number >= 0 and <= 10"))
+        << text;
+  }
+  {
+    const auto [file, text] =
+        issues("robot_mass_outside.yaml",
+               "{length_m: 1, width_m: 0.6, bottom_m: 0.25, height_m: 0.3, mass_kg: 40, "
+               "com_height_m: 0.2}");
+    EXPECT_TRUE(Has(text, file + ":1: body.com_height_m: the body's centre of mass must lie "
+                                 "within its box, from bottom_m 0.25 m to bottom_m + height_m "
+                                 "0.55 m above the floor; got 0.2 m"))
+        << text;
+  }
+  {
+    const auto [file, text] =
+        issues("robot_clearance_key.yaml",
+               "{length_m: 1, width_m: 0.6, bottom_m: 0.1, ground_clearance_m: 0.1, height_m: 0.3, "
+               "mass_kg: 40, com_height_m: 0.2}");
+    EXPECT_TRUE(Has(text, "body.ground_clearance_m: unknown key")) << text;
+  }
+  // The box and the centre of mass apart, the mass at the box's bottom:
+  // accepted, each value as written.
+  const Read ok = ReadModel(
+      WriteScenario("robot_low_mass.yaml",
+                    Robot(kLeft,
+                          "{length_m: 1, width_m: 0.6, bottom_m: 0.2, height_m: 0.3, mass_kg: 40, "
+                          "com_height_m: 0.2}")));
+  ASSERT_TRUE(ok.file) << ok.issues;
+  EXPECT_EQ(ok.file->robot.body.bottom_m, 0.2);
+  EXPECT_EQ(ok.file->robot.body.height_m, 0.3);
+  EXPECT_EQ(ok.file->robot.body.com_height_m, 0.2);
 }
 
 // Guards issue 24 (item 5): two wheels with one name were accepted (the

@@ -90,8 +90,12 @@ TEST(SensorsAssembly, EveryMountOfTheRobotIsAUnit) {
   EXPECT_EQ(s.master->decimation(*s.system->FindUnit("laser_front")), 1);
   // 4096 counts per motor turn x drive gear 21 (raw3.yaml).
   EXPECT_EQ(Param(s, "wheel_encoders", "counts_per_revolution", 4), 4096.0 * 21);
-  // The clearance body is the chassis's box: centred on com_height.
-  EXPECT_NEAR(Param(s, "clearance", "body_bottom"), 0.13 - 0.2, 1e-15);
+  // The clearance body is the chassis's box: where raw3.yaml's bottom_m
+  // puts it, not about the centre of mass.
+  EXPECT_EQ(Param(s, "clearance", "body_bottom"), 0.07);
+  EXPECT_EQ(Param(s, "clearance", "body_height"), 0.33);
+  EXPECT_EQ(Param(s, "chassis", "body_bottom"), 0.07);
+  EXPECT_EQ(Param(s, "chassis", "com_height"), 0.13);
 }
 
 // Guards the Husky's: an LMS151 (its own model file: 0.5 deg at 50 Hz, one

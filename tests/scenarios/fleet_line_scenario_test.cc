@@ -71,17 +71,22 @@ TEST(FleetLine, ARobotStopsForAnother) {
 
 // Guards against robots that do not touch each other: without its fields
 // raw3_a drives into raw3_b, the pair's collision is counted on both sides
-// and raw3_b is pushed out of its place (seeds 1..6, checked once: one
-// collision each side, raw3_b pushed 0.116-0.144 m by 32 s, its hold
+// and raw3_b is pushed from its place (seeds 1..6, checked once: one
+// collision each side, raw3_b pushed 0.031-0.048 m at about 24 s, its hold
 // pushing back; each chassis meets the other's body as unmovable, so who
-// yields is the two controllers' and contacts' matter).
+// yields is the two controllers' and contacts' matter). The bound: 20
+// times what raw3_b drifts when nothing touches it (below 1 mm,
+// ARobotStopsForAnother). (Pushed 0.106-0.144 m while the boxes stood
+// about the centres of mass, -0.07 to 0.33 m: the contact faces' middle
+// then at the centre of mass's height, now 0.105 m above it, at the
+// bodies' real heights, 0.07 to 0.40 m.)
 TEST(FleetLine, RobotsTouchWithoutTheFields) {
   auto without_safety = kInTheWay;
   without_safety.push_back("robots.0.safety.enabled=false");
   const auto without = RunFile(Shipped("fleet_line"), without_safety);
   EXPECT_GE(without.at("raw3_a.robot_raw3_b_collisions"), 1.0);
   EXPECT_GE(without.at("raw3_b.robot_raw3_a_collisions"), 1.0);
-  EXPECT_GT(without.at("raw3_b.max_position_drift_m"), 0.05);
+  EXPECT_GT(without.at("raw3_b.max_position_drift_m"), 0.02);
 }
 
 // Guards against a wait that cannot fail: without it (stop_distance 0)

@@ -279,7 +279,7 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   const auto ms = static_cast<std::size_t>(steer_motor_count_);
   const auto md = static_cast<std::size_t>(drive_motor_count_);
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  body_length_ = body_width_ = body_height_ = kNaN;
+  body_length_ = body_width_ = body_height_ = body_bottom_ = kNaN;
   mass_ = module_mass_ = com_height_ = kNaN;
   steer_rotor_inertia_ = drive_rotor_inertia_ = kNaN;
   wheel_radius_.assign(w, kNaN);
@@ -329,15 +329,20 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
               "body box width along base_link y (inertia and collision with objects)",
               cosim::Rule::Positive().NoDefault());
   v.Parameter("body_height", "m", &body_height_,
-              "body box height, centred on com_height (inertia and collision with objects)",
+              "body box height from body_bottom (inertia and collision with objects)",
               cosim::Rule::Positive().NoDefault());
+  v.Parameter("body_bottom", "m", &body_bottom_,
+              "height of the body box's underside above base_link (the ground clearance; the "
+              "box's position, whatever com_height is)",
+              cosim::Rule::NonNegative().NoDefault());
   v.Parameter("mass", "kg", &mass_, "total mass: body box plus all wheels",
               cosim::Rule::Positive().NoDefault());
   v.Parameter("module_mass", "kg", &module_mass_,
               "mass of one wheel: a steered module (wheel, motors, housing) or a fixed wheel",
               cosim::Rule::Positive().NoDefault());
   v.Parameter("com_height", "m", &com_height_,
-              "height of the body box's centre of mass above the floor (wheels excluded)",
+              "height of the body's centre of mass above base_link (wheels excluded), within "
+              "the body box; the body's inertia is a uniform box of the body's size about it",
               cosim::Rule::Positive().NoDefault());
   v.Parameter("wheel_radius", "m", &wheel_radius_, "radius of each wheel (sphere contact geometry)",
               cosim::Rule::Positive().NoDefault());
@@ -480,8 +485,9 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
            "contact point of each wheel in map (x, y), or the wheel centre without contact", {});
   v.Output("body_box", "m, rad, m/s, rad/s", &body_box_,
            "the body box as others see it (another robot's lasers, chassis and clearance): [x, "
-           "y, yaw, vx, vy, yaw_rate, length, width, z_bottom, z_top] in map, heights its "
-           "bounds",
+           "y, yaw, vx, vy, yaw_rate, length, width, z_bottom, z_top] in map (x, y: "
+           "base_link's; z_bottom, z_top: the box's lowest and highest points, body_bottom and "
+           "body_bottom + body_height above the floor when level)",
            {});
 }
 
@@ -497,6 +503,15 @@ std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
                         "times " + std::to_string(wheel_count_) +
                             " wheels must be less than mass " + cosim::FormatValue(mass_) +
                             ", got " + cosim::FormatValue(module_mass_)});
+  }
+  // The body's centre of mass lies within its box.
+  if (com_height_ > 0.0 && body_height_ > 0.0 && body_bottom_ >= 0.0 &&
+      (com_height_ < body_bottom_ || com_height_ > body_bottom_ + body_height_)) {
+    problems.push_back({"com_height", std::nullopt,
+                        "must lie within the body box, from body_bottom " +
+                            cosim::FormatValue(body_bottom_) + " to body_bottom + body_height " +
+                            cosim::FormatValue(body_bottom_ + body_height_) + ", got " +
+                            cosim::FormatValue(com_height_)});
   }
   // The payload's box: all three sizes (a box) or none (a point mass).
   const auto boxed = std::count_if(payload_size_.begin(), payload_size_.end(),
@@ -542,11 +557,12 @@ void ChassisUnit::Build() {
   dMatrix3 rot;
   dRFromAxisAndAngle(rot, 0.0, 0.0, 1.0, initial_yaw_);
 
-  // The body: the body box (centre of mass at (0, 0, com_height) in
-  // base_link) and the payload as one rigid body, whose origin ODE wants at
-  // their joint centre of mass c; each part's inertia moved to c by the
-  // parallel-axis theorem (dMassTranslate). Without a payload c is the box
-  // centre and nothing is offset.
+  // The body: its mass (centre at (0, 0, com_height) in base_link, the
+  // inertia of a uniform box of the body's size about it) and the payload
+  // as one rigid body, whose origin ODE wants at their joint centre of mass
+  // c; each part's inertia moved to c by the parallel-axis theorem
+  // (dMassTranslate). Without a payload c is the body's centre of mass.
+  // The body box, the solid, is where body_bottom puts it, offset from c.
   o.body = dBodyCreate(f.world());
   dMass m;
   dMassSetBoxTotal(&m, body_mass, body_length_, body_width_, body_height_);
@@ -595,7 +611,7 @@ void ChassisUnit::Build() {
   dBodySetRotation(o.body, rot);
   o.body_geom = dCreateBox(nullptr, body_length_, body_width_, body_height_);
   dGeomSetBody(o.body_geom, o.body);
-  if (payload) dGeomSetOffsetPosition(o.body_geom, -com[0], -com[1], com_height_ - com[2]);
+  dGeomSetOffsetPosition(o.body_geom, -com[0], -com[1], body_bottom_ + 0.5 * body_height_ - com[2]);
   f.SetBodyGeom(o.body_geom, body_friction_);
   if (payload && payload_size_[0] > 0.0 && payload_size_[1] > 0.0 && payload_size_[2] > 0.0) {
     o.payload_geom = dCreateBox(nullptr, payload_size_[0], payload_size_[1], payload_size_[2]);

@@ -35,22 +35,28 @@ namespace linesim::chassis {
 /// steering axis or axle centre). Each wheel contact takes the surface
 /// velocity and friction of the belt patch under it, else the floor's (or,
 /// on a terrain piece, the piece's surface friction, still), with Coulomb
-/// friction while it slides (units/chassis/floor_world.h). The body box
-/// (body_length x body_width x body_height about the body's centre of mass,
-/// com_height above base_link) collides with the scene's obstacles, carried
-/// objects and terrain pieces, never with the floor. A payload (payload_mass at payload_position in base_link, a box of
-/// payload_size) is part of the body: one rigid body whose origin ODE puts
-/// at the centre of mass of body box and payload (ODE requires it there), with
-/// their combined inertia about it (parallel axes), and the two boxes as
-/// geoms offset from it; no joint, so no constraint rows. Input torques act between wheel and body (dBodyAddTorque in equal
-/// and opposite pairs about the body's vertical and the wheel's axle), with
-/// the viscous joint friction, every internal step; the brake is an ODE
-/// joint motor (target velocity 0, force limit brake_torque) on every
-/// wheel joint axis.
+/// friction while it slides (units/chassis/floor_world.h). The body's solid
+/// and its mass are separate facts: the body box (body_length x body_width
+/// on base_link's x and y, from body_bottom to body_bottom + body_height
+/// above base_link) collides with the scene's obstacles, carried objects and
+/// terrain pieces, never with the floor; the body's mass (mass less the
+/// wheels) has its centre com_height above base_link and the inertia of a
+/// uniform box of the body's size about that centre (an idealisation: the
+/// mass spread over the body's size, centred where the robot's data put
+/// its centre of mass, e.g. low batteries). A payload (payload_mass at
+/// payload_position in base_link, a box of payload_size) is part of the
+/// body: one rigid body whose origin ODE puts at the centre of mass of body
+/// and payload (ODE requires it there), with their combined inertia about
+/// it (parallel axes), and the body and payload boxes as geoms offset from
+/// it; no joint, so no constraint rows. Input torques act between wheel
+/// and body (dBodyAddTorque in equal and opposite pairs about the body's
+/// vertical and the wheel's axle), with the viscous joint friction, every
+/// internal step; the brake is an ODE joint motor (target velocity 0, force
+/// limit brake_torque) on every wheel joint axis.
 ///
 /// Frames: map (x, y, z up) and base_link (x forward, y left, z up from the
 /// wheels' contact plane), whose origin is the planform centre of the body
-/// box on the contact plane (under the body box's centre of mass, which is
+/// box on the contact plane (under the body's centre of mass, which is
 /// com_height above it), the point wheel_x and wheel_y refer to. position,
 /// position_3d, linear_velocity and velocity_3d are of that origin (on a
 /// ramp it lies on the ramp, and a payload moves the centre of mass, not
@@ -173,6 +179,7 @@ class ChassisUnit : public cosim::Unit {
   double body_length_;
   double body_width_;
   double body_height_;
+  double body_bottom_;
   double mass_;
   double module_mass_;
   double com_height_;

@@ -208,8 +208,8 @@ ClearanceUnit::ClearanceUnit(std::string name, const models::Scene& scene)
               cosim::Rule::Positive().NoDefault());
   v.Parameter("body_bottom", "m", &body_bottom_,
               "height of the body box's bottom above base_link's origin, along base_link z "
-              "(the box is centred on base_link x, y; negative: below it, as the chassis's "
-              "collision box centred on com_height can be)",
+              "(the box is centred on base_link x, y; the robot description's bottom_m, as "
+              "the chassis's body_bottom; negative: below it)",
               cosim::Rule::Finite().NoDefault());
   v.Parameter("max_clearance", "m", &max_clearance_,
               "clearance reported when no object is nearer (none, or all lifted off); also "

@@ -15,6 +15,7 @@
 
 #include "cosim/time.h"
 #include "models/models_dir.h"
+#include "models/moving_solids.h"
 #include "tests/units/chassis/robots.h"
 #include "tests/units/test_helpers.h"
 #include "units/chassis/floor_world.h"
@@ -356,6 +357,86 @@ TEST(ChassisUnit, PoseTwistAndWheelAnglesIn3D) {
   for (double d : Get(u, "drive_angle")) EXPECT_EQ(d, 0.0);
 }
 
+// Guards against a body box that follows the centre of mass instead of
+// standing where the robot's data put it (issue 35: the Rob@Work 3's box,
+// centred on its 0.13 m centre of mass, spanned -0.07 to 0.33 m, so a
+// scan plane at 0.35 m passed over it). Expected by geometry: at rest on
+// the flat floor body_box is base_link's pose with the body's planform and
+// its heights body_bottom and body_bottom + body_height above base_link
+// (the AABB of a level yawed box spans exactly its own heights; the
+// settled roll and pitch, below 1e-4 rad, move them by less than 0.1 mm),
+// whatever com_height and a payload do to the centre of mass.
+TEST(ChassisUnit, BodyBoxIsWhereTheBodyIsNotWhereItsMassIs) {
+  using models::MovingBox;
+  const auto check = [](ChassisUnit& u, double bottom_m, double height_m, double length_m,
+                        double width_m) {
+    u.Initialize();
+    const auto box = Get(u, "body_box");
+    const auto p = Get(u, "position_3d");
+    ASSERT_EQ(box.size(), MovingBox::kValues);
+    EXPECT_EQ(box[MovingBox::kX], p[0]);
+    EXPECT_EQ(box[MovingBox::kY], p[1]);
+    EXPECT_EQ(box[MovingBox::kYaw], Get(u, "yaw")[0]);
+    EXPECT_EQ(box[MovingBox::kLength], length_m);
+    EXPECT_EQ(box[MovingBox::kWidth], width_m);
+    EXPECT_NEAR(box[MovingBox::kZBottom] - p[2], bottom_m, 1e-4);
+    EXPECT_NEAR(box[MovingBox::kZTop] - p[2], bottom_m + height_m, 1e-4);
+  };
+  for (const double com_m : {kRaw3ComHeightM, 0.30}) {
+    SCOPED_TRACE(com_m);
+    auto robot = Raw3();
+    Set(*robot, "initial_x", 1.0);
+    Set(*robot, "initial_y", -2.0);
+    Set(*robot, "initial_yaw", 0.5);
+    Set(*robot, "com_height", com_m);
+    check(*robot, kRaw3BodyBottomM, kRaw3BodyM[2], kRaw3BodyM[0], kRaw3BodyM[1]);
+  }
+  // The Husky's box, 0.1323 to 0.3798 m, also with paper 2's arm raising
+  // the joint centre of mass to 0.43 m, above the box.
+  auto husky = test_robots::Husky(models::OpenFloor());
+  check(*husky, kHuskyBodyBottomM, kHuskyBodyM[2], kHuskyBodyM[0], kHuskyBodyM[1]);
+  auto armed = test_robots::HuskyWithArm(models::OpenFloor());
+  check(*armed, kHuskyBodyBottomM, kHuskyBodyM[2], kHuskyBodyM[0], kHuskyBodyM[1]);
+
+  // Moving, the box moves with base_link.
+  auto robot = Raw3();
+  ChassisUnit& u = *robot;
+  u.Initialize();
+  SetArray(u, "drive_torque", {2.0, 2.0, 2.0, 2.0});
+  TimeNs t = 0;
+  Advance(u, t, 500);
+  const auto box = Get(u, "body_box");
+  const auto v = Get(u, "velocity_3d");
+  EXPECT_GT(v[0], 0.1);
+  EXPECT_EQ(box[MovingBox::kVx], v[0]);
+  EXPECT_EQ(box[MovingBox::kVy], v[1]);
+  EXPECT_EQ(box[MovingBox::kYawRate], Get(u, "yaw_rate")[0]);
+  EXPECT_NEAR(box[MovingBox::kZBottom] - Get(u, "position_3d")[2], kRaw3BodyBottomM, 1e-3);
+}
+
+// Guards against the solid's placement leaking into the dynamics: the mass
+// is where com_height puts it and has the inertia of a box of the body's
+// size about it, wherever body_bottom puts the box. On an open floor
+// (nothing for the box to meet) two robots whose boxes stand at different
+// heights drive the same path bit for bit.
+TEST(ChassisUnit, BodyBottomMovesTheSolidNotTheMass) {
+  std::vector<double> runs[2];
+  for (int k = 0; k < 2; ++k) {
+    auto robot = Raw3();
+    ChassisUnit& u = *robot;
+    Set(u, "body_bottom", k == 0 ? kRaw3BodyBottomM : 0.0);
+    u.Initialize();
+    SetArray(u, "drive_torque", {2.0, 1.0, 2.0, 1.0});
+    SetArray(u, "steer_torque", {0.1, 0.1, -0.1, -0.1});
+    TimeNs t = 0;
+    Advance(u, t, 400);
+    for (const char* name : {"position_3d", "orientation", "velocity_3d", "angular_velocity"}) {
+      for (const double x : Get(u, name)) runs[k].push_back(x);
+    }
+  }
+  EXPECT_TRUE(SameBits(runs[0], runs[1]));
+}
+
 // Guards against a wrong steering torque sign or module inertia. Analytic:
 // the sphere wheel has one contact on the steering axis, so nothing resists
 // steering but the module's inertia about the vertical,
@@ -543,10 +624,10 @@ TEST(ChassisUnit, RobotSpecificParametersHaveNoDefault) {
     EXPECT_EQ(p.message, "must be set (robot-specific: no default)") << p.variable;
     if (names.empty() || names.back() != p.variable) names.push_back(p.variable);
   }
-  EXPECT_EQ(names,
-            (std::vector<std::string>{"body_length", "body_width", "body_height", "mass",
-                                      "module_mass", "com_height", "wheel_radius", "wheel_x",
-                                      "wheel_y", "steer_rotor_inertia", "drive_rotor_inertia"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"body_length", "body_width", "body_height",
+                                             "body_bottom", "mass", "module_mass", "com_height",
+                                             "wheel_radius", "wheel_x", "wheel_y",
+                                             "steer_rotor_inertia", "drive_rotor_inertia"}));
   EXPECT_THROW(u.Initialize(), cosim::UnitError);
   // Without a steerable wheel there is no steering rotor to ask for.
   ChassisUnit fixed("robot", {-1, -1}, {0, 1}, models::OpenFloor());
@@ -564,6 +645,7 @@ TEST(ChassisUnit, CheckParametersRejectsBadValues) {
   u.variables().SetRealElement(*u.variables().Find("wheel_x"), 2, std::nan(""));
   Set(u, "contact_stiffness", -1.0);
   Set(u, "payload_size", std::vector<double>{0.5, 0.0, 0.3});  // a box needs all three
+  Set(u, "com_height", 0.45);                                  // above the 0.07 to 0.40 m box
   const auto problems = u.CheckParameters();
   std::vector<std::string> names;
   for (const auto& p : problems) {
@@ -571,12 +653,16 @@ TEST(ChassisUnit, CheckParametersRejectsBadValues) {
   }
   // The declared rules in declaration order, then the rule between
   // parameters.
-  EXPECT_EQ(names, (std::vector<std::string>{"wheel_radius[1]", "wheel_x[2]", "contact_stiffness",
-                                             "substeps", "module_mass", "payload_size"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"wheel_radius[1]", "wheel_x[2]", "contact_stiffness",
+                                      "substeps", "module_mass", "com_height", "payload_size"}));
   EXPECT_EQ(problems[2].message, "must be > 0, got -1");
   EXPECT_EQ(problems[3].message, "must be in [1, 1000], got 0");
   EXPECT_EQ(problems[4].message, "times 4 wheels must be less than mass 15, got 5");
   EXPECT_EQ(problems[5].message,
+            "must lie within the body box, from body_bottom 0.07 to body_bottom + body_height "
+            "0.4, got 0.45");
+  EXPECT_EQ(problems[6].message,
             "give all three sizes (a box) or none (a point mass), got 0.5, 0, 0.3");
   try {
     u.Initialize();
@@ -714,6 +800,7 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   Set(*three, "body_length", 0.8);
   Set(*three, "body_width", 0.6);
   Set(*three, "body_height", 0.3);
+  Set(*three, "body_bottom", 0.05);
   Set(*three, "mass", 60.0);
   Set(*three, "module_mass", 3.0);
   Set(*three, "com_height", 0.12);
@@ -868,6 +955,7 @@ std::vector<Expected> Parameters(std::size_t wheels) {
   return {{"body_length", C::kParameter, "m", 0},
           {"body_width", C::kParameter, "m", 0},
           {"body_height", C::kParameter, "m", 0},
+          {"body_bottom", C::kParameter, "m", 0},
           {"mass", C::kParameter, "kg", 0},
           {"module_mass", C::kParameter, "kg", 0},
           {"com_height", C::kParameter, "m", 0},
@@ -992,6 +1080,7 @@ TEST(ChassisUnit, RobotDescriptionMatchesTestRobot) {
   EXPECT_EQ(body["length_m"].as<double>(), kRaw3BodyM[0]);
   EXPECT_EQ(body["width_m"].as<double>(), kRaw3BodyM[1]);
   EXPECT_EQ(body["height_m"].as<double>(), kRaw3BodyM[2]);
+  EXPECT_EQ(body["bottom_m"].as<double>(), kRaw3BodyBottomM);
   EXPECT_EQ(body["mass_kg"].as<double>(), kRaw3MassKg);
   EXPECT_EQ(body["com_height_m"].as<double>(), kRaw3ComHeightM);
   const YAML::Node wheels = root["wheels"];

@@ -360,8 +360,9 @@ TEST(MovingSolids, OtherRobotPushesABrakedRobot) {
 }
 
 // Guards against the Husky's robot description and the test robot
-// drifting apart: models/robots/husky.yaml's body (its com_height_m the
-// derived 0.13 m clearance + 0.2475 / 2 m) is the test robot's.
+// drifting apart: models/robots/husky.yaml's body (its box from the URDF,
+// its com_height_m the assumed 0.13 m clearance + 0.2475 / 2 m) is the
+// test robot's.
 TEST(Husky, RobotDescriptionBodyMatchesTestRobot) {
   const auto path = std::filesystem::path(models::ModelsDir()) / "robots" / "husky.yaml";
   const YAML::Node body = YAML::LoadFile(path.string())["body"];
@@ -369,6 +370,7 @@ TEST(Husky, RobotDescriptionBodyMatchesTestRobot) {
   EXPECT_EQ(body["length_m"].as<double>(), kHuskyBodyM[0]);
   EXPECT_EQ(body["width_m"].as<double>(), kHuskyBodyM[1]);
   EXPECT_EQ(body["height_m"].as<double>(), kHuskyBodyM[2]);
+  EXPECT_EQ(body["bottom_m"].as<double>(), kHuskyBodyBottomM);
   EXPECT_EQ(body["mass_kg"].as<double>(), kHuskyMassKg);
   EXPECT_NEAR(body["com_height_m"].as<double>(), kHuskyComHeightM, 1e-15);
 }

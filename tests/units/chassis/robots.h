@@ -23,8 +23,11 @@ inline constexpr double kRaw3MassKg = 120.0;
 /// low).
 inline constexpr double kRaw3ModuleMassKg = 5.0;
 inline constexpr double kRaw3ComHeightM = 0.13;
-/// Body 1.03 x 0.57 x 0.40 m: paper 1, Table I.
-inline constexpr double kRaw3BodyM[3] = {1.03, 0.57, 0.40};
+/// Body planform 1.03 x 0.57 m (paper 1, Table I), 0.33 m high from its
+/// underside 0.07 m above the floor (the public URDF's base mesh) to Table
+/// I's 0.40 m: models/robots/raw3.yaml.
+inline constexpr double kRaw3BodyM[3] = {1.03, 0.57, 0.33};
+inline constexpr double kRaw3BodyBottomM = 0.07;
 /// Wheel radius and steering-axis positions: raw3-1 Platform.ini
 /// (ipa320/cob_robots).
 inline constexpr double kRaw3WheelRadiusM = 0.080;
@@ -46,13 +49,16 @@ inline constexpr double kHuskyWheelRadiusM = 0.1651;
 inline constexpr double kHuskyHalfBaseM = 0.256;
 /// Half track: wheel separation 0.5708 m (URDF).
 inline constexpr double kHuskyHalfTrackM = 0.2854;
-/// Base box 0.9874 x 0.5709 x 0.2475 m (URDF).
+/// Base box 0.9874 x 0.5709 x 0.2475 m (URDF), its bottom plate (the URDF's
+/// base_link) wheel_radius - wheel_vertical_offset = 0.1651 - 0.03282 m
+/// above the floor (the manual's 130 mm ground clearance).
 inline constexpr double kHuskyBodyM[3] = {0.9874, 0.5709, 0.2475};
+inline constexpr double kHuskyBodyBottomM = 0.1323;
 /// Total 50 kg (manual spec table), 2.637 kg per wheel (URDF).
 inline constexpr double kHuskyMassKg = 50.0;
 inline constexpr double kHuskyWheelMassKg = 2.637;
-/// Box centre: its bottom at the 130 mm ground clearance (manual) plus half
-/// its height: 0.25375 m, as models/robots/husky.yaml's com_height_m.
+/// Centre of mass: ASSUMPTION of models/robots/husky.yaml (com_height_m),
+/// mid-height of the box over the manual's 130 mm ground clearance.
 inline constexpr double kHuskyComHeightM = 0.130 + 0.5 * kHuskyBodyM[2];
 /// Wheel contact mu 1.0 (URDF gazebo tags).
 inline constexpr double kHuskyMu = 1.0;
@@ -64,8 +70,8 @@ inline constexpr double kHuskyMu = 1.0;
 /// the base link). Mount plate 5 kg: ASSUMPTION (a 10 mm aluminium plate of
 /// about 0.45 x 0.4 m with its bolts). Centre of mass 0.61 m above the floor
 /// on the robot's centre line: ASSUMPTION (the arm folded for transport over
-/// the centre of the top plate, whose surface is at 0.13 + 0.2475 =
-/// 0.3775 m; the folded arm's centre of mass about 0.26 m above its base,
+/// the centre of the top plate, at the body's top, 0.1323 + 0.2475 =
+/// 0.38 m; the folded arm's centre of mass about 0.26 m above its base,
 /// the plate's 5 mm above the top). Box 0.6 x 0.3 x 0.55 m about it:
 /// ASSUMPTION, the folded arm's envelope (top at 0.885 m).
 inline constexpr double kUr10MassKg = 32.7;
@@ -86,6 +92,7 @@ inline std::unique_ptr<ChassisUnit> Raw3(models::Scene scene = models::OpenFloor
   Set(*u, "body_length", kRaw3BodyM[0]);
   Set(*u, "body_width", kRaw3BodyM[1]);
   Set(*u, "body_height", kRaw3BodyM[2]);
+  Set(*u, "body_bottom", kRaw3BodyBottomM);
   Set(*u, "mass", kRaw3MassKg);
   Set(*u, "module_mass", kRaw3ModuleMassKg);
   Set(*u, "com_height", kRaw3ComHeightM);
@@ -110,6 +117,7 @@ inline std::unique_ptr<ChassisUnit> Husky(models::Scene scene, const std::string
   Set(*u, "body_length", kHuskyBodyM[0]);
   Set(*u, "body_width", kHuskyBodyM[1]);
   Set(*u, "body_height", kHuskyBodyM[2]);
+  Set(*u, "body_bottom", kHuskyBodyBottomM);
   Set(*u, "mass", kHuskyMassKg);
   Set(*u, "module_mass", kHuskyWheelMassKg);
   Set(*u, "com_height", kHuskyComHeightM);

@@ -397,8 +397,8 @@ TEST(Clearance, PrunedEqualsFullForJumpingPoses) {
 
 // Guards the required body parameters: a unit without the body's size
 // refuses to start, naming each missing one; a non-finite body_bottom is
-// refused too (a negative one is allowed: the chassis's collision box,
-// centred on com_height, can reach below the floor).
+// refused too (a negative one is allowed: the box is placed relative to
+// base_link, whatever a robot description makes of it).
 TEST(Clearance, MissingBodySizeIsRefused) {
   ClearanceUnit u("clearance", SceneWith({}));
   auto problems = u.CheckParameters();
