@@ -1,3 +1,6 @@
+#include <cmath>
+#include <string>
+
 #include "cosim/time.h"
 #include "loader/assembly/concerns.h"
 
@@ -168,6 +171,28 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
         cosim::Reduction::kFinal);
     add("localization_yaw_error_rms_rad", Signal(kLocalizationError, "rms_yaw_error"),
         cosim::Reduction::kFinal);
+    // The error while the robot is on each slope of the scene (a terrain
+    // piece with a pitch or a roll: paper 2's ramp): the truth's base_link
+    // inside the piece's footprint.
+    for (const models::TerrainPiece& t : b.spec().scene.terrain) {
+      if (t.pitch_rad == 0.0 && t.roll_rad == 0.0) continue;
+      const std::string unit = "localization_error_on_" + t.name;
+      b.Unit(unit, "pose_error");
+      Parameters& r = b.Params(unit);
+      const auto axes = models::TerrainAxes(t);
+      const double h = 0.5 * t.thickness_m;
+      r["region_x"] = t.center_x_m + h * axes[2][0];
+      r["region_y"] = t.center_y_m + h * axes[2][1];
+      r["region_yaw"] = t.yaw_rad;
+      r["region_length"] = t.length_m * std::cos(t.pitch_rad);
+      r["region_width"] = t.width_m * std::cos(t.roll_rad);
+      b.Connect(s.true_position, Signal(unit, "true_position"));
+      b.Connect(s.true_yaw, Signal(unit, "true_yaw"));
+      b.Connect(s.position, Signal(unit, "estimated_position"));
+      b.Connect(s.yaw, Signal(unit, "estimated_yaw"));
+      add(unit + "_max_m", Signal(unit, "max_position_error"), cosim::Reduction::kFinal);
+      add(unit + "_rms_m", Signal(unit, "rms_position_error"), cosim::Reduction::kFinal);
+    }
     // The share of the run the localization spent on its fallback (source 1).
     for (const Port& source : s.localization_sources) {
       add(source.unit + "_fallback_fraction", source, cosim::Reduction::kMean);

@@ -1,7 +1,9 @@
 #include "units/estimation/perfect_match_localization_unit.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <span>
 #include <utility>
 
@@ -33,6 +35,7 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
   }
   const std::size_t L = beam_counts_.size();
   mapping_range_bias_.assign(L, 0.0);
+  mount_z_.assign(L, 0.0);
   // The LMS151's limits (paper 2's laser) where the shared parameters
   // differ from hector's.
   range_min_ = 0.5;
@@ -42,6 +45,9 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
   using cosim::Rule;
   auto& v = variables();
   DeclareMountXY();
+  v.Parameter("mount_z", "m", &mount_z_,
+              "per laser: its origin's height above base_link (with attitude terrain)",
+              Rule::Finite());
   DeclareBeamGeometry("per laser: its yaw in base_link (roll and pitch ignored: 3-DoF as paper 2)");
   DeclareRangeLimits(
       "nearer returns are skipped (the LMS151's 0.5 m, operating instructions 8012471)",
@@ -99,6 +105,28 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
               "sensitivity to it",
               Rule::NonNegative());
   DeclareCovarianceFloorYaw();
+  v.Parameter("attitude", &attitude_,
+              "none: the scan plane is level (3-DoF on a flat floor); terrain: the base's pitch "
+              "and roll from the scene's terrain under the wheels at the estimated pose, the "
+              "points projected into the map's plane and those below the map's floor_m + "
+              "ground_clearance dropped, the odometry projected",
+              Rule::OneOf({"none", "terrain"}));
+  v.Parameter("wheelbase", "m", &wheelbase_,
+              "attitude terrain: the contact points' spread along base_link x", Rule::Positive());
+  v.Parameter("track", "m", &track_, "attitude terrain: the contact points' spread across",
+              Rule::Positive());
+  v.Parameter("wheel_radius", "m", &wheel_radius_,
+              "attitude terrain: the wheels' radius (each rests on the ground's profile as a "
+              "circle)",
+              Rule::Positive());
+  v.Parameter("kink_tolerance", "m", &kink_tolerance_,
+              "attitude terrain: no match while the ground under the tyres departs from one "
+              "plane by more than this (the chassis across a ramp's foot or top)",
+              Rule::Positive());
+  v.Parameter("ground_clearance", "m", &ground_clearance_,
+              "attitude terrain: a point less than this above the map's floor (or below it) hit "
+              "the ground and is dropped",
+              Rule::NonNegative());
 
   for (std::size_t k = 0; k < L; ++k) {
     DeclareScanInputs(k);
@@ -125,9 +153,18 @@ PerfectMatchLocalizationUnit::PerfectMatchLocalizationUnit(std::string name,
            "(1: every point on an outline)",
            {});
   v.Output("map_in_use", "1", &map_in_use_, "the map of the latest scan matched (its index)", {});
+  v.Output("pitch", "rad", &pitch_,
+           "attitude terrain: the base's pitch at the current estimate (ROS: + nose down; 0 "
+           "with none)",
+           {});
+  v.Output("roll", "rad", &roll_,
+           "attitude terrain: the base's roll at the current estimate (+ right side down)", {});
+  v.Output("low_points", "1", &low_points_,
+           "points of the latest scan dropped as ground hits (attitude terrain)", {});
   v.Output("laser_status", "1", &laser_status_,
            "per laser: 0 ok, 1 no new scan within scan_timeout, 2 blacked out (fewer than "
-           "min_points returns), 3 last match rejected, 4 map_index names no map",
+           "min_points returns), 3 last match rejected, 4 map_index names no map, 5 held: "
+           "the chassis across a kink of the ground (attitude terrain)",
            {});
   v.Output("source", "1", &source_,
            "0: pose from a match within scan_timeout; 1: held (or odometry-predicted) since", {});
@@ -208,6 +245,116 @@ void PerfectMatchLocalizationUnit::Initialize() {
   match_error_ = 0.0;
   match_inlier_fraction_ = 0.0;
   map_in_use_ = static_cast<double>(map_index_);
+  low_points_ = 0.0;
+  UpdateAttitude(estimate_);
+}
+
+void PerfectMatchLocalizationUnit::UpdateAttitude(const Pose& at) {
+  if (attitude_ != "terrain") {
+    pitch_ = roll_ = base_height_ = ground_unevenness_ = 0.0;
+    odometry_scale_x_ = odometry_scale_y_ = 1.0;
+    return;
+  }
+  // Each wheel a circle of wheel_radius rolling on the ground's profile
+  // along the heading: its centre rests at the highest of ground + sqrt(R^2
+  // - u^2) over the contact patch's neighbourhood |u| <= R (on a slope the
+  // tyre touches ahead of or behind its axle, so the chassis starts to
+  // pitch before the axle reaches the ramp: R tan(pitch / 2) earlier).
+  const double c = std::cos(at.yaw), s = std::sin(at.yaw);
+  const double a = 0.5 * wheelbase_, b = 0.5 * track_, R = wheel_radius_;
+  constexpr int kSamples = 16;  // intervals over the diameter: 2 cm for the Husky's 0.165 m
+  std::array<double, 4> h{};    // wheel centres: front left, front right, rear left, rear right
+  const std::array<std::array<double, 2>, 4> corner = {{{a, b}, {a, -b}, {-a, b}, {-a, -b}}};
+  // The ground's samples under the four tyres, and the least-squares plane
+  // through them (normal equations of z = z0 + gx u + gy w).
+  std::array<double, 9> m{};
+  std::array<double, 3> rhs{};
+  std::array<std::array<double, 3>, 4 * (kSamples + 1)> samples{};
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    double top = -std::numeric_limits<double>::infinity();
+    for (int j = 0; j <= kSamples; ++j) {
+      const double u = R * (2.0 * j / kSamples - 1.0);
+      const double along = corner[i][0] + u, w = corner[i][1];
+      const double lift = std::sqrt(std::max(0.0, R * R - u * u));
+      const double g = GroundAt(at.x + c * along - s * w, at.y + s * along + c * w);
+      top = std::max(top, g + lift);
+      samples[count++] = {along, w, g};
+      const std::array<double, 3> row = {1.0, along, w};
+      for (std::size_t r = 0; r < 3; ++r) {
+        rhs[r] += row[r] * g;
+        for (std::size_t q = 0; q < 3; ++q) m[3 * r + q] += row[r] * row[q];
+      }
+    }
+    h[i] = top;
+  }
+  // Cramer's rule on the 3 x 3 normal equations (well conditioned: the
+  // samples span the wheelbase and the track).
+  const auto det3 = [](const std::array<double, 9>& q) {
+    return q[0] * (q[4] * q[8] - q[5] * q[7]) - q[1] * (q[3] * q[8] - q[5] * q[6]) +
+           q[2] * (q[3] * q[7] - q[4] * q[6]);
+  };
+  const double d = det3(m);
+  std::array<double, 3> plane{};
+  for (std::size_t col = 0; col < 3; ++col) {
+    std::array<double, 9> q = m;
+    for (std::size_t r = 0; r < 3; ++r) q[3 * r + col] = rhs[r];
+    plane[col] = det3(q) / d;
+  }
+  ground_unevenness_ = 0.0;
+  for (std::size_t k = 0; k < count; ++k) {
+    const auto& p = samples[k];
+    ground_unevenness_ = std::max(ground_unevenness_,
+                                  std::abs(p[2] - (plane[0] + plane[1] * p[0] + plane[2] * p[1])));
+  }
+  // The least-squares plane z = z0 + gx u + gy w through the wheel centres
+  // (exact for four coplanar ones; across a kink the four wheels' mean
+  // slope: an idealisation, a rigid chassis there rests on three).
+  const double gx = ((h[0] + h[1]) - (h[2] + h[3])) / (4.0 * a);
+  const double gy = ((h[0] + h[2]) - (h[1] + h[3])) / (4.0 * b);
+  const double norm = std::sqrt(1.0 + gx * gx + gy * gy);
+  // base_link's origin: on the contact plane, R below the centres' plane
+  // along its normal.
+  base_height_ = 0.25 * (h[0] + h[1] + h[2] + h[3]) - R * norm;
+  // The body's z axis is the plane's normal (-gx, -gy, 1) / |n|; in
+  // Ry(pitch) Rx(roll) it is (cos roll sin pitch, -sin roll, cos roll cos
+  // pitch).
+  pitch_ = std::atan2(-gx, 1.0);
+  roll_ = std::asin(gy / norm);
+  odometry_scale_x_ = std::cos(pitch_);
+  odometry_scale_y_ = std::cos(roll_);
+}
+
+double PerfectMatchLocalizationUnit::GroundAt(double x, double y) const {
+  double z = 0.0;
+  for (const models::TerrainPiece& t : scene_.terrain) {
+    if (const auto top = models::TerrainTopAt(t, x, y)) z = std::max(z, *top);
+  }
+  return z;
+}
+
+std::size_t PerfectMatchLocalizationUnit::DropGroundHits(std::size_t n, const Pose& start) {
+  const double c = std::cos(start.yaw), s = std::sin(start.yaw);
+  std::size_t kept = 0, low = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double x = start.x + c * px_[i] - s * py_[i], y = start.y + s * px_[i] + c * py_[i];
+    if (base_height_ + pz_[i] < GroundAt(x, y) + ground_clearance_) {
+      ++low;
+      continue;
+    }
+    px_[kept] = px_[i];
+    py_[kept] = py_[i];
+    pz_[kept] = pz_[i];
+    ++kept;
+  }
+  low_points_ += static_cast<double>(low);
+  return kept;
+}
+
+cosim::StepResult PerfectMatchLocalizationUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
+  const cosim::StepResult result = ScanLocalizer::DoStep(t, dt);
+  UpdateAttitude({position_[0], position_[1], yaw_});
+  return result;
 }
 
 void PerfectMatchLocalizationUnit::ProcessScan(int k, cosim::TimeNs match_ns) {
@@ -219,15 +366,35 @@ void PerfectMatchLocalizationUnit::ProcessScan(int k, cosim::TimeNs match_ns) {
   // A map this laser built by SLAM carries its bias (see the header).
   const double map_bias =
       specs_[static_cast<std::size_t>(map_index_)].from_own_laser ? mapping_range_bias_[kk] : 0.0;
-  // Deskew by the odometry twist.
-  const std::size_t n =
-      CollectPoints(k, map_bias, deskew_ && odometry_prediction_, odometry_velocity_[0],
-                    odometry_velocity_[1], odometry_yaw_rate_);
+  const Pose start = MatchStart(match_ns);
+  // With attitude terrain: the points projected by the base's attitude
+  // under the start, those below the map's floor dropped.
+  std::optional<Tilt> tilt;
+  if (attitude_ == "terrain") {
+    UpdateAttitude(start);
+    // Across a kink (a ramp's foot or top) the chassis' pitch is the
+    // tyres' and the suspension's, not the ground's plane, and it changes
+    // with the position along the route: an attitude from the estimate
+    // would then feed the estimate's error back (a wall 4.5 m ahead moves
+    // 20 mm per degree of pitch at 15 deg). The odometry carries the pose
+    // over it.
+    if (ground_unevenness_ > kink_tolerance_) {
+      SetStatus(k, 5);
+      return;
+    }
+    const double floor_m = specs_[static_cast<std::size_t>(map_index_)].floor_m;
+    tilt = Tilt{pitch_, roll_, mount_z_[kk], floor_m + ground_clearance_ - base_height_};
+  }
+  // Deskew by the odometry twist (projected with the attitude).
+  const std::size_t collected = CollectPoints(
+      k, map_bias, deskew_ && odometry_prediction_, odometry_scale_x_ * odometry_velocity_[0],
+      odometry_scale_y_ * odometry_velocity_[1], odometry_yaw_rate_, tilt ? &*tilt : nullptr);
+  low_points_ = static_cast<double>(dropped_low_);
+  const std::size_t n = tilt ? DropGroundHits(collected, start) : collected;
   if (n < static_cast<std::size_t>(min_points_)) {
     SetStatus(k, 2);
     return;
   }
-  const Pose start = MatchStart(match_ns);
   map_in_use_ = static_cast<double>(map_index_);
   const PerfectMatch::Result res = matcher_->Match(
       *maps_[static_cast<std::size_t>(map_index_)], std::span<const double>(px_.data(), n),

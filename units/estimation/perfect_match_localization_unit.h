@@ -24,11 +24,24 @@ namespace linesim::estimation {
 /// match inputs (the EKF with odometry).
 ///
 /// 3-DoF as paper 2's matcher: each laser's beams are put into base_link by
-/// its mount's x, y and yaw; roll and pitch (of the mount and of the robot
-/// on a ramp) are ignored. The maps are horizontal slices of the scene's
-/// static solids (structural key `maps`: name, height_m, optional region),
-/// all built in Initialize (before time zero); switching maps never resets
-/// the pose.
+/// its mount's x, y and yaw; the mount's roll and pitch are ignored. The
+/// robot's own attitude (`attitude`): none, the scan plane taken as level
+/// (a robot on a flat floor); terrain, the attitude from the scene's known
+/// terrain (a ramp) under the wheels' contact points at the match's start
+/// pose (the corners of the rectangle wheelbase x track about base_link):
+/// the least-squares plane through the ground's heights there (the floor at z 0, or the top face of
+/// the highest terrain piece above the point) gives pitch, roll and base_link's height. Each beam's
+/// point is then turned by that pitch and roll, its horizontal part matched (a pitched scan reads a
+/// wall at d as d / cos pitch), and a point less than ground_clearance above the map's floor_m or
+/// above the ground under it is dropped (it hit the floor, the ramp or the van floor: a pitched
+/// scan plane cuts them in a line across the route, a phantom wall that moves with the robot).
+/// While the ground under the tyres is not one plane (within kink_tolerance: the chassis across the
+/// ramp's foot or top) no scan is matched (laser_status 5) and the
+/// odometry carries the pose. The odometry that predicts
+/// the start is projected too (its vx times cos pitch, vy times cos roll),
+/// and the pitch and roll are outputs for pose_fusion's. The maps are horizontal slices of the
+/// scene's static solids (structural key `maps`: name, height_m, optional region), all built in
+/// Initialize (before time zero); switching maps never resets the pose.
 ///
 /// Per new scan of laser k (scan_count_k changed; several lasers' scans in
 /// one step in the order of their match times):
@@ -60,7 +73,8 @@ namespace linesim::estimation {
 ///    hessian, match_error, match_inlier_fraction,
 ///    match_time, match_count + 1.
 /// laser_status per laser: 0 ok, 1 no new scan within scan_timeout, 2
-/// blacked out, 3 rejected, 4 no such map. source: 0 the pose is from a
+/// blacked out, 3 rejected, 4 no such map, 5 held across a kink of the
+/// ground (attitude terrain). source: 0 the pose is from a
 /// match within scan_timeout, 1 held (or odometry-predicted with
 /// motion_prediction odometry) since.
 class PerfectMatchLocalizationUnit : public ScanLocalizer {
@@ -78,6 +92,9 @@ class PerfectMatchLocalizationUnit : public ScanLocalizer {
     /// its maps "built using SLAM"), not from the geometry: see
     /// mapping_range_bias.
     bool from_own_laser = false;
+    /// The floor the map's outlines stand on (m, map z): with attitude
+    /// terrain, points lower than it plus ground_clearance are dropped.
+    double floor_m = 0.0;
   };
 
   /// One entry of `beam_counts` per laser (1..kMaxLasers, each 1..100000
@@ -91,6 +108,9 @@ class PerfectMatchLocalizationUnit : public ScanLocalizer {
   /// OccupancyGrid::kMaxCells (refused at load, not when the maps are built).
   std::vector<cosim::ParameterProblem> CheckParameters() const override;
   void Initialize() override;
+  /// The shared step, then the attitude at its end (the outputs, and the
+  /// odometry's projection in the next step's prediction).
+  cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
 
   int map_count() const { return static_cast<int>(specs_.size()); }
   /// Map i (after Initialize).
@@ -105,6 +125,17 @@ class PerfectMatchLocalizationUnit : public ScanLocalizer {
 
  private:
   void Derive();
+  /// With attitude terrain: the ground's plane under the contact points at
+  /// (x, y, yaw) into pitch_, roll_, base_height_ and the odometry's
+  /// projection factors; with none, level.
+  void UpdateAttitude(const Pose& at);
+  /// The ground's height at map (x, y): the floor (0) or the highest
+  /// terrain top face over it.
+  double GroundAt(double x, double y) const;
+  /// Drops from the n collected points (px_, py_, pz_) those less than
+  /// ground_clearance above the ground under them (placed from `start`):
+  /// the ramp, the van floor. Returns the count kept.
+  std::size_t DropGroundHits(std::size_t n, const Pose& start);
   void ProcessScan(int k, cosim::TimeNs match_ns) override;
 
   std::vector<MapSpec> specs_;
@@ -120,6 +151,11 @@ class PerfectMatchLocalizationUnit : public ScanLocalizer {
                rprop_stride_ = 1;
   double max_mean_error_ = 0.5;
   double range_bias_sigma_ = 0.0;
+  std::string attitude_ = "none";
+  double wheelbase_ = 0.5, track_ = 0.5, wheel_radius_ = 0.1;
+  std::vector<double> mount_z_;
+  double ground_clearance_ = 0.1;
+  double kink_tolerance_ = 0.002;
 
   // Inputs beside the shared ones.
   std::vector<double> mapping_range_bias_;  // per laser
@@ -127,6 +163,9 @@ class PerfectMatchLocalizationUnit : public ScanLocalizer {
 
   // Outputs beside the shared ones.
   double match_error_ = 0.0, match_inlier_fraction_ = 0.0, map_in_use_ = 0.0;
+  double pitch_ = 0.0, roll_ = 0.0, low_points_ = 0.0;
+  double base_height_ = 0.0;        // base_link's z in map under the attitude's pose
+  double ground_unevenness_ = 0.0;  // the tyres' ground samples' largest departure from their plane
 
   PerfectMatch::Result last_result_;
 };

@@ -34,11 +34,12 @@ std::optional<std::vector<Unit::MapSpec>> ReadMaps(const UnitBuildContext& c) {
       ok = false;
       continue;
     }
-    c.reader.CheckKeys(m, mp, {"name", "height_m", "region", "cell_m", "source"});
+    c.reader.CheckKeys(m, mp, {"name", "height_m", "floor_m", "region", "cell_m", "source"});
     Unit::MapSpec spec;
     spec.name = c.reader.String(m, mp, "name", std::nullopt);
     spec.height_m = c.reader.Real(m, mp, "height_m", std::nullopt, {-100.0, 100.0});
     spec.cell_m = c.reader.Real(m, mp, "cell_m", 0.0, {0.0, 0.5});
+    spec.floor_m = c.reader.Real(m, mp, "floor_m", 0.0, {-100.0, 100.0});
     spec.from_own_laser =
         c.reader.String(m, mp, "source", "geometry", {"geometry", "own_laser"}) == "own_laser";
     for (std::size_t j = 0; j < maps.size(); ++j) {
@@ -97,6 +98,8 @@ const config::UnitTypeRegistrar kPerfectMatch(
        "one entry per laser: its beam count (the size of its ranges_<k> input), e.g. [541]"},
       {"maps",
        "the maps, in map_index order: each {name, height_m (the slice's z above the floor), "
+       "floor_m (optional, 0: the z of the floor its outlines stand on; with attitude terrain "
+       "points below it plus ground_clearance are dropped), "
        "region (optional, {min_x_m, max_x_m, min_y_m, max_y_m}: only the solids whose footprint "
        "lies inside it; absent: every static solid), cell_m (optional: its lookup grid's cell, "
        "else the lookup_cell parameter), source (optional: geometry, the default, a map of the "

@@ -105,6 +105,11 @@ PoseFusionUnit::PoseFusionUnit(std::string name) : cosim::Unit(kTypeName, std::m
           "vx, vy of base_link in base_link from the wheel odometry (its body_velocity)");
   v.Input("odometry_yaw_rate", "rad/s", &odometry_yaw_rate_,
           "yaw rate from the wheel odometry (its yaw_rate)");
+  v.Input("base_pitch", "rad", &base_pitch_,
+          "the base's pitch (ROS: + nose down): the odometry's vx is projected on the map by "
+          "its cosine (0: level)");
+  v.Input("base_roll", "rad", &base_roll_,
+          "the base's roll: the odometry's vy is projected on the map by its cosine (0: level)");
   v.Input("imu_angular_velocity", "rad/s", &imu_angular_velocity_,
           "angular velocity from the IMU (its frame ~ base_link); z is used with "
           "yaw_rate_source = imu");
@@ -296,8 +301,9 @@ cosim::StepResult PoseFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   if (!InputsFinite(t)) return cosim::StepResult::kError;
   Entry e = At(size_ - 1);
   e.t = t + dt;
-  e.vx = odometry_velocity_[0];
-  e.vy = odometry_velocity_[1];
+  // The wheels' travel projected on the map's plane (1 on the level).
+  e.vx = std::cos(base_pitch_) * odometry_velocity_[0];
+  e.vy = std::cos(base_roll_) * odometry_velocity_[1];
   e.omega = use_imu_ ? imu_angular_velocity_[2] : odometry_yaw_rate_;
   Predict(e.x, e.p, e.vx, e.vy, e.omega, cosim::NsToSeconds(dt));
   Push(e);

@@ -30,7 +30,11 @@ namespace linesim::estimation {
 ///                                                     constant twist)
 ///   theta += omega dt,  b unchanged,
 /// omega the odometry's yaw rate, or the IMU's z rate with
-/// yaw_rate_source = imu. Process noise (continuous white noise,
+/// yaw_rate_source = imu, and v_odo's x times cos(base_pitch), its y times
+/// cos(base_roll): on a slope a wheel's travel is longer than its
+/// projection on the map (2.07 m of ramp for 2.0 m of map at 15 deg; the
+/// attitude from whoever knows it, e.g. perfect_match_localization's
+/// attitude terrain; 0, level, when not connected). Process noise (continuous white noise,
 /// integrated over the step): velocity_noise^2 dt on each position
 /// coordinate, yaw_rate_noise^2 dt on theta, offset_random_walk^2 dt on each
 /// of b.
@@ -118,6 +122,7 @@ class PoseFusionUnit : public cosim::Unit {
   // Inputs.
   std::vector<double> odometry_velocity_;
   double odometry_yaw_rate_ = 0.0;
+  double base_pitch_ = 0.0, base_roll_ = 0.0;
   std::vector<double> imu_angular_velocity_;
   std::vector<double> match_position_;
   double match_yaw_ = 0.0;

@@ -54,6 +54,7 @@ ScanLocalizer::ScanLocalizer(const char* type_name, std::string name, std::vecto
   hessian_.assign(9, 0.0);
   px_.assign(max_beams, 0.0);
   py_.assign(max_beams, 0.0);
+  pz_.assign(max_beams, 0.0);
   order_.assign(L, 0);
   mid_offset_ns_.assign(L, 0);
   last_scan_ns_.assign(L, 0);
@@ -204,13 +205,14 @@ ScanLocalizer::Pose ScanLocalizer::Predict(const Pose& p, double s) const {
   // interval (second order in the turn).
   const double mid = p.yaw + 0.5 * odometry_yaw_rate_ * s;
   const double c = std::cos(mid), sn = std::sin(mid);
-  const double vx = odometry_velocity_[0], vy = odometry_velocity_[1];
+  const double vx = odometry_scale_x_ * odometry_velocity_[0],
+               vy = odometry_scale_y_ * odometry_velocity_[1];
   return {p.x + (c * vx - sn * vy) * s, p.y + (sn * vx + c * vy) * s,
           wrap_angle_(p.yaw + odometry_yaw_rate_ * s)};
 }
 
 std::size_t ScanLocalizer::CollectPoints(int k, double range_offset, bool deskew, double vx,
-                                         double vy, double w) {
+                                         double vy, double w, const Tilt* tilt) {
   const auto kk = static_cast<std::size_t>(k);
   const std::vector<double>& r = ranges_[kk];
   const std::vector<double>& bc = beam_cos_[kk];
@@ -221,11 +223,28 @@ std::size_t ScanLocalizer::CollectPoints(int k, double range_offset, bool deskew
   // p_match = R(w dt) p_i + v dt; R to second order in w dt (w dt <= 0.02
   // rad for 1 rad/s over half of an S300 sweep: error below 1.5e-6 r).
   const double mid_s = cosim::NsToSeconds(mid_offset_ns_[kk]);
+  // The tilt's rotation Ry(pitch) Rx(roll): x' = cp x + sp (sr y + cr z),
+  // y' = cr y - sr z, z' = -sp x + cp (sr y + cr z).
+  const double cp = tilt ? std::cos(tilt->pitch) : 1.0, sp = tilt ? std::sin(tilt->pitch) : 0.0;
+  const double cr = tilt ? std::cos(tilt->roll) : 1.0, sr = tilt ? std::sin(tilt->roll) : 0.0;
   std::size_t n = 0;
+  dropped_low_ = 0;
   for (std::size_t i = 0; i < r.size(); ++i) {
     if (!(r[i] >= range_min_ && r[i] <= usable_range_max_) || r[i] <= 0.0) continue;
     const double ri = r[i] - range_offset;
     double x = mx + ri * bc[i], y = my + ri * bs[i];
+    if (tilt) {
+      const double up = sr * y + cr * tilt->mount_z;
+      const double z = -sp * x + cp * up;
+      if (z < tilt->min_z) {
+        ++dropped_low_;
+        continue;
+      }
+      pz_[n] = z;
+      const double xh = cp * x + sp * up;
+      y = cr * y - sr * tilt->mount_z;
+      x = xh;
+    }
     if (deskew) {
       const double dt = beam_dt_[kk][i] - mid_s;
       const double th = w * dt, c = 1.0 - 0.5 * th * th;

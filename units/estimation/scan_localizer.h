@@ -76,12 +76,25 @@ class ScanLocalizer : public cosim::Unit {
   void InitializeTracking();
   /// `p` moved by the odometry inputs over `seconds` (may be < 0).
   Pose Predict(const Pose& p, double seconds) const;
+  /// The base's attitude for a scan: each beam's point, put at (mount_x,
+  /// mount_y, mount_z) + r (cos, sin, 0) in base_link, is turned by
+  /// Ry(pitch) Rx(roll) (ROS REP 103: + pitch lowers the nose, + roll
+  /// lowers the right side) into the frame of base_link's yaw alone; a
+  /// point lower than min_z there (m, relative to base_link's origin) is
+  /// dropped, the others keep their horizontal part.
+  struct Tilt {
+    double pitch = 0.0, roll = 0.0;
+    double mount_z = 0.0;
+    double min_z = 0.0;
+  };
   /// Laser k's returns in [range_min, usable_range_max] as points in
   /// base_link (px_, py_; their count), each range less `range_offset`;
-  /// with `deskew` moved from the beam's time to the match time by the
-  /// base_link twist (vx, vy, w).
-  std::size_t CollectPoints(int k, double range_offset, bool deskew, double vx, double vy,
-                            double w);
+  /// with `tilt`, projected into the map's plane and the low ones dropped
+  /// (their number in dropped_low_; the kept ones' heights above base_link's
+  /// origin in pz_); with `deskew` moved from the beam's
+  /// time to the match time by the base_link twist (vx, vy, w).
+  std::size_t CollectPoints(int k, double range_offset, bool deskew, double vx, double vy, double w,
+                            const Tilt* tilt = nullptr);
   /// Where a match at `match_ns` starts.
   Pose MatchStart(cosim::TimeNs match_ns) const;
   /// Within max_jump and max_jump_yaw of `start`.
@@ -122,6 +135,10 @@ class ScanLocalizer : public cosim::Unit {
   std::vector<double> scan_count_, scan_time_;
   std::vector<double> odometry_velocity_;
   double odometry_yaw_rate_ = 0.0;
+  /// Factors on the odometry's vx and vy in Predict: a wheel's travel on a
+  /// slope is longer than its projection on the map (cos pitch, cos roll;
+  /// 1 on the level, set by a unit that knows the attitude).
+  double odometry_scale_x_ = 1.0, odometry_scale_y_ = 1.0;
 
   // Outputs.
   std::vector<double> position_, covariance_, hessian_, laser_status_;
@@ -134,8 +151,9 @@ class ScanLocalizer : public cosim::Unit {
   bool odometry_prediction_ = false;
 
   // Scratch (sized in the constructor): the points of one scan.
-  std::vector<double> px_, py_;
+  std::vector<double> px_, py_, pz_;
   std::vector<int> order_;
+  std::size_t dropped_low_ = 0;  // the last CollectPoints' points below Tilt::min_z
 
   // State.
   cosim::TimeNs start_ = 0;

@@ -10,6 +10,15 @@ namespace linesim::evaluation {
 
 PoseErrorUnit::PoseErrorUnit(std::string name) : cosim::Unit(kTypeName, std::move(name)) {
   auto& v = variables();
+  v.Parameter("region_x", "m", &region_x_, "centre x of the region the statistics count in",
+              cosim::Rule::Finite());
+  v.Parameter("region_y", "m", &region_y_, "centre y of the region", cosim::Rule::Finite());
+  v.Parameter("region_yaw", "rad", &region_yaw_, "heading of the region's length",
+              cosim::Rule::Finite());
+  v.Parameter("region_length", "m", &region_length_,
+              "the region's length (0: no region, every point counts)", cosim::Rule::NonNegative());
+  v.Parameter("region_width", "m", &region_width_, "the region's width",
+              cosim::Rule::NonNegative());
   v.Input("true_position", "m", &true_position_, "true x, y of base_link in map");
   v.Input("true_yaw", "rad", &true_yaw_, "true yaw of base_link");
   v.Input("estimated_position", "m", &estimated_position_, "estimated x, y of base_link in map");
@@ -25,6 +34,10 @@ PoseErrorUnit::PoseErrorUnit(std::string name) : cosim::Unit(kTypeName, std::mov
            "root mean square of position_error over the communication points so far", {});
   v.Output("max_yaw_error", "rad", &max_yaw_error_, "largest |yaw_error| so far", {});
   v.Output("rms_yaw_error", "rad", &rms_yaw_error_, "root mean square of yaw_error so far", {});
+  v.Output("samples", "1", &samples_out_,
+           "communication points counted so far (with a region: those with the true position "
+           "in it)",
+           {});
 }
 
 void PoseErrorUnit::Evaluate() {
@@ -38,6 +51,7 @@ void PoseErrorUnit::Initialize() {
   sum_squared_position_ = sum_squared_yaw_ = 0.0;
   samples_ = 0;
   max_position_error_ = rms_position_error_ = max_yaw_error_ = rms_yaw_error_ = 0.0;
+  samples_out_ = 0.0;
   Evaluate();
 }
 
@@ -46,9 +60,18 @@ cosim::StepResult PoseErrorUnit::DoStep(cosim::TimeNs t, cosim::TimeNs) {
   if (!InputsFinite(t)) return cosim::StepResult::kError;
   // The inputs are those at the step's start: count them.
   Evaluate();
+  if (region_length_ > 0.0) {
+    const double dx = true_position_[0] - region_x_, dy = true_position_[1] - region_y_;
+    const double c = std::cos(region_yaw_), s = std::sin(region_yaw_);
+    if (std::abs(c * dx + s * dy) > 0.5 * region_length_ ||
+        std::abs(-s * dx + c * dy) > 0.5 * region_width_) {
+      return cosim::StepResult::kOk;
+    }
+  }
   sum_squared_position_ += position_error_ * position_error_;
   sum_squared_yaw_ += yaw_error_ * yaw_error_;
   ++samples_;
+  samples_out_ = static_cast<double>(samples_);
   const double n = static_cast<double>(samples_);
   max_position_error_ = std::max(max_position_error_, position_error_);
   max_yaw_error_ = std::max(max_yaw_error_, std::abs(yaw_error_));
@@ -71,6 +94,7 @@ void PoseErrorUnit::RestoreInternal(const cosim::UnitState& state) {
   sum_squared_position_ = state.reals[0];
   sum_squared_yaw_ = state.reals[1];
   samples_ = state.integers[0];
+  samples_out_ = static_cast<double>(samples_);
 }
 
 }  // namespace linesim::evaluation

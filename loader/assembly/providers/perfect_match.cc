@@ -21,7 +21,7 @@ void AddPerfectMatch(SystemBuilder& b, const ProviderContext& c, Signals& s) {
   // The nearest usable range of all lasers, and the largest per-device
   // range bias (the LMS151's systematic error) for the match covariance.
   std::optional<double> range_min, bias_sigma;
-  WireLasers(b, c, s, kPerfectMatch, false, [&](const DeviceNumbers& device) {
+  WireLasers(b, c, s, kPerfectMatch, true, [&](const DeviceNumbers& device) {
     if (const auto v = device.Get("range_min")) range_min = std::max(range_min.value_or(0.0), *v);
     if (const auto v = device.Get("bias_sigma"))
       bias_sigma = std::max(bias_sigma.value_or(0.0), *v);
@@ -33,6 +33,21 @@ void AddPerfectMatch(SystemBuilder& b, const ProviderContext& c, Signals& s) {
               Signal(kPerfectMatch, "mapping_range_bias_" + std::to_string(k)));
   }
   if (range_min) p["range_min"] = *range_min;
+  // The wheels' contact rectangle, for the attitude from known terrain
+  // (parameter attitude terrain: the base's pitch and roll on a ramp).
+  const auto& wheels = c.file.robot.wheels;
+  if (!wheels.empty()) {
+    double min_x = wheels.front().x_m, max_x = min_x, min_y = wheels.front().y_m, max_y = min_y;
+    for (const auto& w : wheels) {
+      min_x = std::min(min_x, w.x_m);
+      max_x = std::max(max_x, w.x_m);
+      min_y = std::min(min_y, w.y_m);
+      max_y = std::max(max_y, w.y_m);
+    }
+    if (max_x > min_x) p["wheelbase"] = max_x - min_x;
+    if (max_y > min_y) p["track"] = max_y - min_y;
+    p["wheel_radius"] = wheels.front().radius_m;
+  }
   if (bias_sigma) p["range_bias_sigma"] = *bias_sigma;
   // 3 DoF as paper 2's matcher: every map is a slice at the first laser's
   // height above the map's floor.
@@ -54,7 +69,9 @@ void AddPerfectMatch(SystemBuilder& b, const ProviderContext& c, Signals& s) {
       YAML::Node one;
       const std::string name = r.String(given[i], path, "name", std::nullopt);
       one["name"] = name;
-      one["height_m"] = Num(r.Real(given[i], path, "floor_m", 0.0, {-10.0, 100.0}) + scan_z);
+      const double floor_m = r.Real(given[i], path, "floor_m", 0.0, {-10.0, 100.0});
+      one["height_m"] = Num(floor_m + scan_z);
+      one["floor_m"] = Num(floor_m);
       for (const char* key : {"region", "cell_m", "source"}) {
         if (Child(given[i], key).IsDefined()) one[key] = Child(given[i], key);
       }
@@ -88,6 +105,10 @@ void LocalizationPerfectMatch(SystemBuilder& b, const ProviderContext& c, Signal
   b.Params(kPerfectMatch)["motion_prediction"] = "odometry";
   ConnectOdometryToMatcher(b, kPerfectMatch);
   AddPoseFusion(b, c, s, kPerfectMatch);
+  // The attitude the matcher knows (0 unless its attitude is terrain)
+  // projects the fusion's odometry on the map too.
+  b.Connect(Signal(kPerfectMatch, "pitch"), Signal(kPoseFusion, "base_pitch"));
+  b.Connect(Signal(kPerfectMatch, "roll"), Signal(kPoseFusion, "base_roll"));
   Parameters& f = b.Params(kPoseFusion);
   f["offset_random_walk"] = 0;
   f["initial_offset_sigma"] = 0;

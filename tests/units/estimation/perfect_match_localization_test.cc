@@ -346,6 +346,48 @@ TEST(PerfectMatchLocalization, FusedWithOdometryTheEkfIsConsistent) {
   test_spread::Print("EKF NEES mean over 50 runs", set_means);
 }
 
+// Guards the attitude from known terrain (paper 2's ramp): on the ramp's
+// plane the Husky's pitch is the ramp's, -atan(0.54 / 2.0) (nose up, ROS
+// sign), its roll 0, and base_link's height the ramp's top under it; on the
+// level both are 0. Across the ramp's foot (front tyres on the ramp, rear
+// on the floor) a scan is not matched (laser_status 5) and the count stays;
+// on the ramp's plane the same scan is matched. With attitude none the
+// outputs stay 0 anywhere.
+TEST(PerfectMatchLocalization, AttitudeFromTheRampUnderTheWheels) {
+  const models::Scene scene = VanBay();
+  const double ramp_pitch = std::atan2(0.54, 2.0);
+  const auto make = [&](Pose at) {
+    auto u = MakeUnit(scene, VanMaps(), at);
+    u->variables().SetString(*u->variables().Find("attitude"), "terrain");
+    // The Husky's contact rectangle and tyres (models/robots/husky.yaml).
+    SetAll(*u, "wheelbase", 0.512);
+    SetAll(*u, "track", 0.5708);
+    SetAll(*u, "wheel_radius", 0.165);
+    u->Setup(0, 1000 * kMs);
+    u->Initialize();
+    return u;
+  };
+  auto mid = make({3.0, 0.0, 0.0});
+  EXPECT_NEAR(Get(*mid, "pitch")[0], -ramp_pitch, 1e-9);
+  EXPECT_NEAR(Get(*mid, "roll")[0], 0.0, 1e-12);
+  auto level = make({0.0, 0.0, 0.0});
+  EXPECT_EQ(Get(*level, "pitch")[0], 0.0);
+  // A scan at the foot: held; the same range list on the ramp: matched.
+  const std::vector<double> r = ScanAt(SolidsAt(scene, 0.35), {1.9, 0.0, 0.0});
+  auto foot = make({1.9, 0.0, 0.0});
+  EXPECT_LT(Get(*foot, "pitch")[0], -0.01);
+  EXPECT_GT(Get(*foot, "pitch")[0], -ramp_pitch);
+  Feed(*foot, r, 40 * kMs);
+  EXPECT_EQ(Get(*foot, "laser_status")[0], 5.0);
+  EXPECT_EQ(Get(*foot, "match_count")[0], 0.0);
+  auto none = MakeUnit(scene, VanMaps(), {3.0, 0.0, 0.0});
+  none->Setup(0, 1000 * kMs);
+  none->Initialize();
+  EXPECT_EQ(Get(*none, "pitch")[0], 0.0);
+  Feed(*none, r, 40 * kMs);
+  EXPECT_NE(Get(*none, "laser_status")[0], 5.0);
+}
+
 // A restored unit continues bit for bit (its maps are rebuilt from the
 // parameters; the pose, counts and odometry prediction are state).
 TEST(PerfectMatchLocalization, RestoredUnitContinuesBitForBit) {
