@@ -49,10 +49,47 @@ void AddMotors(SystemBuilder& b, const RobotFile& file) {
   b.MergeSettings(kMotors, file.motor_settings, robot.file, "motors");
 }
 
+// Each wheel's tread (the robot file's treads entry it names) and its
+// friction on every scene surface: the surface's pair for the tread's
+// material, else the surface's own friction.
+void AddTreads(SystemBuilder& b, const RobotFile& file, const models::Scene& scene) {
+  const models::RobotDescription& robot = file.robot;
+  Parameters& c = b.Params(kChassis);
+  const std::string cp = "units.chassis.parameters";
+  const std::pair<const char*, double models::TreadDescription::*> fields[] = {
+      {"slip_stiffness", &models::TreadDescription::slip_stiffness},
+      {"cornering_stiffness", &models::TreadDescription::cornering_stiffness},
+      {"longitudinal_relaxation", &models::TreadDescription::longitudinal_relaxation_m},
+      {"lateral_relaxation", &models::TreadDescription::lateral_relaxation_m},
+      {"damping_ratio", &models::TreadDescription::damping_ratio},
+      {"patch_length", &models::TreadDescription::patch_length_m},
+      {"patch_width", &models::TreadDescription::patch_width_m}};
+  const char* keys[] = {"slip_stiffness", "cornering_stiffness", "longitudinal_relaxation_m",
+                        "lateral_relaxation_m", "damping_ratio", "patch_length_m",
+                        "patch_width_m"};
+  for (std::size_t f = 0; f < std::size(fields); ++f) {
+    const std::string param = std::string("tread_") + fields[f].first;
+    std::vector<double> values;
+    for (std::size_t k = 0; k < robot.wheels.size(); ++k) {
+      const models::WheelDescription& w = robot.wheels[k];
+      values.push_back(w.tread.*fields[f].second);
+      b.Origin(JoinPath(JoinPath(cp, param), std::to_string(k)),
+               file.At(JoinPath(JoinPath("treads", w.tread.name), keys[f])));
+    }
+    c[param] = values;
+    b.Origin(JoinPath(cp, param), file.At("treads"));
+  }
+  std::vector<double> friction;
+  for (const models::WheelDescription& w : robot.wheels) {
+    for (const models::Surface& s : scene.surfaces) friction.push_back(s.FrictionFor(w.tread.material));
+  }
+  c["wheel_friction"] = friction;
+}
+
 }  // namespace
 
 Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& start,
-                      RobotInfo& info) {
+                      const models::Scene& scene, RobotInfo& info) {
   const models::RobotDescription& robot = file.robot;
   Signals s;
   const auto motors = robot.Motors();
@@ -149,6 +186,7 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
     b.Origin(JoinPath(cp, "payload_position"), at("x_m"));
     b.Origin(JoinPath(cp, "payload_size"), at("length_m"));
   }
+  AddTreads(b, file, scene);
   c["initial_x"] = start.x_m;
   c["initial_y"] = start.y_m;
   c["initial_yaw"] = start.yaw_rad;

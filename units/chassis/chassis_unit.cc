@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <utility>
 
 #include "models/angle.h"
@@ -386,11 +387,7 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   v.Parameter("contact_damping", "N.s/m", &contact_damping_,
               "normal damping of one contact point (default 1e4: well damped)",
               cosim::Rule::NonNegative());
-  v.Parameter("slip_damping", "N.s/m", &slip_damping_,
-              "sliding contact: resistance to slip across its slip direction, bounded by "
-              "friction x normal force (damps a step-to-step swing of the slip direction; "
-              "default 1e5, see units/chassis/floor_world.h)",
-              cosim::Rule::Positive());
+  DeclareTreadParameters();
   v.Parameter("suspension_stiffness", "N/m", &suspension_stiffness_,
               "stiffness of a steered module along its steering axis (hinge2 suspension; "
               "default 1e7: a near-rigid mount)",
@@ -485,6 +482,75 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
            {});
 }
 
+void ChassisUnit::DeclareTreadParameters() {
+  const auto w = static_cast<std::size_t>(wheel_count_);
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  for (auto* values : {&tread_slip_stiffness_, &tread_cornering_stiffness_,
+                       &tread_longitudinal_relaxation_, &tread_lateral_relaxation_,
+                       &tread_damping_ratio_, &tread_patch_length_, &tread_patch_width_}) {
+    values->assign(w, kNaN);
+  }
+  // Each wheel on each surface: the surface's own friction unless the
+  // robot's tread material has its own pair (loader/assembly).
+  for (std::size_t k = 0; k < w; ++k) {
+    for (const models::Surface& s : scene_.surfaces) wheel_friction_.push_back(s.friction);
+  }
+  auto& v = variables();
+  const auto tyre = cosim::Rule::Positive().NoDefault();
+  v.Parameter("tread_slip_stiffness", "1", &tread_slip_stiffness_,
+              "each wheel's longitudinal slip stiffness per unit load, C_kappa / F_z (N per "
+              "unit slip per N): the creep slope of a brush tyre",
+              tyre);
+  v.Parameter("tread_cornering_stiffness", "1/rad", &tread_cornering_stiffness_,
+              "each wheel's cornering stiffness per unit load, C_alpha / F_z", tyre);
+  v.Parameter("tread_longitudinal_relaxation", "m", &tread_longitudinal_relaxation_,
+              "each wheel's longitudinal relaxation length sigma_kappa: tread stiffness "
+              "C_kappa / sigma_kappa at the wheel's static load",
+              tyre);
+  v.Parameter("tread_lateral_relaxation", "m", &tread_lateral_relaxation_,
+              "each wheel's lateral relaxation length sigma_alpha", tyre);
+  v.Parameter("tread_damping_ratio", "1", &tread_damping_ratio_,
+              "each wheel's tangential tread damping as a ratio of critical for its static "
+              "load on its tread stiffness",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("tread_patch_length", "m", &tread_patch_length_,
+              "each wheel's contact patch length along its rolling direction (0: a point)",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("tread_patch_width", "m", &tread_patch_width_,
+              "each wheel's contact patch width (0: a point)",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("wheel_friction", "1", &wheel_friction_,
+              "Coulomb coefficient of each wheel's tread on each scene surface, wheel-major "
+              "(default: each surface's friction)",
+              cosim::Rule::NonNegative());
+}
+
+Tread ChassisUnit::WheelTread(std::size_t k) const {
+  Tread t;
+  // The static load of one wheel: the robot's weight shared by its wheels.
+  const double load_n = (mass_ + payload_mass_) * kGravityMps2 / wheel_count_;
+  const double c[2] = {tread_slip_stiffness_[k], tread_cornering_stiffness_[k]};
+  const double sigma[2] = {tread_longitudinal_relaxation_[k], tread_lateral_relaxation_[k]};
+  for (int r = 0; r < 2; ++r) {
+    t.relaxation_m[r] = sigma[r];
+    t.stiffness_n_per_m[r] = c[r] * load_n / sigma[r];
+    t.damping_n_s_per_m[r] =
+        2.0 * tread_damping_ratio_[k] * std::sqrt(t.stiffness_n_per_m[r] * load_n / kGravityMps2);
+  }
+  t.patch_length_m = tread_patch_length_[k];
+  t.patch_width_m = tread_patch_width_[k];
+  t.axle[1] = 1.0;  // the wheel body's local y
+  // The floor world's surfaces: the floor, the belts, the terrain pieces.
+  const std::size_t surfaces = scene_.surfaces.size();
+  const auto mu = [&](int scene_surface) {
+    return wheel_friction_[k * surfaces + static_cast<std::size_t>(scene_surface)];
+  };
+  t.mu.push_back(mu(scene_.floor.surface));
+  for (const models::Belt& b : scene_.belts) t.mu.push_back(mu(b.surface));
+  for (const models::TerrainPiece& p : scene_.terrain) t.mu.push_back(mu(p.surface));
+  return t;
+}
+
 ChassisUnit::~ChassisUnit() = default;
 
 std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
@@ -523,11 +589,11 @@ void ChassisUnit::Build() {
   std::vector<BeltPatch> belts;
   for (const models::Belt& belt : scene_.belts) {
     const models::Rect& r = belt.area;
-    belts.push_back(
-        {r.center_x_m, r.center_y_m, r.length_m, r.width_m, r.direction_rad, mu_of(belt.surface)});
+    belts.push_back({r.center_x_m, r.center_y_m, r.length_m, r.width_m, r.direction_rad,
+                     mu_of(belt.surface), belt.edge_gap_m});
   }
   f.SetBelts(std::move(belts));
-  f.SetSurface({mu_of(scene_.floor.surface), contact_stiffness_, contact_damping_, slip_damping_});
+  f.SetSurface({mu_of(scene_.floor.surface), contact_stiffness_, contact_damping_});
   for (const models::Obstacle& obstacle : scene_.obstacles) f.AddObstacle(obstacle.solid);
   for (const models::CarriedObject& obj : scene_.carried) f.AddCarried(obj.solid, obj.belt);
   for (const models::TerrainPiece& piece : scene_.terrain) f.AddTerrain(piece, mu_of(piece.surface));
@@ -630,7 +696,7 @@ void ChassisUnit::Build() {
     dBodySetRotation(w, rot);
     dGeomID g = dCreateSphere(nullptr, radius);
     dGeomSetBody(g, w);
-    f.AddGeom(g);
+    f.AddGeom(g, WheelTread(k));
     dJointID j = nullptr;
     if (steered) {
       j = dJointCreateHinge2(f.world(), nullptr);
@@ -880,6 +946,8 @@ void ChassisUnit::Settle() {
     dBodySetLinearVel(b, 0.0, 0.0, 0.0);
     dBodySetAngularVel(b, 0.0, 0.0, 0.0);
   }
+  // At rest at time zero: the treads unloaded of what settling left.
+  f.ResetTreads();
   // The contacts at the moved positions, for the outputs and the first step.
   f.Probe();
   if (const std::string bad = OffFloorWheel(); !bad.empty()) {
@@ -1032,7 +1100,7 @@ void ChassisUnit::ComputeOutputs() {
     const GeomContact& gc = o.floor->contact(static_cast<int>(k));
     wheel_surface_[k] = gc.surface;
     double vx = 0.0, vy = 0.0;
-    o.floor->SurfaceVelocity(gc.surface, &vx, &vy);
+    o.floor->PatchVelocity(static_cast<int>(k), &vx, &vy);
     wheel_surface_velocity_[2 * k] = c * vx + s * vy;
     wheel_surface_velocity_[2 * k + 1] = -s * vx + c * vy;
     wheel_contact_[2 * k] = gc.x_m;
@@ -1117,6 +1185,8 @@ void ChassisUnit::SaveInternal(cosim::UnitState& state) const {
       state.reals.insert(state.reals.end(), v, v + n);
     }
   }
+  const std::vector<double> treads = ode_->floor->TreadStates();
+  state.reals.insert(state.reals.end(), treads.begin(), treads.end());
 }
 
 void ChassisUnit::RestoreInternal(const cosim::UnitState& state) {
@@ -1125,7 +1195,8 @@ void ChassisUnit::RestoreInternal(const cosim::UnitState& state) {
   // Couplings are velocity rows and carried objects follow the inputs:
   // neither holds state of its own.
   const bool init = state.integers.size() == 1 && state.integers[0] != 0;
-  const std::size_t reals = init ? bodies * kRealsPerBody : 0;
+  const std::size_t reals =
+      init ? bodies * (kRealsPerBody + kTreadStateReals) - kTreadStateReals : 0;
   if (state.integers.size() != 1 || state.reals.size() != reals) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
@@ -1152,6 +1223,7 @@ void ChassisUnit::RestoreInternal(const cosim::UnitState& state) {
     dBodySetLinearVel(b, r[7], r[8], r[9]);
     dBodySetAngularVel(b, r[10], r[11], r[12]);
   }
+  ode_->floor->SetTreadStates(std::span<const double>(r, kTreadStateReals * (bodies - 1)));
   // The contacts at the restored positions, for the next step.
   ode_->floor->Probe();
   initialized_ = true;

@@ -11,6 +11,8 @@
 
 namespace linesim::chassis {
 
+struct Tread;  // units/chassis/floor_world.h
+
 /// A wheeled robot base on a factory floor with conveyor-belt patches,
 /// obstacles and belt-carried objects, simulated with ODE (dWorldStep). One
 /// code for any wheel topology: a swerve base (Rob@Work 3: every wheel with
@@ -137,6 +139,12 @@ class ChassisUnit : public cosim::Unit {
   // The ODE objects; defined in the .cc so that ODE stays private.
   struct Ode;
 
+  /// Declares the tread and wheel_friction parameters (sized by the wheel
+  /// and surface counts).
+  void DeclareTreadParameters();
+  /// Wheel k's tread for the floor world: stiffness and damping at its
+  /// static load, its patch, its friction on the floor world's surfaces.
+  Tread WheelTread(std::size_t k) const;
   /// Creates a fresh world with the robot at the initial pose (no settle).
   void Build();
   /// Before settling: when terrain lies under a wheel at the initial pose,
@@ -189,7 +197,12 @@ class ChassisUnit : public cosim::Unit {
   double body_friction_ = 0.5;
   double contact_stiffness_ = 1e6;
   double contact_damping_ = 1e4;
-  double slip_damping_ = 1e5;
+  // Per wheel: its tread (a transient brush tyre, units/chassis/floor_world.h)
+  // and its Coulomb coefficient on each scene surface (wheel-major).
+  std::vector<double> tread_slip_stiffness_, tread_cornering_stiffness_;
+  std::vector<double> tread_longitudinal_relaxation_, tread_lateral_relaxation_;
+  std::vector<double> tread_damping_ratio_, tread_patch_length_, tread_patch_width_;
+  std::vector<double> wheel_friction_;
   double suspension_stiffness_ = 1e7;
   double suspension_damping_ = 1e4;
   double brake_torque_ = 30.0;

@@ -260,10 +260,12 @@ TEST(ChassisUnit, BrakedRobotStraddlingBeltEdgeTurns) {
 }
 
 // Guards against wrong drive torque signs, a missing reflected rotor
-// inertia, wrong body/map frames and a wrong drive_rate. Analytic: four
-// wheels at heading 0 each pushed by tau / r, rolling without slip:
+// inertia, wrong body/map frames, a wrong drive_rate and a tread without
+// creep. Analytic: four wheels at heading 0 each pushed by tau / r:
 //   a = 4 tau / r / (M + 4 J_axle / r^2),  J_axle = m_mod r^2 / 2 + J_drive,
-// and drive_rate = v / r (kinematics of rolling).
+// and drive_rate = v (1 + kappa) / r: the brush tyre's longitudinal creep
+// kappa = F / C_kappa under the traction F = M a / 4 each, C_kappa = c N,
+// N = M g / 4 (equal loads): kappa = a / (c g).
 TEST(ChassisUnit, EqualDriveTorquesAccelerateForward) {
   const double tau_nm = 2.0, yaw0 = 0.5;
   const double r = kWheelRadiusM;
@@ -292,7 +294,13 @@ TEST(ChassisUnit, EqualDriveTorquesAccelerateForward) {
     const double s_m = 0.5 * a * t_s * t_s;
     EXPECT_NEAR(std::hypot(p[0], p[1]), s_m, 0.01 * s_m);
     EXPECT_NEAR(std::atan2(p[1], p[0]), yaw0, 1e-2);
-    for (double w : Get(u, "drive_rate")) EXPECT_NEAR(w, bv[0] / r, 1e-3 * bv[0] / r);
+    // The traction is the body's share M a / 4 (the modules' own inertia
+    // is driven through the joints, not the tread).
+    const double body_a = 4.0 * (tau_nm / r - j_axle / r / r * a) / kMassKg;
+    const double kappa = body_a / (kRaw3Tread.slip_stiffness * kGravityMps2);
+    for (double w : Get(u, "drive_rate")) {
+      EXPECT_NEAR(w, bv[0] * (1.0 + kappa) / r, 2e-3 * bv[0] / r);
+    }
   }
   // Negative torques drive backwards.
   auto robot = Raw3();
@@ -463,8 +471,8 @@ TEST(ChassisUnit, SaveRestoreIsBitForBit) {
 // Guards the unit's own check of its internal state (the variable count
 // matches, so only RestoreInternal can refuse): an initialised state holds
 // 13 reals per body (position 3, quaternion 4, linear and angular velocity
-// 3 each) for the body and 4 modules, and one integer; one saved before
-// Initialize holds no reals.
+// 3 each) for the body and 4 modules, 6 per tread (deflection and force
+// direction) and one integer; one saved before Initialize holds no reals.
 TEST(ChassisUnit, RestoreRefusesTruncatedInternalState) {
   auto robot = Raw3();
   ChassisUnit& u = *robot;
@@ -472,7 +480,7 @@ TEST(ChassisUnit, RestoreRefusesTruncatedInternalState) {
   ASSERT_TRUE(before_init.reals.empty());
   u.Initialize();
   const cosim::UnitState saved = u.SaveState();
-  ASSERT_EQ(saved.reals.size(), 13u * 5u);
+  ASSERT_EQ(saved.reals.size(), 13u * 5u + 6u * 4u);
   ASSERT_EQ(saved.integers.size(), 1u);
   cosim::UnitState short_reals = saved;
   short_reals.reals.pop_back();
@@ -546,7 +554,11 @@ TEST(ChassisUnit, RobotSpecificParametersHaveNoDefault) {
   EXPECT_EQ(names,
             (std::vector<std::string>{"body_length", "body_width", "body_height", "mass",
                                       "module_mass", "com_height", "wheel_radius", "wheel_x",
-                                      "wheel_y", "steer_rotor_inertia", "drive_rotor_inertia"}));
+                                      "wheel_y", "steer_rotor_inertia", "drive_rotor_inertia",
+                                      "tread_slip_stiffness", "tread_cornering_stiffness",
+                                      "tread_longitudinal_relaxation", "tread_lateral_relaxation",
+                                      "tread_damping_ratio", "tread_patch_length",
+                                      "tread_patch_width"}));
   EXPECT_THROW(u.Initialize(), cosim::UnitError);
   // Without a steerable wheel there is no steering rotor to ask for.
   ChassisUnit fixed("robot", {-1, -1}, {0, 1}, models::OpenFloor());
@@ -601,7 +613,7 @@ TEST(ChassisUnit, DeclaredRulesRefuseValuesOutsideThem) {
   EXPECT_EQ(rule("wheel_x"), "required");
   EXPECT_EQ(rule("steer_rotor_inertia"), "required, >= 0");
   EXPECT_EQ(rule("body_friction"), ">= 0");
-  EXPECT_EQ(rule("slip_damping"), "> 0");
+  EXPECT_EQ(rule("tread_slip_stiffness"), "required, > 0");
   EXPECT_EQ(rule("substeps"), "[1, 1000]");
   EXPECT_EQ(rule("initial_yaw"), "finite");
   // Without a steered wheel the steering rotor inertia has a default (0).
@@ -723,6 +735,7 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   Set(*three, "wheel_y", std::vector<double>{0.0, 0.26, -0.26});
   Set(*three, "steer_rotor_inertia", 0.0);
   Set(*three, "drive_rotor_inertia", 0.0);
+  SetTreads(*three, 3, kRaw3Tread);
   EXPECT_NO_THROW(three->Initialize());
   TimeNs t = 0;
   Advance(*three, t, 10);
@@ -863,7 +876,7 @@ TEST(ChassisUnit, NonFiniteInputOrStateFails) {
 // (notes: signals, one unit of measure per variable).
 using Expected = test_helpers::ExpectedVariable;
 
-std::vector<Expected> Parameters(std::size_t wheels) {
+std::vector<Expected> Parameters(std::size_t wheels, std::size_t surfaces) {
   using C = cosim::Causality;
   return {{"body_length", C::kParameter, "m", 0},
           {"body_width", C::kParameter, "m", 0},
@@ -884,7 +897,14 @@ std::vector<Expected> Parameters(std::size_t wheels) {
           {"body_friction", C::kParameter, "1", 0},
           {"contact_stiffness", C::kParameter, "N/m", 0},
           {"contact_damping", C::kParameter, "N.s/m", 0},
-          {"slip_damping", C::kParameter, "N.s/m", 0},
+          {"tread_slip_stiffness", C::kParameter, "1", wheels},
+          {"tread_cornering_stiffness", C::kParameter, "1/rad", wheels},
+          {"tread_longitudinal_relaxation", C::kParameter, "m", wheels},
+          {"tread_lateral_relaxation", C::kParameter, "m", wheels},
+          {"tread_damping_ratio", C::kParameter, "1", wheels},
+          {"tread_patch_length", C::kParameter, "m", wheels},
+          {"tread_patch_width", C::kParameter, "m", wheels},
+          {"wheel_friction", C::kParameter, "1", wheels * surfaces},
           {"suspension_stiffness", C::kParameter, "N/m", 0},
           {"suspension_damping", C::kParameter, "N.s/m", 0},
           {"brake_torque", C::kParameter, "N.m", 0},
@@ -901,7 +921,7 @@ TEST(ChassisUnit, VariableTable) {
   two.belts.push_back(two.belts[0]);
   auto robot = Raw3(two);
   EXPECT_EQ(robot->type_name(), "chassis");
-  std::vector<Expected> expected = Parameters(4);
+  std::vector<Expected> expected = Parameters(4, 2);
   const std::vector<Expected> swerve = {{"steer_torque", C::kInput, "N.m", 4},
                                         {"drive_torque", C::kInput, "N.m", 4},
                                         {"belt_velocity", C::kInput, "m/s", 4},
@@ -929,7 +949,7 @@ TEST(ChassisUnit, VariableTable) {
 
   // Skid-steer, no belts: no steer_* variables, one drive variable per motor.
   auto husky = Husky(models::OpenFloor());
-  expected = Parameters(4);
+  expected = Parameters(4, 1);
   const std::vector<Expected> skid = {
       {"drive_torque", C::kInput, "N.m", 2},  {"brake", C::kInput, "", 0},
       {"drive_rate", C::kOutput, "rad/s", 2}, {"drive_angle", C::kOutput, "rad", 2},
