@@ -3,6 +3,28 @@
 
 namespace linesim::loader::assembly {
 
+namespace {
+
+// The final approach's demand on the drives: the peak absolute current of
+// any drive motor over the path's last 2 m (a sticking skid-steer winds its
+// currents up there; steady motion needs the rolling resistance's and the
+// stop's share).
+void AddEndCurrent(SystemBuilder& b, const Signals& s) {
+  if (s.drive_motor_element.empty()) return;
+  b.Unit(kEndCurrent, "end_peak");
+  Parameters& p = b.Params(kEndCurrent);
+  p["count"] = static_cast<int>(s.drive_motor_element.size());
+  p["window"] = 2.0;
+  for (std::size_t k = 0; k < s.drive_motor_element.size(); ++k) {
+    b.Connect(Element(kMotors, "current", s.drive_motor_element[k]),
+              Element(kEndCurrent, "values", k));
+  }
+  b.Connect(Signal(kDeviation, "remaining"), Signal(kEndCurrent, "remaining"));
+  b.Metric("peak_drive_current_last_2m_a", Signal(kEndCurrent, "peak"), cosim::Reduction::kFinal);
+}
+
+}  // namespace
+
 void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Signals& s,
                    RobotInfo& info) {
   // The deviation is measured on the ground truth, whatever the robot
@@ -22,6 +44,7 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     add("max_path_deviation_m", deviation, cosim::Reduction::kMax);
     add("final_path_deviation_m", deviation, cosim::Reduction::kFinal);
     add("final_progress_m", Signal(kDeviation, "progress"), cosim::Reduction::kFinal);
+    AddEndCurrent(b, s);
   } else {
     add("max_position_drift_m", deviation, cosim::Reduction::kMax);
     add("final_position_drift_m", deviation, cosim::Reduction::kFinal);

@@ -1,5 +1,6 @@
 #include "units/evaluation/path_deviation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -34,6 +35,8 @@ PathDeviationUnit::PathDeviationUnit(std::string name, std::vector<std::array<do
            "distance of the robot centre from the desired path or held point", {"position"});
   v.Output("progress", "m", &progress_, "arc length of the nearest point along the path",
            {"position"});
+  v.Output("remaining", "m", &remaining_,
+           "path length ahead of that nearest point (0 for a held point)", {"position"});
 }
 
 std::vector<cosim::ParameterProblem> PathDeviationUnit::CheckParameters() const {
@@ -55,6 +58,7 @@ void PathDeviationUnit::Evaluate() {
   const PathDistance d = DistanceToPath(path_, cumulative_m_, position_[0], position_[1]);
   deviation_ = d.distance_m;
   progress_ = d.progress_m;
+  remaining_ = cumulative_m_.empty() ? 0.0 : std::max(0.0, cumulative_m_.back() - progress_);
 }
 
 cosim::StepResult PathDeviationUnit::DoStep(cosim::TimeNs, cosim::TimeNs) {

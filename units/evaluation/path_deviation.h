@@ -51,6 +51,7 @@ class PathDeviationUnit : public cosim::Unit {
   std::vector<double> position_ = std::vector<double>(2, 0.0);
   double deviation_ = 0.0;
   double progress_ = 0.0;
+  double remaining_ = 0.0;
 };
 
 }  // namespace linesim::evaluation
