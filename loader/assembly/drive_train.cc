@@ -64,8 +64,8 @@ void AddTreads(SystemBuilder& b, const RobotFile& file, const models::Scene& sce
       {"damping_ratio", &models::TreadDescription::damping_ratio},
       {"patch_length", &models::TreadDescription::patch_length_m},
       {"patch_width", &models::TreadDescription::patch_width_m}};
-  const char* keys[] = {"slip_stiffness", "cornering_stiffness", "longitudinal_relaxation_m",
-                        "lateral_relaxation_m", "damping_ratio", "patch_length_m",
+  const char* keys[] = {"slip_stiffness",       "cornering_stiffness", "longitudinal_relaxation_m",
+                        "lateral_relaxation_m", "damping_ratio",       "patch_length_m",
                         "patch_width_m"};
   for (std::size_t f = 0; f < std::size(fields); ++f) {
     const std::string param = std::string("tread_") + fields[f].first;
@@ -81,7 +81,8 @@ void AddTreads(SystemBuilder& b, const RobotFile& file, const models::Scene& sce
   }
   std::vector<double> friction;
   for (const models::WheelDescription& w : robot.wheels) {
-    for (const models::Surface& s : scene.surfaces) friction.push_back(s.FrictionFor(w.tread.material));
+    for (const models::Surface& s : scene.surfaces)
+      friction.push_back(s.FrictionFor(w.tread.material));
   }
   c["wheel_friction"] = friction;
 }
@@ -155,7 +156,8 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
   for (const auto& [param, key] :
        {std::pair{"body_length", "body.length_m"}, std::pair{"body_width", "body.width_m"},
         std::pair{"body_height", "body.height_m"}, std::pair{"mass", "body.mass_kg"},
-        std::pair{"com_height", "body.com_height_m"}, std::pair{"module_mass", "wheels.0.mass_kg"}}) {
+        std::pair{"com_height", "body.com_height_m"},
+        std::pair{"module_mass", "wheels.0.mass_kg"}}) {
     b.Origin(JoinPath(cp, param), file.At(key));
   }
   for (const char* param : {"wheel_x", "wheel_y", "wheel_radius"}) {
@@ -198,9 +200,15 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
 
   AddMotors(b, file);
   const auto wire = [&](const char* joint, const std::vector<std::size_t>& elements) {
+    // The torque-speed line, which the chassis applies implicitly (its
+    // joint motor rows): stable at any master step with tyres that creep.
     for (std::size_t k = 0; k < elements.size(); ++k) {
-      b.Connect(Element(kMotors, "torque", elements[k]),
+      b.Connect(Element(kMotors, "line_torque", elements[k]),
                 Element(kChassis, std::string(joint) + "_torque", k));
+      b.Connect(Element(kMotors, "line_slope", elements[k]),
+                Element(kChassis, std::string(joint) + "_torque_slope", k));
+      b.Connect(Element(kMotors, "line_rate", elements[k]),
+                Element(kChassis, std::string(joint) + "_torque_rate", k));
       b.Connect(Element(kChassis, std::string(joint) + "_rate", k),
                 Element(kMotors, "shaft_speed", elements[k]));
     }

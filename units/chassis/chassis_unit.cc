@@ -78,8 +78,6 @@ struct ChassisUnit::Ode {
   std::vector<dGeomID> geoms;
   // Internal step for which the suspension ERP/CFM were set (0: not yet).
   double suspension_h_s = 0.0;
-  // Force limit the joint motors were set to (NaN: not yet).
-  double motor_fmax_nm = std::numeric_limits<double>::quiet_NaN();
 
   Ode() = default;
   Ode(const Ode&) = delete;
@@ -106,7 +104,6 @@ struct ChassisUnit::Ode {
     floor.reset();
     suspension_h_s = 0.0;
     ground_slope[0] = ground_slope[1] = 0.0;
-    motor_fmax_nm = std::numeric_limits<double>::quiet_NaN();
   }
 
   // Every body, the base first.
@@ -289,6 +286,10 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   if (ms == 0) steer_rotor_inertia_ = 0.0;  // no steering motor to reflect
   steer_torque_.assign(ms, 0.0);
   drive_torque_.assign(md, 0.0);
+  steer_torque_slope_.assign(ms, 0.0);
+  steer_torque_rate_.assign(ms, 0.0);
+  drive_torque_slope_.assign(md, 0.0);
+  drive_torque_rate_.assign(md, 0.0);
   belt_velocity_.assign(2 * b, 0.0);
   belt_travel_.assign(b, 0.0);
   if (moving_boxes < 0 || moving_cylinders < 0) {
@@ -414,6 +415,24 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   }
   v.Input("drive_torque", "N.m", &drive_torque_,
           "torque of each drive motor about the axle of its wheels, + drives them forward");
+  // The motors' torque-speed lines: a DC motor's torque falls steeply with
+  // its speed (back-EMF). Applied as given over a step, that damping is
+  // explicit and a light wheel on a creeping tyre oscillates out of bounds
+  // at a 5 ms step; as the joint's motor row it is implicit.
+  if (ms > 0) {
+    v.Input("steer_torque_slope", "N.m.s/rad", &steer_torque_slope_,
+            "d steer_torque / d steer_rate of each steering motor at steer_torque_rate (<= 0; "
+            "0: steer_torque is applied as given over the step)");
+    v.Input("steer_torque_rate", "rad/s", &steer_torque_rate_,
+            "the steering rate at which steer_torque holds (with a slope: the torque follows "
+            "its line through it within the step)");
+  }
+  v.Input("drive_torque_slope", "N.m.s/rad", &drive_torque_slope_,
+          "d drive_torque / d drive_rate of each drive motor at drive_torque_rate (<= 0; 0: "
+          "drive_torque is applied as given over the step)");
+  v.Input("drive_torque_rate", "rad/s", &drive_torque_rate_,
+          "the drive rate at which drive_torque holds (with a slope: the torque follows its "
+          "line through it within the step)");
   if (b > 0) {
     v.Input("belt_velocity", "m/s", &belt_velocity_,
             "surface velocity of each scene belt in map: vx, vy per belt");
@@ -565,8 +584,8 @@ std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
                             ", got " + cosim::FormatValue(module_mass_)});
   }
   // The payload's box: all three sizes (a box) or none (a point mass).
-  const auto boxed = std::count_if(payload_size_.begin(), payload_size_.end(),
-                                   [](double d) { return d > 0.0; });
+  const auto boxed =
+      std::count_if(payload_size_.begin(), payload_size_.end(), [](double d) { return d > 0.0; });
   if (boxed != 0 && boxed != 3) {
     problems.push_back({"payload_size", std::nullopt,
                         "give all three sizes (a box) or none (a point mass), got " +
@@ -596,7 +615,8 @@ void ChassisUnit::Build() {
   f.SetSurface({mu_of(scene_.floor.surface), contact_stiffness_, contact_damping_});
   for (const models::Obstacle& obstacle : scene_.obstacles) f.AddObstacle(obstacle.solid);
   for (const models::CarriedObject& obj : scene_.carried) f.AddCarried(obj.solid, obj.belt);
-  for (const models::TerrainPiece& piece : scene_.terrain) f.AddTerrain(piece, mu_of(piece.surface));
+  for (const models::TerrainPiece& piece : scene_.terrain)
+    f.AddTerrain(piece, mu_of(piece.surface));
 
   // Start with the contacts pressed in by equal shares of the weight, so
   // that the settle has little to do. The suspension starts unloaded (its
@@ -622,8 +642,9 @@ void ChassisUnit::Build() {
     const double total = body_mass + payload_mass_;
     for (int d = 0; d < 3; ++d) {
       const double box_d = d == 2 ? com_height_ : 0.0;
-      com[d] = (body_mass * box_d + payload_mass_ * payload_position_[static_cast<std::size_t>(d)]) /
-               total;
+      com[d] =
+          (body_mass * box_d + payload_mass_ * payload_position_[static_cast<std::size_t>(d)]) /
+          total;
     }
     dMassTranslate(&m, -com[0], -com[1], com_height_ - com[2]);
     dMass mp;
@@ -850,20 +871,54 @@ void ChassisUnit::SetSuspension(double h_s) {
 }
 
 void ChassisUnit::SetJointMotors(bool hold, double max_torque_nm) {
-  // A joint motor with target velocity 0 and force limit 0 adds no row.
-  const double fmax = hold ? max_torque_nm : 0.0;
-  if (fmax == ode_->motor_fmax_nm) return;
-  ode_->motor_fmax_nm = fmax;
+  // Axis 0 of a joint is a steered wheel's steering axis, axis 1 its axle
+  // (hinge2's axes 1 and 2; a fixed wheel's hinge has only the axle). Its
+  // row: velocity `vel`, force limit `fmax` (0: no row), CFM `cfm`.
+  const double world_cfm = dWorldGetCFM(ode_->floor->world());
+  const auto set = [](dJointID j, bool steered, int axis, double vel, double fmax, double cfm) {
+    if (steered) {
+      const int group = axis == 0 ? 0 : dParamGroup;
+      dJointSetHinge2Param(j, dParamVel + group, vel);
+      dJointSetHinge2Param(j, dParamFMax + group, fmax);
+      dJointSetHinge2Param(j, dParamCFM + group, cfm);
+    } else {
+      dJointSetHingeParam(j, dParamVel, vel);
+      dJointSetHingeParam(j, dParamFMax, fmax);
+      dJointSetHingeParam(j, dParamCFM, cfm);
+    }
+  };
+  // A motor's torque-speed line tau(r) = tau0 + slope (r - r0), r the
+  // wheel's rate relative to the body about the joint axis (the joint's own
+  // rate is -r: ODE's rate is body1's - body2's, and body1 is the body),
+  // as the joint's motor row: the row enforces -r = vel - cfm lambda and
+  // puts -lambda on the wheel, so cfm = 1 / c and vel = -(r0 + tau0 / c)
+  // with c = -slope give the wheel tau0 - c (r - r0) at the end of each
+  // internal step (implicit: stable at any slope and step).
+  const auto line = [&](dJointID j, bool steered, int axis, double tau0, double slope, double r0) {
+    const double c = -slope;
+    set(j, steered, axis, -(r0 + tau0 / c), dInfinity, 1.0 / c);
+  };
   for (std::size_t k = 0; k < ode_->joints.size(); ++k) {
     const dJointID j = ode_->joints[k];
-    if (ode_->steered[k]) {
-      dJointSetHinge2Param(j, dParamVel, 0.0);
-      dJointSetHinge2Param(j, dParamFMax, fmax);
-      dJointSetHinge2Param(j, dParamVel2, 0.0);
-      dJointSetHinge2Param(j, dParamFMax2, fmax);
+    const bool steered = ode_->steered[k];
+    if (hold) {
+      if (steered) set(j, true, 0, 0.0, max_torque_nm, world_cfm);
+      set(j, steered, 1, 0.0, max_torque_nm, world_cfm);
+      continue;
+    }
+    if (steered) {
+      const auto sm = static_cast<std::size_t>(steer_motor_[k]);
+      if (ImplicitSteer(sm)) {
+        line(j, true, 0, steer_torque_[sm], steer_torque_slope_[sm], steer_torque_rate_[sm]);
+      } else {
+        set(j, true, 0, 0.0, 0.0, world_cfm);
+      }
+    }
+    const auto dm = static_cast<std::size_t>(drive_motor_[k]);
+    if (leads_drive_motor_[k] && ImplicitDrive(dm)) {
+      line(j, steered, 1, drive_torque_[dm], drive_torque_slope_[dm], drive_torque_rate_[dm]);
     } else {
-      dJointSetHingeParam(j, dParamVel, 0.0);
-      dJointSetHingeParam(j, dParamFMax, fmax);
+      set(j, steered, 1, 0.0, 0.0, world_cfm);
     }
   }
 }
@@ -881,11 +936,16 @@ void ChassisUnit::ApplyTorques() {
     const double rel[3] = {ww[0] - wb[0], ww[1] - wb[1], ww[2] - wb[2]};
     const int sm = steer_motor_[k];
     const auto dm = static_cast<unsigned>(drive_motor_[k]);
-    const double steer =
-        sm >= 0 ? steer_torque_[static_cast<std::size_t>(sm)] - steer_friction_ * Dot(up, rel)
-                : 0.0;
+    // A motor whose torque the joint row applies (SetJointMotors) adds
+    // only the joint's viscous friction here.
+    double steer = 0.0;
+    if (sm >= 0) {
+      const auto m = static_cast<std::size_t>(sm);
+      steer =
+          (brake_ || !ImplicitSteer(m) ? steer_torque_[m] : 0.0) - steer_friction_ * Dot(up, rel);
+    }
     double drive = -drive_friction_ * Dot(axle, rel);
-    if (leads_drive_motor_[k]) drive = drive_torque_[dm] - drive_friction_ * Dot(axle, rel);
+    if (leads_drive_motor_[k] && (brake_ || !ImplicitDrive(dm))) drive += drive_torque_[dm];
     // The motor turns the wheel and reacts on the body: equal and opposite.
     const double t[3] = {steer * up[0] + drive * axle[0], steer * up[1] + drive * axle[1],
                          steer * up[2] + drive * axle[2]};
@@ -929,8 +989,8 @@ void ChassisUnit::Settle() {
   const double bx = origin[0], by = origin[1];
   // On terrain the ground rises along its slope: moved back to the initial
   // x, y, the robot moves up or down with it (0 on the floor).
-  const double lift = ode_->ground_slope[0] * (initial_x_ - bx) +
-                      ode_->ground_slope[1] * (initial_y_ - by);
+  const double lift =
+      ode_->ground_slope[0] * (initial_x_ - bx) + ode_->ground_slope[1] * (initial_y_ - by);
   const double turn = initial_yaw_ - Yaw(dBodyGetRotation(ode_->body));
   const double c = std::cos(turn), s = std::sin(turn);
   dQuaternion q_turn;

@@ -154,7 +154,12 @@ class ChassisUnit : public cosim::Unit {
   void Settle();
   /// Suspension ERP/CFM for internal step h_s (only when h_s changes).
   void SetSuspension(double h_s);
+  /// hold: every joint motor at velocity 0 up to max_torque_nm (the brake,
+  /// or holding while settling); else each motor with a torque-speed slope
+  /// is its joint's motor row (implicit), the others none.
   void SetJointMotors(bool hold, double max_torque_nm);
+  bool ImplicitSteer(std::size_t m) const { return steer_torque_slope_[m] < 0.0; }
+  bool ImplicitDrive(std::size_t m) const { return drive_torque_slope_[m] < 0.0; }
   void ApplyTorques();
   /// Hands belt_velocity and belt_travel to the floor world.
   void SetBeltInputs();
@@ -213,6 +218,8 @@ class ChassisUnit : public cosim::Unit {
 
   // Inputs.
   std::vector<double> steer_torque_, drive_torque_, belt_velocity_, belt_travel_;
+  std::vector<double> steer_torque_slope_, steer_torque_rate_, drive_torque_slope_,
+      drive_torque_rate_;
   std::vector<double> moving_boxes_, moving_cylinders_;
   std::int64_t own_box_ = -1;
   bool brake_ = false;

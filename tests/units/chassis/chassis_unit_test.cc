@@ -266,6 +266,32 @@ TEST(ChassisUnit, BrakedRobotStraddlingBeltEdgeTurns) {
 // and drive_rate = v (1 + kappa) / r: the brush tyre's longitudinal creep
 // kappa = F / C_kappa under the traction F = M a / 4 each, C_kappa = c N,
 // N = M g / 4 (equal loads): kappa = a / (c g).
+// Guards the motors' torque-speed lines as implicit joint rows: each drive
+// motor gives tau = c (r0 - r) (drive_torque 0 at drive_torque_rate r0,
+// slope -c), a steep line for the wheel's inertia (h c / J_axle about 50 at
+// a 5 ms step, where the same torque applied explicitly diverges). The
+// wheels settle at r0, the robot at r0 times the rolling radius (nothing
+// resists on a level floor), and a negative r0 drives backwards.
+TEST(ChassisUnit, TorqueSpeedLinesAreAppliedImplicitly) {
+  const double c = 40.0;
+  for (const double r0 : {3.0, -2.0}) {
+    SCOPED_TRACE(r0);
+    auto robot = Raw3();
+    ChassisUnit& u = *robot;
+    Set(u, "drive_friction", 0.0);
+    u.Initialize();
+    SetArray(u, "drive_torque", {0.0, 0.0, 0.0, 0.0});
+    SetArray(u, "drive_torque_slope", {-c, -c, -c, -c});
+    SetArray(u, "drive_torque_rate", {r0, r0, r0, r0});
+    TimeNs t = 0;
+    Advance(u, t, 400, 5 * kMs);
+    for (double w : Get(u, "drive_rate")) EXPECT_NEAR(w, r0, 1e-3 * std::abs(r0));
+    EXPECT_NEAR(Get(u, "body_linear_velocity")[0], r0 * kWheelRadiusM,
+                2e-3 * std::abs(r0) * kWheelRadiusM);
+    EXPECT_NEAR(Get(u, "yaw_rate")[0], 0.0, 1e-3);
+  }
+}
+
 TEST(ChassisUnit, EqualDriveTorquesAccelerateForward) {
   const double tau_nm = 2.0, yaw0 = 0.5;
   const double r = kWheelRadiusM;
@@ -551,14 +577,12 @@ TEST(ChassisUnit, RobotSpecificParametersHaveNoDefault) {
     EXPECT_EQ(p.message, "must be set (robot-specific: no default)") << p.variable;
     if (names.empty() || names.back() != p.variable) names.push_back(p.variable);
   }
-  EXPECT_EQ(names,
-            (std::vector<std::string>{"body_length", "body_width", "body_height", "mass",
-                                      "module_mass", "com_height", "wheel_radius", "wheel_x",
-                                      "wheel_y", "steer_rotor_inertia", "drive_rotor_inertia",
-                                      "tread_slip_stiffness", "tread_cornering_stiffness",
-                                      "tread_longitudinal_relaxation", "tread_lateral_relaxation",
-                                      "tread_damping_ratio", "tread_patch_length",
-                                      "tread_patch_width"}));
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "body_length", "body_width", "body_height", "mass", "module_mass",
+                       "com_height", "wheel_radius", "wheel_x", "wheel_y", "steer_rotor_inertia",
+                       "drive_rotor_inertia", "tread_slip_stiffness", "tread_cornering_stiffness",
+                       "tread_longitudinal_relaxation", "tread_lateral_relaxation",
+                       "tread_damping_ratio", "tread_patch_length", "tread_patch_width"}));
   EXPECT_THROW(u.Initialize(), cosim::UnitError);
   // Without a steerable wheel there is no steering rotor to ask for.
   ChassisUnit fixed("robot", {-1, -1}, {0, 1}, models::OpenFloor());
@@ -688,9 +712,9 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   car.width_m = 1.8;
   car.height_m = 1.2;
   bad.carried.push_back({"car", 0, car});
-  EXPECT_NE(scene_problem(bad).find(
-                "carried object 'car' overhangs the downstream end of belt 'belt'"),
-            std::string::npos)
+  EXPECT_NE(
+      scene_problem(bad).find("carried object 'car' overhangs the downstream end of belt 'belt'"),
+      std::string::npos)
       << scene_problem(bad);
   bad.carried[0].solid.x_m = 2.75;  // its front exactly at the end: on the belt
   EXPECT_EQ(scene_problem(bad), "");
@@ -924,6 +948,10 @@ TEST(ChassisUnit, VariableTable) {
   std::vector<Expected> expected = Parameters(4, 2);
   const std::vector<Expected> swerve = {{"steer_torque", C::kInput, "N.m", 4},
                                         {"drive_torque", C::kInput, "N.m", 4},
+                                        {"steer_torque_slope", C::kInput, "N.m.s/rad", 4},
+                                        {"steer_torque_rate", C::kInput, "rad/s", 4},
+                                        {"drive_torque_slope", C::kInput, "N.m.s/rad", 4},
+                                        {"drive_torque_rate", C::kInput, "rad/s", 4},
                                         {"belt_velocity", C::kInput, "m/s", 4},
                                         {"belt_travel", C::kInput, "m", 2},
                                         {"brake", C::kInput, "", 0},
@@ -950,16 +978,25 @@ TEST(ChassisUnit, VariableTable) {
   // Skid-steer, no belts: no steer_* variables, one drive variable per motor.
   auto husky = Husky(models::OpenFloor());
   expected = Parameters(4, 1);
-  const std::vector<Expected> skid = {
-      {"drive_torque", C::kInput, "N.m", 2},  {"brake", C::kInput, "", 0},
-      {"drive_rate", C::kOutput, "rad/s", 2}, {"drive_angle", C::kOutput, "rad", 2},
-      {"position", C::kOutput, "m", 2},       {"yaw", C::kOutput, "rad", 0},
-      {"linear_velocity", C::kOutput, "m/s", 2}, {"yaw_rate", C::kOutput, "rad/s", 0},
-      {"body_linear_velocity", C::kOutput, "m/s", 2}, {"position_3d", C::kOutput, "m", 3},
-      {"orientation", C::kOutput, "1", 4},    {"velocity_3d", C::kOutput, "m/s", 3},
-      {"angular_velocity", C::kOutput, "rad/s", 3},
-      {"wheel_surface", C::kOutput, "1", 4},  {"wheel_surface_velocity", C::kOutput, "m/s", 8},
-      {"wheel_contact", C::kOutput, "m", 8},  {"body_box", C::kOutput, "m, rad, m/s, rad/s", 10}};
+  const std::vector<Expected> skid = {{"drive_torque", C::kInput, "N.m", 2},
+                                      {"drive_torque_slope", C::kInput, "N.m.s/rad", 2},
+                                      {"drive_torque_rate", C::kInput, "rad/s", 2},
+                                      {"brake", C::kInput, "", 0},
+                                      {"drive_rate", C::kOutput, "rad/s", 2},
+                                      {"drive_angle", C::kOutput, "rad", 2},
+                                      {"position", C::kOutput, "m", 2},
+                                      {"yaw", C::kOutput, "rad", 0},
+                                      {"linear_velocity", C::kOutput, "m/s", 2},
+                                      {"yaw_rate", C::kOutput, "rad/s", 0},
+                                      {"body_linear_velocity", C::kOutput, "m/s", 2},
+                                      {"position_3d", C::kOutput, "m", 3},
+                                      {"orientation", C::kOutput, "1", 4},
+                                      {"velocity_3d", C::kOutput, "m/s", 3},
+                                      {"angular_velocity", C::kOutput, "rad/s", 3},
+                                      {"wheel_surface", C::kOutput, "1", 4},
+                                      {"wheel_surface_velocity", C::kOutput, "m/s", 8},
+                                      {"wheel_contact", C::kOutput, "m", 8},
+                                      {"body_box", C::kOutput, "m, rad, m/s, rad/s", 10}};
   expected.insert(expected.end(), skid.begin(), skid.end());
   test_helpers::ExpectTable(*husky, expected);
 }
