@@ -38,10 +38,12 @@ class Reader {
     out.root = root;
     r_.CheckKeys(root, "",
                  {"description", "source", "body", "wheels", "motor_groups", "controller",
-                  "chassis", "motors", "path_follower", "sensor_mounts", "payload", "safety"});
+                  "chassis", "motors", "path_follower", "sensor_mounts", "payload", "safety",
+                  "treads"});
     robot.description = r_.String(root, "", "description", "");
     Body(Child(root, "body"), robot.body);
     MotorGroups(Child(root, "motor_groups"), robot);
+    Treads(Child(root, "treads"));
     Wheels(Child(root, "wheels"), robot);
     Controller(Child(root, "controller"), out);
     SensorMounts(Child(root, "sensor_mounts"), out);
@@ -218,6 +220,42 @@ class Reader {
     }
   }
 
+  // The tread types by name: a transient brush tyre each (every value with
+  // its source in the robot file).
+  void Treads(const YAML::Node& map) {
+    const std::string path = "treads";
+    if (!map.IsDefined() || map.IsNull()) {
+      r_.Error(root_, path, "missing required key: a map of tread types by name");
+      return;
+    }
+    if (!r_.ExpectMap(map, path)) return;
+    for (const auto& kv : map) {
+      models::TreadDescription t;
+      t.name = kv.first.Scalar();
+      const std::string tp = JoinPath(path, t.name);
+      const YAML::Node node = kv.second;
+      if (!r_.ExpectMap(node, tp)) continue;
+      r_.CheckKeys(node, tp,
+                   {"material", "slip_stiffness", "cornering_stiffness",
+                    "longitudinal_relaxation_m", "lateral_relaxation_m", "damping_ratio",
+                    "patch_length_m", "patch_width_m", "source"});
+      t.material = r_.String(node, tp, "material", std::nullopt);
+      // Slip stiffness per unit load: car tyres 10-30, small solid wheels
+      // more; 1000 leaves room without admitting nonsense.
+      constexpr Range kPerLoad{0.0, 1000.0, true};
+      t.slip_stiffness = r_.Real(node, tp, "slip_stiffness", std::nullopt, kPerLoad);
+      t.cornering_stiffness = r_.Real(node, tp, "cornering_stiffness", std::nullopt, kPerLoad);
+      constexpr Range kRelaxationM{0.0, 10.0, true};
+      t.longitudinal_relaxation_m =
+          r_.Real(node, tp, "longitudinal_relaxation_m", std::nullopt, kRelaxationM);
+      t.lateral_relaxation_m = r_.Real(node, tp, "lateral_relaxation_m", std::nullopt, kRelaxationM);
+      t.damping_ratio = r_.Real(node, tp, "damping_ratio", std::nullopt, {0.0, 10.0});
+      t.patch_length_m = r_.Real(node, tp, "patch_length_m", std::nullopt, {0.0, 2.0});
+      t.patch_width_m = r_.Real(node, tp, "patch_width_m", std::nullopt, {0.0, 2.0});
+      treads_[t.name] = {t, node};
+    }
+  }
+
   void Wheels(const YAML::Node& list, models::RobotDescription& robot) {
     const std::string path = "wheels";
     if (!list.IsDefined()) {
@@ -233,7 +271,7 @@ class Reader {
       if (!r_.ExpectMap(node, wp)) continue;
       r_.CheckKeys(node, wp,
                    {"name", "x_m", "y_m", "radius_m", "width_m", "mass_kg", "steer_inertia_kgm2",
-                    "steer_motor", "drive_motor"});
+                    "steer_motor", "drive_motor", "tread"});
       models::WheelDescription w;
       w.name = r_.String(node, wp, "name", std::nullopt);
       // Messages, columns and the plots name a wheel: one name, one wheel.
@@ -247,6 +285,16 @@ class Reader {
       w.width_m = r_.Real(node, wp, "width_m", std::nullopt, kSizeM);
       w.mass_kg = r_.Real(node, wp, "mass_kg", std::nullopt, kMassKg);
       w.drive_motor = MotorName(node, wp, "drive_motor", true).value_or("");
+      if (const auto tread = r_.String(node, wp, "tread", std::nullopt); !tread.empty()) {
+        if (const auto it = treads_.find(tread); it != treads_.end()) {
+          w.tread = it->second.first;
+        } else {
+          std::vector<std::string> names;
+          for (const auto& [name, t] : treads_) names.push_back(name);
+          r_.Error(Child(node, "tread"), JoinPath(wp, "tread"),
+                   "no tread '" + tread + "' in treads; treads: " + JoinNames(names));
+        }
+      }
       w.steer_motor = MotorName(node, wp, "steer_motor", false);
       w.steer_inertia_kgm2 =
           r_.Real(node, wp, "steer_inertia_kgm2", w.steer_motor ? std::nullopt : std::optional(0.0),
@@ -407,6 +455,7 @@ class Reader {
   std::string file_;
   std::set<std::string> motor_names_;
   std::map<std::string, Origin> motor_at_;
+  std::map<std::string, std::pair<models::TreadDescription, YAML::Node>> treads_;
   std::vector<YAML::Node> motor_models_;
   YAML::Node root_;
 };

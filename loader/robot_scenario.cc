@@ -115,7 +115,7 @@ void AssembleRobot(assembly::SystemBuilder& b, const std::vector<std::string>& r
   CheckStartPose(b, scene, start);
   info.start_pose = {start.x_m, start.y_m, start.yaw_rad};
   if (file) {
-    assembly::Signals s = assembly::AddDriveTrain(b, *file, start, info);
+    assembly::Signals s = assembly::AddDriveTrain(b, *file, start, scene, info);
     assembly::AddLine(b, scene, s);
     assembly::AddSensors(b, *file, s);
     assembly::AddSensing(b, *file, start, scene, s);

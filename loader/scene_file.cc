@@ -113,12 +113,22 @@ class SceneParser {
       r_.CheckKeys(item, p,
                    {"name", "friction", "texture_contrast", "illumination_lux", "flicker_hz",
                     "flicker_depth", "roughness_m", "roughness_length_m", "texture_period_m",
-                    "texture_periodic_share"});
+                    "texture_periodic_share", "tread_friction"});
       models::Surface surface;
       surface.name = Name(item, p, surface_names_);
       // Rubber or polyurethane on floors and belts is 0.5-1.0; 3 leaves
       // room for studies without admitting nonsense.
       surface.friction = r_.Real(item, p, "friction", std::nullopt, {0.0, 3.0});
+      // Per tread material (a robot's treads name theirs): {rubber: 0.75}.
+      if (const YAML::Node pairs = Child(item, "tread_friction"); pairs.IsDefined()) {
+        const std::string pp = JoinPath(p, "tread_friction");
+        if (r_.ExpectMap(pairs, pp)) {
+          for (const auto& kv : pairs) {
+            const std::string material = kv.first.Scalar();
+            surface.tread_friction[material] = r_.Real(pairs, pp, material, std::nullopt, {0.0, 3.0});
+          }
+        }
+      }
       surface.texture_contrast = r_.Real(item, p, "texture_contrast", std::nullopt, {0.0, 1.0});
       // Direct sunlight is about 1e5 lx.
       surface.illumination_lux = r_.Real(item, p, "illumination_lux", std::nullopt, {0.0, 1e5});
@@ -170,7 +180,8 @@ class SceneParser {
       r_.CheckKeys(
           b, p,
           {"name", "surface", "center_x_m", "center_y_m", "length_m", "width_m", "direction_deg",
-           "speed_mps", "speed_variation", "variation_period_s", "acceleration_mps2", "schedule"});
+           "speed_mps", "speed_variation", "variation_period_s", "acceleration_mps2", "schedule",
+           "edge_gap_m"});
       models::Belt belt;
       // A belt without a name is "belt_<index>"; without a surface its top
       // is the floor's covering.
@@ -191,6 +202,10 @@ class SceneParser {
       belt.speed_variation = r_.Real(b, p, "speed_variation", 0.1, {0.0, 0.5});
       belt.variation_period_s = r_.Real(b, p, "variation_period_s", 20.0, {0.0, 1e6, true});
       belt.acceleration_mps2 = r_.Real(b, p, "acceleration_mps2", 0.5, {0.0, 100.0, true});
+      // Flush with the floor and no gap unless the scene says. The wheels
+      // ride over it (a gap takes friction from the patch over it; the
+      // ground stays a plane), so it is meant for gaps of a few mm.
+      belt.edge_gap_m = r_.Real(b, p, "edge_gap_m", 0.0, {0.0, 0.05});
       Schedule(Child(b, "schedule"), JoinPath(p, "schedule"), belt);
       OnTheFloor(b, p, belt);
       s_.belts.push_back(belt);

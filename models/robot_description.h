@@ -51,6 +51,22 @@ struct PayloadDescription {
   double length_m = 0.0, width_m = 0.0, height_m = 0.0;
 };
 
+/// A wheel's tread: a transient brush tyre (units/chassis/floor_world.h).
+/// Slip stiffnesses are per unit of the wheel's static load (C / F_z), so a
+/// tread keeps its creep slope under another payload.
+struct TreadDescription {
+  std::string name;
+  /// Its material, which pairs with a scene surface's tread_friction.
+  std::string material;
+  double slip_stiffness = 0.0;           // C_kappa / F_z, per unit slip
+  double cornering_stiffness = 0.0;      // C_alpha / F_z, 1/rad
+  double longitudinal_relaxation_m = 0.0;
+  double lateral_relaxation_m = 0.0;
+  double damping_ratio = 0.0;
+  double patch_length_m = 0.0;           // along the rolling direction
+  double patch_width_m = 0.0;
+};
+
 struct WheelDescription {
   std::string name;
   /// Contact point below the wheel centre (the steering axis of a
@@ -69,6 +85,8 @@ struct WheelDescription {
   /// Wheels naming the same drive motor share it (belt or chain).
   std::optional<std::string> steer_motor;
   std::string drive_motor;
+  /// Its tread (the robot file's treads entry it names).
+  TreadDescription tread;
 };
 
 /// Motors of one model behind one kind of gear.

@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,7 +20,8 @@ namespace linesim::models {
 /// looking down at it sees.
 struct Surface {
   std::string name;
-  /// Coulomb coefficient of a robot wheel's tread on it (dimensionless).
+  /// Coulomb coefficient of a robot wheel's tread on it (dimensionless),
+  /// for a tread material without a pair of its own (tread_friction).
   double friction = 0.0;
   /// Texture contrast (dimensionless, 0..1): the standard deviation of the
   /// surface's reflectance over its mean, at the scale of a few millimetres
@@ -50,6 +52,14 @@ struct Surface {
   double texture_period_m = 0.0;
   /// Share (0..1) of the texture's contrast that is periodic.
   double texture_periodic_share = 0.0;
+  /// Coulomb coefficient per tread material (models::TreadDescription's
+  /// material: rubber, polyurethane, ...): friction per pair of materials.
+  std::map<std::string, double> tread_friction = {};
+  /// The friction of a tread of `material` on it.
+  double FrictionFor(const std::string& material) const {
+    const auto it = tread_friction.find(material);
+    return it == tread_friction.end() ? friction : it->second;
+  }
 };
 
 /// A rectangle on the floor: centre, size, and the direction of its length
@@ -74,6 +84,9 @@ struct Belt {
   Rect area;
   /// Index into Scene::surfaces of its top (its friction and optics).
   int surface = 0;
+  /// The open gap between the belt's edges and the floor around it (m): a
+  /// wheel's contact patch over it carries nothing.
+  double edge_gap_m = 0.0;
   double nominal_speed_mps = 0.0;
   /// Relative amplitude of the slow speed variation (0.1: +-10 %).
   double speed_variation = 0.0;

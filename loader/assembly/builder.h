@@ -23,6 +23,8 @@ inline constexpr const char* kMotors = "motors";
 inline constexpr const char* kWheelController = "wheel_controller";
 inline constexpr const char* kPathFollower = "path_follower";
 inline constexpr const char* kDeviation = "deviation";
+/// The drives' peak current over the path's last metres.
+inline constexpr const char* kEndCurrent = "end_current";
 inline constexpr const char* kClearance = "clearance";
 /// A fleet's robot's distance from the other robots (loader/robot_scenario.cc).
 inline constexpr const char* kRobotClearance = "robot_clearance";

@@ -84,7 +84,7 @@ models::Scene AddScene(SystemBuilder& b);
 /// robot: the chassis (ODE) and the motors (one CVODE unit for every motor
 /// group), wired torque to joint and joint rate to shaft.
 Signals AddDriveTrain(SystemBuilder& b, const RobotFile& robot, const StartPose& start,
-                      RobotInfo& info);
+                      const models::Scene& scene, RobotInfo& info);
 
 /// The line's belt unit, driving the scene's belts under the chassis.
 void AddLine(SystemBuilder& b, const models::Scene& scene, Signals& s);

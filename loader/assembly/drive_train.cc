@@ -49,10 +49,48 @@ void AddMotors(SystemBuilder& b, const RobotFile& file) {
   b.MergeSettings(kMotors, file.motor_settings, robot.file, "motors");
 }
 
+// Each wheel's tread (the robot file's treads entry it names) and its
+// friction on every scene surface: the surface's pair for the tread's
+// material, else the surface's own friction.
+void AddTreads(SystemBuilder& b, const RobotFile& file, const models::Scene& scene) {
+  const models::RobotDescription& robot = file.robot;
+  Parameters& c = b.Params(kChassis);
+  const std::string cp = "units.chassis.parameters";
+  const std::pair<const char*, double models::TreadDescription::*> fields[] = {
+      {"slip_stiffness", &models::TreadDescription::slip_stiffness},
+      {"cornering_stiffness", &models::TreadDescription::cornering_stiffness},
+      {"longitudinal_relaxation", &models::TreadDescription::longitudinal_relaxation_m},
+      {"lateral_relaxation", &models::TreadDescription::lateral_relaxation_m},
+      {"damping_ratio", &models::TreadDescription::damping_ratio},
+      {"patch_length", &models::TreadDescription::patch_length_m},
+      {"patch_width", &models::TreadDescription::patch_width_m}};
+  const char* keys[] = {"slip_stiffness",       "cornering_stiffness", "longitudinal_relaxation_m",
+                        "lateral_relaxation_m", "damping_ratio",       "patch_length_m",
+                        "patch_width_m"};
+  for (std::size_t f = 0; f < std::size(fields); ++f) {
+    const std::string param = std::string("tread_") + fields[f].first;
+    std::vector<double> values;
+    for (std::size_t k = 0; k < robot.wheels.size(); ++k) {
+      const models::WheelDescription& w = robot.wheels[k];
+      values.push_back(w.tread.*fields[f].second);
+      b.Origin(JoinPath(JoinPath(cp, param), std::to_string(k)),
+               file.At(JoinPath(JoinPath("treads", w.tread.name), keys[f])));
+    }
+    c[param] = values;
+    b.Origin(JoinPath(cp, param), file.At("treads"));
+  }
+  std::vector<double> friction;
+  for (const models::WheelDescription& w : robot.wheels) {
+    for (const models::Surface& s : scene.surfaces)
+      friction.push_back(s.FrictionFor(w.tread.material));
+  }
+  c["wheel_friction"] = friction;
+}
+
 }  // namespace
 
 Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& start,
-                      RobotInfo& info) {
+                      const models::Scene& scene, RobotInfo& info) {
   const models::RobotDescription& robot = file.robot;
   Signals s;
   const auto motors = robot.Motors();
@@ -151,6 +189,7 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
     b.Origin(JoinPath(cp, "payload_position"), at("x_m"));
     b.Origin(JoinPath(cp, "payload_size"), at("length_m"));
   }
+  AddTreads(b, file, scene);
   c["initial_x"] = start.x_m;
   c["initial_y"] = start.y_m;
   c["initial_yaw"] = start.yaw_rad;
@@ -162,9 +201,15 @@ Signals AddDriveTrain(SystemBuilder& b, const RobotFile& file, const StartPose& 
 
   AddMotors(b, file);
   const auto wire = [&](const char* joint, const std::vector<std::size_t>& elements) {
+    // The torque-speed line, which the chassis applies implicitly (its
+    // joint motor rows): stable at any master step with tyres that creep.
     for (std::size_t k = 0; k < elements.size(); ++k) {
-      b.Connect(Element(kMotors, "torque", elements[k]),
+      b.Connect(Element(kMotors, "line_torque", elements[k]),
                 Element(kChassis, std::string(joint) + "_torque", k));
+      b.Connect(Element(kMotors, "line_slope", elements[k]),
+                Element(kChassis, std::string(joint) + "_torque_slope", k));
+      b.Connect(Element(kMotors, "line_rate", elements[k]),
+                Element(kChassis, std::string(joint) + "_torque_rate", k));
       b.Connect(Element(kChassis, std::string(joint) + "_rate", k),
                 Element(kMotors, "shaft_speed", elements[k]));
     }

@@ -73,6 +73,22 @@ void AddFlowError(SystemBuilder& b, Signals& s, RobotInfo& info) {
     }
     info.flow_reference_column = s.belt_ground_truth.Name();
   }
+// The final approach's demand on the drives: the peak absolute current of
+// any drive motor over the path's last 2 m (a sticking skid-steer winds its
+// currents up there; steady motion needs the rolling resistance's and the
+// stop's share).
+void AddEndCurrent(SystemBuilder& b, const Signals& s) {
+  if (s.drive_motor_element.empty()) return;
+  b.Unit(kEndCurrent, "end_peak");
+  Parameters& p = b.Params(kEndCurrent);
+  p["count"] = static_cast<int>(s.drive_motor_element.size());
+  p["window"] = 2.0;
+  for (std::size_t k = 0; k < s.drive_motor_element.size(); ++k) {
+    b.Connect(Element(kMotors, "current", s.drive_motor_element[k]),
+              Element(kEndCurrent, "values", k));
+  }
+  b.Connect(Signal(kDeviation, "remaining"), Signal(kEndCurrent, "remaining"));
+  b.Metric("peak_drive_current_last_2m_a", Signal(kEndCurrent, "peak"), cosim::Reduction::kFinal);
 }
 
 }  // namespace
@@ -101,6 +117,7 @@ void AddEvaluation(SystemBuilder& b, const models::RobotDescription& robot, Sign
     if (info.task == "path") {
       add("crossing_success", Signal(kDeviation, "success"), cosim::Reduction::kFinal);
     }
+    AddEndCurrent(b, s);
   } else {
     add("max_position_drift_m", deviation, cosim::Reduction::kMax);
     add("final_position_drift_m", deviation, cosim::Reduction::kFinal);

@@ -31,17 +31,26 @@ Read ReadModel(const std::string& model, const std::string& relative_to = "scena
 const char* kBody =
     "{length_m: 1, width_m: 0.6, bottom_m: 0.1, height_m: 0.3, mass_kg: 40, com_height_m: 0.2}";
 
-std::string Robot(const std::string& wheel0, const std::string& body = kBody) {
+// A wheel without a `tread` key gets the file's one tread type (the treads
+// come last, so that the lines the tests name stay where they were).
+std::string Robot(std::string wheel0, const std::string& body = kBody) {
+  if (wheel0.find("tread:") == std::string::npos && !wheel0.empty() && wheel0.back() == '}') {
+    wheel0.insert(wheel0.size() - 1, ", tread: t");
+  }
   return "body: " + body + "\n" +
          "wheels:\n"
          "  - " + wheel0 + "\n"
          "  - {name: r, x_m: 0, y_m: -0.3, radius_m: 0.1, width_m: 0.05, mass_kg: 2, "
-         "drive_motor: right}\n"
+         "drive_motor: right, tread: t}\n"
          "motor_groups:\n"
          "  - {name: drive, model: maxon_re40_148877, gear_ratio: 20, gear_efficiency: 0.8,\n"
          "     motors: [left, right]}\n"
          "controller: {kind: differential, effective_track: 0.8}\n"
-         "path_follower: {max_speed: 1.0, max_yaw_rate: 1.0}\n";
+         "path_follower: {max_speed: 1.0, max_yaw_rate: 1.0}\n"
+         "treads:\n"
+         "  t: {material: rubber, slip_stiffness: 6.9, cornering_stiffness: 6.9,\n"
+         "      longitudinal_relaxation_m: 0.04, lateral_relaxation_m: 0.04, damping_ratio: 0.1,\n"
+         "      patch_length_m: 0.08, patch_width_m: 0.05}\n";
 }
 
 const char* kLeft =
@@ -200,6 +209,32 @@ TEST(RobotFile, TopologyProblemsAreNamed) {
   EXPECT_TRUE(ReadModel(WriteScenario("robot_ok.yaml", Robot(kLeft))).file);
 }
 
+// Guards the treads (the tyre model's parameters, every one with a source
+// in the shipped files): a wheel naming no known tread type, a tread type
+// missing a key, and a file without treads are each named at their key.
+TEST(RobotFile, TreadsAreRequiredAndNamedAtTheirKeys) {
+  const Read unknown = ReadModel(
+      WriteScenario("robot_unknown_tread.yaml",
+                    Robot("{name: l, x_m: 0, y_m: 0.3, radius_m: 0.1, width_m: 0.05, mass_kg: 2, "
+                          "drive_motor: left, tread: slick}")));
+  EXPECT_FALSE(unknown.file);
+  EXPECT_TRUE(Has(unknown.issues, "wheels.0.tread: no tread 'slick' in treads; treads: t"))
+      << unknown.issues;
+
+  std::string text = Robot(kLeft);
+  text.replace(text.find("damping_ratio: 0.1,"), 19, "");
+  const Read missing = ReadModel(WriteScenario("robot_tread_missing_key.yaml", text));
+  EXPECT_FALSE(missing.file);
+  EXPECT_TRUE(Has(missing.issues, "treads.t.damping_ratio")) << missing.issues;
+
+  text = Robot(kLeft);
+  const auto from = text.find("treads:"), to = text.find("wheels:");
+  text.erase(from, to - from);
+  const Read none = ReadModel(WriteScenario("robot_no_treads.yaml", text));
+  EXPECT_FALSE(none.file);
+  EXPECT_TRUE(Has(none.issues, "treads: missing required key")) << none.issues;
+}
+
 // Guards the sensor mounts' keys: a PX4Flow looks straight down (a roll or
 // pitch would be dropped, so it is refused), a wheel encoder has no pose,
 // and a step below 1 ns (which would round to "the default") is refused.
@@ -245,8 +280,9 @@ TEST(RobotFile, WheelMassesAndMotorModelsMustAgree) {
   two.replace(two.find("  - {name: drive, model: maxon_re40_148877,"), 0,
               "  - {name: other, model: " + motor + ", gear_ratio: 10, gear_efficiency: 0.9,\n"
               "     motors: [spare]}\n");
-  two.replace(two.find("drive_motor: right}"), 19, "drive_motor: right}\n  - {name: s, x_m: 0.2, "
-              "y_m: 0.3, radius_m: 0.1, width_m: 0.05, mass_kg: 2, drive_motor: spare}");
+  two.replace(two.find("drive_motor: right, tread: t}"), 29,
+              "drive_motor: right, tread: t}\n  - {name: s, x_m: 0.2, y_m: 0.3, radius_m: 0.1, "
+              "width_m: 0.05, mass_kg: 2, drive_motor: spare, tread: t}");
   const Read b = ReadModel(WriteScenario("robot_two_motors.yaml", two));
   EXPECT_TRUE(Has(b.issues, "motor_groups.1.model: the motor models of one robot must set the "
                             "same keys: 'viscous_friction'"))

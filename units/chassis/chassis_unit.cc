@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <utility>
 
 #include "models/angle.h"
@@ -77,8 +78,6 @@ struct ChassisUnit::Ode {
   std::vector<dGeomID> geoms;
   // Internal step for which the suspension ERP/CFM were set (0: not yet).
   double suspension_h_s = 0.0;
-  // Force limit the joint motors were set to (NaN: not yet).
-  double motor_fmax_nm = std::numeric_limits<double>::quiet_NaN();
 
   Ode() = default;
   Ode(const Ode&) = delete;
@@ -105,7 +104,6 @@ struct ChassisUnit::Ode {
     floor.reset();
     suspension_h_s = 0.0;
     ground_slope[0] = ground_slope[1] = 0.0;
-    motor_fmax_nm = std::numeric_limits<double>::quiet_NaN();
   }
 
   // Every body, the base first.
@@ -288,6 +286,10 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   if (ms == 0) steer_rotor_inertia_ = 0.0;  // no steering motor to reflect
   steer_torque_.assign(ms, 0.0);
   drive_torque_.assign(md, 0.0);
+  steer_torque_slope_.assign(ms, 0.0);
+  steer_torque_rate_.assign(ms, 0.0);
+  drive_torque_slope_.assign(md, 0.0);
+  drive_torque_rate_.assign(md, 0.0);
   belt_velocity_.assign(2 * b, 0.0);
   belt_travel_.assign(b, 0.0);
   if (moving_boxes < 0 || moving_cylinders < 0) {
@@ -391,11 +393,7 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   v.Parameter("contact_damping", "N.s/m", &contact_damping_,
               "normal damping of one contact point (default 1e4: well damped)",
               cosim::Rule::NonNegative());
-  v.Parameter("slip_damping", "N.s/m", &slip_damping_,
-              "sliding contact: resistance to slip across its slip direction, bounded by "
-              "friction x normal force (damps a step-to-step swing of the slip direction; "
-              "default 1e5, see units/chassis/floor_world.h)",
-              cosim::Rule::Positive());
+  DeclareTreadParameters();
   v.Parameter("suspension_stiffness", "N/m", &suspension_stiffness_,
               "stiffness of a steered module along its steering axis (hinge2 suspension; "
               "default 1e7: a near-rigid mount)",
@@ -422,6 +420,24 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   }
   v.Input("drive_torque", "N.m", &drive_torque_,
           "torque of each drive motor about the axle of its wheels, + drives them forward");
+  // The motors' torque-speed lines: a DC motor's torque falls steeply with
+  // its speed (back-EMF). Applied as given over a step, that damping is
+  // explicit and a light wheel on a creeping tyre oscillates out of bounds
+  // at a 5 ms step; as the joint's motor row it is implicit.
+  if (ms > 0) {
+    v.Input("steer_torque_slope", "N.m.s/rad", &steer_torque_slope_,
+            "d steer_torque / d steer_rate of each steering motor at steer_torque_rate (<= 0; "
+            "0: steer_torque is applied as given over the step)");
+    v.Input("steer_torque_rate", "rad/s", &steer_torque_rate_,
+            "the steering rate at which steer_torque holds (with a slope: the torque follows "
+            "its line through it within the step)");
+  }
+  v.Input("drive_torque_slope", "N.m.s/rad", &drive_torque_slope_,
+          "d drive_torque / d drive_rate of each drive motor at drive_torque_rate (<= 0; 0: "
+          "drive_torque is applied as given over the step)");
+  v.Input("drive_torque_rate", "rad/s", &drive_torque_rate_,
+          "the drive rate at which drive_torque holds (with a slope: the torque follows its "
+          "line through it within the step)");
   if (b > 0) {
     v.Input("belt_velocity", "m/s", &belt_velocity_,
             "surface velocity of each scene belt in map: vx, vy per belt");
@@ -491,6 +507,75 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
            {});
 }
 
+void ChassisUnit::DeclareTreadParameters() {
+  const auto w = static_cast<std::size_t>(wheel_count_);
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  for (auto* values : {&tread_slip_stiffness_, &tread_cornering_stiffness_,
+                       &tread_longitudinal_relaxation_, &tread_lateral_relaxation_,
+                       &tread_damping_ratio_, &tread_patch_length_, &tread_patch_width_}) {
+    values->assign(w, kNaN);
+  }
+  // Each wheel on each surface: the surface's own friction unless the
+  // robot's tread material has its own pair (loader/assembly).
+  for (std::size_t k = 0; k < w; ++k) {
+    for (const models::Surface& s : scene_.surfaces) wheel_friction_.push_back(s.friction);
+  }
+  auto& v = variables();
+  const auto tyre = cosim::Rule::Positive().NoDefault();
+  v.Parameter("tread_slip_stiffness", "1", &tread_slip_stiffness_,
+              "each wheel's longitudinal slip stiffness per unit load, C_kappa / F_z (N per "
+              "unit slip per N): the creep slope of a brush tyre",
+              tyre);
+  v.Parameter("tread_cornering_stiffness", "1/rad", &tread_cornering_stiffness_,
+              "each wheel's cornering stiffness per unit load, C_alpha / F_z", tyre);
+  v.Parameter("tread_longitudinal_relaxation", "m", &tread_longitudinal_relaxation_,
+              "each wheel's longitudinal relaxation length sigma_kappa: tread stiffness "
+              "C_kappa / sigma_kappa at the wheel's static load",
+              tyre);
+  v.Parameter("tread_lateral_relaxation", "m", &tread_lateral_relaxation_,
+              "each wheel's lateral relaxation length sigma_alpha", tyre);
+  v.Parameter("tread_damping_ratio", "1", &tread_damping_ratio_,
+              "each wheel's tangential tread damping as a ratio of critical for its static "
+              "load on its tread stiffness",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("tread_patch_length", "m", &tread_patch_length_,
+              "each wheel's contact patch length along its rolling direction (0: a point)",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("tread_patch_width", "m", &tread_patch_width_,
+              "each wheel's contact patch width (0: a point)",
+              cosim::Rule::NonNegative().NoDefault());
+  v.Parameter("wheel_friction", "1", &wheel_friction_,
+              "Coulomb coefficient of each wheel's tread on each scene surface, wheel-major "
+              "(default: each surface's friction)",
+              cosim::Rule::NonNegative());
+}
+
+Tread ChassisUnit::WheelTread(std::size_t k) const {
+  Tread t;
+  // The static load of one wheel: the robot's weight shared by its wheels.
+  const double load_n = (mass_ + payload_mass_) * kGravityMps2 / wheel_count_;
+  const double c[2] = {tread_slip_stiffness_[k], tread_cornering_stiffness_[k]};
+  const double sigma[2] = {tread_longitudinal_relaxation_[k], tread_lateral_relaxation_[k]};
+  for (int r = 0; r < 2; ++r) {
+    t.relaxation_m[r] = sigma[r];
+    t.stiffness_n_per_m[r] = c[r] * load_n / sigma[r];
+    t.damping_n_s_per_m[r] =
+        2.0 * tread_damping_ratio_[k] * std::sqrt(t.stiffness_n_per_m[r] * load_n / kGravityMps2);
+  }
+  t.patch_length_m = tread_patch_length_[k];
+  t.patch_width_m = tread_patch_width_[k];
+  t.axle[1] = 1.0;  // the wheel body's local y
+  // The floor world's surfaces: the floor, the belts, the terrain pieces.
+  const std::size_t surfaces = scene_.surfaces.size();
+  const auto mu = [&](int scene_surface) {
+    return wheel_friction_[k * surfaces + static_cast<std::size_t>(scene_surface)];
+  };
+  t.mu.push_back(mu(scene_.floor.surface));
+  for (const models::Belt& b : scene_.belts) t.mu.push_back(mu(b.surface));
+  for (const models::TerrainPiece& p : scene_.terrain) t.mu.push_back(mu(p.surface));
+  return t;
+}
+
 ChassisUnit::~ChassisUnit() = default;
 
 std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
@@ -514,8 +599,8 @@ std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
                             cosim::FormatValue(com_height_)});
   }
   // The payload's box: all three sizes (a box) or none (a point mass).
-  const auto boxed = std::count_if(payload_size_.begin(), payload_size_.end(),
-                                   [](double d) { return d > 0.0; });
+  const auto boxed =
+      std::count_if(payload_size_.begin(), payload_size_.end(), [](double d) { return d > 0.0; });
   if (boxed != 0 && boxed != 3) {
     problems.push_back({"payload_size", std::nullopt,
                         "give all three sizes (a box) or none (a point mass), got " +
@@ -538,14 +623,15 @@ void ChassisUnit::Build() {
   std::vector<BeltPatch> belts;
   for (const models::Belt& belt : scene_.belts) {
     const models::Rect& r = belt.area;
-    belts.push_back(
-        {r.center_x_m, r.center_y_m, r.length_m, r.width_m, r.direction_rad, mu_of(belt.surface)});
+    belts.push_back({r.center_x_m, r.center_y_m, r.length_m, r.width_m, r.direction_rad,
+                     mu_of(belt.surface), belt.edge_gap_m});
   }
   f.SetBelts(std::move(belts));
-  f.SetSurface({mu_of(scene_.floor.surface), contact_stiffness_, contact_damping_, slip_damping_});
+  f.SetSurface({mu_of(scene_.floor.surface), contact_stiffness_, contact_damping_});
   for (const models::Obstacle& obstacle : scene_.obstacles) f.AddObstacle(obstacle.solid);
   for (const models::CarriedObject& obj : scene_.carried) f.AddCarried(obj.solid, obj.belt);
-  for (const models::TerrainPiece& piece : scene_.terrain) f.AddTerrain(piece, mu_of(piece.surface));
+  for (const models::TerrainPiece& piece : scene_.terrain)
+    f.AddTerrain(piece, mu_of(piece.surface));
 
   // Start with the contacts pressed in by equal shares of the weight, so
   // that the settle has little to do. The suspension starts unloaded (its
@@ -572,8 +658,9 @@ void ChassisUnit::Build() {
     const double total = body_mass + payload_mass_;
     for (int d = 0; d < 3; ++d) {
       const double box_d = d == 2 ? com_height_ : 0.0;
-      com[d] = (body_mass * box_d + payload_mass_ * payload_position_[static_cast<std::size_t>(d)]) /
-               total;
+      com[d] =
+          (body_mass * box_d + payload_mass_ * payload_position_[static_cast<std::size_t>(d)]) /
+          total;
     }
     dMassTranslate(&m, -com[0], -com[1], com_height_ - com[2]);
     dMass mp;
@@ -646,7 +733,7 @@ void ChassisUnit::Build() {
     dBodySetRotation(w, rot);
     dGeomID g = dCreateSphere(nullptr, radius);
     dGeomSetBody(g, w);
-    f.AddGeom(g);
+    f.AddGeom(g, WheelTread(k));
     dJointID j = nullptr;
     if (steered) {
       j = dJointCreateHinge2(f.world(), nullptr);
@@ -800,20 +887,54 @@ void ChassisUnit::SetSuspension(double h_s) {
 }
 
 void ChassisUnit::SetJointMotors(bool hold, double max_torque_nm) {
-  // A joint motor with target velocity 0 and force limit 0 adds no row.
-  const double fmax = hold ? max_torque_nm : 0.0;
-  if (fmax == ode_->motor_fmax_nm) return;
-  ode_->motor_fmax_nm = fmax;
+  // Axis 0 of a joint is a steered wheel's steering axis, axis 1 its axle
+  // (hinge2's axes 1 and 2; a fixed wheel's hinge has only the axle). Its
+  // row: velocity `vel`, force limit `fmax` (0: no row), CFM `cfm`.
+  const double world_cfm = dWorldGetCFM(ode_->floor->world());
+  const auto set = [](dJointID j, bool steered, int axis, double vel, double fmax, double cfm) {
+    if (steered) {
+      const int group = axis == 0 ? 0 : dParamGroup;
+      dJointSetHinge2Param(j, dParamVel + group, vel);
+      dJointSetHinge2Param(j, dParamFMax + group, fmax);
+      dJointSetHinge2Param(j, dParamCFM + group, cfm);
+    } else {
+      dJointSetHingeParam(j, dParamVel, vel);
+      dJointSetHingeParam(j, dParamFMax, fmax);
+      dJointSetHingeParam(j, dParamCFM, cfm);
+    }
+  };
+  // A motor's torque-speed line tau(r) = tau0 + slope (r - r0), r the
+  // wheel's rate relative to the body about the joint axis (the joint's own
+  // rate is -r: ODE's rate is body1's - body2's, and body1 is the body),
+  // as the joint's motor row: the row enforces -r = vel - cfm lambda and
+  // puts -lambda on the wheel, so cfm = 1 / c and vel = -(r0 + tau0 / c)
+  // with c = -slope give the wheel tau0 - c (r - r0) at the end of each
+  // internal step (implicit: stable at any slope and step).
+  const auto line = [&](dJointID j, bool steered, int axis, double tau0, double slope, double r0) {
+    const double c = -slope;
+    set(j, steered, axis, -(r0 + tau0 / c), dInfinity, 1.0 / c);
+  };
   for (std::size_t k = 0; k < ode_->joints.size(); ++k) {
     const dJointID j = ode_->joints[k];
-    if (ode_->steered[k]) {
-      dJointSetHinge2Param(j, dParamVel, 0.0);
-      dJointSetHinge2Param(j, dParamFMax, fmax);
-      dJointSetHinge2Param(j, dParamVel2, 0.0);
-      dJointSetHinge2Param(j, dParamFMax2, fmax);
+    const bool steered = ode_->steered[k];
+    if (hold) {
+      if (steered) set(j, true, 0, 0.0, max_torque_nm, world_cfm);
+      set(j, steered, 1, 0.0, max_torque_nm, world_cfm);
+      continue;
+    }
+    if (steered) {
+      const auto sm = static_cast<std::size_t>(steer_motor_[k]);
+      if (ImplicitSteer(sm)) {
+        line(j, true, 0, steer_torque_[sm], steer_torque_slope_[sm], steer_torque_rate_[sm]);
+      } else {
+        set(j, true, 0, 0.0, 0.0, world_cfm);
+      }
+    }
+    const auto dm = static_cast<std::size_t>(drive_motor_[k]);
+    if (leads_drive_motor_[k] && ImplicitDrive(dm)) {
+      line(j, steered, 1, drive_torque_[dm], drive_torque_slope_[dm], drive_torque_rate_[dm]);
     } else {
-      dJointSetHingeParam(j, dParamVel, 0.0);
-      dJointSetHingeParam(j, dParamFMax, fmax);
+      set(j, steered, 1, 0.0, 0.0, world_cfm);
     }
   }
 }
@@ -831,11 +952,16 @@ void ChassisUnit::ApplyTorques() {
     const double rel[3] = {ww[0] - wb[0], ww[1] - wb[1], ww[2] - wb[2]};
     const int sm = steer_motor_[k];
     const auto dm = static_cast<unsigned>(drive_motor_[k]);
-    const double steer =
-        sm >= 0 ? steer_torque_[static_cast<std::size_t>(sm)] - steer_friction_ * Dot(up, rel)
-                : 0.0;
+    // A motor whose torque the joint row applies (SetJointMotors) adds
+    // only the joint's viscous friction here.
+    double steer = 0.0;
+    if (sm >= 0) {
+      const auto m = static_cast<std::size_t>(sm);
+      steer =
+          (brake_ || !ImplicitSteer(m) ? steer_torque_[m] : 0.0) - steer_friction_ * Dot(up, rel);
+    }
     double drive = -drive_friction_ * Dot(axle, rel);
-    if (leads_drive_motor_[k]) drive = drive_torque_[dm] - drive_friction_ * Dot(axle, rel);
+    if (leads_drive_motor_[k] && (brake_ || !ImplicitDrive(dm))) drive += drive_torque_[dm];
     // The motor turns the wheel and reacts on the body: equal and opposite.
     const double t[3] = {steer * up[0] + drive * axle[0], steer * up[1] + drive * axle[1],
                          steer * up[2] + drive * axle[2]};
@@ -879,8 +1005,8 @@ void ChassisUnit::Settle() {
   const double bx = origin[0], by = origin[1];
   // On terrain the ground rises along its slope: moved back to the initial
   // x, y, the robot moves up or down with it (0 on the floor).
-  const double lift = ode_->ground_slope[0] * (initial_x_ - bx) +
-                      ode_->ground_slope[1] * (initial_y_ - by);
+  const double lift =
+      ode_->ground_slope[0] * (initial_x_ - bx) + ode_->ground_slope[1] * (initial_y_ - by);
   const double turn = initial_yaw_ - Yaw(dBodyGetRotation(ode_->body));
   const double c = std::cos(turn), s = std::sin(turn);
   dQuaternion q_turn;
@@ -896,6 +1022,8 @@ void ChassisUnit::Settle() {
     dBodySetLinearVel(b, 0.0, 0.0, 0.0);
     dBodySetAngularVel(b, 0.0, 0.0, 0.0);
   }
+  // At rest at time zero: the treads unloaded of what settling left.
+  f.ResetTreads();
   // The contacts at the moved positions, for the outputs and the first step.
   f.Probe();
   if (const std::string bad = OffFloorWheel(); !bad.empty()) {
@@ -1048,7 +1176,7 @@ void ChassisUnit::ComputeOutputs() {
     const GeomContact& gc = o.floor->contact(static_cast<int>(k));
     wheel_surface_[k] = gc.surface;
     double vx = 0.0, vy = 0.0;
-    o.floor->SurfaceVelocity(gc.surface, &vx, &vy);
+    o.floor->PatchVelocity(static_cast<int>(k), &vx, &vy);
     wheel_surface_velocity_[2 * k] = c * vx + s * vy;
     wheel_surface_velocity_[2 * k + 1] = -s * vx + c * vy;
     wheel_contact_[2 * k] = gc.x_m;
@@ -1133,6 +1261,8 @@ void ChassisUnit::SaveInternal(cosim::UnitState& state) const {
       state.reals.insert(state.reals.end(), v, v + n);
     }
   }
+  const std::vector<double> treads = ode_->floor->TreadStates();
+  state.reals.insert(state.reals.end(), treads.begin(), treads.end());
 }
 
 void ChassisUnit::RestoreInternal(const cosim::UnitState& state) {
@@ -1141,7 +1271,8 @@ void ChassisUnit::RestoreInternal(const cosim::UnitState& state) {
   // Couplings are velocity rows and carried objects follow the inputs:
   // neither holds state of its own.
   const bool init = state.integers.size() == 1 && state.integers[0] != 0;
-  const std::size_t reals = init ? bodies * kRealsPerBody : 0;
+  const std::size_t reals =
+      init ? bodies * (kRealsPerBody + kTreadStateReals) - kTreadStateReals : 0;
   if (state.integers.size() != 1 || state.reals.size() != reals) {
     throw cosim::UnitError(Where() + ": saved state has " + std::to_string(state.reals.size()) +
                            " reals and " + std::to_string(state.integers.size()) +
@@ -1168,6 +1299,7 @@ void ChassisUnit::RestoreInternal(const cosim::UnitState& state) {
     dBodySetLinearVel(b, r[7], r[8], r[9]);
     dBodySetAngularVel(b, r[10], r[11], r[12]);
   }
+  ode_->floor->SetTreadStates(std::span<const double>(r, kTreadStateReals * (bodies - 1)));
   // The contacts at the restored positions, for the next step.
   ode_->floor->Probe();
   initialized_ = true;

@@ -11,6 +11,8 @@
 
 namespace linesim::chassis {
 
+struct Tread;  // units/chassis/floor_world.h
+
 /// A wheeled robot base on a factory floor with conveyor-belt patches,
 /// obstacles and belt-carried objects, simulated with ODE (dWorldStep). One
 /// code for any wheel topology: a swerve base (Rob@Work 3: every wheel with
@@ -143,6 +145,12 @@ class ChassisUnit : public cosim::Unit {
   // The ODE objects; defined in the .cc so that ODE stays private.
   struct Ode;
 
+  /// Declares the tread and wheel_friction parameters (sized by the wheel
+  /// and surface counts).
+  void DeclareTreadParameters();
+  /// Wheel k's tread for the floor world: stiffness and damping at its
+  /// static load, its patch, its friction on the floor world's surfaces.
+  Tread WheelTread(std::size_t k) const;
   /// Creates a fresh world with the robot at the initial pose (no settle).
   void Build();
   /// Before settling: when terrain lies under a wheel at the initial pose,
@@ -152,7 +160,12 @@ class ChassisUnit : public cosim::Unit {
   void Settle();
   /// Suspension ERP/CFM for internal step h_s (only when h_s changes).
   void SetSuspension(double h_s);
+  /// hold: every joint motor at velocity 0 up to max_torque_nm (the brake,
+  /// or holding while settling); else each motor with a torque-speed slope
+  /// is its joint's motor row (implicit), the others none.
   void SetJointMotors(bool hold, double max_torque_nm);
+  bool ImplicitSteer(std::size_t m) const { return steer_torque_slope_[m] < 0.0; }
+  bool ImplicitDrive(std::size_t m) const { return drive_torque_slope_[m] < 0.0; }
   void ApplyTorques();
   /// Hands belt_velocity and belt_travel to the floor world.
   void SetBeltInputs();
@@ -196,7 +209,12 @@ class ChassisUnit : public cosim::Unit {
   double body_friction_ = 0.5;
   double contact_stiffness_ = 1e6;
   double contact_damping_ = 1e4;
-  double slip_damping_ = 1e5;
+  // Per wheel: its tread (a transient brush tyre, units/chassis/floor_world.h)
+  // and its Coulomb coefficient on each scene surface (wheel-major).
+  std::vector<double> tread_slip_stiffness_, tread_cornering_stiffness_;
+  std::vector<double> tread_longitudinal_relaxation_, tread_lateral_relaxation_;
+  std::vector<double> tread_damping_ratio_, tread_patch_length_, tread_patch_width_;
+  std::vector<double> wheel_friction_;
   double suspension_stiffness_ = 1e7;
   double suspension_damping_ = 1e4;
   double brake_torque_ = 30.0;
@@ -207,6 +225,8 @@ class ChassisUnit : public cosim::Unit {
 
   // Inputs.
   std::vector<double> steer_torque_, drive_torque_, belt_velocity_, belt_travel_;
+  std::vector<double> steer_torque_slope_, steer_torque_rate_, drive_torque_slope_,
+      drive_torque_rate_;
   std::vector<double> moving_boxes_, moving_cylinders_;
   std::int64_t own_box_ = -1;
   bool brake_ = false;

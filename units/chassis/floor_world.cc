@@ -102,7 +102,166 @@ dGeomID SolidGeom(const models::Solid& s, double* z_m) {
   return g;
 }
 
+
+// Area of the convex polygon `poly` (n vertices, x y pairs, counter-
+// clockwise or clockwise) inside the box |x| <= hx, |y| <= hy: clipped by
+// the box's four half-planes in turn (Sutherland-Hodgman), then the
+// shoelace formula. A quadrilateral clipped by four lines has at most 8
+// vertices.
+double AreaInBox(const std::array<double, 8>& quad, double hx, double hy) {
+  std::array<double, 32> a{}, b{};
+  int n = 4;
+  std::copy(quad.begin(), quad.end(), a.begin());
+  // Half-plane k keeps s * coord(axis) <= h.
+  const int axis[4] = {0, 0, 1, 1};
+  const double sign[4] = {1.0, -1.0, 1.0, -1.0};
+  const double half[4] = {hx, hx, hy, hy};
+  for (int k = 0; k < 4 && n > 0; ++k) {
+    int m = 0;
+    const auto inside = [&](const double* v) { return sign[k] * v[axis[k]] <= half[k]; };
+    for (int j = 0; j < n; ++j) {
+      const double* p = &a[static_cast<std::size_t>(2 * j)];
+      const double* q = &a[static_cast<std::size_t>(2 * ((j + 1) % n))];
+      const bool pin = inside(p), qin = inside(q);
+      if (pin) {
+        b[static_cast<std::size_t>(2 * m)] = p[0];
+        b[static_cast<std::size_t>(2 * m + 1)] = p[1];
+        ++m;
+      }
+      if (pin != qin) {
+        const double t = (half[k] - sign[k] * p[axis[k]]) / (sign[k] * (q[axis[k]] - p[axis[k]]));
+        b[static_cast<std::size_t>(2 * m)] = p[0] + t * (q[0] - p[0]);
+        b[static_cast<std::size_t>(2 * m + 1)] = p[1] + t * (q[1] - p[1]);
+        ++m;
+      }
+    }
+    n = m;
+    std::swap(a, b);
+  }
+  double twice = 0.0;
+  for (int j = 0; j < n; ++j) {
+    const auto p = static_cast<std::size_t>(2 * j), q = static_cast<std::size_t>(2 * ((j + 1) % n));
+    twice += a[p] * a[q + 1] - a[q] * a[p + 1];
+  }
+  return 0.5 * std::abs(twice);
+}
+
 }  // namespace
+
+void FloorWorld::Rows(std::size_t i, const dReal* nrm, double e0[3], double e1[3]) const {
+  const Tread& t = treads_[i];
+  const dBodyID body = dGeomGetBody(geoms_[i]);
+  double len = 0.0;
+  if (body && (t.axle[0] != 0.0 || t.axle[1] != 0.0 || t.axle[2] != 0.0)) {
+    dVector3 axle;
+    dBodyVectorToWorld(body, t.axle[0], t.axle[1], t.axle[2], axle);
+    e0[0] = axle[1] * nrm[2] - axle[2] * nrm[1];
+    e0[1] = axle[2] * nrm[0] - axle[0] * nrm[2];
+    e0[2] = axle[0] * nrm[1] - axle[1] * nrm[0];
+    len = std::sqrt(e0[0] * e0[0] + e0[1] * e0[1] + e0[2] * e0[2]);
+  }
+  if (len < 1e-6) {
+    // No rolling direction: map x on the contact plane, or map y if x is
+    // the normal.
+    const double axis[3] = {std::abs(nrm[0]) < 0.9 ? 1.0 : 0.0,
+                            std::abs(nrm[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+    const double an = axis[0] * nrm[0] + axis[1] * nrm[1];
+    for (int d = 0; d < 3; ++d) e0[d] = axis[d] - an * nrm[d];
+    len = std::sqrt(e0[0] * e0[0] + e0[1] * e0[1] + e0[2] * e0[2]);
+  }
+  for (int d = 0; d < 3; ++d) e0[d] /= len;
+  e1[0] = nrm[1] * e0[2] - nrm[2] * e0[1];
+  e1[1] = nrm[2] * e0[0] - nrm[0] * e0[2];
+  e1[2] = nrm[0] * e0[1] - nrm[1] * e0[0];
+}
+
+FloorWorld::Patch FloorWorld::PatchAt(std::size_t i, const dContactGeom& g, int surface) const {
+  Patch patch;
+  if (surface > belt_count()) return patch;  // a terrain piece: one surface
+  const Tread& t = treads_[i];
+  const bool point = !(t.patch_length_m > 0.0 && t.patch_width_m > 0.0);
+  double e0[3], e1[3];
+  Rows(i, g.normal, e0, e1);
+  // The patch's corners on the floor plane (its rows made horizontal).
+  const double l0 = std::hypot(e0[0], e0[1]);
+  const double ax = l0 > 1e-9 ? e0[0] / l0 : 1.0, ay = l0 > 1e-9 ? e0[1] / l0 : 0.0;
+  const double hl = 0.5 * t.patch_length_m, hw = 0.5 * t.patch_width_m;
+  const double reach = std::hypot(hl, hw);
+  const double area = t.patch_length_m * t.patch_width_m;
+  double gap = 0.0;
+  patch.own_share = 0.0;
+  int kept = 0;
+  for (std::size_t k = 0; k < belts_.size(); ++k) {
+    const BeltPatch& b = belts_[k];
+    const auto& u = belt_axes_[k];
+    const double dx = g.pos[0] - b.center_x_m, dy = g.pos[1] - b.center_y_m;
+    const double along = dx * u[0] + dy * u[1], across = dx * u[2] + dy * u[3];
+    const double bl = 0.5 * b.length_m, bw = 0.5 * b.width_m, bg = b.edge_gap_m;
+    double in = 0.0, out_gap = 0.0;
+    if (point) {
+      const bool on = std::abs(along) <= bl && std::abs(across) <= bw;
+      in = on ? 1.0 : 0.0;
+      out_gap = !on && std::abs(along) <= bl + bg && std::abs(across) <= bw + bg ? 1.0 : 0.0;
+    } else {
+      if (std::abs(along) >= bl + bg + reach || std::abs(across) >= bw + bg + reach) continue;
+      if (std::abs(along) <= bl - reach && std::abs(across) <= bw - reach) {
+        in = 1.0;
+      } else {
+        // Corners in the belt's frame: centre +- hl rolling +- hw across.
+        const double ra = ax * u[0] + ay * u[1], rc = ax * u[2] + ay * u[3];  // rolling dir
+        const double sa = -rc, sc = ra;                                     // across it
+        std::array<double, 8> quad{};
+        const double cs[4][2] = {{hl, hw}, {-hl, hw}, {-hl, -hw}, {hl, -hw}};
+        for (int c = 0; c < 4; ++c) {
+          quad[static_cast<std::size_t>(2 * c)] = along + cs[c][0] * ra + cs[c][1] * sa;
+          quad[static_cast<std::size_t>(2 * c + 1)] = across + cs[c][0] * rc + cs[c][1] * sc;
+        }
+        in = AreaInBox(quad, bl, bw) / area;
+        out_gap = bg > 0.0 ? AreaInBox(quad, bl + bg, bw + bg) / area - in : 0.0;
+      }
+    }
+    gap += out_gap;
+    if (in <= 0.0) continue;
+    // Keep the kPatchBelts largest shares.
+    std::size_t slot = 0;
+    if (kept < kPatchBelts) {
+      slot = static_cast<std::size_t>(kept++);
+    } else {
+      slot = patch.belt_share[0] < patch.belt_share[1] ? 0 : 1;
+      if (patch.belt_share[slot] >= in) continue;
+    }
+    patch.belt[slot] = static_cast<int>(k);
+    patch.belt_share[slot] = in;
+  }
+  patch.own_share = std::max(0.0, 1.0 - patch.belt_share[0] - patch.belt_share[1] - gap);
+  return patch;
+}
+
+void FloorWorld::PatchSurface(std::size_t i, const Patch& patch, int s, double v[3],
+                              double* mu) const {
+  v[0] = v[1] = v[2] = 0.0;
+  const double support = patch.Support();
+  if (!(support > 0.0)) {
+    *mu = 0.0;
+    return;
+  }
+  // The surface the point touches: the floor (0) on the plane, else its
+  // terrain piece, still either way.
+  const int own = s > belt_count() ? s : 0;
+  double weighted_mu = patch.own_share * SurfaceMu(i, own);
+  for (std::size_t b = 0; b < static_cast<std::size_t>(kPatchBelts); ++b) {
+    const int k = patch.belt[b];
+    if (k < 0) continue;
+    const double w = patch.belt_share[b];
+    weighted_mu += w * SurfaceMu(i, k + 1);
+    const auto& bv = belt_velocity_mps_[static_cast<std::size_t>(k)];
+    v[0] += w * bv[0];
+    v[1] += w * bv[1];
+  }
+  v[0] /= support;
+  v[1] /= support;
+  *mu = weighted_mu / support;
+}
 
 void FloorWorld::AddObstacle(const models::Solid& solid) {
   double z = 0.0;
@@ -380,7 +539,7 @@ void FloorWorld::CollideMoving(dGeomID body_geom, const Aabb& body) {
   }
 }
 
-int FloorWorld::AddGeom(dGeomID geom) {
+int FloorWorld::AddGeom(dGeomID geom, Tread tread) {
   geoms_.push_back(geom);
   GeomContact c;
   const dReal* p = dGeomGetPosition(geom);
@@ -388,6 +547,8 @@ int FloorWorld::AddGeom(dGeomID geom) {
   c.y_m = p[1];
   contacts_.push_back(c);
   points_.emplace_back();
+  treads_.push_back(std::move(tread));
+  tread_states_.emplace_back();
   collided_ = false;
   return static_cast<int>(geoms_.size()) - 1;
 }
@@ -396,7 +557,66 @@ void FloorWorld::ClearGeoms() {
   geoms_.clear();
   contacts_.clear();
   points_.clear();
+  treads_.clear();
+  tread_states_.clear();
   collided_ = false;
+}
+
+std::vector<double> FloorWorld::TreadStates() const {
+  std::vector<double> out;
+  out.reserve(tread_states_.size() * kTreadStateReals);
+  for (const TreadState& t : tread_states_) {
+    out.insert(out.end(), t.deflection, t.deflection + 3);
+    out.insert(out.end(), t.force_dir, t.force_dir + 3);
+  }
+  return out;
+}
+
+void FloorWorld::SetTreadStates(std::span<const double> values) {
+  if (values.size() != tread_states_.size() * kTreadStateReals) {
+    throw std::invalid_argument("FloorWorld: " + std::to_string(values.size()) +
+                                " tread state values for " +
+                                std::to_string(tread_states_.size()) + " treads");
+  }
+  for (std::size_t i = 0; i < tread_states_.size(); ++i) {
+    const double* v = values.data() + i * kTreadStateReals;
+    TreadState& t = tread_states_[i];
+    std::copy(v, v + 3, t.deflection);
+    std::copy(v + 3, v + 6, t.force_dir);
+  }
+}
+
+void FloorWorld::ResetTreads() {
+  for (TreadState& t : tread_states_) t = TreadState{};
+}
+
+double FloorWorld::TreadEnergy() const {
+  double energy = 0.0;
+  for (std::size_t i = 0; i < treads_.size(); ++i) {
+    const TreadState& t = tread_states_[i];
+    for (int r = 0; r < 2; ++r) {
+      const double d = t.e[r][0] * t.deflection[0] + t.e[r][1] * t.deflection[1] +
+                       t.e[r][2] * t.deflection[2];
+      energy += 0.5 * t.support * treads_[i].stiffness_n_per_m[r] * d * d;
+    }
+  }
+  return energy;
+}
+
+void FloorWorld::PatchVelocity(int i, double* vx_mps, double* vy_mps) const {
+  const auto k = static_cast<std::size_t>(i);
+  const Points& pts = points_[k];
+  *vx_mps = 0.0;
+  *vy_mps = 0.0;
+  if (pts.count == 0) return;
+  std::size_t deepest = 0;
+  for (std::size_t j = 1; j < static_cast<std::size_t>(pts.count); ++j) {
+    if (pts.contact[j].geom.depth > pts.contact[deepest].geom.depth) deepest = j;
+  }
+  double v[3], mu = 0.0;
+  PatchSurface(k, pts.patch[deepest], pts.surface[deepest], v, &mu);
+  *vx_mps = v[0];
+  *vy_mps = v[1];
 }
 
 int FloorWorld::SurfaceAt(double x_m, double y_m) const {
@@ -414,7 +634,9 @@ int FloorWorld::SurfaceAt(double x_m, double y_m) const {
   return 0;
 }
 
-double FloorWorld::SurfaceMu(int s) const {
+double FloorWorld::SurfaceMu(std::size_t i, int s) const {
+  const std::vector<double>& own = treads_[i].mu;
+  if (s >= 0 && static_cast<std::size_t>(s) < own.size()) return own[static_cast<std::size_t>(s)];
   if (s > belt_count()) return terrain_[static_cast<std::size_t>(s - belt_count() - 1)].mu;
   return s > 0 ? belts_[static_cast<std::size_t>(s - 1)].mu : surface_.mu;
 }
@@ -469,7 +691,11 @@ void FloorWorld::Collide(std::size_t i) {
     c.x_m = p[0];
     c.y_m = p[1];
     c.depth_m = 0.0;
+    c.support_share = 0.0;
     return;
+  }
+  for (std::size_t j = 0; j < static_cast<std::size_t>(n); ++j) {
+    pts.patch[j] = PatchAt(i, pts.contact[j].geom, pts.surface[j]);
   }
   double sx = 0.0, sy = 0.0;
   std::size_t deepest = 0;
@@ -483,6 +709,7 @@ void FloorWorld::Collide(std::size_t i) {
   c.y_m = sy / n;
   c.surface = pts.surface[deepest];
   c.depth_m = pts.contact[deepest].geom.depth;
+  c.support_share = pts.patch[deepest].Support();
 }
 
 void FloorWorld::Probe() {
@@ -491,58 +718,156 @@ void FloorWorld::Probe() {
   collided_ = true;
 }
 
-void FloorWorld::MakeJoints(std::size_t i, double erp, double cfm) {
-  const auto tangent = [](const dReal* nrm, const double v[3], double out[3]) {
-    const double vn = v[0] * nrm[0] + v[1] * nrm[1] + v[2] * nrm[2];
-    for (int d = 0; d < 3; ++d) out[d] = v[d] - vn * nrm[d];
-    return std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
-  };
+void FloorWorld::MakeJoints(std::size_t i, double h_s, double erp, double cfm) {
   Points& pts = points_[i];
-  for (std::size_t j = 0; j < static_cast<std::size_t>(pts.count); ++j) {
+  const Tread& tread = treads_[i];
+  TreadState& state = tread_states_[i];
+  const dBodyID body = dGeomGetBody(geoms_[i]);
+  const auto n_points = static_cast<std::size_t>(pts.count);
+  pts.joints = 0;
+  if (n_points == 0) return;
+  const bool rolls = tread.axle[0] != 0.0 || tread.axle[1] != 0.0 || tread.axle[2] != 0.0;
+  const dReal* centre_v = body ? dBodyGetLinearVel(body) : nullptr;
+  // The shared deflection's share per point: each point's rows carry
+  // 1 / n of the tread's stiffness and damping (their forces add up).
+  const double per_point = 1.0 / static_cast<double>(n_points);
+  std::size_t deepest = 0;
+  for (std::size_t j = 0; j < n_points; ++j) {
+    if (pts.contact[j].geom.depth > pts.contact[deepest].geom.depth) deepest = j;
+  }
+  for (std::size_t j = 0; j < n_points; ++j) {
     dContact& p = pts.contact[j];
     const dReal* nrm = p.geom.normal;
-    double vx = 0.0, vy = 0.0;
-    SurfaceVelocity(pts.surface[j], &vx, &vy);
-    const double surface[3] = {vx, vy, 0.0};
-    // Slip of the body's contact point over the surface, at step start.
-    const dBodyID body = dGeomGetBody(p.geom.g1);
-    dVector3 point_v = {0.0, 0.0, 0.0, 0.0};
-    if (body) dBodyGetPointVel(body, p.geom.pos[0], p.geom.pos[1], p.geom.pos[2], point_v);
-    const double slip[3] = {point_v[0] - vx, point_v[1] - vy, point_v[2]};
-    double t1[3], fallback[3];
-    const double slip_mps = tangent(nrm, slip, t1);
-    const double surface_mps = tangent(nrm, surface, fallback);
-    if (slip_mps > kSlipAlignMps) {
-      for (double& e : t1) e /= slip_mps;
-    } else if (surface_mps > 0.0) {
-      for (int d = 0; d < 3; ++d) t1[d] = fallback[d] / surface_mps;
-    } else {
-      // Sticking on a still surface: any tangent will do; map x on the
-      // plane, or map y if x is the normal.
-      const double axis[3] = {std::abs(nrm[0]) < 0.9 ? 1.0 : 0.0,
-                              std::abs(nrm[0]) < 0.9 ? 0.0 : 1.0, 0.0};
-      const double len = tangent(nrm, axis, t1);
-      for (double& e : t1) e /= len;
-    }
-    // ODE's second friction direction is normal x fdir1.
-    const double t2[3] = {nrm[1] * t1[2] - nrm[2] * t1[1], nrm[2] * t1[0] - nrm[0] * t1[2],
-                          nrm[0] * t1[1] - nrm[1] * t1[0]};
-    const bool sliding = slip_mps > kSlipAlignMps;
+    double e[2][3], v_surface[3], mu = 0.0;
+    Rows(i, nrm, e[0], e[1]);
+    PatchSurface(i, pts.patch[j], pts.surface[j], v_surface, &mu);
+    const double support = pts.patch[j].Support();
     p.surface.mode = dContactApprox1 | dContactSoftCFM | dContactSoftERP | dContactMotion1 |
-                     dContactMotion2 | dContactFDir1 | (sliding ? dContactSlip2 : 0);
-    p.surface.mu = SurfaceMu(pts.surface[j]);
-    p.surface.slip2 = 1.0 / surface_.slip_damping_n_s_per_m;
+                     dContactMotion2 | dContactFDir1 | dContactSlip1 | dContactSlip2 | dContactMu2;
+    double motion[2], slip[2], bound[2], relax[2];
+    const double* u = state.force_dir;
+    const bool saturated = u[0] != 0.0 || u[1] != 0.0 || u[2] != 0.0;
+    for (int r = 0; r < 2; ++r) {
+      const double* er = e[r];
+      // Forward speed of the wheel centre over the surface: the rate at
+      // which new tread enters the patch (a block never relaxes).
+      const double vx = centre_v && rolls ? e[0][0] * (centre_v[0] - v_surface[0]) +
+                                                e[0][1] * (centre_v[1] - v_surface[1]) +
+                                                e[0][2] * centre_v[2]
+                                          : 0.0;
+      relax[r] = 1.0 / (1.0 + h_s * std::abs(vx) / tread.relaxation_m[r]);
+      const double k = support * per_point * tread.stiffness_n_per_m[r] * relax[r];
+      const double d = support * per_point * tread.damping_n_s_per_m[r];
+      const double delta = er[0] * state.deflection[0] + er[1] * state.deflection[1] +
+                           er[2] * state.deflection[2];
+      const double surface_along = er[0] * v_surface[0] + er[1] * v_surface[1];
+      if (h_s * k + d > 0.0) {
+        slip[r] = 1.0 / (h_s * k + d);
+        motion[r] = surface_along - k * slip[r] * delta;  // (erp / h) delta, erp = h k slip
+      } else {
+        slip[r] = 1.0;  // nothing under the patch: no friction (bound 0)
+        motion[r] = surface_along;
+      }
+      // A saturated tread's mu split by its force direction, never below
+      // kMinMuShare: ODE's LCP fails on a friction row with a bound near 0
+      // and a large slip ("LCP internal error, s <= 0": seen at shares of
+      // 0.1 and below, none at 0.2). A row keeps 0.2 mu N at least, so a
+      // tread sliding along one row may carry up to 0.2 mu N across it
+      // (1.02 mu N in all) when the other row slides too.
+      bound[r] = saturated ? mu * std::max(kMinMuShare, std::abs(er[0] * u[0] + er[1] * u[1] +
+                                                                  er[2] * u[2]))
+                           : mu;
+    }
+    p.surface.mu = bound[0];
+    p.surface.mu2 = bound[1];
+    p.surface.slip1 = slip[0];
+    p.surface.slip2 = slip[1];
     p.surface.soft_erp = erp;
     p.surface.soft_cfm = cfm;
-    p.surface.motion1 = surface[0] * t1[0] + surface[1] * t1[1];
-    p.surface.motion2 = surface[0] * t2[0] + surface[1] * t2[1];
+    p.surface.motion1 = motion[0];
+    p.surface.motion2 = motion[1];
     p.surface.motionN = 0.0;
     p.surface.bounce = 0.0;
     p.surface.bounce_vel = 0.0;
-    for (int d = 0; d < 3; ++d) p.fdir1[d] = t1[d];
+    for (int d = 0; d < 3; ++d) p.fdir1[d] = e[0][d];
     const dJointID joint = dJointCreateContact(world_, group_, &p);
     // body1 = the moving geom's body, body2 = the static floor or piece (0).
     dJointAttach(joint, body, dGeomGetBody(p.geom.g2));
+    dJointSetFeedback(joint, &pts.feedback[j]);
+    if (j == deepest) {
+      std::copy(&e[0][0], &e[0][0] + 6, &state.e[0][0]);
+      state.relax[0] = relax[0];
+      state.relax[1] = relax[1];
+      state.mu = mu;
+      state.support = support;
+      std::copy(v_surface, v_surface + 3, state.surface_v);
+    }
+  }
+  pts.joints = static_cast<int>(n_points);
+}
+
+void FloorWorld::UpdateTread(std::size_t i, double h_s) {
+  Points& pts = points_[i];
+  TreadState& state = tread_states_[i];
+  const Tread& tread = treads_[i];
+  if (pts.joints == 0 || !(state.support > 0.0)) {
+    state = TreadState{};  // off the ground (or over a gap): the tread unloads
+    return;
+  }
+  // The step's normal load and the slip at its end, at the points it used.
+  const dBodyID body = dGeomGetBody(geoms_[i]);
+  double load = 0.0, slip[2] = {0.0, 0.0};
+  const double n_points = pts.joints;
+  for (std::size_t j = 0; j < static_cast<std::size_t>(pts.joints); ++j) {
+    const dContactGeom& g = pts.contact[j].geom;
+    const dReal* f = pts.feedback[j].f1;
+    load += f[0] * g.normal[0] + f[1] * g.normal[1] + f[2] * g.normal[2];
+    dVector3 v = {0.0, 0.0, 0.0, 0.0};
+    if (body) dBodyGetPointVel(body, g.pos[0], g.pos[1], g.pos[2], v);
+    for (int r = 0; r < 2; ++r) {
+      const double* er = state.e[r];
+      slip[r] += (er[0] * (v[0] - state.surface_v[0]) + er[1] * (v[1] - state.surface_v[1]) +
+                  er[2] * v[2]) /
+                 n_points;
+    }
+  }
+  // delta(t + h) = (delta + h v_slip) / (1 + h |V_x| / sigma) per row, and
+  // the force those springs and dampers ask for.
+  double delta[2], trial[2];
+  for (int r = 0; r < 2; ++r) {
+    const double* er = state.e[r];
+    const double d0 = er[0] * state.deflection[0] + er[1] * state.deflection[1] +
+                      er[2] * state.deflection[2];
+    delta[r] = (d0 + h_s * slip[r]) * state.relax[r];
+    trial[r] = -state.support * (tread.stiffness_n_per_m[r] * delta[r] +
+                                 tread.damping_n_s_per_m[r] * slip[r]);
+  }
+  const double limit = state.mu * std::max(load, 0.0);
+  const double trial_n = std::hypot(trial[0], trial[1]);
+  std::fill(state.force_dir, state.force_dir + 3, 0.0);
+  if (trial_n > limit) {
+    // Saturated: the next step's force is mu N along -slip while the tread
+    // slides, along the trial force while it barely moves.
+    const double slip_n = std::hypot(slip[0], slip[1]);
+    double u[2] = {trial[0] / trial_n, trial[1] / trial_n};
+    if (slip_n > kSlipAlignMps) {
+      u[0] = -slip[0] / slip_n;
+      u[1] = -slip[1] / slip_n;
+    }
+    for (int r = 0; r < 2; ++r) {
+      for (int d = 0; d < 3; ++d) state.force_dir[d] += u[r] * state.e[r][d];
+    }
+    // The bristles deflect no further than mu N holds them (elasto-plastic):
+    // the springs' force is scaled back onto the circle, which only takes
+    // energy out of the tread.
+    const double spring_n = state.support * std::hypot(tread.stiffness_n_per_m[0] * delta[0],
+                                                       tread.stiffness_n_per_m[1] * delta[1]);
+    if (spring_n > limit) {
+      for (double& d : delta) d *= limit / spring_n;
+    }
+  }
+  for (int d = 0; d < 3; ++d) {
+    state.deflection[d] = delta[0] * state.e[0][d] + delta[1] * state.e[1][d];
   }
 }
 
@@ -551,11 +876,14 @@ bool FloorWorld::Step(double h_s) {
   int ok = 0;
   try {
     if (!collided_) Probe();
-    for (std::size_t i = 0; i < geoms_.size(); ++i) MakeJoints(i, erp, cfm);
+    for (std::size_t i = 0; i < geoms_.size(); ++i) MakeJoints(i, h_s, erp, cfm);
     CollideObjects(erp, cfm);
     ok = dWorldStep(world_, h_s);
     travel_elapsed_s_ += h_s;
     moving_elapsed_s_ += h_s;
+    if (ok != 0) {
+      for (std::size_t i = 0; i < geoms_.size(); ++i) UpdateTread(i, h_s);
+    }
     dJointGroupEmpty(group_);
     // At the new positions: for contact(i) now and the next step's joints.
     if (ok != 0) Probe();

@@ -53,6 +53,9 @@ struct BeltPatch {
   double width_m = 1.0;        // across it
   double direction_rad = 0.0;  // of the length axis, counter-clockwise from map x
   double mu = 0.8;             // Coulomb coefficient of a wheel on its surface
+  // Width of the open gap between the belt's edges and the floor around it
+  // (outside `length` x `width`): a contact patch over it carries nothing.
+  double edge_gap_m = 0.0;
 };
 
 /// The belt travel over which a carried object (its footprint at zero
@@ -61,16 +64,39 @@ struct BeltPatch {
 /// max < 0 when it does not lie on the belt at zero travel.
 std::array<double, 2> CarriedTravelRange(const BeltPatch& b, const models::Solid& solid);
 
-/// Contact parameters shared by every contact with the floor and the belts
-/// (each belt has its own mu: BeltPatch::mu).
+/// Normal contact parameters shared by every contact with the floor and the
+/// belts (each belt has its own mu: BeltPatch::mu), and the floor's mu.
 struct ContactSurface {
   double mu = 0.8;                 // Coulomb coefficient on the floor (dContactApprox1)
   double stiffness_n_per_m = 1e6;  // per contact point
   double damping_n_s_per_m = 1e4;  // per contact point
-  // A sliding contact's resistance to sideways slip (across its slip
-  // direction), bounded by mu N; see FloorWorld.
-  double slip_damping_n_s_per_m = 1e5;
 };
+
+/// The tread of one registered geom: a transient (relaxation-length) brush
+/// tyre. Index 0 is along the rolling direction (longitudinal), 1 across it
+/// (lateral). The tread's tangential deflection delta obeys
+///   d(delta)/dt = v_slip - (|V_x| / sigma) delta,  F = -k delta - d v_slip,
+/// |F| <= mu N (see FloorWorld), with k = C / sigma (C the slip stiffness).
+struct Tread {
+  double stiffness_n_per_m[2] = {0.0, 0.0};   // k = C / sigma
+  double damping_n_s_per_m[2] = {0.0, 0.0};   // d
+  double relaxation_m[2] = {1.0, 1.0};        // sigma; a geom without axle never relaxes
+  // The contact patch (along the rolling direction, across it); 0: a point.
+  double patch_length_m = 0.0;
+  double patch_width_m = 0.0;
+  // The wheel's axle in its body's frame: the rolling direction is axle x
+  // normal. All zero: a block (no rolling direction, no relaxation; rows
+  // along map x and y projected on the contact plane).
+  double axle[3] = {0.0, 0.0, 0.0};
+  // Coulomb coefficient of this tread on each surface index (as
+  // GeomContact: floor, belts, terrain pieces); empty: the surfaces' own.
+  std::vector<double> mu;
+};
+
+/// The saved state of one tread (FloorWorld::TreadStates): its deflection
+/// and the direction of its saturated force (zero when it was not
+/// saturated), both in map.
+inline constexpr std::size_t kTreadStateReals = 6;
 
 /// What one geom touched in the last collision pass (the end of the last
 /// Step, or Probe).
@@ -83,6 +109,9 @@ struct GeomContact {
   double x_m = 0.0;  // mean contact point in map, or the geom position without contact
   double y_m = 0.0;
   double depth_m = 0.0;  // penetration of the deepest contact point (0 without contact)
+  // Share of the deepest point's contact patch over each kind of ground:
+  // the surface it touches (floor or terrain piece), the belts, the gaps.
+  double support_share = 0.0;  // 1 - gap share (0 without contact)
 };
 
 /// Owns the dWorld (gravity -z), a joint group for contacts and the static
@@ -100,25 +129,58 @@ struct GeomContact {
 /// and the static floor as body2 (0), so with motion_i = fdir_i . v_surface
 /// a sticking contact point moves with the surface.
 ///
-/// Friction: dContactApprox1 bounds each friction row by mu N on its own (a
-/// pyramid, not Coulomb's cone), so the rows' orientation matters. With
-/// fdir1 fixed along the belt and along map x on the floor, a braked robot
-/// straddling a belt edge turned at 0.267 rad/s with the scene along map x
-/// and at 0.222 rad/s with the same scene turned by 45 deg. So a contact
-/// point that slides over its surface faster than kSlipAlignMps (slip taken
-/// at the start of the step) gets one friction row along its slip with
-/// bound mu N (Coulomb sliding friction, the same in any orientation:
-/// 0.2305 rad/s for every turn of that scene; 0.229 rad/s from the
-/// quasi-static Coulomb balance). Its second row, across the slip, is not
-/// left frictionless: taking the slip direction from the step's start, a
-/// free sideways row let a contact's slip swing by 90 degrees each step (a
-/// 2 ms limit cycle of the wheel rates, 8 % of their value, whenever a robot
-/// fought the belt). It is a damper instead (ODE force-dependent slip,
-/// dContactSlip2): force = slip_damping x sideways slip, bounded by mu N.
-/// At 1e5 N.s/m it cuts that cycle tenfold and keeps the straddle scene at
-/// 0.2304 rad/s; 1e6 would stiffen it into a pyramid again (0.213 rad/s).
-/// A slower (sticking) contact keeps both rows, fdir1 along the surface
-/// velocity, or map x on the still floor.
+/// Tyres (Tread): every registered geom (a wheel) meets the ground through a
+/// transient brush tyre, the first-order (relaxation-length) approximation
+/// of the brush model (Pacejka, Tire and Vehicle Dynamics, ch. 3 and 7). Its
+/// tangential deflection delta (a 3-vector in map, in the contact plane: the
+/// bristle tips stay on the ground when the wheel steers) obeys, per row i
+/// (0 along the rolling direction e0 = axle x normal, 1 across it, e1 =
+/// normal x e0),
+///   d(delta_i)/dt = v_slip,i - (|V_x| / sigma_i) delta_i,
+///   F_i = -k_i delta_i - d_i v_slip,i,   |F| <= mu N,
+/// v_slip the contact point's velocity over the surface, V_x the wheel
+/// centre's along e0. Rolling at steady slip gives F = C slip (creep, C =
+/// k sigma); at standstill it is a spring (a parked robot holds). It is
+/// implicit inside ODE's LCP: a friction row satisfies
+///   fdir_i . v_body1 = motion_i - slip_i F_i
+/// (dContactSlip1/2 are the row's CFM, motion1/2 its right-hand side;
+/// contact.cpp and step.cpp of ODE 0.16), so with the relaxation taken
+/// implicitly (k' = k / (1 + h |V_x| / sigma)) motion_i = e_i . v_surface -
+/// (erp / h) delta_i, slip_i = 1 / (h k' + d), erp = h k' / (h k' + d) make
+/// F_i = -k delta_i(t + h) - d v_slip,i(t + h): stable at any stiffness and
+/// step. The Coulomb bound stays ODE's (dContactApprox1: mu N per row from
+/// the same LCP's normal force). After dWorldStep each tread's deflection
+/// is advanced with the new slip (the step's force read back through
+/// dJointFeedback); when the trial force -k delta - d v_slip exceeds mu N
+/// the tread saturates: its force is mu N along -v_slip while it slides
+/// (along the trial force while it barely moves), and delta is clipped to
+/// that force (elasto-plastic). The friction circle: the rows' bounds are
+/// mu N each (a square, the pyramid) while the tread is inside the circle
+/// (its forces are the springs', within mu N); once saturated, the next
+/// step splits mu between the rows by that direction (dContactMu2: mu |e_i
+/// . u|), so a sliding tread's force is mu N along its slip. What remains of
+/// the pyramid: the one step in which a tread leaves the circle may reach up
+/// to sqrt(2) mu N diagonally, and a saturated tread follows a turn of its
+/// force direction one step late. No spin (bore) torque: the patch acts at
+/// one point.
+///
+/// Patches: each contact point stands for a patch of Tread::patch_length
+/// x patch_width about it, along e0 and e1. On the floor plane the patch's
+/// area is split over the floor, the belts under it and their edge gaps
+/// (exact polygon areas, so a patch crossing a belt edge changes
+/// continuously); the point takes the area-weighted surface velocity and mu
+/// of its supported part, and its rows the supported share of k and d. One
+/// point per wheel keeps the dense LCP small; for the linear brush the
+/// patch's force is linear in its bristles' slip, so the average is exact
+/// for a surface velocity varying across the patch (along it a steady brush
+/// weights the leading part more: idealised as uniform). A terrain piece is
+/// one surface (no belts on it).
+///
+/// Sign of the surface motion: a contact joint enforces
+///   fdir_i . (v_body1 - v_body2) = motion_i   (i = 1, 2; fdir2 = n x fdir1)
+/// at the contact point (without slip). The moving geom's body is always
+/// attached as body1 and the static floor as body2 (0), so with motion_i =
+/// fdir_i . v_surface a sticking contact point moves with the surface.
 ///
 /// Terrain: rigid tilted boxes (models::TerrainPiece: ramps, a van's load
 /// floor, a bump) that the registered geoms (the wheels) stand on exactly as
@@ -171,11 +233,22 @@ class FloorWorld {
   void SetSurface(const ContactSurface& surface) { surface_ = surface; }
   const ContactSurface& surface() const { return surface_; }
 
-  /// Registers a geom attached to a body of this world; returns its index.
-  /// The caller keeps ownership and must remove it (ClearGeoms) before
-  /// destroying it.
-  int AddGeom(dGeomID geom);
+  /// Registers a geom attached to a body of this world, with its tread;
+  /// returns its index. The caller keeps ownership and must remove it
+  /// (ClearGeoms) before destroying it.
+  int AddGeom(dGeomID geom, Tread tread);
   void ClearGeoms();
+  /// Every tread's state (kTreadStateReals each, in geom order), for a
+  /// saved state; SetTreadStates takes them back (throws
+  /// std::invalid_argument for a wrong count). ResetTreads unloads them.
+  std::vector<double> TreadStates() const;
+  void SetTreadStates(std::span<const double> values);
+  void ResetTreads();
+  /// Elastic energy stored in the treads, sum of k_i delta_i^2 / 2 (J).
+  double TreadEnergy() const;
+  /// The surface velocity under geom i's contact patch (its deepest point;
+  /// zero without contact), area-weighted over the supported part.
+  void PatchVelocity(int i, double* vx_mps, double* vy_mps) const;
 
   /// The geom (attached to a body of this world) that collides with
   /// obstacles, carried objects and terrain pieces, or nullptr (none); the
@@ -253,17 +326,48 @@ class FloorWorld {
  private:
   // A box on a plane gives at most 4 points; room for odd shapes.
   static constexpr int kMaxPoints = 8;
-  // Slip speed above which a contact slides (one friction row along the
-  // slip): far below any sliding speed of interest, far above ODE's
-  // residual velocity of a sticking contact (about 1e-12 m/s).
+  // Slip speed above which a saturated tread slides (its force along -slip):
+  // far below any sliding speed of interest, far above ODE's residual
+  // velocity of a sticking contact (about 1e-12 m/s).
   static constexpr double kSlipAlignMps = 1e-4;
+  // Least share of mu a saturated tread's row keeps (see MakeJoints: ODE's
+  // LCP fails near 0).
+  static constexpr double kMinMuShare = 0.2;
 
-  // The contact points of one geom from its last Collide, and the surface
-  // (as SurfaceAt) under each.
+  // Belts a patch can lie on at once; a third one under the same patch is
+  // left out (belts are met one edge at a time).
+  static constexpr int kPatchBelts = 2;
+  // What lies under one contact point's patch: area shares of the surface
+  // the point touches (the floor, or its terrain piece), of up to
+  // kPatchBelts belts, the rest being gap.
+  struct Patch {
+    double own_share = 1.0;
+    std::array<int, kPatchBelts> belt{-1, -1};
+    std::array<double, kPatchBelts> belt_share{0.0, 0.0};
+    double Support() const { return own_share + belt_share[0] + belt_share[1]; }
+  };
+  // The contact points of one geom from its last Collide, the surface (as
+  // SurfaceAt) under each and its patch; the feedback of the joints the
+  // last Step made from them, and the rows they used.
   struct Points {
     std::array<dContact, kMaxPoints> contact{};
     std::array<int, kMaxPoints> surface{};
+    std::array<Patch, kMaxPoints> patch{};
+    std::array<dJointFeedback, kMaxPoints> feedback{};
     int count = 0;
+    int joints = 0;
+  };
+  // A tread's state and what the last MakeJoints computed for its update.
+  struct TreadState {
+    double deflection[3] = {0.0, 0.0, 0.0};
+    double force_dir[3] = {0.0, 0.0, 0.0};
+    // Rows, relaxation factors 1 / (1 + h |V_x| / sigma_i), patch friction,
+    // supported share and surface velocity of the deepest point, for the
+    // update after the step.
+    double e[2][3] = {};
+    double relax[2] = {1.0, 1.0};
+    double mu = 0.0, support = 0.0;
+    double surface_v[3] = {0.0, 0.0, 0.0};
   };
 
   /// Collides geom i with the floor and the near terrain into points_[i]
@@ -272,10 +376,19 @@ class FloorWorld {
   /// Lists again the obstacles and terrain pieces near the robot when the
   /// AABB of all its geoms left the listed region.
   void UpdateNear();
-  /// Coulomb coefficient of a wheel on surface index s (as GeomContact).
-  double SurfaceMu(int s) const;
-  /// Contact joints for the points of geom i.
-  void MakeJoints(std::size_t i, double erp, double cfm);
+  /// Coulomb coefficient of geom i's tread on surface index s (as
+  /// GeomContact).
+  double SurfaceMu(std::size_t i, int s) const;
+  /// The patch of geom i's contact point j (on surface `surface`).
+  Patch PatchAt(std::size_t i, const dContactGeom& g, int surface) const;
+  /// Rolling direction e0 and e1 = n x e0 of geom i at a contact normal.
+  void Rows(std::size_t i, const dReal* normal, double e0[3], double e1[3]) const;
+  /// Surface velocity (map) and friction over a patch on surface s.
+  void PatchSurface(std::size_t i, const Patch& patch, int s, double v[3], double* mu) const;
+  /// Contact joints for the points of geom i (the tyre rows of its tread).
+  void MakeJoints(std::size_t i, double h_s, double erp, double cfm);
+  /// After dWorldStep: advances geom i's tread deflection (saturation, clip).
+  void UpdateTread(std::size_t i, double h_s);
   /// Contact joints between the body geom and the objects it touches.
   void CollideObjects(double erp, double cfm);
   /// Contact joints for the points where body geom `body_geom` touches
@@ -348,6 +461,8 @@ class FloorWorld {
   double object_erp_ = 0.0, object_cfm_ = 0.0;
   std::vector<GeomContact> contacts_;
   std::vector<Points> points_;
+  std::vector<Tread> treads_;
+  std::vector<TreadState> tread_states_;
   // Whether points_ hold the current positions of every geom (a Probe or
   // Step since the last AddGeom, ClearGeoms or SetBelts).
   bool collided_ = false;

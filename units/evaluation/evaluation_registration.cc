@@ -1,6 +1,7 @@
 // Registers the evaluation family's unit types (see config/unit_registry.h).
 #include "config/unit_registry.h"
 #include "units/evaluation/clearance.h"
+#include "units/evaluation/end_peak.h"
 #include "units/evaluation/path_deviation.h"
 #include "units/evaluation/pose_error.h"
 #include "units/evaluation/robot_clearance.h"
@@ -36,6 +37,19 @@ const config::UnitTypeRegistrar kPathDeviation(
      "",
      {{"path", "list of points [x, y] (m): a polyline, or one point for a hold"}},
      MakePathDeviation});
+
+std::unique_ptr<cosim::Unit> MakeEndPeak(const UnitBuildContext& c) {
+  const auto count = c.reader.Integer(c.parameters, c.path, "count", 1, 1, 1024);
+  return std::make_unique<EndPeakUnit>(c.name, static_cast<int>(count));
+}
+
+const config::UnitTypeRegistrar kEndPeak(
+    {EndPeakUnit::kTypeName,
+     "largest absolute value of a set of signals (a robot's drive currents) over the last "
+     "`window` metres of its path",
+     "",
+     {{"count", "number of signals in the input `values` (default 1)"}},
+     MakeEndPeak});
 
 std::unique_ptr<cosim::Unit> MakeSurfaceVelocityError(const UnitBuildContext& c) {
   const auto sensors = c.reader.Integer(c.parameters, c.path, "sensors", 1, 1, 64);

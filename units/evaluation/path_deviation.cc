@@ -1,5 +1,6 @@
 #include "units/evaluation/path_deviation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -44,6 +45,8 @@ PathDeviationUnit::PathDeviationUnit(std::string name, std::vector<std::array<do
            "1 while the deviation has stayed within band and the robot is within band of the "
            "path's end along it (a hold: within band), else 0",
            {"position"});
+  v.Output("remaining", "m", &remaining_,
+           "path length ahead of that nearest point (0 for a held point)", {"position"});
 }
 
 std::vector<cosim::ParameterProblem> PathDeviationUnit::CheckParameters() const {
@@ -69,6 +72,7 @@ void PathDeviationUnit::Evaluate() {
   band_exceeded_ = out ? 1.0 : 0.0;
   const bool arrived = path_.size() < 2 || progress_ >= cumulative_m_.back() - band_;
   success_ = !out && arrived ? 1.0 : 0.0;
+  remaining_ = cumulative_m_.empty() ? 0.0 : std::max(0.0, cumulative_m_.back() - progress_);
 }
 
 cosim::StepResult PathDeviationUnit::DoStep(cosim::TimeNs, cosim::TimeNs) {

@@ -67,6 +67,7 @@ class PathDeviationUnit : public cosim::Unit {
   double progress_ = 0.0;
   bool exceeded_ = false;  // the deviation left the band at some step
   double band_exceeded_ = 0.0, success_ = 0.0;
+  double remaining_ = 0.0;
 };
 
 }  // namespace linesim::evaluation

@@ -94,6 +94,9 @@ DcMotorUnit::DcMotorUnit(std::string name, int count, MotorMode mode)
     speed_.assign(n, 0.0);
   } else {
     shaft_speed_.assign(n, 0.0);
+    line_torque_.assign(n, 0.0);
+    line_rate_.assign(n, 0.0);
+    line_slope_.assign(n, 0.0);
     shaft_slope_.assign(n, 0.0);
     previous_shaft_speed_.assign(n, 0.0);
   }
@@ -161,6 +164,21 @@ DcMotorUnit::DcMotorUnit(std::string name, int count, MotorMode mode)
              "torque delivered by the gearbox, eta N (k_t i - b N shaft_speed); rotor "
              "inertia not included",
              {"shaft_speed"});
+    // The motor's torque falls with its shaft speed (back-EMF, friction),
+    // within a step too. A physics unit that applies torque as given over a
+    // step makes that damping explicit: a light wheel on a creeping tyre
+    // then oscillates out of bounds. These give it the line to apply
+    // implicitly (the chassis as its joint's motor row).
+    v.Output("line_torque", "N.m", &line_torque_,
+             "torque on the torque-speed line at line_rate: eta N (k_t i - b N line_rate)", {});
+    v.Output("line_rate", "rad/s", &line_rate_,
+             "output shaft speed the current was integrated against at the step's end (the "
+             "held or extrapolated shaft_speed)",
+             {});
+    v.Output("line_slope", "N.m.s/rad", &line_slope_,
+             "d torque / d shaft speed with the current in equilibrium, -eta N^2 (b + k_t^2 / "
+             "R): L / R (0.28 ms for the RE 40) is short against a step",
+             {});
   }
 
   const auto size = static_cast<sunindextype>(count_ * states_per_motor_);
@@ -288,6 +306,11 @@ void DcMotorUnit::ComputeCoefficients() {
     di_di_[k] = -resistance_[k] * inv_l;
     di_dw_[k] = -torque_constant_[k] * inv_l;
     di_dv_[k] = inv_l;
+    if (mode_ == MotorMode::kCurrentOnly) {
+      line_slope_[k] =
+          -gear_efficiency_[k] * gear_ratio_[k] * gear_ratio_[k] *
+          (viscous_friction_[k] + torque_constant_[k] * torque_constant_[k] / resistance_[k]);
+    }
     if (mode_ == MotorMode::kFull) {
       const double n_eta = gear_ratio_[k] * gear_efficiency_[k];
       const double j_eff = rotor_inertia_[k] + load_inertia_[k] / (n_eta * gear_ratio_[k]);
@@ -357,6 +380,9 @@ void DcMotorUnit::ComputeOutputs() {
     } else {
       // Feedthrough: the torque uses the shaft speed input as it is now.
       w_rotor = gear_ratio_[kk] * shaft_speed_[kk];
+      line_torque_[kk] =
+          gear_efficiency_[kk] * gear_ratio_[kk] *
+          (torque_constant_[kk] * i - viscous_friction_[kk] * gear_ratio_[kk] * line_rate_[kk]);
     }
     current_[kk] = i;
     torque_[kk] = gear_efficiency_[kk] * gear_ratio_[kk] *
@@ -381,6 +407,7 @@ void DcMotorUnit::Initialize() {
       y_[static_cast<std::size_t>(2 * k + 1)] = gear_ratio_[kk] * initial_speed_[kk];
     }
   }
+  line_rate_ = shaft_speed_;
   ComputeOutputs();
   initialized_ = true;
   restart_pending_ = true;
@@ -481,6 +508,12 @@ cosim::StepResult DcMotorUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   const double* y = N_VGetArrayPointer(sun_->y);
   std::copy(y, y + y_.size(), y_.begin());
   end_time_ = t + dt;
+  if (mode_ == MotorMode::kCurrentOnly) {
+    for (std::size_t k = 0; k < line_rate_.size(); ++k) {
+      line_rate_[k] = held_shaft_speed_[k];
+      if (first_order_) line_rate_[k] += shaft_slope_[k] * (t1_s - held_since_s_);
+    }
+  }
   ComputeOutputs();
   restart_pending_ = false;
   return cosim::StepResult::kOk;

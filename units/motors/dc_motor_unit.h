@@ -127,6 +127,9 @@ class DcMotorUnit : public cosim::Unit {
   std::vector<double> voltage_, load_torque_, shaft_speed_;
   // Outputs.
   std::vector<double> current_, speed_, torque_;
+  // Current-only mode: the torque-speed line over the next step, torque
+  // line_torque_ + line_slope_ (w - line_rate_) at output shaft speed w.
+  std::vector<double> line_torque_, line_rate_, line_slope_;
 
   // Right-hand side coefficients per motor, from the parameters.
   std::vector<double> di_di_, di_dw_, di_dv_, dw_di_, dw_dw_, dw_dload_;

@@ -261,10 +261,38 @@ TEST(ChassisUnit, BrakedRobotStraddlingBeltEdgeTurns) {
 }
 
 // Guards against wrong drive torque signs, a missing reflected rotor
-// inertia, wrong body/map frames and a wrong drive_rate. Analytic: four
-// wheels at heading 0 each pushed by tau / r, rolling without slip:
+// inertia, wrong body/map frames, a wrong drive_rate and a tread without
+// creep. Analytic: four wheels at heading 0 each pushed by tau / r:
 //   a = 4 tau / r / (M + 4 J_axle / r^2),  J_axle = m_mod r^2 / 2 + J_drive,
-// and drive_rate = v / r (kinematics of rolling).
+// and drive_rate = v (1 + kappa) / r: the brush tyre's longitudinal creep
+// kappa = F / C_kappa under the traction F = M a / 4 each, C_kappa = c N,
+// N = M g / 4 (equal loads): kappa = a / (c g).
+// Guards the motors' torque-speed lines as implicit joint rows: each drive
+// motor gives tau = c (r0 - r) (drive_torque 0 at drive_torque_rate r0,
+// slope -c), a steep line for the wheel's inertia (h c / J_axle about 50 at
+// a 5 ms step, where the same torque applied explicitly diverges). The
+// wheels settle at r0, the robot at r0 times the rolling radius (nothing
+// resists on a level floor), and a negative r0 drives backwards.
+TEST(ChassisUnit, TorqueSpeedLinesAreAppliedImplicitly) {
+  const double c = 40.0;
+  for (const double r0 : {3.0, -2.0}) {
+    SCOPED_TRACE(r0);
+    auto robot = Raw3();
+    ChassisUnit& u = *robot;
+    Set(u, "drive_friction", 0.0);
+    u.Initialize();
+    SetArray(u, "drive_torque", {0.0, 0.0, 0.0, 0.0});
+    SetArray(u, "drive_torque_slope", {-c, -c, -c, -c});
+    SetArray(u, "drive_torque_rate", {r0, r0, r0, r0});
+    TimeNs t = 0;
+    Advance(u, t, 400, 5 * kMs);
+    for (double w : Get(u, "drive_rate")) EXPECT_NEAR(w, r0, 1e-3 * std::abs(r0));
+    EXPECT_NEAR(Get(u, "body_linear_velocity")[0], r0 * kWheelRadiusM,
+                2e-3 * std::abs(r0) * kWheelRadiusM);
+    EXPECT_NEAR(Get(u, "yaw_rate")[0], 0.0, 1e-3);
+  }
+}
+
 TEST(ChassisUnit, EqualDriveTorquesAccelerateForward) {
   const double tau_nm = 2.0, yaw0 = 0.5;
   const double r = kWheelRadiusM;
@@ -293,7 +321,13 @@ TEST(ChassisUnit, EqualDriveTorquesAccelerateForward) {
     const double s_m = 0.5 * a * t_s * t_s;
     EXPECT_NEAR(std::hypot(p[0], p[1]), s_m, 0.01 * s_m);
     EXPECT_NEAR(std::atan2(p[1], p[0]), yaw0, 1e-2);
-    for (double w : Get(u, "drive_rate")) EXPECT_NEAR(w, bv[0] / r, 1e-3 * bv[0] / r);
+    // The traction is the body's share M a / 4 (the modules' own inertia
+    // is driven through the joints, not the tread).
+    const double body_a = 4.0 * (tau_nm / r - j_axle / r / r * a) / kMassKg;
+    const double kappa = body_a / (kRaw3Tread.slip_stiffness * kGravityMps2);
+    for (double w : Get(u, "drive_rate")) {
+      EXPECT_NEAR(w, bv[0] * (1.0 + kappa) / r, 2e-3 * bv[0] / r);
+    }
   }
   // Negative torques drive backwards.
   auto robot = Raw3();
@@ -544,8 +578,8 @@ TEST(ChassisUnit, SaveRestoreIsBitForBit) {
 // Guards the unit's own check of its internal state (the variable count
 // matches, so only RestoreInternal can refuse): an initialised state holds
 // 13 reals per body (position 3, quaternion 4, linear and angular velocity
-// 3 each) for the body and 4 modules, and one integer; one saved before
-// Initialize holds no reals.
+// 3 each) for the body and 4 modules, 6 per tread (deflection and force
+// direction) and one integer; one saved before Initialize holds no reals.
 TEST(ChassisUnit, RestoreRefusesTruncatedInternalState) {
   auto robot = Raw3();
   ChassisUnit& u = *robot;
@@ -553,7 +587,7 @@ TEST(ChassisUnit, RestoreRefusesTruncatedInternalState) {
   ASSERT_TRUE(before_init.reals.empty());
   u.Initialize();
   const cosim::UnitState saved = u.SaveState();
-  ASSERT_EQ(saved.reals.size(), 13u * 5u);
+  ASSERT_EQ(saved.reals.size(), 13u * 5u + 6u * 4u);
   ASSERT_EQ(saved.integers.size(), 1u);
   cosim::UnitState short_reals = saved;
   short_reals.reals.pop_back();
@@ -624,10 +658,13 @@ TEST(ChassisUnit, RobotSpecificParametersHaveNoDefault) {
     EXPECT_EQ(p.message, "must be set (robot-specific: no default)") << p.variable;
     if (names.empty() || names.back() != p.variable) names.push_back(p.variable);
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"body_length", "body_width", "body_height",
-                                             "body_bottom", "mass", "module_mass", "com_height",
-                                             "wheel_radius", "wheel_x", "wheel_y",
-                                             "steer_rotor_inertia", "drive_rotor_inertia"}));
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "body_length", "body_width", "body_height", "body_bottom", "mass",
+                       "module_mass", "com_height", "wheel_radius", "wheel_x", "wheel_y",
+                       "steer_rotor_inertia", "drive_rotor_inertia", "tread_slip_stiffness",
+                       "tread_cornering_stiffness", "tread_longitudinal_relaxation",
+                       "tread_lateral_relaxation", "tread_damping_ratio", "tread_patch_length",
+                       "tread_patch_width"}));
   EXPECT_THROW(u.Initialize(), cosim::UnitError);
   // Without a steerable wheel there is no steering rotor to ask for.
   ChassisUnit fixed("robot", {-1, -1}, {0, 1}, models::OpenFloor());
@@ -687,7 +724,7 @@ TEST(ChassisUnit, DeclaredRulesRefuseValuesOutsideThem) {
   EXPECT_EQ(rule("wheel_x"), "required");
   EXPECT_EQ(rule("steer_rotor_inertia"), "required, >= 0");
   EXPECT_EQ(rule("body_friction"), ">= 0");
-  EXPECT_EQ(rule("slip_damping"), "> 0");
+  EXPECT_EQ(rule("tread_slip_stiffness"), "required, > 0");
   EXPECT_EQ(rule("substeps"), "[1, 1000]");
   EXPECT_EQ(rule("initial_yaw"), "finite");
   // Without a steered wheel the steering rotor inertia has a default (0).
@@ -762,9 +799,9 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   car.width_m = 1.8;
   car.height_m = 1.2;
   bad.carried.push_back({"car", 0, car});
-  EXPECT_NE(scene_problem(bad).find(
-                "carried object 'car' overhangs the downstream end of belt 'belt'"),
-            std::string::npos)
+  EXPECT_NE(
+      scene_problem(bad).find("carried object 'car' overhangs the downstream end of belt 'belt'"),
+      std::string::npos)
       << scene_problem(bad);
   bad.carried[0].solid.x_m = 2.75;  // its front exactly at the end: on the belt
   EXPECT_EQ(scene_problem(bad), "");
@@ -810,6 +847,7 @@ TEST(ChassisUnit, ConstructorChecksTopologyAndScene) {
   Set(*three, "wheel_y", std::vector<double>{0.0, 0.26, -0.26});
   Set(*three, "steer_rotor_inertia", 0.0);
   Set(*three, "drive_rotor_inertia", 0.0);
+  SetTreads(*three, 3, kRaw3Tread);
   EXPECT_NO_THROW(three->Initialize());
   TimeNs t = 0;
   Advance(*three, t, 10);
@@ -950,7 +988,7 @@ TEST(ChassisUnit, NonFiniteInputOrStateFails) {
 // (notes: signals, one unit of measure per variable).
 using Expected = test_helpers::ExpectedVariable;
 
-std::vector<Expected> Parameters(std::size_t wheels) {
+std::vector<Expected> Parameters(std::size_t wheels, std::size_t surfaces) {
   using C = cosim::Causality;
   return {{"body_length", C::kParameter, "m", 0},
           {"body_width", C::kParameter, "m", 0},
@@ -972,7 +1010,14 @@ std::vector<Expected> Parameters(std::size_t wheels) {
           {"body_friction", C::kParameter, "1", 0},
           {"contact_stiffness", C::kParameter, "N/m", 0},
           {"contact_damping", C::kParameter, "N.s/m", 0},
-          {"slip_damping", C::kParameter, "N.s/m", 0},
+          {"tread_slip_stiffness", C::kParameter, "1", wheels},
+          {"tread_cornering_stiffness", C::kParameter, "1/rad", wheels},
+          {"tread_longitudinal_relaxation", C::kParameter, "m", wheels},
+          {"tread_lateral_relaxation", C::kParameter, "m", wheels},
+          {"tread_damping_ratio", C::kParameter, "1", wheels},
+          {"tread_patch_length", C::kParameter, "m", wheels},
+          {"tread_patch_width", C::kParameter, "m", wheels},
+          {"wheel_friction", C::kParameter, "1", wheels * surfaces},
           {"suspension_stiffness", C::kParameter, "N/m", 0},
           {"suspension_damping", C::kParameter, "N.s/m", 0},
           {"brake_torque", C::kParameter, "N.m", 0},
@@ -989,9 +1034,13 @@ TEST(ChassisUnit, VariableTable) {
   two.belts.push_back(two.belts[0]);
   auto robot = Raw3(two);
   EXPECT_EQ(robot->type_name(), "chassis");
-  std::vector<Expected> expected = Parameters(4);
+  std::vector<Expected> expected = Parameters(4, 2);
   const std::vector<Expected> swerve = {{"steer_torque", C::kInput, "N.m", 4},
                                         {"drive_torque", C::kInput, "N.m", 4},
+                                        {"steer_torque_slope", C::kInput, "N.m.s/rad", 4},
+                                        {"steer_torque_rate", C::kInput, "rad/s", 4},
+                                        {"drive_torque_slope", C::kInput, "N.m.s/rad", 4},
+                                        {"drive_torque_rate", C::kInput, "rad/s", 4},
                                         {"belt_velocity", C::kInput, "m/s", 4},
                                         {"belt_travel", C::kInput, "m", 2},
                                         {"brake", C::kInput, "", 0},
@@ -1017,17 +1066,26 @@ TEST(ChassisUnit, VariableTable) {
 
   // Skid-steer, no belts: no steer_* variables, one drive variable per motor.
   auto husky = Husky(models::OpenFloor());
-  expected = Parameters(4);
-  const std::vector<Expected> skid = {
-      {"drive_torque", C::kInput, "N.m", 2},  {"brake", C::kInput, "", 0},
-      {"drive_rate", C::kOutput, "rad/s", 2}, {"drive_angle", C::kOutput, "rad", 2},
-      {"position", C::kOutput, "m", 2},       {"yaw", C::kOutput, "rad", 0},
-      {"linear_velocity", C::kOutput, "m/s", 2}, {"yaw_rate", C::kOutput, "rad/s", 0},
-      {"body_linear_velocity", C::kOutput, "m/s", 2}, {"position_3d", C::kOutput, "m", 3},
-      {"orientation", C::kOutput, "1", 4},    {"velocity_3d", C::kOutput, "m/s", 3},
-      {"angular_velocity", C::kOutput, "rad/s", 3},
-      {"wheel_surface", C::kOutput, "1", 4},  {"wheel_surface_velocity", C::kOutput, "m/s", 8},
-      {"wheel_contact", C::kOutput, "m", 8},  {"body_box", C::kOutput, "m, rad, m/s, rad/s", 10}};
+  expected = Parameters(4, 1);
+  const std::vector<Expected> skid = {{"drive_torque", C::kInput, "N.m", 2},
+                                      {"drive_torque_slope", C::kInput, "N.m.s/rad", 2},
+                                      {"drive_torque_rate", C::kInput, "rad/s", 2},
+                                      {"brake", C::kInput, "", 0},
+                                      {"drive_rate", C::kOutput, "rad/s", 2},
+                                      {"drive_angle", C::kOutput, "rad", 2},
+                                      {"position", C::kOutput, "m", 2},
+                                      {"yaw", C::kOutput, "rad", 0},
+                                      {"linear_velocity", C::kOutput, "m/s", 2},
+                                      {"yaw_rate", C::kOutput, "rad/s", 0},
+                                      {"body_linear_velocity", C::kOutput, "m/s", 2},
+                                      {"position_3d", C::kOutput, "m", 3},
+                                      {"orientation", C::kOutput, "1", 4},
+                                      {"velocity_3d", C::kOutput, "m/s", 3},
+                                      {"angular_velocity", C::kOutput, "rad/s", 3},
+                                      {"wheel_surface", C::kOutput, "1", 4},
+                                      {"wheel_surface_velocity", C::kOutput, "m/s", 8},
+                                      {"wheel_contact", C::kOutput, "m", 8},
+                                      {"body_box", C::kOutput, "m, rad, m/s, rad/s", 10}};
   expected.insert(expected.end(), skid.begin(), skid.end());
   test_helpers::ExpectTable(*husky, expected);
 }

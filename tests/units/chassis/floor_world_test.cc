@@ -14,6 +14,18 @@ namespace {
 
 constexpr double kStepS = 1e-3;
 
+// A block's tread (no rolling direction): a shear spring of 1e5 N/m each
+// way, critically damped on the block's mass (d = 2 sqrt(k m)), so that a
+// block that stops sliding settles within a few ms (1 / sqrt(k / m) = 4.5
+// ms for 2 kg) instead of ringing on it.
+Tread BlockTread(double mass_kg) {
+  Tread t;
+  const double k = 1e5, d = 2.0 * std::sqrt(k * mass_kg);
+  t.stiffness_n_per_m[0] = t.stiffness_n_per_m[1] = k;
+  t.damping_n_s_per_m[0] = t.damping_n_s_per_m[1] = d;
+  return t;
+}
+
 // A free box resting on the floor plane, registered with the floor world.
 struct Box {
   dBodyID body = nullptr;
@@ -30,7 +42,7 @@ struct Box {
     dBodySetPosition(body, x_m, y_m, 0.5 * side_m - depth_m);
     geom = dCreateBox(nullptr, side_m, side_m, side_m);
     dGeomSetBody(geom, body);
-    f.AddGeom(geom);
+    f.AddGeom(geom, BlockTread(mass_kg));
   }
   // Declared after the world, so destroyed before it.
   ~Box() { dGeomDestroy(geom); }
@@ -120,7 +132,11 @@ TEST(FloorWorld, BoxFollowsBeltInAnyDirection) {
 // (ODE's dContactApprox1 pyramid would brake a diagonal slide with
 // sqrt(2) mu N). Analytic, Coulomb: a box sliding on the still floor
 // decelerates at mu g along its velocity, whatever that direction:
-// v(t) = v0 - mu g t, direction unchanged.
+// v(t) = v0 - mu g t, direction unchanged. The first step, in which the
+// tread leaves the friction circle, is bounded by the pyramid (each row mu
+// N): its velocity change mu g h may turn the direction by at most
+// mu g h / v0 = 4.9 mrad; from then on the saturated tread's force is along
+// -slip, and the direction holds.
 TEST(FloorWorld, SlidingFrictionIsCoulombInAnyDirection) {
   const double mu = 0.5, v0_mps = 1.0;
   for (const double dir_rad : {0.0, std::numbers::pi / 4.0, 2.0}) {
@@ -129,10 +145,13 @@ TEST(FloorWorld, SlidingFrictionIsCoulombInAnyDirection) {
     f.SetSurface({mu, 1e6, 1e4});
     Box box(f, 0.0, 0.0, 2.0, 0.2);
     dBodySetLinearVel(box.body, v0_mps * std::cos(dir_rad), v0_mps * std::sin(dir_rad), 0.0);
-    for (int i = 0; i < 100; ++i) ASSERT_TRUE(f.Step(kStepS));
+    ASSERT_TRUE(f.Step(kStepS));
+    const double after_first = std::atan2(box.vy(), box.vx());
+    EXPECT_NEAR(after_first, dir_rad, mu * kGravityMps2 * kStepS / v0_mps);
+    for (int i = 1; i < 100; ++i) ASSERT_TRUE(f.Step(kStepS));
     const double v_mps = v0_mps - mu * kGravityMps2 * 0.1;
     EXPECT_NEAR(std::hypot(box.vx(), box.vy()), v_mps, 0.01 * v_mps);
-    EXPECT_NEAR(std::atan2(box.vy(), box.vx()), dir_rad, 1e-6);
+    EXPECT_NEAR(std::atan2(box.vy(), box.vx()), after_first, 1e-6);
   }
 }
 
@@ -311,7 +330,7 @@ TEST(FloorWorld, SphereRollsOntoARampOverItsEdge) {
   dBodySetAngularVel(b, 0.0, 2.0 / r, 0.0);
   const dGeomID g = dCreateSphere(nullptr, r);
   dGeomSetBody(g, b);
-  f.AddGeom(g);
+  f.AddGeom(g, BlockTread(m));
   double deepest = 0.0;
   int most_points = 0;
   bool on_ramp = false;
@@ -330,6 +349,185 @@ TEST(FloorWorld, SphereRollsOntoARampOverItsEdge) {
   const dReal* p = dBodyGetPosition(b);
   EXPECT_GT(p[0], 1.3);
   EXPECT_NEAR(p[2], (p[0] - 1.0) * std::tan(pitch) + r / std::cos(pitch), 2e-3);
+  f.ClearGeoms();
+  dGeomDestroy(g);
+}
+
+
+// A wheel (a sphere on an axle along its body's y) whose centre is held by
+// a hinge to the world at the height that presses it in by load_n, free to
+// spin: the ground under it moves, the tread does the rest.
+struct HeldWheel {
+  dBodyID body = nullptr;
+  dGeomID geom = nullptr;
+  dJointID hinge = nullptr;
+  dJointFeedback feedback{};
+
+  HeldWheel(FloorWorld& f, double yaw_rad, double load_n, const Tread& tread) {
+    const double r = 0.1, m = 2.0;
+    body = dBodyCreate(f.world());
+    dMass mass;
+    dMassSetSphereTotal(&mass, m, r);
+    dBodySetMass(body, &mass);
+    dBodySetPosition(body, 0.0, 0.0, r - load_n / f.surface().stiffness_n_per_m);
+    dMatrix3 rot;
+    dRFromAxisAndAngle(rot, 0.0, 0.0, 1.0, yaw_rad);
+    dBodySetRotation(body, rot);
+    geom = dCreateSphere(nullptr, r);
+    dGeomSetBody(geom, body);
+    f.AddGeom(geom, tread);
+    hinge = dJointCreateHinge(f.world(), nullptr);
+    dJointAttach(hinge, body, nullptr);
+    const dReal* p = dBodyGetPosition(body);
+    dJointSetHingeAnchor(hinge, p[0], p[1], p[2]);
+    dJointSetHingeAxis(hinge, -std::sin(yaw_rad), std::cos(yaw_rad), 0.0);
+    dJointSetFeedback(hinge, &feedback);
+  }
+  ~HeldWheel() { dGeomDestroy(geom); }
+  HeldWheel(const HeldWheel&) = delete;
+  HeldWheel& operator=(const HeldWheel&) = delete;
+  // The force the ground puts on the wheel, from the hinge that holds it
+  // (the hinge's force on the wheel is minus that, plus the weight).
+  double Along(double yaw_rad) const {
+    return -(feedback.f1[0] * std::cos(yaw_rad) + feedback.f1[1] * std::sin(yaw_rad));
+  }
+  double Across(double yaw_rad) const {
+    return -(-feedback.f1[0] * std::sin(yaw_rad) + feedback.f1[1] * std::cos(yaw_rad));
+  }
+};
+
+// A rolling tread with cornering stiffness C and relaxation length sigma.
+Tread RollingTread(double c_n_per_rad, double sigma_m) {
+  Tread t;
+  for (int r = 0; r < 2; ++r) {
+    t.stiffness_n_per_m[r] = c_n_per_rad / sigma_m;
+    t.relaxation_m[r] = sigma_m;
+  }
+  t.axle[1] = 1.0;
+  return t;
+}
+
+// Guards the transient brush tyre's creep and relaxation (Pacejka, ch. 7):
+// a wheel held at slip angle alpha over a belt running at v builds its
+// lateral force as F(t) = C alpha (1 - exp(-v t / sigma)) (the first-order
+// relaxation; the deflection starts at 0), to the creep force C alpha far
+// below mu N. Numbers: C = 1000 N/rad, sigma = 0.05 m, alpha = 0.02 rad,
+// v = 0.2 m/s: C alpha = 20 N (mu N = 240 N), time constant 0.25 s. The
+// implicit step's relaxation is exp's first-order rational approximant:
+// at h = 1 ms, v h / sigma = 0.004, off by 0.2 % per time constant.
+TEST(FloorWorld, TreadCreepBuildsOverTheRelaxationLength) {
+  const double c = 1000.0, sigma = 0.05, alpha = 0.02, v = 0.2, load = 300.0;
+  FloorWorld f;
+  f.SetSurface({0.8, 1e6, 1e4});
+  f.SetBelts({{0.0, 0.0, 10.0, 10.0, 0.0, 0.8}});
+  // The wheel heads along -x turned by alpha: the belt (+x) runs under it
+  // backwards at v, with a lateral slip v sin(alpha).
+  const double yaw = std::numbers::pi + alpha;
+  HeldWheel wheel(f, yaw, load, RollingTread(c, sigma));
+  for (int i = 0; i < 300; ++i) ASSERT_TRUE(f.Step(kStepS));  // settle on the still belt
+  f.ResetTreads();
+  f.SetBeltVelocity(0, v, 0.0);
+  const double tau = sigma / v;
+  const double steady = c * std::sin(alpha) * v / std::abs(v * std::cos(alpha));
+  double at_tau = 0.0;
+  for (int i = 1; i <= 2000; ++i) {
+    ASSERT_TRUE(f.Step(kStepS));
+    if (i == static_cast<int>(std::lround(tau / kStepS))) at_tau = std::abs(wheel.Across(yaw));
+  }
+  // The wheel spins up within a few ms (its inertia on the longitudinal
+  // creep), so the relaxation starts at once.
+  EXPECT_NEAR(at_tau, steady * (1.0 - std::exp(-1.0)), 0.02 * steady);
+  EXPECT_NEAR(std::abs(wheel.Across(yaw)), steady, 0.01 * steady);
+  // Free to spin: no longitudinal force once it rolls with the belt.
+  EXPECT_NEAR(wheel.Along(yaw), 0.0, 0.01 * steady);
+  f.ClearGeoms();
+}
+
+// Guards against a contact that creates energy (a passive system's energy
+// never rises): a block put on a running belt slides, then sticks on its
+// tread; in the belt's frame (the only frame in which the belt does no
+// work) kinetic + potential + tread energy may only fall. Checked every
+// step, with a tolerance of 1e-6 J for the normal springs' rounding.
+TEST(FloorWorld, ContactsNeverCreateEnergyInTheBeltsFrame) {
+  const double v = 0.3, m = 2.0;
+  for (const bool sideways : {false, true}) {
+    SCOPED_TRACE(sideways);
+    FloorWorld f;
+    f.SetSurface({0.8, 1e6, 1e4});
+    f.SetBelts({{0.0, 0.0, 10.0, 10.0, 0.0, 0.8}});
+    Box box(f, 0.0, 0.0, m, 0.2);
+    for (int i = 0; i < 200; ++i) ASSERT_TRUE(f.Step(kStepS));
+    f.ResetTreads();
+    f.SetBeltVelocity(0, v, 0.0);
+    if (sideways) {
+      // A slow sideways push too, so that both rows work.
+      dBodySetLinearVel(box.body, 0.0, 0.05, 0.0);
+    }
+    const auto energy = [&] {
+      const dReal* lv = dBodyGetLinearVel(box.body);
+      const dReal* av = dBodyGetAngularVel(box.body);
+      dMass mass;
+      dBodyGetMass(box.body, &mass);
+      double rot = 0.0;  // w . I w in the body's frame: the cube's I is isotropic
+      for (int d = 0; d < 3; ++d) rot += mass.I[5 * d] * av[d] * av[d];
+      const double dv[3] = {lv[0] - v, lv[1], lv[2]};
+      return 0.5 * m * (dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]) + 0.5 * rot +
+             m * kGravityMps2 * dBodyGetPosition(box.body)[2] + f.TreadEnergy();
+    };
+    double before = energy(), rise = 0.0;
+    for (int i = 0; i < 500; ++i) {
+      ASSERT_TRUE(f.Step(kStepS));
+      const double now = energy();
+      rise = std::max(rise, now - before);
+      before = now;
+    }
+    EXPECT_LT(rise, 1e-6);
+    EXPECT_NEAR(box.vx(), v, 1e-6);  // stuck on the belt at the end
+  }
+}
+
+// Guards against a wheel whose surface velocity jumps where its patch
+// crosses a belt edge, and against a gap that carries friction: rolled
+// across the edge, the patch's surface velocity is the belt's share of its
+// area (a linear ramp over the patch length for an edge across the rolling
+// direction), and over the edge gap the supported share drops by the gap's
+// width over the patch length.
+TEST(FloorWorld, PatchCrossesABeltEdgeContinuously) {
+  const double length = 0.05, width = 0.04, gap = 0.01;
+  FloorWorld f;
+  f.SetSurface({0.8, 1e6, 1e4});
+  // The belt covers x > 0 (its edge at x = 0, across map y).
+  f.SetBelts({{5.0, 0.0, 10.0, 10.0, 0.0, 0.8, gap}});
+  f.SetBeltVelocity(0, 0.0, 0.4);
+  Tread tread = RollingTread(1000.0, 0.05);
+  tread.patch_length_m = length;
+  tread.patch_width_m = width;
+  const dBodyID b = dBodyCreate(f.world());
+  dMass mass;
+  dMassSetSphereTotal(&mass, 2.0, 0.1);
+  dBodySetMass(b, &mass);
+  const dGeomID g = dCreateSphere(nullptr, 0.1);
+  dGeomSetBody(g, b);
+  f.AddGeom(g, tread);
+  for (const double x : {-0.06, -0.04, -0.02, -0.015, 0.0, 0.01, 0.02, 0.03, 0.05}) {
+    SCOPED_TRACE(x);
+    dBodySetPosition(b, x, 0.0, 0.0999);
+    f.Probe();
+    // Area shares along x of the patch [x - 0.025, x + 0.025]: belt x > 0,
+    // gap -0.01 < x < 0, floor x < -0.01.
+    const auto overlap = [&](double lo, double hi) {
+      return std::clamp(std::min(hi, x + 0.5 * length) - std::max(lo, x - 0.5 * length), 0.0,
+                        length) /
+             length;
+    };
+    const double belt = overlap(0.0, 1.0), in_gap = overlap(-gap, 0.0);
+    const double support = 1.0 - in_gap;
+    double vx = 0.0, vy = 0.0;
+    f.PatchVelocity(0, &vx, &vy);
+    EXPECT_NEAR(f.contact(0).support_share, support, 1e-12);
+    EXPECT_NEAR(vy, 0.4 * belt / support, 1e-12);
+    EXPECT_EQ(vx, 0.0);
+  }
   f.ClearGeoms();
   dGeomDestroy(g);
 }

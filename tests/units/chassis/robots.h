@@ -84,6 +84,29 @@ inline void Set(cosim::Unit& u, const std::string& name, const cosim::Value& v) 
   u.variables().SetValue(*u.variables().Find(name), v);
 }
 
+/// A tread type (models/robots/*.yaml treads, with their sources there):
+/// slip stiffnesses per unit load, relaxation lengths, damping ratio, patch.
+struct TreadValues {
+  double slip_stiffness, cornering_stiffness, relaxation_m, damping_ratio, patch_length_m,
+      patch_width_m;
+};
+/// The Rob@Work 3's 160 mm polyurethane tread (raw3.yaml pu_160).
+inline constexpr TreadValues kRaw3Tread = {9.5, 9.5, 0.0069, 0.1, 0.014, 0.05};
+/// The Husky's 13 in pneumatic tyre (husky.yaml pneumatic_13in).
+inline constexpr TreadValues kHuskyTread = {6.9, 6.9, 0.041, 0.1, 0.081, 0.1143};
+
+/// Every wheel of `u` (n wheels) on tread `t`.
+inline void SetTreads(cosim::Unit& u, std::size_t n, const TreadValues& t) {
+  const auto all = [n](double v) { return std::vector<double>(n, v); };
+  Set(u, "tread_slip_stiffness", all(t.slip_stiffness));
+  Set(u, "tread_cornering_stiffness", all(t.cornering_stiffness));
+  Set(u, "tread_longitudinal_relaxation", all(t.relaxation_m));
+  Set(u, "tread_lateral_relaxation", all(t.relaxation_m));
+  Set(u, "tread_damping_ratio", all(t.damping_ratio));
+  Set(u, "tread_patch_length", all(t.patch_length_m));
+  Set(u, "tread_patch_width", all(t.patch_width_m));
+}
+
 /// Rob@Work 3: four modules, each its own steering and drive motor.
 inline std::unique_ptr<ChassisUnit> Raw3(models::Scene scene = models::OpenFloor(),
                                          const std::string& name = "robot") {
@@ -101,6 +124,7 @@ inline std::unique_ptr<ChassisUnit> Raw3(models::Scene scene = models::OpenFloor
   Set(*u, "wheel_y", std::vector<double>(kRaw3WheelYM, kRaw3WheelYM + 4));
   Set(*u, "steer_rotor_inertia", kRaw3SteerRotorKgm2);
   Set(*u, "drive_rotor_inertia", kRaw3DriveRotorKgm2);
+  SetTreads(*u, 4, kRaw3Tread);
   return u;
 }
 
@@ -128,6 +152,7 @@ inline std::unique_ptr<ChassisUnit> Husky(models::Scene scene, const std::string
   // confirmed"): the tests leave it out; none of their steady states
   // depends on an inertia.
   Set(*u, "drive_rotor_inertia", 0.0);
+  SetTreads(*u, 4, kHuskyTread);
   return u;
 }
 

@@ -48,6 +48,7 @@ TEST(PathDeviationUnit, OutputsFollowThePose) {
   u.UpdateOutputs();
   EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("deviation")), 0.04);
   EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("progress")), 3.0);
+  EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("remaining")), 1.0);  // of the 4 m path
   EXPECT_EQ(u.DoStep(0, 1'000'000), cosim::StepResult::kOk);
   EXPECT_DOUBLE_EQ(v.GetReal(*v.Find("deviation")), 0.04);
 }

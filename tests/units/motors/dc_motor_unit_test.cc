@@ -325,6 +325,40 @@ TEST(DcMotorUnit, CurrentOnlyTorqueFollowsNewShaftSpeedOnUpdate) {
   EXPECT_NEAR(Get(u, "torque")[0], eta * n * (m.kt * i - m.b * n * 30.0), 1e-12);
 }
 
+// Guards the torque-speed line a physics unit applies implicitly: with the
+// current settled at shaft speed w (L / R = 0.28 ms, 20 ms of 1 ms steps),
+// the line passes through the steady torque there and its slope is the
+// steady line's, so it gives the steady torque at any other speed w2:
+// eta N (k_t (V - k_t N w2) / R - b N w2) (the model's equations at di/dt = 0).
+TEST(DcMotorUnit, CurrentOnlyLineIsTheSteadyTorqueSpeedLine) {
+  const Motor m;
+  const double n = 21.0, eta = 0.75, v = 24.0;
+  const auto steady = [&](double w) {
+    return eta * n * (m.kt * (v - m.kt * n * w) / m.r - m.b * n * w);
+  };
+  for (const char* hold : {"zero_order", "first_order"}) {
+    SCOPED_TRACE(hold);
+    DcMotorUnit u("m", 1, MotorMode::kCurrentOnly);
+    SetAll(u, "gear_ratio", n);
+    SetAll(u, "gear_efficiency", eta);
+    u.variables().SetString(*u.variables().Find("shaft_speed_hold"), hold);
+    SetAll(u, "voltage", v);
+    SetAll(u, "shaft_speed", 10.0);
+    u.Initialize();
+    EXPECT_EQ(Get(u, "line_rate")[0], 10.0);
+    EXPECT_NEAR(Get(u, "line_slope")[0], -eta * n * n * (m.b + m.kt * m.kt / m.r), 1e-12);
+    for (cosim::TimeNs t = 0; t < 20 * kMs; t += kMs) {
+      ASSERT_EQ(u.DoStep(t, kMs), cosim::StepResult::kOk);
+    }
+    EXPECT_EQ(Get(u, "line_rate")[0], 10.0);
+    for (const double w2 : {0.0, 10.0, 25.0}) {
+      const double on_line =
+          Get(u, "line_torque")[0] + Get(u, "line_slope")[0] * (w2 - Get(u, "line_rate")[0]);
+      EXPECT_NEAR(on_line, steady(w2), 1e-6 * std::abs(steady(0.0)));
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------
 // (d) Guards against motors of one instance leaking into each other (state
 // or parameter indexing, Jacobian blocks). Each must match its own
@@ -715,7 +749,8 @@ class RigidLoad : public cosim::Unit {
 };
 
 TEST(DcMotorUnit, CurrentOnlyInALoopThroughTheMasterFollowsFullModel) {
-  // A quarter of the 120 kg Rob@Work 3 on an 80 mm wheel (paper 1, Table I; raw3-1 Platform.ini): m r^2.
+  // A quarter of the 120 kg Rob@Work 3 on an 80 mm wheel (paper 1, Table I; raw3-1 Platform.ini): m
+  // r^2.
   const double j_wheel = 30.0 * 0.08 * 0.08;
   Motor m;
   m.n = 21.0;
@@ -832,7 +867,10 @@ TEST(DcMotorUnit, VariableTableCurrentOnlyMode) {
                  {"voltage", C::kInput, "V", {}},
                  {"shaft_speed", C::kInput, "rad/s", {}},
                  {"current", C::kOutput, "A", {}},
-                 {"torque", C::kOutput, "N.m", {"shaft_speed"}}});
+                 {"torque", C::kOutput, "N.m", {"shaft_speed"}},
+                 {"line_torque", C::kOutput, "N.m", {}},
+                 {"line_rate", C::kOutput, "rad/s", {}},
+                 {"line_slope", C::kOutput, "N.m.s/rad", {}}});
 }
 
 // Guards against the defaults drifting from the data sheet they cite.
