@@ -73,6 +73,8 @@ void AddFlowError(SystemBuilder& b, Signals& s, RobotInfo& info) {
     }
     info.flow_reference_column = s.belt_ground_truth.Name();
   }
+}
+
 // The final approach's demand on the drives: the peak absolute current of
 // any drive motor over the path's last 2 m (a sticking skid-steer winds its
 // currents up there; steady motion needs the rolling resistance's and the
