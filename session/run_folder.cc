@@ -254,7 +254,8 @@ std::vector<OutputBound> OutputBounds(const loader::Scenario& s, const FolderOpt
     files.push_back({others > 0 ? "the plots.gp files" : "plots.gp", plots,
                      others > 0 ? "one per robot, with their data" : "with its data"});
     if (options.replay) {
-      const replay::ReplaySpec spec = replay::ReplaySpecFor(s, kPaperBoundM, kPaperBoundLabel);
+      const replay::ReplaySpec spec =
+          replay::ReplaySpecFor(s, s.robot->figure_bound.value_m, s.robot->figure_bound.label);
       const cosim::MasterOptions& o = s.master->options();
       const auto frames = std::max<cosim::TimeNs>(o.stop - o.start, 0) /
                               std::max<cosim::TimeNs>(1, spec.rates.frame_interval) +
