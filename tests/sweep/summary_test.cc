@@ -589,7 +589,8 @@ TEST_F(WriteSweepReportTest, WritesHistograms) {
   EXPECT_NE(script.find("exp(-0.5 *"), std::string::npos);
   EXPECT_NE(script.find("set arrow from -0.019, graph 0 to -0.019, graph 1"), std::string::npos)
       << script;
-  EXPECT_NE(script.find("paper 2, Table 1: std 0.005"), std::string::npos) << script;
+  EXPECT_NE(script.find("title 'source: paper 2, Table 1'"), std::string::npos) << script;
+  EXPECT_NE(script.find("source: std 0.005 m, as N(0, std)"), std::string::npos) << script;
 }
 
 // Guards Table 1 as files: ours (the 5 ok runs -2..2: max |x| 2, std

@@ -98,6 +98,8 @@ TEST(PoseFusionUnit, DeclaresItsVariables) {
                                 {"initial_yaw", Causality::kParameter, "rad", 0},
                                 {"odometry_velocity", Causality::kInput, "m/s", 2},
                                 {"odometry_yaw_rate", Causality::kInput, "rad/s", 0},
+                                {"base_pitch", Causality::kInput, "rad", 0},
+                                {"base_roll", Causality::kInput, "rad", 0},
                                 {"imu_angular_velocity", Causality::kInput, "rad/s", 3},
                                 {"match_position", Causality::kInput, "m", 2},
                                 {"match_yaw", Causality::kInput, "rad", 0},
