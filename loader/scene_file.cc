@@ -113,7 +113,7 @@ class SceneParser {
       r_.CheckKeys(item, p,
                    {"name", "friction", "texture_contrast", "illumination_lux", "flicker_hz",
                     "flicker_depth", "roughness_m", "roughness_length_m", "texture_period_m",
-                    "texture_periodic_share", "tread_friction"});
+                    "texture_periodic_share", "tread_friction", "unevenness"});
       models::Surface surface;
       surface.name = Name(item, p, surface_names_);
       // Rubber or polyurethane on floors and belts is 0.5-1.0; 3 leaves
@@ -125,7 +125,8 @@ class SceneParser {
         if (r_.ExpectMap(pairs, pp)) {
           for (const auto& kv : pairs) {
             const std::string material = kv.first.Scalar();
-            surface.tread_friction[material] = r_.Real(pairs, pp, material, std::nullopt, {0.0, 3.0});
+            surface.tread_friction[material] =
+                r_.Real(pairs, pp, material, std::nullopt, {0.0, 3.0});
           }
         }
       }
@@ -138,10 +139,48 @@ class SceneParser {
       surface.roughness_m = r_.Real(item, p, "roughness_m", 0.0, {0.0, 0.05});
       surface.roughness_length_m = r_.Real(item, p, "roughness_length_m", 0.01, {1e-4, 10.0});
       surface.texture_period_m = r_.Real(item, p, "texture_period_m", 0.0, {0.0, 1.0});
-      surface.texture_periodic_share =
-          r_.Real(item, p, "texture_periodic_share", 0.0, {0.0, 1.0});
+      surface.texture_periodic_share = r_.Real(item, p, "texture_periodic_share", 0.0, {0.0, 1.0});
+      if (const YAML::Node u = Child(item, "unevenness"); u.IsDefined()) {
+        surface.unevenness = Unevenness(u, JoinPath(p, "unevenness"));
+      }
       s_.surfaces.push_back(surface);
     }
+  }
+
+  // A surface's height profile (models/surface_profile.h): an ISO 8608
+  // class letter or its G_d(n0), the band and the seed.
+  models::Unevenness Unevenness(const YAML::Node& node, const std::string& path) {
+    models::Unevenness u;
+    if (!r_.ExpectMap(node, path)) return u;
+    r_.CheckKeys(node, path,
+                 {"iso8608_class", "psd_n0_m3", "waviness", "min_wavelength_m", "max_wavelength_m",
+                  "components", "seed"});
+    const bool by_class = Child(node, "iso8608_class").IsDefined();
+    if (by_class == Child(node, "psd_n0_m3").IsDefined()) {
+      r_.Error(node, path,
+               "expected one of iso8608_class (A to H) or psd_n0_m3 (G_d at 0.1 cycles/m)");
+      return u;
+    }
+    if (by_class) {
+      const std::string letter = r_.String(node, path, "iso8608_class", std::nullopt,
+                                           {"A", "B", "C", "D", "E", "F", "G", "H"});
+      if (letter.size() == 1) u.psd_n0_m3 = models::Iso8608ClassPsd(letter[0]);
+    } else {
+      // Class H's upper limit is 262144e-6 m^3 (ISO 8608).
+      u.psd_n0_m3 = r_.Real(node, path, "psd_n0_m3", std::nullopt, {0.0, 0.5});
+    }
+    u.waviness = r_.Real(node, path, "waviness", 2.0, {1.0, 4.0});
+    u.min_wavelength_m = r_.Real(node, path, "min_wavelength_m", 0.05, {1e-3, 100.0, true});
+    u.max_wavelength_m = r_.Real(node, path, "max_wavelength_m", 10.0, {1e-3, 1e3, true});
+    if (!(u.max_wavelength_m > u.min_wavelength_m)) {
+      r_.Error(
+          Child(node, "max_wavelength_m").IsDefined() ? Child(node, "max_wavelength_m") : node,
+          JoinPath(path, "max_wavelength_m"),
+          "expected more than min_wavelength_m (" + YAML::Node(u.min_wavelength_m).Scalar() + ")");
+    }
+    u.components = static_cast<int>(r_.Integer(node, path, "components", 32, 1, 256));
+    u.seed = static_cast<std::uint64_t>(r_.Integer(node, path, "seed", 1, 0, 1'000'000'000));
+    return u;
   }
 
   void FloorOf(const YAML::Node& floor, const std::string& path, const YAML::Node& root) {
@@ -177,11 +216,10 @@ class SceneParser {
 
   void Belts(const YAML::Node& list, const std::string& path) {
     for (const auto& [p, b] : Items(list, path)) {
-      r_.CheckKeys(
-          b, p,
-          {"name", "surface", "center_x_m", "center_y_m", "length_m", "width_m", "direction_deg",
-           "speed_mps", "speed_variation", "variation_period_s", "acceleration_mps2", "schedule",
-           "edge_gap_m"});
+      r_.CheckKeys(b, p,
+                   {"name", "surface", "center_x_m", "center_y_m", "length_m", "width_m",
+                    "direction_deg", "speed_mps", "speed_variation", "variation_period_s",
+                    "acceleration_mps2", "schedule", "edge_gap_m"});
       models::Belt belt;
       // A belt without a name is "belt_<index>"; without a surface its top
       // is the floor's covering.
@@ -222,7 +260,8 @@ class SceneParser {
     const models::Rect& a = belt.area;
     const double c = std::cos(a.direction_rad), s = std::sin(a.direction_rad);
     // Rounding of the rotation: a belt whose edge is the floor's is on it.
-    const double slack = 1e-9 * (1.0 + std::abs(a.center_x_m) + std::abs(a.center_y_m) + a.length_m);
+    const double slack =
+        1e-9 * (1.0 + std::abs(a.center_x_m) + std::abs(a.center_y_m) + a.length_m);
     for (const double u : {-0.5, 0.5}) {
       for (const double v : {-0.5, 0.5}) {
         const double x = a.center_x_m + c * u * a.length_m - s * v * a.width_m;
@@ -312,7 +351,8 @@ class SceneParser {
       r_.CheckKeys(item, p, {"name", "kind", "box", "cylinder"});
       models::Obstacle o;
       o.name = Name(item, p, names);
-      o.kind = r_.String(item, p, "kind", std::nullopt, {"wall", "pillar", "cart", "rack", "vehicle", "beacon"});
+      o.kind = r_.String(item, p, "kind", std::nullopt,
+                         {"wall", "pillar", "cart", "rack", "vehicle", "beacon"});
       if (auto solid = Shape(item, p, true)) o.solid = *solid;
       s_.obstacles.push_back(o);
     }

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "models/surface_profile.h"
+
 /// The typed description of a scene (models/scenes/*.yaml): the floor and
 /// its surfaces, the belts of the line, static obstacles, objects the belts
 /// carry, and 3D terrain pieces. Read once by the loader (loader/scene_file.h)
@@ -52,6 +54,10 @@ struct Surface {
   double texture_period_m = 0.0;
   /// Share (0..1) of the texture's contrast that is periodic.
   double texture_periodic_share = 0.0;
+  /// The height profile wheels ride on where this surface is the floor or a
+  /// terrain piece's top (belts stay level): ISO 8608's spectrum over a
+  /// band of wavelengths (models/surface_profile.h). Flat by default.
+  Unevenness unevenness = {};
   /// Coulomb coefficient per tread material (models::TreadDescription's
   /// material: rubber, polyurethane, ...): friction per pair of materials.
   std::map<std::string, double> tread_friction = {};

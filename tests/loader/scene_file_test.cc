@@ -140,8 +140,9 @@ TEST(SceneFile, CarriedCopiesAndSkidsRefuseWhatCannotBe) {
   EXPECT_NE(issues("wide", "[{skids: {gauge_m: 1.8}}]").find("scene.carried.0.skids.gauge_m"),
             std::string::npos);
   EXPECT_NE(issues("floor", "[{box: {bottom_m: 0}}]").find("bottom_m > 0"), std::string::npos);
-  EXPECT_NE(issues("clash", "[{}, {name: body_2, belt: line, box: {x_m: -3, y_m: 0, length_m: 1, "
-                            "width_m: 1, height_m: 1}}]")
+  EXPECT_NE(issues("clash",
+                   "[{}, {name: body_2, belt: line, box: {x_m: -3, y_m: 0, length_m: 1, "
+                   "width_m: 1, height_m: 1}}]")
                 .find("body_2"),
             std::string::npos);
   EXPECT_NE(issues("scalar", "[{copies: 3}]").find("scene.carried.0.copies"), std::string::npos);
@@ -195,6 +196,40 @@ TEST(SceneFile, RangesAndTypesAreChecked) {
   EXPECT_TRUE(Has(issues, "belts.0.speed_mps: value 0 is out of range: expected a number > 0"))
       << issues;
   EXPECT_TRUE(Has(issues, "carried.0.box.height_m: expected a number, got 'tall'")) << issues;
+}
+
+// Guards a surface's unevenness: a class letter gives ISO 8608's G_d(n0)
+// (class B: 64e-6 m^3) and the defaults; a class and a G_d at once, a
+// letter outside A-H, a band whose longest wavelength is not the longer,
+// and an unknown key are refused at their keys, all at once.
+TEST(SceneFile, UnevennessIsReadAndItsMistakesNamed) {
+  std::string text = kSmallScene;
+  const std::string surface = "illumination_lux: 500}";
+  text.replace(text.find(surface), surface.size(),
+               "illumination_lux: 500, unevenness: {iso8608_class: B, seed: 4}}");
+  const models::Scene scene = LoadSceneFile(WriteScenario("uneven_scene.yaml", text));
+  const models::Unevenness& u = scene.surfaces[0].unevenness;
+  EXPECT_DOUBLE_EQ(u.psd_n0_m3, 64e-6);
+  EXPECT_EQ(u.seed, 4u);
+  EXPECT_EQ(u.waviness, 2.0);
+  EXPECT_EQ(u.min_wavelength_m, 0.05);
+  EXPECT_EQ(u.max_wavelength_m, 10.0);
+  EXPECT_TRUE(
+      LoadSceneFile(WriteScenario("flat_scene.yaml", kSmallScene)).surfaces[0].unevenness.Flat());
+  const auto issues = [&](const std::string& name, const std::string& map) {
+    std::string bad = kSmallScene;
+    bad.replace(bad.find(surface), surface.size(),
+                "illumination_lux: 500, unevenness: " + map + "}");
+    return SceneIssues(WriteScenario(name, bad));
+  };
+  EXPECT_TRUE(Has(issues("both.yaml", "{iso8608_class: A, psd_n0_m3: 1e-5}"),
+                  "surfaces.0.unevenness: expected one of iso8608_class (A to H) or psd_n0_m3"));
+  EXPECT_TRUE(
+      Has(issues("letter.yaml", "{iso8608_class: Z}"), "surfaces.0.unevenness.iso8608_class"));
+  EXPECT_TRUE(
+      Has(issues("band.yaml", "{iso8608_class: A, min_wavelength_m: 2, max_wavelength_m: 1}"),
+          "surfaces.0.unevenness.max_wavelength_m: expected more than min_wavelength_m"));
+  EXPECT_TRUE(Has(issues("key.yaml", "{iso8608_class: A, sead: 2}"), "surfaces.0.unevenness.sead"));
 }
 
 // Guards the default: a scenario without `scene` gets the open floor, and
@@ -260,8 +295,8 @@ TEST(ScenarioScene, OverridesByIndexAndAddedItems) {
 // the floor's friction), a value out of range is reported as set on the
 // command line, and keys the file lacks are still refused with the closest.
 TEST(ScenarioScene, SetReachesTheNamedSceneFile) {
-  const std::string f = WriteScenario("named_scene.yaml", std::string(kValidScenario) +
-                                                              "scene: {model: factory_line}\n");
+  const std::string f = WriteScenario(
+      "named_scene.yaml", std::string(kValidScenario) + "scene: {model: factory_line}\n");
   const Scenario s =
       LoadScenario(f, {"scene.belts.0.speed_mps=0.2", "scene.surfaces.0.friction=0.5"});
   ASSERT_FALSE(s.scene.belts.empty());
@@ -277,8 +312,8 @@ TEST(ScenarioScene, SetReachesTheNamedSceneFile) {
 // Guards the merge by index: an empty list would silently remove nothing
 // from the scene file's list, so it is refused at its key.
 TEST(ScenarioScene, EmptyListOverTheFilesItemsIsRefused) {
-  const std::string f = WriteScenario("empty_list.yaml", std::string(kValidScenario) +
-                                                             "scene: {model: factory_line}\n");
+  const std::string f = WriteScenario(
+      "empty_list.yaml", std::string(kValidScenario) + "scene: {model: factory_line}\n");
   const std::string e = Issues(f, {"scene.obstacles=[]"});
   EXPECT_TRUE(Has(e, "scene.obstacles (set on the command line): an empty list removes nothing"))
       << e;
@@ -290,8 +325,8 @@ TEST(ScenarioScene, EmptyListOverTheFilesItemsIsRefused) {
 // key the user wrote: the scenario's scene key, or in a robot scenario the
 // line.belts key it came from; and over the open floor's surfaces too.
 TEST(ScenarioScene, EmptyListAtAnyDepthOverItemsIsRefused) {
-  const std::string f = WriteScenario("empty_nested.yaml", std::string(kValidScenario) +
-                                                               "scene: {model: factory_line}\n");
+  const std::string f = WriteScenario(
+      "empty_nested.yaml", std::string(kValidScenario) + "scene: {model: factory_line}\n");
   std::string e = Issues(f, {"scene.belts.0.schedule=[]"});
   EXPECT_TRUE(Has(e,
                   "scene.belts.0.schedule (set on the command line): an empty list removes "
@@ -299,23 +334,25 @@ TEST(ScenarioScene, EmptyListAtAnyDepthOverItemsIsRefused) {
       << e;
   const std::string hold = LINESIM_SOURCE_DIR "/scenarios/hold_on_belt.yaml";
   e = Issues(hold, {"line.belts.0.schedule=[]"});
-  EXPECT_TRUE(Has(e, "line.belts.0.schedule (set on the command line): an empty list removes "
-                     "nothing"))
+  EXPECT_TRUE(Has(e,
+                  "line.belts.0.schedule (set on the command line): an empty list removes "
+                  "nothing"))
       << e;
   EXPECT_FALSE(Has(e, "scene.belts")) << e;
   // Written in the file, it is refused at its line.
-  const std::string written = WriteScenario(
-      "empty_nested_written.yaml",
-      std::string(kValidScenario) +
-          "scene:\n  model: factory_line\n  belts:\n    - schedule: []\n");
+  const std::string written =
+      WriteScenario("empty_nested_written.yaml",
+                    std::string(kValidScenario) +
+                        "scene:\n  model: factory_line\n  belts:\n    - schedule: []\n");
   e = Issues(written);
   EXPECT_TRUE(Has(e, written + ":16: scene.belts.0.schedule: an empty list removes nothing")) << e;
   // Without model: the open floor's surfaces.
   const std::string open =
       WriteScenario("empty_open.yaml", std::string(kValidScenario) + "scene: {surfaces: []}\n");
   e = Issues(open);
-  EXPECT_TRUE(Has(e, "scene.surfaces: an empty list removes nothing: lists merge item by item "
-                     "onto the open floor's 1 items"))
+  EXPECT_TRUE(Has(e,
+                  "scene.surfaces: an empty list removes nothing: lists merge item by item "
+                  "onto the open floor's 1 items"))
       << e;
   // A list with items still merges.
   EXPECT_EQ(Issues(f, {"scene.belts.0.schedule=[{time_s: 0, on: false}]"}), "(no error)");
@@ -383,8 +420,8 @@ TEST(ScenarioScene, SetOnTheCommandLine) {
 // (factory_line's floor runs x -15 to 15 m); with neither or both set on
 // the command line, at the maximum as before.
 TEST(ScenarioScene, AContradictionIsReportedAtTheKeySetOnTheCommandLine) {
-  const std::string f = WriteScenario("floor_set.yaml", std::string(kValidScenario) +
-                                                            "scene: {model: factory_line}\n");
+  const std::string f = WriteScenario(
+      "floor_set.yaml", std::string(kValidScenario) + "scene: {model: factory_line}\n");
   const std::string min = Issues(f, {"scene.floor.min_x_m=20"});
   EXPECT_TRUE(Has(min, f + ": scene.floor.min_x_m (set on the command line): expected less than "
                            "max_x_m (15)"))
@@ -421,8 +458,7 @@ TEST(ScenarioScene, ABeltOffTheFloorIsRefused) {
   EXPECT_EQ(SceneIssues(WriteScenario("belt_edge.yaml", edge)), "(no error)");
   const std::string cross = LINESIM_SOURCE_DIR "/scenarios/cross_line.yaml";
   const std::string line = Issues(cross, {"line.belts.0.center_y_m=1000"});
-  EXPECT_TRUE(Has(line, "line.belts.0.center_y_m (set on the command line): belt "))
-      << line;
+  EXPECT_TRUE(Has(line, "line.belts.0.center_y_m (set on the command line): belt ")) << line;
   EXPECT_TRUE(Has(line, "lies off the floor: its corner (-10, 999) m")) << line;
 }
 

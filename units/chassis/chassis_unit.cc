@@ -628,10 +628,15 @@ void ChassisUnit::Build() {
   }
   f.SetBelts(std::move(belts));
   f.SetSurface({mu_of(scene_.floor.surface), contact_stiffness_, contact_damping_});
+  const auto profile_of = [&](int surface) {
+    return models::SurfaceProfile(scene_.surfaces[static_cast<std::size_t>(surface)].unevenness);
+  };
+  f.SetFloorProfile(profile_of(scene_.floor.surface));
   for (const models::Obstacle& obstacle : scene_.obstacles) f.AddObstacle(obstacle.solid);
   for (const models::CarriedObject& obj : scene_.carried) f.AddCarried(obj.solid, obj.belt);
-  for (const models::TerrainPiece& piece : scene_.terrain)
-    f.AddTerrain(piece, mu_of(piece.surface));
+  for (const models::TerrainPiece& piece : scene_.terrain) {
+    f.AddTerrain(piece, mu_of(piece.surface), profile_of(piece.surface));
+  }
 
   // Start with the contacts pressed in by equal shares of the weight, so
   // that the settle has little to do. The suspension starts unloaded (its

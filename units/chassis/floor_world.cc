@@ -102,7 +102,6 @@ dGeomID SolidGeom(const models::Solid& s, double* z_m) {
   return g;
 }
 
-
 // Area of the convex polygon `poly` (n vertices, x y pairs, counter-
 // clockwise or clockwise) inside the box |x| <= hx, |y| <= hy: clipped by
 // the box's four half-planes in turn (Sutherland-Hodgman), then the
@@ -163,8 +162,8 @@ void FloorWorld::Rows(std::size_t i, const dReal* nrm, double e0[3], double e1[3
   if (len < 1e-6) {
     // No rolling direction: map x on the contact plane, or map y if x is
     // the normal.
-    const double axis[3] = {std::abs(nrm[0]) < 0.9 ? 1.0 : 0.0,
-                            std::abs(nrm[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+    const double axis[3] = {std::abs(nrm[0]) < 0.9 ? 1.0 : 0.0, std::abs(nrm[0]) < 0.9 ? 0.0 : 1.0,
+                            0.0};
     const double an = axis[0] * nrm[0] + axis[1] * nrm[1];
     for (int d = 0; d < 3; ++d) e0[d] = axis[d] - an * nrm[d];
     len = std::sqrt(e0[0] * e0[0] + e0[1] * e0[1] + e0[2] * e0[2]);
@@ -209,7 +208,7 @@ FloorWorld::Patch FloorWorld::PatchAt(std::size_t i, const dContactGeom& g, int 
       } else {
         // Corners in the belt's frame: centre +- hl rolling +- hw across.
         const double ra = ax * u[0] + ay * u[1], rc = ax * u[2] + ay * u[3];  // rolling dir
-        const double sa = -rc, sc = ra;                                     // across it
+        const double sa = -rc, sc = ra;                                       // across it
         std::array<double, 8> quad{};
         const double cs[4][2] = {{hl, hw}, {-hl, hw}, {-hl, -hw}, {hl, -hw}};
         for (int c = 0; c < 4; ++c) {
@@ -273,15 +272,23 @@ void FloorWorld::AddObstacle(const models::Solid& solid) {
   collided_ = false;
 }
 
-void FloorWorld::AddTerrain(const models::TerrainPiece& t, double mu) {
+void FloorWorld::SetFloorProfile(const models::SurfaceProfile& profile) {
+  floor_profile_ = profile;
+  dGeomPlaneSetParams(floor_, 0.0, 0.0, 1.0, profile.bound_m());
+  collided_ = false;
+}
+
+void FloorWorld::AddTerrain(const models::TerrainPiece& t, double mu,
+                            const models::SurfaceProfile& profile) {
   if (!(t.length_m > 0.0 && t.width_m > 0.0 && t.thickness_m > 0.0)) {
     throw std::invalid_argument("FloorWorld: terrain piece '" + t.name +
                                 "' needs a positive length, width and thickness");
   }
   Terrain piece;
   piece.mu = mu;
-  piece.geom = dCreateBox(nullptr, t.length_m, t.width_m, t.thickness_m);
-  dGeomSetPosition(piece.geom, t.center_x_m, t.center_y_m, t.center_z_m);
+  piece.profile = profile;
+  piece.raise_m = profile.bound_m();
+  piece.geom = dCreateBox(nullptr, t.length_m, t.width_m, t.thickness_m + piece.raise_m);
   // R = Rz(yaw) Ry(-pitch) Rx(roll): + pitch raises the far (+length) end,
   // as models::TerrainPiece says (and units/sensors/ray_scene.cc draws it);
   // its columns are the piece's axes in map. ODE's rows hold 4 entries.
@@ -299,6 +306,10 @@ void FloorWorld::AddTerrain(const models::TerrainPiece& t, double mu) {
     rot[4 * r + 3] = 0.0;
   }
   dGeomSetRotation(piece.geom, rot);
+  // Thicker upwards by the profile's bound: the nominal bottom stays.
+  const double up = 0.5 * piece.raise_m;
+  dGeomSetPosition(piece.geom, t.center_x_m + up * az[0], t.center_y_m + up * az[1],
+                   t.center_z_m + up * az[2]);
   dGeomGetAABB(piece.geom, piece.aabb.data());
   terrain_.push_back(piece);
   near_region_ = {1.0, -1.0, 1.0, -1.0, 1.0, -1.0};  // list again
@@ -313,10 +324,12 @@ double FloorWorld::TerrainTopAt(double x_m, double y_m) const {
     dVector3 size;
     dGeomBoxGetLengths(t.geom, size);
     // The piece's axes (columns of R) and its top face's centre.
-    const double ax[3] = {r[0], r[4], r[8]}, ay[3] = {r[1], r[5], r[9]}, az[3] = {r[2], r[6], r[10]};
+    const double ax[3] = {r[0], r[4], r[8]}, ay[3] = {r[1], r[5], r[9]},
+                 az[3] = {r[2], r[6], r[10]};
     if (az[2] <= 0.0) continue;  // never for a tilt within +-89 deg
-    const double tc[3] = {c[0] + 0.5 * size[2] * az[0], c[1] + 0.5 * size[2] * az[1],
-                          c[2] + 0.5 * size[2] * az[2]};
+    // (The nominal top: a box stands raise_m above it for its profile.)
+    const double half = 0.5 * size[2] - t.raise_m;
+    const double tc[3] = {c[0] + half * az[0], c[1] + half * az[1], c[2] + half * az[2]};
     // The top face's plane above (x, y), and that point in the piece's axes.
     const double z = tc[2] - (az[0] * (x_m - tc[0]) + az[1] * (y_m - tc[1])) / az[2];
     const double d[3] = {x_m - tc[0], y_m - tc[1], z - tc[2]};
@@ -441,9 +454,9 @@ void FloorWorld::UpdateNear() {
 }
 
 void FloorWorld::CollideObjects(double erp, double cfm) {
-  if (body_geoms_.empty() || (near_obstacles_.empty() && near_terrain_.empty() &&
-                              carried_.empty() && moving_box_geoms_.empty() &&
-                              moving_cylinder_geoms_.empty())) {
+  if (body_geoms_.empty() ||
+      (near_obstacles_.empty() && near_terrain_.empty() && carried_.empty() &&
+       moving_box_geoms_.empty() && moving_cylinder_geoms_.empty())) {
     return;
   }
   object_erp_ = erp;
@@ -477,8 +490,8 @@ void FloorWorld::CollideObjects(double erp, double cfm) {
   }
 }
 
-void FloorWorld::SetMovingSolids(std::span<const double> boxes,
-                                 std::span<const double> cylinders, int own_box) {
+void FloorWorld::SetMovingSolids(std::span<const double> boxes, std::span<const double> cylinders,
+                                 int own_box) {
   own_box_ = own_box;
   using models::MovingBox;
   using models::MovingCylinder;
@@ -575,8 +588,8 @@ std::vector<double> FloorWorld::TreadStates() const {
 void FloorWorld::SetTreadStates(std::span<const double> values) {
   if (values.size() != tread_states_.size() * kTreadStateReals) {
     throw std::invalid_argument("FloorWorld: " + std::to_string(values.size()) +
-                                " tread state values for " +
-                                std::to_string(tread_states_.size()) + " treads");
+                                " tread state values for " + std::to_string(tread_states_.size()) +
+                                " treads");
   }
   for (std::size_t i = 0; i < tread_states_.size(); ++i) {
     const double* v = values.data() + i * kTreadStateReals;
@@ -595,8 +608,8 @@ double FloorWorld::TreadEnergy() const {
   for (std::size_t i = 0; i < treads_.size(); ++i) {
     const TreadState& t = tread_states_[i];
     for (int r = 0; r < 2; ++r) {
-      const double d = t.e[r][0] * t.deflection[0] + t.e[r][1] * t.deflection[1] +
-                       t.e[r][2] * t.deflection[2];
+      const double d =
+          t.e[r][0] * t.deflection[0] + t.e[r][1] * t.deflection[1] + t.e[r][2] * t.deflection[2];
       energy += 0.5 * t.support * treads_[i].stiffness_n_per_m[r] * d * d;
     }
   }
@@ -671,6 +684,7 @@ void FloorWorld::Collide(std::size_t i) {
   };
   int n = dCollide(geom, floor_, kMaxPoints, &pts.contact[0].geom, sizeof(dContact));
   orient(0, n, floor_, -1);
+  if (floor_profile_.bound_m() > 0.0) n = ToUnevenSurface(pts, 0, n, 0);
   if (!near_terrain_.empty()) {
     Aabb box;
     dGeomGetAABB(geom, box.data());
@@ -679,8 +693,9 @@ void FloorWorld::Collide(std::size_t i) {
       if (n >= kMaxPoints || !Overlap(box, t.aabb)) continue;
       const int m = dCollide(geom, t.geom, kMaxPoints - n,
                              &pts.contact[static_cast<std::size_t>(n)].geom, sizeof(dContact));
-      orient(n, n + m, t.geom, belt_count() + 1 + static_cast<int>(j));
-      n += m;
+      const int s = belt_count() + 1 + static_cast<int>(j);
+      orient(n, n + m, t.geom, s);
+      n = t.raise_m > 0.0 ? ToUnevenSurface(pts, n, n + m, s) : n + m;
     }
   }
   pts.count = n;
@@ -710,6 +725,63 @@ void FloorWorld::Collide(std::size_t i) {
   c.surface = pts.surface[deepest];
   c.depth_m = pts.contact[deepest].geom.depth;
   c.support_share = pts.patch[deepest].Support();
+}
+
+int FloorWorld::ToUnevenSurface(Points& pts, int from, int to, int s) const {
+  // The surface's plane: its axes (columns of R), a point of its nominal
+  // level and how far the collision geometry stands above that.
+  const models::SurfaceProfile* profile = &floor_profile_;
+  double ax[3] = {1.0, 0.0, 0.0}, ay[3] = {0.0, 1.0, 0.0}, az[3] = {0.0, 0.0, 1.0};
+  double origin[3] = {0.0, 0.0, 0.0};
+  double raise = floor_profile_.bound_m();
+  const int piece = s - belt_count() - 1;
+  if (piece >= 0) {
+    const Terrain& t = terrain_[static_cast<std::size_t>(piece)];
+    profile = &t.profile;
+    raise = t.raise_m;
+    const dReal* r = dGeomGetRotation(t.geom);
+    const dReal* c = dGeomGetPosition(t.geom);
+    dVector3 size;
+    dGeomBoxGetLengths(t.geom, size);
+    for (int k = 0; k < 3; ++k) {
+      ax[k] = r[4 * k];
+      ay[k] = r[4 * k + 1];
+      az[k] = r[4 * k + 2];
+    }
+    const double half = 0.5 * size[2] - raise;  // to the nominal top
+    for (int k = 0; k < 3; ++k) origin[k] = c[k] + half * az[k];
+  }
+  int kept = from;
+  for (int j = from; j < to; ++j) {
+    dContact& contact = pts.contact[static_cast<std::size_t>(j)];
+    dContactGeom& g = contact.geom;
+    const double facing = g.normal[0] * az[0] + g.normal[1] * az[1] + g.normal[2] * az[2];
+    double h = 0.0, dh_du = 0.0, dh_dv = 0.0;
+    // A belt is level (h = 0): only the floor around it is uneven.
+    const bool on_profile = piece >= 0 || pts.surface[static_cast<std::size_t>(j)] == 0;
+    if (on_profile) {
+      const double d[3] = {g.pos[0] - origin[0], g.pos[1] - origin[1], g.pos[2] - origin[2]};
+      const double u = ax[0] * d[0] + ax[1] * d[1] + ax[2] * d[2];
+      const double v = ay[0] * d[0] + ay[1] * d[1] + ay[2] * d[2];
+      h = profile->Height(u, v, &dh_du, &dh_dv);
+    }
+    const double drop = (raise - h) * facing;
+    g.depth -= drop;
+    if (!(g.depth > 0.0)) continue;
+    double nrm[3];
+    for (int k = 0; k < 3; ++k) {
+      g.pos[k] -= drop * az[k];
+      nrm[k] = g.normal[k] - facing * (dh_du * ax[k] + dh_dv * ay[k]);
+    }
+    const double len = std::sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    for (int k = 0; k < 3; ++k) g.normal[k] = nrm[k] / len;
+    if (kept != j) {
+      pts.contact[static_cast<std::size_t>(kept)] = contact;
+      pts.surface[static_cast<std::size_t>(kept)] = pts.surface[static_cast<std::size_t>(j)];
+    }
+    ++kept;
+  }
+  return kept;
 }
 
 void FloorWorld::Probe() {
@@ -751,15 +823,15 @@ void FloorWorld::MakeJoints(std::size_t i, double h_s, double erp, double cfm) {
       const double* er = e[r];
       // Forward speed of the wheel centre over the surface: the rate at
       // which new tread enters the patch (a block never relaxes).
-      const double vx = centre_v && rolls ? e[0][0] * (centre_v[0] - v_surface[0]) +
-                                                e[0][1] * (centre_v[1] - v_surface[1]) +
-                                                e[0][2] * centre_v[2]
-                                          : 0.0;
+      const double vx = centre_v && rolls
+                            ? e[0][0] * (centre_v[0] - v_surface[0]) +
+                                  e[0][1] * (centre_v[1] - v_surface[1]) + e[0][2] * centre_v[2]
+                            : 0.0;
       relax[r] = 1.0 / (1.0 + h_s * std::abs(vx) / tread.relaxation_m[r]);
       const double k = support * per_point * tread.stiffness_n_per_m[r] * relax[r];
       const double d = support * per_point * tread.damping_n_s_per_m[r];
-      const double delta = er[0] * state.deflection[0] + er[1] * state.deflection[1] +
-                           er[2] * state.deflection[2];
+      const double delta =
+          er[0] * state.deflection[0] + er[1] * state.deflection[1] + er[2] * state.deflection[2];
       const double surface_along = er[0] * v_surface[0] + er[1] * v_surface[1];
       if (h_s * k + d > 0.0) {
         slip[r] = 1.0 / (h_s * k + d);
@@ -774,8 +846,8 @@ void FloorWorld::MakeJoints(std::size_t i, double h_s, double erp, double cfm) {
       // 0.1 and below, none at 0.2). A row keeps 0.2 mu N at least, so a
       // tread sliding along one row may carry up to 0.2 mu N across it
       // (1.02 mu N in all) when the other row slides too.
-      bound[r] = saturated ? mu * std::max(kMinMuShare, std::abs(er[0] * u[0] + er[1] * u[1] +
-                                                                  er[2] * u[2]))
+      bound[r] = saturated ? mu * std::max(kMinMuShare,
+                                           std::abs(er[0] * u[0] + er[1] * u[1] + er[2] * u[2]))
                            : mu;
     }
     p.surface.mu = bound[0];
@@ -836,11 +908,11 @@ void FloorWorld::UpdateTread(std::size_t i, double h_s) {
   double delta[2], trial[2];
   for (int r = 0; r < 2; ++r) {
     const double* er = state.e[r];
-    const double d0 = er[0] * state.deflection[0] + er[1] * state.deflection[1] +
-                      er[2] * state.deflection[2];
+    const double d0 =
+        er[0] * state.deflection[0] + er[1] * state.deflection[1] + er[2] * state.deflection[2];
     delta[r] = (d0 + h_s * slip[r]) * state.relax[r];
-    trial[r] = -state.support * (tread.stiffness_n_per_m[r] * delta[r] +
-                                 tread.damping_n_s_per_m[r] * slip[r]);
+    trial[r] = -state.support *
+               (tread.stiffness_n_per_m[r] * delta[r] + tread.damping_n_s_per_m[r] * slip[r]);
   }
   const double limit = state.mu * std::max(load, 0.0);
   const double trial_n = std::hypot(trial[0], trial[1]);

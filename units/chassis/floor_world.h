@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "models/scene.h"
+#include "models/surface_profile.h"
 
 namespace linesim::chassis {
 
@@ -78,9 +79,9 @@ struct ContactSurface {
 ///   d(delta)/dt = v_slip - (|V_x| / sigma) delta,  F = -k delta - d v_slip,
 /// |F| <= mu N (see FloorWorld), with k = C / sigma (C the slip stiffness).
 struct Tread {
-  double stiffness_n_per_m[2] = {0.0, 0.0};   // k = C / sigma
-  double damping_n_s_per_m[2] = {0.0, 0.0};   // d
-  double relaxation_m[2] = {1.0, 1.0};        // sigma; a geom without axle never relaxes
+  double stiffness_n_per_m[2] = {0.0, 0.0};  // k = C / sigma
+  double damping_n_s_per_m[2] = {0.0, 0.0};  // d
+  double relaxation_m[2] = {1.0, 1.0};       // sigma; a geom without axle never relaxes
   // The contact patch (along the rolling direction, across it); 0: a point.
   double patch_length_m = 0.0;
   double patch_width_m = 0.0;
@@ -195,6 +196,21 @@ struct GeomContact {
 /// box edge turns its normal continuously about the edge (no cylinder-box,
 /// whose edge contacts ODE approximates).
 ///
+/// Uneven surfaces: the floor (outside the belts) and a terrain piece's top
+/// face may carry a height profile h(u, v) (models::SurfaceProfile, zero
+/// mean, |h| <= H = its bound) in their own plane's axes (the floor: map x,
+/// y; a piece: along, across). The collision geometry stands H above the
+/// nominal surface (the floor plane at z = H, a piece's box H thicker
+/// upwards), so a wheel touching the true surface anywhere is found; each
+/// point found is then moved onto the true surface: along the surface's
+/// normal n_s, its depth less (H - h) (n . n_s) and its normal tilted by the
+/// gradient, n + (n . n_s) R (-dh/du, -dh/dv, 0) normalised (R the plane's
+/// axes), so a face contact meets the tilted tangent plane and an edge or
+/// side contact (n . n_s near 0) stays as it was; a point left with no
+/// depth is dropped. A belt's contact points are level at z = 0 (depth
+/// less H). The depth is the vertical gap to the tangent plane at the
+/// point below the contact (exact to the slope's square).
+///
 /// Objects: static obstacles and belt-carried objects are collision
 /// geometry for the registered body geoms (the robot's body box and a
 /// payload's box; wheels touch the floor and the terrain only), collided
@@ -275,7 +291,11 @@ class FloorWorld {
   /// FloorWorld owns its geom. Surface index belt_count() + 1 + j for the
   /// j-th piece added (add belts first). Throws std::invalid_argument for a
   /// size that is not positive.
-  void AddTerrain(const models::TerrainPiece& piece, double mu);
+  void AddTerrain(const models::TerrainPiece& piece, double mu,
+                  const models::SurfaceProfile& profile = {});
+  /// The floor's height profile (the floor plane outside the belts; belts
+  /// stay level). See the class comment's "Uneven surfaces".
+  void SetFloorProfile(const models::SurfaceProfile& profile);
   int terrain_count() const { return static_cast<int>(terrain_.size()); }
   /// Height of the highest terrain top face above map point (x, y) (its
   /// edges included), or -infinity when no piece's top face is above it.
@@ -427,6 +447,8 @@ class FloorWorld {
   dThreadingImplementationID threading_ = nullptr;
   dJointGroupID group_ = nullptr;
   dGeomID floor_ = nullptr;
+  // The floor's profile; the plane stands at its bound.
+  models::SurfaceProfile floor_profile_;
   ContactSurface surface_;
   std::vector<BeltPatch> belts_;
   std::vector<std::array<double, 2>> belt_velocity_mps_;
@@ -441,7 +463,15 @@ class FloorWorld {
     dGeomID geom = nullptr;
     Aabb aabb{};
     double mu = 0.0;
+    // Its top face's profile, and how far its box stands above the
+    // nominal top for it (the profile's bound).
+    models::SurfaceProfile profile;
+    double raise_m = 0.0;
   };
+  /// Moves the contact points [from, to) of pts found on surface index s
+  /// (as GeomContact) onto its profile; returns the new count (points
+  /// without depth dropped, the rest kept in order from `from`).
+  int ToUnevenSurface(Points& pts, int from, int to, int s) const;
   std::vector<Terrain> terrain_;
   // The region the near lists hold for (empty at first: min > max), and
   // the obstacles and terrain pieces whose AABB overlaps it.

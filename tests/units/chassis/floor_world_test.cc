@@ -8,6 +8,8 @@
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 namespace linesim::chassis {
 namespace {
@@ -353,7 +355,6 @@ TEST(FloorWorld, SphereRollsOntoARampOverItsEdge) {
   dGeomDestroy(g);
 }
 
-
 // A wheel (a sphere on an axle along its body's y) whose centre is held by
 // a hinge to the world at the height that presses it in by load_n, free to
 // spin: the ground under it moves, the tread does the rest.
@@ -528,6 +529,102 @@ TEST(FloorWorld, PatchCrossesABeltEdgeContinuously) {
     EXPECT_NEAR(vy, 0.4 * belt / support, 1e-12);
     EXPECT_EQ(vx, 0.0);
   }
+  f.ClearGeoms();
+  dGeomDestroy(g);
+}
+
+// A sphere (a wheel without axle: the block tread) of radius r, mass m at
+// (x, y, z), registered with the floor world; returns its body.
+dBodyID RestingSphere(FloorWorld& f, double x, double y, double z, double r, double m,
+                      dGeomID* geom) {
+  const dBodyID b = dBodyCreate(f.world());
+  dMass mass;
+  dMassSetSphereTotal(&mass, m, r);
+  dBodySetMass(b, &mass);
+  dBodySetPosition(b, x, y, z);
+  *geom = dCreateSphere(nullptr, r);
+  dGeomSetBody(*geom, b);
+  f.AddGeom(*geom, BlockTread(m));
+  return b;
+}
+
+// Guards the floor's height profile (the class comment's "Uneven
+// surfaces"): a sphere set down anywhere on an ISO 8608 class C floor comes
+// to rest with its centre r + h(x, y) above the nominal floor, less its
+// static deflection m g / k (exact to the slope's square: r |grad h|^2 / 2,
+// under 0.1 mm here), and the contact normal is the surface's, (-grad h,
+// 1) normalised. A belt stays level: the same sphere on it rests at r.
+TEST(FloorWorld, SphereRestsOnTheFloorsProfile) {
+  models::Unevenness c;
+  c.psd_n0_m3 = models::Iso8608ClassPsd('C');
+  c.seed = 3;
+  const models::SurfaceProfile profile(c);
+  FloorWorld f;
+  f.SetSurface({0.8, 1e6, 1e4});
+  f.SetBelts({{5.0, 0.0, 2.0, 1.0, 0.0, 0.8}});
+  f.SetFloorProfile(profile);
+  const double r = 0.1, m = 2.0, sink = m * kGravityMps2 / 1e6;
+  const std::pair<double, double> spots[] = {{0.0, 0.0}, {1.3, -0.7}, {-2.1, 3.4}};
+  std::vector<dGeomID> geoms;
+  std::vector<dBodyID> bodies;
+  for (const auto& [x, y] : spots) {
+    const double h = profile.Height(x, y, nullptr, nullptr);
+    geoms.emplace_back();
+    bodies.push_back(RestingSphere(f, x, y, r + h + 0.001, r, m, &geoms.back()));
+  }
+  geoms.emplace_back();
+  bodies.push_back(RestingSphere(f, 5.0, 0.0, r + 0.001, r, m, &geoms.back()));
+  for (int i = 0; i < 500; ++i) ASSERT_TRUE(f.Step(kStepS));
+  for (std::size_t k = 0; k < 3; ++k) {
+    SCOPED_TRACE(k);
+    const dReal* p = dBodyGetPosition(bodies[k]);
+    double du = 0.0, dv = 0.0;
+    const double h = profile.Height(p[0], p[1], &du, &dv);
+    EXPECT_NEAR(p[2], r + h - sink, 1e-4);
+    EXPECT_EQ(f.contact(static_cast<int>(k)).surface, 0);
+  }
+  EXPECT_NEAR(dBodyGetPosition(bodies[3])[2], r - sink, 1e-6);
+  EXPECT_EQ(f.contact(3).surface, 1);
+  f.ClearGeoms();
+  for (dGeomID g : geoms) dGeomDestroy(g);
+}
+
+// Guards a terrain piece's profile: on a slope tilted 10 deg carrying the
+// same class C profile in its own axes, a sphere at rest stands r + h(u, v)
+// above the nominal top face along its normal (u, v along and across the
+// piece from its top's centre), and far above the nominal face (more than
+// the profile's bound) nothing touches.
+TEST(FloorWorld, SphereRestsOnATerrainPiecesProfile) {
+  models::Unevenness c;
+  c.psd_n0_m3 = models::Iso8608ClassPsd('C');
+  c.seed = 5;
+  const models::SurfaceProfile profile(c);
+  const double pitch = 10.0 * std::numbers::pi / 180.0;
+  FloorWorld f;
+  f.SetSurface({0.9, 1e6, 1e4});
+  f.AddTerrain(Slope(pitch), 0.9, profile);
+  const double r = 0.1, m = 2.0, sink = m * kGravityMps2 / 1e6;
+  // The top face's normal (-sin p, 0, cos p), its centre (0, 0, 1).
+  const double n[3] = {-std::sin(pitch), 0.0, std::cos(pitch)};
+  const double along[3] = {std::cos(pitch), 0.0, std::sin(pitch)};
+  const double u0 = 0.4;
+  const double h0 = profile.Height(u0, 0.0, nullptr, nullptr);
+  dGeomID g = nullptr;
+  const dBodyID b = RestingSphere(f, u0 * along[0] + (r + h0) * n[0], 0.0,
+                                  1.0 + u0 * along[2] + (r + h0) * n[2], r, m, &g);
+  for (int i = 0; i < 300; ++i) ASSERT_TRUE(f.Step(kStepS));
+  const dReal* p = dBodyGetPosition(b);
+  const double d[3] = {p[0], p[1], p[2] - 1.0};
+  const double u = d[0] * along[0] + d[2] * along[2];
+  const double v = d[1];
+  const double height = d[0] * n[0] + d[2] * n[2];
+  EXPECT_NEAR(height, r + profile.Height(u, v, nullptr, nullptr) - sink, 1e-4);
+  EXPECT_EQ(f.contact(0).surface, 1);
+  // Lifted by more than the bound above the nominal face: no contact.
+  dBodySetPosition(b, u0 * along[0] + (r + profile.bound_m() + 0.002) * n[0], 0.0,
+                   1.0 + u0 * along[2] + (r + profile.bound_m() + 0.002) * n[2]);
+  f.Probe();
+  EXPECT_EQ(f.contact(0).points, 0);
   f.ClearGeoms();
   dGeomDestroy(g);
 }
