@@ -126,6 +126,17 @@ class Unit {
   /// master checks; this catches start values and units stepped by hand.
   bool InputsFinite(TimeNs t);
 
+  /// For DoStep, UpdateOutputs and Initialize, where a signal in seconds
+  /// (a scan's or a match's time) becomes nanoseconds: the time, or a
+  /// UnitError naming the unit and `variable` when it is no time linesim
+  /// represents (cosim::TimeProblem: beyond kMaxTimeSeconds, below 1 ns,
+  /// not finite).
+  TimeNs InputTimeNs(double seconds, const std::string& variable) const;
+  /// The same where a count carried as a Real (an encoder's position in
+  /// counts) becomes an integer: `count` when it is finite and within
+  /// +-kMaxExactCount, else a UnitError naming `variable`.
+  double CheckCount(double count, const std::string& variable) const;
+
   /// For DoStep: record why the step failed and return kError.
   StepResult Fail(std::string message, std::string variable = {}) {
     last_error_ = std::move(message);

@@ -180,7 +180,7 @@ cosim::StepResult SafetyFieldUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     // In whole nanoseconds: the delay ends on the step it should, whatever
     // the step's rounding in seconds.
     clear_for_ += dt;
-    if (clear_for_ >= static_cast<cosim::TimeNs>(std::llround(restart_delay_ * 1e9))) {
+    if (clear_for_ >= cosim::SecondsToNs(restart_delay_)) {
       target_ = kNoLimit;
     }
   }
