@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "models/angle.h"
+#include "models/polygon.h"
 
 namespace linesim::loader::assembly {
 
@@ -29,13 +30,24 @@ YAML::Node ReadPolygonInScanner(YamlReader& r, const YAML::Node& item, const std
     r.Error(list, full, "a field needs at least 3 corners [x, y] (m, base_link)");
     return YAML::Node();
   }
-  std::vector<std::array<double, 2>> corners;
-  const double c = std::cos(myaw), s = std::sin(myaw);
+  std::vector<std::array<double, 2>> given;
   for (std::size_t i = 0; i < list.size(); ++i) {
     if (auto p = r.AsPoint(list[i], JoinPath(full, std::to_string(i)), {-100.0, 100.0})) {
-      const double dx = (*p)[0] - mx, dy = (*p)[1] - my;
-      corners.push_back({c * dx + s * dy, -s * dx + c * dy});
+      given.push_back(*p);
     }
+  }
+  if (given.size() != list.size()) return YAML::Node();
+  // Checked as written (base_link): a degenerate polygon holds no point, a
+  // field that silently never stops the robot.
+  if (const auto problem = models::PolygonProblem(given)) {
+    r.Error(list, full, "the field " + *problem);
+    return YAML::Node();
+  }
+  std::vector<std::array<double, 2>> corners;
+  const double c = std::cos(myaw), s = std::sin(myaw);
+  for (const auto& p : given) {
+    const double dx = p[0] - mx, dy = p[1] - my;
+    corners.push_back({c * dx + s * dy, -s * dx + c * dy});
   }
   return PointList(corners);
 }

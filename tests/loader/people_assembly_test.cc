@@ -102,5 +102,35 @@ TEST(PeopleAssembly, FieldSetsComeFromTheRobotFile) {
   EXPECT_TRUE(Has(husky, "safety.scanner")) << husky;
 }
 
+// The one-robot scenario the next tests vary: the Rob@Work 3 at (0, -4)
+// facing +y (its body 1.03 x 0.57 m, heights -0.07 to 0.33 m).
+const std::string kBase = R"(name: t
+duration_s: 1
+robot: {model: raw3, pose: {x_m: 0, y_m: -4, yaw_deg: 90}}
+scene: {model: factory_line}
+task: {type: path, waypoints: [[0, -4], [0, 3]], speed_mps: 0.3}
+sensors: {default: false, laser_front: true}
+)";
+
+// Guards issue 37: a collinear, zero-area or self-intersecting field was
+// accepted and silently disabled the stop: refused at its key, as written
+// (base_link), in the scenario or the robot file.
+TEST(PeopleAssembly, DegenerateFieldsRefusedAtTheirKey) {
+  const auto field = [&](const std::string& name, const std::string& protective) {
+    return Issues(WriteScenario(
+        name, kBase + "safety:\n  field_sets:\n    - {max_speed_mps: 1, protective: " + protective +
+                  "}\n"));
+  };
+  std::string issues = field("field_line.yaml", "[[0.3, -0.2], [0.6, 0.0], [0.9, 0.2]]");
+  EXPECT_TRUE(Has(issues, "safety.field_sets.0.protective: the field has zero area")) << issues;
+  issues = field("field_bow.yaml", "[[0.3, -0.3], [0.9, 0.3], [0.9, -0.3], [0.3, 0.3]]");
+  EXPECT_TRUE(Has(issues, "safety.field_sets.0.protective: the field is self-intersecting"))
+      << issues;
+  issues = field("field_repeat.yaml", "[[0.3, -0.3], [0.9, -0.3], [0.9, -0.3], [0.3, 0.3]]");
+  EXPECT_TRUE(Has(issues, "repeats corner 1")) << issues;
+  EXPECT_EQ(field("field_ok.yaml", "[[0.3, -0.3], [0.9, -0.3], [0.9, 0.3], [0.3, 0.3]]"),
+            "(no error)");
+}
+
 }  // namespace
 }  // namespace linesim::loader::testing

@@ -215,6 +215,25 @@ TEST(SafetyField, RestartDelayIsATimeWithinTheLimit) {
   EXPECT_EQ(Get(held.u, "velocity_command_out")[0], 0.0);
 }
 
+// Guards issue 37: a collinear or zero-area protective field was accepted
+// and silently disabled the stop (no beam point is ever inside a line):
+// refused, as a self-intersecting one and a degenerate warning field are.
+TEST(SafetyField, RefusesDegenerateFields) {
+  const auto refused = [](SafetyFieldUnit::FieldSet set, const std::string& text) {
+    try {
+      SafetyFieldUnit u("safety", 541, {std::move(set)});
+    } catch (const cosim::UnitError& e) {
+      return std::string(e.what()).find(text) != std::string::npos;
+    }
+    return false;
+  };
+  EXPECT_TRUE(refused({1e9, {{0.1, 0}, {0.5, 0}, {0.9, 0}}, {}}, "protective field has zero area"));
+  EXPECT_TRUE(refused({1e9, {{0, 0}, {1, 1}, {1, 0}, {0, 1}}, {}}, "self-intersecting"));
+  EXPECT_TRUE(refused({1e9, {{0, 0}, {1, 0}}, {}}, "at least 3 corners"));
+  EXPECT_TRUE(refused({1e9, Fields().protective, {{0, 0}, {1, 0}, {2, 0}}}, "warning field"));
+  EXPECT_FALSE(refused(Fields(), ""));
+}
+
 TEST(SafetyField, InsidePolygon) {
   const std::vector<std::array<double, 2>> tri = {{0, 0}, {1, 0}, {0, 1}};
   EXPECT_TRUE(SafetyFieldUnit::Inside(tri, 0.2, 0.2));
