@@ -99,6 +99,11 @@ class Unit {
   /// step.
   const std::string& stop_request() const { return stop_request_; }
 
+  /// What the unit warned of during its run (Warn), in order: each "at t =
+  /// T s: what". The session reports them with the run (summary.json
+  /// "warnings", the console); they never fail it.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
   /// "unit 'name' (type)": how messages name this unit.
   std::string Where() const { return "unit '" + name_ + "' (" + type_name_ + ")"; }
 
@@ -150,6 +155,17 @@ class Unit {
   }
   /// For DoStep: the step succeeded and the unit asks to end the run here.
   void RequestStop(std::string reason) { stop_request_ = std::move(reason); }
+  /// Something the run's results should be read with (a contact the model
+  /// does not resolve), at time t. At most kMaxWarnings are kept: beyond
+  /// kMaxWarnings - 1 the last says how many more there were.
+  void Warn(TimeNs t, const std::string& what);
+  static constexpr std::size_t kMaxWarnings = 20;
+  /// For Initialize, which may run several times before time zero: forget
+  /// the warnings of an earlier call.
+  void ClearWarnings() {
+    warnings_.clear();
+    warnings_dropped_ = 0;
+  }
 
  private:
   std::string type_name_;
@@ -158,6 +174,8 @@ class Unit {
   std::string last_error_;
   std::string last_error_variable_;
   std::string stop_request_;
+  std::vector<std::string> warnings_;
+  std::size_t warnings_dropped_ = 0;
 };
 
 }  // namespace linesim::cosim

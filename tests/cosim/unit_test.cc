@@ -168,9 +168,10 @@ struct Converting : Unit {
     variables().Input("scan_time", "s", &scan_time, "a time in seconds");
     variables().Input("position", "1", &position, "counts");
   }
-  StepResult DoStep(TimeNs, TimeNs) override {
+  StepResult DoStep(TimeNs t, TimeNs) override {
     scan_ns = InputTimeNs(scan_time, "scan_time");
     count = static_cast<std::int64_t>(CheckCount(position, "position"));
+    Warn(t, "stepped");
     return StepResult::kOk;
   }
   double scan_time = 0.0, position = 0.0;
@@ -217,6 +218,18 @@ TEST(UnitConversions, TimesAndCountsOutsideTheirRangeNameTheVariable) {
       EXPECT_THAT(e.what(), HasSubstr("beyond +-2^53"));
     }
   }
+}
+
+// Guards the warnings' bound: a unit warning every step keeps
+// kMaxWarnings of them, the last saying how many more there were.
+TEST(UnitWarnings, KeptInOrderAndBounded) {
+  Converting u;
+  for (TimeNs t = 0; t < 25; ++t) u.DoStep(t * 1'000'000, 1);
+  const auto& w = u.warnings();
+  ASSERT_EQ(w.size(), 20u);  // Unit::kMaxWarnings
+  EXPECT_EQ(w.front(), "at t = 0 s: stepped");
+  EXPECT_EQ(w[1], "at t = 0.001 s: stepped");
+  EXPECT_EQ(w.back(), "and 6 more warnings like the ones before");
 }
 
 }  // namespace

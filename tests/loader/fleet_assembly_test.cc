@@ -59,8 +59,9 @@ TEST(FleetAssembly, RobotsAreScopedByTheirNames) {
 
 // Guards the one world: the moving_bodies unit gathers the three chassis'
 // bodies (10 numbers each); each robot's chassis, lasers and robot
-// clearance read them whole, leaving out their own robot's, and take the
-// workers' legs and torsos (2 workers x 3 cylinders x 7 numbers).
+// clearance read them whole, leaving out their own robot's; the lasers take
+// the workers' legs and torsos (2 workers x 3 cylinders x 7 numbers), the
+// chassis does not (person contact is not modelled: issue 37).
 TEST(FleetAssembly, EveryRobotSeesTheOthersAndTheWorkers) {
   const Scenario s = LoadScenario(Shipped(), {"duration_s=0.1"});
   for (const char* unit : {"raw3_a.chassis", "raw3_a.laser_front", "raw3_a.laser_rear",
@@ -69,9 +70,13 @@ TEST(FleetAssembly, EveryRobotSeesTheOthersAndTheWorkers) {
     const auto boxes = v.Find("moving_boxes");
     const auto cylinders = v.Find("moving_cylinders");
     ASSERT_TRUE(boxes.has_value()) << unit;
-    ASSERT_TRUE(cylinders.has_value()) << unit;
     EXPECT_EQ(v.info(*boxes).size, 30u) << unit;
-    EXPECT_EQ(v.info(*cylinders).size, 42u) << unit;
+    if (std::string(unit).ends_with(".chassis")) {
+      EXPECT_FALSE(cylinders.has_value()) << unit;
+    } else {
+      ASSERT_TRUE(cylinders.has_value()) << unit;
+      EXPECT_EQ(v.info(*cylinders).size, 42u) << unit;
+    }
   }
   EXPECT_TRUE(Connected(s, "raw3_b.chassis.body_box[0]", "moving_bodies.bodies_in[10]"));
   EXPECT_TRUE(Connected(s, "husky.chassis.body_box[9]", "moving_bodies.bodies_in[29]"));
@@ -139,6 +144,18 @@ robots:
 )");
   issues = Issues(top);
   EXPECT_TRUE(Has(issues, ": task")) << issues;
+}
+
+// Guards issue 37 in a fleet: a robot that would start on a worker is
+// refused at the worker's first waypoint, naming the robot and its pose
+// key.
+TEST(FleetAssembly, WorkersAgainstTheRobots) {
+  std::string issues = Issues(Shipped(), {"robots.2.pose.x_m=1.5", "robots.2.pose.y_m=-6.5"});
+  EXPECT_TRUE(Has(issues, "workers.1.waypoints.0")) << issues;
+  EXPECT_TRUE(Has(issues,
+                  "worker 'worker_2' would start inside or touching the body of robot "
+                  "'husky' (at robots.2.pose)"))
+      << issues;
 }
 
 }  // namespace

@@ -112,6 +112,38 @@ task: {type: path, waypoints: [[0, -4], [0, 3]], speed_mps: 0.3}
 sensors: {default: false, laser_front: true}
 )";
 
+// Guards issue 37: a worker placed inside a robot was accepted and threw it
+// at 11 m/s. Person contact is not modelled, so a worker must start clear
+// of the body: inside or touching is refused at its first waypoint, naming
+// the robot. The body's half width along x here is 0.285 m and a standing
+// worker facing +y has its legs (radius 0.045 m) 0.1 m to either side of
+// its centre: at x = 0.42 the nearer leg overlaps the body by 1 cm, at
+// x = 0.44 it is 1 cm clear.
+TEST(PeopleAssembly, WorkersStartClearOfTheRobot) {
+  const auto with_worker = [&](const std::string& name, const std::string& worker) {
+    return WriteScenario(name, kBase + "workers:\n  - " + worker + "\n");
+  };
+  std::string issues =
+      Issues(with_worker("worker_inside.yaml", "{name: w, waypoints: [[0.0, -4.0]]}"));
+  EXPECT_TRUE(Has(issues, "workers.0.waypoints.0")) << issues;
+  EXPECT_TRUE(Has(issues,
+                  "worker 'w' would start inside or touching the body of the robot (at "
+                  "robot.pose)"))
+      << issues;
+  EXPECT_TRUE(Has(issues, "contact with a person is not modelled")) << issues;
+  issues = Issues(
+      with_worker("worker_touching.yaml", "{name: w, waypoints: [[0.42, -4.0], [0.42, -3.0]]}"));
+  EXPECT_TRUE(Has(issues, "workers.0.waypoints.0")) << issues;
+  EXPECT_EQ(Issues(with_worker("worker_clear.yaml",
+                               "{name: w, waypoints: [[0.44, -4.0], [0.44, -3.0]]}")),
+            "(no error)");
+  // The worker's own body: thicker legs reach the robot from farther.
+  issues = Issues(with_worker(
+      "worker_thick.yaml",
+      "{name: w, waypoints: [[0.5, -4.0], [0.5, -3.0]], parameters: {leg_radius: 0.2}}"));
+  EXPECT_TRUE(Has(issues, "workers.0.waypoints.0")) << issues;
+}
+
 // Guards issue 37: a collinear, zero-area or self-intersecting field was
 // accepted and silently disabled the stop: refused at its key, as written
 // (base_link), in the scenario or the robot file.
