@@ -237,6 +237,25 @@ void ConnectFleet(assembly::SystemBuilder& b, const std::vector<RobotInfo>& robo
   }
 }
 
+// A worker is one of the scene's units, named as the user wrote it: a
+// worker named as a robot would give its metrics the names of the robots'
+// pair metrics (robot_NAME_collisions).
+void CheckWorkerNames(const YAML::Node& root, const std::vector<RobotInfo>& robots, YamlReader& r) {
+  const YAML::Node workers = Child(root, "workers");
+  if (!workers.IsSequence()) return;
+  for (std::size_t i = 0; i < workers.size(); ++i) {
+    const YAML::Node name = Child(workers[i], "name");
+    if (!name.IsScalar()) continue;
+    for (const auto& robot : robots) {
+      if (robot.name != name.Scalar()) continue;
+      r.Error(name, JoinPath(JoinPath("workers", std::to_string(i)), "name"),
+              "'" + robot.name +
+                  "' is the name of a robot: workers and robots need names of "
+                  "their own");
+    }
+  }
+}
+
 // What the robots' expansions give the fleet's.
 struct FleetParts {
   std::vector<RobotInfo> robots;
@@ -376,6 +395,7 @@ SystemSpec ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
 
     MergeRobot(top, b, r, list.size() > 1, std::move(robot), i, fleet);
   }
+  CheckWorkerNames(root, robots, r);
   if (robots.size() > 1 && r.ok()) {
     ConnectFleet(top, robots, fleet.lasers, fleet.recorded);
   }

@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 
+#include "cosim/system.h"
 #include "models/angle.h"
 #include "models/person.h"
 #include "models/polygon.h"
@@ -286,6 +287,13 @@ std::optional<std::string> AddWorker(SystemBuilder& b, const RobotFile& robot,
   r.CheckKeys(item, path, {"name", "waypoints", "pause_s", "start_time_s", "parameters"});
   const std::string name = r.String(item, path, "name", "worker_" + std::to_string(i));
   const YAML::Node name_node = Child(item, "name").IsDefined() ? Child(item, "name") : item;
+  if (!cosim::IsIdentifier(name)) {
+    r.Error(name_node, JoinPath(path, "name"),
+            "worker name '" + name +
+                "' is not valid: expected letters, digits and _ (it names "
+                "the worker's unit, its columns and its metrics)");
+    return std::nullopt;
+  }
   if (b.HasUnit(name)) {
     r.Error(name_node, JoinPath(path, "name"), "'" + name + "' is already the name of a unit");
     return std::nullopt;
@@ -310,13 +318,18 @@ std::optional<std::string> AddWorker(SystemBuilder& b, const RobotFile& robot,
   Parameters& p = b.Params(name);
   const std::string prefix = JoinPath(JoinPath("units", name), "parameters");
   p["waypoints"] = points;
+  b.Origin(JoinPath(prefix, "waypoints"), {waypoints, wp_path, ""});
   // The worker knows where the robot is (it yields to it with a
   // stop_distance; a fleet's are connected by the fleet).
   p["robots"] = 1;
   b.Connect(Signal(kChassis, "body_box"), Signal(name, "robots"));
   ReadPauses(r, item, path, points.size(), p);
+  if (Child(item, "pause_s").IsDefined()) {
+    b.Derived(JoinPath(prefix, "pause"), item, path, "pause_s");
+  }
   if (Child(item, "start_time_s").IsDefined()) {
     p["start_time"] = r.Real(item, path, "start_time_s", 0.0, {0.0, 1e7});
+    b.Derived(JoinPath(prefix, "start_time"), item, path, "start_time_s");
   }
   if (own.IsDefined() && !own.IsNull() && r.ExpectMap(own, JoinPath(path, "parameters"))) {
     for (const auto& kv : own) {
@@ -383,6 +396,12 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
   // The chassis centres the body box on com_height (flat floor).
   c["body_z_min"] = body.com_height_m - 0.5 * body.height_m;
   c["body_z_max"] = body.com_height_m + 0.5 * body.height_m;
+  // A bad body is reported where the robot file gives it.
+  const std::string prefix = JoinPath(JoinPath("units", kPersonClearance), "parameters");
+  b.Origin(JoinPath(prefix, "body_length"), robot.At("body.length_m"));
+  b.Origin(JoinPath(prefix, "body_width"), robot.At("body.width_m"));
+  b.Origin(JoinPath(prefix, "body_z_min"), robot.At("body.height_m"));
+  b.Origin(JoinPath(prefix, "body_z_max"), robot.At("body.height_m"));
   b.Connect(Signal(kChassis, "position_3d"), Signal(kPersonClearance, "position_3d"));
   b.Connect(Signal(kChassis, "orientation"), Signal(kPersonClearance, "orientation"));
   for (const auto& unit : takers) {

@@ -148,7 +148,8 @@ robots:
 
 // Guards issue 37 in a fleet: a robot that would start on a worker is
 // refused at the worker's first waypoint, naming the robot and its pose
-// key.
+// key; a worker named as a robot (whose metrics then took the names of the
+// robots' pair metrics, reported at metrics.44.name) at its name.
 TEST(FleetAssembly, WorkersAgainstTheRobots) {
   std::string issues = Issues(Shipped(), {"robots.2.pose.x_m=1.5", "robots.2.pose.y_m=-6.5"});
   EXPECT_TRUE(Has(issues, "workers.1.waypoints.0")) << issues;
@@ -156,6 +157,10 @@ TEST(FleetAssembly, WorkersAgainstTheRobots) {
                   "worker 'worker_2' would start inside or touching the body of robot "
                   "'husky' (at robots.2.pose)"))
       << issues;
+  issues = Issues(Shipped(), {"workers.0.name=raw3_a"});
+  EXPECT_TRUE(Has(issues, "workers.0.name")) << issues;
+  EXPECT_TRUE(Has(issues, "'raw3_a' is the name of a robot")) << issues;
+  EXPECT_FALSE(Has(issues, "metrics.")) << issues;
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // expand into, and bad input named at its file and key path.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -162,6 +163,43 @@ TEST(PeopleAssembly, DegenerateFieldsRefusedAtTheirKey) {
   EXPECT_TRUE(Has(issues, "repeats corner 1")) << issues;
   EXPECT_EQ(field("field_ok.yaml", "[[0.3, -0.3], [0.9, -0.3], [0.9, 0.3], [0.3, 0.3]]"),
             "(no error)");
+}
+
+// Guards issue 37's messages at the user's key: a repeated waypoint (the
+// worker unit's check) was reported at units.worker.parameters.waypoints.1,
+// a name with a blank in 86 connections.N lines, a scenario metric that a
+// worker's metric repeats at metrics.N.name of the expansion. Each is
+// reported once, at the key the user wrote.
+TEST(PeopleAssembly, WorkerProblemsAtTheWorkersKeys) {
+  std::string issues = Issues(WriteScenario(
+      "worker_repeat.yaml",
+      kBase + "workers:\n  - {name: w, waypoints: [[-3, -1.2], [-3, -1.2], [0, -1.2]]}\n"));
+  EXPECT_TRUE(Has(issues, "workers.0.waypoints.1: repeats the waypoint before it")) << issues;
+  EXPECT_FALSE(Has(issues, "units.")) << issues;
+
+  const std::string blank = WriteScenario(
+      "worker_blank.yaml", kBase + "workers:\n  - {name: bad name, waypoints: [[-3, -1.2]]}\n");
+  issues = Issues(blank);
+  EXPECT_TRUE(Has(issues, "workers.0.name: worker name 'bad name' is not valid")) << issues;
+  EXPECT_FALSE(Has(issues, "connections.")) << issues;
+  EXPECT_EQ(std::count(issues.begin(), issues.end(), '\n'), 0) << issues;  // one issue
+
+  const std::string metric = WriteScenario(
+      "worker_metric.yaml",
+      kBase +
+          "workers:\n  - {name: w, waypoints: [[-3, -1.2]]}\n"
+          "metrics:\n  - {name: w_time_waited_s, of: 'belt.speed[0]', reduce: max}\n");
+  issues = Issues(metric);
+  EXPECT_TRUE(Has(issues,
+                  "metrics.0.name: metric 'w_time_waited_s' is also one the robot "
+                  "scenario gives"))
+      << issues;
+
+  const std::string pause = WriteScenario(
+      "worker_pause.yaml",
+      kBase + "workers:\n  - {name: w, waypoints: [[-3, -1.2], [0, -1.2]], pause_s: [0, -1]}\n");
+  issues = Issues(pause);
+  EXPECT_TRUE(Has(issues, "workers.0.pause_s.1")) << issues;
 }
 
 }  // namespace
