@@ -256,6 +256,21 @@ void CheckWorkerNames(const YAML::Node& root, const std::vector<RobotInfo>& robo
   }
 }
 
+// Before anything is built: every robot's lasers and person clearance take
+// every worker, so the cost grows with the robot-worker pairs.
+bool WorkerCountWithinLimit(const YAML::Node& root, std::size_t robots, YamlReader& r) {
+  const YAML::Node workers = Child(root, "workers");
+  if (!workers.IsSequence() || robots == 0) return true;
+  const std::size_t most = kMaxRobotWorkerPairs / robots;
+  if (workers.size() <= most) return true;
+  r.Error(workers, "workers",
+          std::to_string(workers.size()) + " workers with " + std::to_string(robots) + " robot" +
+              (robots == 1 ? "" : "s") + ": at most " + std::to_string(most) + " (" +
+              std::to_string(kMaxRobotWorkerPairs) +
+              " robot-worker pairs: " + kMaxRobotWorkerPairsWhy + ")");
+  return false;
+}
+
 // What the robots' expansions give the fleet's.
 struct FleetParts {
   std::vector<RobotInfo> robots;
@@ -350,6 +365,17 @@ SystemSpec ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
   if (r.ExpectSequence(list, "robots") && list.size() == 0) {
     r.Error(list, "robots", "expected at least one robot {name, model, pose, task, ...}");
   }
+  // Before anything is built: a fleet's memory and step time grow with the
+  // robots and their pairs.
+  if (list.IsSequence() && list.size() > kMaxRobots) {
+    r.Error(list, "robots",
+            std::to_string(list.size()) + " robots: at most " + std::to_string(kMaxRobots) + " (" +
+                kMaxRobotsWhy + ")");
+    return std::move(top.spec());
+  }
+  if (list.IsSequence() && !WorkerCountWithinLimit(root, list.size(), r)) {
+    return std::move(top.spec());
+  }
   for (std::size_t i = 0; list.IsSequence() && i < list.size(); ++i) {
     const YAML::Node entry = list[i];
     const std::string path = JoinPath("robots", std::to_string(i));
@@ -440,6 +466,7 @@ SystemSpec ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
                "control", "task", "sensors", "sensing", "localization", "units", "connections",
                "recording", "metrics", "reference", "workers", "safety"});
   assembly::SystemBuilder b(root, r);
+  if (!WorkerCountWithinLimit(root, 1, r)) return std::move(b.spec());
   ReadSystemHead(root, r, b.spec());
   const models::Scene scene = assembly::AddScene(b);
   AssembleRobot(b, {"model", "pose", "payload"}, scene, info);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <string>
 
+#include "loader/robot_scenario.h"
 #include "tests/loader/scenario_test.h"
 
 namespace linesim::loader::testing {
@@ -161,6 +162,37 @@ TEST(FleetAssembly, WorkersAgainstTheRobots) {
   EXPECT_TRUE(Has(issues, "workers.0.name")) << issues;
   EXPECT_TRUE(Has(issues, "'raw3_a' is the name of a robot")) << issues;
   EXPECT_FALSE(Has(issues, "metrics.")) << issues;
+}
+
+// Guards issue 37: 1,000 robots reached 7.7 GB and std::bad_alloc after
+// 267 s. More than kMaxRobots are refused at `robots` before anything is
+// built, naming the limit; so are more workers than the robot-worker pairs
+// allow with them.
+TEST(FleetAssembly, TooManyRobotsRefusedAtRobots) {
+  std::string text = "name: t\nduration_s: 1\nscene: {model: factory_line}\nrobots:\n";
+  for (std::size_t i = 0; i <= kMaxRobots; ++i) {
+    text += "  - {name: r" + std::to_string(i) + ", model: raw3, task: {type: hold}}\n";
+  }
+  std::string issues = Issues(WriteScenario("fleet_many.yaml", text));
+  EXPECT_TRUE(Has(issues, "robots: " + std::to_string(kMaxRobots + 1) + " robots: at most " +
+                              std::to_string(kMaxRobots) + " ("))
+      << issues;
+  EXPECT_FALSE(Has(issues, "would start inside")) << issues;  // nothing was expanded
+
+  std::string workers =
+      "name: t\nduration_s: 1\nscene: {model: factory_line}\nrobots:\n"
+      "  - {name: a, model: raw3, task: {type: hold}}\n"
+      "  - {name: b, model: raw3, pose: {x_m: 3}, task: {type: hold}}\n"
+      "workers:\n";
+  for (std::size_t k = 0; k <= kMaxRobotWorkerPairs / 2; ++k) {
+    workers +=
+        "  - {waypoints: [[-10, " + std::to_string(-9.0 + 0.001 * static_cast<double>(k)) + "]]}\n";
+  }
+  issues = Issues(WriteScenario("fleet_many_workers.yaml", workers));
+  EXPECT_TRUE(Has(issues, "workers: " + std::to_string(kMaxRobotWorkerPairs / 2 + 1) +
+                              " workers with 2 robots: at most " +
+                              std::to_string(kMaxRobotWorkerPairs / 2)))
+      << issues;
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <iterator>
 #include <string>
 
+#include "loader/robot_scenario.h"
 #include "tests/loader/scenario_test.h"
 
 namespace linesim::loader::testing {
@@ -200,6 +201,24 @@ TEST(PeopleAssembly, WorkerProblemsAtTheWorkersKeys) {
       kBase + "workers:\n  - {name: w, waypoints: [[-3, -1.2], [0, -1.2]], pause_s: [0, -1]}\n");
   issues = Issues(pause);
   EXPECT_TRUE(Has(issues, "workers.0.pause_s.1")) << issues;
+}
+
+// Guards issue 37: 3,400 workers were refused after 20 s at an internal key
+// (units.chassis.parameters.moving_cylinders) that never said "workers".
+// Too many are refused at `workers`, naming the limit, before anything is
+// built (this one-robot file's limit: kMaxRobotWorkerPairs).
+TEST(PeopleAssembly, TooManyWorkersRefusedAtWorkers) {
+  std::string text = kBase + "workers:\n";
+  for (std::size_t k = 0; k <= kMaxRobotWorkerPairs; ++k) {
+    text += "  - {waypoints: [[" + std::to_string(-10.0 + 0.01 * static_cast<double>(k)) +
+            ", -8.0]]}\n";
+  }
+  const std::string issues = Issues(WriteScenario("many_workers.yaml", text));
+  EXPECT_TRUE(Has(issues, "workers: " + std::to_string(kMaxRobotWorkerPairs + 1) +
+                              " workers with 1 robot: at most " +
+                              std::to_string(kMaxRobotWorkerPairs)))
+      << issues;
+  EXPECT_EQ(std::count(issues.begin(), issues.end(), '\n'), 0) << issues;  // one issue
 }
 
 }  // namespace
