@@ -54,7 +54,11 @@ seed fuzz_robot_scenario scenarios/worker_crossing.yaml scenarios/fleet_line.yam
 seed fuzz_description models/robots/*.yaml models/scenes/*.yaml
 seed fuzz_sweep_file scenarios/sweeps/*.yaml
 mkdir -p "$out/corpus/fuzz_results_file"
-LINESIM_FUZZ_SEED_DIR="$out/corpus/fuzz_results_file" build-asan/fuzz/fuzz_results_file
+# Its seeds come from its own binary, built only when it is one of the
+# harnesses asked for.
+if [ -x build-asan/fuzz/fuzz_results_file ]; then
+  LINESIM_FUZZ_SEED_DIR="$out/corpus/fuzz_results_file" build-asan/fuzz/fuzz_results_file
+fi
 seed fuzz_model_description tests/units/fmu/fmus/*.xml
 mkdir -p "$out/corpus/fuzz_fmu_loader"
 for f in build-asan/tests/units/fmu/*.fmu; do
