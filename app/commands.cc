@@ -152,6 +152,7 @@ int RunCommand(const std::string& file, const std::string& out_dir,
   if (written.mcap) std::cout << ", run.mcap";
   std::cout << "\n";
   for (const auto& e : report.errors) std::cerr << "linesim: " << e.message << "\n";
+  for (const auto& w : report.warnings) std::cerr << "linesim: warning: " << w << "\n";
   if (plot_columns && s.robot) {
     plot_columns->error_column = s.robot->error_column;
     plot_columns->belt_on_columns = s.robot->belt_on_columns;

@@ -316,12 +316,12 @@ cosim::TimeNs YamlReader::Time(const YAML::Node& map, const std::string& path,
   const std::string p = JoinPath(path, key);
   const auto seconds = AsReal(node, p, range);
   if (!seconds) return otherwise;
-  // int64 nanoseconds end at 9.22e18 ns; SecondsToNs refuses above 9.2e18.
-  constexpr double kMaxSeconds = 9.2e9;
-  if (std::abs(*seconds) > kMaxSeconds) {
+  // The one limit every time in seconds is checked against (cosim/time.h).
+  if (std::abs(*seconds) > cosim::kMaxTimeSeconds) {
     Error(node, p,
-          "value " + node.Scalar() + " is out of range: a time must be within +-9.2e9 s " +
-              "(int64 nanoseconds)");
+          "value " + node.Scalar() + " is out of range: a time must be within +-4.6e9 s, the " +
+              "longest time linesim represents (int64 nanoseconds, with room for a time plus a " +
+              "duration)");
     return otherwise;
   }
   if (*seconds != 0.0 && std::abs(*seconds) < 1e-9) {

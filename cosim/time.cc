@@ -7,6 +7,20 @@
 
 namespace linesim::cosim {
 
+std::optional<std::string> TimeProblem(double seconds) {
+  if (!std::isfinite(seconds)) {
+    return std::string(std::isnan(seconds) ? "is nan" : "is infinite") + ", not a time";
+  }
+  if (std::abs(seconds) > kMaxTimeSeconds) {
+    return "is beyond +-4.6e9 s, the longest time linesim represents (int64 nanoseconds, "
+           "with room for a time plus a duration)";
+  }
+  if (seconds != 0.0 && std::abs(seconds) < kTimeResolutionSeconds) {
+    return std::string("is below 1 ns, the time resolution (it would round to 0)");
+  }
+  return std::nullopt;
+}
+
 TimeNs SecondsToNs(double seconds) {
   const double ns = std::round(seconds * 1e9);
   if (!std::isfinite(ns) || std::abs(ns) > 9.2e18) {

@@ -1,5 +1,7 @@
 #include "cosim/unit.h"
 
+#include <cmath>
+
 namespace linesim::cosim {
 
 UnitState Unit::SaveState() const {
@@ -72,6 +74,39 @@ bool Unit::InputsFinite(TimeNs t) {
   if (!problem) return true;
   Fail(Where() + ": " + problem->text + " at t = " + FormatSeconds(t) + " s", problem->variable);
   return false;
+}
+
+void Unit::Warn(TimeNs t, const std::string& what) {
+  // The last place says how many more there were.
+  if (warnings_.size() + 1 < kMaxWarnings) {
+    warnings_.push_back("at t = " + FormatSeconds(t) + " s: " + what);
+    return;
+  }
+  ++warnings_dropped_;
+  const std::string more = "and " + std::to_string(warnings_dropped_) + " more warning" +
+                           (warnings_dropped_ == 1 ? "" : "s") + " like the ones before";
+  if (warnings_.size() < kMaxWarnings) {
+    warnings_.push_back(more);
+  } else {
+    warnings_.back() = more;
+  }
+}
+
+TimeNs Unit::InputTimeNs(double seconds, const std::string& variable) const {
+  if (const auto problem = TimeProblem(seconds)) {
+    throw UnitError(Where() + ": '" + variable + "' = " + FormatValue(seconds) + " s " + *problem,
+                    variable);
+  }
+  return SecondsToNs(seconds);
+}
+
+double Unit::CheckCount(double count, const std::string& variable) const {
+  if (!(std::abs(count) <= kMaxExactCount)) {
+    throw UnitError(Where() + ": '" + variable + "' = " + FormatValue(count) +
+                        " counts is beyond +-2^53, the largest count a Real carries exactly",
+                    variable);
+  }
+  return count;
 }
 
 void Unit::ThrowIfBadParameters() const {

@@ -99,6 +99,11 @@ class Unit {
   /// step.
   const std::string& stop_request() const { return stop_request_; }
 
+  /// What the unit warned of during its run (Warn), in order: each "at t =
+  /// T s: what". The session reports them with the run (summary.json
+  /// "warnings", the console); they never fail it.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
   /// "unit 'name' (type)": how messages name this unit.
   std::string Where() const { return "unit '" + name_ + "' (" + type_name_ + ")"; }
 
@@ -126,6 +131,17 @@ class Unit {
   /// master checks; this catches start values and units stepped by hand.
   bool InputsFinite(TimeNs t);
 
+  /// For DoStep, UpdateOutputs and Initialize, where a signal in seconds
+  /// (a scan's or a match's time) becomes nanoseconds: the time, or a
+  /// UnitError naming the unit and `variable` when it is no time linesim
+  /// represents (cosim::TimeProblem: beyond kMaxTimeSeconds, below 1 ns,
+  /// not finite).
+  TimeNs InputTimeNs(double seconds, const std::string& variable) const;
+  /// The same where a count carried as a Real (an encoder's position in
+  /// counts) becomes an integer: `count` when it is finite and within
+  /// +-kMaxExactCount, else a UnitError naming `variable`.
+  double CheckCount(double count, const std::string& variable) const;
+
   /// For DoStep: record why the step failed and return kError.
   StepResult Fail(std::string message, std::string variable = {}) {
     last_error_ = std::move(message);
@@ -139,6 +155,17 @@ class Unit {
   }
   /// For DoStep: the step succeeded and the unit asks to end the run here.
   void RequestStop(std::string reason) { stop_request_ = std::move(reason); }
+  /// Something the run's results should be read with (a contact the model
+  /// does not resolve), at time t. At most kMaxWarnings are kept: beyond
+  /// kMaxWarnings - 1 the last says how many more there were.
+  void Warn(TimeNs t, const std::string& what);
+  static constexpr std::size_t kMaxWarnings = 20;
+  /// For Initialize, which may run several times before time zero: forget
+  /// the warnings of an earlier call.
+  void ClearWarnings() {
+    warnings_.clear();
+    warnings_dropped_ = 0;
+  }
 
  private:
   std::string type_name_;
@@ -147,6 +174,8 @@ class Unit {
   std::string last_error_;
   std::string last_error_variable_;
   std::string stop_request_;
+  std::vector<std::string> warnings_;
+  std::size_t warnings_dropped_ = 0;
 };
 
 }  // namespace linesim::cosim

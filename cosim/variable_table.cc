@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "cosim/time.h"
+
 namespace linesim::cosim {
 
 std::string_view ToString(VarType t) {
@@ -157,6 +159,34 @@ Rule Rule::NoDefault() const {
   return r;
 }
 
+Rule Rule::Limited(double max_abs, double resolution, const char* why) const {
+  Rule r = *this;
+  r.numeric_ = true;
+  if (!r.min_ || r.min_->value < -max_abs) r.min_ = Bound{-max_abs, true};
+  if (!r.max_ || r.max_->value > max_abs) r.max_ = Bound{max_abs, true};
+  if (r.min_->value > r.max_->value) {
+    throw std::logic_error("Rule: no value lies between " + FormatValue(r.min_->value) + " and " +
+                           FormatValue(r.max_->value) + " within the limit");
+  }
+  r.limit_ = Limit{max_abs, resolution, why};
+  return r;
+}
+
+Rule Rule::Time() const {
+  return Limited(kMaxTimeSeconds, kTimeResolutionSeconds,
+                 "4.6e9 s is the longest time linesim represents: int64 nanoseconds, with room "
+                 "for a time plus a duration");
+}
+
+Rule Rule::Count() const {
+  return Limited(kMaxExactCount, 0.0, "2^53 is the largest count a Real carries exactly");
+}
+
+std::string Rule::LimitReason(double x) const {
+  if (!limit_ || std::abs(x) <= limit_->max_abs) return "";
+  return std::string(" (") + limit_->why + ")";
+}
+
 bool Rule::empty() const { return !numeric_ && !strings_ && !integers_ && !required_; }
 
 std::string Rule::Bounds() const {
@@ -202,7 +232,13 @@ std::optional<std::string> Rule::Violation(double x) const {
   }
   const bool low = min_ && (min_->inclusive ? x < min_->value : x <= min_->value);
   const bool high = max_ && (max_->inclusive ? x > max_->value : x >= max_->value);
-  if (low || high) return "must be " + bounds + ", got " + FormatValue(x);
+  if (low || high) return "must be " + bounds + LimitReason(x) + ", got " + FormatValue(x);
+  if (limit_ && x != 0.0 && std::abs(x) < limit_->resolution) {
+    return "must be " + std::string(min_ && min_->value == 0.0 && !min_->inclusive ? "" : "0 or ") +
+           "at least " + FormatValue(limit_->resolution) +
+           " in magnitude (1 ns is the time resolution: it would round to 0), got " +
+           FormatValue(x);
+  }
   return std::nullopt;
 }
 
@@ -276,6 +312,13 @@ Variability SignalVariability(VarType t) {
                                                            : Variability::kDiscrete;
 }
 
+// A parameter in seconds: units convert it to integer nanoseconds, so its
+// rule is a time's (Rule::Time) whatever else it says.
+bool IsTime(const VariableInfo& i) {
+  return i.causality == Causality::kParameter && i.unit == "s" &&
+         (i.type == VarType::kReal || i.type == VarType::kRealArray);
+}
+
 // A required parameter's start value: NaN, every element NaN, or "".
 bool IsUnset(double x) { return std::isnan(x); }
 bool IsUnset(const std::vector<double>& x) {
@@ -305,6 +348,7 @@ ValueRef VariableTable::Bind(std::string name, Causality causality, Variability 
   if (by_name_.count(info.name)) {
     throw std::logic_error("variable '" + info.name + "' declared twice");
   }
+  if (IsTime(info)) info.rule = Rule().Time();
   info.ref = static_cast<ValueRef>(infos_.size());
   by_name_.emplace(info.name, info.ref);
   if constexpr (std::is_same_v<T, double> || std::is_same_v<T, std::vector<double>>) {
@@ -388,7 +432,7 @@ void VariableTable::SetRule(ValueRef ref, Rule rule) {
                              FormatValue(start) + ": start it at NaN (or \"\")");
     }
   }
-  i.rule = std::move(rule);
+  i.rule = IsTime(i) ? rule.Time() : std::move(rule);
 }
 
 void VariableTable::Lock() {

@@ -13,6 +13,12 @@
 
 namespace linesim::cosim {
 
+/// The largest count a Real carries exactly (2^53: a double holds every
+/// integer up to it). A count held in a Real (an encoder's counts, a
+/// count per revolution) that a unit converts to an integer stays within
+/// it (Rule::Count, Unit::CheckCount).
+inline constexpr double kMaxExactCount = 9007199254740992.0;
+
 /// Value reference: the index of a variable in its unit's table.
 using ValueRef = std::uint32_t;
 
@@ -93,6 +99,17 @@ class Rule {
   /// or "" means "not set" and is reported as "must be set (robot-specific:
   /// no default)".
   Rule NoDefault() const;
+  /// The same rule for a time in seconds, which units convert to integer
+  /// nanoseconds: also finite, within +-kMaxTimeSeconds (cosim/time.h; an
+  /// end the rule leaves open or puts beyond it becomes the limit), and
+  /// not a non-zero value below the 1 ns resolution; a value refused by
+  /// the limit is told why. VariableTable gives it to every Real parameter
+  /// whose unit is "s", so no unit declares it by hand.
+  Rule Time() const;
+  /// The same rule for a count carried as a Real that the unit converts to
+  /// an integer (an encoder's counts per revolution): also finite and
+  /// within +-kMaxExactCount, told why when refused by it.
+  Rule Count() const;
 
   bool empty() const;
   bool required() const { return required_; }
@@ -119,11 +136,23 @@ class Rule {
     bool inclusive = true;
   };
   std::string Bounds() const;  // "> 0", "[0, 1]"; "" without bounds
-  bool numeric_ = false;       // a number rule: finite, maybe bounded
+  /// The rule bounded to +-max_abs (Time, Count).
+  Rule Limited(double max_abs, double resolution, const char* why) const;
+  /// " (why)" when `x` broke an end that is the limit's.
+  std::string LimitReason(double x) const;
+  bool numeric_ = false;  // a number rule: finite, maybe bounded
   std::optional<Bound> min_, max_;
   std::optional<std::vector<std::string>> strings_;
   std::optional<std::vector<std::int64_t>> integers_;
   bool required_ = false;
+  // Time, Count: the representable range (both ends are within it), the
+  // resolution (a non-zero value below it is refused; 0: none) and why.
+  struct Limit {
+    double max_abs = 0;
+    double resolution = 0;
+    const char* why = "";
+  };
+  std::optional<Limit> limit_;
 };
 
 struct VariableInfo {

@@ -110,6 +110,26 @@ void AddBuffer(zip_t* zip, const std::string& name, const std::string& text) {
   }
 }
 
+// The FMU's unit is built at fmi2Instantiate from the resource file alone:
+// a type that builds without parameters (linesim inspect's placeholder of a
+// structural key, a safety_field's one field set) may need values it was
+// not given. Built here as the runtime will build it, so that an FMU that
+// could not instantiate is never written.
+void RefuseUnbuildableResource(const fs::path& scratch, const std::string& resource,
+                               const std::string& scene_text, const std::string& instance,
+                               const std::string& type) {
+  const fs::path folder = scratch / "resources";
+  fs::create_directories(folder);
+  WriteFile(folder / kResourceFile, resource);
+  if (!scene_text.empty()) WriteFile(folder / kSceneFile, scene_text);
+  try {
+    loader::LoadScenario((folder / kResourceFile).string());
+  } catch (const config::ScenarioError& e) {
+    throw ExportError("a " + type + " unit needs values to be built (give them with --set):" +
+                      Describe(e, instance));
+  }
+}
+
 }  // namespace
 
 std::string RuntimeLibraryPath() {
@@ -238,6 +258,7 @@ ExportResult ExportFmu(const ExportOptions& o) {
       "# The unit this FMU runs (linesim export-fmu), read by its binary at\n"
       "# fmi2Instantiate: a linesim scenario with this one unit.\n" +
       Emit(scenario);
+  RefuseUnbuildableResource(scratch.path(), result.resource, scene_text, instance, type->name);
   result.model_identifier = type->name;
   result.guid = GuidOfResources(result.resource, scene_text);
   const DescriptionInfo info{type->name, result.model_identifier, result.guid,

@@ -264,6 +264,40 @@ void ConnectFleet(assembly::SystemBuilder& b, const std::vector<RobotInfo>& robo
   }
 }
 
+// A worker is one of the scene's units, named as the user wrote it: a
+// worker named as a robot would give its metrics the names of the robots'
+// pair metrics (robot_NAME_collisions).
+void CheckWorkerNames(const YAML::Node& root, const std::vector<RobotInfo>& robots, YamlReader& r) {
+  const YAML::Node workers = Child(root, "workers");
+  if (!workers.IsSequence()) return;
+  for (std::size_t i = 0; i < workers.size(); ++i) {
+    const YAML::Node name = Child(workers[i], "name");
+    if (!name.IsScalar()) continue;
+    for (const auto& robot : robots) {
+      if (robot.name != name.Scalar()) continue;
+      r.Error(name, JoinPath(JoinPath("workers", std::to_string(i)), "name"),
+              "'" + robot.name +
+                  "' is the name of a robot: workers and robots need names of "
+                  "their own");
+    }
+  }
+}
+
+// Before anything is built: every robot's lasers and person clearance take
+// every worker, so the cost grows with the robot-worker pairs.
+bool WorkerCountWithinLimit(const YAML::Node& root, std::size_t robots, YamlReader& r) {
+  const YAML::Node workers = Child(root, "workers");
+  if (!workers.IsSequence() || robots == 0) return true;
+  const std::size_t most = kMaxRobotWorkerPairs / robots;
+  if (workers.size() <= most) return true;
+  r.Error(workers, "workers",
+          std::to_string(workers.size()) + " workers with " + std::to_string(robots) + " robot" +
+              (robots == 1 ? "" : "s") + ": at most " + std::to_string(most) + " (" +
+              std::to_string(kMaxRobotWorkerPairs) +
+              " robot-worker pairs: " + kMaxRobotWorkerPairsWhy + ")");
+  return false;
+}
+
 // What the robots' expansions give the fleet's.
 struct FleetParts {
   std::vector<RobotInfo> robots;
@@ -358,6 +392,17 @@ SystemSpec ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
   if (r.ExpectSequence(list, "robots") && list.size() == 0) {
     r.Error(list, "robots", "expected at least one robot {name, model, pose, task, ...}");
   }
+  // Before anything is built: a fleet's memory and step time grow with the
+  // robots and their pairs.
+  if (list.IsSequence() && list.size() > kMaxRobots) {
+    r.Error(list, "robots",
+            std::to_string(list.size()) + " robots: at most " + std::to_string(kMaxRobots) + " (" +
+                kMaxRobotsWhy + ")");
+    return std::move(top.spec());
+  }
+  if (list.IsSequence() && !WorkerCountWithinLimit(root, list.size(), r)) {
+    return std::move(top.spec());
+  }
   for (std::size_t i = 0; list.IsSequence() && i < list.size(); ++i) {
     const YAML::Node entry = list[i];
     const std::string path = JoinPath("robots", std::to_string(i));
@@ -415,6 +460,7 @@ SystemSpec ExpandFleet(const YAML::Node& root, YamlReader& r, RobotInfo& info) {
 
     MergeRobot(top, b, r, list.size() > 1, std::move(robot), i, fleet);
   }
+  CheckWorkerNames(root, robots, r);
   if (robots.size() > 1 && r.ok()) {
     ConnectFleet(top, robots, fleet.lasers, fleet.recorded);
   }
@@ -461,6 +507,7 @@ SystemSpec ExpandRobotScenario(const YAML::Node& root, YamlReader& r, RobotInfo&
                "localization", "units",       "connections", "recording", "metrics", "reference",
                "workers",      "safety",      "figures"});
   assembly::SystemBuilder b(root, r);
+  if (!WorkerCountWithinLimit(root, 1, r)) return std::move(b.spec());
   ReadSystemHead(root, r, b.spec());
   const models::Scene scene = assembly::AddScene(b);
   AssembleRobot(b, {"model", "pose", "payload"}, scene, info);

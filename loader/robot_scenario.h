@@ -97,6 +97,30 @@ struct RobotInfo {
   std::vector<RobotInfo> fleet;
 };
 
+/// The most robots a fleet (`robots:`) may have, checked before anything is
+/// built and named at `robots`. Measured (linesim inspect of fleets of
+/// Rob@Work 3 with every sensor, peak memory): 74 MB at 20 robots, 271 MB
+/// at 80, 615 MB at 160, i.e. about 2.5 MB per robot and 7 KB per pair of
+/// robots (each robot's lasers, chassis and clearance take every other
+/// body); 350 MB at 100. 1,000 robots needed 10 GB and ended in
+/// std::bad_alloc (issue 37). docs/scenarios.md, "A fleet".
+inline constexpr std::size_t kMaxRobots = 100;
+inline constexpr const char* kMaxRobotsWhy =
+    "each robot takes about 2.5 MB and each pair of robots 7 KB, as every robot's lasers, "
+    "chassis and clearance take every other body: 100 robots load in 0.35 GB, 1,000 needed "
+    "10 GB";
+/// The most robot-worker pairs (robots x workers: every robot's lasers and
+/// person clearance take every worker's legs and torso, 21 numbers each,
+/// element by element), checked before anything is built and named at
+/// `workers`. Measured: 1 robot with 200 workers 80 MB, with 800 248 MB;
+/// 10 robots with 100 workers 287 MB, with 200 526 MB: about 0.25 MB per
+/// pair. 3,400 workers were refused after 20 s at an internal key (issue
+/// 37). docs/scenarios.md, "Workers".
+inline constexpr std::size_t kMaxRobotWorkerPairs = 1000;
+inline constexpr const char* kMaxRobotWorkerPairsWhy =
+    "every robot's lasers and person clearance take every worker's legs and torso, about "
+    "0.25 MB per robot-worker pair: 1,000 pairs load in 0.25 GB";
+
 /// A robot scenario is written at the level of robot, scene, line, control,
 /// task, sensing and localization (docs/scenarios.md); it is recognised by
 /// its top-level `robot` key, or `robots` for a fleet (a list of robots,

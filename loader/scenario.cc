@@ -399,13 +399,21 @@ class Builder {
   }
 
   void BuildMetrics(const std::vector<MetricDefinition>& list) {
-    std::set<std::string> seen;
+    std::map<std::string, std::size_t> seen;
     for (std::size_t i = 0; i < list.size(); ++i) {
       const MetricDefinition& m = list[i];
       const std::string path = "metrics." + std::to_string(i);
-      if (!seen.insert(m.name).second) {
-        r_.Error(Child(m.node, "name"), JoinPath(path, "name"),
-                 "metric '" + m.name + "' defined twice");
+      if (const auto [it, fresh] = seen.emplace(m.name, i); !fresh) {
+        // A robot scenario's own metric that its expansion gives too (a
+        // worker's, a robot's): reported at the one the file wrote, the
+        // derived one has no key of the user's.
+        const MetricDefinition& first = list[it->second];
+        const bool derived = !m.node.IsMap() && first.node.IsMap();
+        r_.Error(Child(derived ? first.node : m.node, "name"),
+                 JoinPath("metrics." + std::to_string(derived ? it->second : i), "name"),
+                 derived ? "metric '" + m.name + "' is also one the robot scenario gives (of " +
+                               m.of + "): give yours another name"
+                         : "metric '" + m.name + "' defined twice");
       }
       if (m.of.empty()) continue;
       cosim::MetricSpec spec;

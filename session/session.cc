@@ -179,6 +179,10 @@ RunReport Session::Run(const std::atomic<bool>* stop) {
   report.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   report.metrics = metrics.Results();
   report.errors = report.result.errors;
+  for (std::size_t u = 0; u < s_.system->unit_count(); ++u) {
+    const cosim::Unit& unit = s_.system->unit(u);
+    for (const auto& w : unit.warnings()) report.warnings.push_back(unit.Where() + " " + w);
+  }
   // A metric that overflowed fails the run, naming the metric.
   for (auto& e : metrics.NonFiniteErrors(report.result.end_time)) {
     report.errors.push_back(std::move(e));
@@ -219,6 +223,11 @@ nlohmann::ordered_json Summary(const loader::Scenario& s, const std::string& fil
   Json messages = Json::array();
   for (const auto& e : report.errors) messages.push_back(e.message);
   summary["errors"] = messages;
+  // What the units warned of (a worker touching a robot): the results hold,
+  // but are to be read with it.
+  Json warnings = Json::array();
+  for (const auto& w : report.warnings) warnings.push_back(w);
+  summary["warnings"] = warnings;
   // A unit that asked to end the run early (an FMU's terminate request):
   // which and why; absent when the run reached its stop time.
   if (!result.ended_by.empty()) summary["ended_by"] = result.ended_by;

@@ -33,6 +33,10 @@ struct RunReport {
   /// Every failure: the master's, a metric that overflowed, and any the
   /// caller adds (AddFailure: an output that could not be written).
   std::vector<cosim::RunError> errors;
+  /// What the units warned of (cosim::Unit::Warn: a contact the model does
+  /// not resolve), each "unit 'name' (type) at t = T s: what"; they do not
+  /// fail the run.
+  std::vector<std::string> warnings;
 
   bool ok() const { return !interrupted && errors.empty(); }
   /// "ok", "failed" or "interrupted" (summary.json's status).

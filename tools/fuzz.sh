@@ -3,6 +3,8 @@
 # build: tools/sanitizer_build.sh) and runs each for SECONDS (default 60)
 # from a corpus seeded with the shipped files:
 #   fuzz_scenario           scenarios/*.yaml (and variants with --set lines)
+#   fuzz_robot_scenario     the fleet and worker scenarios (and variants with
+#                           --set lines), loaded and run for 0.1 s
 #   fuzz_description        models/robots/*.yaml, models/scenes/*.yaml
 #   fuzz_sweep_file         scenarios/sweeps/*.yaml
 #   fuzz_results_file       a results.csv of scenarios/sweeps/master_step.yaml
@@ -21,7 +23,8 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 harnesses=("$@")
-[ ${#harnesses[@]} -gt 0 ] || harnesses=(fuzz_scenario fuzz_description fuzz_sweep_file
+[ ${#harnesses[@]} -gt 0 ] || harnesses=(fuzz_scenario fuzz_robot_scenario fuzz_description
+                                         fuzz_sweep_file
                                          fuzz_results_file fuzz_model_description
                                          fuzz_fmu_loader fuzz_replay_data)
 bash tools/setup.sh
@@ -43,6 +46,14 @@ seed fuzz_scenario scenarios/*.yaml
 { cat scenarios/motor_step.yaml
   printf '#set units.motors.parameters.gear_ratio.0=15\n#set duration_s=1\n'
 } > "$out/corpus/fuzz_scenario/motor_step_set.yaml"
+seed fuzz_robot_scenario scenarios/worker_crossing.yaml scenarios/fleet_line.yaml
+# The safety function's times, the workers' starts and the field shapes.
+{ cat scenarios/worker_crossing.yaml
+  printf '#set safety.parameters.restart_delay=0.5\n#set workers.0.start_time_s=0\n'
+} > "$out/corpus/fuzz_robot_scenario/worker_crossing_set.yaml"
+{ cat scenarios/fleet_line.yaml
+  printf '#set robots.0.safety.parameters.restart_delay=1\n#set workers.1.pause_s=0\n'
+} > "$out/corpus/fuzz_robot_scenario/fleet_line_set.yaml"
 seed fuzz_description models/robots/*.yaml models/scenes/*.yaml
 seed fuzz_sweep_file scenarios/sweeps/*.yaml
 mkdir -p "$out/corpus/fuzz_results_file"
@@ -69,8 +80,11 @@ for h in "${harnesses[@]}"; do
   # profile first, which took over 15 minutes on a 2 GB heap without saving
   # the input; a runaway input is caught by -timeout (saved as timeout-...),
   # one huge allocation by -malloc_limit_mb.
+  # A harness's dictionary of keys and values, when it has one.
+  dict=()
+  [ -f "fuzz/$h.dict" ] && dict=(-dict="fuzz/$h.dict")
   if build-asan/fuzz/"$h" -max_total_time="$seconds" -timeout=30 -rss_limit_mb=0 \
-       -malloc_limit_mb=2048 \
+       -malloc_limit_mb=2048 "${dict[@]}" \
        -print_final_stats=1 -artifact_prefix="$out/findings/$h-" \
        "$out/corpus/$h" > "$log" 2>&1; then
     result=clean

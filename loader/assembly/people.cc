@@ -3,9 +3,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 
+#include "cosim/system.h"
 #include "models/angle.h"
+#include "models/person.h"
+#include "models/polygon.h"
 
 namespace linesim::loader::assembly {
 
@@ -31,13 +35,24 @@ YAML::Node ReadPolygonInScanner(YamlReader& r, const YAML::Node& item, const std
     r.Error(list, full, "a field needs at least 3 corners [x, y] (m, base_link)");
     return YAML::Node();
   }
-  std::vector<std::array<double, 2>> corners;
-  const double c = std::cos(myaw), s = std::sin(myaw);
+  std::vector<std::array<double, 2>> given;
   for (std::size_t i = 0; i < list.size(); ++i) {
     if (auto p = r.AsPoint(list[i], JoinPath(full, std::to_string(i)), {-100.0, 100.0})) {
-      const double dx = (*p)[0] - mx, dy = (*p)[1] - my;
-      corners.push_back({c * dx + s * dy, -s * dx + c * dy});
+      given.push_back(*p);
     }
+  }
+  if (given.size() != list.size()) return YAML::Node();
+  // Checked as written (base_link): a degenerate polygon holds no point, a
+  // field that silently never stops the robot.
+  if (const auto problem = models::PolygonProblem(given)) {
+    r.Error(list, full, "the field " + *problem);
+    return YAML::Node();
+  }
+  std::vector<std::array<double, 2>> corners;
+  const double c = std::cos(myaw), s = std::sin(myaw);
+  for (const auto& p : given) {
+    const double dx = p[0] - mx, dy = p[1] - my;
+    corners.push_back({c * dx + s * dy, -s * dx + c * dy});
   }
   return PointList(corners);
 }
@@ -181,6 +196,169 @@ void AddSafetyFields(SystemBuilder& b, const RobotFile& robot, Signals& s, Robot
   s.yaw_rate_command_input = Signal(kSafety, "yaw_rate_command");
 }
 
+namespace {
+
+// The worker's body as workers.N.parameters give it, the defaults
+// (models/person.h) otherwise: a value that is no number is the worker
+// unit's to report.
+models::PersonBody BodyOf(const YAML::Node& params) {
+  models::PersonBody body;
+  const auto number = [&](const char* key, double& into) {
+    double x = 0.0;
+    const YAML::Node v = Child(params, key);
+    if (v.IsDefined() && v.IsScalar() && YAML::convert<double>::decode(v, x) && std::isfinite(x)) {
+      into = x;
+    }
+  };
+  number("leg_radius", body.leg_radius_m);
+  number("leg_spacing", body.leg_spacing_m);
+  number("crotch_height", body.crotch_height_m);
+  number("torso_radius", body.torso_radius_m);
+  number("stature", body.stature_m);
+  return body;
+}
+
+// The worker's heading at the start: its first segment's, or initial_yaw
+// (deg) when it stands at one point.
+double StartYaw(const std::vector<std::array<double, 2>>& points, const YAML::Node& params) {
+  if (points.size() >= 2 && points[1] != points[0]) {
+    return std::atan2(points[1][1] - points[0][1], points[1][0] - points[0][0]);
+  }
+  double deg = 0.0;
+  const YAML::Node v = Child(params, "initial_yaw");
+  if (v.IsDefined() && v.IsScalar() && YAML::convert<double>::decode(v, deg) &&
+      std::isfinite(deg)) {
+    return deg * models::kDegToRad;
+  }
+  return 0.0;
+}
+
+// Person contact is not modelled (docs/scenarios.md, "Workers"): a worker
+// that would start inside or touching the robot's body is refused at its
+// first waypoint, naming the robot.
+void CheckStartClear(SystemBuilder& b, const RobotFile& robot, const RobotInfo& info,
+                     const std::string& name, const YAML::Node& waypoints,
+                     const std::string& wp_path, const std::vector<std::array<double, 2>>& points,
+                     const YAML::Node& params) {
+  const models::BodyDescription& body = robot.robot.body;
+  if (points.empty() || !(body.length_m > 0.0 && body.width_m > 0.0)) return;
+  const double box[models::MovingBox::kValues] = {info.start_pose[0],
+                                                  info.start_pose[1],
+                                                  info.start_pose[2],
+                                                  0.0,
+                                                  0.0,
+                                                  0.0,
+                                                  body.length_m,
+                                                  body.width_m,
+                                                  body.com_height_m - 0.5 * body.height_m,
+                                                  body.com_height_m + 0.5 * body.height_m};
+  const auto person =
+      models::StandingPerson(BodyOf(params), points[0][0], points[0][1], StartYaw(points, params));
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < models::kPersonCylinders; ++k) {
+    nearest = std::min(nearest, models::CylinderBoxDistance(
+                                    person.data() + k * models::MovingCylinder::kValues, box));
+  }
+  if (nearest > 0.0) return;
+  const std::string robot_name = info.name.empty() ? "the robot" : "robot '" + info.name + "'";
+  b.reader().Error(waypoints[0], JoinPath(wp_path, "0"),
+                   "worker '" + name + "' would start inside or touching the body of " +
+                       robot_name + " (at " + b.reader().Scoped("robot.pose") +
+                       "): contact with a person is not modelled, so a worker must start clear "
+                       "of every robot");
+}
+
+// pause_s: one number for every waypoint, or one per waypoint.
+void ReadPauses(YamlReader& r, const YAML::Node& item, const std::string& path,
+                std::size_t waypoint_count, Parameters& p) {
+  const YAML::Node pause = Child(item, "pause_s");
+  if (!pause.IsDefined()) return;
+  const std::string pause_path = JoinPath(path, "pause_s");
+  if (pause.IsSequence()) {
+    if (pause.size() != waypoint_count) {
+      r.Error(pause, pause_path,
+              "expected one pause per waypoint (" + std::to_string(waypoint_count) + "), got " +
+                  std::to_string(pause.size()));
+    }
+    std::vector<double> v;
+    for (std::size_t k = 0; k < pause.size(); ++k) {
+      v.push_back(
+          r.AsReal(pause[k], JoinPath(pause_path, std::to_string(k)), {0.0, 1e7}).value_or(0.0));
+    }
+    p["pause"] = v;
+  } else {
+    const double v = r.Real(item, path, "pause_s", 0.0, {0.0, 1e7});
+    p["pause"] = std::vector<double>(waypoint_count, v);
+  }
+}
+
+// Worker i of `workers:` as a worker unit, its values' origins at the
+// worker's keys (so that the unit's complaints are reported there); its
+// name, or nothing when the item is refused.
+std::optional<std::string> AddWorker(SystemBuilder& b, const RobotFile& robot,
+                                     const RobotInfo& info, const YAML::Node& item, std::size_t i) {
+  YamlReader& r = b.reader();
+  const std::string path = JoinPath("workers", std::to_string(i));
+  if (!r.ExpectMap(item, path)) return std::nullopt;
+  r.CheckKeys(item, path, {"name", "waypoints", "pause_s", "start_time_s", "parameters"});
+  const std::string name = r.String(item, path, "name", "worker_" + std::to_string(i));
+  const YAML::Node name_node = Child(item, "name").IsDefined() ? Child(item, "name") : item;
+  if (!cosim::IsIdentifier(name)) {
+    r.Error(name_node, JoinPath(path, "name"),
+            "worker name '" + name +
+                "' is not valid: expected letters, digits and _ (it names "
+                "the worker's unit, its columns and its metrics)");
+    return std::nullopt;
+  }
+  if (b.HasUnit(name)) {
+    r.Error(name_node, JoinPath(path, "name"), "'" + name + "' is already the name of a unit");
+    return std::nullopt;
+  }
+  const YAML::Node waypoints = Child(item, "waypoints");
+  const std::string wp_path = JoinPath(path, "waypoints");
+  if (!waypoints.IsDefined()) {
+    r.Error(item, wp_path, "missing required key: a list of points [x, y] (m, map)");
+    return std::nullopt;
+  }
+  if (!r.ExpectSequence(waypoints, wp_path)) return std::nullopt;
+  if (waypoints.size() == 0) r.Error(waypoints, wp_path, "expected at least one point [x, y]");
+  std::vector<std::array<double, 2>> points;
+  for (std::size_t k = 0; k < waypoints.size(); ++k) {
+    if (auto q = r.AsPoint(waypoints[k], JoinPath(wp_path, std::to_string(k)), {-1e6, 1e6})) {
+      points.push_back(*q);
+    }
+  }
+  const YAML::Node own = Child(item, "parameters");
+  CheckStartClear(b, robot, info, name, waypoints, wp_path, points, own);
+  b.Unit(name, "worker");
+  Parameters& p = b.Params(name);
+  const std::string prefix = JoinPath(JoinPath("units", name), "parameters");
+  p["waypoints"] = points;
+  b.Origin(JoinPath(prefix, "waypoints"), {waypoints, wp_path, ""});
+  // The worker knows where the robot is (it yields to it with a
+  // stop_distance; a fleet's are connected by the fleet).
+  p["robots"] = 1;
+  b.Connect(Signal(kChassis, "body_box"), Signal(name, "robots"));
+  ReadPauses(r, item, path, points.size(), p);
+  if (Child(item, "pause_s").IsDefined()) {
+    b.Derived(JoinPath(prefix, "pause"), item, path, "pause_s");
+  }
+  if (Child(item, "start_time_s").IsDefined()) {
+    p["start_time"] = r.Real(item, path, "start_time_s", 0.0, {0.0, 1e7});
+    b.Derived(JoinPath(prefix, "start_time"), item, path, "start_time_s");
+  }
+  if (own.IsDefined() && !own.IsNull() && r.ExpectMap(own, JoinPath(path, "parameters"))) {
+    for (const auto& kv : own) {
+      const std::string key = kv.first.Scalar();
+      p[key] = ParameterValue(kv.second);
+      b.Derived(JoinPath(prefix, key), own, JoinPath(path, "parameters"), key);
+    }
+  }
+  return name;
+}
+
+}  // namespace
+
 void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo& info) {
   YamlReader& r = b.reader();
   const auto add = [&](const std::string& name, const Port& of, cosim::Reduction reduce) {
@@ -208,107 +386,54 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
   if (!r.ExpectSequence(list, "workers")) return;
   std::vector<std::string> names;
   for (std::size_t i = 0; i < list.size(); ++i) {
-    const std::string path = JoinPath("workers", std::to_string(i));
-    const YAML::Node item = list[i];
-    if (!r.ExpectMap(item, path)) continue;
-    r.CheckKeys(item, path, {"name", "waypoints", "pause_s", "start_time_s", "parameters"});
-    const std::string name = r.String(item, path, "name", "worker_" + std::to_string(i));
-    if (b.HasUnit(name)) {
-      r.Error(Child(item, "name").IsDefined() ? Child(item, "name") : item, JoinPath(path, "name"),
-              "'" + name + "' is already the name of a unit");
-      continue;
-    }
-    const YAML::Node waypoints = Child(item, "waypoints");
-    const std::string wp_path = JoinPath(path, "waypoints");
-    std::vector<std::array<double, 2>> points;
-    if (!waypoints.IsDefined()) {
-      r.Error(item, wp_path, "missing required key: a list of points [x, y] (m, map)");
-      continue;
-    }
-    if (!r.ExpectSequence(waypoints, wp_path)) continue;
-    if (waypoints.size() == 0) r.Error(waypoints, wp_path, "expected at least one point [x, y]");
-    for (std::size_t k = 0; k < waypoints.size(); ++k) {
-      if (auto q = r.AsPoint(waypoints[k], JoinPath(wp_path, std::to_string(k)), {-1e6, 1e6})) {
-        points.push_back(*q);
-      }
-    }
-    b.Unit(name, "worker");
-    Parameters& p = b.Params(name);
-    p["waypoints"] = points;
-    // The worker knows where the robot is (it yields to it with a
-    // stop_distance; a fleet's are connected by the fleet).
-    p["robots"] = 1;
-    b.Connect(Signal(kChassis, "body_box"), Signal(name, "robots"));
-    // pause_s: one number for every waypoint, or one per waypoint.
-    if (const YAML::Node pause = Child(item, "pause_s"); pause.IsDefined()) {
-      const std::string pause_path = JoinPath(path, "pause_s");
-      if (pause.IsSequence()) {
-        if (pause.size() != points.size()) {
-          r.Error(pause, pause_path,
-                  "expected one pause per waypoint (" + std::to_string(points.size()) + "), got " +
-                      std::to_string(pause.size()));
-        }
-        std::vector<double> v;
-        for (std::size_t k = 0; k < pause.size(); ++k) {
-          v.push_back(r.AsReal(pause[k], JoinPath(pause_path, std::to_string(k)), {0.0, 1e7})
-                          .value_or(0.0));
-        }
-        p["pause"] = v;
-      } else {
-        const double v = r.Real(item, path, "pause_s", 0.0, {0.0, 1e7});
-        p["pause"] = std::vector<double>(points.size(), v);
-      }
-    }
-    if (Child(item, "start_time_s").IsDefined()) {
-      p["start_time"] = r.Real(item, path, "start_time_s", 0.0, {0.0, 1e7});
-    }
-    const YAML::Node own = Child(item, "parameters");
-    if (own.IsDefined() && !own.IsNull() && r.ExpectMap(own, JoinPath(path, "parameters"))) {
-      for (const auto& kv : own) {
-        const std::string key = kv.first.Scalar();
-        p[key] = ParameterValue(kv.second);
-        b.Derived(JoinPath(JoinPath(JoinPath("units", name), "parameters"), key), own,
-                  JoinPath(path, "parameters"), key);
-      }
-    }
-    names.push_back(name);
+    if (auto name = AddWorker(b, robot, info, list[i], i)) names.push_back(std::move(*name));
   }
   if (names.empty()) return;
 
   // Every laser on the robot sees every worker's cylinders, at each beam's
-  // time (units/sensors/ray_scene.h), and the body meets them (the chassis).
+  // time (units/sensors/ray_scene.h). The body does not collide with them:
+  // contact with a person is not modelled (no force either way); the
+  // person_clearance unit counts and times it and warns.
   const int per_worker = kCylindersPerWorker * kCylinderValues;
-  std::vector<std::string> takers = {kChassis};
+  std::vector<std::string> takers;
   for (const auto& m : s.sensors) {
     if (m.kind == "laser_scanner") takers.push_back(m.name);
   }
-  for (const auto& unit : takers) {
-    b.Params(unit)["moving_cylinders"] = static_cast<int>(names.size()) * kCylindersPerWorker;
-    for (std::size_t w = 0; w < names.size(); ++w) {
-      for (int j = 0; j < per_worker; ++j) {
-        b.Connect(Element(names[w], "cylinders", static_cast<std::size_t>(j)),
-                  Element(unit, "moving_cylinders", w * per_worker + static_cast<std::size_t>(j)));
-      }
-    }
-  }
-
+  takers.push_back(kPersonClearance);
   // The body's distance from the people: the clearance unit's box.
   const models::BodyDescription& body = robot.robot.body;
   b.Unit(kPersonClearance, "person_clearance");
   Parameters& c = b.Params(kPersonClearance);
   c["workers"] = static_cast<int>(names.size());
+  YAML::Node worker_names(YAML::NodeType::Sequence);
+  for (const auto& name : names) worker_names.push_back(name);
+  c["worker_names"] = ParameterValue(worker_names);
   c["body_length"] = body.length_m;
   c["body_width"] = body.width_m;
   // The body box where the robot file puts it (the chassis's; flat floor).
   c["body_z_min"] = body.bottom_m;
   c["body_z_max"] = body.top_m();
+  // A bad body is reported where the robot file gives it.
+  const std::string prefix = JoinPath(JoinPath("units", kPersonClearance), "parameters");
+  b.Origin(JoinPath(prefix, "body_length"), robot.At("body.length_m"));
+  b.Origin(JoinPath(prefix, "body_width"), robot.At("body.width_m"));
+  b.Origin(JoinPath(prefix, "body_z_min"), robot.At("body.bottom_m"));
+  b.Origin(JoinPath(prefix, "body_z_max"), robot.At("body.height_m"));
   b.Connect(Signal(kChassis, "position_3d"), Signal(kPersonClearance, "position_3d"));
   b.Connect(Signal(kChassis, "orientation"), Signal(kPersonClearance, "orientation"));
-  for (std::size_t w = 0; w < names.size(); ++w) {
-    for (int j = 0; j < per_worker; ++j) {
-      b.Connect(Element(names[w], "cylinders", static_cast<std::size_t>(j)),
-                Element(kPersonClearance, "cylinders", w * per_worker + static_cast<std::size_t>(j)));
+  for (const auto& unit : takers) {
+    if (unit != kPersonClearance) {
+      b.Params(unit)["moving_cylinders"] = static_cast<int>(names.size()) * kCylindersPerWorker;
     }
+    const std::string input = unit == kPersonClearance ? "cylinders" : "moving_cylinders";
+    for (std::size_t w = 0; w < names.size(); ++w) {
+      for (int j = 0; j < per_worker; ++j) {
+        b.Connect(Element(names[w], "cylinders", static_cast<std::size_t>(j)),
+                  Element(unit, input, w * per_worker + static_cast<std::size_t>(j)));
+      }
+    }
+  }
+  for (std::size_t w = 0; w < names.size(); ++w) {
     s.recorded.push_back(Signal(names[w], "pose"));
     info.worker_columns.emplace_back(Element(names[w], "pose", 0).Name(),
                                      Element(names[w], "pose", 1).Name());
@@ -325,6 +450,7 @@ void AddWorkers(SystemBuilder& b, const RobotFile& robot, Signals& s, RobotInfo&
   if (b.HasUnit(kSafety)) info.person_distance_column = Signal(kPersonClearance, "distance").Name();
   add("min_person_distance_m", Signal(kPersonClearance, "min_distance"), cosim::Reduction::kFinal);
   add("person_collisions", Signal(kPersonClearance, "collisions"), cosim::Reduction::kFinal);
+  add("person_contact_time_s", Signal(kPersonClearance, "contact_time"), cosim::Reduction::kFinal);
 }
 
 }  // namespace linesim::loader::assembly

@@ -76,6 +76,16 @@ class DeviceNumbers {
   std::optional<double> Get(const std::string& key) const;
   /// A number the estimator cannot do without (reported when missing).
   double Required(const std::string& key) const;
+  /// The device's beam_count as the laser unit takes it (a whole number
+  /// from 1 to kMaxBeams), or 0 when it is not one: the laser unit reports
+  /// it at its key, and nothing converts an out-of-range number to int.
+  int BeamCount() const { return WholeBeams(Required("beam_count")); }
+  static int WholeBeams(double n) {
+    return n >= 1.0 && n <= kMaxBeams && n == static_cast<double>(static_cast<int>(n))
+               ? static_cast<int>(n)
+               : 0;
+  }
+  static constexpr double kMaxBeams = 100000;  // the laser_scanner unit's limit
 
  private:
   YAML::Node Find(const std::string& key) const;

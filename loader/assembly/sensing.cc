@@ -122,7 +122,7 @@ void WireLasers(SystemBuilder& b, const ProviderContext& c, const Signals& s, co
   for (std::size_t k = 0; k < lasers.size(); ++k) {
     const models::SensorMount& m = *lasers[k];
     const DeviceNumbers device(b, c, m);
-    beams.push_back(static_cast<int>(device.Required("beam_count")));
+    beams.push_back(device.BeamCount());
     x.push_back(m.x_m);
     y.push_back(m.y_m);
     z.push_back(m.z_m);
@@ -299,7 +299,7 @@ void AddBeaconGroundTruth(SystemBuilder& b, const RobotFile& file, const StartPo
   const DeviceNumbers device(b, c, m);
   b.Unit(kBeacons, "beacon_localization");
   Parameters& p = b.Params(kBeacons);
-  p["beam_count"] = static_cast<int>(device.Required("beam_count"));
+  p["beam_count"] = device.BeamCount();
   p["mount_x"] = m.x_m;
   p["mount_y"] = m.y_m;
   p["mount_yaw"] = m.yaw_rad;
@@ -411,10 +411,12 @@ void AddSensing(SystemBuilder& b, const RobotFile& file, const StartPose& start,
                             JoinPath("sensors", m.name)};
     const DeviceNumbers device(b, c, m);
     const auto first = device.Get("first_beam_angle"), step = device.Get("angular_step"),
-               no_return = device.Get("no_return_value"), beams = device.Get("beam_count");
-    if (first && step && no_return && beams && *beams >= 1.0) {
-      s.scan_geometry = RobotInfo::ScanGeometry{
-          m.x_m, m.y_m, m.yaw_rad, *first, *step, *no_return, static_cast<int>(*beams)};
+               no_return = device.Get("no_return_value");
+    const auto beam_count = device.Get("beam_count");
+    const int beams = beam_count ? DeviceNumbers::WholeBeams(*beam_count) : 0;
+    if (first && step && no_return && beams >= 1) {
+      s.scan_geometry =
+          RobotInfo::ScanGeometry{m.x_m, m.y_m, m.yaw_rad, *first, *step, *no_return, beams};
     }
   }
 }

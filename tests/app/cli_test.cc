@@ -359,6 +359,43 @@ TEST(Cli, RobotLevelBadInputExitsTwo) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// Guards issue 37: a time or a count a unit converts to an integer was not
+// range-checked (a restart_delay of 9.2e9 s overflowed and restarted the
+// robot at once). Each class, a huge value, a negative, NaN and infinity,
+// a time below the 1 ns resolution, is bad input: exit 2, the key named,
+// the limit said, nothing written.
+TEST(Cli, TimesAndCountsOutOfRangeExitTwoAtTheirKey) {
+  const std::string worker = LINESIM_SOURCE_DIR "/scenarios/worker_crossing.yaml";
+  const std::string key = "safety.parameters.restart_delay";
+  const auto delay = [](const std::string& v) {
+    return "safety.parameters={restart_delay: " + v + "}";
+  };
+  struct Case {
+    std::string file, set, key, says;
+  };
+  const std::vector<Case> cases = {
+      {worker, delay("1e10"), key, "4.6e9 s is the longest time linesim represents"},
+      {worker, delay("9.3e9"), key, "must be in [0, 4.6e+09]"},
+      {worker, delay("-1"), key, "must be in [0, 4.6e+09], got -1"},
+      {worker, delay(".nan"), key, "expected a number"},
+      {worker, delay(".inf"), key, "must be finite and in [0, 4.6e+09], got inf"},
+      {worker, "sensors.laser_front={parameters: {scan_period: 1e-12}}",
+       "sensors.laser_front.parameters.scan_period", "1 ns is the time resolution"},
+      {kCrossLine,
+       "sensors={default: true, belt_ground_truth: {parameters: {counts_per_revolution: 1e17}}}",
+       "sensors.belt_ground_truth.parameters.counts_per_revolution",
+       "2^53 is the largest count a Real carries exactly"},
+  };
+  for (const auto& c : cases) {
+    const std::string out = Fresh("limits");
+    const Result r = Linesim("run " + c.file + " --out " + out + " --set '" + c.set + "'");
+    EXPECT_EQ(r.status, 2) << c.set << ": " << r.err;
+    EXPECT_NE(r.err.find(c.key), std::string::npos) << c.set << ": " << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << c.set << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.set;
+  }
+}
+
 // Guards determinism of a robot run (ODE, CVODE, the seeded belt): same
 // file and seed give the same bytes, under Jacobi with 2 threads too.
 // Guards master.retry on a robot run where no unit discards: the run is

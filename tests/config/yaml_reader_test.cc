@@ -10,10 +10,11 @@ bool Has(const std::string& text, const std::string& part) {
 }
 
 // Guards times: whole nanoseconds, a nonzero time below 1 ns and one beyond
-// int64 nanoseconds (9.22e9 s) refused at their keys instead of silently
-// becoming 0 (or one master step) or throwing.
+// cosim::kMaxTimeSeconds (4.6e9 s: half of int64 nanoseconds, so that a time
+// plus a duration fits; 5e9 s would fit on its own) refused at their keys
+// instead of silently becoming 0 (or one master step) or throwing.
 TEST(YamlReader, TimeIsWholeNanosecondsAndRefusesWhatTheyCannotHold) {
-  const YAML::Node map = YAML::Load("{ok: 0.002, zero: 0, tiny: 1.0e-10, huge: 1.0e10, nan: .nan}");
+  const YAML::Node map = YAML::Load("{ok: 0.002, zero: 0, tiny: 1.0e-10, huge: 5.0e9, nan: .nan}");
   YamlReader r("f.yaml");
   EXPECT_EQ(r.Time(map, "m", "ok", std::nullopt), 2'000'000);
   EXPECT_EQ(r.Time(map, "m", "zero", std::nullopt), 0);
@@ -28,6 +29,7 @@ TEST(YamlReader, TimeIsWholeNanosecondsAndRefusesWhatTheyCannotHold) {
   EXPECT_TRUE(Has(r.issues()[0].message, "below one nanosecond")) << r.issues()[0].message;
   EXPECT_TRUE(Has(r.issues()[0].message, "expected 0 or at least 1e-9 s")) << r.issues()[0].message;
   EXPECT_EQ(r.issues()[1].key_path, "m.huge");
+  EXPECT_TRUE(Has(r.issues()[1].message, "within +-4.6e9 s")) << r.issues()[1].message;
   EXPECT_TRUE(Has(r.issues()[1].message, "int64 nanoseconds")) << r.issues()[1].message;
   EXPECT_EQ(r.issues()[2].key_path, "m.nan");
   EXPECT_TRUE(Has(r.issues()[2].message, "expected a number")) << r.issues()[2].message;

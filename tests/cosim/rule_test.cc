@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "cosim/unit.h"
 
@@ -14,6 +16,99 @@ namespace {
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Guards issue 37: a safety_field restart_delay of 9.2e9 s or more restarted
+// the robot at once, as a delay of 0 (llround(x * 1e9) overflowed int64).
+// Every Real parameter in seconds gets the time's rule from the table,
+// whatever the unit declared: finite, within +-4.6e9 s (cosim::
+// kMaxTimeSeconds: a time plus a duration fits int64 nanoseconds), no
+// non-zero value below 1 ns; a value the limit refuses is told the limit.
+TEST(Rule, EveryParameterInSecondsIsATime) {
+  struct Timed : Unit {
+    Timed() : Unit("timed", "t") {
+      variables().Parameter("delay", "s", &delay, "declared >= 0", Rule::NonNegative());
+      variables().Parameter("period", "s", &period, "declared > 0", Rule::Positive());
+      variables().Parameter("offset", "s", &offset, "declared without a rule");
+      variables().Parameter("pauses", "s", &pauses, "an array", Rule::NonNegative());
+      variables().Parameter("window", "s", &window, "bounded tighter", Rule::Range(0, 1));
+      variables().Parameter("length", "m", &length, "not a time", Rule::NonNegative());
+    }
+    StepResult DoStep(TimeNs, TimeNs) override { return StepResult::kOk; }
+    double delay = 2.0, period = 0.04, offset = 0.0, window = 0.2, length = 1.0;
+    std::vector<double> pauses = {0.0, 6.0};
+  };
+  Timed u;
+  EXPECT_TRUE(u.CheckParameters().empty());
+  const auto& t = u.variables();
+  const auto rule = [&](const char* name) { return t.info(*t.Find(name)).rule; };
+  // The bounds are the limit's where the unit left them open (inspect and
+  // FMI's min/max show them).
+  EXPECT_EQ(rule("delay").Text(), "[0, 4.6e+09]");
+  EXPECT_EQ(rule("offset").Text(), "[-4.6e+09, 4.6e+09]");
+  EXPECT_EQ(rule("window").Text(), "[0, 1]");
+  EXPECT_EQ(rule("length").Text(), ">= 0");
+  EXPECT_EQ(rule("delay").upper(), kMaxTimeSeconds);
+
+  // A huge value, the limit named.
+  const auto huge = rule("delay").Violation(1e10);
+  ASSERT_TRUE(huge);
+  EXPECT_NE(huge->find("must be in [0, 4.6e+09] (4.6e9 s is the longest time linesim "
+                       "represents: int64 nanoseconds"),
+            std::string::npos)
+      << *huge;
+  EXPECT_NE(huge->find("got 1e+10"), std::string::npos) << *huge;
+  EXPECT_FALSE(rule("delay").Violation(kMaxTimeSeconds));
+  EXPECT_TRUE(rule("delay").Violation(std::nextafter(kMaxTimeSeconds, kInf)));
+  EXPECT_TRUE(rule("offset").Violation(-1e10));
+  EXPECT_FALSE(rule("offset").Violation(-1.0));
+  // A negative where the unit said so, NaN and inf always.
+  EXPECT_EQ(rule("delay").Violation(-1.0), "must be in [0, 4.6e+09], got -1");
+  EXPECT_TRUE(rule("offset").Violation(kNan));
+  EXPECT_TRUE(rule("offset").Violation(kInf));
+  // Below the resolution: it would round to 0 ns.
+  const auto tiny = rule("period").Violation(1e-12);
+  ASSERT_TRUE(tiny);
+  EXPECT_NE(tiny->find("must be at least 1e-09 in magnitude (1 ns is the time resolution"),
+            std::string::npos)
+      << *tiny;
+  EXPECT_NE(rule("delay").Violation(1e-12)->find("must be 0 or at least 1e-09"), std::string::npos);
+  EXPECT_FALSE(rule("delay").Violation(0.0));
+  EXPECT_FALSE(rule("delay").Violation(1e-9));
+
+  // CheckParameters, element by element.
+  u.delay = 1e10;
+  u.pauses = {1.0, 9.3e9};
+  const auto problems = u.CheckParameters();
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_EQ(problems[0].variable, "delay");
+  EXPECT_EQ(problems[1].variable, "pauses");
+  EXPECT_EQ(problems[1].index, 1u);
+  // A rule set later (by a helper) is a time's too.
+  double later = 0.0;
+  VariableTable table;
+  const ValueRef ref = table.Parameter("later", "s", &later, "set below");
+  table.SetRule(ref, Rule::Positive());
+  EXPECT_EQ(table.info(ref).rule.Text(), "(0, 4.6e+09]");
+}
+
+// Guards the counts' rule (an encoder's counts per revolution, which its
+// unit turns into integer counts): finite and within +-2^53, the largest
+// count a Real carries exactly, named when refused.
+TEST(Rule, CountsStayWithinWhatARealCarriesExactly) {
+  const Rule cpr = Rule::Positive().NoDefault().Count();
+  EXPECT_FALSE(cpr.Violation(16384.0));
+  EXPECT_FALSE(cpr.Violation(kMaxExactCount));
+  const auto huge = cpr.Violation(1e17);
+  ASSERT_TRUE(huge);
+  EXPECT_NE(huge->find("2^53 is the largest count a Real carries exactly"), std::string::npos)
+      << *huge;
+  EXPECT_EQ(cpr.Violation(-1.0), "must be in (0, 9007199254740992], got -1");
+  EXPECT_EQ(cpr.Violation(kNan), "must be set (robot-specific: no default)");
+  EXPECT_TRUE(cpr.Violation(kInf));
+  EXPECT_TRUE(cpr.required());
+  // No resolution: a small count per revolution is a count.
+  EXPECT_FALSE(cpr.Violation(1e-12));
+}
 
 // Guards the one wording of a broken rule: what was expected, then the
 // value, for every kind of rule; and the text inspect prints.

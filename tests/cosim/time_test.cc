@@ -72,3 +72,27 @@ TEST(NsToSeconds, ScalesByOneBillion) {
 
 }  // namespace
 }  // namespace linesim::cosim
+
+namespace linesim::cosim {
+namespace {
+
+// Guards issue 37's one limit for every time linesim converts: zero and 1 ns
+// to kMaxTimeSeconds (4.6e9 s, half of int64 nanoseconds, so that a time
+// plus a duration fits: 4.6e18 + 4.6e18 < 9.22e18) of either sign are
+// times; nothing else is, and the reason is given.
+TEST(TimeProblem, NamesTheLimit) {
+  EXPECT_FALSE(TimeProblem(0.0));
+  EXPECT_FALSE(TimeProblem(1e-9));
+  EXPECT_FALSE(TimeProblem(-2.5));
+  EXPECT_FALSE(TimeProblem(kMaxTimeSeconds));
+  EXPECT_FALSE(TimeProblem(-kMaxTimeSeconds));
+  EXPECT_LT(2.0 * kMaxTimeSeconds * 1e9, 9.2233720368547758e18);
+  EXPECT_NE(TimeProblem(9.2e9)->find("beyond +-4.6e9 s"), std::string::npos);
+  EXPECT_NE(TimeProblem(-1e10)->find("beyond +-4.6e9 s"), std::string::npos);
+  EXPECT_EQ(*TimeProblem(std::numeric_limits<double>::quiet_NaN()), "is nan, not a time");
+  EXPECT_EQ(*TimeProblem(-std::numeric_limits<double>::infinity()), "is infinite, not a time");
+  EXPECT_NE(TimeProblem(1e-12)->find("below 1 ns"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace linesim::cosim

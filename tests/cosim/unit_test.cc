@@ -7,6 +7,7 @@
 
 #include <bit>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "tests/cosim/test_units.h"
@@ -152,6 +153,83 @@ TEST(UnitState, RestoringATruncatedInternalStateThrows) {
   UnitState s = mass1.SaveState();
   s.reals.pop_back();
   EXPECT_THROW(mass1.RestoreState(s), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace linesim::cosim
+
+namespace linesim::cosim {
+namespace {
+
+// A unit that converts its inputs as units do: a scan's time in seconds to
+// nanoseconds, an encoder's position in counts to an integer.
+struct Converting : Unit {
+  Converting() : Unit("converting", "c") {
+    variables().Input("scan_time", "s", &scan_time, "a time in seconds");
+    variables().Input("position", "1", &position, "counts");
+  }
+  StepResult DoStep(TimeNs t, TimeNs) override {
+    scan_ns = InputTimeNs(scan_time, "scan_time");
+    count = static_cast<std::int64_t>(CheckCount(position, "position"));
+    Warn(t, "stepped");
+    return StepResult::kOk;
+  }
+  double scan_time = 0.0, position = 0.0;
+  TimeNs scan_ns = 0;
+  std::int64_t count = 0;
+};
+
+// Guards issue 37 for signals: a time or a count a unit turns into an
+// integer (a match's time, an encoder's counts) was cast unchecked
+// (undefined beyond int64); now the step fails naming the unit and the
+// variable, and the limit.
+TEST(UnitConversions, TimesAndCountsOutsideTheirRangeNameTheVariable) {
+  Converting u;
+  u.scan_time = 1.5;
+  u.position = 123.0;
+  EXPECT_EQ(u.DoStep(0, 1), StepResult::kOk);
+  EXPECT_EQ(u.scan_ns, 1'500'000'000);
+  EXPECT_EQ(u.count, 123);
+  for (double bad : {1e10, -1e10, std::numeric_limits<double>::quiet_NaN(),
+                     std::numeric_limits<double>::infinity(), 1e-12}) {
+    u.scan_time = bad;
+    try {
+      u.DoStep(0, 1);
+      FAIL() << "accepted scan_time " << bad;
+    } catch (const UnitError& e) {
+      EXPECT_EQ(e.variable(), "scan_time");
+      EXPECT_THAT(e.what(), HasSubstr("unit 'c' (converting): 'scan_time' = "));
+    }
+  }
+  u.scan_time = 1e10;
+  try {
+    u.DoStep(0, 1);
+  } catch (const UnitError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("beyond +-4.6e9 s, the longest time linesim represents"));
+  }
+  u.scan_time = 0.0;
+  for (double bad : {1e17, -1e17, std::numeric_limits<double>::quiet_NaN()}) {
+    u.position = bad;
+    try {
+      u.DoStep(0, 1);
+      FAIL() << "accepted position " << bad;
+    } catch (const UnitError& e) {
+      EXPECT_EQ(e.variable(), "position");
+      EXPECT_THAT(e.what(), HasSubstr("beyond +-2^53"));
+    }
+  }
+}
+
+// Guards the warnings' bound: a unit warning every step keeps
+// kMaxWarnings of them, the last saying how many more there were.
+TEST(UnitWarnings, KeptInOrderAndBounded) {
+  Converting u;
+  for (TimeNs t = 0; t < 25; ++t) u.DoStep(t * 1'000'000, 1);
+  const auto& w = u.warnings();
+  ASSERT_EQ(w.size(), 20u);  // Unit::kMaxWarnings
+  EXPECT_EQ(w.front(), "at t = 0 s: stepped");
+  EXPECT_EQ(w[1], "at t = 0.001 s: stepped");
+  EXPECT_EQ(w.back(), "and 6 more warnings like the ones before");
 }
 
 }  // namespace

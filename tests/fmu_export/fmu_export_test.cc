@@ -575,6 +575,49 @@ TEST(FmuExport, TheVariableCountsTheDocsGiveAreAnExports) {
   EXPECT_EQ(std::to_string(v2.variables), m[3].str());
 }
 
+// Guards issue 37: `export-fmu safety_field` (worker, path_follower,
+// route_follower) with no --set said "wrote", but the FMU refused to
+// instantiate: the unit had been built as `linesim inspect` builds it,
+// with placeholders for its structural keys, and the FMU's resource file
+// (which fmi2Instantiate loads) lacked them. Refused now, naming the keys
+// that need values, and nothing is written; with them, the export works.
+TEST(FmuExport, RefusesAUnitThatCouldNotInstantiate) {
+  Scratch s("needs_values");
+  const auto message = [&](const std::string& type, std::vector<std::string> sets) {
+    try {
+      ExportFmu({type, std::move(sets), s / (type + ".fmu"), "", "", 0});
+    } catch (const ExportError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(exported)");
+  };
+  const std::vector<std::pair<std::string, std::string>> needs = {
+      {"safety_field", "--set field_sets"},
+      {"worker", "--set waypoints"},
+      {"path_follower", "--set "},
+      {"route_follower", "--set "}};
+  for (const auto& [type, key] : needs) {
+    const std::string text = message(type, {});
+    EXPECT_NE(text.find("a " + type + " unit needs values to be built (give them with --set)"),
+              std::string::npos)
+        << text;
+    EXPECT_NE(text.find(key), std::string::npos) << text;
+    EXPECT_FALSE(fs::exists(s / (type + ".fmu"))) << type;
+  }
+  EXPECT_EQ(message("worker", {"waypoints=[[0, 0], [1, 0]]"}), "(exported)");
+  EXPECT_EQ(message("safety_field",
+                    {"field_sets=[{max_speed_mps: 1, protective: [[0, -0.4], [0.6, -0.4], "
+                     "[0.6, 0.4]]}]"}),
+            "(exported)");
+  // What was written instantiates (imported back and initialized).
+  for (const char* type : {"worker", "safety_field"}) {
+    fmu::FmuUnit imported(std::string(type) + "_fmu", s / (std::string(type) + ".fmu"));
+    imported.Setup(0, 100 * kMs);
+    EXPECT_NO_THROW(imported.Initialize()) << type;
+    imported.Terminate();
+  }
+}
+
 // The command line: `linesim export-fmu`, then `linesim inspect` of the FMU.
 TEST(FmuExport, CommandLineExportsAndInspectReadsIt) {
   Scratch s("cli");

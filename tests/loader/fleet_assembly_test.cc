@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <string>
 
+#include "loader/robot_scenario.h"
 #include "tests/loader/scenario_test.h"
 
 namespace linesim::loader::testing {
@@ -59,8 +60,9 @@ TEST(FleetAssembly, RobotsAreScopedByTheirNames) {
 
 // Guards the one world: the moving_bodies unit gathers the three chassis'
 // bodies (10 numbers each); each robot's chassis, lasers and robot
-// clearance read them whole, leaving out their own robot's, and take the
-// workers' legs and torsos (2 workers x 3 cylinders x 7 numbers).
+// clearance read them whole, leaving out their own robot's; the lasers take
+// the workers' legs and torsos (2 workers x 3 cylinders x 7 numbers), the
+// chassis does not (person contact is not modelled: issue 37).
 TEST(FleetAssembly, EveryRobotSeesTheOthersAndTheWorkers) {
   const Scenario s = LoadScenario(Shipped(), {"duration_s=0.1"});
   for (const char* unit : {"raw3_a.chassis", "raw3_a.laser_front", "raw3_a.laser_rear",
@@ -69,9 +71,13 @@ TEST(FleetAssembly, EveryRobotSeesTheOthersAndTheWorkers) {
     const auto boxes = v.Find("moving_boxes");
     const auto cylinders = v.Find("moving_cylinders");
     ASSERT_TRUE(boxes.has_value()) << unit;
-    ASSERT_TRUE(cylinders.has_value()) << unit;
     EXPECT_EQ(v.info(*boxes).size, 30u) << unit;
-    EXPECT_EQ(v.info(*cylinders).size, 42u) << unit;
+    if (std::string(unit).ends_with(".chassis")) {
+      EXPECT_FALSE(cylinders.has_value()) << unit;
+    } else {
+      ASSERT_TRUE(cylinders.has_value()) << unit;
+      EXPECT_EQ(v.info(*cylinders).size, 42u) << unit;
+    }
   }
   EXPECT_TRUE(Connected(s, "raw3_b.chassis.body_box[0]", "moving_bodies.bodies_in[10]"));
   EXPECT_TRUE(Connected(s, "husky.chassis.body_box[9]", "moving_bodies.bodies_in[29]"));
@@ -139,6 +145,54 @@ robots:
 )");
   issues = Issues(top);
   EXPECT_TRUE(Has(issues, ": task")) << issues;
+}
+
+// Guards issue 37 in a fleet: a robot that would start on a worker is
+// refused at the worker's first waypoint, naming the robot and its pose
+// key; a worker named as a robot (whose metrics then took the names of the
+// robots' pair metrics, reported at metrics.44.name) at its name.
+TEST(FleetAssembly, WorkersAgainstTheRobots) {
+  std::string issues = Issues(Shipped(), {"robots.2.pose.x_m=1.5", "robots.2.pose.y_m=-6.5"});
+  EXPECT_TRUE(Has(issues, "workers.1.waypoints.0")) << issues;
+  EXPECT_TRUE(Has(issues,
+                  "worker 'worker_2' would start inside or touching the body of robot "
+                  "'husky' (at robots.2.pose)"))
+      << issues;
+  issues = Issues(Shipped(), {"workers.0.name=raw3_a"});
+  EXPECT_TRUE(Has(issues, "workers.0.name")) << issues;
+  EXPECT_TRUE(Has(issues, "'raw3_a' is the name of a robot")) << issues;
+  EXPECT_FALSE(Has(issues, "metrics.")) << issues;
+}
+
+// Guards issue 37: 1,000 robots reached 7.7 GB and std::bad_alloc after
+// 267 s. More than kMaxRobots are refused at `robots` before anything is
+// built, naming the limit; so are more workers than the robot-worker pairs
+// allow with them.
+TEST(FleetAssembly, TooManyRobotsRefusedAtRobots) {
+  std::string text = "name: t\nduration_s: 1\nscene: {model: factory_line}\nrobots:\n";
+  for (std::size_t i = 0; i <= kMaxRobots; ++i) {
+    text += "  - {name: r" + std::to_string(i) + ", model: raw3, task: {type: hold}}\n";
+  }
+  std::string issues = Issues(WriteScenario("fleet_many.yaml", text));
+  EXPECT_TRUE(Has(issues, "robots: " + std::to_string(kMaxRobots + 1) + " robots: at most " +
+                              std::to_string(kMaxRobots) + " ("))
+      << issues;
+  EXPECT_FALSE(Has(issues, "would start inside")) << issues;  // nothing was expanded
+
+  std::string workers =
+      "name: t\nduration_s: 1\nscene: {model: factory_line}\nrobots:\n"
+      "  - {name: a, model: raw3, task: {type: hold}}\n"
+      "  - {name: b, model: raw3, pose: {x_m: 3}, task: {type: hold}}\n"
+      "workers:\n";
+  for (std::size_t k = 0; k <= kMaxRobotWorkerPairs / 2; ++k) {
+    workers +=
+        "  - {waypoints: [[-10, " + std::to_string(-9.0 + 0.001 * static_cast<double>(k)) + "]]}\n";
+  }
+  issues = Issues(WriteScenario("fleet_many_workers.yaml", workers));
+  EXPECT_TRUE(Has(issues, "workers: " + std::to_string(kMaxRobotWorkerPairs / 2 + 1) +
+                              " workers with 2 robots: at most " +
+                              std::to_string(kMaxRobotWorkerPairs / 2)))
+      << issues;
 }
 
 }  // namespace

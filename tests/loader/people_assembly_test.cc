@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "loader/robot_scenario.h"
 #include "tests/loader/scenario_test.h"
 
 namespace linesim::loader::testing {
@@ -133,6 +134,123 @@ TEST(PeopleAssembly, FieldSetsComeFromTheRobotFile) {
   // The Husky has no safety section and no S300.
   const std::string husky = Issues(Shipped(), {"robot.model=husky"});
   EXPECT_TRUE(Has(husky, "safety.scanner")) << husky;
+}
+
+// The one-robot scenario the next tests vary: the Rob@Work 3 at (0, -4)
+// facing +y (its body 1.03 x 0.57 m, heights -0.07 to 0.33 m).
+const std::string kBase = R"(name: t
+duration_s: 1
+robot: {model: raw3, pose: {x_m: 0, y_m: -4, yaw_deg: 90}}
+scene: {model: factory_line}
+task: {type: path, waypoints: [[0, -4], [0, 3]], speed_mps: 0.3}
+sensors: {default: false, laser_front: true}
+)";
+
+// Guards issue 37: a worker placed inside a robot was accepted and threw it
+// at 11 m/s. Person contact is not modelled, so a worker must start clear
+// of the body: inside or touching is refused at its first waypoint, naming
+// the robot. The body's half width along x here is 0.285 m and a standing
+// worker facing +y has its legs (radius 0.045 m) 0.1 m to either side of
+// its centre: at x = 0.42 the nearer leg overlaps the body by 1 cm, at
+// x = 0.44 it is 1 cm clear.
+TEST(PeopleAssembly, WorkersStartClearOfTheRobot) {
+  const auto with_worker = [&](const std::string& name, const std::string& worker) {
+    return WriteScenario(name, kBase + "workers:\n  - " + worker + "\n");
+  };
+  std::string issues =
+      Issues(with_worker("worker_inside.yaml", "{name: w, waypoints: [[0.0, -4.0]]}"));
+  EXPECT_TRUE(Has(issues, "workers.0.waypoints.0")) << issues;
+  EXPECT_TRUE(Has(issues,
+                  "worker 'w' would start inside or touching the body of the robot (at "
+                  "robot.pose)"))
+      << issues;
+  EXPECT_TRUE(Has(issues, "contact with a person is not modelled")) << issues;
+  issues = Issues(
+      with_worker("worker_touching.yaml", "{name: w, waypoints: [[0.42, -4.0], [0.42, -3.0]]}"));
+  EXPECT_TRUE(Has(issues, "workers.0.waypoints.0")) << issues;
+  EXPECT_EQ(Issues(with_worker("worker_clear.yaml",
+                               "{name: w, waypoints: [[0.44, -4.0], [0.44, -3.0]]}")),
+            "(no error)");
+  // The worker's own body: thicker legs reach the robot from farther.
+  issues = Issues(with_worker(
+      "worker_thick.yaml",
+      "{name: w, waypoints: [[0.5, -4.0], [0.5, -3.0]], parameters: {leg_radius: 0.2}}"));
+  EXPECT_TRUE(Has(issues, "workers.0.waypoints.0")) << issues;
+}
+
+// Guards issue 37: a collinear, zero-area or self-intersecting field was
+// accepted and silently disabled the stop: refused at its key, as written
+// (base_link), in the scenario or the robot file.
+TEST(PeopleAssembly, DegenerateFieldsRefusedAtTheirKey) {
+  const auto field = [&](const std::string& name, const std::string& protective) {
+    return Issues(WriteScenario(
+        name, kBase + "safety:\n  field_sets:\n    - {max_speed_mps: 1, protective: " + protective +
+                  "}\n"));
+  };
+  std::string issues = field("field_line.yaml", "[[0.3, -0.2], [0.6, 0.0], [0.9, 0.2]]");
+  EXPECT_TRUE(Has(issues, "safety.field_sets.0.protective: the field has zero area")) << issues;
+  issues = field("field_bow.yaml", "[[0.3, -0.3], [0.9, 0.3], [0.9, -0.3], [0.3, 0.3]]");
+  EXPECT_TRUE(Has(issues, "safety.field_sets.0.protective: the field is self-intersecting"))
+      << issues;
+  issues = field("field_repeat.yaml", "[[0.3, -0.3], [0.9, -0.3], [0.9, -0.3], [0.3, 0.3]]");
+  EXPECT_TRUE(Has(issues, "repeats corner 1")) << issues;
+  EXPECT_EQ(field("field_ok.yaml", "[[0.3, -0.3], [0.9, -0.3], [0.9, 0.3], [0.3, 0.3]]"),
+            "(no error)");
+}
+
+// Guards issue 37's messages at the user's key: a repeated waypoint (the
+// worker unit's check) was reported at units.worker.parameters.waypoints.1,
+// a name with a blank in 86 connections.N lines, a scenario metric that a
+// worker's metric repeats at metrics.N.name of the expansion. Each is
+// reported once, at the key the user wrote.
+TEST(PeopleAssembly, WorkerProblemsAtTheWorkersKeys) {
+  std::string issues = Issues(WriteScenario(
+      "worker_repeat.yaml",
+      kBase + "workers:\n  - {name: w, waypoints: [[-3, -1.2], [-3, -1.2], [0, -1.2]]}\n"));
+  EXPECT_TRUE(Has(issues, "workers.0.waypoints.1: repeats the waypoint before it")) << issues;
+  EXPECT_FALSE(Has(issues, "units.")) << issues;
+
+  const std::string blank = WriteScenario(
+      "worker_blank.yaml", kBase + "workers:\n  - {name: bad name, waypoints: [[-3, -1.2]]}\n");
+  issues = Issues(blank);
+  EXPECT_TRUE(Has(issues, "workers.0.name: worker name 'bad name' is not valid")) << issues;
+  EXPECT_FALSE(Has(issues, "connections.")) << issues;
+  EXPECT_EQ(std::count(issues.begin(), issues.end(), '\n'), 0) << issues;  // one issue
+
+  const std::string metric = WriteScenario(
+      "worker_metric.yaml",
+      kBase +
+          "workers:\n  - {name: w, waypoints: [[-3, -1.2]]}\n"
+          "metrics:\n  - {name: w_time_waited_s, of: 'belt.speed[0]', reduce: max}\n");
+  issues = Issues(metric);
+  EXPECT_TRUE(Has(issues,
+                  "metrics.0.name: metric 'w_time_waited_s' is also one the robot "
+                  "scenario gives"))
+      << issues;
+
+  const std::string pause = WriteScenario(
+      "worker_pause.yaml",
+      kBase + "workers:\n  - {name: w, waypoints: [[-3, -1.2], [0, -1.2]], pause_s: [0, -1]}\n");
+  issues = Issues(pause);
+  EXPECT_TRUE(Has(issues, "workers.0.pause_s.1")) << issues;
+}
+
+// Guards issue 37: 3,400 workers were refused after 20 s at an internal key
+// (units.chassis.parameters.moving_cylinders) that never said "workers".
+// Too many are refused at `workers`, naming the limit, before anything is
+// built (this one-robot file's limit: kMaxRobotWorkerPairs).
+TEST(PeopleAssembly, TooManyWorkersRefusedAtWorkers) {
+  std::string text = kBase + "workers:\n";
+  for (std::size_t k = 0; k <= kMaxRobotWorkerPairs; ++k) {
+    text += "  - {waypoints: [[" + std::to_string(-10.0 + 0.01 * static_cast<double>(k)) +
+            ", -8.0]]}\n";
+  }
+  const std::string issues = Issues(WriteScenario("many_workers.yaml", text));
+  EXPECT_TRUE(Has(issues, "workers: " + std::to_string(kMaxRobotWorkerPairs + 1) +
+                              " workers with 1 robot: at most " +
+                              std::to_string(kMaxRobotWorkerPairs)))
+      << issues;
+  EXPECT_EQ(std::count(issues.begin(), issues.end(), '\n'), 0) << issues;  // one issue
 }
 
 }  // namespace

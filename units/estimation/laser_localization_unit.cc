@@ -241,7 +241,7 @@ void LaserLocalizationUnit::ProcessScan(int k, cosim::TimeNs match_ns) {
   const Pose matched{res.pose.x, res.pose.y, RemainderAngle(res.pose.yaw)};
   // Drop the matches older than the window but the newest of them (the
   // window's start), then the velocity from it to this match.
-  const auto window_ns = static_cast<cosim::TimeNs>(std::llround(velocity_window_ * 1e9));
+  const auto window_ns = cosim::SecondsToNs(velocity_window_);
   while (history_size_ >= 2 &&
          history_ns_[(history_begin_ + 1) % kHistory] <= match_ns - window_ns) {
     history_begin_ = (history_begin_ + 1) % kHistory;

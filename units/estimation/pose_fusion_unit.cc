@@ -311,7 +311,7 @@ cosim::StepResult PoseFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
 
   if (match_count_ != last_match_count_) {
     last_match_count_ = match_count_;
-    const auto time = static_cast<cosim::TimeNs>(std::llround(match_time_ * 1e9));
+    const auto time = InputTimeNs(match_time_, "match_time");
     // Fused up to now: the state predicts where the match should be.
     const bool fused =
         last_match_time_ != kNoMatch && cosim::NsToSeconds(e.t - last_match_time_) <= timeout_;

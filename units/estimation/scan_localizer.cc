@@ -290,7 +290,12 @@ cosim::StepResult ScanLocalizer::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   ClearError();
   if (!InputsFinite(t)) return cosim::StepResult::kError;
   const cosim::TimeNs end = t + dt;
-  // The new scans, in the order of their match times.
+  // The new scans, in the order of their match times (each scan's time
+  // a time linesim represents: OrderNewScans converts it).
+  for (std::size_t k = 0; k < scan_time_.size(); ++k) {
+    if (scan_count_[k] != last_count_[k])
+      InputTimeNs(scan_time_[k], "scan_time[" + std::to_string(k) + "]");
+  }
   const int fresh = OrderNewScans(scan_count_, last_count_, scan_time_, mid_offset_ns_, order_);
   for (int j = 0; j < fresh; ++j) {
     const auto k = static_cast<std::size_t>(order_[static_cast<std::size_t>(j)]);

@@ -529,7 +529,7 @@ void SurfaceFusionUnit::UpdateImu(const double enc[2], double h, cosim::TimeNs t
     if (m[0] == 0.0 && m[1] == 0.0 && m[2] == 0.0 && m[3] == 0.0) continue;
     if (t < ramp_until_[k]) continue;  // already open
     ReopenBlock(2 + 2 * k, initial_sigma_);
-    ramp_until_[k] = t + static_cast<cosim::TimeNs>(std::llround(ramp_time_ * 1e9));
+    ramp_until_[k] = t + cosim::SecondsToNs(ramp_time_);
     ++switches_[k];
   }
 }
@@ -643,7 +643,7 @@ cosim::StepResult SurfaceFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   // reckoning at its time = D(t_m) = D(t) - (t - t_m) sum_k M_k u_k.
   if (match_count_ != last_match_count_) {
     last_match_count_ = match_count_;
-    const auto tm = static_cast<cosim::TimeNs>(std::llround(match_time_ * 1e9));
+    const auto tm = InputTimeNs(match_time_, "match_time");
     double pe[2];
     if (DeadReckoningAt(tm, pe)) {
       const double z[2] = {laser_position_[0] - pe[0], laser_position_[1] - pe[1]};
@@ -728,7 +728,7 @@ cosim::StepResult SurfaceFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
             state_[ai] = (m[3] * slope[0] - m[1] * slope[1]) / det;
             state_[ai + 1] = (-m[2] * slope[0] + m[0] * slope[1]) / det;
             ReopenBlock(ai, std::sqrt(slope_var / det));
-            ramp_until_[only] = t + static_cast<cosim::TimeNs>(std::llround(ramp_time_ * 1e9));
+            ramp_until_[only] = t + cosim::SecondsToNs(ramp_time_);
             ++switches_[only];
             under = 0;  // done
           }
@@ -747,7 +747,7 @@ cosim::StepResult SurfaceFusionUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
           const double* m = &drift_[4 * k];
           if (m[0] == 0.0 && m[1] == 0.0 && m[2] == 0.0 && m[3] == 0.0) continue;
           ReopenBlock(2 + 2 * k, initial_sigma_);
-          ramp_until_[k] = t + static_cast<cosim::TimeNs>(std::llround(ramp_time_ * 1e9));
+          ramp_until_[k] = t + cosim::SecondsToNs(ramp_time_);
           ++switches_[k];
         }
       }

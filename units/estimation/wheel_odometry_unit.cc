@@ -58,7 +58,7 @@ WheelOdometryUnit::WheelOdometryUnit(std::string name, Kind kind, int wheels)
                        "then W drive joints (the wheel_encoder's; robot-specific)"
                      : "counts per wheel revolution of the left and the right drive channel "
                        "(the wheel_encoder's; robot-specific)",
-              cosim::Rule::Positive().NoDefault());
+              cosim::Rule::Positive().NoDefault().Count());
   if (!swerve) {
     v.Parameter("effective_track", "m", &effective_track_,
                 "track that relates the sides' speed difference to the yaw rate, omega = "
@@ -205,6 +205,9 @@ void WheelOdometryUnit::UpdateOutputs() { ComputeSample(); }
 void WheelOdometryUnit::ComputeSample() {
   const auto w = static_cast<std::size_t>(wheels_);
   for (std::size_t c = 0; c < channels_; ++c) {
+    if (!(std::abs(counts_[c]) <= cosim::kMaxExactCount)) {
+      CheckCount(counts_[c], "counts[" + std::to_string(c) + "]");  // throws
+    }
     pending_counts_[c] = static_cast<std::int64_t>(std::llround(counts_[c]));
   }
   const double interval_s = cosim::NsToSeconds(now_ - committed_time_);

@@ -409,7 +409,10 @@ void BeaconLocalizationUnit::Detect() {
     const double ri = ranges_[ki];
     // A seed: the nearest return within a beacon's angular half width at
     // its range (the nearest point of a cylinder faces the laser).
-    const int w = static_cast<int>(std::ceil(std::asin(std::min(1.0, r0 / (ri + r0))) / step));
+    // In beams, at most all of them (a tiny angular_step must not overflow
+    // the int).
+    const int w = static_cast<int>(std::min(
+        std::ceil(std::asin(std::min(1.0, r0 / (ri + r0))) / step), static_cast<double>(n)));
     bool seed = true;
     for (int j = std::max(0, i - w); j <= std::min(n - 1, i + w) && seed; ++j) {
       const auto kj = static_cast<std::size_t>(j);
@@ -815,8 +818,8 @@ cosim::StepResult BeaconLocalizationUnit::DoStep(cosim::TimeNs t, cosim::TimeNs)
   was_active_ = active_;
   if (scan_count_ != last_count_) {
     last_count_ = scan_count_;
-    if (active_ &&
-        cosim::SecondsToNs(scan_time_) >= active_since_ns_ + cosim::SecondsToNs(uncover_delay_)) {
+    if (active_ && InputTimeNs(scan_time_, "scan_time") >=
+                       active_since_ns_ + cosim::SecondsToNs(uncover_delay_)) {
       ProcessScan();
     }
   }

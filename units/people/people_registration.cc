@@ -26,8 +26,25 @@ const config::UnitTypeRegistrar kWorker(
      MakeWorker});
 
 std::unique_ptr<cosim::Unit> MakePersonClearance(const config::UnitBuildContext& c) {
+  const std::size_t issues_before = c.reader.issues().size();
   const auto workers = c.reader.Integer(c.parameters, c.path, "workers", 1, 1, 10000);
-  return std::make_unique<PersonClearanceUnit>(c.name, static_cast<int>(workers));
+  std::vector<std::string> names;
+  const YAML::Node list = config::Child(c.parameters, "worker_names");
+  const std::string path = config::JoinPath(c.path, "worker_names");
+  if (list.IsDefined() && !list.IsNull() && c.reader.ExpectSequence(list, path)) {
+    if (list.size() != static_cast<std::size_t>(workers)) {
+      c.reader.Error(list, path,
+                     "expected one name per worker (" + std::to_string(workers) + "), got " +
+                         std::to_string(list.size()));
+    }
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      if (auto name = c.reader.AsString(list[k], config::JoinPath(path, std::to_string(k)))) {
+        names.push_back(*name);
+      }
+    }
+  }
+  if (c.reader.issues().size() != issues_before) return nullptr;
+  return std::make_unique<PersonClearanceUnit>(c.name, static_cast<int>(workers), std::move(names));
 }
 
 const config::UnitTypeRegistrar kPersonClearance(
@@ -35,7 +52,10 @@ const config::UnitTypeRegistrar kPersonClearance(
      "distance of the robot's body from the workers' legs and torsos, and robot-person "
      "contacts counted as collisions (per worker)",
      "",
-     {{"workers", "number of workers (the input `cylinders` holds 21 numbers each; default 1)"}},
+     {{"workers", "number of workers (the input `cylinders` holds 21 numbers each; default 1)"},
+      {"worker_names",
+       "the workers' names, one per worker, for the contact warnings (default: "
+       "worker 0, worker 1, ...)"}},
      MakePersonClearance});
 
 }  // namespace

@@ -6,10 +6,17 @@
 
 namespace linesim::people {
 
-PersonClearanceUnit::PersonClearanceUnit(std::string name, int workers)
-    : cosim::Unit(kTypeName, std::move(name)), workers_(workers) {
+PersonClearanceUnit::PersonClearanceUnit(std::string name, int workers,
+                                         std::vector<std::string> names)
+    : cosim::Unit(kTypeName, std::move(name)), workers_(workers), names_(std::move(names)) {
   if (workers_ < 1) throw cosim::UnitError(Where() + ": needs at least one worker");
   const auto n = static_cast<std::size_t>(workers_);
+  if (!names_.empty() && names_.size() != n) {
+    throw cosim::UnitError(Where() + ": " + std::to_string(names_.size()) + " names for " +
+                           std::to_string(n) + " workers");
+  }
+  for (std::size_t k = names_.size(); k < n; ++k) names_.push_back("worker " + std::to_string(k));
+  worker_contact_time_.assign(n, 0.0);
   cylinders_.assign(n * kCylindersPerWorker * kCylinderValues, 0.0);
   worker_distance_.assign(n, 0.0);
   worker_collisions_.assign(n, 0.0);
@@ -37,6 +44,10 @@ PersonClearanceUnit::PersonClearanceUnit(std::string name, int workers)
   v.Output("worker_distance", "m", &worker_distance_, "distance to each worker", {});
   v.Output("worker_collisions", "1", &worker_collisions_,
            "contact events with each worker so far (the pair robot - worker k)", {});
+  v.Output("contact_time", "s", &contact_time_,
+           "time the body has touched a worker so far (the steps ending in contact)", {});
+  v.Output("worker_contact_time", "s", &worker_contact_time_,
+           "time the body has touched each worker so far", {});
 }
 
 double PersonClearanceUnit::DistanceToRectangle(double x, double y, double hx, double hy) {
@@ -45,7 +56,7 @@ double PersonClearanceUnit::DistanceToRectangle(double x, double y, double hx, d
   return std::hypot(dx, dy);
 }
 
-void PersonClearanceUnit::Evaluate(bool commit) {
+void PersonClearanceUnit::Evaluate(bool commit, cosim::TimeNs t, cosim::TimeNs dt) {
   const double w = orientation_[0], qx = orientation_[1], qy = orientation_[2],
                qz = orientation_[3];
   const double yaw = std::atan2(2.0 * (w * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz));
@@ -53,6 +64,7 @@ void PersonClearanceUnit::Evaluate(bool commit) {
   const double hx = 0.5 * body_length_, hy = 0.5 * body_width_;
   distance_ = std::numeric_limits<double>::max();
   nearest_ = -1.0;
+  bool any_contact = false;
   for (int k = 0; k < workers_; ++k) {
     double best = std::numeric_limits<double>::max();
     for (int j = 0; j < kCylindersPerWorker; ++j) {
@@ -74,25 +86,34 @@ void PersonClearanceUnit::Evaluate(bool commit) {
       if (contact && !contact_before_[ku]) {
         worker_collisions_[ku] += 1.0;
         collisions_ += 1.0;
+        Warn(t + dt, names_[ku] +
+                         " touches the robot's body: contact with a person is not "
+                         "modelled (neither is pushed; the body passes through), so "
+                         "the motion from here on is not what a real contact gives");
       }
+      if (contact) worker_contact_time_[ku] += cosim::NsToSeconds(dt);
       contact_before_[ku] = contact ? 1 : 0;
     }
+    any_contact = any_contact || contact;
   }
+  if (commit && any_contact) contact_time_ += cosim::NsToSeconds(dt);
   min_distance_ = std::min(min_distance_, distance_);
 }
 
 void PersonClearanceUnit::Initialize() {
   ThrowIfBadParameters();
+  ClearWarnings();
   std::fill(contact_before_.begin(), contact_before_.end(), 0);
   std::fill(worker_collisions_.begin(), worker_collisions_.end(), 0.0);
-  collisions_ = 0.0;
+  std::fill(worker_contact_time_.begin(), worker_contact_time_.end(), 0.0);
+  collisions_ = contact_time_ = 0.0;
   min_distance_ = std::numeric_limits<double>::max();
-  Evaluate(true);
+  Evaluate(true, start_, 0);
 }
 
-cosim::StepResult PersonClearanceUnit::DoStep(cosim::TimeNs t, cosim::TimeNs) {
+cosim::StepResult PersonClearanceUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
   if (!InputsFinite(t)) return cosim::StepResult::kError;
-  Evaluate(true);
+  Evaluate(true, t, dt);
   return cosim::StepResult::kOk;
 }
 

@@ -22,15 +22,27 @@ namespace linesim::people {
 /// are ignored (a torso above a low base). A worker is in contact when any
 /// of its cylinders is at distance 0; a collision is one contact event (in
 /// contact now, not at the previous step), counted per worker
-/// (`worker_collisions`: the pair robot - worker k).
+/// (`worker_collisions`: the pair robot - worker k), and timed
+/// (`contact_time`: the steps that end in contact, summed).
+///
+/// Contact with a person is not modelled: nothing pushes either (the
+/// chassis does not collide with the workers' cylinders, the worker walks
+/// its plan), so the body passes through the person. Each contact event is
+/// therefore also a warning of the run (cosim::Unit::Warn), naming the
+/// worker: what follows it is not what a real contact would give.
 class PersonClearanceUnit : public cosim::Unit {
  public:
   static constexpr const char* kTypeName = "person_clearance";
   static constexpr int kCylindersPerWorker = 3;
   static constexpr int kCylinderValues = 7;
 
-  PersonClearanceUnit(std::string name, int workers);
+  /// `names`: the workers' names for the warnings (empty: "worker k").
+  PersonClearanceUnit(std::string name, int workers, std::vector<std::string> names = {});
 
+  void Setup(cosim::TimeNs start, cosim::TimeNs stop) override {
+    (void)stop;
+    start_ = start;
+  }
   void Initialize() override;
   cosim::StepResult DoStep(cosim::TimeNs t, cosim::TimeNs dt) override;
 
@@ -43,9 +55,11 @@ class PersonClearanceUnit : public cosim::Unit {
   void RestoreInternal(const cosim::UnitState& state) override;
 
  private:
-  void Evaluate(bool commit);
+  void Evaluate(bool commit, cosim::TimeNs t, cosim::TimeNs dt);
 
   int workers_;
+  std::vector<std::string> names_;
+  cosim::TimeNs start_ = 0;
   // Parameters (the clearance unit's body; the assembly sets them from the
   // robot file).
   double body_length_, body_width_, body_z_min_ = 0.0, body_z_max_ = 0.5;
@@ -54,8 +68,9 @@ class PersonClearanceUnit : public cosim::Unit {
   std::vector<double> orientation_ = {1.0, 0.0, 0.0, 0.0};
   std::vector<double> cylinders_;
   // Outputs.
-  double distance_ = 0.0, min_distance_ = 0.0, nearest_ = -1.0, collisions_ = 0.0;
-  std::vector<double> worker_distance_, worker_collisions_;
+  double distance_ = 0.0, min_distance_ = 0.0, nearest_ = -1.0, collisions_ = 0.0,
+         contact_time_ = 0.0;
+  std::vector<double> worker_distance_, worker_collisions_, worker_contact_time_;
   // State: per worker, in contact at the last step.
   std::vector<std::uint8_t> contact_before_;
 };

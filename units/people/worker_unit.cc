@@ -47,22 +47,13 @@ WorkerUnit::WorkerUnit(std::string name, std::vector<std::array<double, 2>> wayp
   v.Parameter("initial_phase", "1", &initial_phase_,
               "the left leg's gait phase at the start (strides; 0: start of its stance)",
               Rule::Finite());
-  // At a scanner's height (0.18 m) the leg is the lower shank above the
-  // ankle: ANSUR 1988 (Gordon et al. 1989), men, mean ankle circumference
-  // 0.226 m and calf circumference 0.377 m; between them about 0.26 m with
-  // work trousers, a radius of 0.045 m.
+  // The body's defaults and their sources: models/person.h.
   v.Parameter("leg_radius", "m", &leg_radius_,
               "radius of a leg's section at a scanner's height (lower shank: ANSUR 1988)",
               Rule::Positive());
-  // DIN 33402-2 (2005), men 50th percentile: hip breadth standing 0.36 m; the
-  // legs' axes at ankle height are about the step width plus a shank apart
-  // (step width 0.08-0.10 m, Perry & Burnfield 2010): 0.2 m.
   v.Parameter("leg_spacing", "m", &leg_spacing_,
               "distance between the legs' axes across the heading (DIN 33402-2 hip breadth)",
               Rule::Positive());
-  // DIN 33402-2 (2005), men 50th percentile: stature 1.75 m, crotch height
-  // 0.84 m (ANSUR 1988 gives 0.84 m too); shoulder breadth 0.40-0.46 m, so
-  // a torso cylinder of radius 0.2 m.
   v.Parameter("crotch_height", "m", &crotch_height_,
               "top of the legs, bottom of the torso (0.84 m: DIN 33402-2)", Rule::Positive());
   v.Parameter("torso_radius", "m", &torso_radius_,

@@ -6,6 +6,7 @@
 
 #include "cosim/time.h"
 #include "cosim/unit.h"
+#include "models/person.h"
 
 namespace linesim::people {
 
@@ -112,8 +113,13 @@ class WorkerUnit : public cosim::Unit {
   std::vector<double> pause_s_;
   double start_time_s_ = 0.0;
   double speed_ = 1.37, acceleration_ = 1.0, stride_length_ = 1.41, stance_fraction_ = 0.6,
-         initial_phase_ = 0.0, leg_radius_ = 0.045, leg_spacing_ = 0.2, crotch_height_ = 0.84,
-         torso_radius_ = 0.2, stature_ = 1.75, initial_yaw_deg_ = 0.0;
+         initial_phase_ = 0.0, initial_yaw_deg_ = 0.0;
+  // The body (models/person.h has the sources).
+  double leg_radius_ = models::PersonBody{}.leg_radius_m,
+         leg_spacing_ = models::PersonBody{}.leg_spacing_m,
+         crotch_height_ = models::PersonBody{}.crotch_height_m,
+         torso_radius_ = models::PersonBody{}.torso_radius_m,
+         stature_ = models::PersonBody{}.stature_m;
 
   double stop_distance_ = 0.0;
   // Inputs: the robots' bodies (empty without robots).

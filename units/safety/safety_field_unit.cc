@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "models/polygon.h"
+
 namespace linesim::safety {
 
 namespace {
@@ -16,12 +18,16 @@ SafetyFieldUnit::SafetyFieldUnit(std::string name, int beam_count, std::vector<F
       sets_(std::move(field_sets)) {
   if (beam_count_ < 1) throw cosim::UnitError(Where() + ": needs at least one beam");
   if (sets_.empty()) throw cosim::UnitError(Where() + ": needs at least one field set");
+  // A degenerate polygon holds no point: a field that never stops.
   for (std::size_t i = 0; i < sets_.size(); ++i) {
-    if (sets_[i].protective.size() < 3 || sets_[i].warning.size() == 1 ||
-        sets_[i].warning.size() == 2) {
+    if (const auto problem = models::PolygonProblem(sets_[i].protective)) {
       throw cosim::UnitError(Where() + ": field set " + std::to_string(i) +
-                             " needs a protective polygon of at least 3 corners (and a warning "
-                             "polygon of none or at least 3)");
+                             ": the protective field " + *problem);
+    }
+    if (sets_[i].warning.empty()) continue;
+    if (const auto problem = models::PolygonProblem(sets_[i].warning)) {
+      throw cosim::UnitError(Where() + ": field set " + std::to_string(i) + ": the warning field " +
+                             *problem + " (give none or a polygon)");
     }
   }
   ranges_.assign(static_cast<std::size_t>(beam_count_), 0.0);
@@ -180,7 +186,7 @@ cosim::StepResult SafetyFieldUnit::DoStep(cosim::TimeNs t, cosim::TimeNs dt) {
     // In whole nanoseconds: the delay ends on the step it should, whatever
     // the step's rounding in seconds.
     clear_for_ += dt;
-    if (clear_for_ >= static_cast<cosim::TimeNs>(std::llround(restart_delay_ * 1e9))) {
+    if (clear_for_ >= cosim::SecondsToNs(restart_delay_)) {
       target_ = kNoLimit;
     }
   }

@@ -51,8 +51,9 @@ class SafetyFieldUnit : public cosim::Unit {
     std::vector<std::array<double, 2>> protective, warning;  // warning may be empty
   };
 
-  /// At least one field set, each with a protective polygon of >= 3 corners
-  /// (a warning polygon: none or >= 3). Throws cosim::UnitError otherwise.
+  /// At least one field set, each with a protective polygon and a warning
+  /// polygon (or none) that are simple polygons (models::PolygonProblem:
+  /// no zero area, no crossing edges). Throws cosim::UnitError otherwise.
   SafetyFieldUnit(std::string name, int beam_count, std::vector<FieldSet> field_sets);
 
   std::vector<cosim::ParameterProblem> CheckParameters() const override;

@@ -1,5 +1,6 @@
 // Registers the safety family's unit types (see config/unit_registry.h).
 #include "config/unit_registry.h"
+#include "models/polygon.h"
 #include "units/safety/safety_field_unit.h"
 
 namespace linesim::safety {
@@ -26,6 +27,12 @@ std::vector<std::array<double, 2>> ReadPolygon(config::YamlReader& r, const YAML
   }
   for (std::size_t i = 0; i < list.size(); ++i) {
     if (auto p = r.AsPoint(list[i], JoinPath(path, std::to_string(i)))) corners.push_back(*p);
+  }
+  if (corners.size() != list.size()) return {};
+  // A degenerate polygon holds no point: a field that never stops.
+  if (const auto problem = models::PolygonProblem(corners)) {
+    r.Error(list, path, "the field " + *problem);
+    return {};
   }
   return corners;
 }

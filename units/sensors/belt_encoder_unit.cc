@@ -22,7 +22,7 @@ BeltEncoderUnit::BeltEncoderUnit(std::string name)
               cosim::Rule::Positive().NoDefault());
   v.Parameter("counts_per_revolution", "1", &counts_per_revolution_,
               "encoder counts per wheel revolution (x4 with quadrature decoding)",
-              cosim::Rule::Positive().NoDefault());
+              cosim::Rule::Positive().NoDefault().Count());
   v.Parameter("hysteresis", "1", &hysteresis_,
               "hysteresis of the decoder's edges, in counts (0: ideal decoder)",
               cosim::Rule::Range(0.0, true, 1.0, false));
@@ -40,7 +40,7 @@ BeltEncoderUnit::BeltEncoderUnit(std::string name)
 }
 
 double BeltEncoderUnit::Position() const {
-  return travel_ / wheel_radius_ * counts_per_revolution_ / kTwoPi;
+  return CheckCount(travel_ / wheel_radius_ * counts_per_revolution_ / kTwoPi, "counts");
 }
 
 void BeltEncoderUnit::Setup(cosim::TimeNs start, cosim::TimeNs) { start_ = start; }

@@ -2,6 +2,7 @@
 #include <optional>
 
 #include "config/unit_registry.h"
+#include "models/polygon.h"
 #include "units/sensors/laser_scanner_unit.h"
 
 namespace linesim::sensors {
@@ -52,6 +53,11 @@ std::unique_ptr<cosim::Unit> MakeLaserScanner(const UnitBuildContext& c) {
         if (auto p = c.reader.AsPoint(list[i], config::JoinPath(path, std::to_string(i)))) {
           field.push_back(*p);
         }
+      }
+      // A degenerate polygon holds no point: an OSSD that never switches.
+      if (const auto problem = models::PolygonProblem(field);
+          problem && field.size() == list.size()) {
+        c.reader.Error(list, path, "the protective field " + *problem);
       }
     }
   }

@@ -28,7 +28,7 @@ WheelEncoderUnit::WheelEncoderUnit(std::string name, int channels)
   v.Parameter("counts_per_revolution", "1", &counts_per_revolution_,
               "counts per joint revolution: encoder counts per motor revolution (x4 with "
               "quadrature decoding) times the gear ratio; one per channel (robot-specific)",
-              cosim::Rule::Positive().NoDefault());
+              cosim::Rule::Positive().NoDefault().Count());
   v.Parameter("hysteresis", "1", &hysteresis_,
               "hysteresis of the decoder's edges, in counts: after counting up, the count "
               "steps down only once the shaft is this far below the edge (0: ideal decoder)",
@@ -48,7 +48,8 @@ WheelEncoderUnit::WheelEncoderUnit(std::string name, int channels)
 void WheelEncoderUnit::Initialize() {
   ThrowIfBadParameters();
   for (std::size_t i = 0; i < angle_.size(); ++i) {
-    const double position = angle_[i] * counts_per_revolution_[i] / kTwoPi;
+    const double position = CheckCount(angle_[i] * counts_per_revolution_[i] / kTwoPi,
+                                       "counts[" + std::to_string(i) + "]");
     committed_[i] = static_cast<std::int64_t>(std::floor(position));
     counts_[i] = static_cast<double>(committed_[i]);
     rate_[i] = 0.0;
@@ -60,12 +61,14 @@ void WheelEncoderUnit::UpdateOutputs() {
   const double interval_s = cosim::NsToSeconds(interval_);
   for (std::size_t i = 0; i < angle_.size(); ++i) {
     const double cpr = counts_per_revolution_[i];
-    const std::int64_t c =
-        IncrementalCount(committed_[i], angle_[i] * cpr / kTwoPi, hysteresis_);
+    const double position = angle_[i] * cpr / kTwoPi;
+    if (!(std::abs(position) <= cosim::kMaxExactCount)) {
+      CheckCount(position, "counts[" + std::to_string(i) + "]");  // throws
+    }
+    const std::int64_t c = IncrementalCount(committed_[i], position, hysteresis_);
     counts_[i] = static_cast<double>(c);
-    rate_[i] = interval_ > 0
-                   ? static_cast<double>(c - committed_[i]) * kTwoPi / cpr / interval_s
-                   : 0.0;
+    rate_[i] =
+        interval_ > 0 ? static_cast<double>(c - committed_[i]) * kTwoPi / cpr / interval_s : 0.0;
   }
 }
 

@@ -66,5 +66,48 @@ TEST(PersonClearance, ContactEvents) {
   EXPECT_EQ(Get(u, "worker_collisions")[0], 2.0);
 }
 
+// Guards issue 37's report of a contact, which nothing resolves (person
+// contact is not modelled): the time in contact is summed over the steps
+// that end in contact (3 of 10 ms here), per worker and in all; each
+// contact event is a warning naming the worker and the time; Initialize
+// (which the master may call more than once) starts them afresh.
+TEST(PersonClearance, ContactIsTimedAndWarned) {
+  PersonClearanceUnit u("pc", 2, {"alice", "bob"});
+  SetAll(u, "body_length", 1.0);
+  SetAll(u, "body_width", 0.6);
+  const auto both = [](double xa, double xb) {
+    std::vector<double> c = Worker(xa, 0.0);
+    const std::vector<double> b = Worker(xb, 3.0);
+    c.insert(c.end(), b.begin(), b.end());
+    return c;
+  };
+  SetArray(u, "cylinders", both(3.0, 3.0));
+  u.Setup(0, 0);
+  u.Initialize();
+  u.Initialize();
+  EXPECT_TRUE(u.warnings().empty());
+  const cosim::TimeNs dt = 10'000'000;
+  cosim::TimeNs t = 0;
+  const auto step = [&](double xa) {
+    SetArray(u, "cylinders", both(xa, 3.0));
+    ASSERT_EQ(u.DoStep(t, dt), cosim::StepResult::kOk);
+    t += dt;
+  };
+  step(0.52);  // touching from 10 ms
+  step(0.52);
+  step(1.0);   // clear
+  step(0.54);  // again from 40 ms
+  EXPECT_NEAR(Get(u, "contact_time")[0], 0.03, 1e-15);
+  EXPECT_NEAR(Get(u, "worker_contact_time")[0], 0.03, 1e-15);
+  EXPECT_EQ(Get(u, "worker_contact_time")[1], 0.0);
+  ASSERT_EQ(u.warnings().size(), 2u);
+  EXPECT_EQ(u.warnings()[0].rfind("at t = 0.01 s: alice touches the robot's body: contact with "
+                                  "a person is not modelled",
+                                  0),
+            0u)
+      << u.warnings()[0];
+  EXPECT_EQ(u.warnings()[1].rfind("at t = 0.04 s: alice", 0), 0u) << u.warnings()[1];
+}
+
 }  // namespace
 }  // namespace linesim::people

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <string>
 
 #include "../test_helpers.h"
 
@@ -182,6 +184,54 @@ TEST(SafetyField, FieldSetSwitchesWithSpeed) {
     EXPECT_EQ(Get(u, "field_set")[0], speed < 0.2 ? 0.0 : 1.0);
     EXPECT_EQ(Get(u, "protective_clear")[0], speed < 0.2 ? 1.0 : 0.0) << speed;
   }
+}
+
+// Guards issue 37: a restart_delay of 9.2e9 s or more overflowed its
+// conversion to nanoseconds (llround(9.3e18) is not an int64) and the robot
+// restarted at once, as with a delay of 0. Such a value is refused before
+// the run, naming the limit; the longest delay linesim represents holds the
+// robot (no restart within a run).
+TEST(SafetyField, RestartDelayIsATimeWithinTheLimit) {
+  Driven d(0.3);
+  const auto ref = *d.u.variables().Find("restart_delay");
+  for (double bad : {9.3e9, 1e10, -1.0, std::numeric_limits<double>::quiet_NaN(),
+                     std::numeric_limits<double>::infinity()}) {
+    d.u.variables().SetReal(ref, bad);
+    const auto problems = d.u.CheckParameters();
+    ASSERT_EQ(problems.size(), 1u) << bad;
+    EXPECT_EQ(problems[0].variable, "restart_delay");
+  }
+  d.u.variables().SetReal(ref, 1e10);
+  EXPECT_NE(d.u.CheckParameters()[0].message.find("4.6e9 s is the longest time"),
+            std::string::npos);
+
+  Driven held(0.3);
+  held.u.variables().SetReal(ref, cosim::kMaxTimeSeconds);
+  held.u.Initialize();
+  const auto inside = Leg(0.5), clear = Leg(3.0);
+  for (int k = 0; k < 20; ++k) held.Step(k % 2 == 0 ? &inside : nullptr);
+  ASSERT_EQ(Get(held.u, "velocity_command_out")[0], 0.0);
+  for (int k = 0; k < 500; ++k) held.Step(k % 2 == 0 ? &clear : nullptr);  // 10 s clear
+  EXPECT_EQ(Get(held.u, "velocity_command_out")[0], 0.0);
+}
+
+// Guards issue 37: a collinear or zero-area protective field was accepted
+// and silently disabled the stop (no beam point is ever inside a line):
+// refused, as a self-intersecting one and a degenerate warning field are.
+TEST(SafetyField, RefusesDegenerateFields) {
+  const auto refused = [](SafetyFieldUnit::FieldSet set, const std::string& text) {
+    try {
+      SafetyFieldUnit u("safety", 541, {std::move(set)});
+    } catch (const cosim::UnitError& e) {
+      return std::string(e.what()).find(text) != std::string::npos;
+    }
+    return false;
+  };
+  EXPECT_TRUE(refused({1e9, {{0.1, 0}, {0.5, 0}, {0.9, 0}}, {}}, "protective field has zero area"));
+  EXPECT_TRUE(refused({1e9, {{0, 0}, {1, 1}, {1, 0}, {0, 1}}, {}}, "self-intersecting"));
+  EXPECT_TRUE(refused({1e9, {{0, 0}, {1, 0}}, {}}, "at least 3 corners"));
+  EXPECT_TRUE(refused({1e9, Fields().protective, {{0, 0}, {1, 0}, {2, 0}}}, "warning field"));
+  EXPECT_FALSE(refused(Fields(), ""));
 }
 
 TEST(SafetyField, InsidePolygon) {
