@@ -50,8 +50,10 @@ void WriteSeeds(const std::string& dir) {
   for (const char* name : {"cross_line", "fleet_line", "worker_crossing"}) {
     linesim::session::Session session(
         std::string(LINESIM_SOURCE_DIR) + "/scenarios/" + name + ".yaml", {"duration_s=0.2"});
-    linesim::replay::ReplayRecorder recorder(linesim::replay::ReplaySpecFor(
-        session.scenario(), linesim::session::kPaperBoundM, linesim::session::kPaperBoundLabel));
+    // The scenario's own figure bound, as a run folder's replay has it.
+    const auto& bound = session.scenario().robot->figure_bound;
+    linesim::replay::ReplayRecorder recorder(
+        linesim::replay::ReplaySpecFor(session.scenario(), bound.value_m, bound.label));
     session.AddObserver(&recorder);
     session.Run();
     std::ofstream(dir + "/" + name + ".json", std::ios::binary) << recorder.DataJson();

@@ -232,7 +232,9 @@ std::string PlaceTimeLabels(const std::vector<std::pair<Point, double>>& instant
   };
   std::vector<Group> groups;
   for (std::size_t i = 0; i < instants.size(); ++i) {
-    const auto& [at, t] = instants[i];
+    // Not a structured binding: clang 14 cannot capture one in a lambda.
+    const Point& at = instants[i].first;
+    const double t = instants[i].second;
     auto it = std::find_if(groups.begin(), groups.end(), [&](const Group& g) {
       return std::hypot(at.x - g.at.x, at.y - g.at.y) < join_m;
     });
