@@ -131,8 +131,13 @@ TEST(OpticFlowScenario, PaperOnesFilterTakesTwoThirdsOffThePlateaus) {
     ratio.push_back(filtered.values[i] / raw.values[i]);
     EXPECT_LT(ratio.back(), 0.36) << i;
   }
+  // The median over however many seeds ran (the sanitizer build runs
+  // fewer: run_scenario.h).
+  ASSERT_FALSE(ratio.empty());
   std::sort(ratio.begin(), ratio.end());
-  EXPECT_LE(0.5 * (ratio[3] + ratio[4]), 1.0 / 3.0);
+  const std::size_t n = ratio.size();
+  const double median = n % 2 == 1 ? ratio[n / 2] : 0.5 * (ratio[n / 2 - 1] + ratio[n / 2]);
+  EXPECT_LE(median, 1.0 / 3.0);
   test_spread::Print("plateau filtered / raw", ratio);
 }
 
