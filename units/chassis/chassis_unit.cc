@@ -208,62 +208,7 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   if (const std::string bad = TopologyProblem(steer_motor_, drive_motor_); !bad.empty()) {
     throw cosim::UnitError(Where() + ": " + bad);
   }
-  const auto surface_ok = [&](int s) {
-    return s >= 0 && static_cast<std::size_t>(s) < scene_.surfaces.size();
-  };
-  if (!surface_ok(scene_.floor.surface)) {
-    throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': the floor's surface " +
-                           std::to_string(scene_.floor.surface) + " is not one of its " +
-                           std::to_string(scene_.surfaces.size()) + " surfaces");
-  }
-  for (const auto& belt : scene_.belts) {
-    if (!surface_ok(belt.surface)) {
-      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': belt '" + belt.name +
-                             "' has surface " + std::to_string(belt.surface) + ", not one of its " +
-                             std::to_string(scene_.surfaces.size()) + " surfaces");
-    }
-  }
-  for (const auto& obj : scene_.carried) {
-    if (obj.belt < 0 || obj.belt >= belt_count_) {
-      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': carried object '" +
-                             obj.name + "' is on belt " + std::to_string(obj.belt) +
-                             ", not one of its " + std::to_string(belt_count_) + " belts");
-    }
-    // It leaves the scene at its belt's end (FloorWorld), so it must not
-    // start past it; one upstream of the belt waits there and is put on
-    // the line once its footprint lies wholly on it (a line of bodies that
-    // enter in turn).
-    const models::Belt& belt = scene_.belts[static_cast<std::size_t>(obj.belt)];
-    const models::Rect& r = belt.area;
-    const auto range = CarriedTravelRange(
-        {r.center_x_m, r.center_y_m, r.length_m, r.width_m, r.direction_rad, 0.0}, obj.solid);
-    if (!(0.0 <= range[1] && range[0] <= range[1])) {
-      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': carried object '" +
-                             obj.name + "' overhangs the downstream end of belt '" + belt.name +
-                             "' at time zero, or is longer than the belt (its footprint must "
-                             "lie along the belt's length, or wait upstream of it)");
-    }
-  }
-  for (const auto& piece : scene_.terrain) {
-    if (!surface_ok(piece.surface)) {
-      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': terrain '" + piece.name +
-                             "' has surface " + std::to_string(piece.surface) +
-                             ", not one of its " + std::to_string(scene_.surfaces.size()) +
-                             " surfaces");
-    }
-    if (!(piece.length_m > 0.0 && piece.width_m > 0.0 && piece.thickness_m > 0.0)) {
-      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': terrain '" + piece.name +
-                             "' needs a positive length, width and thickness");
-    }
-  }
-  if (!(scene_.floor.min_x_m < scene_.floor.max_x_m &&
-        scene_.floor.min_y_m < scene_.floor.max_y_m)) {
-    throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': the floor's rectangle is " +
-                           "empty (x " + cosim::FormatValue(scene_.floor.min_x_m) + " to " +
-                           cosim::FormatValue(scene_.floor.max_x_m) + ", y " +
-                           cosim::FormatValue(scene_.floor.min_y_m) + " to " +
-                           cosim::FormatValue(scene_.floor.max_y_m) + ")");
-  }
+  CheckScene();
   steer_motor_count_ = MotorCount(steer_motor_);
   drive_motor_count_ = MotorCount(drive_motor_);
   std::vector<char> motor_led(static_cast<std::size_t>(drive_motor_count_), 0);
@@ -323,6 +268,13 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
   wheel_surface_velocity_.assign(2 * w, 0.0);
   wheel_contact_.assign(2 * w, 0.0);
 
+  DeclareParameters();
+  DeclareSignals();
+}
+
+// The parameters, in the variable table's order.
+void ChassisUnit::DeclareParameters() {
+  const auto ms = static_cast<std::size_t>(steer_motor_count_);
   auto& v = variables();
   v.Parameter("body_length", "m", &body_length_,
               "body box length along base_link x (inertia and collision with objects)",
@@ -412,7 +364,74 @@ ChassisUnit::ChassisUnit(std::string name, std::vector<int> steer_motor,
               cosim::Rule::Finite());
   v.Parameter("initial_yaw", "rad", &initial_yaw_, "base_link yaw in map at the start",
               cosim::Rule::Finite());
+}
 
+// The scene's references and sizes the chassis relies on (the loader checks
+// them for a scene file; a scene built in code reaches here unchecked).
+void ChassisUnit::CheckScene() const {
+  const auto surface_ok = [&](int s) {
+    return s >= 0 && static_cast<std::size_t>(s) < scene_.surfaces.size();
+  };
+  if (!surface_ok(scene_.floor.surface)) {
+    throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': the floor's surface " +
+                           std::to_string(scene_.floor.surface) + " is not one of its " +
+                           std::to_string(scene_.surfaces.size()) + " surfaces");
+  }
+  for (const auto& belt : scene_.belts) {
+    if (!surface_ok(belt.surface)) {
+      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': belt '" + belt.name +
+                             "' has surface " + std::to_string(belt.surface) + ", not one of its " +
+                             std::to_string(scene_.surfaces.size()) + " surfaces");
+    }
+  }
+  for (const auto& obj : scene_.carried) {
+    if (obj.belt < 0 || obj.belt >= belt_count_) {
+      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': carried object '" +
+                             obj.name + "' is on belt " + std::to_string(obj.belt) +
+                             ", not one of its " + std::to_string(belt_count_) + " belts");
+    }
+    // It leaves the scene at its belt's end (FloorWorld), so it must not
+    // start past it; one upstream of the belt waits there and is put on
+    // the line once its footprint lies wholly on it (a line of bodies that
+    // enter in turn).
+    const models::Belt& belt = scene_.belts[static_cast<std::size_t>(obj.belt)];
+    const models::Rect& r = belt.area;
+    const auto range = CarriedTravelRange(
+        {r.center_x_m, r.center_y_m, r.length_m, r.width_m, r.direction_rad, 0.0}, obj.solid);
+    if (!(0.0 <= range[1] && range[0] <= range[1])) {
+      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': carried object '" +
+                             obj.name + "' overhangs the downstream end of belt '" + belt.name +
+                             "' at time zero, or is longer than the belt (its footprint must "
+                             "lie along the belt's length, or wait upstream of it)");
+    }
+  }
+  for (const auto& piece : scene_.terrain) {
+    if (!surface_ok(piece.surface)) {
+      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': terrain '" + piece.name +
+                             "' has surface " + std::to_string(piece.surface) +
+                             ", not one of its " + std::to_string(scene_.surfaces.size()) +
+                             " surfaces");
+    }
+    if (!(piece.length_m > 0.0 && piece.width_m > 0.0 && piece.thickness_m > 0.0)) {
+      throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': terrain '" + piece.name +
+                             "' needs a positive length, width and thickness");
+    }
+  }
+  if (!(scene_.floor.min_x_m < scene_.floor.max_x_m &&
+        scene_.floor.min_y_m < scene_.floor.max_y_m)) {
+    throw cosim::UnitError(Where() + ": scene '" + scene_.name + "': the floor's rectangle is " +
+                           "empty (x " + cosim::FormatValue(scene_.floor.min_x_m) + " to " +
+                           cosim::FormatValue(scene_.floor.max_x_m) + ", y " +
+                           cosim::FormatValue(scene_.floor.min_y_m) + " to " +
+                           cosim::FormatValue(scene_.floor.max_y_m) + ")");
+  }
+}
+
+// The inputs and outputs, after the parameters, in the variable table's order.
+void ChassisUnit::DeclareSignals() {
+  const auto b = static_cast<std::size_t>(belt_count_);
+  const auto ms = static_cast<std::size_t>(steer_motor_count_);
+  auto& v = variables();
   if (ms > 0) {
     v.Input("steer_torque", "N.m", &steer_torque_,
             "torque of each steering motor about its wheel's steering axis, + counter-clockwise "
@@ -611,12 +630,9 @@ std::vector<cosim::ParameterProblem> ChassisUnit::CheckParameters() const {
   return problems;
 }
 
-void ChassisUnit::Build() {
-  EnsureOdeForThisThread();
-  Ode& o = *ode_;
-  o.Clear();
-  o.floor = std::make_unique<FloorWorld>();
-  FloorWorld& f = *o.floor;
+// The scene in the floor world: belts, the floor's contact and profile,
+// obstacles, carried objects and terrain pieces.
+void ChassisUnit::AddScene(FloorWorld& f) const {
   const auto mu_of = [&](int surface) {
     return scene_.surfaces[static_cast<std::size_t>(surface)].friction;
   };
@@ -637,6 +653,15 @@ void ChassisUnit::Build() {
   for (const models::TerrainPiece& piece : scene_.terrain) {
     f.AddTerrain(piece, mu_of(piece.surface), profile_of(piece.surface));
   }
+}
+
+void ChassisUnit::Build() {
+  EnsureOdeForThisThread();
+  Ode& o = *ode_;
+  o.Clear();
+  o.floor = std::make_unique<FloorWorld>();
+  FloorWorld& f = *o.floor;
+  AddScene(f);
 
   // Start with the contacts pressed in by equal shares of the weight, so
   // that the settle has little to do. The suspension starts unloaded (its

@@ -11,7 +11,8 @@
 
 namespace linesim::chassis {
 
-struct Tread;  // units/chassis/floor_world.h
+struct Tread;      // units/chassis/floor_world.h
+class FloorWorld;  // units/chassis/floor_world.h
 
 /// A wheeled robot base on a factory floor with conveyor-belt patches,
 /// obstacles and belt-carried objects, simulated with ODE (dWorldStep). One
@@ -148,6 +149,13 @@ class ChassisUnit : public cosim::Unit {
   /// Declares the tread and wheel_friction parameters (sized by the wheel
   /// and surface counts).
   void DeclareTreadParameters();
+  /// Throws cosim::UnitError for a scene reference or size the chassis
+  /// cannot build (a surface index out of range, an empty floor, ...).
+  void CheckScene() const;
+  /// Declares the parameters (the tread's among them).
+  void DeclareParameters();
+  /// Declares the inputs and outputs (after the parameters).
+  void DeclareSignals();
   /// Wheel k's tread for the floor world: stiffness and damping at its
   /// static load, its patch, its friction on the floor world's surfaces.
   Tread WheelTread(std::size_t k) const;
@@ -157,6 +165,8 @@ class ChassisUnit : public cosim::Unit {
   /// tilts and lifts the robot (rigidly, about base_link's origin) onto the
   /// plane through the ground heights under its wheels.
   void PlaceOnTerrain();
+  /// The scene's belts, floor, obstacles, carried objects and terrain into f.
+  void AddScene(FloorWorld& f) const;
   void Settle();
   /// Suspension ERP/CFM for internal step h_s (only when h_s changes).
   void SetSuspension(double h_s);
