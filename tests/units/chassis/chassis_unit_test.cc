@@ -260,19 +260,14 @@ TEST(ChassisUnit, BrakedRobotStraddlingBeltEdgeTurns) {
   }
 }
 
-// Guards against wrong drive torque signs, a missing reflected rotor
-// inertia, wrong body/map frames, a wrong drive_rate and a tread without
-// creep. Analytic: four wheels at heading 0 each pushed by tau / r:
-//   a = 4 tau / r / (M + 4 J_axle / r^2),  J_axle = m_mod r^2 / 2 + J_drive,
-// and drive_rate = v (1 + kappa) / r: the brush tyre's longitudinal creep
-// kappa = F / C_kappa under the traction F = M a / 4 each, C_kappa = c N,
-// N = M g / 4 (equal loads): kappa = a / (c g).
 // Guards the motors' torque-speed lines as implicit joint rows: each drive
 // motor gives tau = c (r0 - r) (drive_torque 0 at drive_torque_rate r0,
-// slope -c), a steep line for the wheel's inertia (h c / J_axle about 50 at
-// a 5 ms step, where the same torque applied explicitly diverges). The
-// wheels settle at r0, the robot at r0 times the rolling radius (nothing
-// resists on a level floor), and a negative r0 drives backwards.
+// slope -c), a steep line for the wheel's inertia: h c / J_axle = 9.7 at a
+// 5 ms step (J_axle = m_mod r^2 / 2 + J_drive = 0.0207 kg.m^2), beyond
+// explicit Euler's bound of 2, where the same torque applied as given over
+// the step diverges. The wheels settle at r0, the robot at r0 times the
+// rolling radius (nothing resists on a level floor), and a negative r0
+// drives backwards.
 TEST(ChassisUnit, TorqueSpeedLinesAreAppliedImplicitly) {
   const double c = 40.0;
   for (const double r0 : {3.0, -2.0}) {
@@ -293,6 +288,13 @@ TEST(ChassisUnit, TorqueSpeedLinesAreAppliedImplicitly) {
   }
 }
 
+// Guards against wrong drive torque signs, a missing reflected rotor
+// inertia, wrong body/map frames, a wrong drive_rate and a tread without
+// creep. Analytic: four wheels at heading 0 each pushed by tau / r:
+//   a = 4 tau / r / (M + 4 J_axle / r^2),  J_axle = m_mod r^2 / 2 + J_drive,
+// and drive_rate = v (1 + kappa) / r: the brush tyre's longitudinal creep
+// kappa = F / C_kappa under the traction F = M a / 4 each, C_kappa = c N,
+// N = M g / 4 (equal loads): kappa = a / (c g).
 TEST(ChassisUnit, EqualDriveTorquesAccelerateForward) {
   const double tau_nm = 2.0, yaw0 = 0.5;
   const double r = kWheelRadiusM;
